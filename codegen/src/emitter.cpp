@@ -1,0 +1,118 @@
+#include "symoro/codegen/emitter.hpp"
+
+#include <charconv>
+#include <cmath>
+#include <regex>
+#include <stdexcept>
+#include <unordered_map>
+
+#include "symoro/codegen/passes.hpp"
+
+namespace symoro::codegen {
+
+std::string cpp_literal(double v) {
+  if (!std::isfinite(v)) throw std::logic_error("non-finite constant in generated code");
+  char buf[64];
+  const auto res = std::to_chars(buf, buf + sizeof buf, v);  // shortest round-trip form
+  std::string s(buf, res.ptr);
+  if (s.find_first_of(".e") == std::string::npos) s += ".0";
+  return s;
+}
+
+namespace {
+
+// Operator precedence of an emitted operand, to place parentheses only where needed.
+enum Prec { kSum = 1, kProduct = 2, kUnary = 3, kAtom = 4 };
+
+struct Text {
+  std::string s;
+  int prec = kAtom;
+};
+
+std::string wrap(const Text& t, int min_prec) { return t.prec >= min_prec ? t.s : "(" + t.s + ")"; }
+
+constexpr std::size_t kMaxInlineLength = 90;
+
+}  // namespace
+
+std::string emit_body(const ExprGraph& g, const std::map<std::string, std::string>& inputs,
+                      const std::vector<Assignment>& outputs, const std::string& indent) {
+  std::vector<NodeId> roots;
+  for (const auto& o : outputs) roots.push_back(o.value);
+  const std::vector<NodeId> order = reachable(g, roots);
+
+  std::unordered_map<NodeId, int> uses;
+  for (NodeId id : order) {
+    const Node& n = g.node(id);
+    if (n.a >= 0) ++uses[n.a];
+    if (n.b >= 0) ++uses[n.b];
+  }
+  for (NodeId r : roots) ++uses[r];
+  std::unordered_map<NodeId, bool> pow_operand;  // a power's operand is always named: x*x repeats it
+  for (NodeId id : order)
+    if (g.node(id).op == Op::Pow) pow_operand[g.node(id).a] = true;
+  int temps = 0;
+
+  static const std::regex plain_name("^[A-Za-z][A-Za-z0-9_]*$");
+  static const std::regex reserved("^(t[0-9]+|Scalar|q|qd|qdd|tau|phi|s|out|[A-Z]|M|W|T|J|h|basis|sin|cos|sign|pow|int|do|if|for|new|and|or|not|xor|auto|case|char|long|this|true|false|void)$");
+  std::string body;
+  std::unordered_map<NodeId, Text> text;
+  for (NodeId id : order) {
+    const Node& n = g.node(id);
+    if (n.op == Op::Symbol) {
+      const std::string& name = g.symbol_name(n.symbol);
+      auto it = inputs.find(name);
+      if (it == inputs.end()) throw std::logic_error("symbol '" + name + "' is not an input of this function");
+      std::string local = std::regex_match(name, plain_name) && !std::regex_match(name, reserved) ? name : "s_" + name;
+      body += indent + "const Scalar " + local + "(" + it->second + ");\n";
+      text[id] = {local, kAtom};
+      continue;
+    }
+    if (n.op == Op::Constant) {
+      text[id] = {cpp_literal(n.value), n.value < 0 ? kUnary : kAtom};
+      continue;
+    }
+    auto arg = [&](NodeId c) -> const Text& { return text.at(c); };
+    Text t;
+    switch (n.op) {
+      case Op::Add: t = {wrap(arg(n.a), kSum) + " + " + wrap(arg(n.b), kProduct), kSum}; break;
+      case Op::Sub: t = {wrap(arg(n.a), kSum) + " - " + wrap(arg(n.b), kProduct), kSum}; break;
+      case Op::Mul: t = {wrap(arg(n.a), kProduct) + " * " + wrap(arg(n.b), kUnary), kProduct}; break;
+      case Op::Div: t = {wrap(arg(n.a), kProduct) + " / " + wrap(arg(n.b), kUnary), kProduct}; break;
+      case Op::Neg: t = {"-" + wrap(arg(n.a), kUnary), kUnary}; break;
+      case Op::Sin: t = {"sin(" + arg(n.a).s + ")", kAtom}; break;
+      case Op::Cos: t = {"cos(" + arg(n.a).s + ")", kAtom}; break;
+      case Op::Sign: t = {"sign(" + arg(n.a).s + ")", kAtom}; break;
+      case Op::Pow: {
+        const double e = n.value;
+        const std::string x = wrap(arg(n.a), kAtom);
+        if (e == std::floor(e) && std::fabs(e) <= 4) {
+          std::string p = x;
+          for (int i = 1; i < static_cast<int>(std::fabs(e)); ++i) p += " * " + x;
+          t = e > 0 ? Text{p, kProduct} : Text{"1.0 / (" + p + ")", kProduct};
+        } else {
+          t = {"pow(" + arg(n.a).s + ", " + cpp_literal(e) + ")", kAtom};
+        }
+        break;
+      }
+      case Op::Constant:
+      case Op::Symbol: break;
+    }
+    // A node used once is written inline into its user.
+    if (uses[id] == 1 && t.s.size() <= kMaxInlineLength && !pow_operand.count(id)) {
+      text[id] = t;
+    } else {
+      const std::string name = "t" + std::to_string(temps++);
+      body += indent + "const Scalar " + name + " = " + t.s + ";\n";
+      text[id] = {name, kAtom};
+    }
+  }
+  for (const auto& o : outputs) {
+    const Node& n = g.node(o.value);
+    const std::string v = n.op == Op::Constant ? "Scalar(" + cpp_literal(n.value) + ")" : text.at(o.value).s;
+    body += indent + o.target + " = " + v + ";\n";
+  }
+  return body;
+}
+
+}  // namespace symoro::codegen

@@ -1,0 +1,195 @@
+#include "symoro/codegen/robot_spec.hpp"
+
+#include <yaml-cpp/yaml.h>
+
+#include <cmath>
+#include <regex>
+#include <set>
+
+namespace symoro::codegen {
+
+InputError::InputError(const std::string& file, int line, int column, const std::string& message)
+    : std::runtime_error(file + ":" + std::to_string(line) + ":" + std::to_string(column) +
+                         ": error: " + message) {}
+
+namespace {
+
+const std::map<std::string, std::string> kDefaultUnits = {
+    {"XX", "kg*m^2"}, {"XY", "kg*m^2"}, {"XZ", "kg*m^2"}, {"YY", "kg*m^2"}, {"YZ", "kg*m^2"},
+    {"ZZ", "kg*m^2"}, {"MX", "kg*m"},   {"MY", "kg*m"},   {"MZ", "kg*m"},   {"M", "kg"},
+    {"IA", "kg*m^2"}, {"FV", "N*m*s/rad"}, {"FS", "N*m"}};
+const std::map<std::string, std::string> kDefaultPrismaticUnits = {
+    {"IA", "kg"}, {"FV", "N*s/m"}, {"FS", "N"}};
+
+struct Reader {
+  std::string path;
+
+  [[noreturn]] void fail(const YAML::Node& n, const std::string& message) const {
+    const YAML::Mark m = n.Mark();
+    throw InputError(path, m.line + 1, m.column + 1, message);
+  }
+
+  // A number, or a string "<number> deg".
+  double number(const YAML::Node& n, const std::string& what) const {
+    if (!n || !n.IsScalar()) fail(n, what + " must be a number");
+    const std::string s = n.Scalar();
+    static const std::regex deg(R"(^\s*([-+]?[0-9]*\.?[0-9]+([eE][-+]?[0-9]+)?)\s*deg\s*$)");
+    std::smatch m;
+    if (std::regex_match(s, m, deg)) return std::stod(m[1].str()) * M_PI / 180.0;
+    try {
+      std::size_t used = 0;
+      const double v = std::stod(s, &used);
+      if (used != s.size() || !std::isfinite(v)) fail(n, what + " must be a finite number, not '" + s + "'");
+      return v;
+    } catch (const std::logic_error&) {
+      fail(n, what + " must be a number (or '<number> deg'), not '" + s + "'");
+    }
+  }
+
+  std::string string(const YAML::Node& n, const std::string& what) const {
+    if (!n || !n.IsScalar()) fail(n, what + " must be a string");
+    return n.Scalar();
+  }
+
+  void only_keys(const YAML::Node& map, const std::set<std::string>& allowed,
+                 const std::string& where) const {
+    for (const auto& kv : map) {
+      const std::string key = kv.first.Scalar();
+      if (!allowed.count(key)) {
+        std::string list;
+        for (const auto& a : allowed) list += (list.empty() ? "" : ", ") + a;
+        fail(kv.first, "unknown key '" + key + "' in " + where + " (expected one of: " + list + ")");
+      }
+    }
+  }
+};
+
+bool is_identifier(const std::string& s) {
+  static const std::regex id("^[A-Za-z_][A-Za-z0-9_]*$");
+  return std::regex_match(s, id);
+}
+
+}  // namespace
+
+bool glob_match(const std::string& pattern, const std::string& name) {
+  // Iterative wildcard matching with backtracking to the last '*'.
+  std::size_t p = 0, n = 0, star = std::string::npos, mark = 0;
+  while (n < name.size()) {
+    if (p < pattern.size() && pattern[p] == name[n]) {
+      ++p, ++n;
+    } else if (p < pattern.size() && pattern[p] == '*') {
+      star = p++, mark = n;
+    } else if (star != std::string::npos) {
+      p = star + 1, n = ++mark;
+    } else {
+      return false;
+    }
+  }
+  while (p < pattern.size() && pattern[p] == '*') ++p;
+  return p == pattern.size();
+}
+
+RobotSpec read_robot_spec(const std::string& path) {
+  YAML::Node root;
+  try {
+    root = YAML::LoadFile(path);
+  } catch (const YAML::BadFile&) {
+    throw InputError(path, 0, 0, "cannot open file");
+  } catch (const YAML::Exception& e) {
+    throw InputError(path, e.mark.line + 1, e.mark.column + 1, e.msg);
+  }
+  Reader r{path};
+  if (!root.IsMap()) throw InputError(path, 1, 1, "robot.yaml must be a mapping of keys");
+  r.only_keys(root, {"name", "description", "constants", "joints", "parameter_units",
+                     "identified", "variants"},
+              "robot.yaml");
+
+  RobotSpec spec;
+  spec.path = path;
+  if (root["description"]) spec.description = r.string(root["description"], "description");
+
+  if (const auto c = root["constants"]) {
+    if (!c.IsMap()) r.fail(c, "constants must map names to numbers");
+    for (const auto& kv : c) {
+      const std::string name = kv.first.Scalar();
+      if (!is_identifier(name)) r.fail(kv.first, "'" + name + "' is not a symbol name");
+      spec.constants[name] = r.number(kv.second, "constant " + name);
+    }
+  }
+
+  const auto joints = root["joints"];
+  if (!joints || !joints.IsSequence() || joints.size() == 0)
+    throw InputError(path, 1, 1, "missing 'joints': a list with one entry per joint");
+  std::set<std::string> joint_names;
+  for (const auto& j : joints) {
+    if (!j.IsMap()) r.fail(j, "a joint must be a mapping (name, lower, upper, velocity, effort)");
+    r.only_keys(j, {"name", "lower", "upper", "velocity", "effort", "audit"}, "a joint");
+    JointSpec js;
+    js.name = r.string(j["name"], "joint name");
+    if (!is_identifier(js.name)) r.fail(j["name"], "joint name '" + js.name + "' is not an identifier");
+    if (!joint_names.insert(js.name).second) r.fail(j["name"], "duplicate joint name '" + js.name + "'");
+    if (!j["lower"] || !j["upper"]) r.fail(j, "joint " + js.name + " needs 'lower' and 'upper'");
+    js.lower = r.number(j["lower"], "lower");
+    js.upper = r.number(j["upper"], "upper");
+    if (!(js.lower < js.upper)) r.fail(j["upper"], "joint " + js.name + ": upper must exceed lower");
+    if (!j["velocity"] || !j["effort"]) r.fail(j, "joint " + js.name + " needs 'velocity' and 'effort'");
+    js.velocity = r.number(j["velocity"], "velocity");
+    js.effort = r.number(j["effort"], "effort");
+    if (js.velocity <= 0 || js.effort <= 0) r.fail(j, "joint " + js.name + ": velocity and effort limits must be positive");
+    js.audit_lower = js.lower;
+    js.audit_upper = js.upper;
+    if (const auto a = j["audit"]) {
+      if (!a.IsSequence() || a.size() != 2) r.fail(a, "audit must be [lower, upper]");
+      js.audit_lower = r.number(a[0], "audit lower bound");
+      js.audit_upper = r.number(a[1], "audit upper bound");
+      if (!(js.audit_lower < js.audit_upper)) r.fail(a, "audit: upper must exceed lower");
+    }
+    spec.joints.push_back(js);
+  }
+
+  spec.units = kDefaultUnits;
+  spec.prismatic_units = kDefaultPrismaticUnits;
+  if (const auto u = root["parameter_units"]) {
+    r.only_keys(u, {"revolute", "prismatic"}, "parameter_units");
+    auto read = [&](const YAML::Node& m, std::map<std::string, std::string>& into) {
+      if (!m) return;
+      if (!m.IsMap()) r.fail(m, "units must map families (XX, MX, IA, FV, ...) to unit strings");
+      for (const auto& kv : m) {
+        const std::string fam = kv.first.Scalar();
+        if (!kDefaultUnits.count(fam)) r.fail(kv.first, "unknown parameter family '" + fam + "'");
+        into[fam] = r.string(kv.second, "unit");
+      }
+    };
+    read(u["revolute"], spec.units);
+    read(u["prismatic"], spec.prismatic_units);
+  }
+
+  if (const auto v = root["variants"]) {
+    if (!v.IsMap()) r.fail(v, "variants must map variant names to {description, fixed}");
+    for (const auto& kv : v) {
+      VariantSpec vs;
+      vs.name = kv.first.Scalar();
+      vs.line = kv.first.Mark().line + 1;
+      static const std::regex lower_id("^[a-z][a-z0-9_]*$");
+      if (!std::regex_match(vs.name, lower_id) || vs.name == "full" || vs.name == "param")
+        r.fail(kv.first, "variant name '" + vs.name +
+                             "' must be a lower-case identifier other than 'full' and 'param'");
+      r.only_keys(kv.second, {"description", "fixed"}, "variant " + vs.name);
+      if (kv.second["description"]) vs.description = r.string(kv.second["description"], "description");
+      const auto f = kv.second["fixed"];
+      if (!f || !f.IsMap() || f.size() == 0)
+        r.fail(kv.second, "variant " + vs.name + " needs 'fixed': a map of parameter patterns to values");
+      for (const auto& p : f) vs.fixed.emplace_back(p.first.Scalar(), r.number(p.second, "fixed value"));
+      spec.variants.push_back(vs);
+    }
+  }
+  if (const auto id = root["identified"]) {
+    spec.identified = r.string(id, "identified");
+    bool known = spec.identified == "full";
+    for (const auto& v : spec.variants) known = known || v.name == spec.identified;
+    if (!known) r.fail(id, "identified: '" + spec.identified + "' is neither 'full' nor a variant");
+  }
+  return spec;
+}
+
+}  // namespace symoro::codegen

@@ -1,0 +1,199 @@
+// symoroc: the model compiler's command line (generate, check, info).
+#include <CLI/CLI.hpp>
+#include <fmt/core.h>
+
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <set>
+#include <sstream>
+
+#include "symoro/codegen/generator.hpp"
+#include "symoro/grammar/parser.hpp"
+
+namespace fs = std::filesystem;
+using namespace symoro::codegen;
+
+namespace {
+
+std::string read_text(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  std::ostringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+// Writes through a temporary file and a rename, so a reader never sees half a header.
+void write_atomically(const fs::path& p, const std::string& text) {
+  fs::create_directories(p.parent_path());
+  const fs::path tmp = p.string() + ".tmp";
+  {
+    std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
+    out << text;
+    if (!out.flush()) throw std::runtime_error("cannot write " + tmp.string());
+  }
+  fs::rename(tmp, p);
+}
+
+std::vector<fs::path> robot_dirs(const fs::path& robots) {
+  std::vector<fs::path> out;
+  if (!fs::is_directory(robots)) throw std::runtime_error(robots.string() + ": not a directory");
+  for (const auto& e : fs::directory_iterator(robots))
+    if (e.is_directory() && fs::exists(e.path() / "robot.yaml")) out.push_back(e.path());
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
+std::set<std::string> files_under(const fs::path& root, const fs::path& dir) {
+  std::set<std::string> out;
+  if (!fs::is_directory(dir)) return out;
+  for (const auto& e : fs::recursive_directory_iterator(dir))
+    if (e.is_regular_file()) out.insert(fs::relative(e.path(), root).generic_string());
+  return out;
+}
+
+int first_difference_line(const std::string& a, const std::string& b) {
+  int line = 1;
+  for (std::size_t i = 0; i < a.size() && i < b.size(); ++i) {
+    if (a[i] != b[i]) return line;
+    if (a[i] == '\n') ++line;
+  }
+  return line;
+}
+
+int generate(const std::vector<std::string>& dirs, const std::string& out_root) {
+  for (const auto& dir : dirs) {
+    RobotModel robot = load_robot(dir);
+    const Generation gen = generate_robot(robot);
+    std::set<std::string> fresh;
+    for (const auto& f : gen.files) {
+      write_atomically(fs::path(out_root) / f.path, f.content);
+      fresh.insert(f.path);
+    }
+    for (const auto& old : files_under(out_root, fs::path(out_root) / robot.name))
+      if (!fresh.count(old)) fs::remove(fs::path(out_root) / old);  // stale output of an old variant
+    fmt::print("{}: {} files, {} models\n", robot.name, gen.files.size(), gen.models.size());
+  }
+  return 0;
+}
+
+int check(const std::string& robots, const std::string& generated) {
+  int problems = 0;
+  std::set<std::string> names;
+  for (const auto& dir : robot_dirs(robots)) {
+    RobotModel robot = load_robot(dir.string());
+    names.insert(robot.name);
+    const Generation gen = generate_robot(robot);
+    std::set<std::string> expected;
+    for (const auto& f : gen.files) {
+      expected.insert(f.path);
+      const fs::path p = fs::path(generated) / f.path;
+      if (!fs::exists(p)) {
+        fmt::print("missing   {}\n", p.string());
+        ++problems;
+        continue;
+      }
+      const std::string on_disk = read_text(p);
+      if (on_disk != f.content) {
+        fmt::print("differs   {} (from line {})\n", p.string(), first_difference_line(on_disk, f.content));
+        ++problems;
+      }
+    }
+    for (const auto& f : files_under(generated, fs::path(generated) / robot.name))
+      if (!expected.count(f)) {
+        fmt::print("extra     {}\n", (fs::path(generated) / f).string());
+        ++problems;
+      }
+  }
+  if (fs::is_directory(generated))
+    for (const auto& e : fs::directory_iterator(generated))
+      if (e.is_directory() && !names.count(e.path().filename().string())) {
+        fmt::print("stale     {} (no robots/{})\n", e.path().string(), e.path().filename().string());
+        ++problems;
+      }
+  if (problems) {
+    fmt::print("symoroc check: {} difference(s) between {} and a fresh generation from {}.\n"
+               "Run: symoroc generate {}/* -o {}\n", problems, generated, robots, robots, generated);
+    return 1;
+  }
+  fmt::print("symoroc check: {} is up to date ({} robots).\n", generated, names.size());
+  return 0;
+}
+
+int info(const std::string& dir) {
+  RobotModel robot = load_robot(dir);
+  const Generation gen = generate_robot(robot);
+  fmt::print("robot {} ({} joints, {} standard parameters, {} base parameters)\n", robot.name, robot.n,
+             robot.standard.size(), robot.base.size());
+  if (!robot.spec.description.empty()) fmt::print("  {}\n", robot.spec.description);
+  fmt::print("joints:\n");
+  for (int j = 0; j < robot.n; ++j) {
+    const auto& js = robot.spec.joints[j];
+    fmt::print("  {:>2} {:<18} {} {:<6} [{:.4g}, {:.4g}]  |qd| <= {:.4g}  |tau| <= {:.4g}  audit [{:.4g}, {:.4g}]\n", j + 1,
+               js.name, robot.frames[j].sigma ? "prismatic" : "revolute ", robot.q[j], js.lower, js.upper, js.velocity,
+               js.effort, js.audit_lower, js.audit_upper);
+  }
+  for (const auto& m : gen.models) {
+    fmt::print("\nmodel {}: {} identified parameters", m.name, m.identified.size());
+    if (!m.fixed.empty()) fmt::print(", {} fixed", m.fixed.size());
+    fmt::print("\n");
+    if (!m.description.empty()) fmt::print("  {}\n", m.description);
+    std::string line = " ";
+    for (std::size_t i = 0; i < m.identified.size(); ++i) {
+      std::string item = fmt::format(" {}:{} [{}]", i, m.identified[i].name, m.identified[i].unit);
+      if (line.size() + item.size() > 100) {
+        fmt::print("{}\n", line);
+        line = " ";
+      }
+      line += item;
+    }
+    fmt::print("{}\n", line);
+    if (!m.fixed.empty()) {
+      std::string fixed = "  fixed:";
+      for (const auto& [name, v] : m.fixed) fixed += fmt::format(" {}={}", name, v);
+      fmt::print("{}\n", fixed);
+    }
+    fmt::print("  {:<20} {:>7} {:>7} {:>5} {:>5} {:>5} {:>5} {:>5} {:>7}\n", "function", "add", "mul", "div", "neg",
+               "pow", "trig", "sign", "total");
+    for (const auto& f : m.functions)
+      fmt::print("  {:<20} {:>7} {:>7} {:>5} {:>5} {:>5} {:>5} {:>5} {:>7}\n", f.name, f.ops.add, f.ops.mul,
+                 f.ops.div, f.ops.neg, f.ops.pow, f.ops.trig, f.ops.sign, f.ops.total());
+  }
+  return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"symoroc: compiles OpenSYMORO model files into specialized, autodiff-ready C++"};
+  app.require_subcommand(1);
+
+  std::vector<std::string> gen_dirs;
+  std::string out_root = "generated";
+  auto* gen = app.add_subcommand("generate", "Generate the headers of one or more robot folders");
+  gen->add_option("robot_dirs", gen_dirs, "robots/<name> folders")->required()->check(CLI::ExistingDirectory);
+  gen->add_option("-o,--output", out_root, "Output root (headers go to <output>/<name>/include)")->capture_default_str();
+
+  std::string robots = "robots", generated = "generated";
+  auto* chk = app.add_subcommand("check", "Fail when the generated headers differ from a fresh generation");
+  chk->add_option("--robots", robots, "Folder of robot folders")->capture_default_str();
+  chk->add_option("--generated", generated, "Folder of generated headers")->capture_default_str();
+
+  std::string info_dir;
+  auto* inf = app.add_subcommand("info", "Parameters, counts and operation counts of a robot");
+  inf->add_option("robot_dir", info_dir, "robots/<name>")->required()->check(CLI::ExistingDirectory);
+
+  CLI11_PARSE(app, argc, argv);
+  try {
+    if (*gen) return generate(gen_dirs, out_root);
+    if (*chk) return check(robots, generated);
+    if (*inf) return info(info_dir);
+  } catch (const symoro::grammar::ParseError& e) {
+    std::cerr << e.what() << "\n";
+    return 2;
+  } catch (const std::exception& e) {
+    std::cerr << "symoroc: " << e.what() << "\n";
+    return 2;
+  }
+  return 0;
+}
