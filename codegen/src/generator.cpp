@@ -1,5 +1,6 @@
 #include "symoro/codegen/generator.hpp"
 
+#include <algorithm>
 #include <set>
 #include <sstream>
 
@@ -90,6 +91,12 @@ class ModelWriter {
 
   std::vector<NodeId> specialize(const std::vector<NodeId>& roots) {
     return substitute(g_, roots, replacements_);
+  }
+
+  bool is_identified(const std::string& name) const {
+    for (int p : identified_)
+      if (r_.base[p].name == name) return true;
+    return false;
   }
 
   std::vector<std::string> identified_names() const {
@@ -335,24 +342,28 @@ class ModelWriter {
   // ---------------------------------------------------------------- inertia.hpp
   std::string inertia_header() {
     const int n = r_.n;
-    // M(j, k) = sum_p phi_p d DG{j}{p} / d QDP{k}, fixed parameters at their values.
+    // M(q; phi): the derivative of the factored Newton-Euler torque (idm.txt) with respect to
+    // qdd, far cheaper than summing the basis. The basis below comes from the DIM.
     std::vector<std::vector<NodeId>> M(n, std::vector<NodeId>(n)), M0(n, std::vector<NodeId>(n));
+    const auto tau = specialize(r_.idm);
+    std::map<std::string, NodeId> at_rest;
+    for (const auto& s : r_.qd) at_rest[s] = g_.zero();
+    for (const auto& s : r_.qdd) at_rest[s] = g_.zero();
+    for (int k = 0; k < n; ++k) {
+      const auto column = substitute(g_, differentiate(g_, tau, r_.qdd[k]), at_rest);
+      for (int j = k; j < n; ++j) M[j][k] = M[k][j] = column[j];
+      for (const auto& s : free_symbols(g_, column))
+        if (std::find(r_.q.begin(), r_.q.end(), s) == r_.q.end() && !is_identified(s))
+          throw InputError(r_.dir + "/idm.txt", 0, 0, "the inertia matrix depends on " + s + ": the IDM is not linear in the accelerations");
+    }
     std::map<int, double> fixed(fixed_index_.begin(), fixed_index_.end());
     for (int j = 0; j < n; ++j)
       for (int k = 0; k <= j; ++k) {
-        NodeId sum = g_.zero(), constant = g_.zero();
-        for (std::size_t p = 0; p < r_.base.size(); ++p) {
-          const NodeId d = dd_[k][j][p];
-          if (g_.is_constant(d, 0.0)) continue;
-          auto f = fixed.find(static_cast<int>(p));
-          const NodeId coeff = f == fixed.end() ? g_.symbol(r_.base[p].name) : g_.constant(f->second);
-          sum = g_.add(sum, g_.mul(coeff, d));
-          if (f != fixed.end()) constant = g_.add(constant, g_.mul(coeff, d));
-        }
-        M[j][k] = M[k][j] = sum;
+        NodeId constant = g_.zero();
+        for (const auto& [p, v] : fixed) constant = g_.add(constant, g_.mul(g_.constant(v), dd_[k][j][p]));
         M0[j][k] = M0[k][j] = constant;
       }
-    std::string s = banner("Inertia matrix M(q; phi) and its parameter-linear basis, from d(dim.txt)/d(qdd).");
+    std::string s = banner("Inertia matrix M(q; phi) = d tau / d qdd (idm.txt) and its parameter-linear basis (dim.txt).");
     s += "#include <array>\n" + kinematic_includes() + open();
     s += function("// The joint-space inertia matrix M(q; phi), rotor inertias included.\n",
                   "inertia", {q_in(), phi_in()}, {"M", "nq", "nq", M});

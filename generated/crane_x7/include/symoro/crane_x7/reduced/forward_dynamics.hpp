@@ -188,19 +188,19 @@ inline void forward_dynamics(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixB
   const Scalar t94 = t11 * XXR7;
   const Scalar t95 = t43 * t56 - t41 * t57;
   const Scalar t96 = t42 * t56;
-  const Scalar t97 = t96 + (GAM7 - QP7 * FV7);
-  const Scalar t98 = t42 * t73 - t45 * MX7 - t75 * t97;
-  const Scalar t99 = t76 * t97 - (t45 * MY7 + t41 * t73);
-  const Scalar t100 = t42 * t57 + t44 * XXR7;
-  const Scalar t101 = t10 * t94;
-  const Scalar t102 = ZZR6 + t11 * t94;
-  const Scalar t103 = t36 * t54 + (t11 * t100 + t10 * t95);
+  const Scalar t97 = t10 * t94;
+  const Scalar t98 = ZZR6 + t11 * t94;
+  const Scalar t99 = t96 + (GAM7 - QP7 * FV7);
+  const Scalar t100 = t42 * t73 - t45 * MX7 - t75 * t99;
+  const Scalar t101 = t76 * t99 - (t45 * MY7 + t41 * t73);
+  const Scalar t102 = t42 * t57 + t44 * XXR7;
+  const Scalar t103 = t36 * t54 + (t11 * t102 + t10 * t95);
   const Scalar t104 = GAM6 - QP6 * FV6 - t103;
-  const Scalar t105 = 1.0 / (IA6 + t102);
+  const Scalar t105 = 1.0 / (IA6 + t98);
   const Scalar t106 = MYR6 * t105;
   const Scalar t107 = t90 * t105;
-  const Scalar t108 = t101 * t105;
-  const Scalar t109 = t102 * t105;
+  const Scalar t108 = t97 * t105;
+  const Scalar t109 = t98 * t105;
   const Scalar t110 = t10 * (t10 * t78 + t11 * t79) + t11 * (t10 * t81 + t11 * t82) + MYR6 * t106;
   const Scalar t111 = MYR6 * t107;
   const Scalar t112 = MYR6 * t108;
@@ -209,13 +209,13 @@ inline void forward_dynamics(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixB
   const Scalar t115 = t90 * t107;
   const Scalar t116 = t87 + t90 * t108;
   const Scalar t117 = t90 - t90 * t109;
-  const Scalar t118 = XXR6 + t10 * (t10 * XXR7) - t101 * t108;
-  const Scalar t119 = t101 - t101 * t109;
-  const Scalar t120 = t40 * MX6 + t36 * t72 - (t10 * t98 - t11 * t99) + (t38 * (t101 * t106) + t39 * t89 + t104 * t106);
-  const Scalar t121 = t38 * (t87 + t101 * t107) + t104 * t107 - t92;
-  const Scalar t122 = t35 * (t37 * MX6) - t36 * (t37 * MYR6) + (t11 * t98 + t10 * t99) + (t39 * t91 - t38 * MYR6);
-  const Scalar t123 = t104 * t108 - t38 * t118 - (t36 * t55 - (t10 * t100 - t11 * t95));
-  const Scalar t124 = t77 * t97 - t96 - (t37 * t54 - t35 * t55) + t39 * t84;
+  const Scalar t118 = XXR6 + t10 * (t10 * XXR7) - t97 * t108;
+  const Scalar t119 = t97 - t97 * t109;
+  const Scalar t120 = t40 * MX6 + t36 * t72 - (t10 * t100 - t11 * t101) + (t38 * (t97 * t106) + t39 * t89 + t104 * t106);
+  const Scalar t121 = t38 * (t87 + t97 * t107) + t104 * t107 - t92;
+  const Scalar t122 = t35 * (t37 * MX6) - t36 * (t37 * MYR6) + (t11 * t100 + t10 * t101) + (t39 * t91 - t38 * MYR6);
+  const Scalar t123 = t104 * t108 - t38 * t118 - (t36 * t55 - (t10 * t102 - t11 * t95));
+  const Scalar t124 = t77 * t99 - t96 - (t37 * t54 - t35 * t55) + t39 * t84;
   const Scalar t125 = t9 * t110 - t8 * t111;
   const Scalar t126 = t8 * t112 - t9 * t89;
   const Scalar t127 = t8 * t89 + t9 * t112;
@@ -226,7 +226,7 @@ inline void forward_dynamics(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixB
   const Scalar t132 = t8 * MYR6 + t9 * t91;
   const Scalar t133 = t9 * t118;
   const Scalar t134 = t8 * t84;
-  const Scalar t135 = t9 * (t101 - t102 * t108);
+  const Scalar t135 = t9 * (t97 - t98 * t108);
   const Scalar t136 = t8 * t88;
   const Scalar t137 = t8 * t125 - t9 * t128;
   const Scalar t138 = t8 * t126 + t9 * t129;
@@ -274,7 +274,7 @@ inline void forward_dynamics(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixB
   const Scalar t180 = t139 - t135 * t151;
   const Scalar t181 = t135 * t152;
   const Scalar t182 = t141 + t135 * t154;
-  const Scalar t183 = t102 - t102 * t109 - t135 * t155;
+  const Scalar t183 = t98 - t98 * t109 - t135 * t155;
   const Scalar t184 = t135 * t156 - t135;
   const Scalar t185 = t68 * t159 + t69 * t165 - t70 * t171 + t32 * (t145 - t142 * t153) + t33 * (t146 - t135 * t153);
   const Scalar t186 = t30 * t71 - t34 * MX5 - (t8 * t120 + t9 * t121) + (t70 * t169 - (t68 * t157 + t69 * t163) + t32 * t175 - t33 * t180 - t149 * t151);
@@ -452,7 +452,7 @@ inline void forward_dynamics(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixB
   qdd(3, 0) = t343;
   qdd(4, 0) = t350;
   qdd(5, 0) = t104 * t105 - t353;
-  qdd(6, 0) = t74 * t97 - t354;
+  qdd(6, 0) = t74 * t99 - t354;
   qdd(7, 0) = 1.0 / IA8 * (GAM8 - QP8 * FV8);
 }
 

@@ -1,0 +1,16 @@
+#!/usr/bin/env bash
+# The main job, end to end on the bundled CRANE-X7 (no hardware): install what is missing,
+# build, check that generated/ matches a fresh compilation of robots/, install the package and
+# run the example application against it.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+bash tools/install_deps.sh
+cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release >/dev/null
+cmake --build build -j"$(nproc)"
+build/codegen/symoroc check
+build/codegen/symoroc info robots/crane_x7
+prefix="$PWD/build/install"
+cmake --install build --prefix "$prefix" >/dev/null
+cmake -S tests/package -B build/example -G Ninja -DCMAKE_PREFIX_PATH="$prefix" >/dev/null
+cmake --build build/example
+build/example/crane_x7_example

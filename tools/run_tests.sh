@@ -1,0 +1,33 @@
+#!/usr/bin/env bash
+# Every test: install what is missing, build, run the GoogleTest suite through ctest, check
+# generated/ against a fresh compilation, drop an unseen robot folder in and run its generic
+# tests, and fuzz the grammar for a bounded time (FUZZ_SECONDS, default 60).
+set -euo pipefail
+cd "$(dirname "$0")/.."
+bash tools/install_deps.sh
+jobs=$(nproc)
+
+cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release >/dev/null
+cmake --build build -j"$jobs"
+build/codegen/symoroc check
+
+# A robot folder the suite has never seen: a copy under a new name, in a scratch tree.
+scratch=build/unseen
+rm -rf "$scratch" && mkdir -p "$scratch/robots"
+cp -r CMakeLists.txt cmake grammar codegen runtime tests bench "$scratch/"
+cp -r robots/stanford_rrp "$scratch/robots/unseen_arm"
+cmake -S "$scratch" -B "$scratch/build" -G Ninja -DCMAKE_BUILD_TYPE=Release -DSYMORO_BUILD_BENCHMARKS=OFF >/dev/null
+cmake --build "$scratch/build" -j"$jobs" --target test_robot_unseen_arm
+ctest --test-dir "$scratch/build" -R '^unseen_arm\.' --output-on-failure -j"$jobs"
+
+# Grammar fuzzing with clang's libFuzzer, bounded in time.
+cmake -S . -B build/fuzz -G Ninja -DSYMORO_BUILD_FUZZER=ON -DCMAKE_CXX_COMPILER=clang++ -DCMAKE_BUILD_TYPE=RelWithDebInfo >/dev/null
+cmake --build build/fuzz -j"$jobs" --target fuzz_grammar
+mkdir -p build/fuzz/corpus
+cp tests/fuzz/corpus/* build/fuzz/corpus/
+build/fuzz/tests/fuzz/fuzz_grammar -max_total_time="${FUZZ_SECONDS:-60}" -max_len=4096 -timeout=10 \
+  -dict=tests/fuzz/grammar.dict build/fuzz/corpus 2>build/fuzz/fuzz.log || { tail -40 build/fuzz/fuzz.log; exit 1; }
+grep -E "^Done|#[0-9]+.*DONE" build/fuzz/fuzz.log | tail -1
+
+# The whole suite last, so its summary closes the output.
+ctest --test-dir build --output-on-failure -j"$jobs"
