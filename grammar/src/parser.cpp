@@ -39,7 +39,8 @@ std::string format_error(const std::string& file, int line, int column, const st
                     ": error: " + message + "\n" + printable_line(source_line) + "\n";
   // Copy tabs from the source line so the caret lines up however the terminal expands them.
   for (int i = 0; i + 1 < column; ++i)
-    out += (static_cast<std::size_t>(i) < source_line.size() && source_line[i] == '\t') ? '\t' : ' ';
+    out += (static_cast<std::size_t>(i) < source_line.size() && source_line[i] == '\t') ? '\t'
+                                                                                         : ' ';
   return out + "^";
 }
 
@@ -124,8 +125,8 @@ class Source {
     // Parsing goes line by line, so the line of the previous lookup is the usual answer.
     if (!(starts_[hint_] <= offset &&
           (hint_ + 1 == starts_.size() || offset < starts_[hint_ + 1]))) {
-      hint_ = static_cast<std::size_t>(std::upper_bound(starts_.begin(), starts_.end(), offset) -
-                                       starts_.begin()) - 1;
+      const auto next = std::upper_bound(starts_.begin(), starts_.end(), offset);
+      hint_ = static_cast<std::size_t>(next - starts_.begin()) - 1;
     }
     return {static_cast<int>(hint_) + 1, static_cast<int>(offset - starts_[hint_]) + 1};
   }
@@ -134,8 +135,9 @@ class Source {
     const Position p = position(at);
     const Line& line = lines_[static_cast<std::size_t>(p.line) - 1];
     const auto offset = static_cast<std::size_t>(line.begin - parsed_);
+    const auto length = static_cast<std::size_t>(line.end - line.begin);
     throw ParseError(path_, p.line, p.column, message,
-                     std::string(original_.substr(offset, static_cast<std::size_t>(line.end - line.begin))));
+                     std::string(original_.substr(offset, length)));
   }
 
   // `at` is where a parser wanted `what`; `last` ends the text it was given.
@@ -263,7 +265,8 @@ struct Builder {
   void finish_call() {
     const std::size_t mark = calls.back();
     calls.pop_back();
-    std::vector<Node> args(std::make_move_iterator(stack.begin() + static_cast<std::ptrdiff_t>(mark)),
+    const auto first_arg = stack.begin() + static_cast<std::ptrdiff_t>(mark);
+    std::vector<Node> args(std::make_move_iterator(first_arg),
                            std::make_move_iterator(stack.end()));
     stack.resize(mark);
     Node function = pop();
@@ -284,7 +287,6 @@ template <typename Subject>
 struct expect_parser : x3::parser<expect_parser<Subject>> {
   using attribute_type = x3::unused_type;
   static bool const has_attribute = false;
-  static bool const has_action = true;
 
   constexpr expect_parser(const Subject& s, const char* w) : subject(s), what(w) {}
 
@@ -311,7 +313,6 @@ template <typename Open, typename Body>
 struct nest_parser : x3::parser<nest_parser<Open, Body>> {
   using attribute_type = x3::unused_type;
   static bool const has_attribute = false;
-  static bool const has_action = true;
 
   constexpr nest_parser(const Open& o, const Body& b) : open(o), body(b) {}
 
@@ -422,11 +423,11 @@ BOOST_SPIRIT_DEFINE(expr, unary)
 const auto whole_expression =
     expect(expr, "an expression") >> expect(x3::eoi, "an operator or the end of the expression");
 
-const auto equation_line = expect(identifier[set_name], "an equation 'NAME = expression;' or '*=*'") >>
-                           expect('=', "'=' after the name") >>
-                           expect(expr, "an expression after '='") >>
-                           expect(';', "';' at the end of the equation") >>
-                           expect(x3::eoi, "the end of the line after ';'");
+const auto equation_line =
+    expect(identifier[set_name], "an equation 'NAME = expression;' or '*=*'") >>
+    expect('=', "'=' after the name") >> expect(expr, "an expression after '='") >>
+    expect(';', "';' at the end of the equation") >>
+    expect(x3::eoi, "the end of the line after ';'");
 
 const auto header_line = +identifier[add_column] >> expect(x3::eoi, "a column name");
 
@@ -460,7 +461,7 @@ Expr take_expr(Builder& b) { return std::move(b.stack.back().expr); }
 constexpr std::string_view kEquations = "Equations:";
 constexpr std::string_view kEnd = "*=*";
 
-std::string count(std::size_t n, const std::string& noun) {
+std::string plural(std::size_t n, const std::string& noun) {
   return std::to_string(n) + " " + noun + (n == 1 ? "" : "s");
 }
 
@@ -578,8 +579,8 @@ class ModelParser {
       const std::size_t columns = table.columns.size();
       if (cells != columns) {
         const Iterator where = cells > columns ? b_.stack[columns].begin : t.data() + t.size();
-        src_.fail(where, "row has " + count(cells, "cell") + " but the header has " +
-                             count(columns, "column"));
+        src_.fail(where, "row has " + plural(cells, "cell") + " but the header has " +
+                             plural(columns, "column"));
       }
       Table::Row row;
       row.at = at(i_);
@@ -655,7 +656,8 @@ Expr parse_expression(std::string_view text, const std::string& path) {
   // Trailing blanks and line breaks are not part of the expression: an error at its end then
   // points just past its last character.
   const auto end = text.find_last_not_of(" \t\r\n");
-  run(b, whole_expression, text.data(), text.data() + (end == std::string_view::npos ? 0 : end + 1));
+  const std::size_t length = end == std::string_view::npos ? 0 : end + 1;
+  run(b, whole_expression, text.data(), text.data() + length);
   return take_expr(b);
 }
 

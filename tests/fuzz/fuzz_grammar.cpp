@@ -33,9 +33,7 @@ void check(const Table& table) {
   }
 }
 
-void check(const ParseError& e) {
-  check(e.line() >= 1 && e.column() >= 1 && !e.message().empty());
-}
+void check(const ParseError& e) { check(e.line() >= 1 && e.column() >= 1 && !e.message().empty()); }
 
 }  // namespace
 

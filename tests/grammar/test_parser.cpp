@@ -77,8 +77,7 @@ void expect_error(const std::function<void()>& parse, int line, int column,
   }
 }
 
-void expect_model_error(const std::string& text, int line, int column,
-                        const std::string& message) {
+void expect_model_error(const std::string& text, int line, int column, const std::string& message) {
   expect_error([&] { parse_model_file(text, "model.txt"); }, line, column, message);
 }
 
@@ -93,7 +92,8 @@ void expect_expr_error(const std::string& text, int line, int column, const std:
 // A small model file whose equation section is `equations` (each line as given).
 std::string model_with(const std::string& equations) {
   return "Title\n\nGeometric parameters\nj       ant     theta\n1       0       th1\n\n"
-         "Equations:\n" + equations + "*=*\n";
+         "Equations:\n" +
+         equations + "*=*\n";
 }
 
 // Model files of the real robots.
@@ -191,7 +191,8 @@ TEST(RealFiles, EveryParFileParses) {
 
 TEST(Planar2r, DimStructure) {
   const ModelFile dim = read_model_file((kRobots / "planar2r" / "dim.txt").string());
-  EXPECT_EQ(dim.title, std::vector<std::string>{"Dynamic Identification Model (Newton-Euler method)"});
+  EXPECT_EQ(dim.title,
+            std::vector<std::string>{"Dynamic Identification Model (Newton-Euler method)"});
   ASSERT_EQ(dim.tables.size(), 4u);
   EXPECT_EQ(dim.tables[0].title, "Geometric parameters");
   EXPECT_EQ(dim.tables[1].title, "Dynamic inertia parameters");
@@ -264,10 +265,10 @@ TEST(Planar2r, JacobianAndGeometry) {
 }
 
 Bindings planar2r_point() {
-  return {{"th1", 0.4},   {"th2", -0.9},  {"QP1", 1.3},  {"QP2", -0.6}, {"QDP1", 0.5},
-          {"QDP2", 2.0},  {"L1", 0.8},    {"G3", 9.81},  {"ZZR1", 1.7}, {"ZZ2", 0.35},
-          {"MXR1", 2.1},  {"MY1", -0.2},  {"MX2", 0.45}, {"MY2", 0.07}, {"IA2", 0.02},
-          {"FS1", 0.3},   {"FS2", 0.25},  {"FV1", 0.11}, {"FV2", 0.09}};
+  return {{"th1", 0.4},  {"th2", -0.9}, {"QP1", 1.3},  {"QP2", -0.6}, {"QDP1", 0.5},
+          {"QDP2", 2.0}, {"L1", 0.8},   {"G3", 9.81},  {"ZZR1", 1.7}, {"ZZ2", 0.35},
+          {"MXR1", 2.1}, {"MY1", -0.2}, {"MX2", 0.45}, {"MY2", 0.07}, {"IA2", 0.02},
+          {"FS1", 0.3},  {"FS2", 0.25}, {"FV1", 0.11}, {"FV2", 0.09}};
 }
 
 TEST(Planar2r, InertiaMatrixByHand) {
@@ -317,9 +318,9 @@ TEST(Planar2r, GroupedParameters) {
   EXPECT_EQ(regp.grouped_tables[0].at.line, 43);
   EXPECT_EQ(regp.grouped_tables[1].rows[0].cells[6].name, "ZZR1");
 
-  const Bindings in = {{"th1", 0.1}, {"th2", 0.2}, {"L1", 0.8}, {"M1", 3.0}, {"M2", 1.5},
-                       {"MX1", 0.4}, {"IA1", 0.01}, {"ZZ1", 0.2}, {"XX1", 0}, {"XX2", 0},
-                       {"YY1", 0.6}, {"YY2", 0.3},  {"MZ1", 0}, {"MZ2", 0}};
+  const Bindings in = {{"th1", 0.1}, {"th2", 0.2},  {"L1", 0.8},  {"M1", 3.0}, {"M2", 1.5},
+                       {"MX1", 0.4}, {"IA1", 0.01}, {"ZZ1", 0.2}, {"XX1", 0},  {"XX2", 0},
+                       {"YY1", 0.6}, {"YY2", 0.3},  {"MZ1", 0},   {"MZ2", 0}};
   const auto v = run_equations(regp.equations, in);
   EXPECT_DOUBLE_EQ(v.at("ZZR1"), 0.01 + 0.64 * 1.5 + 0.2);
   EXPECT_DOUBLE_EQ(v.at("MXR1"), 0.8 * 1.5 + 0.4);
@@ -419,10 +420,10 @@ TEST(Expressions, Positions) {
   ASSERT_EQ(e.kind, Kind::Subtract);
   EXPECT_EQ(e.at.column, 1);
   const Expr& sum = e.args[0];
-  EXPECT_EQ(sum.args[1].at.column, 5);           // the '(' of (b*c)
-  EXPECT_EQ(sum.args[1].args[1].at.column, 8);   // c
-  EXPECT_EQ(e.args[1].at.column, 13);            // the unary '-'
-  EXPECT_EQ(e.args[1].args[0].at.column, 14);    // d
+  EXPECT_EQ(sum.args[1].at.column, 5);          // the '(' of (b*c)
+  EXPECT_EQ(sum.args[1].args[1].at.column, 8);  // c
+  EXPECT_EQ(e.args[1].at.column, 13);           // the unary '-'
+  EXPECT_EQ(e.args[1].args[0].at.column, 14);   // d
 
   const Expr multi = parse_expression("  x\n  * y\r\n", "t");
   EXPECT_EQ(multi.at.line, 1);
@@ -526,9 +527,11 @@ TEST(Errors, Equations) {
   expect_model_error(model_with("A = b;\nB = c @ d;\n"), 9, 7, "unexpected character '@'");
   expect_model_error(model_with("A = (b + c;\n"), 8, 11, "expected ')'");
   expect_model_error(model_with("A = b + c);\n"), 8, 10, "expected ';' at the end of the equation");
-  expect_model_error(model_with("A = cos(b;\n"), 8, 10, "expected ')' after the function arguments");
+  expect_model_error(model_with("A = cos(b;\n"), 8, 10,
+                     "expected ')' after the function arguments");
   expect_model_error(model_with("A b;\n"), 8, 3, "expected '=' after the name");
-  expect_model_error(model_with("2A = b;\n"), 8, 1, "expected an equation 'NAME = expression;' or '*=*'");
+  expect_model_error(model_with("2A = b;\n"), 8, 1,
+                     "expected an equation 'NAME = expression;' or '*=*'");
   expect_model_error(model_with("A = b; c\n"), 8, 8, "expected the end of the line after ';'");
   expect_model_error(model_with("A = b*;\n"), 8, 7, "expected an expression after '*'");
   expect_model_error(model_with("A = 1e400;\n"), 8, 5, "number out of range");
