@@ -38,9 +38,9 @@ std::string format_error(const std::string& file, int line, int column, const st
   std::string out = file + ":" + std::to_string(line) + ":" + std::to_string(column) +
                     ": error: " + message + "\n" + printable_line(source_line) + "\n";
   // Copy tabs from the source line so the caret lines up however the terminal expands them.
-  for (int i = 0; i + 1 < column; ++i)
-    out += (static_cast<std::size_t>(i) < source_line.size() && source_line[i] == '\t') ? '\t'
-                                                                                         : ' ';
+  const auto indent = static_cast<std::size_t>(std::max(column - 1, 0));
+  for (std::size_t i = 0; i < indent; ++i)
+    out += i < source_line.size() && source_line[i] == '\t' ? '\t' : ' ';
   return out + "^";
 }
 

@@ -1,7 +1,7 @@
 // Uses the generated CRANE-X7 model through the installed package: the paper's identified
 // 39-parameter model (Appendix A) at posture A. Exits non-zero if the regressor and the
 // Newton-Euler torque disagree or the inertia matrix is not positive definite.
-#include <Eigen/Cholesky>
+#include <Eigen/Eigenvalues>
 #include <cmath>
 #include <cstdio>
 #include <symoro/crane_x7.hpp>
