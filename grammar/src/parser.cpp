@@ -12,6 +12,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <set>
 #include <system_error>
 #include <utility>
 
@@ -106,29 +107,26 @@ class Source {
       std::size_t end = stop;
       if (end > start && original[end - 1] == '\r') --end;
       lines_.push_back({parsed + start, parsed + end});
-      starts_.push_back(start);
       if (nl == std::string_view::npos) break;
       start = nl + 1;
     }
     // A final line break ends the last line rather than starting an empty one.
-    if (lines_.size() > 1 && starts_.back() == original.size()) {
-      lines_.pop_back();
-      starts_.pop_back();
-    }
+    if (lines_.size() > 1 && lines_.back().begin == parsed + original.size()) lines_.pop_back();
   }
 
   const std::string& path() const { return path_; }
   const std::vector<Line>& lines() const { return lines_; }
 
   Position position(Iterator p) const {
-    const auto offset = static_cast<std::size_t>(p - parsed_);
     // Parsing goes line by line, so the line of the previous lookup is the usual answer.
-    if (!(starts_[hint_] <= offset &&
-          (hint_ + 1 == starts_.size() || offset < starts_[hint_ + 1]))) {
-      const auto next = std::upper_bound(starts_.begin(), starts_.end(), offset);
-      hint_ = static_cast<std::size_t>(next - starts_.begin()) - 1;
+    const bool on_hint = lines_[hint_].begin <= p &&
+                         (hint_ + 1 == lines_.size() || p < lines_[hint_ + 1].begin);
+    if (!on_hint) {
+      const auto next = std::upper_bound(lines_.begin(), lines_.end(), p,
+                                         [](Iterator q, const Line& l) { return q < l.begin; });
+      hint_ = static_cast<std::size_t>(next - lines_.begin()) - 1;
     }
-    return {static_cast<int>(hint_) + 1, static_cast<int>(offset - starts_[hint_]) + 1};
+    return {static_cast<int>(hint_) + 1, static_cast<int>(p - lines_[hint_].begin) + 1};
   }
 
   [[noreturn]] void fail(Iterator at, const std::string& message) const {
@@ -172,7 +170,6 @@ class Source {
   Iterator parsed_;
   std::string path_;
   std::vector<Line> lines_;
-  std::vector<std::size_t> starts_;
   mutable std::size_t hint_ = 0;
 };
 
@@ -511,7 +508,7 @@ class ModelParser {
   Iterator first_char(std::size_t i) const { return text(i).data(); }
   Position at(std::size_t i) const { return src_.position(first_char(i)); }
 
-  // Moves i_ to the next non-blank line; false at the end of the file.
+  // Moves i_ to the next non-blank line; true when there is none.
   bool rest_is_blank() {
     while (i_ < lines_.size() && text(i_).empty()) ++i_;
     return i_ == lines_.size();
@@ -565,10 +562,10 @@ class ModelParser {
     while (text(i_).empty());  // is_title() saw the header ahead
 
     run(b_, header_line, lines_[i_].begin, lines_[i_].end);
+    std::set<std::string_view> seen;
     for (std::size_t c = 0; c < b_.columns.size(); ++c)
-      for (std::size_t d = 0; d < c; ++d)
-        if (b_.columns[c] == b_.columns[d])
-          src_.fail(b_.column_at[c], "duplicate column '" + b_.columns[c] + "'");
+      if (!seen.insert(b_.columns[c]).second)
+        src_.fail(b_.column_at[c], "duplicate column '" + b_.columns[c] + "'");
     table.columns = std::move(b_.columns);
 
     for (++i_; i_ < lines_.size(); ++i_) {

@@ -29,11 +29,12 @@ struct AsTypes<std::tuple<Model...>> {
 };
 using Models = AsTypes<SYMORO_ROBOT_NS::Models>::type;
 
-// Test names: the full model, then its variants by position in Models.
+// Test names: "full" for the robot's full model, else the variant's name.
 struct ModelName {
   template <class Model>
-  static std::string GetName(int index) {
-    return std::is_same_v<typename Model::Parent, Model> ? "full" : "variant" + std::to_string(index);
+  static std::string GetName(int) {
+    const std::string variant = Model::variant_name;
+    return variant.empty() ? "full" : variant;
   }
 };
 
@@ -252,6 +253,26 @@ TYPED_TEST(RobotModel, JetDerivativesInQMatchFiniteDifferences) {
     // The value part of the Jet evaluation is the double evaluation.
     EXPECT_TRUE(close(values(M::forward_dynamics(q, s.qd, tau, phi)),
                       M::forward_dynamics(s.q, s.qd, tau, phi), kRelTol));
+  });
+}
+
+// The Jacobian is the derivative of the forward kinematics: linear rows d p / d q, angular rows
+// the axial vector of (d R / d q_k) R^T.
+TYPED_TEST(RobotModel, JacobianIsTheDerivativeOfForwardKinematics) {
+  using M = TypeParam;
+  this->for_states([&](const State<M>& s, const auto&) {
+    const auto T = M::forward_kinematics(seeded<M::nq>(s.q));
+    const Eigen::Matrix3d R = values(T.template topLeftCorner<3, 3>());
+    Eigen::Matrix<double, 6, M::nq> expected;
+    for (int k = 0; k < M::nq; ++k) {
+      const auto d = [&](int r, int c) { return T(r, c).v(k); };
+      Eigen::Matrix3d dR;
+      for (int r = 0; r < 3; ++r)
+        for (int c = 0; c < 3; ++c) dR(r, c) = d(r, c);
+      const Eigen::Matrix3d w = dR * R.transpose();  // skew-symmetric
+      expected.col(k) << d(0, 3), d(1, 3), d(2, 3), w(2, 1), w(0, 2), w(1, 0);
+    }
+    EXPECT_TRUE(close(M::jacobian(s.q), expected, kRelTol));
   });
 }
 
