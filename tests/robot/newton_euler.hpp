@@ -4,7 +4,6 @@
 // parameters, so it checks the grouping into base parameters as well as the dynamics.
 #pragma once
 
-#include <cmath>
 #include <vector>
 
 #include <Eigen/Core>
