@@ -135,17 +135,18 @@ class ModelWriter {
       args += i.name + ", ";
       sizes += "  eigen_assert(" + i.name + ".size() == " + str(static_cast<int>(i.symbols.size())) + ");\n";
     }
+    const std::string body = emit_body(g_, symbols, assignments, "  ");
     std::string s = doc;
     s += "template <" + types + "class Out>\n";
     s += "inline void " + name + "(" + params + "const Eigen::MatrixBase<Out>& out) {\n";
-    s += "  using Scalar = typename Out::Scalar;\n";
+    if (!body.empty()) s += "  using Scalar = typename Out::Scalar;\n";  // unused when all outputs are 0
     s += "  using std::cos;\n  using std::pow;\n  using std::sin;\n  using ::symoro::sign;\n";
     s += sizes;
     for (const auto& i : in) s += "  static_cast<void>(" + i.name + ");\n";
     s += "  Eigen::MatrixBase<Out>& " + o.name + " = const_cast<Eigen::MatrixBase<Out>&>(out);\n";
     s += "  " + o.name + ".derived().resize(" + o.rows + ", " + o.cols + ");\n";
     s += "  " + o.name + ".setZero();\n";
-    s += emit_body(g_, symbols, assignments, "  ");
+    s += body;
     s += "}\n\n";
 
     std::string promoted;

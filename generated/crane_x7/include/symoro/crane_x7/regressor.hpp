@@ -618,7 +618,6 @@ inline Eigen::Matrix<::symoro::promote_t<typename Q::Scalar, typename QD::Scalar
 // The torque of the parameters fixed at generation time (zero when all fixed values are 0).
 template <class Q, class QD, class QDD, class Out>
 inline void fixed_torque(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<QD>& qd, const Eigen::MatrixBase<QDD>& qdd, const Eigen::MatrixBase<Out>& out) {
-  using Scalar = typename Out::Scalar;
   using std::cos;
   using std::pow;
   using std::sin;
