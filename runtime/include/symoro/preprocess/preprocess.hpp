@@ -1,0 +1,57 @@
+// From a raw log to regression-ready samples (paper, Sec. V-B): time-axis correction of
+// irregular stamps, zero-phase anti-alias filtering, velocity and acceleration estimation,
+// and resampling to a target interval keeping only the samples on the target grid.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "symoro/io/log.hpp"
+
+namespace symoro::preprocess {
+
+struct Options {
+  double base_period = 0.001;  // s, the uniform grid of the corrected time axis
+  // Gaps (dropped samples) up to this length are bridged by interpolation; longer gaps split
+  // the log into separately processed pieces. Both are counted in the Report.
+  double max_gap = 0.02;  // s
+  int filter_order = 4;   // Butterworth order, applied forward and backward (zero phase)
+  // One low-pass is applied to q and tau alike (so that the regressor and the torque see the
+  // same filter): cutoff = min(derivative_cutoff, anti_alias_fraction * target Nyquist).
+  double derivative_cutoff = 15.0;    // Hz
+  double anti_alias_fraction = 0.8;
+};
+
+struct Report {
+  int raw_samples = 0;
+  int irregular_stamps = 0;   // intervals deviating from base_period by more than 10 %
+  int gaps_bridged = 0;       // gaps longer than 1.5 base periods and up to max_gap
+  int missing_samples = 0;    // base-grid samples filled in across bridged gaps
+  int pieces = 0;             // independent pieces after splitting at long gaps
+  double cutoff = 0;          // Hz, the low-pass actually used
+  int kept_samples = 0;       // target-grid samples returned
+  std::string summary() const;  // one line for logs and reports
+};
+
+// Regression-ready samples at one interval: rows are samples on the target grid.
+struct Samples {
+  double interval = 0;         // s
+  Eigen::VectorXd time;        // s, multiples of `interval` from the log's first stamp
+  Eigen::MatrixXd q, qd, qdd, tau;  // samples x joints
+  std::vector<int> piece;      // which piece of the log each sample came from
+  Report report;
+};
+
+// Throws DataError when the log cannot give samples at this interval (too short, interval
+// not a multiple of base_period).
+Samples preprocess(const io::Log& log, double interval, const Options& options = {});
+
+// The paper's four intervals.
+inline const std::vector<double>& paper_intervals() {
+  static const std::vector<double> v{0.010, 0.020, 0.040, 0.080};
+  return v;
+}
+
+}  // namespace symoro::preprocess
