@@ -1,0 +1,107 @@
+// The digital twin's configuration (robots/<robot>/twin.yaml): the robot's "truth" (a URDF-like
+// chain with CAD inertials, drive inertia and friction), its servos, the controller that
+// realizes the trajectories, the integrator, and the switchable effects. Read once, validated
+// with file and line; everything downstream works on these plain structs.
+#pragma once
+
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+
+namespace symoro::twin {
+
+struct UrdfJoint {
+  std::string name;
+  bool fixed = false;
+  int model_joint = 0;                 // 1-based joint of the model; 0 when fixed
+  Eigen::Vector3d xyz = Eigen::Vector3d::Zero(), rpy = Eigen::Vector3d::Zero();
+  Eigen::Vector3d axis = Eigen::Vector3d::UnitZ();
+};
+
+// A rigid body's inertial in URDF form, fixed to the child link of URDF joint `on`.
+struct UrdfInertial {
+  std::string name;
+  std::string on;
+  Eigen::Vector3d origin = Eigen::Vector3d::Zero();  // fixed offset of the body in that link
+  double mass = 0;
+  Eigen::Vector3d com = Eigen::Vector3d::Zero(), rpy = Eigen::Vector3d::Zero();
+  Eigen::Matrix3d inertia = Eigen::Matrix3d::Zero();  // about the CoM, in the rpy frame
+};
+
+struct UrdfChain {
+  Eigen::Isometry3d base_in_urdf = Eigen::Isometry3d::Identity();  // model frame 0 in the URDF base
+  std::vector<UrdfJoint> joints;
+  std::vector<UrdfInertial> inertials;
+};
+
+struct Servo {
+  std::string model;
+  double torque_constant = 0;  // N m / A
+  double current_unit = 0;     // A per count
+  double current_limit = 0;    // A
+  int encoder_counts = 0;      // per revolution
+};
+
+struct ControllerConfig {
+  double period = 0.001;
+  double pseudo_derivative_time = 0.002;
+  double communication_delay = 0.0009;
+  Eigen::VectorXd realization_inertia, realization_damping;  // M-hat, D-hat
+  Eigen::VectorXd bandwidth, damping_ratio;                  // -> K_P = w^2, K_V = 2 zeta w
+};
+
+struct Effects {
+  bool coulomb = false;
+  Eigen::VectorXd coulomb_torque;
+  double coulomb_smoothing_velocity = 0.01;
+  bool stribeck = false;
+  Eigen::VectorXd stribeck_torque;
+  double stribeck_velocity = 0.05;
+  bool torque_offset = false;
+  Eigen::VectorXd offset_torque;
+  bool backlash = false;
+  Eigen::VectorXd backlash_width;       // rad, total play; 0 = rigid joint
+  double backlash_frequency = 100;      // Hz
+  double backlash_damping_ratio = 0.1;
+  bool payload = false;
+  double payload_mass = 0;
+  Eigen::Vector3d payload_com = Eigen::Vector3d::Zero();
+  bool torque_constant_error = false;
+  Eigen::VectorXd torque_constant_scale;
+  bool sensor_noise = false;
+  double encoder_noise = 0;   // counts
+  double current_noise = 0;   // A
+  bool timestamp_jitter = false;
+  double jitter_std = 0, jitter_max = 0;
+  bool dropped_samples = false;
+  double drop_probability = 0;
+  int drop_max_burst = 1;
+
+  // Turns every effect off (the ideal twin: only the servos' quantization and the delay).
+  void disable_all();
+  // Sets one effect on or off by its twin.yaml name; throws std::invalid_argument if unknown.
+  void set(const std::string& name, bool enabled);
+  static const std::vector<std::string>& names();
+  std::vector<std::string> enabled() const;
+};
+
+struct TwinConfig {
+  std::string path;
+  UrdfChain chain;
+  Eigen::VectorXd rotor_inertia, viscous;
+  std::vector<Servo> servos;
+  ControllerConfig controller;
+  double max_step = 0.0005;
+  Effects effects;
+};
+
+// Reads twin.yaml for a robot with `joints` joints. `override_path` (optional, may be empty):
+// a second YAML file whose keys replace those of the first (maps merge, other values replace),
+// for experiments that change a few effects. Errors name the file and line.
+TwinConfig read_twin_config(const std::filesystem::path& path, int joints,
+                            const std::filesystem::path& override_path = {});
+
+}  // namespace symoro::twin

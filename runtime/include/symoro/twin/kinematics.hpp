@@ -1,0 +1,31 @@
+// Forward kinematics of the two descriptions the twin reconciles: the model's modified
+// Denavit-Hartenberg frames (Model::frames) and a URDF chain (twin.yaml). Plain double code;
+// the twin uses it to map CAD inertials into the model's link frames and to check the mapping.
+#pragma once
+
+#include <vector>
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+
+#include "symoro/model_info.hpp"
+#include "symoro/twin/config.hpp"
+
+namespace symoro::twin {
+
+// ^{ant}T_j = Rot(z, gamma) Trans(z, b) Rot(x, alpha) Trans(x, d) Rot(z, theta) Trans(z, r),
+// with the joint variable added to theta (revolute) or r (prismatic).
+Eigen::Isometry3d mdh_transform(const FrameInfo& f, double q);
+
+// ^0T_j for every frame j = 1..n (index j - 1), following `ant`. q has one entry per movable
+// frame, in frame order.
+std::vector<Eigen::Isometry3d> mdh_poses(const std::vector<FrameInfo>& frames, const Eigen::VectorXd& q);
+
+// The pose in the URDF base of the child link of every URDF joint (index as chain.joints), with
+// the model joint variables q (fixed joints take none).
+std::vector<Eigen::Isometry3d> urdf_poses(const UrdfChain& chain, const Eigen::VectorXd& q);
+
+// URDF rpy (roll about x, pitch about y, yaw about z, fixed axes) as a rotation matrix.
+Eigen::Matrix3d rotation_from_rpy(const Eigen::Vector3d& rpy);
+
+}  // namespace symoro::twin

@@ -1,0 +1,218 @@
+// The closed-loop digital twin: the plant driven by the paper's FF+PD controller through the
+// realization layer of a DYNAMIXEL arm, producing the log a real run would produce.
+//
+// One control cycle k (nominal period T, start t_k = k T + jitter):
+//   t_k        the encoders are sampled (link-side, quantized, optional noise) and the
+//              servos report their present current (quantized, optional noise); the log row
+//              stamps t_k, and its torque is the one computed from that current with the
+//              nominal torque constants, as on the real arm.
+//   t_k + d    after the bus round trip d (reading 8 encoders and writing 8 commands) the new
+//              current commands take effect and are held until the next ones (sample and
+//              hold adds about T/2, so the total delay is about d + T/2).
+// A dropped cycle (failed read) writes no row and the controller reuses its last measurement.
+// Before t = 0 the controller holds the first reference for a pre-roll (not logged), as the
+// real arm holds its start posture before a run.
+#pragma once
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "symoro/control/ffpd.hpp"
+#include "symoro/io/log.hpp"
+#include "symoro/trajectory/trajectory.hpp"
+#include "symoro/twin/config.hpp"
+#include "symoro/twin/plant.hpp"
+#include "symoro/twin/random.hpp"
+#include "symoro/twin/truth.hpp"
+
+namespace symoro::twin {
+
+struct RunOptions {
+  std::string robot;
+  int trial = 1;
+  std::uint64_t seed = 1;   // the run's own seed (see run_seed)
+  double pre_roll = 0.5;    // s of holding the start posture before logging
+};
+
+struct RunStats {
+  double simulated = 0;     // s of logged motion
+  double wall = 0;          // s of computation
+  int cycles = 0, dropped = 0, saturated = 0;  // saturated: cycles with a current at its limit
+  Eigen::VectorXd max_error, rms_error;        // true q_ref - q, rad, per joint
+  Eigen::VectorXd max_torque;                  // |applied motor torque|, N m, per joint
+};
+
+control::FfpdGains controller_gains(const TwinConfig& c);
+
+template <class Model>
+class ClosedLoopTwin {
+ public:
+  static constexpr int n = Model::nq;
+  using Vec = Eigen::Matrix<double, n, 1>;
+
+  explicit ClosedLoopTwin(TwinConfig config) : c_(std::move(config)), truth_(make_truth<Model>(c_)) {
+    if (static_cast<int>(c_.servos.size()) != n) throw DataError(c_.path, 0, "servos: one per joint needed");
+    for (const auto& j : Model::joints) names_.push_back(j.name);
+  }
+
+  const TwinConfig& config() const { return c_; }
+  const Truth<Model>& truth() const { return truth_; }
+
+  io::Log run(const trajectory::Trajectory& traj, const RunOptions& opt, RunStats* stats = nullptr) const {
+    const auto wall0 = std::chrono::steady_clock::now();
+    if (traj.joints() != n)
+      throw DataError(traj.name, 0, "the trajectory has " + std::to_string(traj.joints()) + " joints, the robot " + std::to_string(n));
+    const Effects& e = c_.effects;
+    const double T = c_.controller.period, d = c_.controller.communication_delay;
+    const int K = static_cast<int>(std::llround(traj.duration() / T));
+    Random rng(opt.seed);
+
+    // Servo constants.
+    Vec kt, kt_true, unit, limit, lsb;
+    for (int j = 0; j < n; ++j) {
+      const Servo& s = c_.servos[j];
+      kt(j) = s.torque_constant;
+      kt_true(j) = s.torque_constant * (e.torque_constant_error ? e.torque_constant_scale(j) : 1.0);
+      unit(j) = s.current_unit;
+      limit(j) = std::floor(s.current_limit / s.current_unit) * s.current_unit;
+      lsb(j) = 2 * 3.14159265358979323846 / s.encoder_counts;
+    }
+    auto encoder = [&](const Vec& q) {
+      Vec m;
+      for (int j = 0; j < n; ++j) {
+        const double noise = e.sensor_noise ? e.encoder_noise * rng.normal() : 0.0;
+        m(j) = std::round(q(j) / lsb(j) + noise) * lsb(j);
+      }
+      return m;
+    };
+    auto current_command = [&](const Eigen::VectorXd& u, bool& saturated) {
+      Vec i;
+      for (int j = 0; j < n; ++j) {
+        i(j) = std::round(u(j) / kt(j) / unit(j)) * unit(j);
+        if (std::abs(i(j)) >= limit(j)) {
+          i(j) = std::copysign(limit(j), i(j));
+          saturated = true;
+        }
+      }
+      return i;
+    };
+
+    // References per cycle (the controller steps through them by cycle count).
+    Eigen::VectorXd qr(n), qdr(n), qddr(n);
+    traj.evaluate(0.0, qr, qdr, qddr);
+    Plant<Model> plant(truth_, c_, Vec(qr));
+    control::FfpdController ctrl(controller_gains(c_));
+    Vec q_meas = encoder(plant.q());
+    ctrl.reset(q_meas);
+    Vec current = Vec::Zero();
+    bool sat = false;
+
+    // Pre-roll: hold the first reference so the run starts from the held posture.
+    const int pre = static_cast<int>(std::llround(opt.pre_roll / T));
+    for (int k = 0; k < pre; ++k) {
+      q_meas = encoder(plant.q());
+      const Vec u_cmd = current_command(ctrl.update(q_meas, qr, qdr, qddr), sat);
+      plant.advance(d, kt_true.cwiseProduct(current));
+      current = u_cmd;
+      plant.advance(T - d, kt_true.cwiseProduct(current));
+    }
+
+    io::Log log;
+    log.meta.robot = opt.robot;
+    log.meta.trajectory = traj.name;
+    log.meta.trial = opt.trial;
+    log.meta.seed = opt.seed;
+    log.meta.source = "twin";
+    log.meta.sample_time = T;
+    log.meta.joints = names_;
+    std::string enabled;
+    for (const auto& s : e.enabled()) enabled += (enabled.empty() ? "" : ", ") + s;
+    log.meta.notes = "digital twin (" + c_.path + "); effects: " + (enabled.empty() ? "none" : enabled);
+    const int rows_max = K + 1;
+    log.time.resize(rows_max);
+    for (Eigen::MatrixXd* m : {&log.q, &log.qd, &log.tau, &log.q_ref, &log.qd_ref, &log.qdd_ref}) m->resize(rows_max, n);
+
+    RunStats st;
+    st.max_error = Eigen::VectorXd::Zero(n);
+    st.rms_error = Eigen::VectorXd::Zero(n);
+    st.max_torque = Eigen::VectorXd::Zero(n);
+    int rows = 0, drop_left = 0;
+    double t_now = 0, t_start_next = 0;
+    for (int k = 0; k <= K; ++k) {
+      // The cycle starts at its jittered instant, never before the previous command went out.
+      double t_k = k * T;
+      if (e.timestamp_jitter && k > 0)
+        t_k += std::clamp(e.jitter_std * rng.normal(), -e.jitter_max, e.jitter_max);
+      t_k = std::max(t_k, t_start_next);
+      plant.advance(t_k - t_now, kt_true.cwiseProduct(current));
+      t_now = t_k;
+
+      traj.evaluate(k * T, qr, qdr, qddr);
+      const Vec q_true = plant.q();
+      const Vec err = Vec(qr) - q_true;
+      st.max_error = st.max_error.cwiseMax(err.cwiseAbs());
+      st.rms_error += err.cwiseAbs2();
+      st.max_torque = st.max_torque.cwiseMax(kt_true.cwiseProduct(current).cwiseAbs());
+
+      bool dropped = false;
+      if (e.dropped_samples && k > 0 && k < K) {
+        if (drop_left == 0 && rng.uniform() < e.drop_probability)
+          drop_left = 1 + static_cast<int>(rng.uniform() * e.drop_max_burst);
+        if (drop_left > 0) {
+          dropped = true;
+          --drop_left;
+        }
+      }
+      Vec tau_logged;
+      if (!dropped) {
+        q_meas = encoder(q_true);
+        for (int j = 0; j < n; ++j) {
+          const double noise = e.sensor_noise ? e.current_noise * rng.normal() : 0.0;
+          tau_logged(j) = kt(j) * std::round((current(j) + noise) / unit(j)) * unit(j);
+        }
+      } else {
+        ++st.dropped;
+      }
+      bool cycle_sat = false;
+      const Vec cmd = current_command(ctrl.update(q_meas, qr, qdr, qddr), cycle_sat);
+      st.saturated += cycle_sat;
+      if (!dropped) {
+        log.time(rows) = t_k;
+        log.q.row(rows) = q_meas.transpose();
+        log.qd.row(rows) = ctrl.velocity().transpose();
+        log.tau.row(rows) = tau_logged.transpose();
+        log.q_ref.row(rows) = qr.transpose();
+        log.qd_ref.row(rows) = qdr.transpose();
+        log.qdd_ref.row(rows) = qddr.transpose();
+        ++rows;
+      }
+      plant.advance(d, kt_true.cwiseProduct(current));
+      t_now = t_k + d;
+      current = cmd;
+      t_start_next = t_now + 1e-6;
+    }
+    log.time.conservativeResize(rows);
+    for (Eigen::MatrixXd* m : {&log.q, &log.qd, &log.tau, &log.q_ref, &log.qd_ref, &log.qdd_ref})
+      m->conservativeResize(rows, n);
+
+    st.cycles = K + 1;
+    st.rms_error = (st.rms_error / double(K + 1)).cwiseSqrt();
+    st.simulated = K * T;
+    st.wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
+    if (stats) *stats = st;
+    return log;
+  }
+
+ private:
+  TwinConfig c_;
+  Truth<Model> truth_;
+  std::vector<std::string> names_;
+};
+
+}  // namespace symoro::twin

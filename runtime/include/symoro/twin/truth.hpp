@@ -1,0 +1,67 @@
+// The twin's true parameters for a generated Model (its full model): standard parameters from
+// the CAD chain (plus the payload when enabled), base parameters through base_from_standard,
+// and the link-side parameters used when backlash separates the rotors from the links.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "symoro/twin/config.hpp"
+#include "symoro/twin/standard_parameters.hpp"
+
+namespace symoro::twin {
+
+template <class Model>
+struct Truth {
+  std::vector<LinkInertial> links;                 // per model frame, with the payload
+  Eigen::Matrix<double, Model::ns, 1> standard;    // Coulomb (FS) is 0: the twin applies its own
+  Eigen::Matrix<double, Model::np, 1> phi;         // rigid drives: rotor inertia and viscous friction in the model
+  Eigen::Matrix<double, Model::np, 1> phi_links;   // the same without rotor and viscous terms of backlash joints
+};
+
+template <class Model>
+std::vector<StandardParameterInfo> standard_parameter_list() {
+  return {Model::standard_parameters.begin(), Model::standard_parameters.end()};
+}
+
+template <class Model>
+std::vector<FrameInfo> frame_list() {
+  return {Model::frames.begin(), Model::frames.end()};
+}
+
+// The last frame that carries a mass parameter: where a payload goes.
+template <class Model>
+int payload_frame() {
+  int last = 0;
+  for (const auto& p : Model::standard_parameters)
+    if (std::string(p.family) == "M") last = std::max(last, p.joint);
+  return last;
+}
+
+template <class Model>
+Truth<Model> make_truth(const TwinConfig& c) {
+  constexpr int n = Model::nq;
+  Truth<Model> t;
+  t.links = model_link_inertials(c.chain, frame_list<Model>(), c.path);
+  if (c.effects.payload && c.effects.payload_mass > 0) {
+    const int f = payload_frame<Model>();
+    if (f == 0) throw DataError(c.path, 0, "payload: the model has no link with a mass parameter");
+    add_point_mass(t.links[f - 1], c.effects.payload_mass, c.effects.payload_com);
+  }
+  const auto names = standard_parameter_list<Model>();
+  const Eigen::VectorXd zero = Eigen::VectorXd::Zero(n);
+  t.standard = standard_vector(names, t.links, c.rotor_inertia, c.viscous, zero, c.path);
+  t.phi = Model::base_from_standard(t.standard);
+
+  Eigen::VectorXd ia = c.rotor_inertia, fv = c.viscous;
+  if (c.effects.backlash)
+    for (int j = 0; j < n; ++j)
+      if (c.effects.backlash_width(j) > 0) ia(j) = fv(j) = 0;
+  const Eigen::Matrix<double, Model::ns, 1> s_links = standard_vector(names, t.links, ia, fv, zero, c.path);
+  t.phi_links = Model::base_from_standard(s_links);
+  return t;
+}
+
+}  // namespace symoro::twin
