@@ -187,7 +187,8 @@ TEST(TwinPlant, ConservesEnergyWithoutFrictionAndControl) {
     drift = std::max(drift, std::abs(energy() - e0));
   }
   EXPECT_GT(swing, 0.5);           // the arm really moved (J of kinetic energy)
-  EXPECT_LT(drift, 1e-9 * swing);  // RK4 at 0.5 ms: relative energy error far below 1e-9
+  // RK4 at the configured 1 ms step: measured 4e-9 of the kinetic energy scale after 2 s.
+  EXPECT_LT(drift, 1e-8 * swing);
 }
 
 TEST(TwinPlant, StepIsConvergedFarBelowTheEncoderResolution) {
@@ -212,6 +213,23 @@ TEST(TwinPlant, StepIsConvergedFarBelowTheEncoderResolution) {
   const double lsb = 2 * M_PI / 4096;
   EXPECT_LT(worst, 1e-3 * lsb) << "max |q_coarse - q_fine| = " << worst;
   RecordProperty("step_error_rad", std::to_string(worst));
+}
+
+}  // namespace
+
+namespace {
+
+// The controller's realization inertias (twin.yaml) play the role of a joint-level fit: they
+// must be near the true diagonal inertia at posture A, where the paper fitted them.
+TEST(TwinConfigFile, RealizationInertiaIsTheDiagonalAtPostureA) {
+  const TwinConfig c = config();
+  const auto truth = make_truth<Model>(c);
+  Eigen::VectorXd q = Eigen::VectorXd::Zero(n);
+  q(3) = -M_PI / 2;
+  Eigen::Matrix<double, n, n> M;
+  Model::inertia(q, truth.phi, M);
+  for (int j = 0; j < n; ++j)
+    EXPECT_NEAR(c.controller.realization_inertia(j), M(j, j), 0.1 * M(j, j)) << "joint " << j + 1;
 }
 
 }  // namespace

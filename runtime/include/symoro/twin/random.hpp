@@ -19,16 +19,24 @@ class Random {
     return z ^ (z >> 31);
   }
   double uniform() { return (next() >> 11) * 0x1.0p-53; }  // [0, 1)
-  // Standard normal by Box-Muller (the second value is discarded for simplicity).
+  // Standard normal by Box-Muller; each pair of uniforms gives two values.
   double normal() {
+    if (has_spare_) {
+      has_spare_ = false;
+      return spare_;
+    }
     double u1 = uniform();
     while (u1 <= 0) u1 = uniform();
-    const double u2 = uniform();
-    return std::sqrt(-2 * std::log(u1)) * std::cos(6.283185307179586 * u2);
+    const double r = std::sqrt(-2 * std::log(u1)), a = 6.283185307179586 * uniform();
+    spare_ = r * std::sin(a);
+    has_spare_ = true;
+    return r * std::cos(a);
   }
 
  private:
   std::uint64_t s_;
+  double spare_ = 0;
+  bool has_spare_ = false;
 };
 
 // The seed of one run, from the dataset seed, the trajectory and the trial: independent of

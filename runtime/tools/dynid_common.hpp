@@ -1,0 +1,64 @@
+// Shared pieces of the dynid subcommands: where robot folders are, how a robot is looked up,
+// and a progress display for long batches.
+#pragma once
+
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <mutex>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include <CLI/CLI.hpp>
+
+#include "symoro/model_info.hpp"
+
+namespace symoro::dynid {
+
+struct Common {
+  std::string robot;
+  std::string robots_dir = SYMORO_DEFAULT_ROBOTS_DIR;
+  std::filesystem::path robot_dir() const { return std::filesystem::path(robots_dir) / robot; }
+};
+
+// An error in the command's use (unknown robot, missing file): printed without a stack.
+struct UsageError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+template <class Model>
+std::vector<JointInfo> joint_list() {
+  return {Model::joints.begin(), Model::joints.end()};
+}
+
+// Counts finished items on stderr; redraws one line on a terminal, prints lines otherwise.
+class Progress {
+ public:
+  Progress(int total, std::string what) : total_(total), what_(std::move(what)), start_(clock::now()) {}
+  void done(const std::string& item, const std::string& detail) {
+    std::lock_guard<std::mutex> lock(m_);
+    ++count_;
+    const double elapsed = std::chrono::duration<double>(clock::now() - start_).count();
+    const double eta = count_ > 0 ? elapsed / count_ * (total_ - count_) : 0;
+    std::fprintf(stderr, "%s[%*d/%d] %s %-10s %s  elapsed %.0f s, eta %.0f s%s", tty_ ? "\r\033[K" : "",
+                 width(), count_, total_, what_.c_str(), item.c_str(), detail.c_str(), elapsed, eta,
+                 tty_ && count_ < total_ ? "" : "\n");
+    std::fflush(stderr);
+  }
+
+ private:
+  using clock = std::chrono::steady_clock;
+  int width() const { return static_cast<int>(std::to_string(total_).size()); }
+  int total_, count_ = 0;
+  std::string what_;
+  clock::time_point start_;
+  std::mutex m_;
+  bool tty_ = isatty_stderr();
+  static bool isatty_stderr();
+};
+
+void add_twin_commands(CLI::App& app, Common& common);
+void add_trajectory_commands(CLI::App& app, Common& common);
+
+}  // namespace symoro::dynid
