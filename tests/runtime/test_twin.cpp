@@ -4,6 +4,7 @@
 // loop's tracking error against the bound derived in tracking_bound.hpp.
 #include <cmath>
 #include <fstream>
+#include <iostream>
 #include <random>
 
 #include <gtest/gtest.h>
@@ -230,6 +231,195 @@ TEST(TwinConfigFile, RealizationInertiaIsTheDiagonalAtPostureA) {
   Model::inertia(q, truth.phi, M);
   for (int j = 0; j < n; ++j)
     EXPECT_NEAR(c.controller.realization_inertia(j), M(j, j), 0.1 * M(j, j)) << "joint " << j + 1;
+}
+
+}  // namespace
+
+#include "symoro/trajectory/design.hpp"
+#include "symoro/twin/simulator.hpp"
+#include "symoro/twin/tracking_bound.hpp"
+
+namespace {
+
+// For a critically damped continuous loop without delay the torque gain is exactly 1/(m K_P)
+// (the impulse response t e^{-wt}/m is positive): the sampled loop with delay must be close.
+TEST(TwinTracking, LoopGainMatchesTheContinuousLimit) {
+  TwinConfig c = config();
+  for (int j = 0; j < n; ++j) {
+    const double m = c.controller.realization_inertia(j), w = c.controller.bandwidth(j);
+    const LoopGains g = loop_gains(c, j);
+    EXPECT_NEAR(g.torque, 1 / (m * w * w), 0.15 / (m * w * w)) << "joint " << j + 1;
+    EXPECT_GT(g.measurement, 0.9);  // a measurement error passes at least once to q
+  }
+}
+
+TEST(TwinTracking, ErrorStaysWithinTheDerivedBound) {
+  const TwinConfig c = config();  // default effects: noise, jitter, dropped samples
+  const ClosedLoopTwin<Model> twin(c);
+  const auto design = symoro::trajectory::TrajectoryDesign::read(
+      std::string(SYMORO_ROBOTS_DIR) + "/crane_x7/trajectories.yaml",
+      std::vector<symoro::JointInfo>(Model::joints.begin(), Model::joints.end()));
+  for (const std::string name : {"PA03", "PC06", "AP01", "V01"}) {
+    const auto traj = design.build(name);
+    const auto needed = [&](const Eigen::VectorXd& q, const Eigen::VectorXd& qd, const Eigen::VectorXd& qdd) {
+      Eigen::Matrix<double, n, 1> tau;
+      Model::inverse_dynamics(q, qd, qdd, twin.truth().phi, tau);
+      return Eigen::VectorXd(tau);
+    };
+    const Eigen::VectorXd bound = tracking_error_bound(c, unmodeled_torque(c, traj, needed));
+    RunOptions ro;
+    ro.seed = 11;
+    RunStats st;
+    twin.run(traj, ro, &st);
+    for (int j = 0; j < n; ++j) {
+      EXPECT_LE(st.max_error(j), bound(j)) << name << " joint " << j + 1;
+      // The bound is informative: within a few times the observed error and under 5 deg.
+      EXPECT_LT(bound(j), 5 * M_PI / 180) << name << " joint " << j + 1;
+    }
+    std::cout << name << " max error / bound (deg):";
+    for (int j = 0; j < n; ++j) std::cout << " " << st.max_error(j) * 180 / M_PI << "/" << bound(j) * 180 / M_PI;
+    std::cout << "\n";
+  }
+}
+
+}  // namespace
+
+namespace {
+
+Plant<Model>::Vec posture_a() {
+  Plant<Model>::Vec q = Plant<Model>::Vec::Zero();
+  q(3) = -M_PI / 2;
+  return q;
+}
+
+TEST(TwinEffects, BacklashIsResolvedAndHoldsTheLinkAgainstTheGear) {
+  TwinConfig c = config();
+  c.effects.disable_all();
+  c.effects.backlash = true;
+  // Play on joint 2 only, which gravity keeps loaded: the gear stays in mesh and the motion is
+  // smooth, so step convergence is measurable. (With play everywhere and feedback, the wrist
+  // hunts inside its play: a chaotic, physical limit cycle that no step size "converges".)
+  const double width = c.effects.backlash_width(1);
+  c.effects.backlash_width.setZero();
+  c.effects.backlash_width(1) = width;
+  const auto truth = make_truth<Model>(c);
+  Plant<Model> plant(truth, c, posture_a());
+  EXPECT_LE(plant.max_step(), 0.3 / (2 * M_PI * c.effects.backlash_frequency) + 1e-15);
+  // Under the FF+PD controller (stable, unlike an open-loop hold), swinging joint 2 by 0.2 rad
+  // and back: the step the plant chose is converged (1/8 of it agrees to a fraction of a count).
+  const Eigen::VectorXd zero = Eigen::VectorXd::Zero(n);
+  Plant<Model>::Vec g;
+  Model::inverse_dynamics(posture_a(), zero, zero, truth.phi, g);
+  TwinConfig fine_c = c;
+  fine_c.max_step = plant.max_step() / 8;
+  Plant<Model> fine(truth, fine_c, posture_a());
+  symoro::control::FfpdController ca(controller_gains(c)), cb(controller_gains(c));
+  ca.reset(posture_a()), cb.reset(posture_a());
+  double worst = 0;
+  for (int k = 0; k < 2000; ++k) {
+    Eigen::VectorXd ref = posture_a();
+    ref(1) += 0.2 * std::sin(M_PI * k / 1000.0);
+    const Plant<Model>::Vec ua = ca.update(plant.q(), ref, zero, zero), ub = cb.update(fine.q(), ref, zero, zero);
+    plant.advance(0.001, ua), fine.advance(0.001, ub);
+    worst = std::max(worst, (plant.q() - fine.q()).cwiseAbs().maxCoeff());
+  }
+  EXPECT_LT(worst, 0.05 * 2 * M_PI / 4096) << "step error " << worst;
+  // Settled at posture A again: hold there and look at the gear.
+  for (int k = 0; k < 500; ++k) plant.advance(0.001, ca.update(plant.q(), posture_a(), zero, zero));
+  // Joint 2 carries a large gravity torque: its rotor leads the link by half the play plus the
+  // mesh deflection, on the side that holds the arm up.
+  const double half = c.effects.backlash_width(1) / 2;
+  const double lead = plant.rotor_q()(1) - plant.q()(1);
+  EXPECT_GT(std::abs(lead), half);
+  EXPECT_LT(std::abs(lead), half + 0.01);
+  EXPECT_EQ(lead > 0, g(1) > 0);
+}
+
+TEST(TwinEffects, PayloadAddsItsWeightToTheGravityTorques) {
+  TwinConfig c = config();
+  c.effects.disable_all();
+  const auto plain = make_truth<Model>(c);
+  c.effects.payload = true;
+  const auto loaded = make_truth<Model>(c);
+  const Eigen::VectorXd zero = Eigen::VectorXd::Zero(n);
+  Eigen::VectorXd q = posture_a();
+  q(1) = 0.4, q(5) = 0.3;
+  Plant<Model>::Vec t0, t1;
+  Model::inverse_dynamics(q, zero, zero, plain.phi, t0);
+  Model::inverse_dynamics(q, zero, zero, loaded.phi, t1);
+  // The payload's weight m g acting at its position p: holding torques a_j x (p - o_j) . (m g e_z).
+  const auto T = mdh_poses(frame_list<Model>(), q);
+  const Eigen::Vector3d p = T[6] * c.effects.payload_com;
+  for (int j = 0; j < n; ++j) {
+    const Eigen::Vector3d a = T[j].linear().col(2), o = T[j].translation();
+    const double expected = j < 7 ? a.cross(p - o).dot(Eigen::Vector3d(0, 0, c.effects.payload_mass * 9.80665)) : 0.0;
+    EXPECT_NEAR(t1(j) - t0(j), expected, 1e-12) << "joint " << j + 1;
+  }
+}
+
+TEST(TwinRun, LogHasTheServosResolutionAndIsReproducible) {
+  const TwinConfig c = config();
+  const ClosedLoopTwin<Model> twin(c);
+  const auto design = symoro::trajectory::TrajectoryDesign::read(
+      std::string(SYMORO_ROBOTS_DIR) + "/crane_x7/trajectories.yaml",
+      std::vector<symoro::JointInfo>(Model::joints.begin(), Model::joints.end()));
+  const auto traj = design.build("V02");
+  RunOptions ro;
+  ro.seed = 5;
+  RunStats st;
+  const auto log = twin.run(traj, ro, &st);
+  // Every cycle but the dropped ones is logged, at stamps within the jitter of k T.
+  EXPECT_EQ(log.samples() + st.dropped, st.cycles);
+  EXPECT_GT(st.dropped, 0);
+  const double lsb = 2 * M_PI / 4096;
+  for (int k = 0; k < log.samples(); ++k) {
+    const double cycle = std::round(log.time(k) / 0.001);
+    ASSERT_LE(std::abs(log.time(k) - cycle * 0.001), c.effects.jitter_max + 1e-12);
+    if (k > 0) ASSERT_GT(log.time(k), log.time(k - 1));
+    for (int j = 0; j < n; ++j) {
+      // Encoder counts and current steps: q on the 12-bit grid, tau on the Kt x 2.69 mA grid.
+      ASSERT_NEAR(log.q(k, j) / lsb, std::round(log.q(k, j) / lsb), 1e-6);
+      const double step = c.servos[j].torque_constant * c.servos[j].current_unit;
+      ASSERT_NEAR(log.tau(k, j) / step, std::round(log.tau(k, j) / step), 1e-6);
+    }
+  }
+  const auto again = twin.run(traj, ro);
+  EXPECT_EQ(again.tau, log.tau);
+  EXPECT_EQ(again.time, log.time);
+  ro.seed = 6;
+  const auto other = twin.run(traj, ro);
+  EXPECT_NE(other.time.size() == log.time.size() ? (other.tau - log.tau).norm() : 1.0, 0.0);
+}
+
+// The logged torque is the current the servos held when the row was stamped: the command of
+// the previous cycle (applied d after its measurement). A step in the reference shows in the
+// logged torque one cycle later.
+TEST(TwinRun, CommandReachesTheLogOneCycleLater) {
+  TwinConfig c = config();
+  c.effects.disable_all();
+  // A fine encoder: no count hunting at rest, so only the timing shows.
+  for (auto& s : c.servos) s.encoder_counts = 1 << 30;
+  const ClosedLoopTwin<Model> twin(c);
+  symoro::trajectory::Trajectory step;
+  step.name = "step";
+  symoro::trajectory::Segment hold;
+  hold.from = hold.to = posture_a();
+  hold.profile.duration = 0.01;
+  step.segments.push_back(hold);
+  symoro::trajectory::Segment jump = hold;
+  jump.start = 0.01;
+  jump.from = jump.to = posture_a() + Eigen::VectorXd::Constant(n, 0.01);
+  step.segments.push_back(jump);
+  RunOptions ro;
+  ro.pre_roll = 1.0;
+  const auto log = twin.run(step, ro);
+  const int k = 10;  // the reference jumps at cycle 10
+  for (int j = 0; j < n; ++j) {
+    EXPECT_NEAR(log.tau(k, j), log.tau(k - 1, j), 0.01) << "joint " << j + 1;
+    // One cycle later the P term m K_P 0.01 has arrived.
+    const double kick = c.controller.realization_inertia(j) * std::pow(c.controller.bandwidth(j), 2) * 0.01;
+    EXPECT_GT(log.tau(k + 1, j) - log.tau(k, j), 0.5 * kick) << "joint " << j + 1;
+  }
 }
 
 }  // namespace
