@@ -18,12 +18,25 @@ struct Profile {
   double cruise = 0;    // length of the constant-velocity phase, s (0 when too short)
   // s, ds/dt, d2s/dt2 at time t from the segment start (clamped to [0, duration]).
   void evaluate(double t, double& s, double& sd, double& sdd) const;
+
+  // The move from s = 0 to 1 with |ds/dt| <= velocity and |d2s/dt2| <= acceleration (1/s,
+  // 1/s^2): sine-squared acceleration ramps, a(t) = a_peak sin^2(pi t / ramp), at the
+  // acceleration limit, then a cruise at the velocity limit; when 1 is too short for a cruise,
+  // the peak velocity is lowered instead (ramps only, still at the acceleration limit).
+  static Profile plan(double velocity, double acceleration);
+  // Standing still for `duration` (s stays 0).
+  static Profile hold(double duration);
+  bool moves() const { return ramp > 0; }
+  double peak_velocity() const;      // 1/s, reached at the end of the first ramp
+  double peak_acceleration() const;  // 1/s^2, reached in the middle of the first ramp
 };
 
 struct Segment {
   double start = 0;        // s from the trajectory start
   Eigen::VectorXd from, to;  // waypoints (rad or m), one entry per joint; equal for a hold
   Profile profile;
+  std::string label;       // what the segment belongs to: "hold", "dwell", "transition",
+                           // a primitive such as "P4@B'" or "P2,3(+,-)@C", or "waypoint 3"
   double end() const { return start + profile.duration; }
 };
 
