@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # The main job, end to end on the bundled CRANE-X7 (no hardware): install what is missing,
 # build, check that generated/ matches a fresh compilation of robots/, install the package and
-# run the example application against it.
+# run the example application against it; then simulate the digital twin's whole dataset (the
+# 43 designed trajectories, one trial, seed 1; resumable) and preprocess one log.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash tools/install_deps.sh
@@ -14,3 +15,9 @@ cmake --install build --prefix "$prefix" >/dev/null
 cmake -S tests/package -B build/example -G Ninja -DCMAKE_PREFIX_PATH="$prefix" >/dev/null
 cmake --build build/example
 build/example/crane_x7_example
+
+dynid=build/runtime/tools/dynid
+$dynid trajectories --robot crane_x7
+$dynid twin dataset --robot crane_x7 -o build/twin-data --trials 1 --seed 1
+$dynid preprocess --robot crane_x7 build/twin-data/AG02_t1.csv
+$dynid twin bench --robot crane_x7 --seconds 3

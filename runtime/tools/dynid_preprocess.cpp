@@ -1,0 +1,77 @@
+// dynid preprocess: a log through the preprocessing at the paper's intervals (or chosen ones):
+// prints what was corrected, bridged, split and kept, and optionally writes the regression-
+// ready samples as CSV (time, q, qd, qdd, tau per joint) for inspection.
+#include <fmt/format.h>
+
+#include "dynid_common.hpp"
+#include "symoro/io/atomic_file.hpp"
+#include "symoro/io/log.hpp"
+#include "symoro/io/number_text.hpp"
+#include "symoro/preprocess/preprocess.hpp"
+
+namespace symoro::dynid {
+
+namespace {
+
+struct PreprocessOptions {
+  std::vector<std::string> logs;
+  std::vector<double> intervals_ms;
+  std::string out;
+  preprocess::Options options;
+};
+
+void write_samples(const std::filesystem::path& file, const preprocess::Samples& s) {
+  const int n = static_cast<int>(s.q.cols());
+  std::string text = "time";
+  for (const char* g : {"q", "qd", "qdd", "tau"})
+    for (int j = 1; j <= n; ++j) text += fmt::format(",{}{}", g, j);
+  text += "\n";
+  for (int k = 0; k < s.time.size(); ++k) {
+    io::append_number(text, s.time(k));
+    for (const Eigen::MatrixXd* m : {&s.q, &s.qd, &s.qdd, &s.tau})
+      for (int j = 0; j < n; ++j) {
+        text += ',';
+        io::append_number(text, (*m)(k, j));
+      }
+    text += '\n';
+  }
+  io::write_file_atomically(file, text);
+}
+
+void run(const Common& common, const PreprocessOptions& o) {
+  std::vector<double> intervals;
+  for (double ms : o.intervals_ms) intervals.push_back(ms / 1000);
+  if (intervals.empty()) intervals = preprocess::paper_intervals();
+  for (const auto& path : o.logs) {
+    const io::Log log = io::read_log(path);
+    if (!common.robot.empty() && log.meta.robot != common.robot)
+      throw UsageError(fmt::format("{} is a log of robot '{}', not '{}'", path, log.meta.robot, common.robot));
+    fmt::print("{}: {} samples, {:.1f} s, robot {}, trajectory {}\n", path, log.samples(),
+               log.time(log.samples() - 1) - log.time(0), log.meta.robot, log.meta.trajectory);
+    for (double interval : intervals) {
+      const auto s = preprocess::preprocess(log, interval, o.options);
+      fmt::print("  {:>3.0f} ms: {}\n", interval * 1000, s.report.summary());
+      if (!o.out.empty()) {
+        std::filesystem::create_directories(o.out);
+        const auto stem = std::filesystem::path(path).stem().string();
+        write_samples(std::filesystem::path(o.out) / fmt::format("{}_{:.0f}ms.csv", stem, interval * 1000), s);
+      }
+    }
+  }
+}
+
+}  // namespace
+
+void add_preprocess_commands(CLI::App& app, Common& common) {
+  auto o = std::make_shared<PreprocessOptions>();
+  auto* cmd = app.add_subcommand("preprocess", "Preprocess logs: time axis, zero-phase filter, derivatives, resampling");
+  cmd->add_option("logs", o->logs, "Log CSV files")->required()->check(CLI::ExistingFile);
+  cmd->add_option("--robot", common.robot, "Check that the logs are of this robot");
+  cmd->add_option("--interval", o->intervals_ms, "Target intervals in ms (default: 10 20 40 80)");
+  cmd->add_option("-o,--output", o->out, "Write <log>_<interval>ms.csv samples here");
+  cmd->add_option("--cutoff", o->options.derivative_cutoff, "Low-pass cutoff for the derivatives, Hz");
+  cmd->add_option("--max-gap", o->options.max_gap, "Longest gap bridged by interpolation, s");
+  cmd->callback([&common, o] { run(common, *o); });
+}
+
+}  // namespace symoro::dynid
