@@ -16,7 +16,7 @@ struct Options {
   double base_period = 0.001;  // s, the uniform grid of the corrected time axis
   // Gaps (dropped samples) up to this length are bridged by interpolation; longer gaps split
   // the log into separately processed pieces. Both are counted in the Report.
-  double max_gap = 0.02;  // s
+  double max_gap = 0.01;  // s (bridging error grows as gap^3: 0.08 rad/s^2 of qdd at 10 ms)
   int filter_order = 4;   // Butterworth order, applied forward and backward (zero phase)
   // One low-pass is applied to q and tau alike (so that the regressor and the torque see the
   // same filter): cutoff = min(derivative_cutoff, anti_alias_fraction * target Nyquist).
@@ -30,6 +30,11 @@ struct Report {
   int gaps_bridged = 0;       // gaps longer than 1.5 base periods and up to max_gap
   int missing_samples = 0;    // base-grid samples filled in across bridged gaps
   int pieces = 0;             // independent pieces after splitting at long gaps
+  double max_stamp_deviation = 0;  // s, largest distance of a stamp from its base-grid point
+  // Pieces shorter than the filter's edge padding cannot be filtered; they are left out and
+  // counted here (the log as a whole is rejected when no piece is long enough).
+  int dropped_pieces = 0;
+  int dropped_samples = 0;    // raw samples in the dropped pieces
   double cutoff = 0;          // Hz, the low-pass actually used
   int kept_samples = 0;       // target-grid samples returned
   std::string summary() const;  // one line for logs and reports
@@ -45,7 +50,11 @@ struct Samples {
 };
 
 // Throws DataError when the log cannot give samples at this interval (too short, interval
-// not a multiple of base_period).
+// not a multiple of base_period) or is inconsistent: time not strictly increasing, a value not
+// finite, q and tau of different shapes, stamps whose median interval is not base_period within
+// 10 %. The error names meta.trajectory (or "log") with line 0. Options outside their ranges
+// throw std::invalid_argument. Stages: preprocess/time_axis.hpp, butterworth.hpp,
+// zero_phase.hpp, derivatives.hpp, resample.hpp.
 Samples preprocess(const io::Log& log, double interval, const Options& options = {});
 
 // The paper's four intervals.
