@@ -88,13 +88,15 @@ void twin_run(const Common& common, const TwinOptions& o) {
   fmt::print("\n");
 }
 
-// A finished run is one whose sidecar (written last) names the same seed and trial.
-bool finished(const std::filesystem::path& csv, std::uint64_t seed, int trial) {
+// A finished run is one whose sidecar (written last) names the same seed, trial and twin
+// (configuration fingerprint and effects).
+bool finished(const std::filesystem::path& csv, std::uint64_t seed, int trial, const std::string& notes) {
   const auto meta = io::metadata_path(csv);
   if (!std::filesystem::exists(meta) || !std::filesystem::exists(csv)) return false;
   try {
     const YAML::Node m = YAML::LoadFile(meta.string());
-    return m["seed"].as<std::uint64_t>() == seed && m["trial"].as<int>() == trial;
+    return m["seed"].as<std::uint64_t>() == seed && m["trial"].as<int>() == trial &&
+           m["notes"].as<std::string>() == notes;
   } catch (const YAML::Exception&) {
     return false;
   }
@@ -115,12 +117,12 @@ void twin_dataset(const Common& common, const TwinOptions& o) {
   for (int t = 0; t < static_cast<int>(trajs.size()); ++t)
     for (int k = 1; k <= o.trials; ++k) {
       const auto file = std::filesystem::path(o.out) / run_file(names[t], k);
-      if (finished(file, twin::run_seed(o.seed, names[t], k), k)) ++skipped;
+      if (finished(file, twin::run_seed(o.seed, names[t], k), k, sim.notes())) ++skipped;
       else jobs.push_back({t, k});
     }
   // Longest runs first: better load balance across workers.
   std::stable_sort(jobs.begin(), jobs.end(), [&](const Job& a, const Job& b) { return trajs[a.traj].duration() > trajs[b.traj].duration(); });
-  if (skipped > 0) fmt::print(stderr, "{} runs already finished in {} (same seed): skipped\n", skipped, o.out);
+  if (skipped > 0) fmt::print(stderr, "{} runs already finished in {} (same seed and twin): skipped\n", skipped, o.out);
 
   const int workers = std::max(1, std::min<int>(o.jobs > 0 ? o.jobs : std::thread::hardware_concurrency(), jobs.size()));
   Progress progress(static_cast<int>(jobs.size()), "twin");

@@ -1,6 +1,9 @@
 #include "symoro/twin/config.hpp"
 
 #include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <fstream>
 #include <set>
 #include <stdexcept>
 
@@ -340,9 +343,23 @@ std::vector<std::string> Effects::enabled() const {
   return out;
 }
 
+// FNV-1a over the files' bytes: enough to tell two configurations apart in a log's notes.
+std::string fingerprint(const std::vector<std::filesystem::path>& files) {
+  std::uint64_t h = 1469598103934665603ull;
+  for (const auto& f : files) {
+    std::ifstream in(f, std::ios::binary);
+    for (char ch; in.get(ch);) h = (h ^ static_cast<unsigned char>(ch)) * 1099511628211ull;
+    h = (h ^ 0xff) * 1099511628211ull;
+  }
+  char text[17];
+  std::snprintf(text, sizeof text, "%016llx", static_cast<unsigned long long>(h));
+  return text;
+}
+
 TwinConfig read_twin_config(const std::filesystem::path& path, int joints, const std::filesystem::path& override_path) {
   TwinConfig c;
   c.path = path.string();
+  c.fingerprint = override_path.empty() ? fingerprint({path}) : fingerprint({path, override_path});
   Reader(path.string(), joints, false).apply(load(path), c);
   if (!override_path.empty()) Reader(override_path.string(), joints, true).apply(load(override_path), c);
   const double T = c.controller.period;

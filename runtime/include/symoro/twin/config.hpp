@@ -90,6 +90,7 @@ struct Effects {
 
 struct TwinConfig {
   std::string path;
+  std::string fingerprint;  // hash of the configuration files' bytes: logs record it
   UrdfChain chain;
   Eigen::VectorXd rotor_inertia, viscous;
   std::vector<Servo> servos;

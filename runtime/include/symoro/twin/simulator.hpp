@@ -62,6 +62,14 @@ class ClosedLoopTwin {
   }
 
   const TwinConfig& config() const { return c_; }
+
+  // What a log records about the twin that made it: the configuration file, its fingerprint
+  // and the effects switched on (a dataset reruns a run whose notes differ).
+  std::string notes() const {
+    std::string enabled;
+    for (const auto& s : c_.effects.enabled()) enabled += (enabled.empty() ? "" : ", ") + s;
+    return "digital twin (" + c_.path + ", config " + c_.fingerprint + "); effects: " + (enabled.empty() ? "none" : enabled);
+  }
   const Truth<Model>& truth() const { return truth_; }
 
   io::Log run(const trajectory::Trajectory& traj, const RunOptions& opt, RunStats* stats = nullptr) const {
@@ -131,9 +139,7 @@ class ClosedLoopTwin {
     log.meta.source = "twin";
     log.meta.sample_time = T;
     log.meta.joints = names_;
-    std::string enabled;
-    for (const auto& s : e.enabled()) enabled += (enabled.empty() ? "" : ", ") + s;
-    log.meta.notes = "digital twin (" + c_.path + "); effects: " + (enabled.empty() ? "none" : enabled);
+    log.meta.notes = notes();
     const int rows_max = K + 1;
     log.time.resize(rows_max);
     for (Eigen::MatrixXd* m : {&log.q, &log.qd, &log.tau, &log.q_ref, &log.qd_ref, &log.qdd_ref}) m->resize(rows_max, n);
