@@ -66,11 +66,14 @@ std::string describe(const twin::RunStats& s) {
                      s.max_error.maxCoeff() * 180 / 3.14159265358979323846, s.dropped, s.saturated);
 }
 
+trajectory::TrajectoryDesign read_design(const Common& common, const std::vector<JointInfo>& joints) {
+  return trajectory::TrajectoryDesign::read(common.robot_dir() / "trajectories.yaml", joints);
+}
+
 template <class Model>
 void twin_run(const Common& common, const TwinOptions& o) {
   const twin::ClosedLoopTwin<Model> sim(load_config<Model>(common, o));
-  const auto design = trajectory::TrajectoryDesign::read(common.robot_dir() / "trajectories.yaml", joint_list<Model>());
-  const auto traj = design.build(o.trajectory);
+  const auto traj = read_design(common, joint_list<Model>()).build(o.trajectory);
   twin::RunOptions ro;
   ro.robot = common.robot;
   ro.trial = o.trial;
@@ -105,7 +108,7 @@ bool finished(const std::filesystem::path& csv, std::uint64_t seed, int trial, c
 template <class Model>
 void twin_dataset(const Common& common, const TwinOptions& o) {
   const twin::ClosedLoopTwin<Model> sim(load_config<Model>(common, o));
-  const auto design = trajectory::TrajectoryDesign::read(common.robot_dir() / "trajectories.yaml", joint_list<Model>());
+  const auto design = read_design(common, joint_list<Model>());
   const std::vector<std::string> names = o.only.empty() ? design.names() : o.only;
   std::vector<trajectory::Trajectory> trajs;
   for (const auto& n : names) trajs.push_back(design.build(n));
@@ -182,8 +185,7 @@ void twin_dataset(const Common& common, const TwinOptions& o) {
 template <class Model>
 void twin_bench(const Common& common, const TwinOptions& o) {
   const twin::ClosedLoopTwin<Model> sim(load_config<Model>(common, o));
-  const auto design = trajectory::TrajectoryDesign::read(common.robot_dir() / "trajectories.yaml", joint_list<Model>());
-  const auto traj = design.build(o.trajectory);
+  const auto traj = read_design(common, joint_list<Model>()).build(o.trajectory);
   twin::RunOptions ro;
   ro.robot = common.robot;
   double best = 0, total_sim = 0, total_wall = 0;

@@ -2,17 +2,6 @@
 
 namespace symoro::twin {
 
-Eigen::Isometry3d mdh_transform(const FrameInfo& f, double q) {
-  const double theta = f.theta + (f.sigma == 0 ? q : 0.0);
-  const double r = f.r + (f.sigma == 1 ? q : 0.0);
-  const Eigen::Vector3d z = Eigen::Vector3d::UnitZ(), x = Eigen::Vector3d::UnitX();
-  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
-  T.rotate(Eigen::AngleAxisd(f.gamma, z)).translate(f.b * z);
-  T.rotate(Eigen::AngleAxisd(f.alpha, x)).translate(f.d * x);
-  T.rotate(Eigen::AngleAxisd(theta, z)).translate(r * z);
-  return T;
-}
-
 std::vector<Eigen::Isometry3d> mdh_poses(const std::vector<FrameInfo>& frames, const Eigen::VectorXd& q) {
   const int n = static_cast<int>(frames.size());
   std::vector<Eigen::Isometry3d> T(n);

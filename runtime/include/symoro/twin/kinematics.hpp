@@ -8,14 +8,11 @@
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 
+#include "symoro/mdh.hpp"
 #include "symoro/model_info.hpp"
 #include "symoro/twin/config.hpp"
 
 namespace symoro::twin {
-
-// ^{ant}T_j = Rot(z, gamma) Trans(z, b) Rot(x, alpha) Trans(x, d) Rot(z, theta) Trans(z, r),
-// with the joint variable added to theta (revolute) or r (prismatic).
-Eigen::Isometry3d mdh_transform(const FrameInfo& f, double q);
 
 // ^0T_j for every frame j = 1..n (index j - 1), following `ant`. q has one entry per movable
 // frame, in frame order.
