@@ -1,0 +1,60 @@
+// Closed-loop input error (CLIE) refinement (paper eq. clie) with Ceres:
+//   min_phi  sum_k | tau_m(t_k) - tau_s(t_k; phi) |^2
+// over the target-grid samples of one sampling interval. tau_s comes from the closed-loop
+// simulation (closed_loop.hpp) passed through the same zero-phase low-pass the measurement
+// went through in preprocessing, so both sides see the same filter; the Jacobian is the
+// simulation's forward sensitivities through that (linear) filter: exact, no finite
+// differences. Bounds: about +-bound_factor times each initial value, rotor inertias positive.
+// A trial point whose simulation diverges is rejected (Ceres shrinks its step); a starting
+// point that diverges ends the refinement with a clear report.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "symoro/identify/closed_loop.hpp"
+#include "symoro/preprocess/preprocess.hpp"
+
+namespace symoro::identify {
+
+struct ClieOptions {
+  int max_iterations = 30;
+  double function_tolerance = 1e-7;   // Ceres: relative change of the cost
+  double parameter_tolerance = 1e-8;
+  double gradient_tolerance = 1e-10;
+  double bound_factor = 100;          // bounds phi0_i -+ bound_factor |phi0_i|
+  double min_bound = 1e-4;            // bound half-width floor for phi0_i near 0 (in the parameter's unit)
+  double min_rotor_inertia = 1e-6;    // kg m^2: lower bound of IA parameters
+  bool filter = true;                 // the measurement's low-pass on tau_s (off: raw samples)
+  preprocess::Options preprocess;     // must be the options that produced the measured samples
+};
+
+struct ClieResult {
+  Eigen::VectorXd phi;
+  bool success = false;             // Ceres converged or hit max_iterations from a valid start
+  Divergence start_divergence;      // set when the starting point's simulation diverges
+  std::string termination;          // Ceres' termination type and message
+  double initial_cost = 0, final_cost = 0;  // 0.5 sum of squares, N^2 m^2
+  int iterations = 0;
+  int jacobian_evaluations = 0, residual_evaluations = 0, rejected_divergent = 0;
+  Eigen::VectorXd rms_initial, rms_final;  // per joint torque error at the samples, N m
+  std::vector<int> at_bound;        // parameters ending on a bound
+  double wall = 0;                  // s
+};
+
+// Defined in clie_model.hpp (templates over a generated Model):
+//
+// // The simulated torque at the samples' grid (filtered as the measurement when
+// // options.filter): rows match measured.time. Returns false on divergence (fills *why).
+// template <class Model>
+// bool simulated_samples(const ClosedLoopSimulator<Model>& sim, const preprocess::Samples& measured,
+//                        const Eigen::VectorXd& phi, const ClieOptions& options,
+//                        Eigen::MatrixXd& tau, Divergence* why);
+//
+// template <class Model>
+// ClieResult clie(const ClosedLoopSimulator<Model>& sim, const preprocess::Samples& measured,
+//                 const Eigen::VectorXd& phi0, const ClieOptions& options = {});
+
+}  // namespace symoro::identify

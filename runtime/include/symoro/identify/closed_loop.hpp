@@ -1,0 +1,58 @@
+// The closed-loop simulation CLIE fits through (paper Fig. clie_block): the identified model's
+// forward dynamics driven by the same fixed FF+PD controller, sample-and-hold and bus delay as
+// the experiment, with forward sensitivities d tau / d phi that are the exact derivatives of
+// the discrete simulation (no finite differences).
+//
+// Timing of cycle k (period T, sampling instant t_k = k T, no jitter): q is sampled, the
+// controller computes a command that takes effect at t_k + delay and is held until the next
+// one does. The torque recorded for cycle k is the command in effect at t_k (the previous
+// one), which is what a log row records (twin/simulator.hpp). Before t = 0 the first reference
+// is held for pre_roll seconds, starting from rest at it, as in the experiment.
+#pragma once
+
+#include <string>
+
+#include <Eigen/Core>
+
+#include "symoro/control/ffpd.hpp"
+#include "symoro/preprocess/channels.hpp"
+#include "symoro/trajectory/trajectory.hpp"
+#include "symoro/twin/config.hpp"
+
+namespace symoro::identify {
+
+struct ClosedLoopSetup {
+  control::FfpdGains gains;       // the experiment's controller (realization parameters, gains)
+  double delay = 0.0009;          // s from sampling to the command taking effect
+  double pre_roll = 0.5;          // s holding the first reference before t = 0
+  int substeps = 1;               // integration steps per hold interval
+  double divergence_error = 0.5;  // rad: a tracking error |q_ref - q| beyond it is divergence
+};
+
+// The controller and timing of a twin configuration (its controller section is the lab's).
+ClosedLoopSetup closed_loop_setup(const twin::TwinConfig& config, double pre_roll = 0.5);
+
+// Why a simulation stopped early.
+struct Divergence {
+  bool diverged = false;
+  double time = 0;      // s
+  int joint = -1;       // 0-based, -1 when not joint-specific
+  std::string reason;   // e.g. "tracking error 0.62 rad", "M not positive definite", "not finite"
+  std::string describe() const;  // one line for reports
+};
+
+// Defined in closed_loop_model.hpp (templates over a generated Model):
+//
+// template <class Model> class ClosedLoopSimulator {
+//  public:
+//   ClosedLoopSimulator(ClosedLoopSetup setup, const trajectory::Trajectory& reference);
+//   int cycles() const;            // K + 1 with K = round(duration / T)
+//   double period() const;
+//   // tau: cycles() x nq, row k = the torque recorded at cycle k. With dtau (not null):
+//   // cycles() x (nq * np), column j * np + i = d tau_j / d phi_i. Returns false (and fills
+//   // *why when given) when the simulation diverges; tau is then unusable.
+//   bool simulate(const Eigen::VectorXd& phi, preprocess::Channels& tau, preprocess::Channels* dtau,
+//                 Divergence* why) const;
+// };
+
+}  // namespace symoro::identify

@@ -1,0 +1,52 @@
+// M(q; phi) of a generated model seen through a small type-erased interface, so that the PD
+// audit and the SDP projection are compiled once for every robot. M is affine in phi:
+//   M(q; phi) = C(q) + sum_i phi_i L_i(q)     (the generated inertia_basis)
+// and its derivatives in q are exact (ceres::Jet through the generated inertia()).
+#pragma once
+
+#include <memory>
+#include <vector>
+
+#include <Eigen/Core>
+
+namespace symoro::identify {
+
+// The box of joint angles the all-pose audit covers (rad), one interval per joint.
+struct AuditDomain {
+  Eigen::VectorXd lower, upper;
+  int joints() const { return static_cast<int>(lower.size()); }
+};
+
+// The generated audit domain (JointInfo::audit_lower/audit_upper, robot.yaml).
+template <class Model>
+AuditDomain audit_domain() {
+  AuditDomain d;
+  d.lower.resize(Model::nq);
+  d.upper.resize(Model::nq);
+  for (int j = 0; j < Model::nq; ++j) {
+    d.lower(j) = Model::joints[j].audit_lower;
+    d.upper(j) = Model::joints[j].audit_upper;
+  }
+  return d;
+}
+
+class InertiaFunction {
+ public:
+  virtual ~InertiaFunction() = default;
+  virtual int joints() const = 0;
+  virtual int parameters() const = 0;
+  // M(q; phi), joints x joints.
+  virtual void inertia(const Eigen::VectorXd& q, const Eigen::VectorXd& phi, Eigen::MatrixXd& M) const = 0;
+  // C(q) and L_i(q), i = 0..parameters()-1 (resized by the call).
+  virtual void basis(const Eigen::VectorXd& q, Eigen::MatrixXd& constant,
+                     std::vector<Eigen::MatrixXd>& linear) const = 0;
+  // M(q; phi) and dM/dq_k for k = 0..joints()-1, exact (forward-mode Jets).
+  virtual void inertia_derivatives(const Eigen::VectorXd& q, const Eigen::VectorXd& phi, Eigen::MatrixXd& M,
+                                   std::vector<Eigen::MatrixXd>& dM_dq) const = 0;
+};
+
+// Defined in inertia_function_model.hpp (templates over a generated Model).
+template <class Model>
+std::unique_ptr<InertiaFunction> make_inertia_function();
+
+}  // namespace symoro::identify

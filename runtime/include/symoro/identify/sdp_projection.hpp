@@ -1,0 +1,70 @@
+// The PD-feasible projection (paper eqs. sdp_projection and sdp_rescue):
+//   min |phi - phi0|^2  s.t.  M(q_k; phi) >= eps I  for the poses q_k of a working set,
+// solved as a semidefinite program with CSDP (the distance through a Schur-complement block),
+// inside an exchange loop: the all-pose audit looks for poses where the solution still has
+// lambda_min below the margin, the worst of them join the working set, and the SDP is solved
+// again until the audit passes over the whole box.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "symoro/identify/inertia_function.hpp"
+#include "symoro/identify/pd_audit.hpp"
+
+namespace symoro::identify {
+
+struct ProjectionOptions {
+  double eps = 0.001;          // margin, in M's units (kg m^2)
+  // The audit's verdict accepts lambda_min >= eps - accept_slack; for eps = 0 (the post-CLIE
+  // rescue) the SDP itself uses rescue_floor so that the strict test lambda_min > 0 holds.
+  double accept_slack = 1e-9;
+  double rescue_floor = 1e-7;
+  int max_rounds = 30;         // exchange rounds
+  int poses_per_round = 4;     // worst distinct audit minima added per round
+  AuditOptions audit;          // the audit run after each solve
+  // Diagonal weights of the distance (empty: the paper's plain Euclidean norm).
+  Eigen::VectorXd weights;
+};
+
+struct ProjectionResult {
+  Eigen::VectorXd phi;
+  bool feasible = false;       // the final all-pose audit passed at the margin
+  double eps = 0;              // the margin asked for
+  double lambda_min = 0;       // from the final audit
+  Eigen::VectorXd worst_pose;
+  double distance = 0;         // |phi - phi0| (weighted when weights are given)
+  int rounds = 0;              // SDP solves
+  int poses = 0;               // working-set size at the end
+  std::string status;          // "ok", or CSDP's failure / why the loop stopped
+  double wall = 0;             // s
+};
+
+ProjectionResult project_pd(const InertiaFunction& m, const Eigen::VectorXd& phi0, const AuditDomain& domain,
+                            const ProjectionOptions& options = {});
+
+// The paper's conditional step (Algorithm 1, lines 4-15): audit phi0; when it is not PD,
+// project with the margins in ascending order and adopt the first one whose projection passes
+// the all-pose audit.
+struct ConditionalProjection {
+  AuditResult audit;            // of phi0
+  bool projected = false;       // false: phi0 was PD and is returned unchanged
+  bool feasible = false;        // phi is PD over the box
+  double eps = 0;               // the adopted margin (0 when not projected)
+  Eigen::VectorXd phi;          // the CLIE starting point
+  std::vector<ProjectionResult> attempts;  // one per margin tried
+};
+
+inline const std::vector<double>& paper_margins() {
+  static const std::vector<double> v{0.001, 0.002, 0.005, 0.01};
+  return v;
+}
+
+ConditionalProjection conditional_projection(const InertiaFunction& m, const Eigen::VectorXd& phi0,
+                                             const AuditDomain& domain,
+                                             const std::vector<double>& margins = paper_margins(),
+                                             const ProjectionOptions& options = {});
+
+}  // namespace symoro::identify
