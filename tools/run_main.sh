@@ -2,7 +2,10 @@
 # The main job, end to end on the bundled CRANE-X7 (no hardware): install what is missing,
 # build, check that generated/ matches a fresh compilation of robots/, install the package and
 # run the example application against it; then simulate the digital twin's whole dataset (the
-# 43 designed trajectories, one trial, seed 1; resumable) and preprocess one log.
+# 43 designed trajectories, one trial, seed 1; resumable) and run the whole identification
+# study on it (40 trajectories x 4 intervals: OLS, all-pose PD audit, conditional SDP, CLIE,
+# PCA selection, rescue, final audit, validation on V01-V03) with its report in
+# build/study/report/report.md. Both steps are resumable: a rerun skips what is finished.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash tools/install_deps.sh
@@ -21,3 +24,4 @@ $dynid trajectories --robot crane_x7
 $dynid twin dataset --robot crane_x7 -o build/twin-data --trials 1 --seed 1
 $dynid preprocess --robot crane_x7 build/twin-data/AG02_t1.csv
 $dynid twin bench --robot crane_x7 --seconds 3
+$dynid identify --robot crane_x7 --data build/twin-data -o build/study

@@ -26,6 +26,7 @@ int main(int argc, char** argv) {
   add_trajectory_commands(app, common);
   add_twin_commands(app, common);
   add_preprocess_commands(app, common);
+  add_identify_commands(app, common);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

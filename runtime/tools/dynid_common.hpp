@@ -61,5 +61,6 @@ class Progress {
 void add_twin_commands(CLI::App& app, Common& common);
 void add_trajectory_commands(CLI::App& app, Common& common);
 void add_preprocess_commands(CLI::App& app, Common& common);
+void add_identify_commands(CLI::App& app, Common& common);
 
 }  // namespace symoro::dynid

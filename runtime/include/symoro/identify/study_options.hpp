@@ -1,0 +1,45 @@
+// Every choice of the identification study, with the paper's values as defaults.
+#pragma once
+
+#include <filesystem>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "symoro/identify/clie.hpp"
+#include "symoro/identify/least_squares.hpp"
+#include "symoro/identify/pd_audit.hpp"
+#include "symoro/identify/sdp_projection.hpp"
+#include "symoro/identify/study_result.hpp"
+#include "symoro/preprocess/preprocess.hpp"
+
+namespace symoro::identify {
+
+struct StudyOptions {
+  std::filesystem::path data;   // dataset folder (dataset.yaml and its logs)
+  std::filesystem::path out;    // study folder: runs/ (one file per run) and the report
+  int trial = 1;                // which repetition of each trajectory
+  std::vector<std::string> trajectories;  // identification set (empty: every family but V)
+  std::vector<std::string> validation;    // held-out set (empty: family V)
+  std::string validation_family = "V";
+  std::vector<double> intervals = preprocess::paper_intervals();
+  int threads = 0;              // 0: every core
+  preprocess::Options preprocess;
+  LeastSquaresOptions least_squares;
+  AuditOptions audit;
+  ProjectionOptions projection;  // its eps is set per margin
+  std::vector<double> margins = paper_margins();
+  ClieOptions clie;             // its preprocess options are the study's
+  int pca_components = 5;
+  double variance_fraction = 0.9;
+  double validation_interval = 0;  // s; 0: the selected run's interval
+
+  // Progress: the number of runs and of those already finished, then each new run as it ends.
+  std::function<void(int total, int skipped)> on_start;
+  std::function<void(const RunRecord&)> on_run;
+
+  // The options a run's result depends on, as text for its fingerprint.
+  std::string describe() const;
+};
+
+}  // namespace symoro::identify

@@ -1,0 +1,118 @@
+#include "symoro/identify/run_record_io.hpp"
+
+#include <cstdint>
+
+#include <fmt/format.h>
+#include <yaml-cpp/yaml.h>
+
+#include "symoro/io/atomic_file.hpp"
+
+namespace symoro::identify {
+
+namespace {
+
+void put(YAML::Emitter& y, const char* key, const Eigen::VectorXd& v) {
+  y << YAML::Key << key << YAML::Value << YAML::Flow << YAML::BeginSeq;
+  for (Eigen::Index i = 0; i < v.size(); ++i) y << v(i);
+  y << YAML::EndSeq;
+}
+
+Eigen::VectorXd vec(const YAML::Node& n) {
+  Eigen::VectorXd v(static_cast<Eigen::Index>(n.size()));
+  for (std::size_t i = 0; i < n.size(); ++i) v(static_cast<Eigen::Index>(i)) = n[i].as<double>();
+  return v;
+}
+
+}  // namespace
+
+std::string fingerprint_of(const std::string& text) {
+  // FNV-1a, 64 bit: stable across runs and platforms (std::hash is not).
+  std::uint64_t h = 1469598103934665603ull;
+  for (unsigned char c : text) {
+    h ^= c;
+    h *= 1099511628211ull;
+  }
+  return fmt::format("{:016x}", h);
+}
+
+void save_run(const RunRecord& r, const std::string& fingerprint, const std::filesystem::path& file) {
+  YAML::Emitter y;
+  y.SetDoublePrecision(17);
+  y << YAML::BeginMap;
+  y << YAML::Key << "format" << YAML::Value << "symoro-identification-run 1";
+  y << YAML::Key << "fingerprint" << YAML::Value << fingerprint;
+  y << YAML::Key << "trajectory" << YAML::Value << r.trajectory;
+  y << YAML::Key << "interval" << YAML::Value << r.interval;
+  y << YAML::Key << "samples" << YAML::Value << r.samples;
+  y << YAML::Key << "kappa" << YAML::Value << r.kappa;
+  y << YAML::Key << "kappa_scaled" << YAML::Value << r.kappa_scaled;
+  put(y, "phi_ols", r.phi_ols);
+  put(y, "std_ols", r.std_ols);
+  y << YAML::Key << "residual_rms" << YAML::Value << r.residual_rms;
+  y << YAML::Key << "weighted" << YAML::Value << r.weighted;
+  y << YAML::Key << "ols_lambda_min" << YAML::Value << r.ols_lambda_min;
+  put(y, "ols_worst_pose", r.ols_worst_pose);
+  y << YAML::Key << "ols_pd" << YAML::Value << r.ols_pd;
+  y << YAML::Key << "route" << YAML::Value << r.route;
+  y << YAML::Key << "eps" << YAML::Value << r.eps;
+  y << YAML::Key << "sdp_feasible" << YAML::Value << r.sdp_feasible;
+  put(y, "phi_sdp", r.phi_sdp);
+  put(y, "phi_clie", r.phi_clie);
+  y << YAML::Key << "clie_success" << YAML::Value << r.clie_success;
+  y << YAML::Key << "clie_termination" << YAML::Value << r.clie_termination;
+  y << YAML::Key << "clie_cost_initial" << YAML::Value << r.clie_cost_initial;
+  y << YAML::Key << "clie_cost_final" << YAML::Value << r.clie_cost_final;
+  y << YAML::Key << "clie_iterations" << YAML::Value << r.clie_iterations;
+  put(y, "clie_rms", r.clie_rms);
+  y << YAML::Key << "clie_lambda_min" << YAML::Value << r.clie_lambda_min;
+  y << YAML::Key << "clie_pd" << YAML::Value << r.clie_pd;
+  y << YAML::Key << "t_ols" << YAML::Value << r.t_ols;
+  y << YAML::Key << "t_audit" << YAML::Value << r.t_audit;
+  y << YAML::Key << "t_sdp" << YAML::Value << r.t_sdp;
+  y << YAML::Key << "t_clie" << YAML::Value << r.t_clie;
+  y << YAML::EndMap;
+  io::write_file_atomically(file, std::string(y.c_str()) + "\n");
+}
+
+std::optional<RunRecord> load_run(const std::filesystem::path& file, const std::string& fingerprint) {
+  if (!std::filesystem::exists(file)) return std::nullopt;
+  try {
+    const YAML::Node n = YAML::LoadFile(file.string());
+    if (n["fingerprint"].as<std::string>() != fingerprint) return std::nullopt;
+    RunRecord r;
+    r.trajectory = n["trajectory"].as<std::string>();
+    r.interval = n["interval"].as<double>();
+    r.samples = n["samples"].as<int>();
+    r.kappa = n["kappa"].as<double>();
+    r.kappa_scaled = n["kappa_scaled"].as<double>();
+    r.phi_ols = vec(n["phi_ols"]);
+    r.std_ols = vec(n["std_ols"]);
+    r.residual_rms = n["residual_rms"].as<double>();
+    r.weighted = n["weighted"].as<bool>();
+    r.ols_lambda_min = n["ols_lambda_min"].as<double>();
+    r.ols_worst_pose = vec(n["ols_worst_pose"]);
+    r.ols_pd = n["ols_pd"].as<bool>();
+    r.route = n["route"].as<std::string>();
+    r.eps = n["eps"].as<double>();
+    r.sdp_feasible = n["sdp_feasible"].as<bool>();
+    r.phi_sdp = vec(n["phi_sdp"]);
+    r.phi_clie = vec(n["phi_clie"]);
+    r.clie_success = n["clie_success"].as<bool>();
+    r.clie_termination = n["clie_termination"].as<std::string>();
+    r.clie_cost_initial = n["clie_cost_initial"].as<double>();
+    r.clie_cost_final = n["clie_cost_final"].as<double>();
+    r.clie_iterations = n["clie_iterations"].as<int>();
+    r.clie_rms = vec(n["clie_rms"]);
+    r.clie_lambda_min = n["clie_lambda_min"].as<double>();
+    r.clie_pd = n["clie_pd"].as<bool>();
+    r.t_ols = n["t_ols"].as<double>();
+    r.t_audit = n["t_audit"].as<double>();
+    r.t_sdp = n["t_sdp"].as<double>();
+    r.t_clie = n["t_clie"].as<double>();
+    return r;
+  } catch (const YAML::Exception&) {
+    return std::nullopt;  // unreadable: the run is done again
+  }
+}
+
+}  // namespace symoro::identify

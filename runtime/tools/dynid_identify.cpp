@@ -1,0 +1,134 @@
+// dynid identify: the whole identification study on a dataset (paper Algorithm 1 over every
+// trajectory and interval, PCA selection, rescue, final audit, validation) and its report;
+// resumable: finished runs are kept in <out>/runs/ and skipped by a rerun.
+// dynid identify run: one trajectory at one interval, printed stage by stage (for inspection).
+#include <sys/resource.h>
+
+#include <fmt/format.h>
+
+#include "dynid_common.hpp"
+#include "symoro/identify/report.hpp"
+#include "symoro/identify/study.hpp"
+#include "symoro/robots_registry.hpp"
+#include "symoro/trajectory/design.hpp"
+#include "symoro/twin/config.hpp"
+#include "symoro/twin/truth.hpp"
+
+namespace symoro::dynid {
+
+namespace {
+
+struct IdentifyOptions {
+  std::string data, out;
+  std::vector<double> intervals_ms;
+  std::vector<std::string> only, validation;
+  int threads = 0, trial = 1;
+  bool weighted = false, no_report = false;
+  int clie_iterations = 30;
+  double validation_ms = 0;
+  // identify run
+  std::string trajectory = "AG02";
+  double interval_ms = 40;
+};
+
+template <class Full, class Model>
+identify::StudyResult study(const Common& common, const IdentifyOptions& o, bool quiet) {
+  identify::StudyOptions so;
+  so.data = o.data;
+  so.out = o.out;
+  so.trial = o.trial;
+  so.threads = o.threads;
+  so.trajectories = o.only;
+  so.validation = o.validation;
+  if (!o.intervals_ms.empty()) {
+    so.intervals.clear();
+    for (double ms : o.intervals_ms) so.intervals.push_back(ms / 1000);
+  }
+  so.least_squares.weighted = o.weighted;
+  so.clie.max_iterations = o.clie_iterations;
+  so.validation_interval = o.validation_ms / 1000;
+  auto progress = std::make_shared<std::unique_ptr<Progress>>();
+  so.on_start = [progress, quiet](int total, int skipped) {
+    if (skipped > 0) fmt::print(stderr, "{} of {} runs already finished (same inputs): skipped\n", skipped, total);
+    if (!quiet) *progress = std::make_unique<Progress>(total - skipped, "run");
+  };
+  so.on_run = [progress](const identify::RunRecord& r) {
+    if (*progress)
+      (*progress)->done(r.id(), fmt::format("kappa {:.1f} {} lambda_min(CLIE) {:+.2e} CLIE {:.1f} s", r.kappa, r.route,
+                                            r.clie_lambda_min, r.t_clie));
+  };
+  const auto joints = joint_list<Model>();
+  auto design = trajectory::TrajectoryDesign::read(common.robot_dir() / "trajectories.yaml", joints);
+  const auto twin_path = common.robot_dir() / "twin.yaml";
+  if (!std::filesystem::exists(twin_path))
+    throw UsageError(fmt::format("robot '{}' has no controller description ({} not found)", common.robot, twin_path.string()));
+  const twin::TwinConfig config = twin::read_twin_config(twin_path, Model::nq);
+  identify::Study<Model> s(so, std::move(design), identify::closed_loop_setup(config));
+  identify::StudyResult result = s.run();
+  // On twin data the truth is known: the full model's standard parameters mapped to the
+  // identified model's base parameters (products of inertia dropped for a reduced variant).
+  const identify::Dataset data = identify::read_dataset(o.data);
+  if (!data.twin.empty() && std::filesystem::exists(data.twin)) {
+    const twin::TwinConfig tc = twin::read_twin_config(data.twin, Model::nq);
+    const auto truth = twin::make_truth<Full>(tc);
+    result.truth = Model::base_from_standard(truth.standard);
+  }
+  return result;
+}
+
+template <class Full, class Model>
+void run_study(const Common& common, const IdentifyOptions& o) {
+  if (o.out.empty()) throw UsageError("--out is required");
+  const identify::StudyResult r = study<Full, Model>(common, o, false);
+  rusage usage{};
+  getrusage(RUSAGE_SELF, &usage);
+  fmt::print("{} runs, {} threads: {:.1f} s wall ({:.1f} s of run stages summed), peak memory {:.0f} MB\n",
+             r.runs.size(), r.threads, r.wall, r.wall_runs, usage.ru_maxrss / 1024.0);
+  if (r.selection.run >= 0) {
+    const auto& sel = r.runs[r.selection.run];
+    fmt::print("representative: {} ({}); {}; final audit lambda_min {:.3e} -> {}\n", sel.id(), r.selection.rule,
+               r.rescued ? "rescued (eps = 0)" : "PD without rescue", r.final_lambda_min,
+               r.accepted ? "accepted" : "NOT accepted");
+    for (const auto& v : r.validation)
+      fmt::print("validation {} at {:.0f} ms: RMSE {:.4f} / {:.4f} N m, MNE {:.4f} / {:.4f} (CLIE / rescue)\n",
+                 v.trajectory, v.interval * 1e3, v.rmse_clie, v.rmse_rescue, v.mne_clie, v.mne_rescue);
+  }
+  if (!o.no_report) {
+    const auto files = identify::write_report(r, std::filesystem::path(o.out) / "report");
+    fmt::print("report: {} ({} files)\n", (std::filesystem::path(o.out) / "report" / "report.md").string(), files.size());
+  }
+}
+
+template <class F>
+void dispatch(const Common& common, F&& f) {
+  if (!with_robot(common.robot, [&](auto entry) { f(entry); })) throw UsageError("unknown robot '" + common.robot + "'");
+}
+
+}  // namespace
+
+void add_identify_commands(CLI::App& app, Common& common) {
+  auto o = std::make_shared<IdentifyOptions>();
+  auto* cmd = app.add_subcommand("identify", "Identification study on a dataset: OLS, PD audit, SDP, CLIE, PCA "
+                                             "selection, rescue, validation, report");
+  cmd->add_option("--robot", common.robot, "Robot folder name under robots/")->required();
+  cmd->add_option("--robots-dir", common.robots_dir, "Where the robot folders are");
+  cmd->add_option("--data", o->data, "Dataset folder (dataset.yaml and logs)")->required()->check(CLI::ExistingDirectory);
+  cmd->add_option("-o,--out", o->out, "Study folder (runs/ and report/)")->required();
+  cmd->add_option("--interval", o->intervals_ms, "Sampling intervals in ms (default: 10 20 40 80)");
+  cmd->add_option("--only", o->only, "Identification trajectories (default: every family but V)")->delimiter(',');
+  cmd->add_option("--validation", o->validation, "Validation trajectories (default: family V)")->delimiter(',');
+  cmd->add_option("--trial", o->trial, "Which trial of each trajectory");
+  cmd->add_option("-j,--jobs", o->threads, "Worker threads (default: every core)");
+  cmd->add_flag("--wls", o->weighted, "Weighted least squares (per-joint weights) instead of OLS");
+  cmd->add_option("--clie-iterations", o->clie_iterations, "CLIE iteration limit");
+  cmd->add_option("--validation-interval", o->validation_ms, "Validation interval in ms (default: the selected run's)");
+  cmd->add_flag("--no-report", o->no_report, "Do not write the report");
+  cmd->callback([&common, o] {
+    dispatch(common, [&](auto entry) {
+      using E = decltype(entry);
+      run_study<typename E::FullModel, typename E::IdentifiedModel>(common, *o);
+    });
+  });
+}
+
+}  // namespace symoro::dynid
