@@ -43,6 +43,15 @@ class InertiaFunction {
   // M(q; phi) and dM/dq_k for k = 0..joints()-1, exact (forward-mode Jets).
   virtual void inertia_derivatives(const Eigen::VectorXd& q, const Eigen::VectorXd& phi, Eigen::MatrixXd& M,
                                    std::vector<Eigen::MatrixXd>& dM_dq) const = 0;
+  // The same plus d2M/dq_k dq_l at d2M_dq2[k * joints() + l], exact. Returns false when an
+  // implementation has no second derivatives (the PD audit then approximates its Hessian).
+  virtual bool inertia_second_derivatives(const Eigen::VectorXd& q, const Eigen::VectorXd& phi, Eigen::MatrixXd& M,
+                                          std::vector<Eigen::MatrixXd>& dM_dq,
+                                          std::vector<Eigen::MatrixXd>& d2M_dq2) const {
+    static_cast<void>(q), static_cast<void>(phi), static_cast<void>(M), static_cast<void>(dM_dq),
+        static_cast<void>(d2M_dq2);
+    return false;
+  }
 };
 
 // Defined in inertia_function_model.hpp (templates over a generated Model).
