@@ -1,7 +1,7 @@
 // dynid identify: the whole identification study on a dataset (paper Algorithm 1 over every
 // trajectory and interval, PCA selection, rescue, final audit, validation) and its report;
-// resumable: finished runs are kept in <out>/runs/ and skipped by a rerun.
-// dynid identify run: one trajectory at one interval, printed stage by stage (for inspection).
+// resumable: finished runs are kept in <out>/runs/ and skipped by a rerun. --only and
+// --interval narrow it to a few runs (e.g. --only AG02 --interval 40 to inspect one).
 #include <sys/resource.h>
 
 #include <fmt/format.h>
@@ -23,12 +23,9 @@ struct IdentifyOptions {
   std::vector<double> intervals_ms;
   std::vector<std::string> only, validation;
   int threads = 0, trial = 1;
-  bool weighted = false, no_report = false;
-  int clie_iterations = 30;
+  bool weighted = false, no_report = false, fresh = false;
+  int clie_iterations = 25;
   double validation_ms = 0;
-  // identify run
-  std::string trajectory = "AG02";
-  double interval_ms = 40;
 };
 
 template <class Full, class Model>
@@ -38,6 +35,7 @@ identify::StudyResult study(const Common& common, const IdentifyOptions& o, bool
   so.out = o.out;
   so.trial = o.trial;
   so.threads = o.threads;
+  so.fresh = o.fresh;
   so.trajectories = o.only;
   so.validation = o.validation;
   if (!o.intervals_ms.empty()) {
@@ -123,6 +121,7 @@ void add_identify_commands(CLI::App& app, Common& common) {
   cmd->add_option("--clie-iterations", o->clie_iterations, "CLIE iteration limit");
   cmd->add_option("--validation-interval", o->validation_ms, "Validation interval in ms (default: the selected run's)");
   cmd->add_flag("--no-report", o->no_report, "Do not write the report");
+  cmd->add_flag("--fresh", o->fresh, "Redo every run, even finished ones (to time the whole study)");
   cmd->callback([&common, o] {
     dispatch(common, [&](auto entry) {
       using E = decltype(entry);

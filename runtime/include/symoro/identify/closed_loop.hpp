@@ -27,6 +27,10 @@ struct ClosedLoopSetup {
   double pre_roll = 0.5;          // s holding the first reference before t = 0
   int substeps = 1;               // integration steps per hold interval
   double divergence_error = 0.5;  // rad: a tracking error |q_ref - q| beyond it is divergence
+  // Integration steps end at every sampling instant (the twin's split of a cycle into two
+  // holds) instead of spanning each hold with q(t_k) read inside the step
+  // (closed_loop_model.hpp): twice the work for no accuracy that matters.
+  bool split_at_sampling = false;
 };
 
 // The controller and timing of a twin configuration (its controller section is the lab's).
@@ -53,6 +57,8 @@ struct Divergence {
 //   // *why when given) when the simulation diverges; tau is then unusable.
 //   bool simulate(const Eigen::VectorXd& phi, preprocess::Channels& tau, preprocess::Channels* dtau,
 //                 Divergence* why) const;
+//   // The same, also giving the sampled q (cycles() x nq) when q is not null.
+//   bool simulate(..., Divergence* why, preprocess::Channels* q) const;
 // };
 
 }  // namespace symoro::identify

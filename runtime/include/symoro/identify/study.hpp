@@ -146,7 +146,7 @@ class Study {
       for (double h : o_.intervals) {
         Slot s{name, h, o_.out / "runs" / fmt::format("{}@{}ms.yaml", name, std::lround(h * 1e3)), {}, {}};
         s.fingerprint = fingerprint_of(run_inputs(run, h));
-        s.record = load_run(s.file, s.fingerprint);
+        if (!o_.fresh) s.record = load_run(s.file, s.fingerprint);
         slots.push_back(std::move(s));
       }
     }

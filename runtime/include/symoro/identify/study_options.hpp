@@ -36,7 +36,14 @@ struct StudyOptions {
     return p;
   }();
   std::vector<double> margins = paper_margins();
-  ClieOptions clie;             // its preprocess options are the study's
+  // Its preprocess options are the study's. Stopping rule of MATLAB's lsqnonlin (the paper's):
+  // relative cost change 1e-6; at most 25 steps.
+  ClieOptions clie = [] {
+    ClieOptions c;
+    c.function_tolerance = 1e-6;
+    c.max_iterations = 25;
+    return c;
+  }();
   int pca_components = 5;
   double variance_fraction = 0.9;
   double validation_interval = 0;  // s; 0: the selected run's interval
