@@ -7,6 +7,8 @@
 #include <fstream>
 #include <random>
 
+#include <unistd.h>
+
 #include <Eigen/Eigenvalues>
 #include <gtest/gtest.h>
 #include <yaml-cpp/yaml.h>
@@ -36,7 +38,8 @@ trajectory::TrajectoryDesign design() {
 // A dataset folder as dynid twin dataset writes it (logs and manifest), made once.
 const std::filesystem::path& dataset() {
   static const std::filesystem::path dir = [] {
-    const auto d = std::filesystem::temp_directory_path() / "symoro_study_test_data";
+    // Per process: ctest runs test programs in parallel.
+    const auto d = std::filesystem::temp_directory_path() / ("symoro_study_test_data_" + std::to_string(::getpid()));
     std::filesystem::remove_all(d);
     std::filesystem::create_directories(d);
     const twin::ClosedLoopTwin<Full> tw(twin::read_twin_config(kRobot + "/twin.yaml", Full::nq));
@@ -73,9 +76,14 @@ identify::ClosedLoopSetup setup() {
 }
 
 struct Fixture {
-  std::filesystem::path out = std::filesystem::temp_directory_path() / "symoro_study_test_out";
+  std::filesystem::path out =
+      std::filesystem::temp_directory_path() / ("symoro_study_test_out_" + std::to_string(::getpid()));
   identify::StudyResult first;
   int ran_first = 0;
+  ~Fixture() {
+    std::filesystem::remove_all(out);
+    std::filesystem::remove_all(dataset());
+  }
   Fixture() {
     std::filesystem::remove_all(out);
     auto o = options(out);
@@ -89,7 +97,7 @@ Fixture& fixture() {
   return f;
 }
 
-TEST(Study, RunsEveryTrajectoryAndInterval) {
+void runs_every_trajectory_and_interval() {
   const auto& r = fixture().first;
   ASSERT_EQ(r.runs.size(), kIdent.size() * 2);
   EXPECT_EQ(fixture().ran_first, 6);
@@ -106,7 +114,7 @@ TEST(Study, RunsEveryTrajectoryAndInterval) {
 }
 
 // A rerun finds every run finished: nothing is recomputed and the result is the same.
-TEST(Study, RerunSkipsFinishedRunsAndRedoesStaleOnes) {
+void rerun_skips_finished_runs_and_redoes_stale_ones() {
   auto& f = fixture();
   int ran = 0, skipped = -1;
   auto o = options(f.out);
@@ -137,7 +145,7 @@ TEST(Study, RerunSkipsFinishedRunsAndRedoesStaleOnes) {
 }
 
 // The accepted model is PD everywhere: an independent check by dense random sampling.
-TEST(Study, AcceptedModelIsPositiveDefiniteByBruteForce) {
+void accepted_model_is_positive_definite_by_brute_force() {
   const auto& r = fixture().first;
   ASSERT_TRUE(r.accepted);
   ASSERT_EQ(r.phi_rescue.size(), Model::np);
@@ -159,7 +167,7 @@ TEST(Study, AcceptedModelIsPositiveDefiniteByBruteForce) {
 // Validation: the accepted model's closed-loop torque error on held-out V02 against the floor
 // the twin itself sets (its truth simulated the same way: quantization, noise, the products of
 // inertia the reduced model lacks).
-TEST(Study, ValidationIsNearTheTwinsFloor) {
+void validation_is_near_the_twins_floor() {
   const auto& r = fixture().first;
   ASSERT_EQ(r.validation.size(), 1u);
   const auto& v = r.validation.front();
@@ -176,6 +184,26 @@ TEST(Study, ValidationIsNearTheTwinsFloor) {
   // And the metrics are what they say: recomputed from the stored series.
   const identify::TorqueError e = identify::torque_error(v.tau_measured, v.tau_rescue);
   EXPECT_NEAR(e.rmse, v.rmse_rescue, 1e-12);
+}
+
+// One test: the study runs once per process (it is the expensive part), the checks follow.
+TEST(Study, EndToEndOnTwinData) {
+  {
+    SCOPED_TRACE("runs every trajectory and interval");
+    runs_every_trajectory_and_interval();
+  }
+  {
+    SCOPED_TRACE("accepted model is PD by brute force");
+    accepted_model_is_positive_definite_by_brute_force();
+  }
+  {
+    SCOPED_TRACE("validation near the twin's floor");
+    validation_is_near_the_twins_floor();
+  }
+  {
+    SCOPED_TRACE("rerun skips finished runs, redoes stale ones");
+    rerun_skips_finished_runs_and_redoes_stale_ones();
+  }
 }
 
 }  // namespace
