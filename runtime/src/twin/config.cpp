@@ -211,7 +211,8 @@ class Reader {
 
   void effects(const YAML::Node& node, Effects& e) const {
     check_keys(node, "effects", {"coulomb", "stribeck", "torque_offset", "backlash", "payload",
-                                 "torque_constant_error", "sensor_noise", "timestamp_jitter", "dropped_samples"});
+                                 "torque_constant_error", "actuation_delay", "sensor_noise", "timestamp_jitter",
+                                 "dropped_samples"});
     auto section = [&](const char* name, const std::set<std::string>& keys, bool& enabled, auto&& body) {
       const YAML::Node s = node[name];
       if (!s.IsDefined()) {
@@ -246,6 +247,9 @@ class Reader {
     });
     section("torque_constant_error", {"scale"}, e.torque_constant_error, [&](const YAML::Node& s) {
       field(s, "scale", "torque_constant_error", [&](const YAML::Node& v) { e.torque_constant_scale = positive_per_joint(v, "torque constant scale", false); });
+    });
+    section("actuation_delay", {"delay"}, e.actuation_delay, [&](const YAML::Node& s) {
+      field(s, "delay", "actuation_delay", [&](const YAML::Node& v) { e.actuation_delay_time = positive(v, "actuation delay", true); });
     });
     section("sensor_noise", {"encoder", "current"}, e.sensor_noise, [&](const YAML::Node& s) {
       field(s, "encoder", "sensor_noise", [&](const YAML::Node& v) { e.encoder_noise = positive(v, "encoder noise", true); });
@@ -312,13 +316,14 @@ YAML::Node load(const std::filesystem::path& path) {
 
 const std::vector<std::string>& Effects::names() {
   static const std::vector<std::string> v{"coulomb", "stribeck", "torque_offset", "backlash", "payload",
-                                          "torque_constant_error", "sensor_noise", "timestamp_jitter", "dropped_samples"};
+                                          "torque_constant_error", "actuation_delay", "sensor_noise", "timestamp_jitter",
+                                          "dropped_samples"};
   return v;
 }
 
 void Effects::set(const std::string& name, bool on) {
   bool* flags[] = {&coulomb, &stribeck, &torque_offset, &backlash, &payload,
-                   &torque_constant_error, &sensor_noise, &timestamp_jitter, &dropped_samples};
+                   &torque_constant_error, &actuation_delay, &sensor_noise, &timestamp_jitter, &dropped_samples};
   const auto& n = names();
   for (size_t i = 0; i < n.size(); ++i)
     if (n[i] == name) {
@@ -336,7 +341,7 @@ void Effects::disable_all() {
 
 std::vector<std::string> Effects::enabled() const {
   const bool flags[] = {coulomb, stribeck, torque_offset, backlash, payload,
-                        torque_constant_error, sensor_noise, timestamp_jitter, dropped_samples};
+                        torque_constant_error, actuation_delay, sensor_noise, timestamp_jitter, dropped_samples};
   std::vector<std::string> out;
   for (size_t i = 0; i < names().size(); ++i)
     if (flags[i]) out.push_back(names()[i]);

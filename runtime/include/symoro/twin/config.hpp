@@ -71,6 +71,10 @@ struct Effects {
   Eigen::Vector3d payload_com = Eigen::Vector3d::Zero();
   bool torque_constant_error = false;
   Eigen::VectorXd torque_constant_scale;
+  // The torque lags the current the servo reports (and the controller assumes) by this time:
+  // an unmodelled latency of the current loop and driver, on every joint.
+  bool actuation_delay = false;
+  double actuation_delay_time = 0;  // s
   bool sensor_noise = false;
   double encoder_noise = 0;   // counts
   double current_noise = 0;   // A

@@ -8,7 +8,9 @@
 //              nominal torque constants, as on the real arm.
 //   t_k + d    after the bus round trip d (reading 8 encoders and writing 8 commands) the new
 //              current commands take effect and are held until the next ones (sample and
-//              hold adds about T/2, so the total delay is about d + T/2).
+//              hold adds about T/2, so the total delay is about d + T/2). With the
+//              actuation_delay effect the torque follows the command a further time later,
+//              while the servo keeps reporting the commanded current.
 // A dropped cycle (failed read) writes no row and the controller reuses its last measurement.
 // Before t = 0 the controller holds the first reference for a pre-roll (not logged), as the
 // real arm holds its start posture before a run.
@@ -18,6 +20,8 @@
 #include <chrono>
 #include <cmath>
 #include <cstdint>
+#include <deque>
+#include <utility>
 #include <string>
 #include <vector>
 
@@ -118,17 +122,40 @@ class ClosedLoopTwin {
     control::FfpdController ctrl(controller_gains(c_));
     Vec q_meas = encoder(plant.q());
     ctrl.reset(q_meas);
-    Vec current = Vec::Zero();
+    Vec current = Vec::Zero();  // what the servos report (and the controller commanded)
     bool sat = false;
+    // The current that makes torque: `current` itself, or with the actuation delay, the
+    // commands in the order they went out, each taking effect `lag` after it.
+    const double lag = e.actuation_delay ? e.actuation_delay_time : 0.0;
+    Vec applied = Vec::Zero();
+    std::deque<std::pair<double, Vec>> pending;
+    double clock = -static_cast<double>(std::llround(opt.pre_roll / T)) * T;  // the pre-roll starts there
+    auto drive = [&](double dt) {
+      const double end = clock + dt;
+      while (!pending.empty() && pending.front().first < end) {
+        if (pending.front().first > clock) {
+          plant.advance(pending.front().first - clock, kt_true.cwiseProduct(applied));
+          clock = pending.front().first;
+        }
+        applied = pending.front().second;
+        pending.pop_front();
+      }
+      if (end > clock) plant.advance(end - clock, kt_true.cwiseProduct(applied));
+      clock = end;
+    };
+    auto command = [&](const Vec& c) {
+      current = c;
+      pending.emplace_back(clock + lag, c);
+    };
 
     // Pre-roll: hold the first reference so the run starts from the held posture.
     const int pre = static_cast<int>(std::llround(opt.pre_roll / T));
     for (int k = 0; k < pre; ++k) {
       q_meas = encoder(plant.q());
       const Vec u_cmd = current_command(ctrl.update(q_meas, qr, qdr, qddr), sat);
-      plant.advance(d, kt_true.cwiseProduct(current));
-      current = u_cmd;
-      plant.advance(T - d, kt_true.cwiseProduct(current));
+      drive(d);
+      command(u_cmd);
+      drive(T - d);
     }
 
     io::Log log;
@@ -156,7 +183,7 @@ class ClosedLoopTwin {
       if (e.timestamp_jitter && k > 0)
         t_k += std::clamp(e.jitter_std * rng.normal(), -e.jitter_max, e.jitter_max);
       t_k = std::max(t_k, t_start_next);
-      plant.advance(t_k - t_now, kt_true.cwiseProduct(current));
+      drive(t_k - t_now);
       t_now = t_k;
 
       traj.evaluate(k * T, qr, qdr, qddr);
@@ -164,7 +191,7 @@ class ClosedLoopTwin {
       const Vec err = Vec(qr) - q_true;
       st.max_error = st.max_error.cwiseMax(err.cwiseAbs());
       st.rms_error += err.cwiseAbs2();
-      st.max_torque = st.max_torque.cwiseMax(kt_true.cwiseProduct(current).cwiseAbs());
+      st.max_torque = st.max_torque.cwiseMax(kt_true.cwiseProduct(applied).cwiseAbs());
 
       bool dropped = false;
       if (e.dropped_samples && k > 0 && k < K) {
@@ -198,9 +225,9 @@ class ClosedLoopTwin {
         log.qdd_ref.row(rows) = qddr.transpose();
         ++rows;
       }
-      plant.advance(d, kt_true.cwiseProduct(current));
+      drive(d);
       t_now = t_k + d;
-      current = cmd;
+      command(cmd);
       t_start_next = t_now + 1e-6;
     }
     log.time.conservativeResize(rows);
