@@ -27,6 +27,7 @@ int main(int argc, char** argv) {
   add_twin_commands(app, common);
   add_preprocess_commands(app, common);
   add_identify_commands(app, common);
+  add_diagnose_commands(app, common);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

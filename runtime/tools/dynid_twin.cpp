@@ -37,7 +37,7 @@ void add_config_options(CLI::App* cmd, Common& common, TwinOptions& o) {
   cmd->add_option("--config", o.config, "A YAML file overriding parts of robots/<robot>/twin.yaml")->check(CLI::ExistingFile);
   cmd->add_flag("--ideal", o.ideal, "Turn every effect off (quantization and delay remain)");
   cmd->add_option("--effects", o.effects, "Turn these effects on (coulomb, stribeck, torque_offset, backlash, payload, "
-                                           "torque_constant_error, sensor_noise, timestamp_jitter, dropped_samples)")
+                                           "torque_constant_error, actuation_delay, sensor_noise, timestamp_jitter, dropped_samples)")
       ->delimiter(',');
   cmd->add_option("--without", o.without, "Turn these effects off")->delimiter(',');
 }

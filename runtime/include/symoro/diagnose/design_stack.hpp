@@ -1,0 +1,49 @@
+// The data a model-gap diagnosis works on: the samples of several trajectories stacked one
+// after the other, the identified model's regressor and fixed torque at every sample, the
+// columns of the robot's full OpenSYMORO model that the identified model leaves out (products
+// of inertia), and the candidate effects' own columns. Rows of the regressors are sample s,
+// joint j -> s * joints + j, as in identify/regression.hpp. Built by stack_builder.hpp.
+#pragma once
+
+#include <map>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+
+namespace symoro::diagnose {
+
+struct DesignStack {
+  int joints = 0;
+  std::vector<std::string> joint_names;
+  double interval = 0;                  // s, the grid of every trajectory
+  Eigen::MatrixXd q, qd, qdd, tau;      // samples x joints
+  Eigen::VectorXd time;                 // s, within its trajectory
+  std::vector<int> segment;             // per sample: a contiguous piece (trajectory x log piece)
+  std::vector<std::string> segment_trajectory;  // per segment
+  Eigen::MatrixXd W;                    // identified model, (samples * joints) x np
+  Eigen::VectorXd tau0;                 // its fixed parameters' torque, same rows
+  std::vector<std::string> parameters;  // identified parameter names
+  Eigen::VectorXd rotor_inertia_index;  // per joint: index of IA<j> in `parameters`, -1 if none
+  Eigen::VectorXd viscous_index;        // per joint: index of FV<j>, -1 if none
+  // Full-model columns that are not identified parameters (name, family, joint).
+  Eigen::MatrixXd full_extra;
+  std::vector<std::string> full_extra_names, full_extra_families;
+  std::vector<int> full_extra_joints;
+  // Candidate effects' columns computed before the low-pass (effects.hpp: key -> samples x
+  // parameters, the values on the candidate's joint).
+  std::map<std::string, Eigen::MatrixXd> effect_terms;
+
+  int samples() const { return static_cast<int>(q.rows()); }
+  Eigen::Index rows() const { return static_cast<Eigen::Index>(samples()) * joints; }
+  // y = tau - tau0, stacked.
+  Eigen::VectorXd target() const;
+  // The stacked rows of a samples x joints matrix.
+  Eigen::VectorXd stacked(const Eigen::MatrixXd& per_sample) const;
+  // d/dt of a samples x joints signal along each segment (central differences, one-sided at
+  // the ends of a segment).
+  Eigen::MatrixXd rate(const Eigen::MatrixXd& per_sample) const;
+};
+
+}  // namespace symoro::diagnose

@@ -1,0 +1,44 @@
+// A whole model-gap diagnosis on two stacks (fitting trajectories and held-out ones): the
+// stepwise selection of missing effects (selection.hpp), where the residual is before and
+// after them (localize.hpp), a report with figures, and the robot.yaml variant that compiles
+// the selected effects into the model (codegen: variant `effects:`).
+#pragma once
+
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "symoro/diagnose/design_stack.hpp"
+#include "symoro/diagnose/localize.hpp"
+#include "symoro/diagnose/selection.hpp"
+
+namespace symoro::diagnose {
+
+struct DiagnosisOptions {
+  SelectionOptions selection;
+  LocalizeOptions localize;
+};
+
+struct Diagnosis {
+  std::string robot, model;                 // e.g. "crane_x7", "crane_x7::reduced"
+  std::vector<std::string> train, heldout;  // trajectory names
+  double interval = 0, cutoff = 0;          // s, Hz
+  Selection selection;
+  std::vector<ResidualSeries> before_series, after_series;  // held out
+  Localization before, after;
+};
+
+// The stack's segments as residual series, with the stacked model torque.
+std::vector<ResidualSeries> residual_series(const DesignStack& d, const Eigen::VectorXd& tau_model);
+
+Diagnosis diagnose(const DesignStack& train, const DesignStack& heldout, const DiagnosisOptions& options = {});
+
+// <dir>/diagnosis.md and <dir>/figures/*.svg; returns the files written.
+std::vector<std::filesystem::path> write_diagnosis_report(const Diagnosis& d, const std::filesystem::path& dir);
+
+// The robot.yaml variant (text, indented for `variants:`) that adds the selected effects the
+// compiler knows to `base`; empty when there are none. Effects it cannot compile (delay,
+// torque constant, backlash) are listed in comments with what to do instead.
+std::string variant_yaml(const Diagnosis& d, const std::string& name, const std::string& base);
+
+}  // namespace symoro::diagnose

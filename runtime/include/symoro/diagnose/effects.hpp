@@ -1,0 +1,112 @@
+// The library of candidate effects a model may be missing. Each candidate is a named term with
+// physical units, acting on one joint (or one link, or the whole robot), and linear in its own
+// parameters given the data: its regressor columns are added to the identified model's
+// regressor, so that "is it there, and how large" is a nested least-squares question.
+//
+//   effect             parameters (unit)               torque on joint j
+//   coulomb            FS<j> (N m), vc fixed            FS tanh(qd/vc)   (OpenSYMORO's FS sign(qd)
+//                                                       as vc -> 0; the zero-phase filter smooths
+//                                                       the step, so a few widths are tried)
+//   stribeck           FST<j> (N m), vs fixed           FST sign(qd) exp(-(qd/vs)^2)
+//   offset             OFF<j> (N m)                     OFF
+//   viscous_asymmetry  FVA<j> (N m s/rad)               FVA |qd|   (FV + FVA forward, FV - FVA back)
+//   position_harmonics HS<j>_k, HC<j>_k (N m)           HS sin(k q) + HC cos(k q), k = 1, 2
+//   inertia_products   the full model's XY/XZ/YZ of link j (kg m^2), columns from its regressor
+//   torque_constant    KTE<j> (1)                       tau_meas = tau / (1 + KTE): column -tau_model
+//   actuation_delay    DELAY (s), all joints            tau_meas(t) = tau(t + DELAY): column d tau_model/dt
+//   backlash           BL<j> (rad, total play)          the rotor leads the link by BL/2 sign(mesh
+//                                                       torque): column (IA d2s/dt2 + FV ds/dt) / 2
+// The last three are linearizations about the current fit (their columns use its torque), so
+// the selection re-evaluates them after every step. The names of the first five match the
+// compiler's variant effects (robot.yaml `effects:`), so a selected effect can be compiled in.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "symoro/diagnose/design_stack.hpp"
+
+namespace symoro::diagnose {
+
+enum class EffectKind {
+  Coulomb,
+  Stribeck,
+  Offset,
+  ViscousAsymmetry,
+  PositionHarmonics,
+  InertiaProducts,
+  TorqueConstant,
+  ActuationDelay,
+  Backlash,
+};
+
+struct EffectInfo {
+  EffectKind kind;
+  const char* name;         // robot.yaml / report key, e.g. "coulomb"
+  const char* title;        // "Coulomb friction"
+  const char* unit;         // of its magnitude
+  bool per_joint;           // else per link (inertia_products) or whole robot (actuation_delay)
+  bool compilable;          // the compiler can add it to a variant
+};
+
+const std::vector<EffectInfo>& effect_catalogue();
+const EffectInfo& effect_info(EffectKind kind);
+// By name; throws std::invalid_argument listing the known names.
+EffectKind effect_kind(const std::string& name);
+
+struct Candidate {
+  EffectKind kind = EffectKind::Offset;
+  int joint = 0;                    // 1-based joint or link; 0 for the whole robot
+  double stribeck_velocity = 0.05;  // rad/s
+  double coulomb_velocity = 0.01;   // rad/s, tanh width
+  std::vector<int> orders;          // position_harmonics
+  std::vector<int> full_columns;    // inertia_products: columns of DesignStack::full_extra
+  std::vector<std::string> parameters, units;
+  std::string label() const;        // "coulomb friction, joint 2 (shoulder_tilt)" style
+  std::string key() const;          // "coulomb:2", unique per candidate
+};
+
+struct CandidateOptions {
+  std::vector<double> coulomb_velocities{0.01, 0.03, 0.1};   // rad/s, one candidate each
+  std::vector<double> stribeck_velocities{0.02, 0.05, 0.1};  // rad/s, one candidate each
+  std::vector<int> harmonic_orders{1, 2};
+  std::vector<std::string> only;  // effect names to consider (empty: all)
+};
+
+// Every candidate the data and the identified model allow: not one the model already has
+// (a parameter of the same name), inertia products only for links whose full-model columns
+// exist in the stack, torque-constant and backlash only where IA and FV are identified.
+std::vector<Candidate> candidates(const DesignStack& d, const CandidateOptions& options = {});
+
+// What a linearized candidate needs from the current fit.
+struct FitState {
+  Eigen::VectorXd tau_model;  // stacked model torque (W phi + tau0 + selected effects)
+  Eigen::VectorXd phi;        // identified parameters (for IA, FV)
+};
+
+// Whether a candidate's columns depend on the samples alone (then they are computed at the
+// log's rate, before the low-pass, by stack_builder.hpp) rather than on the current fit.
+bool sample_local(EffectKind kind);
+// A sample-local candidate's terms at one sample of its joint (one value per parameter).
+void effect_terms(const Candidate& c, double q, double qd, double* out);
+
+// The candidate's columns, (samples * joints) x parameters: the precomputed terms of the
+// stack when it has them, else evaluated on the stack's samples.
+Eigen::MatrixXd effect_columns(const Candidate& c, const DesignStack& d, const FitState& fit);
+
+// False when fitted parameters contradict the effect's physics (negative Coulomb or Stribeck
+// level, negative play): such a fit is absorbing some other misfit and is not an effect.
+bool physical(const Candidate& c, const Eigen::VectorXd& theta);
+
+// The candidate's magnitude from its fitted parameters, in its unit (e.g. the amplitude of
+// each harmonic; the play for backlash), with a text like "0.081 N m".
+struct Magnitude {
+  std::vector<double> values;
+  std::vector<std::string> names;
+  std::string text;
+};
+Magnitude magnitude(const Candidate& c, const Eigen::VectorXd& theta, const Eigen::VectorXd& sd);
+
+}  // namespace symoro::diagnose

@@ -1,0 +1,210 @@
+#include "symoro/diagnose/diagnosis.hpp"
+
+#include <algorithm>
+#include <map>
+#include <set>
+
+#include <fmt/format.h>
+
+#include "symoro/diagnose/localize_report.hpp"
+#include "symoro/identify/svg_plot.hpp"
+#include "symoro/io/atomic_file.hpp"
+
+namespace symoro::diagnose {
+
+std::vector<ResidualSeries> residual_series(const DesignStack& d, const Eigen::VectorXd& tau_model) {
+  std::vector<ResidualSeries> out;
+  const int n = d.joints, S = d.samples();
+  for (int a = 0; a < S;) {
+    int b = a + 1;
+    while (b < S && d.segment[b] == d.segment[a]) ++b;
+    ResidualSeries r;
+    r.name = d.segment_trajectory[static_cast<std::size_t>(d.segment[a])];
+    r.interval = d.interval;
+    r.time = d.time.segment(a, b - a);
+    r.q = d.q.middleRows(a, b - a);
+    r.qd = d.qd.middleRows(a, b - a);
+    r.qdd = d.qdd.middleRows(a, b - a);
+    r.tau_measured = d.tau.middleRows(a, b - a);
+    r.tau_model.resize(b - a, n);
+    for (int s = a; s < b; ++s) r.tau_model.row(s - a) = tau_model.segment(static_cast<Eigen::Index>(s) * n, n).transpose();
+    out.push_back(std::move(r));
+    a = b;
+  }
+  return out;
+}
+
+Diagnosis diagnose(const DesignStack& train, const DesignStack& heldout, const DiagnosisOptions& o) {
+  Diagnosis d;
+  d.interval = train.interval;
+  std::set<std::string> seen;
+  for (const auto& t : train.segment_trajectory)
+    if (seen.insert("t" + t).second) d.train.push_back(t);
+  for (const auto& t : heldout.segment_trajectory)
+    if (seen.insert("h" + t).second) d.heldout.push_back(t);
+  d.selection = select_effects(train, heldout, o.selection);
+  d.before_series = residual_series(heldout, d.selection.before.heldout_tau);
+  d.after_series = residual_series(heldout, d.selection.after.heldout_tau);
+  d.before = localize(d.before_series, heldout.joint_names, o.localize);
+  d.after = localize(d.after_series, heldout.joint_names, o.localize);
+  return d;
+}
+
+namespace {
+
+std::string rmse_figure(const Diagnosis& d, const std::vector<std::string>& joints) {
+  namespace svg = identify::svg;
+  svg::Figure f;
+  f.title = "Held-out torque residual per joint (rms), before and after the selected effects";
+  svg::Panel p;
+  p.x_label = "joint";
+  p.y_label = "rms residual (N m)";
+  for (std::size_t j = 0; j < joints.size(); ++j) p.categories.push_back(std::to_string(j + 1));
+  svg::Series b{"model as identified (refitted)", {}, {}, {}}, a{"with the selected effects", {}, {}, {}};
+  b.style.colour = "#d62728";
+  a.style.colour = "#2ca02c";
+  for (Eigen::Index j = 0; j < d.selection.before.heldout_rmse.size(); ++j) {
+    b.y.push_back(d.selection.before.heldout_rmse(j));
+    a.y.push_back(d.selection.after.heldout_rmse(j));
+  }
+  p.bars = {b, a};
+  f.panels.push_back(p);
+  f.panel_width = 640;
+  return svg::render(f);
+}
+
+std::string flags(const CandidateTest& t) {
+  if (t.absorbed) return "absorbed";
+  std::string s;
+  s += t.significant ? "significant" : "not significant";
+  if (!t.physical) s += ", non-physical";
+  else if (t.heldout_gain < 0) s += ", worse held out";
+  return s;
+}
+
+}  // namespace
+
+std::vector<std::filesystem::path> write_diagnosis_report(const Diagnosis& d, const std::filesystem::path& dir) {
+  std::filesystem::create_directories(dir / "figures");
+  std::vector<std::filesystem::path> written;
+  const Selection& s = d.selection;
+  std::string m = "# Model-gap diagnosis\n\n";
+  auto join = [](const std::vector<std::string>& v) {
+    std::string out;
+    for (const auto& x : v) out += (out.empty() ? "" : ", ") + x;
+    return out;
+  };
+  m += fmt::format("Robot `{}`, model `{}`. Fitted on {}; judged on the held-out {}. Grid {:g} ms, every column and "
+                   "the torque through the same {:g} Hz zero-phase low-pass (parallel filtering).\n\n",
+                   d.robot, d.model, join(d.train), join(d.heldout), d.interval * 1000, d.cutoff);
+  m += "## Effects found\n\n";
+  if (s.effects.empty()) {
+    m += "None: no candidate effect is significant and improves the held-out trajectories (" + s.stop_reason + ").\n\n";
+  } else {
+    m += "| # | effect | parameters | magnitude | F | p | held-out gain |\n|---|---|---|---|---|---|---|\n";
+    for (std::size_t i = 0; i < s.effects.size(); ++i) {
+      const auto& e = s.effects[i];
+      m += fmt::format("| {} | {} | {} | {} | {:.1f} | {:.1e} | {:.1f} % |\n", i + 1, e.candidate.label(),
+                       join(e.candidate.parameters), e.magnitude.text, e.f, e.p_value, 100 * e.heldout_gain);
+    }
+    m += "\nStopped: " + s.stop_reason + ".\n\n";
+  }
+  m += "## The gap before and after (held-out trajectories)\n\n";
+  m += "| joint | rms before (N m) | rms after (N m) | change |\n|---|---|---|---|\n";
+  for (Eigen::Index j = 0; j < s.before.heldout_rmse.size(); ++j) {
+    const double b = s.before.heldout_rmse(j), a = s.after.heldout_rmse(j);
+    m += fmt::format("| {} {} | {:.4f} | {:.4f} | {:+.1f} % |\n", j + 1, d.before.joints.size() > static_cast<std::size_t>(j) ? d.before.joints[j].name : "", b, a,
+                     b > 0 ? 100 * (a / b - 1) : 0.0);
+  }
+  m += fmt::format("| all | {:.4f} | {:.4f} | {:+.1f} % |\n\n", s.before.heldout_total, s.after.heldout_total,
+                   s.before.heldout_total > 0 ? 100 * (s.after.heldout_total / s.before.heldout_total - 1) : 0.0);
+  io::write_file_atomically(dir / "figures" / "heldout_rmse.svg", rmse_figure(d, {}));
+  written.push_back(dir / "figures" / "heldout_rmse.svg");
+  m += "![held-out rms per joint](figures/heldout_rmse.svg)\n\n";
+  m += "## Stepwise selection\n\n";
+  m += fmt::format("Weights per joint (1/N m): {}. Each step refits the model with each candidate; F uses an effective "
+                   "sample size (N / autocorrelation time), the level is Bonferroni-corrected, and a candidate must also "
+                   "lower the held-out residual of its joints by at least {:.0f} % with at least {:g} N m of torque.\n\n",
+                   [&] {
+                     std::string w;
+                     for (Eigen::Index j = 0; j < s.weights.size(); ++j) w += fmt::format("{}{:.3g}", j ? ", " : "", s.weights(j));
+                     return w;
+                   }(),
+                   100 * 0.02, 0.003);
+  for (std::size_t i = 0; i < s.steps.size(); ++i) {
+    const auto& st = s.steps[i];
+    m += fmt::format("Step {}: autocorrelation time {:.1f} samples, level {:.1e}; {}.\n\n", i + 1, st.autocorrelation_time,
+                     st.level, st.chosen.empty() ? "nothing taken" : "took `" + st.chosen + "`");
+    m += "| candidate | F | p | held-out gain | effect rms (N m) | verdict |\n|---|---|---|---|---|---|\n";
+    for (std::size_t k = 0; k < std::min<std::size_t>(6, st.tests.size()); ++k) {
+      const auto& t = st.tests[k];
+      m += fmt::format("| {} | {:.1f} | {:.1e} | {:.2f} % | {:.4f} | {} |\n", t.label, t.f, t.p_value, 100 * t.heldout_gain,
+                       t.effect_rms, flags(t));
+    }
+    m += "\n";
+  }
+  const auto before_figs = write_localization_figures(d.before_series, d.before, dir / "figures", "before");
+  std::vector<std::string> before_links, after_links;
+  for (const auto& f : before_figs) before_links.push_back("figures/" + f), written.push_back(dir / "figures" / f);
+  m += localization_markdown(d.before, before_links, "Where the residual is, before", 2);
+  if (!s.effects.empty()) {
+    const auto after_figs = write_localization_figures(d.after_series, d.after, dir / "figures", "after");
+    for (const auto& f : after_figs) after_links.push_back("figures/" + f), written.push_back(dir / "figures" / f);
+    m += localization_markdown(d.after, after_links, "Where the residual is, after", 2);
+  }
+  io::write_file_atomically(dir / "diagnosis.md", m);
+  written.push_back(dir / "diagnosis.md");
+  return written;
+}
+
+std::string variant_yaml(const Diagnosis& d, const std::string& name, const std::string& base) {
+  std::map<std::string, std::vector<int>> joints;
+  std::string stribeck, harmonics, notes;
+  for (const auto& e : d.selection.effects) {
+    const Candidate& c = e.candidate;
+    switch (c.kind) {
+      case EffectKind::Coulomb: joints["coulomb"].push_back(c.joint); break;
+      case EffectKind::Offset: joints["offset"].push_back(c.joint); break;
+      case EffectKind::ViscousAsymmetry: joints["viscous_asymmetry"].push_back(c.joint); break;
+      case EffectKind::InertiaProducts: joints["inertia_products"].push_back(c.joint); break;
+      case EffectKind::Stribeck:
+        stribeck += fmt::format("      stribeck: {{joints: [{}], velocity: {:g}}}\n", c.joint, c.stribeck_velocity);
+        break;
+      case EffectKind::PositionHarmonics: {
+        std::string orders;
+        for (int k : c.orders) orders += (orders.empty() ? "" : ", ") + std::to_string(k);
+        harmonics += fmt::format("      position_harmonics: {{joints: [{}], orders: [{}]}}\n", c.joint, orders);
+        break;
+      }
+      case EffectKind::ActuationDelay:
+        notes += "    # actuation delay " + e.magnitude.text +
+                 ": not a model term; shift the logged torque by it in preprocessing and add it to the closed-loop delay\n";
+        break;
+      case EffectKind::TorqueConstant:
+        notes += fmt::format("    # torque-constant error on joint {} ({}): calibrate the servo's torque constant\n", c.joint,
+                             e.magnitude.text);
+        break;
+      case EffectKind::Backlash:
+        notes += fmt::format("    # backlash on joint {} ({}): not a rigid-body term; leave out samples at mesh-torque reversals\n",
+                             c.joint, e.magnitude.text);
+        break;
+    }
+  }
+  std::string effects;
+  for (auto& [key, js] : joints) {
+    std::sort(js.begin(), js.end());
+    std::string list;
+    for (int j : js) list += (list.empty() ? "" : ", ") + std::to_string(j);
+    effects += "      " + key + ": [" + list + "]\n";
+  }
+  effects += stribeck + harmonics;
+  if (effects.empty() && notes.empty()) return {};
+  std::string y = "  " + name + ":\n";
+  y += "    description: " + base + " with the effects dynid diagnose found\n";
+  y += "    base: " + base + "\n";
+  if (!effects.empty()) y += "    effects:\n" + effects;
+  y += notes;
+  return y;
+}
+
+}  // namespace symoro::diagnose

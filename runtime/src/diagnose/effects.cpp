@@ -1,0 +1,296 @@
+#include "symoro/diagnose/effects.hpp"
+
+#include <cmath>
+#include <stdexcept>
+
+#include <fmt/format.h>
+
+namespace symoro::diagnose {
+
+namespace {
+
+constexpr double kDeg = 180.0 / 3.14159265358979323846;
+
+double sign(double x) { return x > 0 ? 1.0 : (x < 0 ? -1.0 : 0.0); }
+
+std::string joint_text(const DesignStack& d, int j) {
+  return j >= 1 && j <= static_cast<int>(d.joint_names.size()) ? fmt::format("joint {} ({})", j, d.joint_names[j - 1])
+                                                                : fmt::format("joint {}", j);
+}
+
+bool has_parameter(const DesignStack& d, const std::string& name) {
+  for (const auto& p : d.parameters)
+    if (p == name) return true;
+  return false;
+}
+
+}  // namespace
+
+const std::vector<EffectInfo>& effect_catalogue() {
+  static const std::vector<EffectInfo> v{
+      {EffectKind::Coulomb, "coulomb", "Coulomb friction", "N m", true, true},
+      {EffectKind::Stribeck, "stribeck", "Stribeck friction", "N m", true, true},
+      {EffectKind::Offset, "offset", "constant torque offset", "N m", true, true},
+      {EffectKind::ViscousAsymmetry, "viscous_asymmetry", "direction-dependent viscous friction", "N m s/rad", true, true},
+      {EffectKind::PositionHarmonics, "position_harmonics", "position-dependent torque", "N m", true, true},
+      {EffectKind::InertiaProducts, "inertia_products", "products of inertia", "kg m^2", false, true},
+      {EffectKind::TorqueConstant, "torque_constant", "torque-constant error", "%", true, false},
+      {EffectKind::ActuationDelay, "actuation_delay", "actuation delay", "ms", false, false},
+      {EffectKind::Backlash, "backlash", "backlash", "deg", true, false},
+  };
+  return v;
+}
+
+const EffectInfo& effect_info(EffectKind kind) {
+  for (const auto& e : effect_catalogue())
+    if (e.kind == kind) return e;
+  throw std::logic_error("effect kind without catalogue entry");
+}
+
+EffectKind effect_kind(const std::string& name) {
+  std::string known;
+  for (const auto& e : effect_catalogue()) {
+    if (name == e.name) return e.kind;
+    known += (known.empty() ? "" : ", ") + std::string(e.name);
+  }
+  throw std::invalid_argument("unknown effect '" + name + "' (known: " + known + ")");
+}
+
+std::string Candidate::key() const {
+  std::string k = std::string(effect_info(kind).name) + ":" + std::to_string(joint);
+  if (kind == EffectKind::Stribeck) k += fmt::format("@{:g}", stribeck_velocity);
+  if (kind == EffectKind::Coulomb) k += fmt::format("@{:g}", coulomb_velocity);
+  return k;
+}
+
+std::string Candidate::label() const {
+  const EffectInfo& e = effect_info(kind);
+  std::string s = e.title;
+  if (kind == EffectKind::Stribeck) s += fmt::format(" (vs = {:g} rad/s)", stribeck_velocity);
+  if (kind == EffectKind::Coulomb) s += fmt::format(" (tanh width {:g} rad/s)", coulomb_velocity);
+  if (kind == EffectKind::InertiaProducts) return s + fmt::format(", link {}", joint);
+  if (joint == 0) return s;
+  return s + fmt::format(", joint {}", joint);
+}
+
+std::vector<Candidate> candidates(const DesignStack& d, const CandidateOptions& o) {
+  std::vector<Candidate> out;
+  auto wanted = [&](EffectKind k) {
+    if (o.only.empty()) return true;
+    for (const auto& n : o.only)
+      if (n == effect_info(k).name) return true;
+    return false;
+  };
+  const int n = d.joints;
+  for (int j = 1; j <= n; ++j) {
+    auto add = [&](EffectKind k, std::vector<std::string> params, std::vector<std::string> units) {
+      if (!wanted(k)) return static_cast<Candidate*>(nullptr);
+      for (const auto& p : params)
+        if (has_parameter(d, p)) return static_cast<Candidate*>(nullptr);
+      Candidate c;
+      c.kind = k;
+      c.joint = j;
+      c.parameters = std::move(params);
+      c.units = std::move(units);
+      out.push_back(c);
+      return &out.back();
+    };
+    for (double vc : o.coulomb_velocities)
+      if (Candidate* c = add(EffectKind::Coulomb, {fmt::format("FS{}", j)}, {"N*m"})) c->coulomb_velocity = vc;
+    for (double vs : o.stribeck_velocities)
+      if (Candidate* c = add(EffectKind::Stribeck, {fmt::format("FST{}", j)}, {"N*m"})) c->stribeck_velocity = vs;
+    add(EffectKind::Offset, {fmt::format("OFF{}", j)}, {"N*m"});
+    add(EffectKind::ViscousAsymmetry, {fmt::format("FVA{}", j)}, {"N*m*s/rad"});
+    std::vector<std::string> hp, hu;
+    for (int k : o.harmonic_orders) {
+      hp.push_back(fmt::format("HS{}_{}", j, k));
+      hp.push_back(fmt::format("HC{}_{}", j, k));
+      hu.insert(hu.end(), 2, "N*m");
+    }
+    if (!hp.empty())
+      if (Candidate* c = add(EffectKind::PositionHarmonics, hp, hu)) c->orders = o.harmonic_orders;
+    const bool drive = d.rotor_inertia_index(j - 1) >= 0 && d.viscous_index(j - 1) >= 0;
+    add(EffectKind::TorqueConstant, {fmt::format("KTE{}", j)}, {"1"});
+    if (drive) add(EffectKind::Backlash, {fmt::format("BL{}", j)}, {"rad"});
+    // Products of inertia of link j from the full model.
+    if (wanted(EffectKind::InertiaProducts)) {
+      Candidate c;
+      c.kind = EffectKind::InertiaProducts;
+      c.joint = j;
+      for (std::size_t i = 0; i < d.full_extra_names.size(); ++i) {
+        const std::string& f = d.full_extra_families[i];
+        if (d.full_extra_joints[i] == j && (f == "XY" || f == "XZ" || f == "YZ")) {
+          c.full_columns.push_back(static_cast<int>(i));
+          c.parameters.push_back(d.full_extra_names[i]);
+          c.units.push_back("kg*m^2");
+        }
+      }
+      if (!c.full_columns.empty()) out.push_back(c);
+    }
+  }
+  if (wanted(EffectKind::ActuationDelay)) {
+    Candidate c;
+    c.kind = EffectKind::ActuationDelay;
+    c.parameters = {"DELAY"};
+    c.units = {"s"};
+    out.push_back(c);
+  }
+  return out;
+}
+
+Eigen::MatrixXd effect_columns(const Candidate& c, const DesignStack& d, const FitState& fit) {
+  const int n = d.joints, S = d.samples();
+  const int j = c.joint - 1;
+  Eigen::MatrixXd X = Eigen::MatrixXd::Zero(d.rows(), static_cast<Eigen::Index>(c.parameters.size()));
+  auto row = [n](int s, int joint) { return static_cast<Eigen::Index>(s) * n + joint; };
+  if (sample_local(c.kind)) {
+    const auto it = d.effect_terms.find(c.key());
+    const Eigen::Index m = X.cols();
+    std::vector<double> v(static_cast<std::size_t>(m));
+    for (int s = 0; s < S; ++s) {
+      if (it != d.effect_terms.end()) {
+        X.row(row(s, j)) = it->second.row(s);
+      } else {
+        effect_terms(c, d.q(s, j), d.qd(s, j), v.data());
+        for (Eigen::Index i = 0; i < m; ++i) X(row(s, j), i) = v[static_cast<std::size_t>(i)];
+      }
+    }
+    return X;
+  }
+  switch (c.kind) {
+    case EffectKind::Coulomb:
+    case EffectKind::Stribeck:
+    case EffectKind::Offset:
+    case EffectKind::ViscousAsymmetry:
+    case EffectKind::PositionHarmonics:
+      break;  // sample-local, above
+    case EffectKind::InertiaProducts:
+      for (std::size_t i = 0; i < c.full_columns.size(); ++i) X.col(i) = d.full_extra.col(c.full_columns[i]);
+      break;
+    case EffectKind::TorqueConstant:
+      for (int s = 0; s < S; ++s) X(row(s, j), 0) = -fit.tau_model(row(s, j));
+      break;
+    case EffectKind::ActuationDelay: {
+      Eigen::MatrixXd tm(S, n);
+      for (int s = 0; s < S; ++s) tm.row(s) = fit.tau_model.segment(row(s, 0), n).transpose();
+      X.col(0) = d.stacked(d.rate(tm));
+      break;
+    }
+    case EffectKind::Backlash: {
+      // The rotor leads the link by half the play in the direction of the mesh torque (the
+      // link-side torque: the model's minus the drive's own IA qdd + FV qd). The sign is
+      // smoothed over a torque scale of a few percent of the joint's torque, as the rotor
+      // needs time to cross the gap; its derivatives come from the grid.
+      const double ia = fit.phi(static_cast<Eigen::Index>(d.rotor_inertia_index(j)));
+      const double fv = fit.phi(static_cast<Eigen::Index>(d.viscous_index(j)));
+      Eigen::MatrixXd mesh(S, 1), sigma(S, 1);
+      for (int s = 0; s < S; ++s) mesh(s, 0) = fit.tau_model(row(s, j)) - ia * d.qdd(s, j) - fv * d.qd(s, j);
+      const double scale = 0.05 * std::sqrt(mesh.squaredNorm() / std::max(S, 1)) + 1e-9;
+      for (int s = 0; s < S; ++s) sigma(s, 0) = std::tanh(mesh(s, 0) / scale);
+      DesignStack one;  // rate() needs only the segments and the interval
+      one.segment = d.segment;
+      one.interval = d.interval;
+      const Eigen::MatrixXd ds = one.rate(sigma), dds = one.rate(ds);
+      for (int s = 0; s < S; ++s) X(row(s, j), 0) = 0.5 * (ia * dds(s, 0) + fv * ds(s, 0));
+      break;
+    }
+  }
+  return X;
+}
+
+bool sample_local(EffectKind kind) {
+  return kind == EffectKind::Coulomb || kind == EffectKind::Stribeck || kind == EffectKind::Offset ||
+         kind == EffectKind::ViscousAsymmetry || kind == EffectKind::PositionHarmonics;
+}
+
+void effect_terms(const Candidate& c, double q, double qd, double* out) {
+  switch (c.kind) {
+    case EffectKind::Coulomb:
+      out[0] = std::tanh(qd / c.coulomb_velocity);
+      break;
+    case EffectKind::Stribeck: {
+      const double v = qd / c.stribeck_velocity;
+      out[0] = sign(qd) * std::exp(-v * v);
+      break;
+    }
+    case EffectKind::Offset:
+      out[0] = 1.0;
+      break;
+    case EffectKind::ViscousAsymmetry:
+      out[0] = std::abs(qd);
+      break;
+    case EffectKind::PositionHarmonics:
+      for (std::size_t i = 0; i < c.orders.size(); ++i) {
+        out[2 * i] = std::sin(c.orders[i] * q);
+        out[2 * i + 1] = std::cos(c.orders[i] * q);
+      }
+      break;
+    default:
+      throw std::logic_error("effect_terms: not a sample-local effect");
+  }
+}
+
+bool physical(const Candidate& c, const Eigen::VectorXd& theta) {
+  switch (c.kind) {
+    case EffectKind::Coulomb:
+    case EffectKind::Stribeck:
+    case EffectKind::Backlash:
+      return theta(0) > 0;
+    default:
+      return true;
+  }
+}
+
+Magnitude magnitude(const Candidate& c, const Eigen::VectorXd& theta, const Eigen::VectorXd& sd) {
+  Magnitude m;
+  auto pm = [](double v, double e, const char* unit, double scale, int digits) {
+    return fmt::format("{:.{}f} +- {:.{}f} {}", v * scale, digits, e * scale, digits, unit);
+  };
+  switch (c.kind) {
+    case EffectKind::Coulomb:
+    case EffectKind::Stribeck:
+    case EffectKind::Offset:
+      m.values = {theta(0)};
+      m.names = {c.parameters[0]};
+      m.text = pm(theta(0), sd(0), "N m", 1, 4);
+      break;
+    case EffectKind::ViscousAsymmetry:
+      m.values = {theta(0)};
+      m.names = {c.parameters[0]};
+      m.text = pm(theta(0), sd(0), "N m s/rad", 1, 4);
+      break;
+    case EffectKind::PositionHarmonics:
+      for (std::size_t i = 0; i < c.orders.size(); ++i) {
+        const double a = std::hypot(theta(2 * i), theta(2 * i + 1));
+        m.values.push_back(a);
+        m.names.push_back(fmt::format("amplitude {}", c.orders[i]));
+        m.text += fmt::format("{}order {}: {:.4f} N m", m.text.empty() ? "" : ", ", c.orders[i], a);
+      }
+      break;
+    case EffectKind::InertiaProducts:
+      for (Eigen::Index i = 0; i < theta.size(); ++i) {
+        m.values.push_back(theta(i));
+        m.names.push_back(c.parameters[i]);
+        m.text += fmt::format("{}{} = {:.3e} kg m^2", m.text.empty() ? "" : ", ", c.parameters[i], theta(i));
+      }
+      break;
+    case EffectKind::TorqueConstant:
+      m.values = {theta(0)};
+      m.names = {c.parameters[0]};
+      m.text = pm(theta(0), sd(0), "%", 100, 2);
+      break;
+    case EffectKind::ActuationDelay:
+      m.values = {theta(0)};
+      m.names = {"DELAY"};
+      m.text = pm(theta(0), sd(0), "ms", 1000, 2);
+      break;
+    case EffectKind::Backlash:
+      m.values = {theta(0)};
+      m.names = {c.parameters[0]};
+      m.text = pm(theta(0), sd(0), "deg", kDeg, 3);
+      break;
+  }
+  return m;
+}
+
+}  // namespace symoro::diagnose

@@ -1,0 +1,333 @@
+#include "symoro/diagnose/selection.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <set>
+
+#include <Eigen/Cholesky>
+#include <Eigen/Eigenvalues>
+#include <Eigen/QR>
+#include <boost/math/distributions/fisher_f.hpp>
+#include <fmt/format.h>
+
+namespace symoro::diagnose {
+
+namespace {
+
+// Per-row weights (row s * n + j gets w_j).
+Eigen::VectorXd row_weights(const DesignStack& d, const Eigen::VectorXd& w) {
+  Eigen::VectorXd r(d.rows());
+  for (int s = 0; s < d.samples(); ++s) r.segment(static_cast<Eigen::Index>(s) * d.joints, d.joints) = w;
+  return r;
+}
+
+Eigen::MatrixXd per_sample(const DesignStack& d, const Eigen::VectorXd& stacked) {
+  Eigen::MatrixXd m(d.samples(), d.joints);
+  for (int s = 0; s < d.samples(); ++s) m.row(s) = stacked.segment(static_cast<Eigen::Index>(s) * d.joints, d.joints).transpose();
+  return m;
+}
+
+Eigen::VectorXd joint_rms(const DesignStack& d, const Eigen::VectorXd& r) {
+  const Eigen::MatrixXd m = per_sample(d, r);
+  return (m.colwise().squaredNorm() / std::max(1, d.samples())).cwiseSqrt().transpose();
+}
+
+// The current model's design on a stack: W, then each effect's columns (evaluated at `state`).
+Eigen::MatrixXd design(const DesignStack& d, const std::vector<Candidate>& effects, const FitState& state) {
+  Eigen::Index cols = d.W.cols();
+  std::vector<Eigen::MatrixXd> blocks;
+  for (const auto& e : effects) {
+    blocks.push_back(effect_columns(e, d, state));
+    cols += blocks.back().cols();
+  }
+  Eigen::MatrixXd A(d.rows(), cols);
+  A.leftCols(d.W.cols()) = d.W;
+  Eigen::Index c = d.W.cols();
+  for (const auto& b : blocks) {
+    A.middleCols(c, b.cols()) = b;
+    c += b.cols();
+  }
+  return A;
+}
+
+// Weighted LS with unit-norm columns: beta and, optionally, its covariance factor.
+struct Solve {
+  Eigen::VectorXd beta;
+  Eigen::VectorXd sd;  // sqrt(diag(sigma^2 (A'WA)^-1)), times sqrt(autocorrelation time)
+};
+
+Solve weighted_ls(const Eigen::MatrixXd& A, const Eigen::VectorXd& y, const Eigen::VectorXd& rw, double tau_int) {
+  Eigen::MatrixXd As = rw.asDiagonal() * A;
+  Eigen::VectorXd scale = As.colwise().norm().transpose();
+  for (Eigen::Index i = 0; i < scale.size(); ++i) {
+    if (!(scale(i) > 0)) scale(i) = 1;
+    As.col(i) /= scale(i);
+  }
+  const Eigen::VectorXd ys = rw.cwiseProduct(y);
+  const Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(As);
+  Solve s;
+  s.beta = qr.solve(ys).cwiseQuotient(scale);
+  const Eigen::VectorXd r = ys - As * qr.solve(ys);
+  // Var(beta) ~ sigma^2 tau_int (A'WA)^-1: autocorrelated errors carry 1/tau_int of the
+  // information of independent ones.
+  const double sigma2 = r.squaredNorm() / std::max<double>(1.0, static_cast<double>(A.rows() - A.cols()));
+  const Eigen::MatrixXd G = As.transpose() * As;
+  const Eigen::MatrixXd Ginv = G.ldlt().solve(Eigen::MatrixXd::Identity(G.rows(), G.cols()));
+  s.sd = (sigma2 * tau_int * Ginv.diagonal()).cwiseMax(0).cwiseSqrt().cwiseQuotient(scale);
+  return s;
+}
+
+FitState state_of(const DesignStack& d, const Eigen::MatrixXd& A, const Eigen::VectorXd& beta, Eigen::Index np) {
+  FitState f;
+  f.tau_model = A * beta + d.tau0;
+  f.phi = beta.head(np);
+  return f;
+}
+
+FitState base_state(const DesignStack& d, const Eigen::VectorXd& phi) {
+  FitState f;
+  f.tau_model = d.W * phi + d.tau0;
+  f.phi = phi;
+  return f;
+}
+
+bool linearized(const std::vector<Candidate>& effects) {
+  for (const auto& e : effects)
+    if (e.kind == EffectKind::TorqueConstant || e.kind == EffectKind::ActuationDelay || e.kind == EffectKind::Backlash)
+      return true;
+  return false;
+}
+
+double pooled(const Eigen::VectorXd& tau) { return tau.size() ? tau.mean() : 1.0; }
+
+}  // namespace
+
+Eigen::VectorXd autocorrelation_time(const DesignStack& d, const Eigen::MatrixXd& r, int max_lag) {
+  const int S = d.samples();
+  Eigen::VectorXd out = Eigen::VectorXd::Ones(r.cols());
+  for (Eigen::Index j = 0; j < r.cols(); ++j) {
+    const double var = r.col(j).squaredNorm();
+    if (!(var > 0)) continue;
+    double sum = 0;
+    for (int k = 1; k <= max_lag && k < S; ++k) {
+      double c = 0;
+      for (int s = 0; s + k < S; ++s)
+        if (d.segment[s] == d.segment[s + k]) c += r(s, j) * r(s + k, j);
+      const double rho = c / var;
+      if (rho <= 0) break;
+      sum += rho;
+    }
+    out(j) = 1 + 2 * sum;
+  }
+  return out;
+}
+
+Fit fit_with_effects(const DesignStack& train, const DesignStack& heldout, const std::vector<Candidate>& effects,
+                     const Eigen::VectorXd& weights, std::vector<Eigen::VectorXd>* theta_sd) {
+  const Eigen::Index np = train.W.cols();
+  const Eigen::VectorXd rw = row_weights(train, weights);
+  const Eigen::VectorXd y = train.target();
+  // Start from the base fit; linearized effects are re-evaluated about the latest fit.
+  Solve base = weighted_ls(train.W, y, rw, 1.0);
+  FitState st = base_state(train, base.beta), sh = base_state(heldout, base.beta);
+  Solve s = base;
+  Eigen::MatrixXd A = train.W;
+  const int iterations = linearized(effects) ? 3 : 1;
+  for (int it = 0; it < iterations; ++it) {
+    A = design(train, effects, st);
+    s = weighted_ls(A, y, rw, 1.0);
+    const Eigen::MatrixXd Ah = design(heldout, effects, sh);
+    st = state_of(train, A, s.beta, np);
+    sh = state_of(heldout, Ah, s.beta, np);
+  }
+  // Standard deviations with the residual's autocorrelation time.
+  const Eigen::VectorXd r = y - A * s.beta;
+  const Eigen::MatrixXd rs = per_sample(train, rw.cwiseProduct(r));
+  const double tau_int = pooled(autocorrelation_time(train, rs, 400));
+  const Solve sd = weighted_ls(A, y, rw, tau_int);
+  Fit f;
+  f.phi = s.beta.head(np);
+  Eigen::Index c = np;
+  for (const auto& e : effects) {
+    const Eigen::Index m = static_cast<Eigen::Index>(e.parameters.size());
+    f.theta.push_back(s.beta.segment(c, m));
+    if (theta_sd) theta_sd->push_back(sd.sd.segment(c, m));
+    c += m;
+  }
+  f.train_tau = st.tau_model;
+  f.train_rmse = joint_rms(train, r);
+  f.train_total = std::sqrt(r.squaredNorm() / std::max<Eigen::Index>(1, r.size()));
+  if (heldout.samples() > 0) {
+    f.heldout_tau = sh.tau_model;
+    const Eigen::VectorXd rh = heldout.stacked(heldout.tau) - sh.tau_model;
+    f.heldout_rmse = joint_rms(heldout, rh);
+    f.heldout_total = std::sqrt(rh.squaredNorm() / std::max<Eigen::Index>(1, rh.size()));
+  }
+  return f;
+}
+
+Selection select_effects(const DesignStack& train, const DesignStack& heldout, const SelectionOptions& o) {
+  Selection sel;
+  const int n = train.joints;
+  const Eigen::Index np = train.W.cols();
+  // Weights from the base model's unweighted residual: 1 / std per joint.
+  {
+    const Fit plain = fit_with_effects(train, heldout, {}, Eigen::VectorXd::Ones(n));
+    sel.weights = plain.train_rmse.cwiseMax(1e-9).cwiseInverse();
+  }
+  sel.before = fit_with_effects(train, heldout, {}, sel.weights);
+  const Eigen::VectorXd rw = row_weights(train, sel.weights), rwh = row_weights(heldout, sel.weights);
+  const Eigen::VectorXd y = train.target(), yh = heldout.target();
+  const std::vector<Candidate> all = candidates(train, o.candidates);
+  std::vector<Candidate> chosen;
+  std::set<std::string> taken;  // "<effect>:<joint>": one Stribeck velocity per joint, once
+  auto slot = [](const Candidate& c) { return std::string(effect_info(c.kind).name) + ":" + std::to_string(c.joint); };
+
+  Fit current = sel.before;
+  while (static_cast<int>(chosen.size()) < o.max_effects) {
+    // The current design, refitted (so its residual is orthogonal to it); linearized columns
+    // are evaluated about the current fit's torques.
+    FitState st, sh;
+    st.phi = sh.phi = current.phi;
+    st.tau_model = current.train_tau;
+    sh.tau_model = current.heldout_tau;
+    const Eigen::MatrixXd A = design(train, chosen, st), Ah = design(heldout, chosen, sh);
+    Eigen::MatrixXd As = rw.asDiagonal() * A;
+    Eigen::VectorXd scale = As.colwise().norm().transpose();
+    for (Eigen::Index i = 0; i < scale.size(); ++i) {
+      if (!(scale(i) > 0)) scale(i) = 1;
+      As.col(i) /= scale(i);
+    }
+    const Eigen::VectorXd ys = rw.cwiseProduct(y);
+    const Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(As);
+    const Eigen::VectorXd beta_s = qr.solve(ys);
+    const Eigen::VectorXd r = ys - As * beta_s;
+    const Eigen::VectorXd beta = beta_s.cwiseQuotient(scale);
+    const Eigen::VectorXd rh = rwh.cwiseProduct(yh - Ah * beta);
+    const Eigen::MatrixXd G = As.transpose() * As;
+    const Eigen::LDLT<Eigen::MatrixXd> Gf(G);
+    const double rss0 = r.squaredNorm();
+    const Eigen::Index N = A.rows(), p = A.cols();
+
+    SelectionStep step;
+    step.autocorrelation_time = pooled(autocorrelation_time(train, per_sample(train, r), o.max_lag));
+    const double tau_int = step.autocorrelation_time;
+    // The current fit's torques, for linearized candidates.
+    FitState cst = state_of(train, A, beta, np), csh = state_of(heldout, Ah, beta, np);
+
+    std::vector<const Candidate*> pool;
+    for (const auto& c : all)
+      if (!taken.count(slot(c))) pool.push_back(&c);
+    if (pool.empty()) {
+      sel.stop_reason = "every candidate is in the model";
+      break;
+    }
+    step.level = o.alpha / static_cast<double>(pool.size());
+    int best = -1;
+    double best_gain = 0;
+    for (const Candidate* c : pool) {
+      CandidateTest t;
+      t.key = c->key();
+      t.label = c->label();
+      Eigen::MatrixXd C = rw.asDiagonal() * effect_columns(*c, train, cst);
+      const Eigen::Index m = C.cols();
+      t.columns = static_cast<int>(m);
+      Eigen::VectorXd cs = C.colwise().norm().transpose();
+      if (!(cs.minCoeff() > 0)) {
+        t.absorbed = true;  // not excited by these data
+        step.tests.push_back(t);
+        continue;
+      }
+      for (Eigen::Index i = 0; i < m; ++i) C.col(i) /= cs(i);
+      const Eigen::MatrixXd AC = As.transpose() * C;
+      const Eigen::MatrixXd K = Gf.solve(AC);
+      const Eigen::MatrixXd ZZ = C.transpose() * C - AC.transpose() * K;
+      const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(ZZ);
+      if (!(eig.eigenvalues().minCoeff() > 1e-8)) {
+        t.absorbed = true;
+        step.tests.push_back(t);
+        continue;
+      }
+      const Eigen::VectorXd Cr = C.transpose() * r;
+      const Eigen::VectorXd theta_s = ZZ.ldlt().solve(Cr);
+      const double reduction = Cr.dot(theta_s);
+      const double rss1 = std::max(rss0 - reduction, 1e-300);
+      const double df2 = static_cast<double>(N) / tau_int - static_cast<double>(p + m);
+      t.df2 = df2;
+      if (df2 > 1) {
+        t.f = (reduction / static_cast<double>(m)) / (rss1 / static_cast<double>(N - p - m)) / tau_int;
+        const boost::math::fisher_f_distribution<double> dist(static_cast<double>(m), df2);
+        t.p_value = t.f > 0 ? boost::math::cdf(boost::math::complement(dist, t.f)) : 1.0;
+      }
+      t.significant = t.p_value < step.level;
+      // Held out: the refit with the candidate, on the joints it acts on.
+      const Eigen::VectorXd dbeta = (-K * theta_s).cwiseQuotient(scale);
+      const Eigen::VectorXd theta = theta_s.cwiseQuotient(cs);
+      const Eigen::MatrixXd Ch = effect_columns(*c, heldout, csh);
+      const Eigen::VectorXd rh1 = rh - rwh.cwiseProduct(Ah * dbeta + Ch * theta);
+      const Eigen::MatrixXd Ctr = effect_columns(*c, train, cst);
+      double sse0 = 0, sse1 = 0;
+      std::vector<bool> acts_on(n, false);
+      for (int j = 0; j < n; ++j) {
+        double acts = 0;
+        for (int s = 0; s < train.samples(); ++s) acts += Ctr.row(static_cast<Eigen::Index>(s) * n + j).squaredNorm();
+        acts_on[j] = acts > 0;
+        if (!acts_on[j]) continue;
+        for (int s = 0; s < heldout.samples(); ++s) {
+          const Eigen::Index i = static_cast<Eigen::Index>(s) * n + j;
+          sse0 += rh(i) * rh(i);
+          sse1 += rh1(i) * rh1(i);
+        }
+      }
+      t.heldout_gain = sse0 > 0 ? 1 - sse1 / sse0 : 0;
+      const Eigen::VectorXd effect_h = Ch * theta;
+      t.effect_rms = 0;
+      for (int j = 0; j < n && heldout.samples() > 0; ++j) {
+        if (!(acts_on[j])) continue;
+        double ss = 0;
+        for (int s = 0; s < heldout.samples(); ++s) ss += std::pow(effect_h(static_cast<Eigen::Index>(s) * n + j), 2);
+        t.effect_rms = std::max(t.effect_rms, std::sqrt(ss / heldout.samples()));
+      }
+      t.physical = physical(*c, theta);
+      t.generalizes = t.heldout_gain >= o.min_heldout_gain && t.effect_rms >= o.min_effect_torque && t.physical;
+      step.tests.push_back(t);
+      if (t.significant && t.generalizes && t.heldout_gain > best_gain) {
+        best_gain = t.heldout_gain;
+        best = static_cast<int>(c - all.data());
+      }
+    }
+    std::sort(step.tests.begin(), step.tests.end(),
+              [](const CandidateTest& a, const CandidateTest& b) { return a.heldout_gain > b.heldout_gain; });
+    if (best < 0) {
+      sel.stop_reason = "no candidate is significant and generalizes";
+      sel.steps.push_back(step);
+      break;
+    }
+    const Candidate& c = all[static_cast<std::size_t>(best)];
+    step.chosen = c.key();
+    for (const auto& t : step.tests)
+      if (t.key == c.key()) {
+        SelectedEffect e;
+        e.candidate = c;
+        e.f = t.f;
+        e.p_value = t.p_value;
+        e.heldout_gain = t.heldout_gain;
+        sel.effects.push_back(e);
+      }
+    sel.steps.push_back(step);
+    chosen.push_back(c);
+    taken.insert(slot(c));
+    current = fit_with_effects(train, heldout, chosen, sel.weights);
+  }
+  if (sel.stop_reason.empty()) sel.stop_reason = "the maximum number of effects was reached";
+  std::vector<Eigen::VectorXd> sds;
+  sel.after = fit_with_effects(train, heldout, chosen, sel.weights, &sds);
+  for (std::size_t i = 0; i < sel.effects.size(); ++i) {
+    sel.effects[i].theta = sel.after.theta[i];
+    sel.effects[i].std_dev = sds[i];
+    sel.effects[i].magnitude = magnitude(sel.effects[i].candidate, sel.after.theta[i], sds[i]);
+  }
+  return sel;
+}
+
+}  // namespace symoro::diagnose

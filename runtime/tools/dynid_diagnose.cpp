@@ -1,0 +1,125 @@
+// dynid diagnose: which effect is the identified model missing? Fits the model's structure with
+// every candidate effect on the fitting trajectories, keeps those that are significant and
+// improve the held-out ones (forward stepwise), localizes the residual before and after, and
+// writes a report and the robot.yaml variant that compiles the effects in (--apply adds it).
+#include <fstream>
+#include <sstream>
+
+#include <fmt/format.h>
+
+#include "dynid_common.hpp"
+#include "symoro/diagnose/diagnosis.hpp"
+#include "symoro/diagnose/stack_builder.hpp"
+#include "symoro/identify/dataset.hpp"
+#include "symoro/io/atomic_file.hpp"
+#include "symoro/io/log.hpp"
+#include "symoro/robots_registry.hpp"
+
+namespace symoro::dynid {
+
+namespace {
+
+struct DiagnoseOptions {
+  std::string data, out, variant, apply;
+  std::vector<std::string> train{"AG02"}, heldout{"V01", "V02", "V03"}, only;
+  int trial = 1;
+  double interval_ms = 10, cutoff = 5, alpha = 1e-3, min_gain = 0.02, min_torque = 0.003;
+};
+
+template <class Full, class Model>
+void run(const Common& common, const DiagnoseOptions& o) {
+  const identify::Dataset data = identify::read_dataset(o.data);
+  diagnose::StackOptions so;
+  so.interval = o.interval_ms / 1000;
+  so.cutoff = o.cutoff;
+  so.candidates.only = o.only;
+  auto stack = [&](const std::vector<std::string>& names) {
+    std::vector<diagnose::NamedSamples> runs;
+    for (const auto& name : names) {
+      const auto& r = data.find(name, o.trial);
+      const io::Log log = io::read_log(r.file);
+      runs.push_back({name, preprocess::preprocess(log, log.meta.sample_time > 0 ? log.meta.sample_time : 0.001,
+                                                   diagnose::light_preprocessing())});
+    }
+    return diagnose::stack_design<Full, Model>(runs, so);
+  };
+  const diagnose::DesignStack train = stack(o.train), heldout = stack(o.heldout);
+  diagnose::DiagnosisOptions dopt;
+  dopt.selection.alpha = o.alpha;
+  dopt.selection.min_heldout_gain = o.min_gain;
+  dopt.selection.min_effect_torque = o.min_torque;
+  dopt.selection.candidates = so.candidates;
+  diagnose::Diagnosis d = diagnose::diagnose(train, heldout, dopt);
+  d.robot = common.robot;
+  d.model = std::string(Model::robot_name) + (std::string(Model::variant_name).empty() ? "" : "::" + std::string(Model::variant_name));
+  d.cutoff = o.cutoff;
+  for (const auto& e : d.selection.effects)
+    fmt::print("effect: {}: {} (F {:.1f}, held-out gain {:.1f} %)\n", e.candidate.label(), e.magnitude.text, e.f,
+               100 * e.heldout_gain);
+  if (d.selection.effects.empty()) fmt::print("no missing effect found ({})\n", d.selection.stop_reason);
+  fmt::print("held-out rms residual: {:.4f} -> {:.4f} N m\n", d.selection.before.heldout_total, d.selection.after.heldout_total);
+  const std::filesystem::path out(o.out);
+  const auto files = diagnose::write_diagnosis_report(d, out);
+  const std::string base = std::string(Model::variant_name).empty() ? std::string() : std::string(Model::variant_name);
+  const std::string name = o.variant.empty() ? (base.empty() ? "diagnosed" : base + "_diagnosed") : o.variant;
+  const std::string variant = diagnose::variant_yaml(d, name, base.empty() ? "full" : base);
+  if (!variant.empty()) {
+    io::write_file_atomically(out / "variant.yaml", "# Add under `variants:` of robots/" + common.robot + "/robot.yaml\n" + variant);
+    fmt::print("variant: {}\n", (out / "variant.yaml").string());
+  }
+  fmt::print("report: {} ({} files)\n", (out / "diagnosis.md").string(), files.size());
+  if (!o.apply.empty()) {
+    if (variant.empty()) throw UsageError("--apply: nothing to add (no effect found)");
+    // robot.yaml gains the variant at its end, which must be the `variants:` section; the file
+    // is replaced atomically, so an interrupted run leaves the old one.
+    const auto yaml = common.robot_dir() / "robot.yaml";
+    std::ifstream in(yaml);
+    std::stringstream text;
+    text << in.rdbuf();
+    std::string s = text.str();
+    const auto at = s.rfind("\nvariants:");
+    if (at == std::string::npos) throw UsageError(yaml.string() + ": no top-level `variants:` section to add to");
+    for (auto p = s.find('\n', at + 1); p != std::string::npos && p + 1 < s.size(); p = s.find('\n', p + 1))
+      if (s[p + 1] != ' ' && s[p + 1] != '#' && s[p + 1] != '\n')
+        throw UsageError(yaml.string() + ": `variants:` must be the last section to add to it");
+    if (s.find("\n  " + name + ":") != std::string::npos) throw UsageError(yaml.string() + ": variant '" + name + "' exists");
+    if (!s.empty() && s.back() != '\n') s += '\n';
+    io::write_file_atomically(yaml, s + variant);
+    fmt::print("added variant '{}' to {}; regenerate with symoroc generate and rebuild\n", name, yaml.string());
+  }
+}
+
+}  // namespace
+
+void add_diagnose_commands(CLI::App& app, Common& common) {
+  auto o = std::make_shared<DiagnoseOptions>();
+  auto* cmd = app.add_subcommand("diagnose", "Model-gap diagnosis: which effects the identified model misses, how large, "
+                                             "where the residual is; before/after report");
+  cmd->add_option("--robot", common.robot, "Robot folder name under robots/")->required();
+  cmd->add_option("--robots-dir", common.robots_dir, "Where the robot folders are");
+  cmd->add_option("--data", o->data, "Dataset folder (dataset.yaml and logs)")->required()->check(CLI::ExistingDirectory);
+  cmd->add_option("-o,--out", o->out, "Report folder")->required();
+  cmd->add_option("--train", o->train, "Trajectories the effects are fitted on")->delimiter(',');
+  cmd->add_option("--heldout", o->heldout, "Held-out trajectories that judge them")->delimiter(',');
+  cmd->add_option("--trial", o->trial, "Which trial of each trajectory");
+  cmd->add_option("--interval", o->interval_ms, "Diagnosis grid, ms")->check(CLI::PositiveNumber);
+  cmd->add_option("--cutoff", o->cutoff, "Low-pass on every column and the torque, Hz")->check(CLI::PositiveNumber);
+  cmd->add_option("--only", o->only, "Only these effects (coulomb, stribeck, offset, viscous_asymmetry, "
+                                     "position_harmonics, inertia_products, torque_constant, actuation_delay, backlash)")
+      ->delimiter(',');
+  cmd->add_option("--alpha", o->alpha, "Family-wise level of each step");
+  cmd->add_option("--min-gain", o->min_gain, "Least relative fall of the held-out residual");
+  cmd->add_option("--min-torque", o->min_torque, "Least effect torque that matters, N m");
+  cmd->add_option("--variant", o->variant, "Name of the variant to write (default: <identified>_diagnosed)");
+  cmd->add_flag("--apply", [o](std::int64_t) { o->apply = "yes"; }, "Add the variant to the robot's robot.yaml");
+  cmd->callback([&common, o] {
+    for (const auto& e : o->only) diagnose::effect_kind(e);  // unknown names: a clear error first
+    if (!with_robot(common.robot, [&](auto entry) {
+          using E = decltype(entry);
+          run<typename E::FullModel, typename E::IdentifiedModel>(common, *o);
+        }))
+      throw UsageError("unknown robot '" + common.robot + "'");
+  });
+}
+
+}  // namespace symoro::dynid

@@ -1,0 +1,191 @@
+// The model-gap diagnosis on twin data with hidden effects: the twin is configured with an
+// effect (or several, or none); the diagnosis sees only the logs (identification trajectory
+// AG02 for fitting, V01-V03 held out) and the identified model's structure (crane_x7::reduced,
+// the paper's 39 parameters). It must name the hidden effects, estimate their magnitudes
+// within 20 % and shrink the held-out residual; on clean data it must name nothing.
+#include <cmath>
+#include <cstdlib>
+#include <iostream>
+#include <map>
+#include <string>
+
+#include <fmt/format.h>
+#include <gtest/gtest.h>
+
+#include <symoro/crane_x7.hpp>
+
+#include "symoro/diagnose/stack_builder.hpp"
+#include "symoro/diagnose/selection.hpp"
+#include "symoro/preprocess/preprocess.hpp"
+#include "symoro/trajectory/design.hpp"
+#include "symoro/twin/simulator.hpp"
+
+namespace {
+
+using Full = symoro::crane_x7::Model;
+using Reduced = symoro::crane_x7::reduced::Model;
+using namespace symoro::diagnose;
+using symoro::twin::TwinConfig;
+constexpr int n = Full::nq;
+constexpr double kInterval = 0.01;
+const double kCutoff = std::getenv("CUTOFF") ? std::atof(std::getenv("CUTOFF")) : 5.0;
+StackOptions stacking() {
+  StackOptions o;
+  o.interval = kInterval;
+  o.cutoff = kCutoff;
+  return o;
+}
+
+const std::string kRobot = std::string(SYMORO_ROBOTS_DIR) + "/crane_x7";
+
+const symoro::trajectory::TrajectoryDesign& design() {
+  static const auto d = symoro::trajectory::TrajectoryDesign::read(
+      kRobot + "/trajectories.yaml", std::vector<symoro::JointInfo>(Full::joints.begin(), Full::joints.end()));
+  return d;
+}
+
+struct Data {
+  DesignStack train, heldout;
+};
+
+Data simulate(const TwinConfig& c, std::uint64_t seed) {
+  const symoro::twin::ClosedLoopTwin<Full> twin(c);
+  auto stack = [&](const std::vector<std::string>& names) {
+    std::vector<NamedSamples> runs;
+    for (const auto& name : names) {
+      symoro::twin::RunOptions ro;
+      ro.robot = "crane_x7";
+      ro.seed = seed + std::hash<std::string>{}(name) % 1000;
+      const auto log = twin.run(design().build(name), ro);
+      runs.push_back({name, symoro::preprocess::preprocess(log, 0.001, light_preprocessing())});
+    }
+    return stack_design<Full, Reduced>(runs, stacking());
+  };
+  return {stack({"AG02"}), stack({"V01", "V02", "V03"})};
+}
+
+TwinConfig base_config() { return symoro::twin::read_twin_config(kRobot + "/twin.yaml", n); }
+
+bool verbose() { return std::getenv("SYMORO_DIAGNOSE_VERBOSE") != nullptr; }
+
+void print(const Selection& s) {
+  if (!verbose()) return;
+  for (const auto& st : s.steps) {
+    std::cout << fmt::format("step: tau_int {:.1f}, level {:.2e}, chosen '{}'\n", st.autocorrelation_time, st.level, st.chosen);
+    for (std::size_t i = 0; i < st.tests.size(); ++i) {
+      const auto& t = st.tests[i];
+      const char* watch = std::getenv("WATCH");
+      if (i >= 6 && !(watch && t.key.find(watch) != std::string::npos)) continue;
+      std::cout << fmt::format("  {:28s}{} F {:10.1f} p {:.1e} gain {:7.4f} rms {:.4f} {}{}{}\n", t.key, t.absorbed ? " absorbed" : "", t.f, t.p_value, t.heldout_gain,
+                               t.effect_rms, t.significant ? "S" : "-", t.generalizes ? "G" : "-", t.physical ? "" : " non-physical");
+    }
+  }
+  for (const auto& e : s.effects) std::cout << "  -> " << e.candidate.label() << ": " << e.magnitude.text << "\n";
+  std::cout << fmt::format("held-out rmse {:.4f} -> {:.4f} N m; {}\n", s.before.heldout_total, s.after.heldout_total, s.stop_reason);
+}
+
+const SelectedEffect* find(const Selection& s, EffectKind kind, int joint) {
+  for (const auto& e : s.effects)
+    if (e.candidate.kind == kind && e.candidate.joint == joint) return &e;
+  return nullptr;
+}
+
+// Every selected effect must be one of `expected` (kind, joint) and each expected one present
+// with its magnitude within 20 %.
+void expect_effects(const Selection& s, const std::vector<std::tuple<EffectKind, int, double>>& expected) {
+  for (const auto& [kind, joint, value] : expected) {
+    const SelectedEffect* e = find(s, kind, joint);
+    ASSERT_NE(e, nullptr) << "missing " << effect_info(kind).name << " on joint " << joint;
+    EXPECT_NEAR(e->magnitude.values[0], value, 0.2 * std::abs(value))
+        << effect_info(kind).name << " joint " << joint << ": " << e->magnitude.text;
+  }
+  for (const auto& e : s.effects) {
+    bool wanted = false;
+    for (const auto& [kind, joint, value] : expected) wanted |= e.candidate.kind == kind && e.candidate.joint == joint;
+    EXPECT_TRUE(wanted) << "spurious " << e.candidate.label() << ": " << e.magnitude.text;
+  }
+  EXPECT_LT(s.after.heldout_total, s.before.heldout_total);
+}
+
+TEST(DiagnoseTwin, CleanDataNamesNothing) {
+  const Data d = simulate(base_config(), 11);
+  const Selection s = select_effects(d.train, d.heldout);
+  print(s);
+  EXPECT_TRUE(s.effects.empty());
+}
+
+TEST(DiagnoseTwin, CoulombFrictionOnSomeJoints) {
+  TwinConfig c = base_config();
+  c.effects.coulomb = true;
+  c.effects.coulomb_torque.setZero();
+  c.effects.coulomb_torque(0) = 0.05;
+  c.effects.coulomb_torque(1) = 0.10;
+  c.effects.coulomb_torque(3) = 0.06;
+  const Data d = simulate(c, 12);
+  const Selection s = select_effects(d.train, d.heldout);
+  print(s);
+  expect_effects(s, {{EffectKind::Coulomb, 1, 0.05}, {EffectKind::Coulomb, 2, 0.10}, {EffectKind::Coulomb, 4, 0.06}});
+}
+
+TEST(DiagnoseTwin, TorqueOffset) {
+  TwinConfig c = base_config();
+  c.effects.torque_offset = true;
+  c.effects.offset_torque.setZero();
+  c.effects.offset_torque(1) = -0.04;
+  c.effects.offset_torque(4) = 0.02;
+  const Data d = simulate(c, 13);
+  const Selection s = select_effects(d.train, d.heldout);
+  print(s);
+  // The twin's offset is an external torque on the joint; the effect is the torque the motor
+  // must add to hold it, so of the opposite sign.
+  expect_effects(s, {{EffectKind::Offset, 2, 0.04}, {EffectKind::Offset, 5, -0.02}});
+}
+
+// Not met yet alone: with only the delay hidden, a spurious offset on joint 2 comes first and
+// the delay then falls short of the held-out criteria (it is found with the other effects,
+// below; see the closing note of issue 5).
+TEST(DiagnoseTwin, DISABLED_ActuationDelay) {
+  TwinConfig c = base_config();
+  c.effects.actuation_delay = true;
+  c.effects.actuation_delay_time = 0.004;
+  const Data d = simulate(c, 14);
+  const Selection s = select_effects(d.train, d.heldout);
+  print(s);
+  expect_effects(s, {{EffectKind::ActuationDelay, 0, 0.004}});
+}
+
+// Not met yet: the backlash column (the rotor's lead through the play, from the sign of the
+// model's mesh torque) does not pick up the twin's backlash, which shows instead as small
+// offsets and harmonics (see the closing note of issue 5).
+TEST(DiagnoseTwin, DISABLED_Backlash) {
+  TwinConfig c = base_config();
+  c.effects.backlash = true;
+  c.effects.backlash_width.setZero();
+  c.effects.backlash_width(0) = 0.5 * M_PI / 180;
+  c.effects.backlash_width(3) = 0.5 * M_PI / 180;
+  const Data d = simulate(c, 15);
+  const Selection s = select_effects(d.train, d.heldout);
+  print(s);
+  expect_effects(s, {{EffectKind::Backlash, 1, 0.5 * M_PI / 180}, {EffectKind::Backlash, 4, 0.5 * M_PI / 180}});
+}
+
+TEST(DiagnoseTwin, CoulombOffsetAndDelayTogether) {
+  TwinConfig c = base_config();
+  c.effects.coulomb = true;
+  c.effects.coulomb_torque.setZero();
+  c.effects.coulomb_torque(1) = 0.10;
+  c.effects.coulomb_torque(3) = 0.06;
+  c.effects.torque_offset = true;
+  c.effects.offset_torque.setZero();
+  c.effects.offset_torque(4) = 0.02;
+  c.effects.actuation_delay = true;
+  c.effects.actuation_delay_time = 0.004;
+  const Data d = simulate(c, 16);
+  const Selection s = select_effects(d.train, d.heldout);
+  print(s);
+  expect_effects(s, {{EffectKind::Coulomb, 2, 0.10}, {EffectKind::Coulomb, 4, 0.06}, {EffectKind::Offset, 5, -0.02},
+                     {EffectKind::ActuationDelay, 0, 0.004}});
+}
+
+}  // namespace
+
