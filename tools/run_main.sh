@@ -6,6 +6,7 @@
 # study on it (40 trajectories x 4 intervals: OLS, all-pose PD audit, conditional SDP, CLIE,
 # PCA selection, rescue, final audit, validation on V01-V03) with its report in
 # build/study/report/report.md. Both steps are resumable: a rerun skips what is finished.
+# Last, the model-gap diagnosis on twin data with hidden effects (build/diagnosis/).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash tools/install_deps.sh
@@ -25,3 +26,16 @@ $dynid twin dataset --robot crane_x7 -o build/twin-data --trials 1 --seed 1
 $dynid preprocess --robot crane_x7 build/twin-data/AG02_t1.csv
 $dynid twin bench --robot crane_x7 --seconds 3
 $dynid identify --robot crane_x7 --data build/twin-data -o build/study
+
+# The model-gap workflow: a twin dataset with hidden Coulomb friction (joints 2 and 4) and a
+# torque offset (joint 5), which dynid diagnose is not told about; it names them, writes
+# build/diagnosis/diagnosis.md (before/after on V01-V03, figures) and the robot.yaml variant
+# build/diagnosis/variant.yaml (dynid diagnose --apply would add it to robots/crane_x7).
+cat > build/hidden-effects.yaml <<'YAML'
+effects:
+  coulomb: {enabled: true, torque: [0, 0.10, 0, 0.06, 0, 0, 0, 0]}
+  torque_offset: {enabled: true, torque: [0, 0, 0, 0, 0.02, 0, 0, 0]}
+YAML
+$dynid twin dataset --robot crane_x7 -o build/gap-data --trials 1 --seed 2 --only AG02 V01 V02 V03 \
+  --config build/hidden-effects.yaml
+$dynid diagnose --robot crane_x7 --data build/gap-data -o build/diagnosis
