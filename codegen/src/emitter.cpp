@@ -54,7 +54,7 @@ std::string emit_body(const ExprGraph& g, const std::map<std::string, std::strin
   int temps = 0;
 
   static const std::regex plain_name("^[A-Za-z][A-Za-z0-9_]*$");
-  static const std::regex reserved("^(t[0-9]+|Scalar|q|qd|qdd|tau|phi|s|out|[A-Z]|M|W|T|J|h|basis|sin|cos|sign|pow|int|do|if|for|new|and|or|not|xor|auto|case|char|long|this|true|false|void)$");
+  static const std::regex reserved("^(t[0-9]+|Scalar|q|qd|qdd|tau|phi|s|out|[A-Z]|M|W|T|J|h|basis|sin|cos|sign|pow|exp|int|do|if|for|new|and|or|not|xor|auto|case|char|long|this|true|false|void)$");
   std::string body;
   std::unordered_map<NodeId, Text> text;
   for (NodeId id : order) {
@@ -83,6 +83,7 @@ std::string emit_body(const ExprGraph& g, const std::map<std::string, std::strin
       case Op::Sin: t = {"sin(" + arg(n.a).s + ")", kAtom}; break;
       case Op::Cos: t = {"cos(" + arg(n.a).s + ")", kAtom}; break;
       case Op::Sign: t = {"sign(" + arg(n.a).s + ")", kAtom}; break;
+      case Op::Exp: t = {"exp(" + arg(n.a).s + ")", kAtom}; break;
       case Op::Pow: {
         const double e = n.value;
         const std::string x = wrap(arg(n.a), kAtom);

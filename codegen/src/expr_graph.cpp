@@ -173,4 +173,9 @@ NodeId ExprGraph::sign(NodeId a) {
   return intern(Node{Op::Sign, a, -1, 0.0, -1});
 }
 
+NodeId ExprGraph::exp(NodeId a) {
+  if (is_constant(a)) return constant(std::exp(node(a).value));  // exp(0) = 1 exactly
+  return intern(Node{Op::Exp, a, -1, 0.0, -1});
+}
+
 }  // namespace symoro::codegen

@@ -4,6 +4,7 @@
 #include <set>
 #include <sstream>
 
+#include "symoro/codegen/effects.hpp"
 #include "symoro/codegen/emitter.hpp"
 
 namespace symoro::codegen {
@@ -35,9 +36,10 @@ using DimDerivatives = std::vector<std::vector<std::vector<NodeId>>>;
 class ModelWriter {
  public:
   ModelWriter(RobotModel& robot, const DimDerivatives& dd, std::string variant,
-              std::string description, std::vector<std::pair<std::string, double>> fixed)
+              std::string description, std::vector<std::pair<std::string, double>> fixed,
+              std::vector<EffectParameter> effects = {})
       : r_(robot), g_(robot.graph), dd_(dd), variant_(std::move(variant)),
-        description_(std::move(description)), fixed_(std::move(fixed)) {
+        description_(std::move(description)), fixed_(std::move(fixed)), effects_(std::move(effects)) {
     std::map<std::string, double> fixed_value(fixed_.begin(), fixed_.end());
     for (std::size_t p = 0; p < r_.base.size(); ++p) {
       auto it = fixed_value.find(r_.base[p].name);
@@ -48,6 +50,11 @@ class ModelWriter {
         fixed_index_.emplace_back(static_cast<int>(p), it->second);
       }
     }
+    for (const auto& e : effects_) {
+      const NodeId q = g_.symbol(r_.q[e.joint - 1]);
+      const NodeId qd = g_.symbol(r_.qd[e.joint - 1]);
+      effect_terms_.push_back(effect_term(g_, e, q, qd));
+    }
     ns_ = variant_.empty() ? "symoro::" + r_.name : "symoro::" + r_.name + "::" + variant_;
     dir_ = variant_.empty() ? "symoro/" + r_.name : "symoro/" + r_.name + "/" + variant_;
   }
@@ -57,6 +64,10 @@ class ModelWriter {
     summary.name = variant_.empty() ? r_.name : r_.name + "::" + variant_;
     summary.description = description_;
     for (int p : identified_) summary.identified.push_back(r_.base[p]);
+    for (const auto& e : effects_) {
+      summary.identified.push_back({e.name, e.family, e.joint, e.unit});
+      summary.effects.emplace_back(e.name, effect_term_text(e, r_.q[e.joint - 1], r_.qd[e.joint - 1]));
+    }
     summary.fixed = fixed_;
     summary_ = &summary;
     add(out, "model.hpp", model_header());
@@ -99,10 +110,38 @@ class ModelWriter {
     return false;
   }
 
+  // The entries of phi: the identified base parameters, then the effect parameters.
   std::vector<std::string> identified_names() const {
     std::vector<std::string> out;
     for (int p : identified_) out.push_back(r_.base[p].name);
+    for (const auto& e : effects_) out.push_back(e.name);
     return out;
+  }
+  int np() const { return static_cast<int>(identified_.size() + effects_.size()); }
+  int ne() const { return static_cast<int>(effects_.size()); }
+
+  // sum of phi_e * term_e over the effect parameters of joint j (0-based), 0 when it has none.
+  NodeId effect_torque(int j) {
+    NodeId sum = g_.zero();
+    for (std::size_t e = 0; e < effects_.size(); ++e)
+      if (effects_[e].joint == j + 1) {
+        const NodeId parameter = g_.symbol(effects_[e].name);
+        sum = g_.add(sum, g_.mul(parameter, effect_terms_[e]));
+      }
+    return sum;
+  }
+  std::vector<NodeId> plus_effects(std::vector<NodeId> tau) {
+    for (int j = 0; j < r_.n; ++j) tau[j] = g_.add(tau[j], effect_torque(j));
+    return tau;
+  }
+
+  // The `using` declarations of a function body: exp only where it is needed, so that models
+  // without effects read as before.
+  std::string usings(const std::vector<NodeId>& roots) const {
+    bool exp = false;
+    for (NodeId id : reachable(g_, roots)) exp = exp || g_.node(id).op == Op::Exp;
+    return std::string("  using std::cos;\n") + (exp ? "  using std::exp;\n" : "") +
+           "  using std::pow;\n  using std::sin;\n  using ::symoro::sign;\n";
   }
 
   Input q_in() const { return {"Q", "q", r_.q}; }
@@ -140,7 +179,7 @@ class ModelWriter {
     s += "template <" + types + "class Out>\n";
     s += "inline void " + name + "(" + params + "const Eigen::MatrixBase<Out>& out) {\n";
     if (!body.empty()) s += "  using Scalar = typename Out::Scalar;\n";  // unused when all outputs are 0
-    s += "  using std::cos;\n  using std::pow;\n  using std::sin;\n  using ::symoro::sign;\n";
+    s += usings(roots);
     s += sizes;
     for (const auto& i : in) s += "  static_cast<void>(" + i.name + ");\n";
     s += "  Eigen::MatrixBase<Out>& " + o.name + " = const_cast<Eigen::MatrixBase<Out>&>(out);\n";
@@ -180,32 +219,61 @@ class ModelWriter {
     s << "inline constexpr const char* variant_name = " << quoted(variant_) << ";\n";
     s << "inline constexpr const char* description = " << quoted(escape(description_)) << ";\n";
     s << "inline constexpr int nq = " << r_.n << ";  // joints\n";
-    s << "inline constexpr int np = " << identified_.size() << ";  // identified base parameters\n";
-    s << "inline constexpr int ns = " << r_.standard.size() << ";  // standard parameters\n";
-    s << "inline constexpr int nf = " << r_.frames.size() << ";  // frames\n\n";
+    if (ne() == 0) {
+      s << "inline constexpr int np = " << np() << ";  // identified base parameters\n";
+    } else {
+      s << "inline constexpr int np = " << np() << ";  // identified parameters: base parameters, then effect parameters\n";
+    }
+    s << "inline constexpr int ns = " << r_.standard.size() + effects_.size() << ";  // standard parameters\n";
+    s << "inline constexpr int nf = " << r_.frames.size() << ";  // frames\n";
+    if (ne() > 0)
+      s << "inline constexpr int ne = " << ne()
+        << ";  // effect parameters (robot.yaml effects): the last ne entries of phi and of s\n";
+    s << "\n";
     s << "// Identified base parameters: the columns of the regressor and the entries of phi.\n";
     s << "inline constexpr std::array<ParameterInfo, np> parameters = {{\n";
     for (int p : identified_) {
       const auto& b = r_.base[p];
       s << "    {" << quoted(b.name) << ", " << quoted(b.family) << ", " << b.joint << ", " << quoted(b.unit) << "},\n";
     }
+    for (const auto& e : effects_)
+      s << "    {" << quoted(e.name) << ", " << quoted(e.family) << ", " << e.joint << ", " << quoted(e.unit) << "},\n";
     s << "}};\n\n";
     s << "// Indices into phi by name: phi[param::" << (identified_.empty() ? "X" : r_.base[identified_[0]].name) << "].\n";
     s << "namespace param {\nenum : int {\n";
-    for (std::size_t i = 0; i < identified_.size(); ++i) s << "  " << r_.base[identified_[i]].name << " = " << i << ",\n";
+    const auto names = identified_names();
+    for (std::size_t i = 0; i < names.size(); ++i) s << "  " << names[i] << " = " << i << ",\n";
     s << "};\n}  // namespace param\n\n";
     s << "// Base parameters fixed at generation time (robot.yaml variants).\n";
     s << "inline constexpr std::array<FixedParameter, " << fixed_index_.size() << "> fixed_parameters = {{\n";
     for (const auto& [p, v] : fixed_index_) s << "    {" << quoted(r_.base[p].name) << ", " << cpp_literal(v) << "},\n";
     s << "}};\n\n";
-    s << "// Index of each identified parameter in the robot's full parameter vector.\n";
+    s << "// Index of each identified parameter in the robot's full parameter vector"
+      << (ne() > 0 ? " (-1 for the effect\n// parameters, which the full model does not have).\n" : ".\n");
     s << "inline constexpr std::array<int, np> parent_index = {{";
     for (std::size_t i = 0; i < identified_.size(); ++i) s << (i ? ", " : "") << identified_[i];
+    for (std::size_t i = 0; i < effects_.size(); ++i) s << (identified_.empty() && i == 0 ? "" : ", ") << -1;
     s << "}};\n\n";
-    s << "// Standard parameters (the .par's symbols): the argument of base_from_standard.\n";
+    if (ne() == 0) {
+      s << "// Standard parameters (the .par's symbols): the argument of base_from_standard.\n";
+    } else {
+      s << "// Standard parameters (the .par's symbols, then the effect parameters): the argument of\n"
+           "// base_from_standard.\n";
+    }
     s << "inline constexpr std::array<StandardParameterInfo, ns> standard_parameters = {{\n";
     for (const auto& p : r_.standard) s << "    {" << quoted(p.name) << ", " << quoted(p.family) << ", " << p.joint << "},\n";
+    for (const auto& e : effects_) s << "    {" << quoted(e.name) << ", " << quoted(e.family) << ", " << e.joint << "},\n";
     s << "}};\n\n";
+    if (ne() > 0) {
+      s << "// Effect parameters (robot.yaml effects), the last ne entries of phi: name, family, joint,\n"
+           "// order, velocity. Each adds phi * term to its joint's torque: OFF 1, FST sign(qd) exp(-(qd /\n"
+           "// velocity)^2), FVA |qd|, HS sin(order q), HC cos(order q).\n";
+      s << "inline constexpr std::array<EffectParameterInfo, ne> effect_parameters = {{\n";
+      for (const auto& e : effects_)
+        s << "    {" << quoted(e.name) << ", " << quoted(e.family) << ", " << e.joint << ", " << e.order << ", "
+          << cpp_literal(e.velocity) << "},\n";
+      s << "}};\n\n";
+    }
     s << "// name, type, position limits, velocity limit, effort limit, PD-audit domain.\n";
     s << "inline constexpr std::array<JointInfo, nq> joints = {{\n";
     for (int j = 0; j < r_.n; ++j) {
@@ -242,6 +310,7 @@ class ModelWriter {
   std::string base_parameters_header() {
     std::vector<NodeId> rows;
     for (int p : identified_) rows.push_back(r_.base_from_standard[p]);
+    for (const auto& e : effects_) rows.push_back(g_.symbol(e.name));  // identical in s and phi
     std::string s = banner("Base parameters from standard parameters (regp.txt), and to/from the full model.");
     s += "#include <Eigen/Core>\n\n#include \"symoro/scalar.hpp\"\n" + include_self("model.hpp");
     if (!variant_.empty()) s += "#include \"symoro/" + r_.name + "/model.hpp\"\n";
@@ -251,19 +320,23 @@ class ModelWriter {
                   "base_from_standard", {{"S", "s", standard_names()}}, {"phi", "np", "1", column(rows)});
     const std::string parent_np = "::symoro::" + r_.name + "::np";
     s += "// The robot's full base parameter vector from this model's phi, with fixed entries filled in.\n";
+    if (ne() > 0) s += "// The effect parameters (the last ne of phi) have no place in it and are dropped.\n";
+    const std::string loop_end = ne() > 0 ? "np - ne" : "np";
     s += "template <class Phi>\n";
     s += "inline Eigen::Matrix<typename Phi::Scalar, " + parent_np + ", 1> to_parent(const Eigen::MatrixBase<Phi>& phi) {\n";
     s += "  using Scalar = typename Phi::Scalar;\n  eigen_assert(phi.size() == np);\n";
     s += "  Eigen::Matrix<Scalar, " + parent_np + ", 1> full;\n";
-    s += "  for (int i = 0; i < np; ++i) full[parent_index[static_cast<std::size_t>(i)]] = phi[i];\n";
+    s += "  for (int i = 0; i < " + loop_end + "; ++i) full[parent_index[static_cast<std::size_t>(i)]] = phi[i];\n";
     for (const auto& [p, v] : fixed_index_) s += "  full[" + str(p) + "] = Scalar(" + cpp_literal(v) + ");  // " + r_.base[p].name + "\n";
     s += "  return full;\n}\n\n";
-    s += "// This model's phi from the robot's full base parameter vector (fixed entries are dropped).\n";
+    s += "// This model's phi from the robot's full base parameter vector (fixed entries are dropped";
+    s += ne() > 0 ? ";\n// the effect parameters, which it does not have, are 0).\n" : ").\n";
     s += "template <class Full>\n";
     s += "inline Eigen::Matrix<typename Full::Scalar, np, 1> from_parent(const Eigen::MatrixBase<Full>& full) {\n";
     s += "  eigen_assert(full.size() == " + parent_np + ");\n";
     s += "  Eigen::Matrix<typename Full::Scalar, np, 1> phi;\n";
-    s += "  for (int i = 0; i < np; ++i) phi[i] = full[parent_index[static_cast<std::size_t>(i)]];\n";
+    s += "  for (int i = 0; i < " + loop_end + "; ++i) phi[i] = full[parent_index[static_cast<std::size_t>(i)]];\n";
+    if (ne() > 0) s += "  for (int i = np - ne; i < np; ++i) phi[i] = typename Full::Scalar(0);\n";
     s += "  return phi;\n}\n\n";
     s += close();
     return s;
@@ -272,6 +345,7 @@ class ModelWriter {
   std::vector<std::string> standard_names() const {
     std::vector<std::string> out;
     for (const auto& p : r_.standard) out.push_back(p.name);
+    for (const auto& e : effects_) out.push_back(e.name);
     return out;
   }
 
@@ -280,6 +354,7 @@ class ModelWriter {
     std::vector<std::vector<NodeId>> W(r_.n), tau0(r_.n);
     for (int j = 0; j < r_.n; ++j) {
       for (int p : identified_) W[j].push_back(r_.dim[j][p]);
+      for (std::size_t e = 0; e < effects_.size(); ++e) W[j].push_back(effects_[e].joint == j + 1 ? effect_terms_[e] : g_.zero());
       NodeId sum = g_.zero();
       for (const auto& [p, v] : fixed_index_) sum = g_.add(sum, g_.mul(g_.constant(v), r_.dim[j][p]));
       tau0[j] = {sum};
@@ -298,7 +373,7 @@ class ModelWriter {
     std::string s = banner("Inverse dynamics (Newton-Euler, idm.txt).");
     s += kinematic_includes() + open();
     s += function("// Joint torques tau(q, qd, qdd; phi), friction and rotor inertia included.\n",
-                  "inverse_dynamics", {q_in(), qd_in(), qdd_in(), phi_in()}, {"tau", "nq", "1", column(specialize(r_.idm))});
+                  "inverse_dynamics", {q_in(), qd_in(), qdd_in(), phi_in()}, {"tau", "nq", "1", column(plus_effects(specialize(r_.idm)))});
     s += close();
     return s;
   }
@@ -307,16 +382,23 @@ class ModelWriter {
     std::string s = banner("Coriolis, centrifugal, gravity and friction torques (ccg.txt).");
     s += kinematic_includes() + open();
     s += function("// h(q, qd; phi) = tau(q, qd, 0; phi): Coriolis, centrifugal, gravity and friction.\n",
-                  "nonlinear_effects", {q_in(), qd_in(), phi_in()}, {"h", "nq", "1", column(specialize(r_.ccg))});
+                  "nonlinear_effects", {q_in(), qd_in(), phi_in()}, {"h", "nq", "1", column(plus_effects(specialize(r_.ccg)))});
     s += close();
     return s;
   }
 
   std::string forward_dynamics_header() {
+    // The effects' torques act like friction: ddm.txt runs on GAM - (their sum) per joint.
+    std::map<std::string, NodeId> replacements = replacements_;
+    for (int j = 0; j < r_.n; ++j) {
+      const NodeId t = effect_torque(j);
+      if (t != g_.zero()) replacements[r_.tau[j]] = g_.sub(g_.symbol(r_.tau[j]), t);
+    }
+    const auto qdd = substitute(g_, r_.ddm, replacements);
     std::string s = banner("Forward dynamics (direct dynamic model, ddm.txt).");
     s += kinematic_includes() + open();
     s += function("// Joint accelerations qdd(q, qd, tau; phi) = M^-1 (tau - h).\n",
-                  "forward_dynamics", {q_in(), qd_in(), tau_in(), phi_in()}, {"qdd", "nq", "1", column(specialize(r_.ddm))});
+                  "forward_dynamics", {q_in(), qd_in(), tau_in(), phi_in()}, {"qdd", "nq", "1", column(qdd)});
     s += close();
     return s;
   }
@@ -391,7 +473,7 @@ class ModelWriter {
     summary_->functions.push_back({"inertia_basis", count_operations(g_, roots)});
     s += "template <class Q, class Scalar>\n";
     s += "inline void inertia_basis(const Eigen::MatrixBase<Q>& q, InertiaBasis<Scalar>& basis) {\n";
-    s += "  using std::cos;\n  using std::pow;\n  using std::sin;\n  using ::symoro::sign;\n";
+    s += usings(roots);
     s += "  eigen_assert(q.size() == nq);\n  static_cast<void>(q);\n";
     s += "  basis.constant.setZero();\n  for (auto& m : basis.linear) m.setZero();\n";
     s += emit_body(g_, symbols, assignments, "  ");
@@ -413,11 +495,13 @@ class ModelWriter {
     s += "  static constexpr int np = " + ns_ + "::np;\n";
     s += "  static constexpr int ns = " + ns_ + "::ns;\n";
     s += "  static constexpr int nf = " + ns_ + "::nf;\n";
+    if (ne() > 0) s += "  static constexpr int ne = " + ns_ + "::ne;\n";
     for (const char* v : {"robot_name", "variant_name", "description"})
       s += "  static constexpr const char* " + std::string(v) + " = " + ns_ + "::" + v + ";\n";
     for (const char* v : {"parameters", "fixed_parameters", "parent_index", "standard_parameters", "joints", "frames",
                           "gravity"})
       s += "  static constexpr const auto& " + std::string(v) + " = " + ns_ + "::" + v + ";\n";
+    if (ne() > 0) s += "  static constexpr const auto& effect_parameters = " + ns_ + "::effect_parameters;\n";
     s += "  // The robot's full model (this type itself for the full model).\n";
     s += "  using Parent = " + (variant_.empty() ? std::string("Model") : "::symoro::" + r_.name + "::Model") + ";\n";
     s += "  template <class Scalar>\n  using InertiaBasis = " + ns_ + "::InertiaBasis<Scalar>;\n";
@@ -437,6 +521,8 @@ class ModelWriter {
   const DimDerivatives& dd_;
   std::string variant_, description_;
   std::vector<std::pair<std::string, double>> fixed_;
+  std::vector<EffectParameter> effects_;
+  std::vector<NodeId> effect_terms_;  // per effect parameter: its term on its joint's row
   std::vector<int> identified_;
   std::vector<std::pair<int, double>> fixed_index_;
   std::map<std::string, NodeId> replacements_;
@@ -444,7 +530,8 @@ class ModelWriter {
   ModelSummary* summary_ = nullptr;
 };
 
-// Resolves a variant's patterns to base parameters; every pattern must match something.
+// Resolves a variant's patterns to base parameters; every pattern must match something. The
+// base parameters its effects un-fix (coulomb, inertia_products) stay identified.
 std::vector<std::pair<std::string, double>> resolve_fixed(const RobotModel& r, const VariantSpec& v) {
   std::map<std::string, double> fixed;
   for (const auto& [pattern, value] : v.fixed) {
@@ -458,9 +545,45 @@ std::vector<std::pair<std::string, double>> resolve_fixed(const RobotModel& r, c
     }
     if (!matched) throw InputError(r.spec.path, v.line, 1, "variant " + v.name + ": '" + pattern + "' matches no base parameter");
   }
+  for (const auto& e : v.effects) {
+    const auto& families = unfixed_families(e.kind);
+    if (families.empty()) continue;
+    bool found = false;
+    for (const auto& p : r.base)
+      if (p.joint == e.index && std::find(families.begin(), families.end(), p.family) != families.end()) {
+        found = true;
+        fixed.erase(p.name);
+      }
+    if (!found) {
+      std::string list;
+      for (const auto& f : families) list += (list.empty() ? "" : ", ") + f + std::to_string(e.index);
+      throw InputError(r.spec.path, e.line, e.column,
+                       "variant " + v.name + ": effect " + effect_name(e.kind) + " on " +
+                           (effect_on_links(e.kind) ? "link " : "joint ") + std::to_string(e.index) +
+                           ": the model has no such base parameter (" + list + ")");
+    }
+  }
   std::vector<std::pair<std::string, double>> out;
   for (const auto& p : r.base)  // in parameter order
     if (auto it = fixed.find(p.name); it != fixed.end()) out.emplace_back(p.name, it->second);
+  return out;
+}
+
+// The parameters a variant's effects add; their names must be new symbols.
+std::vector<EffectParameter> resolve_effects(const RobotModel& r, const VariantSpec& v) {
+  auto unit = [&](const std::string& family, int joint) {
+    return r.frames[joint - 1].sigma == 1 ? r.spec.prismatic_units.at(family) : r.spec.units.at(family);
+  };
+  std::vector<EffectParameter> out = effect_parameters(v.effects, unit);
+  std::set<std::string> taken;
+  for (const auto& p : r.base) taken.insert(p.name);
+  for (const auto& p : r.standard) taken.insert(p.name);
+  for (const auto& c : r.spec.constants) taken.insert(c.first);
+  for (const auto* list : {&r.q, &r.qd, &r.qdd, &r.tau}) taken.insert(list->begin(), list->end());
+  for (const auto& p : out)
+    if (taken.count(p.name))
+      throw InputError(r.spec.path, v.line, 1,
+                       "variant " + v.name + ": the effect parameter " + p.name + " is already a name of the model");
   return out;
 }
 
@@ -488,7 +611,7 @@ Generation generate_robot(RobotModel& r) {
   full.write(out);
   std::vector<ModelWriter> variants;
   for (const auto& v : r.spec.variants) {
-    variants.emplace_back(r, dd, v.name, v.description, resolve_fixed(r, v));
+    variants.emplace_back(r, dd, v.name, v.description, resolve_fixed(r, v), resolve_effects(r, v));
     variants.back().write(out);
   }
 

@@ -37,6 +37,7 @@ static NodeId rebuild(ExprGraph& g, const Node& n, NodeId a, NodeId b) {
     case Op::Sin: return g.sin(a);
     case Op::Cos: return g.cos(a);
     case Op::Sign: return g.sign(a);
+    case Op::Exp: return g.exp(a);
     case Op::Constant:
     case Op::Symbol: break;
   }
@@ -87,6 +88,7 @@ std::vector<NodeId> differentiate(ExprGraph& g, const std::vector<NodeId>& roots
       case Op::Sin: out = g.mul(g.cos(n.a), d.at(n.a)); break;
       case Op::Cos: out = g.neg(g.mul(g.sin(n.a), d.at(n.a))); break;
       case Op::Sign: break;
+      case Op::Exp: out = g.mul(id, d.at(n.a)); break;  // exp(a)' = exp(a) a', reusing the node
     }
     d.emplace(id, out);
   }
@@ -116,6 +118,7 @@ OperationCount count_operations(const ExprGraph& g, const std::vector<NodeId>& r
       case Op::Sin:
       case Op::Cos: ++c.trig; break;
       case Op::Sign: ++c.sign; break;
+      case Op::Exp: ++c.exp; break;
       case Op::Constant:
       case Op::Symbol: break;
     }

@@ -221,6 +221,15 @@ RobotModel load_robot(const std::string& dir_in) {
   if (static_cast<int>(m.spec.joints.size()) != n)
     throw InputError(m.spec.path, 0, 0, "robot.yaml lists " + std::to_string(m.spec.joints.size()) +
                                             " joints but " + par_path + " has NJ = " + std::to_string(n));
+  for (const auto& v : m.spec.variants)
+    for (const auto& e : v.effects)
+      if (e.index > n) {
+        const std::string what = effect_on_links(e.kind) ? "link" : "joint";
+        throw InputError(m.spec.path, e.line, e.column,
+                         "variant " + v.name + ", effect " + effect_name(e.kind) + ": " + what + " " +
+                             std::to_string(e.index) + " is out of range (the robot has " + std::to_string(n) + " " +
+                             what + "s)");
+      }
 
   const auto &ant = pr.list("ant", n), &sigma = pr.list("sigma", n), &mu = pr.list("mu", n),
              &gamma = pr.list("gamma", n), &b = pr.list("b", n), &alpha = pr.list("alpha", n),

@@ -2,7 +2,9 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include <algorithm>
 #include <cmath>
+#include <functional>
 #include <regex>
 #include <set>
 
@@ -67,6 +69,130 @@ struct Reader {
 bool is_identifier(const std::string& s) {
   static const std::regex id("^[A-Za-z_][A-Za-z0-9_]*$");
   return std::regex_match(s, id);
+}
+
+// A whole number in [lo, hi]; messages start with `where`.
+int whole_number(const Reader& r, const YAML::Node& n, const std::string& what, int lo, int hi,
+                 const std::string& where) {
+  const double v = r.number(n, where + ": " + what);
+  if (v != std::floor(v)) r.fail(n, where + ": " + what + " must be a whole number, not '" + n.Scalar() + "'");
+  if (v < lo) r.fail(n, where + ": " + what + " " + n.Scalar() + " is out of range (at least " + std::to_string(lo) + ")");
+  if (v > hi) r.fail(n, where + ": " + what + " " + n.Scalar() + " is out of range (at most " + std::to_string(hi) + ")");
+  return static_cast<int>(v);
+}
+
+// A non-empty list of distinct whole numbers in [lo, hi], with the node of each.
+std::vector<std::pair<int, YAML::Node>> whole_numbers(const Reader& r, const YAML::Node& list, const std::string& what,
+                                                      int lo, int hi, const std::string& where) {
+  if (!list.IsSequence() || list.size() == 0)
+    r.fail(list, where + " needs a non-empty list of " + what + "s, e.g. [" + std::to_string(lo) + "]");
+  std::vector<std::pair<int, YAML::Node>> out;
+  for (const auto& item : list) {
+    const int k = whole_number(r, item, what, lo, hi, where);
+    for (const auto& [seen, node] : out)
+      if (seen == k) r.fail(item, where + ": duplicate " + what + " " + std::to_string(k));
+    out.emplace_back(k, item);
+  }
+  return out;
+}
+
+// A variant's own `effects:` map (effects.hpp has the catalogue).
+// Joint (link) numbers are checked against the robot's joints by load_robot, which knows them
+// from the .par: here only against the most joints a robot may have.
+std::vector<EffectSpec> read_effects(const Reader& r, const YAML::Node& effects, const std::string& variant) {
+  constexpr int kMaxJoints = 64;
+  const std::string where = "variant " + variant;
+  if (!effects.IsMap() || effects.size() == 0)
+    r.fail(effects, where + ": 'effects' must map effect names (" + effect_names() + ") to joints");
+  std::vector<EffectSpec> out;
+  std::set<std::string> seen;
+  for (const auto& kv : effects) {
+    const std::string name = kv.first.Scalar();
+    const auto kind = effect_kind(name);
+    if (!kind) r.fail(kv.first, where + ": unknown effect '" + name + "' (known effects: " + effect_names() + ")");
+    if (!seen.insert(name).second) r.fail(kv.first, where + ": effect " + name + " appears twice");
+    const std::string what = effect_on_links(*kind) ? "link" : "joint";
+    const std::string effect = where + ", effect " + name;
+    YAML::Node list;
+    list.reset(kv.second);  // reset, not =: assigning a YAML::Node rebinds what it refers to
+    double velocity = 0;
+    std::vector<int> orders;
+    if (*kind == EffectKind::Stribeck || *kind == EffectKind::PositionHarmonics) {
+      const bool stribeck = *kind == EffectKind::Stribeck;
+      const std::string form = stribeck ? "{joints: [...], velocity: <rad/s>}" : "{joints: [...], orders: [...]}";
+      if (!kv.second.IsMap()) r.fail(kv.second, effect + " takes " + form);
+      r.only_keys(kv.second, stribeck ? std::set<std::string>{"joints", "velocity"} : std::set<std::string>{"joints", "orders"},
+                  effect);
+      list.reset(kv.second["joints"]);
+      if (!list) r.fail(kv.second, effect + " needs 'joints': " + form);
+      if (stribeck) {
+        velocity = kDefaultStribeckVelocity;
+        if (const auto vel = kv.second["velocity"]) {
+          velocity = r.number(vel, "the Stribeck velocity");
+          if (!(velocity > 0)) r.fail(vel, effect + ": the Stribeck velocity must be positive (rad/s), not " + vel.Scalar());
+        }
+      } else {
+        const auto o = kv.second["orders"];
+        if (!o) r.fail(kv.second, effect + " needs 'orders': " + form);
+        for (const auto& [k, node] : whole_numbers(r, o, "order", 1, 1000, effect)) orders.push_back(k);
+        std::sort(orders.begin(), orders.end());
+      }
+    }
+    for (const auto& [j, node] : whole_numbers(r, list, what, 1, kMaxJoints, effect)) {
+      const YAML::Mark m = node.Mark();
+      out.push_back({*kind, j, velocity, orders, m.line + 1, m.column + 1});
+    }
+  }
+  return out;
+}
+
+struct RawVariant {
+  VariantSpec spec;     // its own fixed patterns and effects until resolve_bases
+  YAML::Node base_node;  // `base:`, when present
+};
+
+// Prepends each variant's base chain (fixed patterns and effects) to its own, in place.
+void resolve_bases(const Reader& r, std::vector<RawVariant>& raw) {
+  std::vector<int> state(raw.size(), 0);  // 0 to do, 1 on the current chain, 2 resolved
+  std::vector<std::string> chain;
+  std::function<void(std::size_t)> resolve = [&](std::size_t i) {
+    if (state[i] == 2) return;
+    RawVariant& v = raw[i];
+    state[i] = 1;
+    chain.push_back(v.spec.name);
+    if (!v.spec.base.empty()) {
+      std::size_t b = 0;
+      while (b < raw.size() && raw[b].spec.name != v.spec.base) ++b;
+      if (b == raw.size()) {
+        std::string names;
+        for (const auto& o : raw) names += (names.empty() ? "" : ", ") + o.spec.name;
+        r.fail(v.base_node, "variant " + v.spec.name + ": unknown base variant '" + v.spec.base + "' (variants: " + names + ")");
+      }
+      if (state[b] == 1) {
+        std::string cycle;
+        for (auto it = std::find(chain.begin(), chain.end(), raw[b].spec.name); it != chain.end(); ++it) cycle += *it + " -> ";
+        r.fail(v.base_node, "variant " + v.spec.name + ": the base chain " + cycle + raw[b].spec.name + " is a cycle");
+      }
+      resolve(b);
+      const VariantSpec& base = raw[b].spec;
+      for (const auto& e : v.spec.effects)
+        for (const auto& be : base.effects)
+          if (be.kind == e.kind && be.index == e.index)
+            throw InputError(r.path, e.line, e.column,
+                             "variant " + v.spec.name + ": effect " + effect_name(e.kind) + " on " +
+                                 (effect_on_links(e.kind) ? "link " : "joint ") + std::to_string(e.index) +
+                                 " is already in its base variant '" + base.name + "'");
+      std::vector<std::pair<std::string, double>> fixed = base.fixed;
+      fixed.insert(fixed.end(), v.spec.fixed.begin(), v.spec.fixed.end());
+      v.spec.fixed = fixed;
+      std::vector<EffectSpec> effects = base.effects;
+      effects.insert(effects.end(), v.spec.effects.begin(), v.spec.effects.end());
+      v.spec.effects = effects;
+    }
+    chain.pop_back();
+    state[i] = 2;
+  };
+  for (std::size_t i = 0; i < raw.size(); ++i) resolve(i);
 }
 
 }  // namespace
@@ -165,23 +291,38 @@ RobotSpec read_robot_spec(const std::string& path) {
   }
 
   if (const auto v = root["variants"]) {
-    if (!v.IsMap()) r.fail(v, "variants must map variant names to {description, fixed}");
+    if (!v.IsMap()) r.fail(v, "variants must map variant names to {description, base, fixed, effects}");
+    std::vector<RawVariant> raw;
     for (const auto& kv : v) {
-      VariantSpec vs;
+      RawVariant rv;
+      VariantSpec& vs = rv.spec;
       vs.name = kv.first.Scalar();
       vs.line = kv.first.Mark().line + 1;
       static const std::regex lower_id("^[a-z][a-z0-9_]*$");
       if (!std::regex_match(vs.name, lower_id) || vs.name == "full" || vs.name == "param")
         r.fail(kv.first, "variant name '" + vs.name +
                              "' must be a lower-case identifier other than 'full' and 'param'");
-      r.only_keys(kv.second, {"description", "fixed"}, "variant " + vs.name);
+      for (const auto& other : raw)
+        if (other.spec.name == vs.name) r.fail(kv.first, "duplicate variant name '" + vs.name + "'");
+      r.only_keys(kv.second, {"description", "base", "fixed", "effects"}, "variant " + vs.name);
       if (kv.second["description"]) vs.description = r.string(kv.second["description"], "description");
+      if (const auto b = kv.second["base"]) {
+        vs.base = r.string(b, "base");
+        rv.base_node.reset(b);  // reset, not =: assigning a YAML::Node rebinds what it refers to
+      }
       const auto f = kv.second["fixed"];
-      if (!f || !f.IsMap() || f.size() == 0)
-        r.fail(kv.second, "variant " + vs.name + " needs 'fixed': a map of parameter patterns to values");
-      for (const auto& p : f) vs.fixed.emplace_back(p.first.Scalar(), r.number(p.second, "fixed value"));
-      spec.variants.push_back(vs);
+      const auto e = kv.second["effects"];
+      if (f && !f.IsMap()) r.fail(f, "variant " + vs.name + ": 'fixed' must map parameter patterns to values");
+      if ((!f || f.size() == 0) && vs.base.empty() && !e)
+        r.fail(kv.second, "variant " + vs.name +
+                              " needs 'fixed': a map of parameter patterns to values (or 'base' or 'effects')");
+      if (f)
+        for (const auto& p : f) vs.fixed.emplace_back(p.first.Scalar(), r.number(p.second, "fixed value"));
+      if (e) vs.effects = read_effects(r, e, vs.name);
+      raw.push_back(rv);
     }
+    resolve_bases(r, raw);
+    for (const auto& rv : raw) spec.variants.push_back(rv.spec);
   }
   if (const auto id = root["identified"]) {
     spec.identified = r.string(id, "identified");

@@ -153,11 +153,20 @@ int info(const std::string& dir) {
       for (const auto& [name, v] : m.fixed) fixed += fmt::format(" {}={}", name, v);
       fmt::print("{}\n", fixed);
     }
-    fmt::print("  {:<20} {:>7} {:>7} {:>5} {:>5} {:>5} {:>5} {:>5} {:>7}\n", "function", "add", "mul", "div", "neg",
-               "pow", "trig", "sign", "total");
+    if (!m.effects.empty()) {
+      fmt::print("  effects (torque += parameter * term on its joint):\n");
+      for (const auto& [name, term] : m.effects) {
+        std::string unit;
+        for (const auto& p : m.identified)
+          if (p.name == name) unit = p.unit;
+        fmt::print("    {:<10} [{}] * {}\n", name, unit, term);
+      }
+    }
+    fmt::print("  {:<20} {:>7} {:>7} {:>5} {:>5} {:>5} {:>5} {:>5} {:>5} {:>7}\n", "function", "add", "mul", "div",
+               "neg", "pow", "trig", "sign", "exp", "total");
     for (const auto& f : m.functions)
-      fmt::print("  {:<20} {:>7} {:>7} {:>5} {:>5} {:>5} {:>5} {:>5} {:>7}\n", f.name, f.ops.add, f.ops.mul,
-                 f.ops.div, f.ops.neg, f.ops.pow, f.ops.trig, f.ops.sign, f.ops.total());
+      fmt::print("  {:<20} {:>7} {:>7} {:>5} {:>5} {:>5} {:>5} {:>5} {:>5} {:>7}\n", f.name, f.ops.add, f.ops.mul,
+                 f.ops.div, f.ops.neg, f.ops.pow, f.ops.trig, f.ops.sign, f.ops.exp, f.ops.total());
   }
   return 0;
 }

@@ -33,6 +33,7 @@ double eval(const ExprGraph& g, NodeId root, const std::map<std::string, double>
       case Op::Sin: v[id] = std::sin(a()); break;
       case Op::Cos: v[id] = std::cos(a()); break;
       case Op::Sign: v[id] = double((a() > 0) - (a() < 0)); break;
+      case Op::Exp: v[id] = std::exp(a()); break;
     }
   }
   return v.at(root);
@@ -71,6 +72,10 @@ TEST(ExprGraph, ConstantsAndIdentitiesFold) {
   EXPECT_EQ(g.node(g.node(c).a).value, 6.0);
   EXPECT_EQ(g.node(g.add(g.constant(0.25), g.constant(0.5))).value, 0.75);
   EXPECT_EQ(g.node(g.sign(g.constant(-3.0))).value, -1.0);
+  EXPECT_EQ(g.exp(g.zero()), g.one());
+  EXPECT_EQ(g.node(g.exp(g.constant(2.0))).value, std::exp(2.0));
+  EXPECT_EQ(g.exp(g.neg(x)), g.exp(g.neg(x)));
+  EXPECT_NE(g.exp(x), g.exp(g.neg(x)));
   // a + (-2) b is written a - 2 b
   EXPECT_EQ(g.node(g.add(x, g.mul(g.constant(-2.0), g.symbol("b")))).op, Op::Sub);
 }
@@ -90,8 +95,10 @@ TEST(Passes, DerivativesMatchFiniteDifferences) {
   ExprGraph g;
   const NodeId x = g.symbol("x"), y = g.symbol("y");
   // A mix of every operator, shaped like the model files' expressions.
-  const NodeId e = g.add(g.div(g.mul(g.sin(x), g.pow(y, 3.0)), g.add(g.constant(2.0), g.cos(g.mul(x, y)))),
-                         g.sub(g.neg(g.mul(g.constant(0.5), g.pow(x, 2.0))), g.mul(g.sign(y), y)));
+  const NodeId e = g.add(
+      g.add(g.div(g.mul(g.sin(x), g.pow(y, 3.0)), g.add(g.constant(2.0), g.cos(g.mul(x, y)))),
+            g.sub(g.neg(g.mul(g.constant(0.5), g.pow(x, 2.0))), g.mul(g.sign(y), y))),
+      g.mul(g.sign(x), g.exp(g.neg(g.pow(g.mul(g.constant(1.5), x), 2.0)))));  // a Stribeck term
   std::mt19937 rng(7);
   std::uniform_real_distribution<double> u(-2, 2);
   for (int trial = 0; trial < 20; ++trial) {
@@ -119,6 +126,25 @@ TEST(Passes, OperationCountsCountSharedNodesOnce) {
   EXPECT_EQ(c.pow, 1);
   EXPECT_EQ(c.mul, 1);
   EXPECT_EQ(c.add, 1);
+  EXPECT_EQ(c.exp, 0);
+  const NodeId x = g.symbol("x");
+  const auto ce = count_operations(g, {g.add(g.exp(x), g.mul(g.exp(x), x))});
+  EXPECT_EQ(ce.exp, 1);
+  EXPECT_EQ(ce.total(), 3);
+}
+
+TEST(Emitter, ExpIsWrittenAsACallResolvedForTheScalar) {
+  ExprGraph g;
+  const NodeId v = g.symbol("v");
+  const NodeId sign = g.sign(v);  // made first: the older operand of a product is written first
+  const NodeId e = g.mul(sign, g.exp(g.neg(g.pow(g.mul(g.constant(20.0), v), 2.0))));
+  EXPECT_EQ(emit_body(g, {{"v", "qd[1]"}}, {{"out(0)", e}}, ""),
+            "const Scalar v(qd[1]);\n"
+            "const Scalar t0 = 20.0 * v;\n"
+            "out(0) = sign(v) * exp(-(t0 * t0));\n");
+  // d/dv reuses the exp node.
+  const NodeId d = differentiate(g, {e}, "v")[0];
+  EXPECT_EQ(count_operations(g, {e, d}).exp, 1);
 }
 
 TEST(Emitter, LiteralsReadBackExactly) {

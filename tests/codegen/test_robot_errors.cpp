@@ -5,6 +5,8 @@
 #include <fstream>
 #include <regex>
 #include <sstream>
+#include <utility>
+#include <vector>
 
 #include "symoro/codegen/generator.hpp"
 #include "symoro/codegen/robot_model.hpp"
@@ -33,6 +35,12 @@ class BrokenRobot : public ::testing::Test {
   }
   void TearDown() override { fs::remove_all(dir_.parent_path()); }
 
+  // Starts from another folder of robots/ instead.
+  void start_from(const std::string& robot) {
+    fs::remove_all(dir_);
+    fs::copy(fs::path(SYMORO_ROBOTS_DIR) / robot, dir_);
+  }
+
   void replace(const std::string& file, const std::string& from, const std::string& to) {
     std::string text = read(dir_ / file);
     const auto at = text.find(from);
@@ -40,6 +48,11 @@ class BrokenRobot : public ::testing::Test {
     text.replace(at, from.size(), to);
     std::ofstream(dir_ / file) << text;
   }
+
+  // Adds variants (YAML lines indented by two spaces) to robot.yaml's `variants:` map, which
+  // ends the file: its first line is line kFirstAddedLine.
+  void add_variants(const std::string& yaml) { std::ofstream(dir_ / "robot.yaml", std::ios::app) << yaml; }
+  static constexpr int kFirstAddedLine = 28;
 
   // Loading and generating must fail with a message matching `pattern`.
   void expect_error(const std::string& pattern) {
@@ -92,7 +105,7 @@ TEST_F(BrokenRobot, BadJointLimitsPointAtTheYamlLine) {
 }
 
 TEST_F(BrokenRobot, VariantPatternThatMatchesNothing) {
-  std::ofstream(dir_ / "robot.yaml", std::ios::app) << "variants:\n  light:\n    fixed: {\"XY*\": 0}\n";
+  add_variants("  light:\n    fixed: {\"XY*\": 0}\n");
   expect_error(R"(robot\.yaml:\d+:1: error: variant light: 'XY\*' matches no base parameter)");
 }
 
@@ -112,14 +125,167 @@ TEST_F(BrokenRobot, MissingFile) {
 }
 
 TEST_F(BrokenRobot, VariantFixesParametersAndKeepsTheRest) {
-  std::ofstream(dir_ / "robot.yaml", std::ios::app)
-      << "variants:\n  frictionless:\n    fixed: {\"FS*\": 0, \"FV*\": 0}\n";
+  add_variants("  frictionless:\n    fixed: {\"FS*\": 0, \"FV*\": 0}\n");
+  RobotModel r = load_robot(dir_.string());
+  const Generation gen = generate_robot(r);
+  ASSERT_EQ(gen.models.size(), 3u);  // the full model, planar2r's `effects`, this one
+  EXPECT_EQ(gen.models[2].name, "arm::frictionless");
+  EXPECT_EQ(gen.models[2].identified.size(), 7u);
+  EXPECT_EQ(gen.models[2].fixed.size(), 4u);
+}
+
+// ---- variants with `base:` and `effects:` (planar2r's robot.yaml has the variant `effects`,
+// lines 19-27: fixed {"FS*": 0}; coulomb [1]; offset [1, 2]; stribeck joint 2 at 0.05;
+// viscous_asymmetry [2]; position_harmonics joint 1, orders 1 and 2).
+
+std::vector<std::string> names_of(const std::vector<ParameterRef>& ps) {
+  std::vector<std::string> out;
+  for (const auto& p : ps) out.push_back(p.name);
+  return out;
+}
+
+TEST_F(BrokenRobot, EffectsUnfixAndAppendParametersInCanonicalOrder) {
   RobotModel r = load_robot(dir_.string());
   const Generation gen = generate_robot(r);
   ASSERT_EQ(gen.models.size(), 2u);
-  EXPECT_EQ(gen.models[1].name, "arm::frictionless");
-  EXPECT_EQ(gen.models[1].identified.size(), 7u);
-  EXPECT_EQ(gen.models[1].fixed.size(), 4u);
+  const ModelSummary& m = gen.models[1];
+  EXPECT_EQ(m.name, "arm::effects");
+  EXPECT_EQ(names_of(m.identified),
+            (std::vector<std::string>{"ZZR1", "MXR1", "MY1", "ZZ2", "MX2", "MY2", "IA2", "FV1", "FV2", "FS1", "OFF1",
+                                      "OFF2", "FST2", "FVA2", "HS1_1", "HC1_1", "HS1_2", "HC1_2"}));
+  ASSERT_EQ(m.fixed.size(), 1u);  // "FS*" matches FS1 and FS2; coulomb [1] un-fixes FS1
+  EXPECT_EQ(m.fixed[0].first, "FS2");
+  EXPECT_EQ(m.identified[13].unit, "N*m*s/rad");
+  ASSERT_EQ(m.effects.size(), 8u);
+  EXPECT_EQ(m.effects[2], (std::pair<std::string, std::string>{"FST2", "sign(QP2)*exp(-(QP2/0.05)^2)"}));
+  EXPECT_EQ(m.effects[6], (std::pair<std::string, std::string>{"HS1_2", "sin(2*th1)"}));
+}
+
+TEST_F(BrokenRobot, BaseVariantChainsFixedPatternsAndEffects) {
+  add_variants(
+      "  more:\n"
+      "    base: effects\n"
+      "    fixed: {\"FV2\": 0}\n"
+      "    effects:\n"
+      "      position_harmonics: {joints: [2], orders: [3]}\n"
+      "      stribeck: {joints: [1]}\n"
+      "  most:\n"
+      "    base: more\n");
+  RobotModel r = load_robot(dir_.string());
+  const Generation gen = generate_robot(r);
+  ASSERT_EQ(gen.models.size(), 4u);
+  for (std::size_t k : {2u, 3u}) {
+    const ModelSummary& m = gen.models[k];
+    SCOPED_TRACE(m.name);
+    EXPECT_EQ(names_of(m.identified),
+              (std::vector<std::string>{"ZZR1", "MXR1", "MY1", "ZZ2", "MX2", "MY2", "IA2", "FV1", "FS1", "OFF1", "OFF2",
+                                        "FST1", "FST2", "FVA2", "HS1_1", "HC1_1", "HS1_2", "HC1_2", "HS2_3", "HC2_3"}));
+    EXPECT_EQ(m.fixed, (std::vector<std::pair<std::string, double>>{{"FV2", 0.0}, {"FS2", 0.0}}));
+    EXPECT_EQ(m.effects[2].second, "sign(QP1)*exp(-(QP1/0.05)^2)");  // the default Stribeck velocity
+  }
+}
+
+TEST_F(BrokenRobot, PrismaticJointsTakePrismaticUnits) {
+  start_from("stanford_rrp");  // joint 3 is prismatic
+  std::ofstream(dir_ / "robot.yaml", std::ios::app)
+      << "variants:\n  gap:\n    effects:\n      offset: [1, 3]\n      viscous_asymmetry: [3]\n";
+  RobotModel r = load_robot(dir_.string());
+  const Generation gen = generate_robot(r);
+  ASSERT_EQ(gen.models.size(), 2u);
+  const auto& ps = gen.models[1].identified;
+  ASSERT_GE(ps.size(), 3u);
+  const std::vector<ParameterRef> added(ps.end() - 3, ps.end());
+  EXPECT_EQ(names_of(added), (std::vector<std::string>{"OFF1", "OFF3", "FVA3"}));
+  EXPECT_EQ(added[0].unit, "N*m");
+  EXPECT_EQ(added[1].unit, "N");
+  EXPECT_EQ(added[2].unit, "N*s/m");
+}
+
+TEST_F(BrokenRobot, UnknownEffect) {
+  add_variants("  bad:\n    effects:\n      backlash: [1]\n");
+  expect_error(R"(robot\.yaml:30:7: error: variant bad: unknown effect 'backlash' \(known effects: coulomb, )"
+               R"(inertia_products, offset, stribeck, viscous_asymmetry, position_harmonics\))");
+}
+
+TEST_F(BrokenRobot, EffectJointOutOfRange) {
+  add_variants("  bad:\n    effects:\n      offset: [1, 3]\n");
+  expect_error(R"(robot\.yaml:30:19: error: variant bad, effect offset: joint 3 is out of range \(the robot has 2 joints\))");
+}
+
+TEST_F(BrokenRobot, EffectJointMustBeAWholeNumberFromOne) {
+  add_variants("  bad:\n    effects:\n      offset: [0]\n  worse:\n    effects:\n      coulomb: [1.5]\n");
+  expect_error(R"(robot\.yaml:30:16: error: variant bad, effect offset: joint 0 is out of range \(at least 1\))");
+  replace("robot.yaml", "offset: [0]", "offset: [1]");
+  expect_error(R"(robot\.yaml:33:17: error: variant worse, effect coulomb: joint must be a whole number, not '1\.5')");
+}
+
+TEST_F(BrokenRobot, EffectKeyTwice) {
+  add_variants("  bad:\n    effects:\n      offset: [1]\n      offset: [2]\n");
+  expect_error(R"(robot\.yaml:31:7: error: variant bad: effect offset appears twice)");
+}
+
+TEST_F(BrokenRobot, EffectJointTwice) {
+  add_variants("  bad:\n    effects:\n      viscous_asymmetry: [2, 2]\n");
+  expect_error(R"(robot\.yaml:30:30: error: variant bad, effect viscous_asymmetry: duplicate joint 2)");
+}
+
+TEST_F(BrokenRobot, StribeckVelocityMustBePositive) {
+  add_variants("  bad:\n    effects:\n      stribeck: {joints: [1], velocity: 0}\n");
+  expect_error(R"(robot\.yaml:30:41: error: variant bad, effect stribeck: the Stribeck velocity must be positive)");
+}
+
+TEST_F(BrokenRobot, HarmonicOrderMustBeAtLeastOne) {
+  add_variants("  bad:\n    effects:\n      position_harmonics: {joints: [1], orders: [1, 0]}\n");
+  expect_error(R"(robot\.yaml:30:53: error: variant bad, effect position_harmonics: order 0 is out of range \(at least 1\))");
+}
+
+TEST_F(BrokenRobot, HarmonicsNeedOrders) {
+  add_variants("  bad:\n    effects:\n      position_harmonics: {joints: [1]}\n");
+  expect_error(R"(robot\.yaml:30:27: error: variant bad, effect position_harmonics needs 'orders')");
+}
+
+TEST_F(BrokenRobot, EffectOnALinkWithoutSuchParameters) {
+  add_variants("  bad:\n    effects:\n      inertia_products: [1]\n");  // planar2r has no XY, XZ, YZ
+  expect_error(R"(robot\.yaml:30:26: error: variant bad: effect inertia_products on link 1: the model has no such )"
+               R"(base parameter \(XY1, XZ1, YZ1\))");
+}
+
+TEST_F(BrokenRobot, CoulombOfAJointWithoutFS) {
+  start_from("crane_x7_reduced");  // OpenSYMORO's reduced files: no Coulomb friction at all
+  std::ofstream(dir_ / "robot.yaml", std::ios::app) << "variants:\n  gap:\n    effects:\n      coulomb: [3]\n";
+  expect_error(R"(robot\.yaml:27:17: error: variant gap: effect coulomb on joint 3: the model has no such )"
+               R"(base parameter \(FS3\))");
+}
+
+TEST_F(BrokenRobot, UnknownBaseVariant) {
+  add_variants("  bad:\n    base: reduced\n");
+  expect_error(R"(robot\.yaml:29:11: error: variant bad: unknown base variant 'reduced' \(variants: effects, bad\))");
+}
+
+TEST_F(BrokenRobot, BaseChainCycle) {
+  add_variants("  one:\n    base: two\n  two:\n    base: three\n  three:\n    base: one\n");
+  expect_error(R"(robot\.yaml:33:11: error: variant three: the base chain one -> two -> three -> one is a cycle)");
+}
+
+TEST_F(BrokenRobot, VariantIsItsOwnBase) {
+  add_variants("  self:\n    base: self\n");
+  expect_error(R"(robot\.yaml:29:11: error: variant self: the base chain self -> self is a cycle)");
+}
+
+TEST_F(BrokenRobot, EffectAlreadyInTheBaseVariant) {
+  add_variants("  more:\n    base: effects\n    effects:\n      offset: [2]\n");
+  expect_error(R"(robot\.yaml:31:16: error: variant more: effect offset on joint 2 is already in its base variant 'effects')");
+}
+
+TEST_F(BrokenRobot, EffectsMustBeAMap) {
+  add_variants("  bad:\n    effects: [offset]\n");
+  expect_error(R"(robot\.yaml:29:14: error: variant bad: 'effects' must map effect names)");
+}
+
+TEST_F(BrokenRobot, EffectParameterNameClashes) {
+  // A geometric constant named like the parameter an offset of joint 2 adds.
+  replace("robot.yaml", "  G3: 9.80665     # m/s^2\n", "  G3: 9.80665     # m/s^2\n  OFF2: 1.0\n");
+  expect_error(R"(robot\.yaml:20:1: error: variant effects: the effect parameter OFF2 is already a name of the model)");
 }
 
 TEST(Generation, IsReproducible) {

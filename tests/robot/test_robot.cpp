@@ -77,13 +77,18 @@ class RobotModel : public ::testing::Test {
 TYPED_TEST_SUITE(RobotModel, Models, ModelName);
 
 // ---- a. OpenSYMORO's model files, interpreted -------------------------------------------------
+// A variant's effect terms (robot.yaml `effects`) are not in the files: they are added from the
+// hand-written formulas of test_support.hpp (effect_columns, effect_torque).
 
 TYPED_TEST(RobotModel, RegressorMatchesDimColumnByName) {
   using M = TypeParam;
+  constexpr int ne = effect_count<M>;
   const auto names = parameter_names<M>();
   this->for_states([&](const State<M>& s, const auto&) {
-    EXPECT_TRUE(close(M::regressor(s.q, s.qd, s.qdd), this->ref().regressor(s.q, s.qd, s.qdd, names),
-                      kRelTol, names));
+    Eigen::MatrixXd expected = this->ref().regressor(s.q, s.qd, s.qdd, names);
+    EXPECT_TRUE(expected.rightCols(ne).isZero(0.0)) << "an effect parameter is a column of dim.txt";
+    expected.rightCols(ne) = effect_columns<M>(s.q, s.qd);
+    EXPECT_TRUE(close(M::regressor(s.q, s.qd, s.qdd), expected, kRelTol, names));
   });
 }
 
@@ -91,7 +96,8 @@ TYPED_TEST(RobotModel, InverseDynamicsMatchesIdm) {
   using M = TypeParam;
   this->for_states([&](const State<M>& s, const ParameterVector<M>& phi) {
     EXPECT_TRUE(close(M::inverse_dynamics(s.q, s.qd, s.qdd, phi),
-                      this->ref().inverse_dynamics(s.q, s.qd, s.qdd, parent_parameter_values<M>(phi)),
+                      this->ref().inverse_dynamics(s.q, s.qd, s.qdd, parent_parameter_values<M>(phi)) +
+                          effect_torque<M>(s.q, s.qd, phi),
                       kRelTol));
   });
 }
@@ -108,7 +114,8 @@ TYPED_TEST(RobotModel, NonlinearEffectsMatchCcg) {
   using M = TypeParam;
   this->for_states([&](const State<M>& s, const ParameterVector<M>& phi) {
     EXPECT_TRUE(close(M::nonlinear_effects(s.q, s.qd, phi),
-                      this->ref().nonlinear_effects(s.q, s.qd, parent_parameter_values<M>(phi)),
+                      this->ref().nonlinear_effects(s.q, s.qd, parent_parameter_values<M>(phi)) +
+                          effect_torque<M>(s.q, s.qd, phi),
                       kRelTol));
   });
 }
@@ -118,8 +125,10 @@ TYPED_TEST(RobotModel, ForwardDynamicsMatchesDdm) {
   this->for_states([&](const State<M>& s, const auto&) {
     const ParameterVector<M> phi = this->physical_phi();
     const JointVector<M> tau = this->random_torque();
+    // The effects' torque acts on the joints like friction: ddm.txt sees tau minus it.
+    const Eigen::VectorXd net = tau - effect_torque<M>(s.q, s.qd, phi);
     EXPECT_TRUE(close(M::forward_dynamics(s.q, s.qd, tau, phi),
-                      this->ref().forward_dynamics(s.q, s.qd, tau, parent_parameter_values<M>(phi)),
+                      this->ref().forward_dynamics(s.q, s.qd, net, parent_parameter_values<M>(phi)),
                       kRelTol));
   });
 }
@@ -297,16 +306,19 @@ Eigen::VectorXd newton_euler_torque(const std::vector<LinkInertia>& links, const
 }
 
 // For a variant the standard parameters are drawn so that the base parameters it fixes have
-// their fixed values (standard_parameters_of_variant); the first check is that premise.
+// their fixed values (standard_parameters_of_variant); the first check is that premise. The
+// effect parameters (the last ne of s) add their hand-written terms to the Newton-Euler torque.
 TYPED_TEST(RobotModel, NewtonEulerWithStandardParametersMatchesInverseDynamics) {
   using M = TypeParam;
   using Parent = typename M::Parent;
   this->for_states([&](const State<M>& s, const auto&) {
     const auto standard = standard_parameters_of_variant<M>(this->rng_);
     const ParameterVector<M> phi = M::base_from_standard(standard.s);
-    ASSERT_TRUE(close(M::to_parent(phi), Parent::base_from_standard(standard.s), kRelTol));
+    const Eigen::Matrix<double, Parent::ns, 1> par_s = standard.s.template head<Parent::ns>();
+    ASSERT_TRUE(close(M::to_parent(phi), Parent::base_from_standard(par_s), kRelTol));
     EXPECT_TRUE(close(M::inverse_dynamics(s.q, s.qd, s.qdd, phi),
-                      newton_euler_torque<M>(standard.links, s), kRelTol));
+                      newton_euler_torque<M>(standard.links, s) + effect_torque<M>(s.q, s.qd, standard.s),
+                      kRelTol));
   });
 }
 
@@ -334,8 +346,8 @@ TYPED_TEST(RobotModel, NewtonEulerColumnsGiveTheInertia) {
 
 TYPED_TEST(RobotModel, ParameterMetadataIsWellFormed) {
   using M = TypeParam;
-  static const std::set<std::string> families = {"XX", "XY", "XZ", "YY", "YZ", "ZZ", "MX",
-                                                 "MY", "MZ", "M",  "IA", "FV", "FS"};
+  static const std::set<std::string> families = {"XX", "XY", "XZ", "YY", "YZ", "ZZ", "MX",  "MY", "MZ",
+                                                 "M",  "IA", "FV", "FS", "OFF", "FST", "FVA", "HS", "HC"};
   std::set<std::string> seen;
   for (const auto& p : M::parameters) {
     SCOPED_TRACE(p.name);
@@ -346,6 +358,27 @@ TYPED_TEST(RobotModel, ParameterMetadataIsWellFormed) {
     EXPECT_LE(p.joint, int(M::frames.size()));
   }
   EXPECT_EQ(int(M::parameters.size()), M::np);
+  // Effect parameters are the last ne, in the order of effect_parameters, and nothing else is.
+  constexpr int ne = effect_count<M>;
+  for (int i = 0; i < M::np; ++i)
+    EXPECT_EQ(is_effect_family(M::parameters[i].family), i >= M::np - ne) << M::parameters[i].name;
+  if constexpr (ne > 0) {
+    for (int k = 0; k < ne; ++k) {
+      const auto& p = M::parameters[M::np - ne + k];
+      const auto& e = M::effect_parameters[k];
+      SCOPED_TRACE(e.name);
+      EXPECT_EQ(std::string(p.name), e.name);
+      EXPECT_EQ(std::string(p.family), e.family);
+      EXPECT_EQ(p.joint, e.joint);
+      EXPECT_LE(e.joint, M::nq);
+      EXPECT_EQ(M::parent_index[M::np - ne + k], -1);
+      const auto& sp = M::standard_parameters[M::ns - ne + k];
+      EXPECT_EQ(std::string(sp.name), e.name);
+      const std::string family = e.family;
+      EXPECT_EQ(e.order >= 1, family == "HS" || family == "HC");
+      EXPECT_EQ(e.velocity > 0, family == "FST");
+    }
+  }
 }
 
 // The full model's parameters are exactly the columns of dim.txt and the parameter symbols of
@@ -362,24 +395,30 @@ TYPED_TEST(RobotModel, ParametersAreTheBaseParametersOfTheFiles) {
     EXPECT_EQ(mine, std::set<std::string>(symbols.begin(), symbols.end()));
     EXPECT_EQ(M::fixed_parameters.size(), 0u);
   } else {
-    EXPECT_EQ(M::np + int(M::fixed_parameters.size()), Parent::np);
-    std::set<std::string> all = mine;
+    constexpr int ne = effect_count<M>;
+    EXPECT_EQ(M::np - ne + int(M::fixed_parameters.size()), Parent::np);
+    std::set<std::string> all(names.begin(), names.end() - ne);
     for (const auto& f : M::fixed_parameters) EXPECT_TRUE(all.insert(f.name).second) << f.name;
     const auto parent = parameter_names<Parent>();
     EXPECT_EQ(all, std::set<std::string>(parent.begin(), parent.end()));
   }
 }
 
-// to_parent fills the fixed values in and from_parent selects: a round trip is the identity,
-// and each parameter keeps its name.
+// to_parent fills the fixed values in and from_parent selects: a round trip is the identity
+// (but for the effect parameters, which the full model lacks: they come back 0), and each
+// parameter keeps its name.
 TYPED_TEST(RobotModel, ToParentAndFromParentAreConsistent) {
   using M = TypeParam;
   using Parent = typename M::Parent;
+  constexpr int ne = effect_count<M>;
   this->for_states([&](const State<M>&, const ParameterVector<M>& phi) {
     const Eigen::Matrix<double, Parent::np, 1> full = M::to_parent(phi);
-    EXPECT_TRUE(close(M::from_parent(full), phi, 0.0));
+    ParameterVector<M> expected = phi;
+    expected.tail(ne).setZero();
+    EXPECT_TRUE(close(M::from_parent(full), expected, 0.0));
     const ParameterValues by_name = parent_parameter_values<M>(phi);
-    for (int i = 0; i < M::np; ++i) EXPECT_EQ(by_name.at(M::parameters[i].name), phi(i));
+    for (int i = 0; i < M::np - ne; ++i) EXPECT_EQ(by_name.at(M::parameters[i].name), phi(i));
+    for (int i = M::np - ne; i < M::np; ++i) EXPECT_EQ(by_name.count(M::parameters[i].name), 0u);
     for (const auto& f : M::fixed_parameters) EXPECT_EQ(by_name.at(f.name), f.value) << f.name;
   });
 }
@@ -450,10 +489,13 @@ TYPED_TEST(RobotModel, GravityAndStandardParametersFollowThePar) {
       if (e.kind == grammar::Expr::Kind::Symbol)
         expected.push_back(e.name + " " + family + " " + std::to_string(j + 1));
     }
+  // The effect parameters of a variant follow (the last ne; checked with the metadata).
   std::vector<std::string> listed;
-  for (const auto& p : M::standard_parameters)
+  for (int k = 0; k < par_standard_count<M>; ++k) {
+    const auto& p = M::standard_parameters[k];
     listed.push_back(std::string(p.name) + " " + p.family + " " + std::to_string(p.joint));
-  EXPECT_EQ(int(listed.size()), M::ns);
+  }
+  EXPECT_EQ(int(listed.size()), M::ns - effect_count<M>);
   if constexpr (TestFixture::is_full) {
     EXPECT_EQ(listed, expected);
   } else {

@@ -9,6 +9,7 @@
 #include <sstream>
 #include <stdexcept>
 #include <string>
+#include <type_traits>
 #include <vector>
 
 #include <Eigen/Core>
@@ -137,6 +138,61 @@ inline std::vector<double*> link_entry(LinkInertia& L, const std::string& family
   return out;
 }
 
+// ---- model-gap effects (robot.yaml `effects`) -------------------------------------------------
+// A variant with effects publishes ne and effect_parameters: the last ne entries of phi and of
+// s. Their torque terms are written here from the documentation (docs/generated-api.md), not
+// taken from the generated code.
+
+template <class Model, class = void>
+struct EffectCount : std::integral_constant<int, 0> {};
+template <class Model>
+struct EffectCount<Model, std::void_t<decltype(Model::ne)>> : std::integral_constant<int, Model::ne> {};
+template <class Model>
+inline constexpr int effect_count = EffectCount<Model>::value;
+
+inline bool is_effect_family(const std::string& family) {
+  return family == "OFF" || family == "FST" || family == "FVA" || family == "HS" || family == "HC";
+}
+
+// The term an effect parameter multiplies in its joint's torque, at that joint's q and qd.
+inline double effect_term(const std::string& family, int order, double velocity, double q, double qd) {
+  if (family == "OFF") return 1.0;
+  if (family == "FST") return sign_of(qd) * std::exp(-(qd / velocity) * (qd / velocity));
+  if (family == "FVA") return std::abs(qd);
+  if (family == "HS") return std::sin(order * q);
+  if (family == "HC") return std::cos(order * q);
+  throw std::invalid_argument("unknown effect family '" + family + "'");
+}
+
+// The effects' regressor columns (nq x ne): column k holds effect parameter k's term on the row
+// of its joint. Empty (nq x 0) for a model without effects.
+template <class Model, class Q, class QD>
+Eigen::MatrixXd effect_columns(const Q& q, const QD& qd) {
+  Eigen::MatrixXd W = Eigen::MatrixXd::Zero(Model::nq, effect_count<Model>);
+  if constexpr (effect_count<Model> > 0) {
+    for (int k = 0; k < Model::ne; ++k) {
+      const auto& e = Model::effect_parameters[k];
+      const int j = e.joint - 1;
+      W(j, k) = effect_term(e.family, e.order, e.velocity, double(q(j)), double(qd(j)));
+    }
+  }
+  return W;
+}
+
+// The effects' torque for the effect entries `values` (size ne) of phi or s.
+template <class Model, class Q, class QD, class V>
+Eigen::VectorXd effect_torque(const Q& q, const QD& qd, const V& values) {
+  if constexpr (effect_count<Model> == 0) {
+    return Eigen::VectorXd::Zero(Model::nq);
+  } else {
+    return effect_columns<Model>(q, qd) * Eigen::VectorXd(values.tail(Model::ne));
+  }
+}
+
+// The number of standard parameters of the robot's .par (Model::ns without the effects).
+template <class Model>
+inline constexpr int par_standard_count = Model::ns - effect_count<Model>;
+
 // Standard parameters of a model: the vector s of Model::standard_parameters and the same
 // values per link, for the Newton-Euler reference (entries s does not list are 0, as in the
 // robot's .par).
@@ -149,14 +205,15 @@ struct StandardParameters {
 template <class Model>
 std::vector<LinkInertia> links_from_standard(const Eigen::Matrix<double, Model::ns, 1>& s) {
   std::vector<LinkInertia> links(Model::frames.size());
-  for (int k = 0; k < Model::ns; ++k) {
+  for (int k = 0; k < par_standard_count<Model>; ++k) {
     const auto& p = Model::standard_parameters[k];
     for (double* slot : link_entry(links.at(p.joint - 1), p.family)) *slot = s(k);
   }
   return links;
 }
 
-// Physical random standard parameters: the listed entries of physical random links.
+// Physical random standard parameters: the listed entries of physical random links; the effect
+// parameters of a variant with effects (the last ne of s) are drawn in [-0.5, 0.5].
 template <class Model>
 StandardParameters<Model> random_standard_parameters(Random& rng) {
   std::vector<LinkInertia> drawn;
@@ -164,7 +221,7 @@ StandardParameters<Model> random_standard_parameters(Random& rng) {
   StandardParameters<Model> out;
   for (int k = 0; k < Model::ns; ++k) {
     const auto& p = Model::standard_parameters[k];
-    out.s(k) = *link_entry(drawn.at(p.joint - 1), p.family).front();
+    out.s(k) = is_effect_family(p.family) ? rng.uniform(-0.5, 0.5) : *link_entry(drawn.at(p.joint - 1), p.family).front();
   }
   out.links = links_from_standard<Model>(out.s);
   return out;
@@ -182,9 +239,9 @@ StandardParameters<Model> standard_parameters_of_variant(Random& rng) {
   StandardParameters<Model> out = random_standard_parameters<Model>(rng);
   const int nfixed = static_cast<int>(Model::fixed_parameters.size());
   if (nfixed == 0) return out;
-  Eigen::MatrixXd B(Parent::np, Model::ns);
-  for (int k = 0; k < Model::ns; ++k)
-    B.col(k) = Parent::base_from_standard(Eigen::Matrix<double, Model::ns, 1>::Unit(k));
+  Eigen::MatrixXd B = Eigen::MatrixXd::Zero(Parent::np, Model::ns);  // effect columns stay 0
+  for (int k = 0; k < Parent::ns; ++k)
+    B.col(k) = Parent::base_from_standard(Eigen::Matrix<double, Parent::ns, 1>::Unit(k));
   Eigen::MatrixXd fixed_rows(nfixed, Model::ns);
   Eigen::VectorXd fixed_values(nfixed);
   for (int f = 0; f < nfixed; ++f) {
@@ -206,7 +263,7 @@ StandardParameters<Model> standard_parameters_of_variant(Random& rng) {
 }
 
 // The base parameters of the robot's full model by name, from a model's phi (fixed entries of a
-// variant filled in by to_parent).
+// variant filled in by to_parent; effect parameters, which the full model lacks, dropped).
 template <class Model>
 ParameterValues parent_parameter_values(const ParameterVector<Model>& phi) {
   using Parent = typename Model::Parent;

@@ -25,6 +25,7 @@ enum class Op : std::uint8_t {
   Sin,
   Cos,
   Sign,      // -1, 0, +1
+  Exp,       // e ** a
 };
 
 struct Node {
@@ -50,6 +51,7 @@ class ExprGraph {
   NodeId sin(NodeId a);
   NodeId cos(NodeId a);
   NodeId sign(NodeId a);
+  NodeId exp(NodeId a);
 
   NodeId zero() const { return zero_; }
   NodeId one() const { return one_; }

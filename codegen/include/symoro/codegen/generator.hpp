@@ -23,8 +23,9 @@ struct FunctionSummary {
 struct ModelSummary {
   std::string name;  // "crane_x7" or "crane_x7::reduced"
   std::string description;
-  std::vector<ParameterRef> identified;
+  std::vector<ParameterRef> identified;  // base parameters, then effect parameters
   std::vector<std::pair<std::string, double>> fixed;
+  std::vector<std::pair<std::string, std::string>> effects;  // effect parameter, the term it multiplies
   std::vector<FunctionSummary> functions;
 };
 

@@ -1,6 +1,7 @@
 // robot.yaml: what the OpenSYMORO files do not say. Values of the geometric constants, joint
 // names and limits, parameter units, the PD-audit domain, and the variants that fix some base
-// parameters to constants at generation time (the rest are identified).
+// parameters to constants at generation time (the rest are identified) and may add model-gap
+// effects (effects.hpp).
 #pragma once
 
 #include <map>
@@ -9,6 +10,8 @@
 #include <string>
 #include <utility>
 #include <vector>
+
+#include "symoro/codegen/effects.hpp"
 
 namespace symoro::codegen {
 
@@ -29,8 +32,13 @@ struct JointSpec {
 struct VariantSpec {
   std::string name;
   std::string description;
-  // Base parameter name patterns (`*` matches any run of characters) and their fixed values.
+  std::string base;  // the variant it starts from ('base:'), empty for none
+  // Base parameter name patterns (`*` matches any run of characters) and their fixed values:
+  // the base variant's (recursively) first, then the variant's own.
   std::vector<std::pair<std::string, double>> fixed;
+  // Model-gap effects ('effects:'): the base variant's, then the variant's own; at most one
+  // entry per effect and joint (or link).
+  std::vector<EffectSpec> effects;
   int line = 0;  // in robot.yaml
 };
 

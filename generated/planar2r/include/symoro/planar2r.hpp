@@ -5,12 +5,13 @@
 #include <tuple>
 
 #include "symoro/planar2r/all.hpp"
+#include "symoro/planar2r/effects/all.hpp"
 
 namespace symoro::planar2r {
 
 // The identified model by default (robot.yaml 'identified').
 using IdentifiedModel = ::symoro::planar2r::Model;
 // The full model first, then every variant.
-using Models = std::tuple<::symoro::planar2r::Model>;
+using Models = std::tuple<::symoro::planar2r::Model, ::symoro::planar2r::effects::Model>;
 
 }  // namespace symoro::planar2r

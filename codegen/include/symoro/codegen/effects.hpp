@@ -1,0 +1,73 @@
+// Model-gap effects of robot.yaml variants (`effects:`), the catalogue in one place: effect
+// names, the base parameters an effect un-fixes, the parameters it adds (names, families,
+// units, canonical order) and their torque terms. See docs/generated-api.md, "Effects in
+// variants".
+//
+//   coulomb             un-fixes FS<j> (the files already have FSj*sign(QPj))
+//   inertia_products    un-fixes the XY, XZ, YZ base parameters of link j
+//   offset              OFF<j>    [N*m | N]           OFFj * 1
+//   stribeck            FST<j>    [N*m | N]           FSTj * sign(QPj) * exp(-(QPj/v)^2)
+//   viscous_asymmetry   FVA<j>    [N*m*s/rad | N*s/m] FVAj * |QPj|  (QPj*sign(QPj))
+//   position_harmonics  HS<j>_<k>, HC<j>_<k> [N*m | N]  HSj_k*sin(k*qj), HCj_k*cos(k*qj)
+#pragma once
+
+#include <functional>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "symoro/codegen/expr_graph.hpp"
+
+namespace symoro::codegen {
+
+// In catalogue order, which is also the order of the parameters the effects add.
+enum class EffectKind { Coulomb, InertiaProducts, Offset, Stribeck, ViscousAsymmetry, PositionHarmonics };
+
+// The robot.yaml key of an effect ("coulomb", "inertia_products", ...) and back.
+const std::string& effect_name(EffectKind kind);
+std::optional<EffectKind> effect_kind(const std::string& name);
+// Every key, comma separated, in catalogue order (for messages).
+std::string effect_names();
+
+// Whether the effect names links (inertia_products) rather than joints.
+bool effect_on_links(EffectKind kind);
+// The base parameter families the effect un-fixes on its joint or link: {"FS"} for coulomb,
+// {"XY", "XZ", "YZ"} for inertia_products, none for the effects that add parameters.
+const std::vector<std::string>& unfixed_families(EffectKind kind);
+
+inline constexpr double kDefaultStribeckVelocity = 0.05;  // rad/s (m/s for a prismatic joint)
+
+// One effect on one joint (or link) of a variant, as robot.yaml states it.
+struct EffectSpec {
+  EffectKind kind = EffectKind::Offset;
+  int index = 0;             // 1-based joint, or link for inertia_products
+  double velocity = 0;       // stribeck: the Stribeck velocity (> 0)
+  std::vector<int> orders;   // position_harmonics: the harmonic orders, ascending, >= 1
+  int line = 0, column = 0;  // the robot.yaml node that names the joint (for errors)
+};
+
+// A parameter an effect adds: identified, appended after the base parameters.
+struct EffectParameter {
+  std::string name;     // OFF2, FST2, FVA1, HS3_1, HC3_1
+  std::string family;   // OFF, FST, FVA, HS, HC
+  int joint = 0;        // 1-based
+  std::string unit;
+  int order = 0;        // HS, HC: the harmonic order
+  double velocity = 0;  // FST: the Stribeck velocity
+};
+
+// The parameters the effects add, in canonical order: effect kind in catalogue order, joint
+// ascending, order ascending, HS before HC for one order. `unit(family, joint)` is the unit of
+// the base family FS or FV on that joint (prismatic joints have their own); the torque-like
+// parameters take the FS unit, FVA the FV unit.
+std::vector<EffectParameter> effect_parameters(
+    const std::vector<EffectSpec>& effects, const std::function<std::string(const std::string&, int)>& unit);
+
+// The term a parameter multiplies on its joint's row (its regressor entry there), over the
+// nodes of that joint's position q and velocity qd.
+NodeId effect_term(ExprGraph& g, const EffectParameter& p, NodeId q, NodeId qd);
+
+// The same term as text for `symoroc info`, e.g. "sign(QP2)*exp(-(QP2/0.05)^2)".
+std::string effect_term_text(const EffectParameter& p, const std::string& q, const std::string& qd);
+
+}  // namespace symoro::codegen
