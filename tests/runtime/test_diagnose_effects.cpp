@@ -7,6 +7,7 @@
 #include <cstdlib>
 #include <iostream>
 #include <map>
+#include <random>
 #include <string>
 
 #include <fmt/format.h>
@@ -189,3 +190,55 @@ TEST(DiagnoseTwin, CoulombOffsetAndDelayTogether) {
 
 }  // namespace
 
+
+#include <symoro/planar2r.hpp>
+
+namespace {
+
+// The diagnosis's effect terms are the compiler's: planar2r's variant `effects` compiles
+// offsets, Stribeck (0.05 rad/s), direction-dependent viscous friction and position
+// harmonics; each compiled regressor column equals effect_terms() of the same candidate.
+TEST(DiagnoseEffects, TermsMatchTheCompiledVariant) {
+  using E = symoro::planar2r::effects::Model;
+  auto column = [](const char* name) {
+    for (int i = 0; i < E::np; ++i)
+      if (std::string(E::parameters[i].name) == name) return i;
+    ADD_FAILURE() << "no parameter " << name;
+    return 0;
+  };
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<double> u(-1.5, 1.5);
+  for (int trial = 0; trial < 20; ++trial) {
+    Eigen::Vector2d q(u(rng), u(rng)), qd(u(rng) * 0.1, u(rng) * 0.1), qdd(u(rng), u(rng));
+    Eigen::Matrix<double, 2, E::np> W;
+    E::regressor(q, qd, qdd, W);
+    auto check = [&](EffectKind kind, int joint, std::vector<const char*> names, std::vector<int> orders = {}) {
+      Candidate c;
+      c.kind = kind;
+      c.joint = joint;
+      c.stribeck_velocity = 0.05;
+      c.orders = orders;
+      std::vector<double> v(names.size());
+      effect_terms(c, q(joint - 1), qd(joint - 1), v.data());
+      for (std::size_t i = 0; i < names.size(); ++i) {
+        EXPECT_NEAR(W(joint - 1, column(names[i])), v[i], 1e-14) << names[i];
+        EXPECT_EQ(W(2 - joint, column(names[i])), 0.0) << names[i] << " acts on its joint only";
+      }
+    };
+    check(EffectKind::Offset, 1, {"OFF1"});
+    check(EffectKind::Offset, 2, {"OFF2"});
+    check(EffectKind::Stribeck, 2, {"FST2"});
+    check(EffectKind::ViscousAsymmetry, 2, {"FVA2"});
+    check(EffectKind::PositionHarmonics, 1, {"HS1_1", "HC1_1", "HS1_2", "HC1_2"}, {1, 2});
+    // Coulomb: the compiled FS1 is OpenSYMORO's sign(qd), the diagnosis's tanh(qd / vc) tends to it.
+    Candidate c;
+    c.kind = EffectKind::Coulomb;
+    c.joint = 1;
+    c.coulomb_velocity = 1e-9;
+    double v = 0;
+    effect_terms(c, q(0), qd(0), &v);
+    EXPECT_NEAR(W(0, column("FS1")), v, 1e-12);
+  }
+}
+
+}  // namespace
