@@ -56,13 +56,20 @@ struct Solve {
   Eigen::VectorXd sd;  // sqrt(diag(sigma^2 (A'WA)^-1)), times sqrt(autocorrelation time)
 };
 
-Solve weighted_ls(const Eigen::MatrixXd& A, const Eigen::VectorXd& y, const Eigen::VectorXd& rw, double tau_int) {
-  Eigen::MatrixXd As = rw.asDiagonal() * A;
+// Scales the columns of As to unit norm (zero columns stay) and returns the scales: the
+// candidates' units differ by orders of magnitude.
+Eigen::VectorXd unit_columns(Eigen::MatrixXd& As) {
   Eigen::VectorXd scale = As.colwise().norm().transpose();
   for (Eigen::Index i = 0; i < scale.size(); ++i) {
     if (!(scale(i) > 0)) scale(i) = 1;
     As.col(i) /= scale(i);
   }
+  return scale;
+}
+
+Solve weighted_ls(const Eigen::MatrixXd& A, const Eigen::VectorXd& y, const Eigen::VectorXd& rw, double tau_int) {
+  Eigen::MatrixXd As = rw.asDiagonal() * A;
+  const Eigen::VectorXd scale = unit_columns(As);
   const Eigen::VectorXd ys = rw.cwiseProduct(y);
   const Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(As);
   Solve s;
@@ -193,11 +200,7 @@ Selection select_effects(const DesignStack& train, const DesignStack& heldout, c
     sh.tau_model = current.heldout_tau;
     const Eigen::MatrixXd A = design(train, chosen, st), Ah = design(heldout, chosen, sh);
     Eigen::MatrixXd As = rw.asDiagonal() * A;
-    Eigen::VectorXd scale = As.colwise().norm().transpose();
-    for (Eigen::Index i = 0; i < scale.size(); ++i) {
-      if (!(scale(i) > 0)) scale(i) = 1;
-      As.col(i) /= scale(i);
-    }
+    const Eigen::VectorXd scale = unit_columns(As);
     const Eigen::VectorXd ys = rw.cwiseProduct(y);
     const Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(As);
     const Eigen::VectorXd beta_s = qr.solve(ys);
