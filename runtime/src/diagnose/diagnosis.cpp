@@ -42,6 +42,7 @@ Diagnosis diagnose(const DesignStack& train, const DesignStack& heldout, const D
     if (seen.insert("t" + t).second) d.train.push_back(t);
   for (const auto& t : heldout.segment_trajectory)
     if (seen.insert("h" + t).second) d.heldout.push_back(t);
+  d.options = o.selection;
   d.selection = select_effects(train, heldout, o.selection);
   d.before_series = residual_series(heldout, d.selection.before.heldout_tau);
   d.after_series = residual_series(heldout, d.selection.after.heldout_tau);
@@ -123,14 +124,14 @@ std::vector<std::filesystem::path> write_diagnosis_report(const Diagnosis& d, co
   m += "![held-out rms per joint](figures/heldout_rmse.svg)\n\n";
   m += "## Stepwise selection\n\n";
   m += fmt::format("Weights per joint (1/N m): {}. Each step refits the model with each candidate; F uses an effective "
-                   "sample size (N / autocorrelation time), the level is Bonferroni-corrected, and a candidate must also "
+                   "sample size (N / autocorrelation time), the level ({:g} per step) is Bonferroni-corrected, and a candidate must also "
                    "lower the held-out residual of its joints by at least {:.0f} % with at least {:g} N m of torque.\n\n",
                    [&] {
                      std::string w;
                      for (Eigen::Index j = 0; j < s.weights.size(); ++j) w += fmt::format("{}{:.3g}", j ? ", " : "", s.weights(j));
                      return w;
                    }(),
-                   100 * 0.02, 0.003);
+                   d.options.alpha, 100 * d.options.min_heldout_gain, d.options.min_effect_torque);
   for (std::size_t i = 0; i < s.steps.size(); ++i) {
     const auto& st = s.steps[i];
     m += fmt::format("Step {}: autocorrelation time {:.1f} samples, level {:.1e}; {}.\n\n", i + 1, st.autocorrelation_time,

@@ -187,10 +187,7 @@ Eigen::MatrixXd effect_columns(const Candidate& c, const DesignStack& d, const F
       for (int s = 0; s < S; ++s) mesh(s, 0) = fit.tau_model(row(s, j)) - ia * d.qdd(s, j) - fv * d.qd(s, j);
       const double scale = 0.05 * std::sqrt(mesh.squaredNorm() / std::max(S, 1)) + 1e-9;
       for (int s = 0; s < S; ++s) sigma(s, 0) = std::tanh(mesh(s, 0) / scale);
-      DesignStack one;  // rate() needs only the segments and the interval
-      one.segment = d.segment;
-      one.interval = d.interval;
-      const Eigen::MatrixXd ds = one.rate(sigma), dds = one.rate(ds);
+      const Eigen::MatrixXd ds = d.rate(sigma), dds = d.rate(ds);
       for (int s = 0; s < S; ++s) X(row(s, j), 0) = 0.5 * (ia * dds(s, 0) + fv * ds(s, 0));
       break;
     }

@@ -232,7 +232,8 @@ Selection select_effects(const DesignStack& train, const DesignStack& heldout, c
       CandidateTest t;
       t.key = c->key();
       t.label = c->label();
-      Eigen::MatrixXd C = rw.asDiagonal() * effect_columns(*c, train, cst);
+      const Eigen::MatrixXd Ctr = effect_columns(*c, train, cst);
+      Eigen::MatrixXd C = rw.asDiagonal() * Ctr;
       const Eigen::Index m = C.cols();
       t.columns = static_cast<int>(m);
       Eigen::VectorXd cs = C.colwise().norm().transpose();
@@ -268,7 +269,6 @@ Selection select_effects(const DesignStack& train, const DesignStack& heldout, c
       const Eigen::VectorXd theta = theta_s.cwiseQuotient(cs);
       const Eigen::MatrixXd Ch = effect_columns(*c, heldout, csh);
       const Eigen::VectorXd rh1 = rh - rwh.cwiseProduct(Ah * dbeta + Ch * theta);
-      const Eigen::MatrixXd Ctr = effect_columns(*c, train, cst);
       double sse0 = 0, sse1 = 0;
       std::vector<bool> acts_on(n, false);
       for (int j = 0; j < n; ++j) {

@@ -23,6 +23,7 @@ struct Diagnosis {
   std::string robot, model;                 // e.g. "crane_x7", "crane_x7::reduced"
   std::vector<std::string> train, heldout;  // trajectory names
   double interval = 0, cutoff = 0;          // s, Hz
+  SelectionOptions options;                 // what the selection was run with
   Selection selection;
   std::vector<ResidualSeries> before_series, after_series;  // held out
   Localization before, after;
