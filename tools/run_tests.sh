@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Every test: install what is missing, build, run the GoogleTest suite through ctest, check
 # generated/ against a fresh compilation, drop an unseen robot folder in and run its generic
-# tests, and fuzz the grammar for a bounded time (FUZZ_SECONDS, default 60).
+# tests, and fuzz the grammar for a bounded time (FUZZ_SECONDS, default 60) and the DYNAMIXEL
+# decoder (FUZZ_DYNAMIXEL_SECONDS, default 20).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash tools/install_deps.sh
@@ -28,6 +29,14 @@ cp tests/fuzz/corpus/* build/fuzz/corpus/
 build/fuzz/tests/fuzz/fuzz_grammar -max_total_time="${FUZZ_SECONDS:-60}" -max_len=4096 -timeout=10 \
   -dict=tests/fuzz/grammar.dict build/fuzz/corpus 2>build/fuzz/fuzz.log || { tail -40 build/fuzz/fuzz.log; exit 1; }
 grep -E "^Done|#[0-9]+.*DONE" build/fuzz/fuzz.log | tail -1
+
+# DYNAMIXEL Protocol 2.0 decoder fuzzing, bounded in time (FUZZ_DYNAMIXEL_SECONDS, default 20).
+cmake --build build/fuzz -j"$jobs" --target fuzz_dynamixel
+mkdir -p build/fuzz/corpus_dynamixel
+cp tests/fuzz/corpus_dynamixel/* build/fuzz/corpus_dynamixel/
+build/fuzz/tests/fuzz/fuzz_dynamixel -max_total_time="${FUZZ_DYNAMIXEL_SECONDS:-20}" -max_len=2048 -timeout=10 \
+  build/fuzz/corpus_dynamixel 2>build/fuzz/fuzz_dynamixel.log || { tail -40 build/fuzz/fuzz_dynamixel.log; exit 1; }
+grep -E "^Done|#[0-9]+.*DONE" build/fuzz/fuzz_dynamixel.log | tail -1
 
 # The whole suite last, so its summary closes the output.
 ctest --test-dir build --output-on-failure -j"$jobs"
