@@ -6,7 +6,7 @@
 # study on it (40 trajectories x 4 intervals: OLS, all-pose PD audit, conditional SDP, CLIE,
 # PCA selection, rescue, final audit, validation on V01-V03) with its report in
 # build/study/report/report.md. Both steps are resumable: a rerun skips what is finished.
-# Last, the model-gap diagnosis on twin data with hidden effects (build/diagnosis/).
+# Last, the model-gap workflow on twin data with hidden effects (build/diagnosis/, build/gap/).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash tools/install_deps.sh
@@ -30,7 +30,10 @@ $dynid identify --robot crane_x7 --data build/twin-data -o build/study
 # The model-gap workflow: a twin dataset with hidden Coulomb friction (joints 2 and 4) and a
 # torque offset (joint 5), which dynid diagnose is not told about; it names them, writes
 # build/diagnosis/diagnosis.md (before/after on V01-V03, figures) and the robot.yaml variant
-# build/diagnosis/variant.yaml (dynid diagnose --apply would add it to robots/crane_x7).
+# build/diagnosis/variant.yaml. `dynid diagnose --apply` added that variant to robots/crane_x7
+# (reduced_diagnosed, compiled into generated/); both models are identified on the same data
+# (OLS, PD audit, SDP, CLIE on AG02 at 10 ms) and compared on the held-out V01-V03 in
+# build/gap/gap.md.
 cat > build/hidden-effects.yaml <<'YAML'
 effects:
   coulomb: {enabled: true, torque: [0, 0.10, 0, 0.06, 0, 0, 0, 0]}
@@ -39,3 +42,8 @@ YAML
 $dynid twin dataset --robot crane_x7 -o build/gap-data --trials 1 --seed 2 --only AG02 V01 V02 V03 \
   --config build/hidden-effects.yaml
 $dynid diagnose --robot crane_x7 --data build/gap-data -o build/diagnosis
+for model in reduced reduced_diagnosed; do
+  $dynid identify --robot crane_x7 --model $model --data build/gap-data -o build/gap-study-$model \
+    --only AG02 --interval 10 --validation V01,V02,V03
+done
+$dynid compare --robot crane_x7 --before build/gap-study-reduced --after build/gap-study-reduced_diagnosed -o build/gap

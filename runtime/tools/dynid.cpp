@@ -28,6 +28,7 @@ int main(int argc, char** argv) {
   add_preprocess_commands(app, common);
   add_identify_commands(app, common);
   add_diagnose_commands(app, common);
+  add_compare_commands(app, common);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -13,6 +13,7 @@
 #include <CLI/CLI.hpp>
 
 #include "symoro/model_info.hpp"
+#include "symoro/robots_registry.hpp"
 
 namespace symoro::dynid {
 
@@ -58,6 +59,21 @@ class Progress {
   static bool isatty_stderr();
 };
 
+// f(RobotEntry<Full, Model>) for the robot's compiled model named `model` (a robot.yaml variant,
+// or "full"; empty: robot.yaml's `identified`); a usage error naming the robot's models if none.
+template <class F>
+void with_model(const Common& common, const std::string& model, F&& f) {
+  if (with_robot_variant(common.robot, model, [&](auto entry) { f(entry); })) return;
+  const auto names = variant_names(common.robot);
+  if (names.empty()) throw UsageError("unknown robot '" + common.robot + "'");
+  std::string list;
+  for (const auto& n : names) list += (list.empty() ? "" : ", ") + n;
+  throw UsageError("robot '" + common.robot + "' has no compiled model '" + model + "' (it has: " + list +
+                   "); a variant just added to robot.yaml must be generated (symoroc generate robots/" + common.robot +
+                   " -o generated) and dynid rebuilt");
+}
+
+void add_compare_commands(CLI::App& app, Common& common);
 void add_twin_commands(CLI::App& app, Common& common);
 void add_trajectory_commands(CLI::App& app, Common& common);
 void add_preprocess_commands(CLI::App& app, Common& common);

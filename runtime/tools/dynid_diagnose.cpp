@@ -13,14 +13,13 @@
 #include "symoro/identify/dataset.hpp"
 #include "symoro/io/atomic_file.hpp"
 #include "symoro/io/log.hpp"
-#include "symoro/robots_registry.hpp"
 
 namespace symoro::dynid {
 
 namespace {
 
 struct DiagnoseOptions {
-  std::string data, out, variant, apply;
+  std::string data, out, model, variant, apply;
   std::vector<std::string> train{"AG02"}, heldout{"V01", "V02", "V03"}, only;
   int trial = 1;
   double interval_ms = 10, cutoff = 5, alpha = 1e-3, min_gain = 0.02, min_torque = 0.003;
@@ -85,7 +84,8 @@ void run(const Common& common, const DiagnoseOptions& o) {
     if (s.find("\n  " + name + ":") != std::string::npos) throw UsageError(yaml.string() + ": variant '" + name + "' exists");
     if (!s.empty() && s.back() != '\n') s += '\n';
     io::write_file_atomically(yaml, s + variant);
-    fmt::print("added variant '{}' to {}; regenerate with symoroc generate and rebuild\n", name, yaml.string());
+    fmt::print("added variant '{}' to {}; regenerate (symoroc generate {} -o generated) and rebuild, then "
+               "dynid identify --model {}\n", name, yaml.string(), common.robot_dir().string(), name);
   }
 }
 
@@ -110,15 +110,16 @@ void add_diagnose_commands(CLI::App& app, Common& common) {
   cmd->add_option("--alpha", o->alpha, "Family-wise level of each step");
   cmd->add_option("--min-gain", o->min_gain, "Least relative fall of the held-out residual");
   cmd->add_option("--min-torque", o->min_torque, "Least effect torque that matters, N m");
+  cmd->add_option("--model", o->model, "Model whose gap is diagnosed: a robot.yaml variant, or full (default: "
+                                       "robot.yaml's identified)");
   cmd->add_option("--variant", o->variant, "Name of the variant to write (default: <identified>_diagnosed)");
   cmd->add_flag("--apply", [o](std::int64_t) { o->apply = "yes"; }, "Add the variant to the robot's robot.yaml");
   cmd->callback([&common, o] {
     for (const auto& e : o->only) diagnose::effect_kind(e);  // unknown names: a clear error first
-    if (!with_robot(common.robot, [&](auto entry) {
-          using E = decltype(entry);
-          run<typename E::FullModel, typename E::IdentifiedModel>(common, *o);
-        }))
-      throw UsageError("unknown robot '" + common.robot + "'");
+    with_model(common, o->model, [&](auto entry) {
+      using E = decltype(entry);
+      run<typename E::FullModel, typename E::IdentifiedModel>(common, *o);
+    });
   });
 }
 

@@ -9,6 +9,7 @@
 #include "dynid_common.hpp"
 #include "symoro/identify/report.hpp"
 #include "symoro/identify/study.hpp"
+#include "symoro/identify/validation_io.hpp"
 #include "symoro/robots_registry.hpp"
 #include "symoro/trajectory/design.hpp"
 #include "symoro/twin/config.hpp"
@@ -19,7 +20,7 @@ namespace symoro::dynid {
 namespace {
 
 struct IdentifyOptions {
-  std::string data, out;
+  std::string data, out, model;
   std::vector<double> intervals_ms;
   std::vector<std::string> only, validation;
   int threads = 0, trial = 1;
@@ -63,13 +64,13 @@ identify::StudyResult study(const Common& common, const IdentifyOptions& o, bool
   const twin::TwinConfig config = twin::read_twin_config(twin_path, Model::nq);
   identify::Study<Model> s(so, std::move(design), identify::closed_loop_setup(config));
   identify::StudyResult result = s.run();
-  // On twin data the truth is known: the full model's standard parameters mapped to the
-  // identified model's base parameters (products of inertia dropped for a reduced variant).
+  // On twin data the truth is known: the twin's standard parameters mapped to the identified
+  // model's base parameters (products of inertia dropped for a reduced variant), with the hidden
+  // Coulomb friction and offsets where the variant has parameters for them.
   const identify::Dataset data = identify::read_dataset(o.data);
   if (!data.twin.empty() && std::filesystem::exists(data.twin)) {
-    const twin::TwinConfig tc = twin::read_twin_config(data.twin, Model::nq);
-    const auto truth = twin::make_truth<Full>(tc);
-    result.truth = Model::base_from_standard(truth.standard);
+    const twin::TwinConfig tc = twin::read_twin_config(data.twin, Model::nq, data.twin_overrides);
+    result.truth = twin::identified_truth<Model>(tc);
   }
   return result;
 }
@@ -91,15 +92,13 @@ void run_study(const Common& common, const IdentifyOptions& o) {
       fmt::print("validation {} at {:.0f} ms: RMSE {:.4f} / {:.4f} N m, MNE {:.4f} / {:.4f} (CLIE / rescue)\n",
                  v.trajectory, v.interval * 1e3, v.rmse_clie, v.rmse_rescue, v.mne_clie, v.mne_rescue);
   }
+  // The held-out series on disk: dynid compare reads them to set two model variants side by side.
+  if (!identify::write_validation(r, o.out).empty())
+    fmt::print("validation: {}\n", (std::filesystem::path(o.out) / "validation.yaml").string());
   if (!o.no_report) {
     const auto files = identify::write_report(r, std::filesystem::path(o.out) / "report");
     fmt::print("report: {} ({} files)\n", (std::filesystem::path(o.out) / "report" / "report.md").string(), files.size());
   }
-}
-
-template <class F>
-void dispatch(const Common& common, F&& f) {
-  if (!with_robot(common.robot, [&](auto entry) { f(entry); })) throw UsageError("unknown robot '" + common.robot + "'");
 }
 
 }  // namespace
@@ -112,6 +111,8 @@ void add_identify_commands(CLI::App& app, Common& common) {
   cmd->add_option("--robots-dir", common.robots_dir, "Where the robot folders are");
   cmd->add_option("--data", o->data, "Dataset folder (dataset.yaml and logs)")->required()->check(CLI::ExistingDirectory);
   cmd->add_option("-o,--out", o->out, "Study folder (runs/ and report/)")->required();
+  cmd->add_option("--model", o->model, "Model to identify: a robot.yaml variant, or full (default: robot.yaml's "
+                                       "identified)");
   cmd->add_option("--interval", o->intervals_ms, "Sampling intervals in ms (default: 10 20 40 80)");
   cmd->add_option("--only", o->only, "Identification trajectories (default: every family but V)")->delimiter(',');
   cmd->add_option("--validation", o->validation, "Validation trajectories (default: family V)")->delimiter(',');
@@ -123,7 +124,7 @@ void add_identify_commands(CLI::App& app, Common& common) {
   cmd->add_flag("--no-report", o->no_report, "Do not write the report");
   cmd->add_flag("--fresh", o->fresh, "Redo every run, even finished ones (to time the whole study)");
   cmd->callback([&common, o] {
-    dispatch(common, [&](auto entry) {
+    with_model(common, o->model, [&](auto entry) {
       using E = decltype(entry);
       run_study<typename E::FullModel, typename E::IdentifiedModel>(common, *o);
     });

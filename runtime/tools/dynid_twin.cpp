@@ -2,6 +2,8 @@
 // trajectory, repeated trials, one seed; resumable and parallel), or measure its speed.
 #include <algorithm>
 #include <atomic>
+#include <fstream>
+#include <sstream>
 #include <thread>
 
 #include <fmt/format.h>
@@ -169,6 +171,14 @@ void twin_dataset(const Common& common, const TwinOptions& o) {
   y << YAML::Key << "robot" << YAML::Value << common.robot << YAML::Key << "seed" << YAML::Value << o.seed;
   y << YAML::Key << "trials" << YAML::Value << o.trials;
   y << YAML::Key << "twin" << YAML::Value << sim.config().path;
+  if (!o.config.empty()) {
+    // The overrides travel with the dataset: its truth (hidden effects) stays known.
+    std::ifstream in(o.config);
+    std::stringstream text;
+    text << in.rdbuf();
+    io::write_file_atomically(std::filesystem::path(o.out) / "twin_overrides.yaml", text.str());
+    y << YAML::Key << "twin_overrides" << YAML::Value << "twin_overrides.yaml";
+  }
   y << YAML::Key << "effects" << YAML::Value << YAML::Flow << sim.config().effects.enabled();
   y << YAML::Key << "runs" << YAML::Value << YAML::BeginSeq;
   for (int t = 0; t < static_cast<int>(trajs.size()); ++t)

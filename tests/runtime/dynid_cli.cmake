@@ -66,6 +66,22 @@ expect("${out}" "no missing effect found")
 if(NOT EXISTS ${WORK}/diag/diagnosis.md OR NOT EXISTS ${WORK}/diag/figures/heldout_rmse.svg)
   message(FATAL_ERROR "no diagnosis report written")
 endif()
+# A dataset made with --config keeps the overrides, so its truth (the hidden effects) travels
+# with it.
+file(WRITE ${WORK}/hidden.yaml "effects:\n  torque_offset: {enabled: true, torque: [0, 0, 0, 0, 0.02, 0, 0, 0]}\n")
+run(0 out twin dataset --robot crane_x7 -o ${WORK}/hidden --seed 4 --only V01 --config ${WORK}/hidden.yaml)
+file(READ ${WORK}/hidden/dataset.yaml manifest)
+expect("${manifest}" "twin_overrides: twin_overrides.yaml")
+file(READ ${WORK}/hidden/twin_overrides.yaml kept)
+expect("${kept}" "torque: \\[0, 0, 0, 0, 0.02")
+# Models by name: an unknown one is named with the robot's compiled models.
+run(2 out diagnose --robot crane_x7 --data ${ds} -o ${WORK}/diag --model nope)
+expect("${out}" "no compiled model 'nope' \\(it has: full, reduced, reduced_diagnosed")
+run(2 out identify --robot crane_x7 --data ${ds} -o ${WORK}/study --model nope)
+expect("${out}" "no compiled model 'nope'")
+# compare: a folder that is not a study, and a study against itself (no figure trajectory).
+run(1 out compare --before ${WORK}/diag --after ${WORK}/diag -o ${WORK}/gap)
+expect("${out}" "diag/validation.yaml: error: not found")
 file(WRITE ${WORK}/bad.csv "time,q1\n0,1\n")
 run(1 out preprocess ${WORK}/bad.csv)
 expect("${out}" "bad")

@@ -30,6 +30,12 @@ Dataset read_dataset(const std::filesystem::path& dir) {
     if (!root["runs"] || !root["runs"].IsSequence()) throw DataError(manifest.string(), line(root), "'runs' list missing");
     d.robot = root["robot"] ? root["robot"].as<std::string>() : "";
     d.twin = root["twin"] ? root["twin"].as<std::string>() : "";
+    if (root["twin_overrides"]) {  // kept in the dataset folder, so the hidden effects travel with it
+      d.twin_overrides = (d.dir / root["twin_overrides"].as<std::string>()).string();
+      if (!std::filesystem::exists(d.twin_overrides))
+        throw DataError(manifest.string(), line(root["twin_overrides"]),
+                        fmt::format("twin_overrides file {} does not exist", d.twin_overrides));
+    }
     for (const YAML::Node& r : root["runs"]) {
       for (const char* key : {"trajectory", "family", "trial", "file"})
         if (!r[key]) throw DataError(manifest.string(), line(r), fmt::format("run without '{}'", key));

@@ -6,12 +6,13 @@
 
 #include "symoro/crane_x7/all.hpp"
 #include "symoro/crane_x7/reduced/all.hpp"
+#include "symoro/crane_x7/reduced_diagnosed/all.hpp"
 
 namespace symoro::crane_x7 {
 
 // The identified model by default (robot.yaml 'identified').
 using IdentifiedModel = ::symoro::crane_x7::reduced::Model;
 // The full model first, then every variant.
-using Models = std::tuple<::symoro::crane_x7::Model, ::symoro::crane_x7::reduced::Model>;
+using Models = std::tuple<::symoro::crane_x7::Model, ::symoro::crane_x7::reduced::Model, ::symoro::crane_x7::reduced_diagnosed::Model>;
 
 }  // namespace symoro::crane_x7

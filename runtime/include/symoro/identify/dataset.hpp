@@ -18,6 +18,7 @@ struct Dataset {
   std::filesystem::path dir;
   std::string robot;
   std::string twin;             // the twin configuration that made it ("" for measured data)
+  std::string twin_overrides;   // the overrides it was made with (dynid twin dataset --config), or ""
   std::vector<DatasetRun> runs;
   // The run of a trajectory and trial; throws DataError naming dataset.yaml when absent.
   const DatasetRun& find(const std::string& trajectory, int trial) const;

@@ -230,9 +230,15 @@ class Study {
   }
 
   void select_and_accept(StudyResult& out) const {
-    if (out.runs.size() < 2) return;
-    out.pca = pca_clouds(out.runs, o_.pca_components);
-    out.selection = select_central(out.runs, out.pca, o_.variance_fraction);
+    if (out.runs.empty()) return;
+    if (out.runs.size() == 1) {  // one run (--only X --interval h): it is the candidate, no cloud
+      out.selection.run = 0;
+      out.selection.centrality = {0.0};
+      out.selection.rule = "the only run (no PCA cloud)";
+    } else {
+      out.pca = pca_clouds(out.runs, o_.pca_components);
+      out.selection = select_central(out.runs, out.pca, o_.variance_fraction);
+    }
     if (out.selection.run < 0) return;
     const RunRecord& sel = out.runs[out.selection.run];
     out.phi_rescue = sel.phi_clie;

@@ -1,0 +1,53 @@
+// The last step of the model-gap workflow: two identification studies of the same robot on the
+// same data, one with the model before the diagnosed effects were added and one after, set side
+// by side on their held-out validation trajectories (closed-loop simulated torque with each
+// study's accepted parameters against the measurement). Markdown with SVG figures.
+#pragma once
+
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "symoro/identify/validation_io.hpp"
+
+namespace symoro::diagnose {
+
+// One held-out trajectory in both studies.
+struct GapTrajectory {
+  std::string trajectory;
+  double interval = 0;                     // s
+  int samples = 0;
+  double rmse_before = 0, rmse_after = 0;  // N m, accepted parameters, all joints
+  Eigen::VectorXd joint_before, joint_after;
+};
+
+struct GapComparison {
+  std::string robot, before_model, after_model;
+  std::vector<GapTrajectory> trajectories;  // those both studies validated, in the before order
+  std::vector<std::string> only_before, only_after;  // validated by one study alone (left out)
+  // Pooled over the compared trajectories' samples: per joint and over all joints.
+  Eigen::VectorXd joint_before, joint_after;
+  double rmse_before = 0, rmse_after = 0;
+  // Parameters of the after model that the before model does not have (the added effects).
+  std::vector<std::string> added;
+};
+
+// Throws std::invalid_argument when the studies cannot be compared (other robots, no common
+// trajectory, a trajectory validated at different intervals or sample counts).
+GapComparison compare_studies(const identify::StudyValidation& before, const identify::StudyValidation& after);
+
+struct GapReportOptions {
+  std::string before_label = "before", after_label = "after";  // e.g. the study folders
+  std::string figure_trajectory;  // trajectory whose torques are plotted (default: the last compared)
+  std::vector<int> figure_joints;  // 0-based (default: the 3 joints whose error changed most)
+};
+
+// Writes <dir>/gap.md and <dir>/figures/*.svg atomically; returns the files written.
+std::vector<std::filesystem::path> write_gap_report(const identify::StudyValidation& before,
+                                                    const identify::StudyValidation& after,
+                                                    const GapComparison& comparison, const std::filesystem::path& dir,
+                                                    const GapReportOptions& options = {});
+
+}  // namespace symoro::diagnose

@@ -1,0 +1,74 @@
+// dynid compare: the model-gap workflow's before/after. Two identification studies of one robot
+// on the same data (dynid identify -o A, then with --model <diagnosed variant> -o B) set side by
+// side on their held-out validation trajectories: rms torque error per trajectory and joint,
+// the parameters the second model adds, and torque figures. Reads only the studies' folders,
+// so neither model needs to be compiled into this dynid.
+#include <fmt/format.h>
+
+#include "dynid_common.hpp"
+#include "symoro/diagnose/gap_report.hpp"
+#include "symoro/identify/validation_io.hpp"
+
+namespace symoro::dynid {
+
+namespace {
+
+struct CompareOptions {
+  std::string before, after, out, trajectory;
+  std::vector<int> joints;  // 1-based on the command line
+};
+
+void run(const Common& common, const CompareOptions& o) {
+  const identify::StudyValidation before = identify::read_validation(o.before);
+  const identify::StudyValidation after = identify::read_validation(o.after);
+  if (!common.robot.empty() && before.robot != common.robot)
+    throw UsageError(fmt::format("--robot {}, but {} is a study of '{}'", common.robot, o.before, before.robot));
+  diagnose::GapComparison c;
+  try {
+    c = diagnose::compare_studies(before, after);
+  } catch (const std::invalid_argument& e) {
+    throw UsageError(fmt::format("cannot compare {} with {}: {}", o.before, o.after, e.what()));
+  }
+  diagnose::GapReportOptions ro;
+  ro.before_label = std::filesystem::path(o.before).filename().string();
+  ro.after_label = std::filesystem::path(o.after).filename().string();
+  if (ro.before_label.empty() || ro.before_label == ro.after_label) ro.before_label = "before", ro.after_label = "after";
+  ro.figure_trajectory = o.trajectory;
+  for (int j : o.joints) {
+    if (j < 1 || j > c.joint_before.size())
+      throw UsageError(fmt::format("--joints: joint {} is not in 1..{}", j, c.joint_before.size()));
+    ro.figure_joints.push_back(j - 1);
+  }
+  std::vector<std::filesystem::path> files;
+  try {
+    files = diagnose::write_gap_report(before, after, c, o.out, ro);
+  } catch (const std::invalid_argument& e) {
+    throw UsageError(e.what());
+  }
+  for (const auto& t : c.trajectories)
+    fmt::print("{} at {:g} ms: rms error {:.4f} -> {:.4f} N m\n", t.trajectory, t.interval * 1e3, t.rmse_before,
+               t.rmse_after);
+  fmt::print("held-out rms error: {:.4f} N m ({}) -> {:.4f} N m ({}), {:+.1f} %\n", c.rmse_before, c.before_model,
+             c.rmse_after, c.after_model, 100 * (c.rmse_after - c.rmse_before) / c.rmse_before);
+  fmt::print("report: {} ({} files)\n", (std::filesystem::path(o.out) / "gap.md").string(), files.size());
+}
+
+}  // namespace
+
+void add_compare_commands(CLI::App& app, Common& common) {
+  auto o = std::make_shared<CompareOptions>();
+  auto* cmd = app.add_subcommand("compare", "Before/after report of two identification studies (e.g. the identified "
+                                            "model and its diagnosed variant) on their held-out trajectories");
+  cmd->add_option("--robot", common.robot, "Robot the studies are of (checked)");
+  cmd->add_option("--before", o->before, "Study folder of the model before (dynid identify -o)")
+      ->required()
+      ->check(CLI::ExistingDirectory);
+  cmd->add_option("--after", o->after, "Study folder of the model after")->required()->check(CLI::ExistingDirectory);
+  cmd->add_option("-o,--out", o->out, "Report folder (gap.md, figures/)")->required();
+  cmd->add_option("--trajectory", o->trajectory, "Held-out trajectory whose torques are plotted (default: the last)");
+  cmd->add_option("--joints", o->joints, "Joints plotted, 1-based (default: the 3 whose error changed most)")
+      ->delimiter(',');
+  cmd->callback([&common, o] { run(common, *o); });
+}
+
+}  // namespace symoro::dynid
