@@ -77,8 +77,9 @@ void print(const Selection& s) {
       const auto& t = st.tests[i];
       const char* watch = std::getenv("WATCH");
       if (i >= 6 && !(watch && t.key.find(watch) != std::string::npos)) continue;
-      std::cout << fmt::format("  {:28s}{} F {:10.1f} p {:.1e} gain {:7.4f} rms {:.4f} {}{}{}\n", t.key, t.absorbed ? " absorbed" : "", t.f, t.p_value, t.heldout_gain,
-                               t.effect_rms, t.significant ? "S" : "-", t.generalizes ? "G" : "-", t.physical ? "" : " non-physical");
+      std::cout << fmt::format("  {:28s}{} F {:10.1f} p {:.1e} tau {:5.1f} gain {:7.4f} all {:7.4f} rms {:.4f} mag {:.3g} {}{}{}\n", t.key,
+                               t.absorbed ? " absorbed" : "", t.f, t.p_value, t.effective_time, t.heldout_gain, t.heldout_reduction,
+                               t.effect_rms, t.magnitude.empty() ? 0.0 : t.magnitude[0], t.significant ? "S" : "-", t.generalizes ? "G" : "-", t.physical ? "" : " non-physical");
     }
   }
   for (const auto& e : s.effects) std::cout << "  -> " << e.candidate.label() << ": " << e.magnitude.text << "\n";
@@ -142,10 +143,7 @@ TEST(DiagnoseTwin, TorqueOffset) {
   expect_effects(s, {{EffectKind::Offset, 2, 0.04}, {EffectKind::Offset, 5, -0.02}});
 }
 
-// Not met yet alone: with only the delay hidden, a spurious offset on joint 2 comes first and
-// the delay then falls short of the held-out criteria (it is found with the other effects,
-// below; see the closing note of issue 5).
-TEST(DiagnoseTwin, DISABLED_ActuationDelay) {
+TEST(DiagnoseTwin, ActuationDelay) {
   TwinConfig c = base_config();
   c.effects.actuation_delay = true;
   c.effects.actuation_delay_time = 0.004;
@@ -155,9 +153,15 @@ TEST(DiagnoseTwin, DISABLED_ActuationDelay) {
   expect_effects(s, {{EffectKind::ActuationDelay, 0, 0.004}});
 }
 
-// Not met yet: the backlash column (the rotor's lead through the play, from the sign of the
-// model's mesh torque) does not pick up the twin's backlash, which shows instead as small
-// offsets and harmonics (see the closing note of issue 5).
+// Not met: 0.5 deg of play on joints 1 and 4 leaves almost nothing in the 5 Hz band (held-out
+// rmse 0.0058 N m, clean 0.0056; nothing is significant). With the twin's true parameters the
+// residual rms of joint 4 is 0.0057 vs 0.0056 N m clean: the elbow's mesh torque (gravity)
+// hardly reverses, so the rotor seldom crosses the play; the rotor-lead column carries under
+// 0.3 mN m rms there (BL 0.42 deg fitted, p 0.07). Joint 1 gains 0.004 N m rms, but its
+// rotor inertia is folded into ZZR1 in this model (no candidate), and even with the true IA1
+// the rotor-lead column explains under 2 % of it. What backlash does show is the ~100 Hz
+// mesh ringing (it used to leak into joints 2-3 as offsets through a 20 Hz pre-filter, see
+// stack_builder.hpp): a high-band statistic, not this stack's.
 TEST(DiagnoseTwin, DISABLED_Backlash) {
   TwinConfig c = base_config();
   c.effects.backlash = true;
@@ -169,6 +173,7 @@ TEST(DiagnoseTwin, DISABLED_Backlash) {
   print(s);
   expect_effects(s, {{EffectKind::Backlash, 1, 0.5 * M_PI / 180}, {EffectKind::Backlash, 4, 0.5 * M_PI / 180}});
 }
+
 
 TEST(DiagnoseTwin, CoulombOffsetAndDelayTogether) {
   TwinConfig c = base_config();

@@ -178,17 +178,17 @@ Eigen::MatrixXd effect_columns(const Candidate& c, const DesignStack& d, const F
     }
     case EffectKind::Backlash: {
       // The rotor leads the link by half the play in the direction of the mesh torque (the
-      // link-side torque: the model's minus the drive's own IA qdd + FV qd). The sign is
-      // smoothed over a torque scale of a few percent of the joint's torque, as the rotor
-      // needs time to cross the gap; its derivatives come from the grid.
+      // link-side torque: the model's minus the drive's own IA qdd + FV qd), so the motor
+      // torque carries IA d2(delta)/dt2 + FV d(delta)/dt that the link's motion does not show.
+      // delta switches sharply (a smoothed sign over a few percent of the joint's torque), so
+      // it is made as the data were: at the logs' rate, then through the stack's low-pass.
       const double ia = fit.phi(static_cast<Eigen::Index>(d.rotor_inertia_index(j)));
       const double fv = fit.phi(static_cast<Eigen::Index>(d.viscous_index(j)));
-      Eigen::MatrixXd mesh(S, 1), sigma(S, 1);
+      Eigen::MatrixXd mesh(S, 1);
       for (int s = 0; s < S; ++s) mesh(s, 0) = fit.tau_model(row(s, j)) - ia * d.qdd(s, j) - fv * d.qd(s, j);
       const double scale = 0.05 * std::sqrt(mesh.squaredNorm() / std::max(S, 1)) + 1e-9;
-      for (int s = 0; s < S; ++s) sigma(s, 0) = std::tanh(mesh(s, 0) / scale);
-      const Eigen::MatrixXd ds = d.rate(sigma), dds = d.rate(ds);
-      for (int s = 0; s < S; ++s) X(row(s, j), 0) = 0.5 * (ia * dds(s, 0) + fv * ds(s, 0));
+      const auto sigma = d.filtered(mesh, [scale](double m) { return std::tanh(m / scale); });
+      for (int s = 0; s < S; ++s) X(row(s, j), 0) = 0.5 * (ia * sigma.accel(s, 0) + fv * sigma.rate(s, 0));
       break;
     }
   }

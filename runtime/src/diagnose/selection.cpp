@@ -107,6 +107,60 @@ bool linearized(const std::vector<Candidate>& effects) {
 
 double pooled(const Eigen::VectorXd& tau) { return tau.size() ? tau.mean() : 1.0; }
 
+// Per joint, the residual's autocovariance gamma(0..L) along the segments, cut before the first
+// non-positive autocorrelation (the window of autocorrelation_time()).
+std::vector<std::vector<double>> autocovariance(const DesignStack& d, const Eigen::MatrixXd& r, int max_lag) {
+  const int S = d.samples();
+  std::vector<std::vector<double>> g(static_cast<std::size_t>(r.cols()));
+  for (Eigen::Index j = 0; j < r.cols(); ++j) {
+    const double var = r.col(j).squaredNorm();
+    g[j].push_back(var / std::max(S, 1));
+    if (!(var > 0)) continue;
+    for (int k = 1; k <= max_lag && k < S; ++k) {
+      double c = 0;
+      for (int s = 0; s + k < S; ++s)
+        if (d.segment[s] == d.segment[s + k]) c += r(s, j) * r(s + k, j);
+      if (c <= 0) break;
+      g[j].push_back(c / S);
+    }
+  }
+  return g;
+}
+
+// Long-run covariance of the score Z'e when e has the per-joint autocovariances g (joints
+// uncorrelated): sum over joints and lags |k| <= L_j of g_j(k) sum_s z_{s,j} z_{s+k,j}'.
+// With white errors it is sigma^2 Z'Z, the classical F-test's; a slowly varying column (an
+// offset) meets the residual's full autocorrelation, a fast one (a delay) little of it.
+Eigen::MatrixXd score_covariance(const DesignStack& d, const Eigen::MatrixXd& Z, const std::vector<std::vector<double>>& g) {
+  const int n = d.joints, S = d.samples();
+  const Eigen::Index m = Z.cols();
+  Eigen::MatrixXd V = Eigen::MatrixXd::Zero(m, m);
+  for (int j = 0; j < n; ++j) {
+    Eigen::MatrixXd Zj(S, m);
+    for (int s = 0; s < S; ++s) Zj.row(s) = Z.row(static_cast<Eigen::Index>(s) * n + j);
+    if (Zj.squaredNorm() == 0) continue;
+    V += g[j][0] * Zj.transpose() * Zj;
+    for (std::size_t k = 1; k < g[j].size(); ++k) {
+      Eigen::MatrixXd Ck = Eigen::MatrixXd::Zero(m, m);
+      for (int s = 0; s + static_cast<int>(k) < S; ++s)
+        if (d.segment[s] == d.segment[s + k]) Ck.noalias() += Zj.row(s).transpose() * Zj.row(s + k);
+      V += g[j][k] * (Ck + Ck.transpose());
+    }
+  }
+  return V;
+}
+
+// Whether an effect is large enough to act on, in its own terms: a delay against the logs'
+// period (a shift below one sample is not a remedy one can apply, and the logs' own sample and
+// hold sits there), every other effect against the torque resolution on its largest joint.
+bool matters(const Candidate& c, const CandidateTest& t, const DesignStack& d, const SelectionOptions& o) {
+  if (c.kind == EffectKind::ActuationDelay) {
+    const double period = d.base_interval > 0 ? d.base_interval : d.interval;
+    return !t.magnitude.empty() && std::abs(t.magnitude[0]) >= o.min_delay_periods * period;
+  }
+  return t.effect_rms >= o.min_effect_torque;
+}
+
 }  // namespace
 
 Eigen::VectorXd autocorrelation_time(const DesignStack& d, const Eigen::MatrixXd& r, int max_lag) {
@@ -215,6 +269,8 @@ Selection select_effects(const DesignStack& train, const DesignStack& heldout, c
     SelectionStep step;
     step.autocorrelation_time = pooled(autocorrelation_time(train, per_sample(train, r), o.max_lag));
     const double tau_int = step.autocorrelation_time;
+    const auto gamma = autocovariance(train, per_sample(train, r), o.max_lag);
+    const double dof = static_cast<double>(N) / static_cast<double>(std::max<Eigen::Index>(1, N - p));
     // The current fit's torques, for linearized candidates.
     FitState cst = state_of(train, A, beta, np), csh = state_of(heldout, Ah, beta, np);
 
@@ -227,7 +283,7 @@ Selection select_effects(const DesignStack& train, const DesignStack& heldout, c
     }
     step.level = o.alpha / static_cast<double>(pool.size());
     int best = -1;
-    double best_gain = 0;
+    double best_reduction = 0;
     for (const Candidate* c : pool) {
       CandidateTest t;
       t.key = c->key();
@@ -255,13 +311,20 @@ Selection select_effects(const DesignStack& train, const DesignStack& heldout, c
       const Eigen::VectorXd Cr = C.transpose() * r;
       const Eigen::VectorXd theta_s = ZZ.ldlt().solve(Cr);
       const double reduction = Cr.dot(theta_s);
-      const double rss1 = std::max(rss0 - reduction, 1e-300);
+      // Score test with the long-run (autocorrelation-consistent) variance of the score, the
+      // candidate's own columns against the residual's autocorrelation: an offset is judged
+      // against the residual's slow drift, a fast column against the faster part.
+      const Eigen::MatrixXd Z = C - As * K;
+      const Eigen::MatrixXd V = dof * score_covariance(train, Z, gamma);
       const double df2 = static_cast<double>(N) / tau_int - static_cast<double>(p + m);
       t.df2 = df2;
-      if (df2 > 1) {
-        t.f = (reduction / static_cast<double>(m)) / (rss1 / static_cast<double>(N - p - m)) / tau_int;
+      const Eigen::LDLT<Eigen::MatrixXd> Vf(V);
+      const double stat = Vf.info() == Eigen::Success ? Cr.dot(Vf.solve(Cr)) : 0.0;
+      t.effective_time = stat > 0 ? (reduction / (rss0 / static_cast<double>(N - p))) / stat : 1.0;
+      if (df2 > 1 && stat > 0) {
+        t.f = stat / static_cast<double>(m);
         const boost::math::fisher_f_distribution<double> dist(static_cast<double>(m), df2);
-        t.p_value = t.f > 0 ? boost::math::cdf(boost::math::complement(dist, t.f)) : 1.0;
+        t.p_value = boost::math::cdf(boost::math::complement(dist, t.f));
       }
       t.significant = t.p_value < step.level;
       // Held out: the refit with the candidate, on the joints it acts on.
@@ -269,20 +332,23 @@ Selection select_effects(const DesignStack& train, const DesignStack& heldout, c
       const Eigen::VectorXd theta = theta_s.cwiseQuotient(cs);
       const Eigen::MatrixXd Ch = effect_columns(*c, heldout, csh);
       const Eigen::VectorXd rh1 = rh - rwh.cwiseProduct(Ah * dbeta + Ch * theta);
-      double sse0 = 0, sse1 = 0;
+      double sse0 = 0, sse1 = 0, total0 = 0, total1 = 0;
       std::vector<bool> acts_on(n, false);
       for (int j = 0; j < n; ++j) {
         double acts = 0;
         for (int s = 0; s < train.samples(); ++s) acts += Ctr.row(static_cast<Eigen::Index>(s) * n + j).squaredNorm();
         acts_on[j] = acts > 0;
-        if (!acts_on[j]) continue;
         for (int s = 0; s < heldout.samples(); ++s) {
           const Eigen::Index i = static_cast<Eigen::Index>(s) * n + j;
+          total0 += rh(i) * rh(i);
+          total1 += rh1(i) * rh1(i);
+          if (!acts_on[j]) continue;
           sse0 += rh(i) * rh(i);
           sse1 += rh1(i) * rh1(i);
         }
       }
       t.heldout_gain = sse0 > 0 ? 1 - sse1 / sse0 : 0;
+      t.heldout_reduction = total0 > 0 ? 1 - total1 / total0 : 0;
       const Eigen::VectorXd effect_h = Ch * theta;
       t.effect_rms = 0;
       for (int j = 0; j < n && heldout.samples() > 0; ++j) {
@@ -292,15 +358,20 @@ Selection select_effects(const DesignStack& train, const DesignStack& heldout, c
         t.effect_rms = std::max(t.effect_rms, std::sqrt(ss / heldout.samples()));
       }
       t.physical = physical(*c, theta);
-      t.generalizes = t.heldout_gain >= o.min_heldout_gain && t.effect_rms >= o.min_effect_torque && t.physical;
+      t.magnitude = magnitude(*c, theta, Eigen::VectorXd::Zero(theta.size())).values;
+      t.matters = matters(*c, t, train, o);
+      t.generalizes = t.heldout_gain >= o.min_heldout_gain && t.matters && t.physical;
       step.tests.push_back(t);
-      if (t.significant && t.generalizes && t.heldout_gain > best_gain) {
-        best_gain = t.heldout_gain;
+      // Of the admissible candidates, the one that removes most of the held-out residual (all
+      // joints, weighted): the out-of-sample form of forward selection's largest RSS drop. A
+      // gain relative to the candidate's own joints would favour one-joint terms.
+      if (t.significant && t.generalizes && t.heldout_reduction > best_reduction) {
+        best_reduction = t.heldout_reduction;
         best = static_cast<int>(c - all.data());
       }
     }
     std::sort(step.tests.begin(), step.tests.end(),
-              [](const CandidateTest& a, const CandidateTest& b) { return a.heldout_gain > b.heldout_gain; });
+              [](const CandidateTest& a, const CandidateTest& b) { return a.heldout_reduction > b.heldout_reduction; });
     if (best < 0) {
       sel.stop_reason = "no candidate is significant and generalizes";
       sel.steps.push_back(step);

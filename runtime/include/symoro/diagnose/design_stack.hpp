@@ -5,6 +5,7 @@
 // joint j -> s * joints + j, as in identify/regression.hpp. Built by stack_builder.hpp.
 #pragma once
 
+#include <functional>
 #include <map>
 #include <string>
 #include <vector>
@@ -18,6 +19,11 @@ struct DesignStack {
   int joints = 0;
   std::vector<std::string> joint_names;
   double interval = 0;                  // s, the grid of every trajectory
+  // What every column went through (stack_builder.hpp): the logs' period and the zero-phase
+  // Butterworth low-pass; 0 when unknown. Columns computed later from the fit (backlash) are
+  // re-made at this rate and through this filter, as the data were.
+  double base_interval = 0, cutoff = 0;
+  int filter_order = 0;
   Eigen::MatrixXd q, qd, qdd, tau;      // samples x joints
   Eigen::VectorXd time;                 // s, within its trajectory
   std::vector<int> segment;             // per sample: a contiguous piece (trajectory x log piece)
@@ -44,6 +50,15 @@ struct DesignStack {
   // d/dt of a samples x joints signal along each segment (central differences, one-sided at
   // the ends of a segment).
   Eigen::MatrixXd rate(const Eigen::MatrixXd& per_sample) const;
+  // A pointwise function of a smooth grid signal (samples x channels) as the data would show
+  // it: interpolated linearly to the logs' period, mapped by f there, low-passed by the
+  // stack's filter, then sampled back on the grid with its first and second time derivatives.
+  // A sharp f (a sign) would otherwise be differentiated on the grid, where the low-pass that
+  // smooths it in the data is missing. Without the filter's data: f on the grid, rate().
+  struct Filtered {
+    Eigen::MatrixXd value, rate, accel;
+  };
+  Filtered filtered(const Eigen::MatrixXd& per_sample, const std::function<double(double)>& f) const;
 };
 
 }  // namespace symoro::diagnose

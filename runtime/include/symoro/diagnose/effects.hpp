@@ -15,7 +15,9 @@
 //   torque_constant    KTE<j> (1)                       tau_meas = tau / (1 + KTE): column -tau_model
 //   actuation_delay    DELAY (s), all joints            tau_meas(t) = tau(t + DELAY): column d tau_model/dt
 //   backlash           BL<j> (rad, total play)          the rotor leads the link by BL/2 sign(mesh
-//                                                       torque): column (IA d2s/dt2 + FV ds/dt) / 2
+//                                                       torque): column (IA d2s/dt2 + FV ds/dt) / 2,
+//                                                       s made at the logs' rate and low-passed as
+//                                                       the data were (DesignStack::filtered)
 // The last three are linearizations about the current fit (their columns use its torque), so
 // the selection re-evaluates them after every step. The names of the first five match the
 // compiler's variant effects (robot.yaml `effects:`), so a selected effect can be compiled in.

@@ -1,16 +1,21 @@
 // Forward stepwise selection of missing effects, as a statistician would run it:
 //   * every step refits the identified parameters together with the effects chosen so far and
 //     one candidate (nested models: the candidate's columns added to the current design);
-//   * the nested F-test uses the joints' residual scales as weights (joints differ by orders
-//     of magnitude in torque noise) and an effective sample size: filtered, densely sampled
-//     residuals are strongly autocorrelated, so N is divided by the integrated
-//     autocorrelation time of the current residual (else every candidate is "significant");
+//   * the nested test uses the joints' residual scales as weights (joints differ by orders
+//     of magnitude in torque noise); filtered, densely sampled residuals are strongly
+//     autocorrelated, so it is a score test with the score's long-run variance (per joint, the
+//     residual's autocovariance up to its first non-positive lag, against the candidate's
+//     own column at the same lags): a constant column meets the residual's slow drift in
+//     full, a fast one only its fast part (the plain F-test with N / tau_int treats both
+//     alike, which lets offsets through and holds delays back);
 //   * the level is Bonferroni-corrected over the step's candidates;
 //   * a significant candidate must also generalize: on held-out trajectories, refitted with
 //     it, the weighted residual of the joints it acts on must fall by at least
-//     `min_heldout_gain`;
-//   * of those, the one with the largest held-out gain is taken; the selection stops when no
-//     candidate passes. On clean data it reports nothing.
+//     `min_heldout_gain`, and it must matter in its own units (a delay of at least one log
+//     period; any other effect at least `min_effect_torque` rms on a joint);
+//   * of those, the one that removes the largest share of the whole held-out weighted
+//     residual is taken; the selection stops when no candidate passes. On clean data it
+//     reports nothing.
 #pragma once
 
 #include <string>
@@ -29,6 +34,9 @@ struct SelectionOptions {
   // An effect whose torque is smaller than this on every joint it acts on (rms over the
   // held-out samples) does not matter: about half a current step of a DYNAMIXEL X servo.
   double min_effect_torque = 0.003;  // N m
+  // A delay shorter than this many log periods is the logs' own timing (sample and hold), and
+  // not a shift one could apply to the torque.
+  double min_delay_periods = 1.0;
   int max_effects = 10;
   int max_lag = 400;               // samples, for the autocorrelation time
   CandidateOptions candidates;
@@ -39,6 +47,10 @@ struct CandidateTest {
   int columns = 0;
   double f = 0, p_value = 1, df2 = 0;
   double heldout_gain = 0;        // 1 - SSE_after / SSE_before on its joints (held out)
+  double heldout_reduction = 0;   // the same over all joints: what ranks the candidates
+  double effective_time = 1;      // samples per independent score sample (plain / robust statistic)
+  std::vector<double> magnitude;  // its magnitude values (effects.hpp) in this step's fit
+  bool matters = false;           // large enough in its own units
   bool absorbed = false;          // its columns lie in the span of the current design
   double effect_rms = 0;          // N m, its torque on the held-out samples, largest joint
   bool physical = true;           // its parameters agree with its physics (effects.hpp)
@@ -48,7 +60,7 @@ struct CandidateTest {
 struct SelectionStep {
   double autocorrelation_time = 1;  // samples per independent sample (pooled over joints)
   double level = 0;                 // alpha / candidates
-  std::vector<CandidateTest> tests;  // sorted by held-out gain, best first
+  std::vector<CandidateTest> tests;  // sorted by held-out reduction, best first
   std::string chosen;                // key, empty when the selection stopped here
 };
 

@@ -35,12 +35,23 @@ struct StackOptions {
   // left out: the zero-phase filter's end extension is not the signal (a torque spike in a
   // log's first row spreads over ~5 time constants).
   double edge_time_constants = 6;
+  // The candidate effects' own terms (friction: sign-like in qd) take qd low-passed to this
+  // cutoff: noise in qd smooths a sign by its own spread, and the wide band the regressor
+  // needs (light_preprocessing) carries ~0.1 rad/s of quantization noise, more than the
+  // friction's velocity scales. 0: the samples' qd as given.
+  double effect_velocity_cutoff = 20.0;  // Hz
   CandidateOptions candidates;
 };
 
-// The light preprocessing the builder expects: the base period, a cutoff well above the
-// diagnosis low-pass (only to tame the derivatives of quantized positions).
-inline preprocess::Options light_preprocessing(double cutoff_hz = 20.0) {
+// The light preprocessing the builder expects: the base period, a cutoff only to tame the
+// derivatives of quantized positions, and above the drives' vibration modes (gear mesh,
+// ~100 Hz). The regressor is nonlinear in qd: vibration removed before it (a 20 Hz cutoff
+// did) is missing from its Coriolis and centrifugal terms, while the torque keeps their
+// rectified part, which then passes the diagnosis low-pass as a slow misfit on the loaded
+// joints (a spurious offset on joint 2 with a 4 ms delay or with backlash on the twin).
+// The derivative noise it lets in is averaged by the low-pass where it enters linearly; its
+// square biases the velocity-squared terms by well under a mN m at 4096 counts/rev.
+inline preprocess::Options light_preprocessing(double cutoff_hz = 150.0) {
   preprocess::Options o;
   o.derivative_cutoff = cutoff_hz;
   return o;
@@ -53,6 +64,8 @@ DesignStack stack_design(const std::vector<NamedSamples>& runs, const StackOptio
   DesignStack d;
   d.joints = n;
   d.interval = o.interval;
+  d.cutoff = o.cutoff;
+  d.filter_order = o.order;
   for (const auto& j : Identified::joints) d.joint_names.push_back(j.name);
   for (const auto& par : Identified::parameters) d.parameters.push_back(par.name);
   d.rotor_inertia_index = Eigen::VectorXd::Constant(n, -1);
@@ -88,8 +101,15 @@ DesignStack stack_design(const std::vector<NamedSamples>& runs, const StackOptio
   Eigen::Index total = 0;
   double base = runs.empty() ? 0.0 : runs.front().samples.interval;
   if (!(base > 0)) throw std::invalid_argument("stack_design: no samples");
+  d.base_interval = base;
   const auto sections = preprocess::butterworth_lowpass(o.order, o.cutoff, 1.0 / base);
   const int padding = preprocess::zero_phase_padding(sections);
+  std::vector<preprocess::Biquad> slow;
+  int slow_padding = 0;
+  if (o.effect_velocity_cutoff > 0 && o.effect_velocity_cutoff < 0.5 / base) {
+    slow = preprocess::butterworth_lowpass(o.order, o.effect_velocity_cutoff, 1.0 / base);
+    slow_padding = preprocess::zero_phase_padding(slow);
+  }
   const Eigen::Index edge =
       static_cast<Eigen::Index>(std::ceil(o.edge_time_constants * preprocess::slowest_time_constant(sections)));
   for (const auto& r : runs) {
@@ -141,6 +161,8 @@ DesignStack stack_design(const std::vector<NamedSamples>& runs, const StackOptio
     motion.middleCols(n, n) = s.qd.middleRows(pc.begin, L);
     motion.rightCols(n) = s.qdd.middleRows(pc.begin, L);
     preprocess::filtfilt(sections, padding, motion);
+    preprocess::Channels qd_effects = s.qd.middleRows(pc.begin, L);
+    if (!slow.empty() && L > slow_padding + 1) preprocess::filtfilt(slow, slow_padding, qd_effects);
     for (Eigen::Index i = 0; i < K; ++i) {
       const Eigen::Index k = pc.keep[i];
       d.q.row(out + i) = motion.row(k).head(n);
@@ -172,7 +194,7 @@ DesignStack stack_design(const std::vector<NamedSamples>& runs, const StackOptio
         Eigen::Index c0 = p + pe + 2;
         for (std::size_t c = 0; c < local.size(); ++c) {
           if (local[c].joint != j + 1) continue;
-          effect_terms(local[c], q(j), qd(j), terms.data());
+          effect_terms(local[c], q(j), qd_effects(k, j), terms.data());
           for (Eigen::Index i = 0; i < local_cols[c]; ++i) X(k, c0 + i) = terms[static_cast<std::size_t>(i)];
           c0 += local_cols[c];
         }
