@@ -166,10 +166,13 @@ void the_comparison_recomputes_the_studies_own_errors() {
   }
   const auto files = diagnose::write_gap_report(identify::read_validation(s.before_dir),
                                                 identify::read_validation(s.after_dir), c, temp("report"));
-  EXPECT_EQ(files.size(), 3u);
+  // gap.md, the joint bars, the torque figure and three localization figures per model.
+  EXPECT_EQ(files.size(), 9u);
   std::ifstream md(temp("report") / "gap.md");
   const std::string text((std::istreambuf_iterator<char>(md)), std::istreambuf_iterator<char>());
   EXPECT_NE(text.find("| OFF5 | N*m |"), std::string::npos);
+  EXPECT_NE(text.find("## Where the closed-loop error is: before (reduced)"), std::string::npos);
+  EXPECT_NE(text.find("## Where the closed-loop error is: after (reduced_diagnosed)"), std::string::npos);
 }
 
 void malformed_validation_files_name_file_and_line() {

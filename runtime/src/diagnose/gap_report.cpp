@@ -8,6 +8,8 @@
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 
+#include "symoro/diagnose/localize.hpp"
+#include "symoro/diagnose/localize_report.hpp"
 #include "symoro/identify/svg_plot.hpp"
 #include "symoro/io/atomic_file.hpp"
 
@@ -114,6 +116,54 @@ std::string torque_figure(const ValidationRecord& before, const ValidationRecord
     f.panels.push_back(r);
   }
   return svg::render(f);
+}
+
+// The closed-loop residual (measured - accepted model's simulated torque) of the compared
+// trajectories as localization series, split where the time axis has a gap.
+std::vector<ResidualSeries> closed_loop_series(const StudyValidation& s, const GapComparison& c) {
+  std::vector<ResidualSeries> out;
+  for (const auto& t : c.trajectories) {
+    const ValidationRecord* v = find(s, t.trajectory);
+    const Eigen::Index rows = v->time.size();
+    for (Eigen::Index a = 0; a < rows;) {
+      Eigen::Index b = a + 1;
+      while (b < rows && v->time(b) - v->time(b - 1) < 1.5 * v->interval) ++b;
+      ResidualSeries r;
+      r.name = t.trajectory;
+      r.interval = v->interval;
+      r.time = v->time.segment(a, b - a);
+      r.q = v->q.middleRows(a, b - a);
+      r.qd = v->qd.middleRows(a, b - a);
+      r.qdd = v->qdd.middleRows(a, b - a);
+      r.tau_measured = v->tau_measured.middleRows(a, b - a);
+      r.tau_model = v->tau_rescue.middleRows(a, b - a);
+      out.push_back(std::move(r));
+      a = b;
+    }
+  }
+  return out;
+}
+
+// The localization section of one model, with its figures; a note instead when the series
+// cannot be localized (a diverged simulation leaves no finite residual).
+std::string localization_section(const StudyValidation& s, const GapComparison& c, const std::string& label,
+                                 const std::string& prefix, const std::filesystem::path& dir,
+                                 std::vector<std::filesystem::path>& files) {
+  const std::string title = "Where the closed-loop error is: " + label;
+  try {
+    const auto series = closed_loop_series(s, c);
+    const Localization loc = localize(series, {});
+    LocalizationFigureOptions fo;
+    fo.time_trajectory = c.trajectories.back().trajectory;
+    std::vector<std::string> figures;
+    for (const auto& f : write_localization_figures(series, loc, dir / "figures", prefix, fo)) {
+      figures.push_back("figures/" + f);
+      files.push_back(dir / "figures" / f);
+    }
+    return localization_markdown(loc, figures, title, 2);
+  } catch (const std::invalid_argument& e) {
+    return "## " + title + "\n\nNot localized: " + std::string(e.what()) + ".\n\n";
+  }
 }
 
 }  // namespace
@@ -256,6 +306,10 @@ std::vector<std::filesystem::path> write_gap_report(const StudyValidation& befor
   files.push_back(dir / torque);
   md += fmt::format("## {}: torques and errors\n\nMeasured (black), {} (grey, dashed) and {} (red).\n\n![{}]({})\n",
                     traj, bl, al, traj, torque);
+
+  // The disagreement localized (joint, regime, frequency, lag), before and after.
+  md += "\n" + localization_section(before, c, bl, "before", dir, files);
+  md += localization_section(after, c, al, "after", dir, files);
 
   io::write_file_atomically(dir / "gap.md", md);
   files.push_back(dir / "gap.md");

@@ -15,6 +15,9 @@ namespace symoro::identify {
 namespace {
 
 constexpr const char* kFormat = "symoro-validation 1";
+// Per joint, in this order after the time column.
+constexpr const char* kColumns[] = {"q", "qd", "qdd", "measured", "clie", "accepted"};
+constexpr int kPerJoint = 6;
 
 void put(YAML::Emitter& y, const char* key, const Eigen::VectorXd& v) {
   y << YAML::Key << key << YAML::Value << YAML::Flow << YAML::BeginSeq;
@@ -24,11 +27,11 @@ void put(YAML::Emitter& y, const char* key, const Eigen::VectorXd& v) {
 
 std::string csv_name(const std::string& trajectory) { return trajectory + ".csv"; }
 
-// time, measured_1..n, clie_1..n, accepted_1..n: one row per sample.
+// time, q_1..n, qd_1..n, qdd_1..n, measured_1..n, clie_1..n, accepted_1..n: one row per sample.
 std::string series_csv(const ValidationRecord& v) {
   const Eigen::Index n = v.tau_measured.cols(), rows = v.tau_measured.rows();
   std::string out = "time";
-  for (const char* what : {"measured", "clie", "accepted"})
+  for (const char* what : kColumns)
     for (Eigen::Index j = 0; j < n; ++j) out += fmt::format(",{}_{}", what, j + 1);
   out += '\n';
   auto cell = [](const Eigen::MatrixXd& m, Eigen::Index i, Eigen::Index j) {
@@ -36,7 +39,7 @@ std::string series_csv(const ValidationRecord& v) {
   };
   for (Eigen::Index i = 0; i < rows; ++i) {
     io::append_number(out, i < v.time.size() ? v.time(i) : std::numeric_limits<double>::quiet_NaN());
-    for (const Eigen::MatrixXd* m : {&v.tau_measured, &v.tau_clie, &v.tau_rescue})
+    for (const Eigen::MatrixXd* m : {&v.q, &v.qd, &v.qdd, &v.tau_measured, &v.tau_clie, &v.tau_rescue})
       for (Eigen::Index j = 0; j < n; ++j) {
         out += ',';
         io::append_number(out, cell(*m, i, j));
@@ -51,12 +54,12 @@ void read_series(const std::filesystem::path& file, int joints, ValidationRecord
   if (!in) throw DataError(file.string(), 0, "cannot open the validation series (was the study's validation written?)");
   std::string line;
   std::vector<std::vector<double>> rows;
-  const std::size_t columns = 1 + 3 * static_cast<std::size_t>(joints);
+  const std::size_t columns = 1 + kPerJoint * static_cast<std::size_t>(joints);
   int number = 0;
   while (std::getline(in, line)) {
     ++number;
     if (number == 1) {
-      if (line.rfind("time,", 0) != 0) throw DataError(file.string(), 1, "expected the header 'time,measured_1,...'");
+      if (line.rfind("time,q_1,", 0) != 0) throw DataError(file.string(), 1, "expected the header 'time,q_1,...'");
       continue;
     }
     if (line.empty()) continue;
@@ -73,22 +76,18 @@ void read_series(const std::filesystem::path& file, int joints, ValidationRecord
       start = comma + 1;
     }
     if (row.size() != columns)
-      throw DataError(file.string(), number, fmt::format("{} columns, expected {} (time and 3 x {} joints)", row.size(),
-                                                         columns, joints));
+      throw DataError(file.string(), number, fmt::format("{} columns, expected {} (time and {} x {} joints)", row.size(),
+                                                         columns, kPerJoint, joints));
     rows.push_back(std::move(row));
   }
   const Eigen::Index r = static_cast<Eigen::Index>(rows.size());
   v.time.resize(r);
-  v.tau_measured.resize(r, joints);
-  v.tau_clie.resize(r, joints);
-  v.tau_rescue.resize(r, joints);
+  Eigen::MatrixXd* blocks[] = {&v.q, &v.qd, &v.qdd, &v.tau_measured, &v.tau_clie, &v.tau_rescue};
+  for (Eigen::MatrixXd* m : blocks) m->resize(r, joints);
   for (Eigen::Index i = 0; i < r; ++i) {
     v.time(i) = rows[i][0];
-    for (int j = 0; j < joints; ++j) {
-      v.tau_measured(i, j) = rows[i][1 + j];
-      v.tau_clie(i, j) = rows[i][1 + joints + j];
-      v.tau_rescue(i, j) = rows[i][1 + 2 * joints + j];
-    }
+    for (int b = 0; b < kPerJoint; ++b)
+      for (int j = 0; j < joints; ++j) (*blocks[b])(i, j) = rows[i][1 + b * joints + j];
   }
 }
 

@@ -68,8 +68,10 @@ struct ValidationRecord {
   double rmse_clie = 0, rmse_rescue = 0;   // N m, over all joints and samples
   double mne_clie = 0, mne_rescue = 0;     // mean over joints of |e_j| / |tau_m,j| (2-norms)
   Eigen::VectorXd rmse_joint_clie, rmse_joint_rescue;
-  // The series (for the torque figure): samples x joints.
+  // The series (for the torque figure and the closed-loop localization): samples x joints; the
+  // motion is the measured one, preprocessed like the torque.
   Eigen::VectorXd time;
+  Eigen::MatrixXd q, qd, qdd;
   Eigen::MatrixXd tau_measured, tau_clie, tau_rescue;
 };
 

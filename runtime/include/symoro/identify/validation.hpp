@@ -41,6 +41,9 @@ ValidationRecord validate_trajectory(const ClosedLoopSimulator<Model>& sim, cons
   v.interval = measured.interval;
   v.time = measured.time;
   v.tau_measured = measured.tau;
+  v.q = measured.q;
+  v.qd = measured.qd;
+  v.qdd = measured.qdd;
   Divergence why;
   const Eigen::Index n = measured.tau.cols();
   auto run = [&](const Eigen::VectorXd& phi, Eigen::MatrixXd& tau, double& rmse, double& mne, Eigen::VectorXd& joint) {

@@ -1,8 +1,8 @@
 // A study's held-out validation on disk, so that studies of different model variants can be
 // compared later without recompiling either (dynid compare): <study>/validation.yaml (the
 // model, the accepted parameters and each trajectory's errors) and one CSV of torque series
-// per trajectory, <study>/validation/<TRAJ>.csv (time, measured, CLIE and accepted torques per
-// joint). Written atomically; read back with errors naming the file and line.
+// per trajectory, <study>/validation/<TRAJ>.csv (time, then per joint the measured motion q, qd,
+// qdd and the measured, CLIE and accepted torques). Written atomically; read back with errors naming the file and line.
 #pragma once
 
 #include <filesystem>
