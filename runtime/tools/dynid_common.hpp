@@ -79,5 +79,6 @@ void add_trajectory_commands(CLI::App& app, Common& common);
 void add_preprocess_commands(CLI::App& app, Common& common);
 void add_identify_commands(CLI::App& app, Common& common);
 void add_diagnose_commands(CLI::App& app, Common& common);
+void add_control_commands(CLI::App& app, Common& common);
 
 }  // namespace symoro::dynid

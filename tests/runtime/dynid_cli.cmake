@@ -85,4 +85,12 @@ expect("${out}" "diag/validation.yaml: error: not found")
 file(WRITE ${WORK}/bad.csv "time,q1\n0,1\n")
 run(1 out preprocess ${WORK}/bad.csv)
 expect("${out}" "bad")
+# control: one second of AG02 on the virtual bus (emulated servos driving the twin), then a
+# preprocessable log; a missing port is named.
+run(0 out control --robot crane_x7 --virtual --trajectory AG02 --seconds 1 -o ${WORK}/control/run.csv)
+expect("${out}" "completed; torque off confirmed")
+expect("${out}" "overruns")
+run(0 out preprocess --robot crane_x7 ${WORK}/control/run.csv --interval 40 -o ${WORK}/control/samples)
+run(1 out control --robot crane_x7 --port ${WORK}/no_such_tty --seconds 1 -o ${WORK}/control/real.csv)
+expect("${out}" "no_such_tty")
 file(REMOVE_RECURSE ${WORK})

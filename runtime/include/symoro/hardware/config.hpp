@@ -1,0 +1,60 @@
+// The arm's hardware description (robots/<robot>/hardware.yaml): the DYNAMIXEL bus, the servo
+// models (torque constant, current unit and limit), and per joint its servo ID, model, the pulse
+// count of its zero angle, its direction and its current limit; plus the safety settings of the
+// control loop. Read once and checked with file and line, like twin.yaml.
+//
+//   joint angle  q  = direction * (pulses - zero) * 2 pi / 4096            (rad)
+//   joint torque tau = direction * current * torque_constant               (N m)
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "symoro/model_info.hpp"
+
+namespace symoro::hardware {
+
+struct ServoModel {
+  std::string name;                 // "XM430-W350"
+  std::uint16_t model_number = 0;   // Model Number(0), checked by ping at start
+  double torque_constant = 0;       // N m / A
+  double current_unit = 0;          // A per Goal/Present Current unit
+  double current_limit = 0;         // A, the model's maximum
+};
+
+struct JointHardware {
+  std::string name;       // the model's joint name (checked against the robot's joints)
+  std::uint8_t id = 0;    // servo ID
+  ServoModel model;
+  std::int32_t zero = 2048;  // pulses at q = 0
+  int direction = 1;         // +1 or -1
+  double current_limit = 0;  // A, commands saturate here (<= the model's limit)
+};
+
+struct Safety {
+  int watchdog_cycles = 3;            // consecutive failed sync reads that stop the arm
+  double position_tolerance = 0.05;   // rad a joint may pass its robot.yaml limit by
+  double velocity_factor = 1.0;       // stop beyond factor * robot.yaml velocity limit
+  double current_trip_factor = 1.5;   // stop when |present current| > factor * current_limit
+  double approach_speed = 0.3;        // rad/s, the move to the trajectory's start posture
+  double pre_roll = 0.5;              // s holding the start posture before the trajectory
+};
+
+struct HardwareConfig {
+  std::string path;
+  std::uint32_t baud = 3'000'000;
+  int return_delay_time = 0;  // Return Delay Time(9) written at start (2 us units)
+  double period = 0.001;      // s
+  std::vector<JointHardware> joints;
+  Safety safety;
+
+  std::vector<std::uint8_t> ids() const;
+};
+
+// Reads hardware.yaml; `robot_joints` (the model's joints) fixes the order and count: the file
+// lists one entry per joint, by name. Throws DataError(file, line, ...).
+HardwareConfig read_hardware_config(const std::filesystem::path& path, const std::vector<JointInfo>& robot_joints);
+
+}  // namespace symoro::hardware

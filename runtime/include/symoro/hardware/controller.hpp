@@ -1,0 +1,146 @@
+// The arm's 1 kHz control loop over a DYNAMIXEL bus (paper Sec. III): every period, paced by
+// absolute deadlines (clock_nanosleep TIMER_ABSTIME on CLOCK_MONOTONIC, the steady clock),
+//   1. Sync Read Present Current, Velocity and Position (one 10-byte read, all servos),
+//   2. convert to joint units (hardware.yaml: zero, direction, torque constant),
+//   3. check the safety limits, compute the paper's FF+PD with pseudo differentiation
+//      (control/ffpd.hpp) plus an optional model feedforward (e.g. the generated inverse
+//      dynamics with identified parameters: model_feedforward<Model>(phi)),
+//   4. Sync Write Goal Current (saturated at the joints' current limits),
+//   5. stream one log row (io::LogStream: the project's log format, flushed every 100 ms).
+// Phases: start (ping and check every servo's model, torque off, current mode, Return Delay
+// Time, torque on), approach (a smooth move from the measured pose to the trajectory's start at
+// safety.approach_speed), pre-roll (hold, safety.pre_roll), trajectory (logged, t = 0 at its
+// start), then the end of the trajectory or of `seconds`.
+//
+// Safe stop, whatever ends the run (completion, SIGINT/SIGTERM through the stop flag, watchdog:
+// watchdog_cycles consecutive failed sync reads, a servo's hardware alert, a servo that stops
+// answering, a joint beyond its position, velocity or current limit, an exception): Goal
+// Current 0 to every servo, Torque Enable 0 broadcast (both repeated), the log flushed and
+// closed with the reason and timing statistics in its sidecar notes, the reason returned.
+#pragma once
+
+#include <atomic>
+#include <chrono>
+#include <csignal>
+#include <cstdint>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "symoro/control/ffpd.hpp"
+#include "symoro/dynamixel/bus.hpp"
+#include "symoro/hardware/config.hpp"
+#include "symoro/model_info.hpp"
+#include "symoro/trajectory/trajectory.hpp"
+
+namespace symoro::hardware {
+
+enum class StopReason {
+  completed,       // the trajectory (or the requested seconds) ran to its end
+  signal,          // the stop flag (SIGINT / SIGTERM) was set
+  watchdog,        // watchdog_cycles consecutive sync reads failed (state too old)
+  servo_lost,      // a servo stopped answering (named in the message)
+  hardware_error,  // a servo's alert bit: Hardware Error Status named in the message
+  position_limit,
+  velocity_limit,
+  current_limit,
+  setup_failed,    // a servo missing, of the wrong model, or refusing the configuration
+  error,           // an exception (serial port failure, log write failure)
+};
+const char* to_string(StopReason reason);
+
+// Per-cycle timing, in seconds unless named otherwise.
+struct TimingStats {
+  std::int64_t cycles = 0;          // control cycles run (all phases)
+  std::int64_t overruns = 0;        // cycles whose work ended after the next deadline
+  std::int64_t skipped = 0;         // deadlines skipped after an overrun
+  double period_mean = 0, period_std = 0, period_min = 0, period_max = 0;  // between wake-ups
+  double jitter_max = 0;            // max |period - T|
+  double latency_mean = 0, latency_max = 0;  // wake-up after the deadline
+  double work_mean = 0, work_max = 0;        // wake-up to the end of the cycle's work
+  double read_max = 0;              // the longest sync read
+  std::int64_t read_failures = 0;   // cycles whose sync read lacked a servo's data
+  std::int64_t write_failures = 0;  // sync writes not sent in time
+  std::int64_t max_stale = 0;       // most consecutive failed reads
+  std::int64_t saturated = 0;       // cycles with a command at its current limit
+  dynamixel::BusStats bus;
+  std::string summary() const;      // several lines, for people and the log's notes
+};
+
+struct ControlOptions {
+  double seconds = 0;  // run only this much of the trajectory (0: all of it)
+  // The stop flag; nullptr: the process's SIGINT/SIGTERM flag (stop_requested()).
+  const volatile std::sig_atomic_t* stop = nullptr;
+  // Extra joint torque added to FF+PD (N m), from the references: e.g. model_feedforward.
+  // When set, the FF+PD's own realization feedforward (M-hat qdd_ref + D-hat qd_ref) is
+  // replaced by it (the PD part remains).
+  std::function<void(const Eigen::VectorXd& q_ref, const Eigen::VectorXd& qd_ref,
+                     const Eigen::VectorXd& qdd_ref, Eigen::VectorXd& tau)>
+      feedforward;
+  // Consecutive failed sync reads that stop the run (0: hardware.yaml's safety.watchdog_cycles).
+  // An emulated bus on a loaded machine needs more than a real one: its servos are a thread
+  // that may wait milliseconds for a core.
+  int watchdog_cycles = 0;
+  int realtime_priority = 0;  // SCHED_FIFO priority for the loop (0: leave; failure is a warning)
+  bool verbose = true;        // progress and the summary on stderr
+  // Log: robot name, trajectory and notes go in the sidecar; the rest is filled in.
+  std::string robot, source = "robot", notes;
+  int trial = 1;
+  std::chrono::milliseconds log_flush{100};
+};
+
+struct ControlResult {
+  StopReason reason = StopReason::error;
+  std::string message;         // one line: what stopped the run and where
+  TimingStats timing;
+  std::int64_t rows = 0;        // log rows written
+  double trajectory_time = 0;  // s of the trajectory run
+  Eigen::VectorXd max_error;   // max |q_ref - q| per joint over the logged rows, rad
+  bool torque_off_confirmed = false;  // every answering servo read back Torque Enable 0
+};
+
+// The process-wide stop flag, set by stop_signal_handler (installed by StopSignals).
+volatile std::sig_atomic_t& stop_flag();
+// Installs SIGINT and SIGTERM handlers that only set stop_flag() (clearing it first), and
+// restores the previous handlers when destroyed.
+class StopSignals {
+ public:
+  StopSignals();
+  ~StopSignals();
+  StopSignals(const StopSignals&) = delete;
+  StopSignals& operator=(const StopSignals&) = delete;
+
+ private:
+  struct sigaction* previous_;
+};
+
+// Runs `traj` on the arm behind `bus` with FF+PD `gains` (period = hw.period), logging to `csv`.
+// `joints`: the robot's joints (names, limits); hw.joints are in the same order.
+ControlResult run_control(dynamixel::Bus& bus, const HardwareConfig& hw, const std::vector<JointInfo>& joints,
+                          const control::FfpdGains& gains, const trajectory::Trajectory& traj, const std::string& csv,
+                          const ControlOptions& options);
+
+// Goal Current 0 and Torque Enable 0 on every servo of `hw` (sync write, then broadcast, each
+// twice), then reads Torque Enable back; true when every servo answered 0.
+bool safe_stop(dynamixel::Bus& bus, const HardwareConfig& hw);
+
+// The identified model's inverse dynamics as a feedforward: tau = ID(q_ref, qd_ref, qdd_ref; phi).
+template <class Model>
+auto model_feedforward(const Eigen::VectorXd& phi) {
+  using Vec = Eigen::Matrix<double, Model::nq, 1>;
+  using Phi = Eigen::Matrix<double, Model::np, 1>;
+  const Phi p = phi;
+  return [p](const Eigen::VectorXd& q, const Eigen::VectorXd& qd, const Eigen::VectorXd& qdd, Eigen::VectorXd& tau) {
+    Vec out;
+    Model::inverse_dynamics(Vec(q), Vec(qd), Vec(qdd), p, out);
+    tau = out;
+  };
+}
+
+// The `parameters:` list of a study's report/parameters.yaml as the identified model's phi
+// (names in `names` order, every one required). Throws DataError with file and line.
+Eigen::VectorXd read_identified_parameters(const std::string& path, const std::vector<std::string>& names);
+
+}  // namespace symoro::hardware

@@ -1,0 +1,89 @@
+// A log written while it is recorded (a control loop's run): the same files as write_log (CSV +
+// .meta.yaml sidecar, log.hpp), streamed. append() copies one row into memory and never does I/O
+// or allocates (after construction); a background thread writes the rows out every
+// `flush_every` and then rewrites the sidecar (atomically) with the row count written so far,
+// so that the files on disk are always a log read_log accepts, up to the last flush. close()
+// (also from the destructor) writes the rest and the final sidecar (with the notes set last).
+//
+//   io::LogStream log("run.csv", meta, /*references=*/true);
+//   log.append(t, q, qd, tau, q_ref, qd_ref, qdd_ref);   // in the loop, n values each
+//   log.set_notes("...timing...");
+//   log.close();
+//
+// Rows must be finite with strictly increasing time (as write_log requires); a row that is not
+// is dropped and counted (rejected()), so a log on disk stays readable. When the writer falls
+// behind by `capacity` rows, further rows are dropped and counted (overflowed()).
+#pragma once
+
+#include <chrono>
+#include <condition_variable>
+#include <cstdint>
+#include <filesystem>
+#include <mutex>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "symoro/io/log.hpp"
+
+namespace symoro::io {
+
+class LogStream {
+ public:
+  LogStream(std::filesystem::path csv, LogMetadata meta, bool references,
+            std::chrono::milliseconds flush_every = std::chrono::milliseconds(100),
+            std::size_t capacity = 1 << 14);
+  ~LogStream();
+  LogStream(const LogStream&) = delete;
+  LogStream& operator=(const LogStream&) = delete;
+
+  // One row; each pointer holds joints() values (the reference ones are ignored without
+  // references). False when the row was dropped (not finite, time not increasing, overflow).
+  bool append(double time, const double* q, const double* qd, const double* tau,
+              const double* q_ref = nullptr, const double* qd_ref = nullptr,
+              const double* qdd_ref = nullptr);
+  // Notes for the sidecar (written at the next flush and by close()).
+  void set_notes(std::string notes);
+  // Writes what is buffered now and waits until it is on disk (CSV and sidecar).
+  void flush();
+  // Writes everything, the final sidecar, stops the writer; idempotent. Throws DataError when a
+  // file could not be written (also reported by the destructor to stderr, never thrown there).
+  void close();
+
+  const std::filesystem::path& path() const { return csv_; }
+  int joints() const { return n_; }
+  std::int64_t appended() const;  // rows accepted by append()
+  std::int64_t written() const;   // rows on disk (and in the sidecar)
+  std::int64_t rejected() const;
+  std::int64_t overflowed() const;
+
+ private:
+  void run();
+  void write_out(std::vector<double>& rows, std::size_t count);  // writer thread / close()
+  void write_sidecar(std::int64_t samples);
+
+  std::filesystem::path csv_;
+  LogMetadata meta_;
+  bool references_;
+  int n_;
+  std::size_t width_;  // values per row
+  std::chrono::milliseconds flush_every_;
+  std::size_t capacity_;
+
+  mutable std::mutex mutex_;  // front_, counters, notes_, flags
+  std::condition_variable wake_, done_;
+  std::vector<double> front_, back_;
+  std::size_t front_rows_ = 0;
+  std::int64_t appended_ = 0, written_ = 0, rejected_ = 0, overflowed_ = 0;
+  std::uint64_t flush_requests_ = 0, flushes_done_ = 0;
+  double last_time_ = 0;
+  bool has_last_ = false;
+  bool stop_ = false, closed_ = false;
+  std::string notes_;
+  std::string error_;  // first I/O error of the writer
+  int fd_ = -1;
+  std::string text_;  // writer's formatting buffer
+  std::thread thread_;
+};
+
+}  // namespace symoro::io

@@ -1,0 +1,156 @@
+#include "symoro/hardware/config.hpp"
+
+#include <cmath>
+#include <fstream>
+#include <map>
+#include <set>
+#include <sstream>
+
+#include <fmt/format.h>
+#include <yaml-cpp/yaml.h>
+
+#include "symoro/error.hpp"
+
+namespace symoro::hardware {
+
+std::vector<std::uint8_t> HardwareConfig::ids() const {
+  std::vector<std::uint8_t> out;
+  for (const auto& j : joints) out.push_back(j.id);
+  return out;
+}
+
+namespace {
+
+int line_of(const YAML::Node& n) { return n.Mark().is_null() ? 0 : n.Mark().line + 1; }
+
+struct Reader {
+  std::string file;
+  [[noreturn]] void fail(const YAML::Node& at, const std::string& what) const { throw DataError(file, line_of(at), what); }
+  YAML::Node need(const YAML::Node& map, const char* key, const std::string& where) const {
+    const YAML::Node v = map[key];
+    if (!v) fail(map, fmt::format("{}: missing '{}'", where, key));
+    return v;
+  }
+  void keys(const YAML::Node& map, std::initializer_list<const char*> allowed, const std::string& where) const {
+    if (!map.IsMap()) fail(map, where + ": expected a map");
+    for (const auto& kv : map) {
+      const std::string k = kv.first.as<std::string>();
+      bool ok = false;
+      for (const char* a : allowed) ok = ok || k == a;
+      if (!ok) fail(kv.first, fmt::format("{}: unknown key '{}'", where, k));
+    }
+  }
+  double number(const YAML::Node& n, const std::string& what) const {
+    if (!n.IsScalar()) fail(n, what + ": expected a number");
+    try {
+      const double v = n.as<double>();
+      if (!std::isfinite(v)) fail(n, what + ": expected a finite number");
+      return v;
+    } catch (const YAML::Exception&) {
+      fail(n, fmt::format("{}: expected a number, got '{}'", what, n.Scalar()));
+    }
+  }
+  double positive(const YAML::Node& n, const std::string& what) const {
+    const double v = number(n, what);
+    if (!(v > 0)) fail(n, what + ": must be positive");
+    return v;
+  }
+  long long integer(const YAML::Node& n, const std::string& what, long long lo, long long hi) const {
+    const double v = number(n, what);
+    if (v != std::floor(v) || v < lo || v > hi) fail(n, fmt::format("{}: expected a whole number in {}..{}, got '{}'", what, lo, hi, n.Scalar()));
+    return static_cast<long long>(v);
+  }
+  std::string text(const YAML::Node& n, const std::string& what) const {
+    if (!n.IsScalar()) fail(n, what + ": expected text");
+    return n.Scalar();
+  }
+};
+
+}  // namespace
+
+HardwareConfig read_hardware_config(const std::filesystem::path& path, const std::vector<JointInfo>& robot_joints) {
+  HardwareConfig c;
+  c.path = path.string();
+  Reader r{c.path};
+  std::ifstream in(path);
+  if (!in) throw DataError(c.path, 0, "not found (the robot's hardware description)");
+  std::stringstream content;
+  content << in.rdbuf();
+  YAML::Node root;
+  try {
+    root = YAML::Load(content.str());
+  } catch (const YAML::ParserException& e) {
+    throw DataError(c.path, e.mark.is_null() ? 0 : e.mark.line + 1, "invalid YAML: " + e.msg);
+  }
+  if (!root.IsMap()) throw DataError(c.path, 1, "expected a map of keys");
+  r.keys(root, {"format", "bus", "models", "joints", "safety"}, "hardware.yaml");
+  const std::string format = r.text(r.need(root, "format", "hardware.yaml"), "format");
+  if (format != "symoro-hardware 1") r.fail(root["format"], "format: expected 'symoro-hardware 1', got '" + format + "'");
+
+  const YAML::Node bus = r.need(root, "bus", "hardware.yaml");
+  r.keys(bus, {"baud", "return_delay_time", "period"}, "bus");
+  c.baud = static_cast<std::uint32_t>(r.integer(r.need(bus, "baud", "bus"), "bus.baud", 9600, 4'500'000));
+  if (bus["return_delay_time"]) c.return_delay_time = static_cast<int>(r.integer(bus["return_delay_time"], "bus.return_delay_time", 0, 254));
+  if (bus["period"]) c.period = r.positive(bus["period"], "bus.period");
+
+  std::map<std::string, ServoModel> models;
+  const YAML::Node ms = r.need(root, "models", "hardware.yaml");
+  if (!ms.IsMap()) r.fail(ms, "models: expected a map of model name to {model_number, torque_constant, current_unit, current_limit}");
+  for (const auto& kv : ms) {
+    ServoModel m;
+    m.name = kv.first.as<std::string>();
+    const std::string where = "models." + m.name;
+    r.keys(kv.second, {"model_number", "torque_constant", "current_unit", "current_limit"}, where);
+    m.model_number = static_cast<std::uint16_t>(r.integer(r.need(kv.second, "model_number", where), where + ".model_number", 0, 65535));
+    m.torque_constant = r.positive(r.need(kv.second, "torque_constant", where), where + ".torque_constant");
+    m.current_unit = r.positive(r.need(kv.second, "current_unit", where), where + ".current_unit");
+    m.current_limit = r.positive(r.need(kv.second, "current_limit", where), where + ".current_limit");
+    models[m.name] = m;
+  }
+
+  const YAML::Node js = r.need(root, "joints", "hardware.yaml");
+  if (!js.IsSequence()) r.fail(js, "joints: expected a list, one entry per joint");
+  if (js.size() != robot_joints.size())
+    r.fail(js, fmt::format("joints: {} entries, the robot has {} joints", js.size(), robot_joints.size()));
+  std::set<int> ids;
+  for (std::size_t i = 0; i < js.size(); ++i) {
+    const YAML::Node j = js[i];
+    const std::string where = fmt::format("joints[{}]", i + 1);
+    r.keys(j, {"name", "id", "model", "zero", "direction", "current_limit"}, where);
+    JointHardware h;
+    h.name = r.text(r.need(j, "name", where), where + ".name");
+    if (h.name != robot_joints[i].name)
+      r.fail(j["name"], fmt::format("{}: joint '{}' here, the robot's joint {} is '{}'", where, h.name, i + 1, robot_joints[i].name));
+    h.id = static_cast<std::uint8_t>(r.integer(r.need(j, "id", where), where + ".id", 0, 252));
+    if (!ids.insert(h.id).second) r.fail(j["id"], fmt::format("{}: servo ID {} is used twice", where, int(h.id)));
+    const std::string model = r.text(r.need(j, "model", where), where + ".model");
+    const auto m = models.find(model);
+    if (m == models.end()) r.fail(j["model"], fmt::format("{}: unknown servo model '{}' (not under models:)", where, model));
+    h.model = m->second;
+    if (j["zero"]) h.zero = static_cast<std::int32_t>(r.integer(j["zero"], where + ".zero", -1'048'575, 1'048'575));
+    if (j["direction"]) {
+      h.direction = static_cast<int>(r.integer(j["direction"], where + ".direction", -1, 1));
+      if (h.direction == 0) r.fail(j["direction"], where + ".direction: expected 1 or -1");
+    }
+    h.current_limit = r.positive(r.need(j, "current_limit", where), where + ".current_limit");
+    if (h.current_limit > h.model.current_limit)
+      r.fail(j["current_limit"], fmt::format("{}.current_limit: {} A is beyond the {}'s {} A", where, h.current_limit, h.model.name,
+                                             h.model.current_limit));
+    c.joints.push_back(h);
+  }
+
+  if (const YAML::Node s = root["safety"]) {
+    r.keys(s, {"watchdog_cycles", "position_tolerance", "velocity_factor", "current_trip_factor", "approach_speed", "pre_roll"}, "safety");
+    if (s["watchdog_cycles"]) c.safety.watchdog_cycles = static_cast<int>(r.integer(s["watchdog_cycles"], "safety.watchdog_cycles", 1, 1000));
+    if (s["position_tolerance"]) c.safety.position_tolerance = r.number(s["position_tolerance"], "safety.position_tolerance");
+    if (s["velocity_factor"]) c.safety.velocity_factor = r.positive(s["velocity_factor"], "safety.velocity_factor");
+    if (s["current_trip_factor"]) c.safety.current_trip_factor = r.positive(s["current_trip_factor"], "safety.current_trip_factor");
+    if (s["approach_speed"]) c.safety.approach_speed = r.positive(s["approach_speed"], "safety.approach_speed");
+    if (s["pre_roll"]) c.safety.pre_roll = r.number(s["pre_roll"], "safety.pre_roll");
+    if (c.safety.position_tolerance < 0) r.fail(s["position_tolerance"], "safety.position_tolerance: must not be negative");
+    if (c.safety.pre_roll < 0) r.fail(s["pre_roll"], "safety.pre_roll: must not be negative");
+  }
+  return c;
+}
+
+}  // namespace symoro::hardware

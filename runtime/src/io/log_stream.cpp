@@ -1,0 +1,244 @@
+// The streaming log writer: rows into a double buffer, a thread that formats and appends them to
+// the CSV, then rewrites the sidecar with the count on disk.
+#include "symoro/io/log_stream.hpp"
+
+#include <fcntl.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+
+#include "log_columns.hpp"
+#include "log_sidecar.hpp"
+#include "symoro/error.hpp"
+#include "symoro/io/atomic_file.hpp"
+#include "symoro/io/number_text.hpp"
+
+namespace symoro::io {
+
+using detail::Group;
+
+LogStream::LogStream(std::filesystem::path csv, LogMetadata meta, bool references,
+                     std::chrono::milliseconds flush_every, std::size_t capacity)
+    : csv_(std::move(csv)),
+      meta_(std::move(meta)),
+      references_(references),
+      n_(static_cast<int>(meta_.joints.size())),
+      width_(1 + static_cast<std::size_t>(n_) * (references ? 6 : 3)),
+      flush_every_(flush_every),
+      capacity_(capacity < 16 ? 16 : capacity) {
+  if (n_ == 0) throw DataError(csv_.string(), 0, "a streamed log needs joint names");
+  if (meta_.source != "twin" && meta_.source != "robot")
+    throw DataError(csv_.string(), 0, "a streamed log's source is 'robot' or 'twin', not '" + meta_.source + "'");
+  if (!(meta_.sample_time > 0) || !std::isfinite(meta_.sample_time))
+    throw DataError(csv_.string(), 0, "a streamed log needs a positive sample_time");
+  front_.resize(capacity_ * width_);
+  back_.resize(capacity_ * width_);
+  text_.reserve(1 << 20);
+  notes_ = meta_.notes;
+  if (!csv_.parent_path().empty()) std::filesystem::create_directories(csv_.parent_path());
+  fd_ = ::open(csv_.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+  if (fd_ < 0) throw DataError(csv_.string(), 0, std::string("cannot write the log: ") + std::strerror(errno));
+  std::string header = "time";
+  const Group groups[] = {Group::q, Group::qd, Group::tau, Group::q_ref, Group::qd_ref, Group::qdd_ref};
+  for (int g = 0; g < (references_ ? 6 : 3); ++g)
+    for (int j = 0; j < n_; ++j) header += "," + detail::column_name({groups[g], j});
+  header += '\n';
+  if (::write(fd_, header.data(), header.size()) != static_cast<ssize_t>(header.size())) {
+    const int e = errno;
+    ::close(fd_);
+    throw DataError(csv_.string(), 0, std::string("cannot write the log: ") + std::strerror(e));
+  }
+  write_sidecar(0);
+  thread_ = std::thread([this] { run(); });
+}
+
+LogStream::~LogStream() {
+  try {
+    close();
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "%s\n", e.what());
+  }
+}
+
+bool LogStream::append(double time, const double* q, const double* qd, const double* tau, const double* q_ref,
+                       const double* qd_ref, const double* qdd_ref) {
+  const double* groups[] = {q, qd, tau, q_ref, qd_ref, qdd_ref};
+  const int count = references_ ? 6 : 3;
+  bool finite = std::isfinite(time);
+  for (int g = 0; g < count && finite; ++g) {
+    if (!groups[g]) {
+      finite = false;
+      break;
+    }
+    for (int j = 0; j < n_; ++j) finite = finite && std::isfinite(groups[g][j]);
+  }
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (closed_ || !finite || (has_last_ && !(time > last_time_))) {
+    ++rejected_;
+    return false;
+  }
+  if (front_rows_ >= capacity_) {
+    ++overflowed_;
+    return false;
+  }
+  double* out = front_.data() + front_rows_ * width_;
+  *out++ = time;
+  for (int g = 0; g < count; ++g)
+    for (int j = 0; j < n_; ++j) *out++ = groups[g][j];
+  ++front_rows_;
+  ++appended_;
+  last_time_ = time;
+  has_last_ = true;
+  if (front_rows_ >= capacity_ / 2) wake_.notify_one();
+  return true;
+}
+
+void LogStream::set_notes(std::string notes) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  notes_ = std::move(notes);
+}
+
+void LogStream::run() {
+  std::unique_lock<std::mutex> lock(mutex_);
+  for (;;) {
+    const std::uint64_t requested = flush_requests_;
+    wake_.wait_for(lock, flush_every_, [&] { return stop_ || flush_requests_ != requested || front_rows_ >= capacity_ / 2; });
+    const std::uint64_t serving = flush_requests_;
+    const std::size_t rows = front_rows_;
+    std::swap(front_, back_);
+    front_rows_ = 0;
+    const bool stopping = stop_;
+    lock.unlock();
+    if (rows > 0 || serving != flushes_done_) write_out(back_, rows);
+    lock.lock();
+    flushes_done_ = serving;
+    done_.notify_all();
+    if (stopping) return;
+  }
+}
+
+void LogStream::write_out(std::vector<double>& rows, std::size_t count) {
+  text_.clear();
+  char number[max_number_chars];
+  for (std::size_t r = 0; r < count; ++r) {
+    const double* row = rows.data() + r * width_;
+    for (std::size_t c = 0; c < width_; ++c) {
+      char* end = to_text(number, row[c]);
+      text_.append(number, end);
+      text_ += c + 1 < width_ ? ',' : '\n';
+    }
+  }
+  std::size_t done = 0;
+  while (done < text_.size()) {
+    const ssize_t w = ::write(fd_, text_.data() + done, text_.size() - done);
+    if (w < 0 && errno == EINTR) continue;
+    if (w <= 0) {
+      std::lock_guard<std::mutex> lock(mutex_);
+      if (error_.empty()) error_ = std::string("cannot write the log: ") + std::strerror(errno);
+      return;
+    }
+    done += static_cast<std::size_t>(w);
+  }
+  std::int64_t total;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    written_ += static_cast<std::int64_t>(count);
+    total = written_;
+  }
+  try {
+    write_sidecar(total);
+  } catch (const std::exception& e) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (error_.empty()) error_ = e.what();
+  }
+}
+
+void LogStream::write_sidecar(std::int64_t samples) {
+  Log log;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    log.meta = meta_;
+    log.meta.notes = notes_;
+  }
+  log.time = Eigen::VectorXd::Zero(samples);
+  log.q.resize(0, n_);
+  log.qd.resize(0, n_);
+  log.tau.resize(0, n_);
+  if (references_) {
+    log.q_ref.resize(0, n_);
+    log.qd_ref.resize(0, n_);
+    log.qdd_ref.resize(0, n_);
+  }
+  const std::filesystem::path sidecar = metadata_path(csv_);
+  write_file_atomically(sidecar, detail::sidecar_text(log, sidecar.string()));
+}
+
+void LogStream::flush() {
+  std::unique_lock<std::mutex> lock(mutex_);
+  if (closed_) return;
+  const std::uint64_t id = ++flush_requests_;
+  wake_.notify_one();
+  done_.wait(lock, [&] { return flushes_done_ >= id; });
+}
+
+void LogStream::close() {
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (closed_) return;
+    closed_ = true;
+    stop_ = true;
+  }
+  wake_.notify_one();
+  if (thread_.joinable()) thread_.join();
+  // The writer's last pass took what was buffered when it stopped; append() refuses rows now,
+  // but a row may have come in between: write it, then the final sidecar.
+  std::size_t rows;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    rows = front_rows_;
+    front_rows_ = 0;
+  }
+  if (rows > 0) write_out(front_, rows);
+  std::int64_t total;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    total = written_;
+  }
+  try {
+    write_sidecar(total);
+  } catch (const std::exception& e) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (error_.empty()) error_ = e.what();
+  }
+  ::fsync(fd_);
+  ::close(fd_);
+  fd_ = -1;
+  std::string error;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    error = error_;
+  }
+  if (!error.empty()) throw DataError(csv_.string(), 0, error);
+}
+
+std::int64_t LogStream::appended() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return appended_;
+}
+std::int64_t LogStream::written() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return written_;
+}
+std::int64_t LogStream::rejected() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return rejected_;
+}
+std::int64_t LogStream::overflowed() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return overflowed_;
+}
+
+}  // namespace symoro::io

@@ -1,0 +1,144 @@
+// dynid control: run a designed trajectory on the real arm (DYNAMIXEL bus at --port) with the
+// paper's FF+PD at 1 kHz, or with --virtual on the emulated servo chain driving the digital twin
+// (a pseudo-terminal: the same driver, bytes and timing path), and write its log.
+#include <pthread.h>
+#include <sched.h>
+
+#include <algorithm>
+#include <memory>
+#include <string>
+
+#include <fmt/format.h>
+
+#include "dynid_common.hpp"
+#include "symoro/dynamixel/bus.hpp"
+#include "symoro/dynamixel/serial_port.hpp"
+#include "symoro/dynamixel/virtual_bus.hpp"
+#include "symoro/hardware/config.hpp"
+#include "symoro/hardware/controller.hpp"
+#include "symoro/hardware/twin_servo_backend.hpp"
+#include "symoro/robots_registry.hpp"
+#include "symoro/trajectory/design.hpp"
+#include "symoro/twin/simulator.hpp"
+
+namespace symoro::dynid {
+
+namespace {
+
+struct ControlCliOptions {
+  std::string port = "/dev/ttyUSB0";
+  bool virtual_bus = false;
+  std::string trajectory = "AG02";
+  std::string out;
+  std::string params;
+  std::string hardware;  // default robots/<robot>/hardware.yaml
+  std::string twin_config;
+  bool ideal = false;
+  double seconds = 0;
+  int trial = 1;
+  int priority = 0;
+  int watchdog = 0;
+};
+
+template <class Full, class Identified>
+void control(const Common& common, const ControlCliOptions& o) {
+  const std::vector<JointInfo> joints = joint_list<Full>();
+  const auto hw_path = o.hardware.empty() ? common.robot_dir() / "hardware.yaml" : std::filesystem::path(o.hardware);
+  if (!std::filesystem::exists(hw_path))
+    throw UsageError(fmt::format("robot '{}' has no hardware description ({} not found)", common.robot, hw_path.string()));
+  const hardware::HardwareConfig hw = hardware::read_hardware_config(hw_path, joints);
+  const auto twin_path = common.robot_dir() / "twin.yaml";
+  if (!std::filesystem::exists(twin_path))
+    throw UsageError(fmt::format("robot '{}' has no twin.yaml ({} not found): it holds the FF+PD realization gains", common.robot,
+                                 twin_path.string()));
+  twin::TwinConfig tc = twin::read_twin_config(twin_path, Full::nq, o.twin_config);
+  if (o.ideal) tc.effects.disable_all();
+  control::FfpdGains gains = twin::controller_gains(tc);
+  gains.period = hw.period;
+  const trajectory::Trajectory traj =
+      trajectory::TrajectoryDesign::read(common.robot_dir() / "trajectories.yaml", joints).build(o.trajectory);
+
+  hardware::ControlOptions co;
+  co.robot = common.robot;
+  co.trial = o.trial;
+  co.seconds = o.seconds;
+  co.realtime_priority = o.priority;
+  // The emulated servos are a thread that may wait for a core on a loaded machine.
+  co.watchdog_cycles = o.watchdog > 0 ? o.watchdog : (o.virtual_bus ? std::max(20, hw.safety.watchdog_cycles) : 0);
+  co.source = o.virtual_bus ? "twin" : "robot";
+  co.notes = o.virtual_bus ? "dynid control --virtual: virtual DYNAMIXEL bus driving the " + twin::ClosedLoopTwin<Full>(tc).notes()
+                           : "dynid control on " + o.port;
+  if (!o.params.empty()) {
+    std::vector<std::string> names;
+    for (const auto& p : Identified::parameters) names.emplace_back(p.name);
+    const Eigen::VectorXd phi = hardware::read_identified_parameters(o.params, names);
+    co.feedforward = hardware::model_feedforward<Identified>(phi);
+    co.notes += "; model feedforward from " + o.params;
+  }
+
+  std::unique_ptr<dynamixel::VirtualBus> virt;
+  std::string device = o.port;
+  if (o.virtual_bus) {
+    Eigen::VectorXd q(Full::nq), qd(Full::nq), qdd(Full::nq);
+    traj.evaluate(0, q, qd, qdd);
+    // With --rt-priority the emulated servos' thread gets SCHED_FIFO one below the loop (a
+    // thread inherits its creator's scheduling).
+    int policy = 0;
+    sched_param saved{};
+    bool raised = false;
+    if (o.priority > 1) {
+      pthread_getschedparam(pthread_self(), &policy, &saved);
+      sched_param p{};
+      p.sched_priority = o.priority - 1;
+      raised = pthread_setschedparam(pthread_self(), SCHED_FIFO, &p) == 0;
+    }
+    virt = std::make_unique<dynamixel::VirtualBus>(
+        hardware::virtual_servos(hw),
+        std::make_unique<hardware::TwinServoBackend<Full>>(tc, hw, Eigen::Matrix<double, Full::nq, 1>(q)));
+    if (raised) pthread_setschedparam(pthread_self(), policy, &saved);
+    device = virt->device();
+  }
+  dynamixel::SerialPort port(device, hw.baud);
+  dynamixel::Bus bus(port);
+  hardware::StopSignals signals;
+  const hardware::ControlResult r = hardware::run_control(bus, hw, joints, gains, traj, o.out, co);
+  fmt::print("{}: {} rows, {:.3f} s of {}; max |q_ref - q| per joint (deg):", o.out, r.rows, r.trajectory_time, o.trajectory);
+  for (int j = 0; j < r.max_error.size(); ++j) fmt::print(" {:.3f}", r.max_error(j) * 180 / 3.14159265358979323846);
+  fmt::print("\n{}\n", r.timing.summary());
+  if (r.reason != hardware::StopReason::completed)
+    throw std::runtime_error(fmt::format("run stopped ({}): {}; torque off {}", hardware::to_string(r.reason), r.message,
+                                         r.torque_off_confirmed ? "confirmed" : "NOT confirmed for every servo"));
+  fmt::print("completed; torque off {}\n", r.torque_off_confirmed ? "confirmed" : "NOT confirmed for every servo");
+}
+
+}  // namespace
+
+void add_control_commands(CLI::App& app, Common& common) {
+  auto o = std::make_shared<ControlCliOptions>();
+  auto* cmd = app.add_subcommand("control", "Run a trajectory on the arm (DYNAMIXEL bus, FF+PD at 1 kHz) and log it; "
+                                            "--virtual: on the emulated bus driving the digital twin");
+  cmd->add_option("--robot", common.robot, "Robot folder name under robots/")->required();
+  cmd->add_option("--robots-dir", common.robots_dir, "Where the robot folders are");
+  cmd->add_option("--port", o->port, "Serial device of the DYNAMIXEL bus (default /dev/ttyUSB0)");
+  cmd->add_flag("--virtual", o->virtual_bus, "Emulated servos on a pseudo-terminal, driving the digital twin");
+  cmd->add_option("--trajectory", o->trajectory, "Trajectory name (default AG02)");
+  cmd->add_option("-o,--output", o->out, "Log file (CSV; its .meta.yaml sidecar next to it)")->required();
+  cmd->add_option("--params", o->params, "A study's report/parameters.yaml: add the identified model's inverse dynamics "
+                                         "as feedforward")->check(CLI::ExistingFile);
+  cmd->add_option("--seconds", o->seconds, "Run only this much of the trajectory")->check(CLI::PositiveNumber);
+  cmd->add_option("--hardware", o->hardware, "Hardware description (default robots/<robot>/hardware.yaml)")->check(CLI::ExistingFile);
+  cmd->add_option("--config", o->twin_config, "--virtual: a YAML file overriding parts of twin.yaml")->check(CLI::ExistingFile);
+  cmd->add_flag("--ideal", o->ideal, "--virtual: turn every twin effect off");
+  cmd->add_option("--trial", o->trial, "Trial number in the log")->check(CLI::PositiveNumber);
+  cmd->add_option("--watchdog", o->watchdog, "Consecutive failed reads that stop the arm (default: hardware.yaml's; "
+                                             "--virtual: at least 20)")->check(CLI::PositiveNumber);
+  cmd->add_option("--rt-priority", o->priority, "SCHED_FIFO priority of the loop (0: normal scheduling)");
+  cmd->callback([&common, o] {
+    if (!with_robot(common.robot, [&](auto e) {
+          control<typename decltype(e)::FullModel, typename decltype(e)::IdentifiedModel>(common, *o);
+        }))
+      throw UsageError("unknown robot '" + common.robot + "'");
+  });
+}
+
+}  // namespace symoro::dynid
