@@ -6,7 +6,8 @@
 # study on it (40 trajectories x 4 intervals: OLS, all-pose PD audit, conditional SDP, CLIE,
 # PCA selection, rescue, final audit, validation on V01-V03) with its report in
 # build/study/report/report.md. Both steps are resumable: a rerun skips what is finished.
-# Last, the model-gap workflow on twin data with hidden effects (build/diagnosis/, build/gap/).
+# Then the model-gap workflow on twin data with hidden effects (build/diagnosis/, build/gap/),
+# and 5 s of the 1 kHz controller against virtual servos (build/control-virtual.csv).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash tools/install_deps.sh
@@ -47,3 +48,7 @@ for model in reduced reduced_diagnosed; do
     --only AG02 --interval 10 --validation V01,V02,V03
 done
 $dynid compare --robot crane_x7 --before build/gap-study-reduced --after build/gap-study-reduced_diagnosed -o build/gap
+
+# The hardware controller without hardware: 5 s of AG02 at 1 kHz through the real DYNAMIXEL
+# driver over a pseudo-terminal, against virtual servos that drive the digital twin.
+$dynid control --robot crane_x7 --virtual --trajectory AG02 --seconds 5 -o build/control-virtual.csv

@@ -24,6 +24,7 @@ const std::vector<Entry>& catalogue() {
       {EffectKind::Stribeck, "stribeck", {}},
       {EffectKind::ViscousAsymmetry, "viscous_asymmetry", {}},
       {EffectKind::PositionHarmonics, "position_harmonics", {}},
+      {EffectKind::SmoothCoulomb, "smooth_coulomb", {}},
   };
   return entries;
 }
@@ -48,6 +49,8 @@ std::string effect_names() {
 
 bool effect_on_links(EffectKind kind) { return kind == EffectKind::InertiaProducts; }
 
+bool effect_has_velocity(EffectKind kind) { return kind == EffectKind::Stribeck || kind == EffectKind::SmoothCoulomb; }
+
 const std::vector<std::string>& unfixed_families(EffectKind kind) { return entry(kind).unfixes; }
 
 std::vector<EffectParameter> effect_parameters(
@@ -66,6 +69,7 @@ std::vector<EffectParameter> effect_parameters(
       case EffectKind::Offset: out.push_back({"OFF" + js, "OFF", j, unit("FS", j), 0, 0.0}); break;
       case EffectKind::Stribeck: out.push_back({"FST" + js, "FST", j, unit("FS", j), 0, e->velocity}); break;
       case EffectKind::ViscousAsymmetry: out.push_back({"FVA" + js, "FVA", j, unit("FV", j), 0, 0.0}); break;
+      case EffectKind::SmoothCoulomb: out.push_back({"FC" + js, "FC", j, unit("FS", j), 0, e->velocity}); break;
       case EffectKind::PositionHarmonics: {
         std::vector<int> orders = e->orders;
         std::sort(orders.begin(), orders.end());
@@ -96,6 +100,7 @@ NodeId effect_term(ExprGraph& g, const EffectParameter& p, NodeId q, NodeId qd) 
     const NodeId sign = g.sign(qd);
     return g.mul(qd, sign);
   }
+  if (p.family == "FC") return g.tanh(g.div(qd, g.constant(p.velocity)));
   if (p.family == "HS") return g.sin(g.mul(g.constant(p.order), q));
   if (p.family == "HC") return g.cos(g.mul(g.constant(p.order), q));
   throw std::logic_error("no term for effect parameter family " + p.family);
@@ -106,6 +111,7 @@ std::string effect_term_text(const EffectParameter& p, const std::string& q, con
   if (p.family == "OFF") return "1";
   if (p.family == "FST") return "sign(" + qd + ")*exp(-(" + qd + "/" + cpp_literal(p.velocity) + ")^2)";
   if (p.family == "FVA") return "|" + qd + "|";
+  if (p.family == "FC") return "tanh(" + qd + "/" + cpp_literal(p.velocity) + ")";
   if (p.family == "HS") return "sin(" + kq + ")";
   if (p.family == "HC") return "cos(" + kq + ")";
   throw std::logic_error("no term for effect parameter family " + p.family);

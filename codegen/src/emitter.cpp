@@ -84,6 +84,7 @@ std::string emit_body(const ExprGraph& g, const std::map<std::string, std::strin
       case Op::Cos: t = {"cos(" + arg(n.a).s + ")", kAtom}; break;
       case Op::Sign: t = {"sign(" + arg(n.a).s + ")", kAtom}; break;
       case Op::Exp: t = {"exp(" + arg(n.a).s + ")", kAtom}; break;
+      case Op::Tanh: t = {"tanh(" + arg(n.a).s + ")", kAtom}; break;
       case Op::Pow: {
         const double e = n.value;
         const std::string x = wrap(arg(n.a), kAtom);

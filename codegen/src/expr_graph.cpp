@@ -173,6 +173,12 @@ NodeId ExprGraph::sign(NodeId a) {
   return intern(Node{Op::Sign, a, -1, 0.0, -1});
 }
 
+NodeId ExprGraph::tanh(NodeId a) {
+  if (is_constant(a)) return constant(std::tanh(node(a).value));
+  if (node(a).op == Op::Neg) return neg(tanh(node(a).a));  // odd, like sign
+  return intern(Node{Op::Tanh, a, -1, 0.0, -1});
+}
+
 NodeId ExprGraph::exp(NodeId a) {
   if (is_constant(a)) return constant(std::exp(node(a).value));  // exp(0) = 1 exactly
   return intern(Node{Op::Exp, a, -1, 0.0, -1});

@@ -135,13 +135,16 @@ class ModelWriter {
     return tau;
   }
 
-  // The `using` declarations of a function body: exp only where it is needed, so that models
-  // without effects read as before.
+  // The `using` declarations of a function body: exp and tanh only where they are needed, so
+  // that models without effects read as before.
   std::string usings(const std::vector<NodeId>& roots) const {
-    bool exp = false;
-    for (NodeId id : reachable(g_, roots)) exp = exp || g_.node(id).op == Op::Exp;
+    bool exp = false, tanh = false;
+    for (NodeId id : reachable(g_, roots)) {
+      exp = exp || g_.node(id).op == Op::Exp;
+      tanh = tanh || g_.node(id).op == Op::Tanh;
+    }
     return std::string("  using std::cos;\n") + (exp ? "  using std::exp;\n" : "") +
-           "  using std::pow;\n  using std::sin;\n  using ::symoro::sign;\n";
+           "  using std::pow;\n  using std::sin;\n" + (tanh ? "  using std::tanh;\n" : "") + "  using ::symoro::sign;\n";
   }
 
   Input q_in() const { return {"Q", "q", r_.q}; }
@@ -531,7 +534,8 @@ class ModelWriter {
 };
 
 // Resolves a variant's patterns to base parameters; every pattern must match something. The
-// base parameters its effects un-fix (coulomb, inertia_products) stay identified.
+// base parameters its effects un-fix (coulomb, inertia_products) stay identified; smooth_coulomb
+// fixes its joint's FS to 0 (its tanh term replaces the files' sign term).
 std::vector<std::pair<std::string, double>> resolve_fixed(const RobotModel& r, const VariantSpec& v) {
   std::map<std::string, double> fixed;
   for (const auto& [pattern, value] : v.fixed) {
@@ -544,6 +548,16 @@ std::vector<std::pair<std::string, double>> resolve_fixed(const RobotModel& r, c
         throw InputError(r.spec.path, v.line, 1, "variant " + v.name + ": " + p.name + " is fixed to two values");
     }
     if (!matched) throw InputError(r.spec.path, v.line, 1, "variant " + v.name + ": '" + pattern + "' matches no base parameter");
+  }
+  for (const auto& e : v.effects) {
+    if (e.kind != EffectKind::SmoothCoulomb) continue;
+    for (const auto& other : v.effects)
+      if (other.kind == EffectKind::Coulomb && other.index == e.index)
+        throw InputError(r.spec.path, e.line, e.column,
+                         "variant " + v.name + ": joint " + std::to_string(e.index) +
+                             " has both coulomb and smooth_coulomb (one Coulomb friction term per joint)");
+    for (const auto& p : r.base)
+      if (p.joint == e.index && p.family == "FS") fixed[p.name] = 0.0;
   }
   for (const auto& e : v.effects) {
     const auto& families = unfixed_families(e.kind);

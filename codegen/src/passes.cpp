@@ -38,6 +38,7 @@ static NodeId rebuild(ExprGraph& g, const Node& n, NodeId a, NodeId b) {
     case Op::Cos: return g.cos(a);
     case Op::Sign: return g.sign(a);
     case Op::Exp: return g.exp(a);
+    case Op::Tanh: return g.tanh(a);
     case Op::Constant:
     case Op::Symbol: break;
   }
@@ -89,6 +90,9 @@ std::vector<NodeId> differentiate(ExprGraph& g, const std::vector<NodeId>& roots
       case Op::Cos: out = g.neg(g.mul(g.sin(n.a), d.at(n.a))); break;
       case Op::Sign: break;
       case Op::Exp: out = g.mul(id, d.at(n.a)); break;  // exp(a)' = exp(a) a', reusing the node
+      case Op::Tanh:  // tanh(a)' = (1 - tanh(a)^2) a', reusing the node
+        out = g.mul(g.sub(g.one(), g.pow(id, 2.0)), d.at(n.a));
+        break;
     }
     d.emplace(id, out);
   }
@@ -118,7 +122,8 @@ OperationCount count_operations(const ExprGraph& g, const std::vector<NodeId>& r
       case Op::Sin:
       case Op::Cos: ++c.trig; break;
       case Op::Sign: ++c.sign; break;
-      case Op::Exp: ++c.exp; break;
+      case Op::Exp:
+      case Op::Tanh: ++c.exp; break;
       case Op::Constant:
       case Op::Symbol: break;
     }

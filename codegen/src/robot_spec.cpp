@@ -117,8 +117,10 @@ std::vector<EffectSpec> read_effects(const Reader& r, const YAML::Node& effects,
     list.reset(kv.second);  // reset, not =: assigning a YAML::Node rebinds what it refers to
     double velocity = 0;
     std::vector<int> orders;
-    if (*kind == EffectKind::Stribeck || *kind == EffectKind::PositionHarmonics) {
-      const bool stribeck = *kind == EffectKind::Stribeck;
+    if (effect_has_velocity(*kind) || *kind == EffectKind::PositionHarmonics) {
+      const bool stribeck = effect_has_velocity(*kind);
+      const std::string what_velocity =
+          *kind == EffectKind::Stribeck ? "the Stribeck velocity" : "the velocity scale of tanh(qd/v)";
       const std::string form = stribeck ? "{joints: [...], velocity: <rad/s>}" : "{joints: [...], orders: [...]}";
       if (!kv.second.IsMap()) r.fail(kv.second, effect + " takes " + form);
       r.only_keys(kv.second, stribeck ? std::set<std::string>{"joints", "velocity"} : std::set<std::string>{"joints", "orders"},
@@ -126,10 +128,10 @@ std::vector<EffectSpec> read_effects(const Reader& r, const YAML::Node& effects,
       list.reset(kv.second["joints"]);
       if (!list) r.fail(kv.second, effect + " needs 'joints': " + form);
       if (stribeck) {
-        velocity = kDefaultStribeckVelocity;
+        velocity = *kind == EffectKind::Stribeck ? kDefaultStribeckVelocity : kDefaultSmoothCoulombVelocity;
         if (const auto vel = kv.second["velocity"]) {
-          velocity = r.number(vel, "the Stribeck velocity");
-          if (!(velocity > 0)) r.fail(vel, effect + ": the Stribeck velocity must be positive (rad/s), not " + vel.Scalar());
+          velocity = r.number(vel, what_velocity);
+          if (!(velocity > 0)) r.fail(vel, effect + ": " + what_velocity + " must be positive (rad/s), not " + vel.Scalar());
         }
       } else {
         const auto o = kv.second["orders"];

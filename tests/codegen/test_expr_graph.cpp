@@ -34,6 +34,7 @@ double eval(const ExprGraph& g, NodeId root, const std::map<std::string, double>
       case Op::Cos: v[id] = std::cos(a()); break;
       case Op::Sign: v[id] = double((a() > 0) - (a() < 0)); break;
       case Op::Exp: v[id] = std::exp(a()); break;
+      case Op::Tanh: v[id] = std::tanh(a()); break;
     }
   }
   return v.at(root);

@@ -52,7 +52,7 @@ class BrokenRobot : public ::testing::Test {
   // Adds variants (YAML lines indented by two spaces) to robot.yaml's `variants:` map, which
   // ends the file: its first line is line kFirstAddedLine.
   void add_variants(const std::string& yaml) { std::ofstream(dir_ / "robot.yaml", std::ios::app) << yaml; }
-  static constexpr int kFirstAddedLine = 28;
+  static constexpr int kFirstAddedLine = 29;
 
   // Loading and generating must fail with a message matching `pattern`.
   void expect_error(const std::string& pattern) {
@@ -152,13 +152,14 @@ TEST_F(BrokenRobot, EffectsUnfixAndAppendParametersInCanonicalOrder) {
   EXPECT_EQ(m.name, "arm::effects");
   EXPECT_EQ(names_of(m.identified),
             (std::vector<std::string>{"ZZR1", "MXR1", "MY1", "ZZ2", "MX2", "MY2", "IA2", "FV1", "FV2", "FS1", "OFF1",
-                                      "OFF2", "FST2", "FVA2", "HS1_1", "HC1_1", "HS1_2", "HC1_2"}));
+                                      "OFF2", "FST2", "FVA2", "HS1_1", "HC1_1", "HS1_2", "HC1_2", "FC2"}));
   ASSERT_EQ(m.fixed.size(), 1u);  // "FS*" matches FS1 and FS2; coulomb [1] un-fixes FS1
   EXPECT_EQ(m.fixed[0].first, "FS2");
   EXPECT_EQ(m.identified[13].unit, "N*m*s/rad");
-  ASSERT_EQ(m.effects.size(), 8u);
+  ASSERT_EQ(m.effects.size(), 9u);
   EXPECT_EQ(m.effects[2], (std::pair<std::string, std::string>{"FST2", "sign(QP2)*exp(-(QP2/0.05)^2)"}));
   EXPECT_EQ(m.effects[6], (std::pair<std::string, std::string>{"HS1_2", "sin(2*th1)"}));
+  EXPECT_EQ(m.effects[8], (std::pair<std::string, std::string>{"FC2", "tanh(QP2/0.04)"}));
 }
 
 TEST_F(BrokenRobot, BaseVariantChainsFixedPatternsAndEffects) {
@@ -179,7 +180,8 @@ TEST_F(BrokenRobot, BaseVariantChainsFixedPatternsAndEffects) {
     SCOPED_TRACE(m.name);
     EXPECT_EQ(names_of(m.identified),
               (std::vector<std::string>{"ZZR1", "MXR1", "MY1", "ZZ2", "MX2", "MY2", "IA2", "FV1", "FS1", "OFF1", "OFF2",
-                                        "FST1", "FST2", "FVA2", "HS1_1", "HC1_1", "HS1_2", "HC1_2", "HS2_3", "HC2_3"}));
+                                        "FST1", "FST2", "FVA2", "HS1_1", "HC1_1", "HS1_2", "HC1_2", "HS2_3", "HC2_3",
+                                        "FC2"}));
     EXPECT_EQ(m.fixed, (std::vector<std::pair<std::string, double>>{{"FV2", 0.0}, {"FS2", 0.0}}));
     EXPECT_EQ(m.effects[2].second, "sign(QP1)*exp(-(QP1/0.05)^2)");  // the default Stribeck velocity
   }
@@ -203,50 +205,60 @@ TEST_F(BrokenRobot, PrismaticJointsTakePrismaticUnits) {
 
 TEST_F(BrokenRobot, UnknownEffect) {
   add_variants("  bad:\n    effects:\n      backlash: [1]\n");
-  expect_error(R"(robot\.yaml:30:7: error: variant bad: unknown effect 'backlash' \(known effects: coulomb, )"
-               R"(inertia_products, offset, stribeck, viscous_asymmetry, position_harmonics\))");
+  expect_error(R"(robot\.yaml:31:7: error: variant bad: unknown effect 'backlash' \(known effects: coulomb, )"
+               R"(inertia_products, offset, stribeck, viscous_asymmetry, position_harmonics, smooth_coulomb\))");
 }
 
 TEST_F(BrokenRobot, EffectJointOutOfRange) {
   add_variants("  bad:\n    effects:\n      offset: [1, 3]\n");
-  expect_error(R"(robot\.yaml:30:19: error: variant bad, effect offset: joint 3 is out of range \(the robot has 2 joints\))");
+  expect_error(R"(robot\.yaml:31:19: error: variant bad, effect offset: joint 3 is out of range \(the robot has 2 joints\))");
 }
 
 TEST_F(BrokenRobot, EffectJointMustBeAWholeNumberFromOne) {
   add_variants("  bad:\n    effects:\n      offset: [0]\n  worse:\n    effects:\n      coulomb: [1.5]\n");
-  expect_error(R"(robot\.yaml:30:16: error: variant bad, effect offset: joint 0 is out of range \(at least 1\))");
+  expect_error(R"(robot\.yaml:31:16: error: variant bad, effect offset: joint 0 is out of range \(at least 1\))");
   replace("robot.yaml", "offset: [0]", "offset: [1]");
-  expect_error(R"(robot\.yaml:33:17: error: variant worse, effect coulomb: joint must be a whole number, not '1\.5')");
+  expect_error(R"(robot\.yaml:34:17: error: variant worse, effect coulomb: joint must be a whole number, not '1\.5')");
 }
 
 TEST_F(BrokenRobot, EffectKeyTwice) {
   add_variants("  bad:\n    effects:\n      offset: [1]\n      offset: [2]\n");
-  expect_error(R"(robot\.yaml:31:7: error: variant bad: effect offset appears twice)");
+  expect_error(R"(robot\.yaml:32:7: error: variant bad: effect offset appears twice)");
 }
 
 TEST_F(BrokenRobot, EffectJointTwice) {
   add_variants("  bad:\n    effects:\n      viscous_asymmetry: [2, 2]\n");
-  expect_error(R"(robot\.yaml:30:30: error: variant bad, effect viscous_asymmetry: duplicate joint 2)");
+  expect_error(R"(robot\.yaml:31:30: error: variant bad, effect viscous_asymmetry: duplicate joint 2)");
 }
 
 TEST_F(BrokenRobot, StribeckVelocityMustBePositive) {
   add_variants("  bad:\n    effects:\n      stribeck: {joints: [1], velocity: 0}\n");
-  expect_error(R"(robot\.yaml:30:41: error: variant bad, effect stribeck: the Stribeck velocity must be positive)");
+  expect_error(R"(robot\.yaml:31:41: error: variant bad, effect stribeck: the Stribeck velocity must be positive)");
+}
+
+TEST_F(BrokenRobot, SmoothCoulombVelocityMustBePositive) {
+  add_variants("  bad:\n    effects:\n      smooth_coulomb: {joints: [1], velocity: -0.1}\n");
+  expect_error(R"(robot\.yaml:31:47: error: variant bad, effect smooth_coulomb: the velocity scale of tanh\(qd/v\) must be positive)");
+}
+
+TEST_F(BrokenRobot, OneCoulombTermPerJoint) {
+  add_variants("  bad:\n    effects:\n      coulomb: [2]\n      smooth_coulomb: {joints: [2], velocity: 0.03}\n");
+  expect_error(R"(robot\.yaml:32:[0-9]+: error: variant bad: joint 2 has both coulomb and smooth_coulomb)");
 }
 
 TEST_F(BrokenRobot, HarmonicOrderMustBeAtLeastOne) {
   add_variants("  bad:\n    effects:\n      position_harmonics: {joints: [1], orders: [1, 0]}\n");
-  expect_error(R"(robot\.yaml:30:53: error: variant bad, effect position_harmonics: order 0 is out of range \(at least 1\))");
+  expect_error(R"(robot\.yaml:31:53: error: variant bad, effect position_harmonics: order 0 is out of range \(at least 1\))");
 }
 
 TEST_F(BrokenRobot, HarmonicsNeedOrders) {
   add_variants("  bad:\n    effects:\n      position_harmonics: {joints: [1]}\n");
-  expect_error(R"(robot\.yaml:30:27: error: variant bad, effect position_harmonics needs 'orders')");
+  expect_error(R"(robot\.yaml:31:27: error: variant bad, effect position_harmonics needs 'orders')");
 }
 
 TEST_F(BrokenRobot, EffectOnALinkWithoutSuchParameters) {
   add_variants("  bad:\n    effects:\n      inertia_products: [1]\n");  // planar2r has no XY, XZ, YZ
-  expect_error(R"(robot\.yaml:30:26: error: variant bad: effect inertia_products on link 1: the model has no such )"
+  expect_error(R"(robot\.yaml:31:26: error: variant bad: effect inertia_products on link 1: the model has no such )"
                R"(base parameter \(XY1, XZ1, YZ1\))");
 }
 
@@ -259,27 +271,27 @@ TEST_F(BrokenRobot, CoulombOfAJointWithoutFS) {
 
 TEST_F(BrokenRobot, UnknownBaseVariant) {
   add_variants("  bad:\n    base: reduced\n");
-  expect_error(R"(robot\.yaml:29:11: error: variant bad: unknown base variant 'reduced' \(variants: effects, bad\))");
+  expect_error(R"(robot\.yaml:30:11: error: variant bad: unknown base variant 'reduced' \(variants: effects, bad\))");
 }
 
 TEST_F(BrokenRobot, BaseChainCycle) {
   add_variants("  one:\n    base: two\n  two:\n    base: three\n  three:\n    base: one\n");
-  expect_error(R"(robot\.yaml:33:11: error: variant three: the base chain one -> two -> three -> one is a cycle)");
+  expect_error(R"(robot\.yaml:34:11: error: variant three: the base chain one -> two -> three -> one is a cycle)");
 }
 
 TEST_F(BrokenRobot, VariantIsItsOwnBase) {
   add_variants("  self:\n    base: self\n");
-  expect_error(R"(robot\.yaml:29:11: error: variant self: the base chain self -> self is a cycle)");
+  expect_error(R"(robot\.yaml:30:11: error: variant self: the base chain self -> self is a cycle)");
 }
 
 TEST_F(BrokenRobot, EffectAlreadyInTheBaseVariant) {
   add_variants("  more:\n    base: effects\n    effects:\n      offset: [2]\n");
-  expect_error(R"(robot\.yaml:31:16: error: variant more: effect offset on joint 2 is already in its base variant 'effects')");
+  expect_error(R"(robot\.yaml:32:16: error: variant more: effect offset on joint 2 is already in its base variant 'effects')");
 }
 
 TEST_F(BrokenRobot, EffectsMustBeAMap) {
   add_variants("  bad:\n    effects: [offset]\n");
-  expect_error(R"(robot\.yaml:29:14: error: variant bad: 'effects' must map effect names)");
+  expect_error(R"(robot\.yaml:30:14: error: variant bad: 'effects' must map effect names)");
 }
 
 TEST_F(BrokenRobot, EffectParameterNameClashes) {
@@ -297,7 +309,9 @@ TEST(Generation, IsReproducible) {
     EXPECT_EQ(ga.files[i].path, gb.files[i].path);
     EXPECT_EQ(ga.files[i].content, gb.files[i].content) << ga.files[i].path;
   }
-  EXPECT_EQ(ga.models.size(), 2u);
+  // The full model, reduced (the paper's 39) and reduced_diagnosed (39 + OFF5, FC2, FC4).
+  ASSERT_EQ(ga.models.size(), 3u);
   EXPECT_EQ(ga.models[0].identified.size(), 65u);
   EXPECT_EQ(ga.models[1].identified.size(), 39u);
+  EXPECT_EQ(ga.models[2].identified.size(), 42u);
 }

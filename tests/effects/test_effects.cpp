@@ -1,6 +1,7 @@
 // Model-gap effects compiled into a variant (robot.yaml `effects`), on planar2r::effects:
 //   coulomb [1] (FS1 un-fixed while "FS*" fixes the rest), offset [1, 2], stribeck joint 2 at
-//   0.05 rad/s, viscous_asymmetry [2], position_harmonics joint 1, orders 1 and 2.
+//   0.05 rad/s, viscous_asymmetry [2], position_harmonics joint 1, orders 1 and 2,
+//   smooth_coulomb joint 2 at 0.04 rad/s (FS2 stays fixed to 0).
 // Every regressor column is checked against its term written out here, then the functions
 // against each other and against the robot's full model, and the Jet derivatives of the new
 // terms against finite differences.
@@ -26,6 +27,7 @@ using Full = symoro::planar2r::Model;
 using V2 = Eigen::Vector2d;
 
 constexpr double kStribeckVelocity = 0.05;  // robot.yaml
+constexpr double kCoulombVelocity = 0.04;   // robot.yaml, smooth_coulomb
 constexpr double kTight = 1e-13;
 constexpr double kRelTol = 1e-9;
 constexpr int kStates = 40;
@@ -40,7 +42,7 @@ V2 effect_torque_by_hand(const V2& q, const V2& qd, const ParameterVector<Effect
   tau(0) = phi(OFF1) + phi(HS1_1) * std::sin(q(0)) + phi(HC1_1) * std::cos(q(0)) +
            phi(HS1_2) * std::sin(2 * q(0)) + phi(HC1_2) * std::cos(2 * q(0));
   tau(1) = phi(OFF2) + phi(FST2) * sgn(qd(1)) * std::exp(-std::pow(qd(1) / v, 2)) +
-           phi(FVA2) * std::fabs(qd(1));
+           phi(FVA2) * std::fabs(qd(1)) + phi(FC2) * std::tanh(qd(1) / kCoulombVelocity);
   return tau;
 }
 
@@ -61,13 +63,13 @@ class PlanarEffects : public ::testing::Test {
 };
 
 TEST_F(PlanarEffects, ParametersAreAppendedInCanonicalOrderWithUnits) {
-  static_assert(Effects::np == 18 && Effects::ne == 8 && Effects::ns == Full::ns + 8);
-  const std::array<const char*, 18> names = {"ZZR1", "MXR1", "MY1",  "ZZ2",   "MX2",   "MY2",   "IA2",   "FV1",   "FV2",
-                                             "FS1",  "OFF1", "OFF2", "FST2",  "FVA2",  "HS1_1", "HC1_1", "HS1_2", "HC1_2"};
-  const std::array<const char*, 8> units = {"N*m", "N*m", "N*m", "N*m*s/rad", "N*m", "N*m", "N*m", "N*m"};
-  const std::array<int, 8> joints = {1, 2, 2, 2, 1, 1, 1, 1};
+  static_assert(Effects::np == 19 && Effects::ne == 9 && Effects::ns == Full::ns + 9);
+  const std::array<const char*, 19> names = {"ZZR1", "MXR1", "MY1",  "ZZ2",  "MX2",   "MY2",   "IA2",   "FV1",   "FV2",   "FS1",
+                                             "OFF1", "OFF2", "FST2", "FVA2", "HS1_1", "HC1_1", "HS1_2", "HC1_2", "FC2"};
+  const std::array<const char*, 9> units = {"N*m", "N*m", "N*m", "N*m*s/rad", "N*m", "N*m", "N*m", "N*m", "N*m"};
+  const std::array<int, 9> joints = {1, 2, 2, 2, 1, 1, 1, 1, 2};
   for (int i = 0; i < Effects::np; ++i) EXPECT_EQ(std::string(Effects::parameters[i].name), names[i]) << i;
-  for (int k = 0; k < 8; ++k) {
+  for (int k = 0; k < 9; ++k) {
     const auto& p = Effects::parameters[10 + k];
     EXPECT_EQ(std::string(p.unit), units[k]) << p.name;
     EXPECT_EQ(p.joint, joints[k]) << p.name;
@@ -76,7 +78,9 @@ TEST_F(PlanarEffects, ParametersAreAppendedInCanonicalOrderWithUnits) {
   EXPECT_EQ(fx::param::HC1_2, 17);
   EXPECT_EQ(Effects::effect_parameters[2].velocity, kStribeckVelocity);
   EXPECT_EQ(Effects::effect_parameters[6].order, 2);
-  // coulomb [1]: FS1 is identified although "FS*" fixes FS2.
+  EXPECT_EQ(Effects::effect_parameters[8].velocity, kCoulombVelocity);
+  EXPECT_EQ(std::string(Effects::effect_parameters[8].family), "FC");
+  // coulomb [1]: FS1 is identified although "FS*" fixes FS2 (which smooth_coulomb fixes too).
   ASSERT_EQ(Effects::fixed_parameters.size(), 1u);
   EXPECT_EQ(std::string(Effects::fixed_parameters[0].name), "FS2");
   EXPECT_EQ(Effects::fixed_parameters[0].value, 0.0);
@@ -102,6 +106,7 @@ TEST_F(PlanarEffects, RegressorColumnsAreTheTerms) {
     expect_column(HC1_1, std::cos(q1), 0.0);
     expect_column(HS1_2, std::sin(2 * q1), 0.0);
     expect_column(HC1_2, std::cos(2 * q1), 0.0);
+    expect_column(FC2, 0.0, std::tanh(qd2 / kCoulombVelocity));
     // The base parameters' columns are the full model's.
     const auto Wf = Full::regressor(s.q, s.qd, s.qdd);
     for (int i = 0; i < Effects::np - Effects::ne; ++i)
@@ -143,11 +148,11 @@ TEST_F(PlanarEffects, ForwardDynamicsInvertsInverseDynamics) {
 TEST_F(PlanarEffects, BaseFromStandardMapsEffectParametersIdentically) {
   const auto standard = standard_parameters_of_variant<Effects>(rng_);  // FS2 = 0, as fixed
   const ParameterVector<Effects> phi = Effects::base_from_standard(standard.s);
-  EXPECT_TRUE((phi.tail<8>().array() == standard.s.tail<8>().array()).all());
+  EXPECT_TRUE((phi.tail<9>().array() == standard.s.tail<9>().array()).all());
   EXPECT_TRUE(close(Effects::to_parent(phi), Full::base_from_standard(standard.s.head<Full::ns>()), kTight));
-  for (int k = 0; k < 8; ++k)
+  for (int k = 0; k < 9; ++k)
     EXPECT_EQ(std::string(Effects::standard_parameters[Full::ns + k].name), Effects::effect_parameters[k].name);
-  EXPECT_TRUE(Effects::from_parent(Effects::to_parent(phi)).tail<8>().isZero(0.0));
+  EXPECT_TRUE(Effects::from_parent(Effects::to_parent(phi)).tail<9>().isZero(0.0));
 }
 
 // Derivatives in q and qd (Jets seeded on both) of every regressor column and of the torque,
@@ -173,16 +178,21 @@ TEST_F(PlanarEffects, JetDerivativesOfTheTermsMatchFiniteDifferences) {
     };
     const Eigen::MatrixXd W_jet = jet_jacobian(Effects::regressor(q, qd, s.qdd));
     const Eigen::MatrixXd W_fd = finite_difference_jacobian(regressor_at, x, 1e-7);
-    // Rows of d vec(W) / dx for the 8 effect columns (column-major: entry (r, c) is row 2c + r).
-    for (int c = Effects::np - Effects::ne; c < Effects::np; ++c)
-      EXPECT_TRUE(close(W_jet.middleRows(2 * c, 2), W_fd.middleRows(2 * c, 2), 1e-6))
-          << Effects::parameters[c].name;
+    // Rows of d vec(W) / dx for the 9 effect columns (column-major: entry (r, c) is row 2c + r):
+    // relative 1e-6, or 1e-8 absolute where the derivative is below the central difference's
+    // round-off (eps |W| / h ~ 1e-9: saturated tanh and Stribeck terms).
+    for (int c = Effects::np - Effects::ne; c < Effects::np; ++c) {
+      const Eigen::MatrixXd a = W_jet.middleRows(2 * c, 2), b = W_fd.middleRows(2 * c, 2);
+      EXPECT_TRUE(close(a, b, 1e-6) || (a - b).cwiseAbs().maxCoeff() < 1e-8) << Effects::parameters[c].name;
+    }
     // Against the hand-written derivative of the Stribeck term as well.
     const double qd2 = s.qd(1), v = kStribeckVelocity;
     const double dfst = -2.0 * qd2 / (v * v) * sgn(qd2) * std::exp(-std::pow(qd2 / v, 2));
     EXPECT_NEAR(W_jet(2 * fx::param::FST2 + 1, 3), dfst, 1e-12 * (1 + std::fabs(dfst)));
     EXPECT_NEAR(W_jet(2 * fx::param::HS1_2, 0), 2 * std::cos(2 * s.q(0)), 1e-13);
     EXPECT_NEAR(W_jet(2 * fx::param::FVA2 + 1, 3), sgn(qd2), 1e-15);
+    const double th = std::tanh(qd2 / kCoulombVelocity), dfc = (1 - th * th) / kCoulombVelocity;
+    EXPECT_NEAR(W_jet(2 * fx::param::FC2 + 1, 3), dfc, 1e-12 * (1 + std::fabs(dfc)));
     EXPECT_TRUE(close(jet_jacobian(Effects::inverse_dynamics(q, qd, s.qdd, phi)),
                       finite_difference_jacobian(tau_at, x, 1e-7), 1e-6));
   }

@@ -151,7 +151,7 @@ template <class Model>
 inline constexpr int effect_count = EffectCount<Model>::value;
 
 inline bool is_effect_family(const std::string& family) {
-  return family == "OFF" || family == "FST" || family == "FVA" || family == "HS" || family == "HC";
+  return family == "OFF" || family == "FST" || family == "FVA" || family == "HS" || family == "HC" || family == "FC";
 }
 
 // The term an effect parameter multiplies in its joint's torque, at that joint's q and qd.
@@ -161,6 +161,7 @@ inline double effect_term(const std::string& family, int order, double velocity,
   if (family == "FVA") return std::abs(qd);
   if (family == "HS") return std::sin(order * q);
   if (family == "HC") return std::cos(order * q);
+  if (family == "FC") return std::tanh(qd / velocity);
   throw std::invalid_argument("unknown effect family '" + family + "'");
 }
 

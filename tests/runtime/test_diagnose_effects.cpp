@@ -243,6 +243,12 @@ TEST(DiagnoseEffects, TermsMatchTheCompiledVariant) {
     double v = 0;
     effect_terms(c, q(0), qd(0), &v);
     EXPECT_NEAR(W(0, column("FS1")), v, 1e-12);
+    // smooth_coulomb (what dynid diagnose writes for Coulomb): the very tanh(qd / vc) term.
+    c.joint = 2;
+    c.coulomb_velocity = 0.04;
+    effect_terms(c, q(1), qd(1), &v);
+    EXPECT_NEAR(W(1, column("FC2")), v, 1e-14);
+    EXPECT_EQ(W(0, column("FC2")), 0.0);
   }
 }
 

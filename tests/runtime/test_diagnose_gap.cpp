@@ -3,8 +3,8 @@
 // SDP, CLIE, validation) of the paper's model (crane_x7::reduced) and of the variant
 // `dynid diagnose --apply` added to robots/crane_x7/robot.yaml for those effects
 // (crane_x7::reduced_diagnosed, compiled by symoroc), then the before/after comparison read back
-// from the studies' folders. The held-out closed-loop error must shrink, the added offset must
-// match the twin's, and the comparison's numbers must equal the studies' own.
+// from the studies' folders. The held-out closed-loop error must shrink, the added parameters
+// must match the twin's within 20 %, and the comparison's numbers must equal the studies' own.
 #include <cmath>
 #include <fstream>
 
@@ -118,13 +118,13 @@ int index_of(const identify::StudyResult& r, const std::string& name) {
 // The four checks share the two studies (27 s); ctest runs every TEST in its own process, so
 // they are one TEST.
 void variant_has_the_diagnosed_parameters() {
-  // Generated from robots/crane_x7/robot.yaml: the reduced model's 39 plus FS2, FS4, OFF5.
+  // Generated from robots/crane_x7/robot.yaml: the reduced model's 39 plus OFF5, FC2, FC4.
   EXPECT_EQ(After::np, Before::np + 3);
   const auto& r = studies().after;
-  for (const char* name : {"FS2", "FS4", "OFF5"}) EXPECT_GE(index_of(r, name), 0) << name;
-  // The twin's truth reaches the added parameters (Coulomb as FS, the offset as the motor's
+  for (const char* name : {"OFF5", "FC2", "FC4"}) EXPECT_GE(index_of(r, name), 0) << name;
+  // The twin's truth reaches the added parameters (Coulomb as FC, the offset as the motor's
   // holding torque, of the opposite sign).
-  EXPECT_DOUBLE_EQ(r.truth(index_of(r, "FS2")), 0.10);
+  EXPECT_DOUBLE_EQ(r.truth(index_of(r, "FC2")), 0.10);
   EXPECT_DOUBLE_EQ(r.truth(index_of(r, "OFF5")), -0.02);
 }
 
@@ -135,20 +135,20 @@ void heldout_error_shrinks_and_the_offset_is_found() {
   const identify::StudyValidation b = identify::read_validation(s.before_dir), a = identify::read_validation(s.after_dir);
   const diagnose::GapComparison c = diagnose::compare_studies(b, a);
   ASSERT_EQ(c.trajectories.size(), kValid.size());
-  // Every held-out trajectory improves, and the pooled error by more than 7 % (13 % measured);
-  // joint 5, whose offset the variant holds, by more than a quarter (40 % measured).
+  // Every held-out trajectory improves, the pooled error by more than a fifth (35 % measured),
+  // and each joint with a hidden effect by more than a quarter (J2 41 %, J4 35 %, J5 48 %).
   for (const auto& t : c.trajectories) EXPECT_LT(t.rmse_after, t.rmse_before) << t.trajectory;
-  EXPECT_LT(c.rmse_after, 0.93 * c.rmse_before);
-  EXPECT_LT(c.joint_after(4), 0.75 * c.joint_before(4));
-  // The offset within 20 % of the twin's; Coulomb friction positive on both joints. The
-  // compiled OpenSYMORO term FS*sign(qd) comes out low (about 30 % of the truth): joint 2 of
-  // AG02 moves slower than 0.05 rad/s most of the time, where the filtered velocity's noise
-  // flips sign(qd) (errors in the variables); see docs/diagnosis.md.
+  EXPECT_LT(c.rmse_after, 0.8 * c.rmse_before);
+  for (int j : {1, 3, 4}) EXPECT_LT(c.joint_after(j), 0.75 * c.joint_before(j)) << "joint " << j + 1;
+  // The added parameters within 20 % of the twin's (accepted parameters, after CLIE): Coulomb
+  // friction as smooth_coulomb, tanh(qd / 0.03), the width the diagnosis selected. (With the
+  // files' FS*sign(qd) instead, FS2 came out at 0.026: velocity noise flips sign(qd) while
+  // joint 2 moves slowly, see docs/diagnosis.md.)
   const auto& phi = s.after.phi_rescue;
   EXPECT_NEAR(phi(index_of(s.after, "OFF5")), -0.02, 0.004);
-  EXPECT_GT(phi(index_of(s.after, "FS2")), 0.0);
-  EXPECT_GT(phi(index_of(s.after, "FS4")), 0.0);
-  EXPECT_EQ(c.added, (std::vector<std::string>{"FS2", "FS4", "OFF5"}));
+  EXPECT_NEAR(phi(index_of(s.after, "FC2")), 0.10, 0.02);
+  EXPECT_NEAR(phi(index_of(s.after, "FC4")), 0.06, 0.012);
+  EXPECT_EQ(c.added, (std::vector<std::string>{"OFF5", "FC2", "FC4"}));
 }
 
 void the_comparison_recomputes_the_studies_own_errors() {

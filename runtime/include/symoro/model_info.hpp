@@ -20,7 +20,7 @@ struct JointInfo {
 // A base parameter: a column of the regressor and an entry of phi.
 struct ParameterInfo {
   const char* name;    // OpenSYMORO name, e.g. "MYR2"
-  const char* family;  // XX XY XZ YY YZ ZZ MX MY MZ M IA FV FS; effects: OFF FST FVA HS HC
+  const char* family;  // XX XY XZ YY YZ ZZ MX MY MZ M IA FV FS; effects: OFF FST FVA HS HC FC
   int joint;           // 1-based link or joint number
   const char* unit;    // e.g. "kg*m^2"
 };
@@ -29,13 +29,13 @@ struct ParameterInfo {
 // identified, after the base parameters (the last `ne` entries of phi and of the standard
 // vector s, where it maps to itself). It adds phi * term to joint `joint`'s torque, the term by
 // family: OFF 1, FST sign(qd) exp(-(qd / velocity)^2), FVA |qd|, HS sin(order q),
-// HC cos(order q).
+// HC cos(order q), FC tanh(qd / velocity).
 struct EffectParameterInfo {
   const char* name;    // e.g. "FST2", "HS1_2"
-  const char* family;  // OFF FST FVA HS HC
+  const char* family;  // OFF FST FVA HS HC FC
   int joint;           // 1-based
   int order;           // HS, HC: the harmonic order; else 0
-  double velocity;     // FST: the Stribeck velocity (rad/s or m/s); else 0
+  double velocity;     // FST: the Stribeck velocity, FC: the tanh scale (rad/s or m/s); else 0
 };
 
 // A standard (per-link, physical) parameter of the robot description (.par).

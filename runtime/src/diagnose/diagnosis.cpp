@@ -161,21 +161,27 @@ std::vector<std::filesystem::path> write_diagnosis_report(const Diagnosis& d, co
 
 std::string variant_yaml(const Diagnosis& d, const std::string& name, const std::string& base) {
   std::map<std::string, std::vector<int>> joints;
-  std::string stribeck, harmonics, notes;
+  // Effects written {joints: [...], <parameter>}: joints grouped by (effect, parameter text).
+  std::map<std::string, std::map<std::string, std::vector<int>>> shaped;
+  std::string notes;
   for (const auto& e : d.selection.effects) {
     const Candidate& c = e.candidate;
     switch (c.kind) {
-      case EffectKind::Coulomb: joints["coulomb"].push_back(c.joint); break;
+      // Coulomb friction as the diagnosis fitted it, tanh(qd / width): the files' sign(qd)
+      // column is biased towards 0 by velocity noise at slow motion.
+      case EffectKind::Coulomb:
+        shaped["smooth_coulomb"][fmt::format("velocity: {:g}", c.coulomb_velocity)].push_back(c.joint);
+        break;
       case EffectKind::Offset: joints["offset"].push_back(c.joint); break;
       case EffectKind::ViscousAsymmetry: joints["viscous_asymmetry"].push_back(c.joint); break;
       case EffectKind::InertiaProducts: joints["inertia_products"].push_back(c.joint); break;
       case EffectKind::Stribeck:
-        stribeck += fmt::format("      stribeck: {{joints: [{}], velocity: {:g}}}\n", c.joint, c.stribeck_velocity);
+        shaped["stribeck"][fmt::format("velocity: {:g}", c.stribeck_velocity)].push_back(c.joint);
         break;
       case EffectKind::PositionHarmonics: {
         std::string orders;
         for (int k : c.orders) orders += (orders.empty() ? "" : ", ") + std::to_string(k);
-        harmonics += fmt::format("      position_harmonics: {{joints: [{}], orders: [{}]}}\n", c.joint, orders);
+        shaped["position_harmonics"]["orders: [" + orders + "]"].push_back(c.joint);
         break;
       }
       case EffectKind::ActuationDelay:
@@ -192,14 +198,25 @@ std::string variant_yaml(const Diagnosis& d, const std::string& name, const std:
         break;
     }
   }
-  std::string effects;
-  for (auto& [key, js] : joints) {
+  auto list = [](std::vector<int> js) {
     std::sort(js.begin(), js.end());
-    std::string list;
-    for (int j : js) list += (list.empty() ? "" : ", ") + std::to_string(j);
-    effects += "      " + key + ": [" + list + "]\n";
+    std::string out;
+    for (int j : js) out += (out.empty() ? "" : ", ") + std::to_string(j);
+    return out;
+  };
+  std::string effects;
+  for (auto& [key, js] : joints) effects += "      " + key + ": [" + list(js) + "]\n";
+  for (auto& [key, groups] : shaped) {
+    // A variant holds one entry per effect: the group with the most joints; the others noted.
+    auto best = groups.begin();
+    for (auto it = groups.begin(); it != groups.end(); ++it)
+      if (it->second.size() > best->second.size()) best = it;
+    effects += "      " + key + ": {joints: [" + list(best->second) + "], " + best->first + "}\n";
+    for (auto it = groups.begin(); it != groups.end(); ++it)
+      if (it != best)
+        notes += "    # also " + key + " on joints [" + list(it->second) + "] with " + it->first +
+                 " (one entry per effect in a variant: the joints above use " + best->first + ")\n";
   }
-  effects += stribeck + harmonics;
   if (effects.empty() && notes.empty()) return {};
   std::string y = "  " + name + ":\n";
   y += "    description: " + base + " with the effects dynid diagnose found\n";

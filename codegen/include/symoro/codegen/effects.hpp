@@ -9,6 +9,8 @@
 //   stribeck            FST<j>    [N*m | N]           FSTj * sign(QPj) * exp(-(QPj/v)^2)
 //   viscous_asymmetry   FVA<j>    [N*m*s/rad | N*s/m] FVAj * |QPj|  (QPj*sign(QPj))
 //   position_harmonics  HS<j>_<k>, HC<j>_<k> [N*m | N]  HSj_k*sin(k*qj), HCj_k*cos(k*qj)
+//   smooth_coulomb      FC<j>     [N*m | N]           FCj * tanh(QPj/v); fixes FSj to 0 (the
+//                       files' FSj*sign(QPj) would be the same effect with a noise-biased column)
 #pragma once
 
 #include <functional>
@@ -21,7 +23,7 @@
 namespace symoro::codegen {
 
 // In catalogue order, which is also the order of the parameters the effects add.
-enum class EffectKind { Coulomb, InertiaProducts, Offset, Stribeck, ViscousAsymmetry, PositionHarmonics };
+enum class EffectKind { Coulomb, InertiaProducts, Offset, Stribeck, ViscousAsymmetry, PositionHarmonics, SmoothCoulomb };
 
 // The robot.yaml key of an effect ("coulomb", "inertia_products", ...) and back.
 const std::string& effect_name(EffectKind kind);
@@ -36,12 +38,16 @@ bool effect_on_links(EffectKind kind);
 const std::vector<std::string>& unfixed_families(EffectKind kind);
 
 inline constexpr double kDefaultStribeckVelocity = 0.05;  // rad/s (m/s for a prismatic joint)
+// The velocity scale of smooth Coulomb friction tanh(qd / v) when robot.yaml gives none.
+inline constexpr double kDefaultSmoothCoulombVelocity = 0.03;  // rad/s (m/s for a prismatic joint)
+// Whether an effect takes {joints: [...], velocity: v} (stribeck, smooth_coulomb).
+bool effect_has_velocity(EffectKind kind);
 
 // One effect on one joint (or link) of a variant, as robot.yaml states it.
 struct EffectSpec {
   EffectKind kind = EffectKind::Offset;
   int index = 0;             // 1-based joint, or link for inertia_products
-  double velocity = 0;       // stribeck: the Stribeck velocity (> 0)
+  double velocity = 0;       // stribeck, smooth_coulomb: the velocity scale (> 0)
   std::vector<int> orders;   // position_harmonics: the harmonic orders, ascending, >= 1
   int line = 0, column = 0;  // the robot.yaml node that names the joint (for errors)
 };
@@ -53,7 +59,7 @@ struct EffectParameter {
   int joint = 0;        // 1-based
   std::string unit;
   int order = 0;        // HS, HC: the harmonic order
-  double velocity = 0;  // FST: the Stribeck velocity
+  double velocity = 0;  // FST: the Stribeck velocity; FC: the tanh velocity scale
 };
 
 // The parameters the effects add, in canonical order: effect kind in catalogue order, joint

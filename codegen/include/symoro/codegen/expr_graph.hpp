@@ -26,6 +26,7 @@ enum class Op : std::uint8_t {
   Cos,
   Sign,      // -1, 0, +1
   Exp,       // e ** a
+  Tanh,      // hyperbolic tangent (smooth Coulomb friction)
 };
 
 struct Node {
@@ -52,6 +53,7 @@ class ExprGraph {
   NodeId cos(NodeId a);
   NodeId sign(NodeId a);
   NodeId exp(NodeId a);
+  NodeId tanh(NodeId a);
 
   NodeId zero() const { return zero_; }
   NodeId one() const { return one_; }

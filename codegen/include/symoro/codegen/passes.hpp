@@ -16,7 +16,7 @@ std::vector<NodeId> substitute(ExprGraph& g, const std::vector<NodeId>& roots,
                                const std::map<std::string, NodeId>& replacements);
 
 // Symbolic differentiation of every root with respect to one symbol (d sign / dx = 0,
-// d exp(a) / dx = exp(a) da / dx).
+// d exp(a) / dx = exp(a) da / dx, d tanh(a) / dx = (1 - tanh(a)^2) da / dx).
 std::vector<NodeId> differentiate(ExprGraph& g, const std::vector<NodeId>& roots,
                                   const std::string& symbol);
 
@@ -35,7 +35,7 @@ struct OperationCount {
   int pow = 0;  // x**k, emitted as k-1 multiplications for small integers
   int trig = 0; // sin and cos
   int sign = 0;
-  int exp = 0;
+  int exp = 0;  // exp and tanh
   int total() const { return add + mul + div + neg + pow + trig + sign + exp; }
 };
 OperationCount count_operations(const ExprGraph& g, const std::vector<NodeId>& roots);

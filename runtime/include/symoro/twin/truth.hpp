@@ -66,7 +66,7 @@ Truth<Model> make_truth(const TwinConfig& c) {
 
 // The twin's true identified parameters of a Model (any variant): its base parameters plus what
 // the variant's extra parameters can represent of the twin's hidden effects. Coulomb friction
-// (FS, the twin's smoothed Coulomb torque) and offsets (OFFj = minus the twin's external offset
+// (FS or the smooth FC, the twin's smoothed Coulomb torque) and offsets (OFFj = minus the twin's external offset
 // torque: the motor's holding torque); every other effect parameter is 0 in the truth.
 template <class Model>
 Eigen::Matrix<double, Model::np, 1> identified_truth(const TwinConfig& c) {
@@ -75,7 +75,7 @@ Eigen::Matrix<double, Model::np, 1> identified_truth(const TwinConfig& c) {
     const std::string family = Model::standard_parameters[k].family;
     const int j = Model::standard_parameters[k].joint - 1;
     if (j < 0 || j >= Model::nq) continue;
-    if (family == "FS" && c.effects.coulomb) s(k) = c.effects.coulomb_torque(j);
+    if ((family == "FS" || family == "FC") && c.effects.coulomb) s(k) = c.effects.coulomb_torque(j);
     if (family == "OFF" && c.effects.torque_offset) s(k) = -c.effects.offset_torque(j);
   }
   return Model::base_from_standard(s);

@@ -20,7 +20,7 @@ inline void base_from_standard(const Eigen::MatrixBase<S>& s, const Eigen::Matri
   using std::pow;
   using std::sin;
   using ::symoro::sign;
-  eigen_assert(s.size() == 95);
+  eigen_assert(s.size() == 97);
   static_cast<void>(s);
   Eigen::MatrixBase<Out>& phi = const_cast<Eigen::MatrixBase<Out>&>(out);
   phi.derived().resize(np, 1);
@@ -34,11 +34,9 @@ inline void base_from_standard(const Eigen::MatrixBase<S>& s, const Eigen::Matri
   const Scalar MY7(s[85]);
   const Scalar ZZ7(s[83]);
   const Scalar FV1(s[11]);
-  const Scalar FS2(s[25]);
   const Scalar FV2(s[24]);
   const Scalar FV3(s[37]);
   const Scalar IA3(s[36]);
-  const Scalar FS4(s[51]);
   const Scalar FV4(s[50]);
   const Scalar IA4(s[49]);
   const Scalar FV5(s[63]);
@@ -90,6 +88,8 @@ inline void base_from_standard(const Eigen::MatrixBase<S>& s, const Eigen::Matri
   const Scalar IA1(s[10]);
   const Scalar ZZ1(s[5]);
   const Scalar OFF5(s[94]);
+  const Scalar FC2(s[95]);
+  const Scalar FC4(s[96]);
   phi(0, 0) = YY2 + IA1 + ZZ1;
   phi(1, 0) = YY3 + (t3 + t4 + XX2 - YY2);
   phi(2, 0) = YY3 + (t4 + (t3 + IA2)) + ZZ2;
@@ -129,9 +129,9 @@ inline void base_from_standard(const Eigen::MatrixBase<S>& s, const Eigen::Matri
   phi(36, 0) = FV6;
   phi(37, 0) = FV7;
   phi(38, 0) = FV8;
-  phi(39, 0) = FS2;
-  phi(40, 0) = FS4;
-  phi(41, 0) = OFF5;
+  phi(39, 0) = OFF5;
+  phi(40, 0) = FC2;
+  phi(41, 0) = FC4;
 }
 
 template <class S>
@@ -168,7 +168,9 @@ inline Eigen::Matrix<typename Phi::Scalar, ::symoro::crane_x7::np, 1> to_parent(
   full[38] = Scalar(0.0);  // XZ7
   full[39] = Scalar(0.0);  // YZ7
   full[57] = Scalar(0.0);  // FS1
+  full[58] = Scalar(0.0);  // FS2
   full[59] = Scalar(0.0);  // FS3
+  full[60] = Scalar(0.0);  // FS4
   full[61] = Scalar(0.0);  // FS5
   full[62] = Scalar(0.0);  // FS6
   full[63] = Scalar(0.0);  // FS7

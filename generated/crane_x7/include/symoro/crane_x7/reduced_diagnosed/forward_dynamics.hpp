@@ -18,6 +18,7 @@ inline void forward_dynamics(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixB
   using std::cos;
   using std::pow;
   using std::sin;
+  using std::tanh;
   using ::symoro::sign;
   eigen_assert(q.size() == 8);
   eigen_assert(qd.size() == 8);
@@ -128,11 +129,9 @@ inline void forward_dynamics(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixB
   const Scalar ZZ7(phi[22]);
   const Scalar t57 = t43 * ZZ7;
   const Scalar FV1(phi[31]);
-  const Scalar FS2(phi[39]);
   const Scalar FV2(phi[32]);
   const Scalar FV3(phi[33]);
   const Scalar IA3(phi[25]);
-  const Scalar FS4(phi[40]);
   const Scalar FV4(phi[34]);
   const Scalar IA4(phi[26]);
   const Scalar FV5(phi[35]);
@@ -398,7 +397,9 @@ inline void forward_dynamics(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixB
   const Scalar t302 = t1 * (t2 * t270 + t58 * t268 + t59 * t269 + t3 * t271 + t294 * t296) - t0 * (t272 + t294 * t297);
   const Scalar t303 = t1 * (t0 * (t3 * t267 - t2 * t262 + t293 * t297) + t1 * (t2 * t283 - t3 * t285 - t293 * t296));
   const Scalar t304 = 1.0 / (ZZR1 + (t0 * (t0 * t301 + t1 * t300) + t1 * (t0 * t299 + t1 * t298)));
-  const Scalar OFF5(phi[41]);
+  const Scalar OFF5(phi[39]);
+  const Scalar FC2(phi[40]);
+  const Scalar FC4(phi[41]);
   const Scalar t305 = t148 + (GAM5 - OFF5 - QP5 * FV5);
   const Scalar t306 = t30 * t71 - t34 * MX5 - (t8 * t120 + t9 * t121) + (t70 * t168 - (t68 * t156 + t69 * t162) + t32 * t174 - t33 * t179 - t150 * t305);
   const Scalar t307 = t68 * t157 - t69 * t163 - t70 * t169 + t32 * t175 - t33 * t180 + t151 * t305 - (t34 * MYR5 + t29 * t71 - t122);
@@ -407,7 +408,7 @@ inline void forward_dynamics(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixB
   const Scalar t310 = t28 * MYR4 + t23 * t64 + (t184 + t152 * t305 - (t8 * t121 - t9 * t120 - (t29 * (t31 * MX5) + t30 * (t31 * MYR5))));
   const Scalar t311 = t68 * t161 - t69 * t167 + t70 * t173 + t32 * t178 - t33 * t183 + t155 * t305 - t148 - (t25 * t50 - t23 * t51);
   const Scalar t312 = t24 * t50 + (t65 * t307 - t66 * t306 + t7 * t308 + t6 * t309);
-  const Scalar t313 = GAM4 - (sign(QP4) * FS4 + QP4 * FV4) - t312;
+  const Scalar t313 = GAM4 - tanh(33.333333333333336 * QP4) * FC4 - QP4 * FV4 - t312;
   const Scalar t314 = t210 * t313 - (t26 * (t198 - t203 * t210) + t27 * (t199 + t195 * t210)) - (t28 * MX4 + t24 * t64 - (t6 * t306 - t7 * t307));
   const Scalar t315 = t23 * (t25 * MX4) - t24 * (t25 * MYR4) + (t7 * t306 + t6 * t307) + (t27 * (t207 - t195 * t212) - t26 * (t206 - t203 * t212) + t212 * t313);
   const Scalar t316 = t213 * t313 - (t26 * t229 + t27 * t232) - (t24 * t51 - (t65 * t306 + t66 * t307 + t6 * t308 - t7 * t309));
@@ -420,7 +421,7 @@ inline void forward_dynamics(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixB
   const Scalar t323 = t18 * t49 + (t4 * t316 + t5 * t317) + (t60 * t260 + t61 * t265 + t62 * t270 + t20 * t275 - t21 * t280 + t255 * t320);
   const Scalar t324 = t19 * t48 - t17 * t49 + (t312 + (t215 * t313 - (t26 * t231 + t27 * t234))) + (t60 * t261 + t61 * t266 - t62 * t271 + t20 * t276 - t21 * t281 - t256 * t320);
   const Scalar t325 = t60 * t262 + t61 * t267 + t62 * t272 + t20 * t277 - t21 * t282 + t257 * t320 - t319 - (t12 * t47 - QP2 * t46);
-  const Scalar t326 = GAM2 - (sign(QP2) * FS2 + QP2 * FV2) - (t58 * t322 - t59 * t321 + t3 * t323 + t2 * t324 - t13 * t46);
+  const Scalar t326 = GAM2 - tanh(33.333333333333336 * QP2) * FC2 - QP2 * FV2 - (t58 * t322 - t59 * t321 + t3 * t323 + t2 * t324 - t13 * t46);
   const Scalar t327 = t15 * t300 - t14 * t298 + t296 * t326 - (t13 * t47 - (t58 * t321 + t59 * t322 + t2 * t323 - t3 * t324));
   const Scalar t328 = t304 * (GAM1 + (t1 * t327 + t0 * (t15 * t301 - t14 * t299 - t297 * t326 - t325) - QP1 * FV1));
   const Scalar t329 = t328 - 9.80665 * ((t303 - t0 * t302) * t304);

@@ -18,6 +18,7 @@ inline void inverse_dynamics(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixB
   using std::cos;
   using std::pow;
   using std::sin;
+  using std::tanh;
   using ::symoro::sign;
   eigen_assert(q.size() == 8);
   eigen_assert(qd.size() == 8);
@@ -172,11 +173,9 @@ inline void inverse_dynamics(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixB
   const Scalar t92 = (t21 - t20) * MYR3 - (t17 * t17 + t22) * MX3 + (t4 * (t89 - ((t29 * t29 + t35) * MX4 + t36 * MYR4)) - t5 * t91);
   const Scalar t93 = (t20 + t21) * MX3 - (t16 * t16 + t22) * MYR3 + ((t32 + t28 * t30) * MX4 + t38 * MYR4 + t90);
   const Scalar FV1(phi[31]);
-  const Scalar FS2(phi[39]);
   const Scalar FV2(phi[32]);
   const Scalar FV3(phi[33]);
   const Scalar IA3(phi[25]);
-  const Scalar FS4(phi[40]);
   const Scalar FV4(phi[34]);
   const Scalar IA4(phi[26]);
   const Scalar FV5(phi[35]);
@@ -204,11 +203,13 @@ inline void inverse_dynamics(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixB
   const Scalar t108 = t20 * ZZR3 - t17 * t73 + (t27 * MX3 - t4 * t104 - t26 * MYR3 - t5 * t103);
   const Scalar t109 = -9.80665 * t0 * MX2 + (0.25 * (t2 * t92 - t3 * t93) + t2 * t107) - -9.80665 * t1 * MYR2 + t3 * t106;
   const Scalar t110 = t0 * (t12 * t72 - QP2 * t71 - t108) + t1 * (t2 * t106 - 0.25 * (t2 * t93 + t3 * t92) - t3 * t107 - (t15 * XXR2 + t13 * t72));
-  const Scalar OFF5(phi[41]);
+  const Scalar OFF5(phi[39]);
+  const Scalar FC2(phi[40]);
+  const Scalar FC4(phi[41]);
   tau(0, 0) = QP1 * FV1 + (QDP1 * ZZR1 - t110);
-  tau(1, 0) = sign(QP2) * FS2 + QP2 * FV2 + (QDP2 * ZZR2 - t13 * t71 + t109);
+  tau(1, 0) = QP2 * FV2 + (QDP2 * ZZR2 - t13 * t71 + t109) + tanh(33.333333333333336 * QP2) * FC2;
   tau(2, 0) = t108 + (QP3 * FV3 + QDP3 * IA3);
-  tau(3, 0) = sign(QP4) * FS4 + QP4 * FV4 + QDP4 * IA4 + t105;
+  tau(3, 0) = t105 + (QP4 * FV4 + QDP4 * IA4) + tanh(33.333333333333336 * QP4) * FC4;
   tau(4, 0) = t102 + (QP5 * FV5 + QDP5 * IA5) + OFF5;
   tau(5, 0) = t99 + (QP6 * FV6 + QDP6 * IA6);
   tau(6, 0) = t96 + (QP7 * FV7 + QDP7 * IA7);

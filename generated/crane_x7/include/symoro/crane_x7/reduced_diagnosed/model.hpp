@@ -15,9 +15,9 @@ inline constexpr const char* variant_name = "reduced_diagnosed";
 inline constexpr const char* description = "reduced with the effects dynid diagnose found";
 inline constexpr int nq = 8;  // joints
 inline constexpr int np = 42;  // identified parameters: base parameters, then effect parameters
-inline constexpr int ns = 95;  // standard parameters
+inline constexpr int ns = 97;  // standard parameters
 inline constexpr int nf = 8;  // frames
-inline constexpr int ne = 1;  // effect parameters (robot.yaml effects): the last ne entries of phi and of s
+inline constexpr int ne = 3;  // effect parameters (robot.yaml effects): the last ne entries of phi and of s
 
 // Identified base parameters: the columns of the regressor and the entries of phi.
 inline constexpr std::array<ParameterInfo, np> parameters = {{
@@ -60,9 +60,9 @@ inline constexpr std::array<ParameterInfo, np> parameters = {{
     {"FV6", "FV", 6, "N*m*s/rad"},
     {"FV7", "FV", 7, "N*m*s/rad"},
     {"FV8", "FV", 8, "N*m*s/rad"},
-    {"FS2", "FS", 2, "N*m"},
-    {"FS4", "FS", 4, "N*m"},
     {"OFF5", "OFF", 5, "N*m"},
+    {"FC2", "FC", 2, "N*m"},
+    {"FC4", "FC", 4, "N*m"},
 }};
 
 // Indices into phi by name: phi[param::ZZR1].
@@ -107,14 +107,14 @@ enum : int {
   FV6 = 36,
   FV7 = 37,
   FV8 = 38,
-  FS2 = 39,
-  FS4 = 40,
-  OFF5 = 41,
+  OFF5 = 39,
+  FC2 = 40,
+  FC4 = 41,
 };
 }  // namespace param
 
 // Base parameters fixed at generation time (robot.yaml variants).
-inline constexpr std::array<FixedParameter, 24> fixed_parameters = {{
+inline constexpr std::array<FixedParameter, 26> fixed_parameters = {{
     {"XY2", 0.0},
     {"XZ2", 0.0},
     {"YZ2", 0.0},
@@ -134,7 +134,9 @@ inline constexpr std::array<FixedParameter, 24> fixed_parameters = {{
     {"XZ7", 0.0},
     {"YZ7", 0.0},
     {"FS1", 0.0},
+    {"FS2", 0.0},
     {"FS3", 0.0},
+    {"FS4", 0.0},
     {"FS5", 0.0},
     {"FS6", 0.0},
     {"FS7", 0.0},
@@ -143,7 +145,7 @@ inline constexpr std::array<FixedParameter, 24> fixed_parameters = {{
 
 // Index of each identified parameter in the robot's full parameter vector (-1 for the effect
 // parameters, which the full model does not have).
-inline constexpr std::array<int, np> parent_index = {{0, 1, 5, 6, 7, 8, 12, 13, 14, 15, 19, 20, 21, 22, 26, 27, 28, 29, 33, 34, 35, 36, 40, 41, 42, 43, 44, 45, 46, 47, 48, 49, 50, 51, 52, 53, 54, 55, 56, 58, 60, -1}};
+inline constexpr std::array<int, np> parent_index = {{0, 1, 5, 6, 7, 8, 12, 13, 14, 15, 19, 20, 21, 22, 26, 27, 28, 29, 33, 34, 35, 36, 40, 41, 42, 43, 44, 45, 46, 47, 48, 49, 50, 51, 52, 53, 54, 55, 56, -1, -1, -1}};
 
 // Standard parameters (the .par's symbols, then the effect parameters): the argument of
 // base_from_standard.
@@ -243,6 +245,8 @@ inline constexpr std::array<StandardParameterInfo, ns> standard_parameters = {{
     {"FV8", "FV", 8},
     {"FS8", "FS", 8},
     {"OFF5", "OFF", 5},
+    {"FC2", "FC", 2},
+    {"FC4", "FC", 4},
 }};
 
 // Effect parameters (robot.yaml effects), the last ne entries of phi: name, family, joint,
@@ -250,6 +254,8 @@ inline constexpr std::array<StandardParameterInfo, ns> standard_parameters = {{
 // velocity)^2), FVA |qd|, HS sin(order q), HC cos(order q).
 inline constexpr std::array<EffectParameterInfo, ne> effect_parameters = {{
     {"OFF5", "OFF", 5, 0, 0.0},
+    {"FC2", "FC", 2, 0, 0.03},
+    {"FC4", "FC", 4, 0, 0.03},
 }};
 
 // name, type, position limits, velocity limit, effort limit, PD-audit domain.

@@ -18,6 +18,7 @@ inline void nonlinear_effects(const Eigen::MatrixBase<Q>& q, const Eigen::Matrix
   using std::cos;
   using std::pow;
   using std::sin;
+  using std::tanh;
   using ::symoro::sign;
   eigen_assert(q.size() == 8);
   eigen_assert(qd.size() == 8);
@@ -122,10 +123,8 @@ inline void nonlinear_effects(const Eigen::MatrixBase<Q>& q, const Eigen::Matrix
   const Scalar ZZ7(phi[22]);
   const Scalar t54 = t40 * ZZ7;
   const Scalar FV1(phi[31]);
-  const Scalar FS2(phi[39]);
   const Scalar FV2(phi[32]);
   const Scalar FV3(phi[33]);
-  const Scalar FS4(phi[40]);
   const Scalar FV4(phi[34]);
   const Scalar FV5(phi[35]);
   const Scalar FV6(phi[36]);
@@ -183,11 +182,13 @@ inline void nonlinear_effects(const Eigen::MatrixBase<Q>& q, const Eigen::Matrix
   const Scalar t104 = MX3 * t60 - t4 * t100 - MYR3 * t59 - t5 * t99 - (t15 * ZZR3 + t17 * t45);
   const Scalar t105 = -9.80665 * t0 * MX2 + (0.25 * (t2 * t88 - t3 * t89) + t2 * t103) - -9.80665 * t1 * MYR2 + t3 * t102;
   const Scalar t106 = t0 * (t12 * t44 - QP2 * t43 - t104) + t1 * (t2 * t102 - 0.25 * (t2 * t89 + t3 * t88) - t3 * t103 - (t14 * XXR2 + t13 * t44));
-  const Scalar OFF5(phi[41]);
+  const Scalar OFF5(phi[39]);
+  const Scalar FC2(phi[40]);
+  const Scalar FC4(phi[41]);
   h(0, 0) = QP1 * FV1 - t106;
-  h(1, 0) = sign(QP2) * FS2 + QP2 * FV2 + (t105 - t13 * t43);
+  h(1, 0) = QP2 * FV2 + (t105 - t13 * t43) + tanh(33.333333333333336 * QP2) * FC2;
   h(2, 0) = QP3 * FV3 + t104;
-  h(3, 0) = sign(QP4) * FS4 + QP4 * FV4 + t101;
+  h(3, 0) = QP4 * FV4 + t101 + tanh(33.333333333333336 * QP4) * FC4;
   h(4, 0) = QP5 * FV5 + t98 + OFF5;
   h(5, 0) = QP6 * FV6 + t95;
   h(6, 0) = QP7 * FV7 + t92;

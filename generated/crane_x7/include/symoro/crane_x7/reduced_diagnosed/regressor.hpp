@@ -18,6 +18,7 @@ inline void regressor(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<QD>
   using std::cos;
   using std::pow;
   using std::sin;
+  using std::tanh;
   using ::symoro::sign;
   eigen_assert(q.size() == 8);
   eigen_assert(qd.size() == 8);
@@ -322,7 +323,7 @@ inline void regressor(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<QD>
   W(1, 23) = t2 * t207 + 0.25 * (t2 * t208 - t3 * t205) + t3 * t209;
   W(1, 24) = t2 * t219 + 0.25 * (t2 * t220 - t3 * t217) + t3 * t221;
   W(1, 32) = QP2;
-  W(1, 39) = sign(QP2);
+  W(1, 40) = tanh(33.333333333333336 * QP2);
   W(2, 5) = -t23;
   W(2, 6) = t22;
   W(2, 7) = t35;
@@ -363,7 +364,7 @@ inline void regressor(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<QD>
   W(3, 24) = t219;
   W(3, 26) = QDP4;
   W(3, 34) = QP4;
-  W(3, 40) = sign(QP4);
+  W(3, 41) = tanh(33.333333333333336 * QP4);
   W(4, 13) = -t58;
   W(4, 14) = t57;
   W(4, 15) = t70;
@@ -378,7 +379,7 @@ inline void regressor(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<QD>
   W(4, 24) = t215;
   W(4, 27) = QDP5;
   W(4, 35) = QP5;
-  W(4, 41) = Scalar(1.0);
+  W(4, 39) = Scalar(1.0);
   W(5, 17) = t77;
   W(5, 18) = t76;
   W(5, 19) = t88;

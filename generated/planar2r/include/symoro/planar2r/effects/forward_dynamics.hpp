@@ -19,11 +19,12 @@ inline void forward_dynamics(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixB
   using std::exp;
   using std::pow;
   using std::sin;
+  using std::tanh;
   using ::symoro::sign;
   eigen_assert(q.size() == 2);
   eigen_assert(qd.size() == 2);
   eigen_assert(tau.size() == 2);
-  eigen_assert(phi.size() == 18);
+  eigen_assert(phi.size() == 19);
   static_cast<void>(q);
   static_cast<void>(qd);
   static_cast<void>(tau);
@@ -85,7 +86,8 @@ inline void forward_dynamics(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixB
   const Scalar HC1_1(phi[15]);
   const Scalar HS1_2(phi[16]);
   const Scalar HC1_2(phi[17]);
-  const Scalar t30 = GAM2 - (OFF2 + t9 * exp(-(t28 * t28)) * FST2 + QP2 * t9 * FVA2) - QP2 * FV2;
+  const Scalar FC2(phi[18]);
+  const Scalar t30 = GAM2 - (OFF2 + t9 * exp(-(t28 * t28)) * FST2 + QP2 * t9 * FVA2 + tanh(25.0 * QP2) * FC2) - QP2 * FV2;
   const Scalar t31 = t10 * (t13 * t21 - t12 * t18 - t15 * t30 - t8 * MX2) + t11 * (t12 * t19 - t13 * t22 + t16 * t30 - t8 * MY2);
   const Scalar t32 = GAM1 - (OFF1 + t1 * HS1_1 + t0 * HC1_1 + sin(t29) * HS1_2 + cos(t29) * HC1_2) - (QP1 * FV1 + (sign(QP1) * FS1 + (t12 * t20 + t13 * t23 + t17 * t30 + t31)));
   const Scalar t33 = t27 * t32 - (t5 * ((t2 * t24 - t3 * t25 - MY1) * t27) + t6 * ((MXR1 + (t2 * t25 + t3 * t24)) * t27));

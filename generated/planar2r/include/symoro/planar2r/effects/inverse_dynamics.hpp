@@ -19,11 +19,12 @@ inline void inverse_dynamics(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixB
   using std::exp;
   using std::pow;
   using std::sin;
+  using std::tanh;
   using ::symoro::sign;
   eigen_assert(q.size() == 2);
   eigen_assert(qd.size() == 2);
   eigen_assert(qdd.size() == 2);
-  eigen_assert(phi.size() == 18);
+  eigen_assert(phi.size() == 19);
   static_cast<void>(q);
   static_cast<void>(qd);
   static_cast<void>(qdd);
@@ -71,8 +72,9 @@ inline void inverse_dynamics(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixB
   const Scalar HC1_1(phi[15]);
   const Scalar HS1_2(phi[16]);
   const Scalar HC1_2(phi[17]);
+  const Scalar FC2(phi[18]);
   const Scalar t16 = QDP1 * ZZR1 + t13 + (sign(QP1) * FS1 + QP1 * FV1) + (OFF1 + t1 * HS1_1 + t0 * HC1_1 + sin(t15) * HS1_2 + cos(t15) * HC1_2);
-  const Scalar t17 = t12 + (QP2 * FV2 + QDP2 * IA2) + (OFF2 + t11 * exp(-(t14 * t14)) * FST2 + QP2 * t11 * FVA2);
+  const Scalar t17 = t12 + (QP2 * FV2 + QDP2 * IA2) + (OFF2 + t11 * exp(-(t14 * t14)) * FST2 + QP2 * t11 * FVA2 + tanh(25.0 * QP2) * FC2);
   tau(0, 0) = t16;
   tau(1, 0) = t17;
 }

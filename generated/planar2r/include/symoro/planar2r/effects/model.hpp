@@ -12,12 +12,12 @@ namespace symoro::planar2r::effects {
 inline constexpr const char* robot_name = "planar2r";
 // The variant's name; empty for the robot's full model.
 inline constexpr const char* variant_name = "effects";
-inline constexpr const char* description = "every model-gap effect (offsets, Stribeck, asymmetric viscous friction, position harmonics)";
+inline constexpr const char* description = "every model-gap effect (offsets, Stribeck, asymmetric viscous friction, position harmonics, smooth Coulomb)";
 inline constexpr int nq = 2;  // joints
-inline constexpr int np = 18;  // identified parameters: base parameters, then effect parameters
-inline constexpr int ns = 34;  // standard parameters
+inline constexpr int np = 19;  // identified parameters: base parameters, then effect parameters
+inline constexpr int ns = 35;  // standard parameters
 inline constexpr int nf = 2;  // frames
-inline constexpr int ne = 8;  // effect parameters (robot.yaml effects): the last ne entries of phi and of s
+inline constexpr int ne = 9;  // effect parameters (robot.yaml effects): the last ne entries of phi and of s
 
 // Identified base parameters: the columns of the regressor and the entries of phi.
 inline constexpr std::array<ParameterInfo, np> parameters = {{
@@ -39,6 +39,7 @@ inline constexpr std::array<ParameterInfo, np> parameters = {{
     {"HC1_1", "HC", 1, "N*m"},
     {"HS1_2", "HS", 1, "N*m"},
     {"HC1_2", "HC", 1, "N*m"},
+    {"FC2", "FC", 2, "N*m"},
 }};
 
 // Indices into phi by name: phi[param::ZZR1].
@@ -62,6 +63,7 @@ enum : int {
   HC1_1 = 15,
   HS1_2 = 16,
   HC1_2 = 17,
+  FC2 = 18,
 };
 }  // namespace param
 
@@ -72,7 +74,7 @@ inline constexpr std::array<FixedParameter, 1> fixed_parameters = {{
 
 // Index of each identified parameter in the robot's full parameter vector (-1 for the effect
 // parameters, which the full model does not have).
-inline constexpr std::array<int, np> parent_index = {{0, 1, 2, 3, 4, 5, 6, 7, 8, 9, -1, -1, -1, -1, -1, -1, -1, -1}};
+inline constexpr std::array<int, np> parent_index = {{0, 1, 2, 3, 4, 5, 6, 7, 8, 9, -1, -1, -1, -1, -1, -1, -1, -1, -1}};
 
 // Standard parameters (the .par's symbols, then the effect parameters): the argument of
 // base_from_standard.
@@ -111,6 +113,7 @@ inline constexpr std::array<StandardParameterInfo, ns> standard_parameters = {{
     {"HC1_1", "HC", 1},
     {"HS1_2", "HS", 1},
     {"HC1_2", "HC", 1},
+    {"FC2", "FC", 2},
 }};
 
 // Effect parameters (robot.yaml effects), the last ne entries of phi: name, family, joint,
@@ -125,6 +128,7 @@ inline constexpr std::array<EffectParameterInfo, ne> effect_parameters = {{
     {"HC1_1", "HC", 1, 1, 0.0},
     {"HS1_2", "HS", 1, 2, 0.0},
     {"HC1_2", "HC", 1, 2, 0.0},
+    {"FC2", "FC", 2, 0, 0.04},
 }};
 
 // name, type, position limits, velocity limit, effort limit, PD-audit domain.

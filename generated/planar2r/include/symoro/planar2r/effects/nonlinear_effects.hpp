@@ -19,10 +19,11 @@ inline void nonlinear_effects(const Eigen::MatrixBase<Q>& q, const Eigen::Matrix
   using std::exp;
   using std::pow;
   using std::sin;
+  using std::tanh;
   using ::symoro::sign;
   eigen_assert(q.size() == 2);
   eigen_assert(qd.size() == 2);
-  eigen_assert(phi.size() == 18);
+  eigen_assert(phi.size() == 19);
   static_cast<void>(q);
   static_cast<void>(qd);
   static_cast<void>(phi);
@@ -62,8 +63,10 @@ inline void nonlinear_effects(const Eigen::MatrixBase<Q>& q, const Eigen::Matrix
   const Scalar HC1_1(phi[15]);
   const Scalar HS1_2(phi[16]);
   const Scalar HC1_2(phi[17]);
+  const Scalar FC2(phi[18]);
+  const Scalar t14 = OFF2 + t9 * exp(-(t12 * t12)) * FST2 + QP2 * t9 * FVA2 + tanh(25.0 * QP2) * FC2 + (QP2 * FV2 + t10);
   h(0, 0) = t11 + (OFF1 + t1 * HS1_1 + t0 * HC1_1 + sin(t13) * HS1_2 + cos(t13) * HC1_2);
-  h(1, 0) = OFF2 + t9 * exp(-(t12 * t12)) * FST2 + QP2 * t9 * FVA2 + (QP2 * FV2 + t10);
+  h(1, 0) = t14;
 }
 
 template <class Q, class QD, class Phi>

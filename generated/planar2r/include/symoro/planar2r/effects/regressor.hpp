@@ -19,6 +19,7 @@ inline void regressor(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<QD>
   using std::exp;
   using std::pow;
   using std::sin;
+  using std::tanh;
   using ::symoro::sign;
   eigen_assert(q.size() == 2);
   eigen_assert(qd.size() == 2);
@@ -72,6 +73,7 @@ inline void regressor(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<QD>
   W(1, 11) = Scalar(1.0);
   W(1, 12) = t13 * exp(-(t14 * t14));
   W(1, 13) = QP2 * t13;
+  W(1, 18) = tanh(25.0 * QP2);
 }
 
 template <class Q, class QD, class QDD>
