@@ -36,7 +36,7 @@ struct ControlCliOptions {
   bool ideal = false;
   double seconds = 0;
   int trial = 1;
-  int priority = 0;
+  int priority = 30;  // SCHED_FIFO when the system allows it (else normal scheduling, said once)
   int watchdog = 0;
 };
 
@@ -132,7 +132,7 @@ void add_control_commands(CLI::App& app, Common& common) {
   cmd->add_option("--trial", o->trial, "Trial number in the log")->check(CLI::PositiveNumber);
   cmd->add_option("--watchdog", o->watchdog, "Consecutive failed reads that stop the arm (default: hardware.yaml's; "
                                              "--virtual: at least 20)")->check(CLI::PositiveNumber);
-  cmd->add_option("--rt-priority", o->priority, "SCHED_FIFO priority of the loop (0: normal scheduling)");
+  cmd->add_option("--rt-priority", o->priority, "SCHED_FIFO priority of the loop (default 30; 0: normal scheduling; refused: normal, with a note)");
   cmd->callback([&common, o] {
     if (!with_robot(common.robot, [&](auto e) {
           control<typename decltype(e)::FullModel, typename decltype(e)::IdentifiedModel>(common, *o);
