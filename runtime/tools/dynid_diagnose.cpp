@@ -13,6 +13,8 @@
 #include "symoro/identify/dataset.hpp"
 #include "symoro/io/atomic_file.hpp"
 #include "symoro/io/log.hpp"
+#include "symoro/trajectory/design.hpp"
+#include "symoro/twin/config.hpp"
 
 namespace symoro::dynid {
 
@@ -20,6 +22,7 @@ namespace {
 
 struct DiagnoseOptions {
   std::string data, out, model, variant, apply;
+  bool no_backlash = false;
   std::vector<std::string> train{"AG02"}, heldout{"V01", "V02", "V03"}, only;
   int trial = 1;
   double interval_ms = 10, cutoff = 5, alpha = 1e-3, min_gain = 0.02, min_torque = 0.003;
@@ -32,11 +35,13 @@ void run(const Common& common, const DiagnoseOptions& o) {
   so.interval = o.interval_ms / 1000;
   so.cutoff = o.cutoff;
   so.candidates.only = o.only;
+  io::Log first_train;  // the backlash stage's run
   auto stack = [&](const std::vector<std::string>& names) {
     std::vector<diagnose::NamedSamples> runs;
     for (const auto& name : names) {
       const auto& r = data.find(name, o.trial);
-      const io::Log log = io::read_log(r.file);
+      io::Log log = io::read_log(r.file);
+      if (&names == &o.train && name == o.train.front()) first_train = log;
       runs.push_back({name, preprocess::preprocess(log, log.meta.sample_time > 0 ? log.meta.sample_time : 0.001,
                                                    diagnose::light_preprocessing())});
     }
@@ -49,13 +54,28 @@ void run(const Common& common, const DiagnoseOptions& o) {
   dopt.selection.min_effect_torque = o.min_torque;
   dopt.selection.candidates = so.candidates;
   diagnose::Diagnosis d = diagnose::diagnose(train, heldout, dopt);
+  // Backlash from the closed loop's high band, against the robot's digital twin description.
+  const auto twin_path = common.robot_dir() / "twin.yaml";
+  if (!o.no_backlash && std::filesystem::exists(twin_path)) {
+    const auto design = trajectory::TrajectoryDesign::read(common.robot_dir() / "trajectories.yaml", joint_list<Full>());
+    const twin::TwinConfig nominal =
+        diagnose::with_selected_effects(twin::read_twin_config(twin_path, Full::nq), d.selection);
+    d.backlash = diagnose::fit_backlash<Full>(first_train, design.build(o.train.front()), nominal);
+    d.backlash_judged = true;
+  }
   d.robot = common.robot;
   d.model = std::string(Model::robot_name) + (std::string(Model::variant_name).empty() ? "" : "::" + std::string(Model::variant_name));
   d.cutoff = o.cutoff;
   for (const auto& e : d.selection.effects)
     fmt::print("effect: {}: {} (F {:.1f}, held-out gain {:.1f} %)\n", e.candidate.label(), e.magnitude.text, e.f,
                100 * e.heldout_gain);
-  if (d.selection.effects.empty()) fmt::print("no missing effect found ({})\n", d.selection.stop_reason);
+  for (const auto& f : d.backlash.findings)
+    fmt::print("effect: backlash, joint {}: {:.3f} deg of play (high-band torque {:.3f} N m measured, {:.3f} simulated "
+               "without it, {:.3f} with it)\n",
+               f.joint, f.width * 180 / 3.14159265358979323846, f.measured, f.simulated_before, f.simulated_after);
+  if (d.backlash.delay > 0) fmt::print("actuation delay refined on the high band: {:.2f} ms\n", d.backlash.delay * 1e3);
+  if (d.selection.effects.empty() && d.backlash.findings.empty())
+    fmt::print("no missing effect found ({})\n", d.selection.stop_reason);
   fmt::print("held-out rms residual: {:.4f} -> {:.4f} N m\n", d.selection.before.heldout_total, d.selection.after.heldout_total);
   const std::filesystem::path out(o.out);
   const auto files = diagnose::write_diagnosis_report(d, out);
@@ -110,6 +130,7 @@ void add_diagnose_commands(CLI::App& app, Common& common) {
   cmd->add_option("--alpha", o->alpha, "Family-wise level of each step");
   cmd->add_option("--min-gain", o->min_gain, "Least relative fall of the held-out residual");
   cmd->add_option("--min-torque", o->min_torque, "Least effect torque that matters, N m");
+  cmd->add_flag("--no-backlash", o->no_backlash, "Skip the closed-loop high-band stage (backlash; simulates the twin)");
   cmd->add_option("--model", o->model, "Model whose gap is diagnosed: a robot.yaml variant, or full (default: "
                                        "robot.yaml's identified)");
   cmd->add_option("--variant", o->variant, "Name of the variant to write (default: <identified>_diagnosed)");

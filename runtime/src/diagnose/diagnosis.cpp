@@ -110,6 +110,24 @@ std::vector<std::filesystem::path> write_diagnosis_report(const Diagnosis& d, co
     }
     m += "\nStopped: " + s.stop_reason + ".\n\n";
   }
+  if (d.backlash_judged) {
+    const BacklashFit& b = d.backlash;
+    m += "## Backlash: the closed loop's high band\n\n";
+    m += "The fitting run's torque above 40 Hz against the robot's digital twin running the same trajectory in closed "
+         "loop with the effects above (mean and spread over noise seeds); a joint whose excess exceeds 6 spreads and "
+         "5 % gets the play whose simulation reproduces it, then the others are judged again.";
+    if (b.delay > 0) m += fmt::format(" The selected delay, refined on the high band: {:.2f} ms.", b.delay * 1e3);
+    m += "\n\n| joint | measured (N m) | simulated (N m) | spread (N m) | play |\n|---|---|---|---|---|\n";
+    for (Eigen::Index j = 0; j < b.measured.size(); ++j) {
+      std::string play;
+      for (const auto& f : b.findings)
+        if (f.joint == j + 1) play = fmt::format("{:.3f} deg", f.width * 180 / 3.14159265358979323846);
+      m += fmt::format("| {} | {:.4f} | {:.4f} | {:.4f} | {} |\n",
+                       j < static_cast<Eigen::Index>(d.before.joints.size()) ? d.before.joints[j].name : std::to_string(j + 1),
+                       b.measured(j), b.simulated(j), b.spread(j), play.empty() ? "—" : play);
+    }
+    m += b.findings.empty() ? "\nNo backlash found.\n\n" : "\n";
+  }
   m += "## The gap before and after (held-out trajectories)\n\n";
   m += "| joint | rms before (N m) | rms after (N m) | change |\n|---|---|---|---|\n";
   for (Eigen::Index j = 0; j < s.before.heldout_rmse.size(); ++j) {
@@ -217,6 +235,11 @@ std::string variant_yaml(const Diagnosis& d, const std::string& name, const std:
         notes += "    # also " + key + " on joints [" + list(it->second) + "] with " + it->first +
                  " (one entry per effect in a variant: the joints above use " + best->first + ")\n";
   }
+  if (d.backlash_judged)
+    for (const auto& f : d.backlash.findings)
+      notes += fmt::format("    # backlash on joint {} ({:.3f} deg of play, from the closed loop's high band): not a rigid-body "
+                           "term; expect chatter where its mesh torque reverses\n",
+                           f.joint, f.width * 180 / 3.14159265358979323846);
   if (effects.empty() && notes.empty()) return {};
   std::string y = "  " + name + ":\n";
   y += "    description: " + base + " with the effects dynid diagnose found\n";

@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "symoro/diagnose/backlash_fit.hpp"
 #include "symoro/diagnose/design_stack.hpp"
 #include "symoro/diagnose/localize.hpp"
 #include "symoro/diagnose/selection.hpp"
@@ -27,6 +28,10 @@ struct Diagnosis {
   Selection selection;
   std::vector<ResidualSeries> before_series, after_series;  // held out
   Localization before, after;
+  // The closed-loop high-band stage (backlash_fit.hpp), when it ran (dynid diagnose runs it with
+  // the robot's twin description): play per joint and the refined delay.
+  bool backlash_judged = false;
+  BacklashFit backlash;
 };
 
 // The stack's segments as residual series, with the stacked model torque.

@@ -1,0 +1,207 @@
+// Backlash from the closed loop's high band. Play in a gear lets the rotor float between the
+// flanks wherever the mesh torque is small; the 1 kHz FF+PD loop then chatters, and the measured
+// torque (current) gains power far above the diagnosis's 5 Hz band, where the stack's columns
+// cannot see it (a linear column of the low band explains < 2 % of it). So backlash is judged
+// by simulating the experiment: the robot's digital twin (its nominal description, plus the
+// effects the diagnosis already selected) runs the fitting trajectory in closed loop, and
+//   1. a joint whose measured high-band torque rms exceeds the simulated one by more than the
+//      simulation's own spread across noise seeds (and by a relative margin) has a candidate;
+//   2. the joint with the largest excess gets the play width whose simulation reproduces its
+//      measured high-band rms (bisection: the chatter grows with the width), and the others are
+//      re-judged with it in the simulation (a neighbour's chatter couples into them);
+//   3. until no joint exceeds.
+// A joint whose mesh torque never reverses (a gravity-loaded elbow) never crosses its play: its
+// backlash leaves no trace in either band and is not named.
+#pragma once
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "symoro/diagnose/selection.hpp"
+#include "symoro/preprocess/butterworth.hpp"
+#include "symoro/preprocess/preprocess.hpp"
+#include "symoro/preprocess/zero_phase.hpp"
+#include "symoro/trajectory/design.hpp"
+#include "symoro/twin/config.hpp"
+#include "symoro/twin/simulator.hpp"
+
+namespace symoro::diagnose {
+
+struct BacklashFitOptions {
+  double band_hz = 40;        // the high band starts here (the low band ends at the stack's 5 Hz)
+  double light_hz = 150;      // the 1 kHz preprocessing's low-pass (the band's top)
+  int seeds = 3;              // simulations of the nominal loop: the spread of the high-band rms
+  double sigmas = 6;          // an excess must exceed this many spreads ...
+  double relative = 0.05;     // ... and this fraction of the simulated rms
+  double max_width = 0.1;     // rad (5.7 deg): the bisection's upper end
+  int bisection_steps = 10;   // width resolution max_width / 2^steps
+  std::uint64_t seed = 7919;  // of the simulations (any: they are not the data's)
+  // A selected actuation delay shapes the loop's ringing in the high band far more finely than
+  // the low band resolves it: it is refined first (golden section over +-delay_range of it,
+  // matching the log of the high-band rms on every joint), so its ringing is not taken for play.
+  double delay_range = 0.3;
+  int delay_steps = 10;
+};
+
+struct BacklashFinding {
+  int joint = 0;                  // 1-based
+  double width = 0;               // rad, total play
+  double measured = 0;            // N m, high-band torque rms of the data
+  double simulated_before = 0;    // N m, of the simulation without this joint's play (mean over seeds)
+  double spread = 0;              // N m, its standard deviation over seeds
+  double simulated_after = 0;     // N m, with the fitted play
+};
+
+struct BacklashFit {
+  Eigen::VectorXd measured, simulated, spread;  // per joint, the final judgement (N m)
+  std::vector<BacklashFinding> findings;
+  double delay = 0;               // s, the refined actuation delay (0: none was selected)
+  int simulations = 0;
+};
+
+// The twin description with the effects the selection named that the twin can play: Coulomb
+// friction, offsets (the twin's is the external torque: minus the effect) and the delay.
+inline twin::TwinConfig with_selected_effects(twin::TwinConfig c, const Selection& s) {
+  const Eigen::Index n = c.rotor_inertia.size();
+  for (const auto& e : s.effects) {
+    const int j = e.candidate.joint - 1;
+    const double v = e.magnitude.values.empty() ? 0.0 : e.magnitude.values[0];
+    switch (e.candidate.kind) {
+      case EffectKind::Coulomb:
+        if (!c.effects.coulomb) c.effects.coulomb_torque = Eigen::VectorXd::Zero(n);
+        c.effects.coulomb = true;
+        c.effects.coulomb_torque(j) = v;
+        break;
+      case EffectKind::Offset:
+        if (!c.effects.torque_offset) c.effects.offset_torque = Eigen::VectorXd::Zero(n);
+        c.effects.torque_offset = true;
+        c.effects.offset_torque(j) = -v;
+        break;
+      case EffectKind::ActuationDelay:
+        c.effects.actuation_delay = true;
+        c.effects.actuation_delay_time = v;
+        break;
+      default: break;
+    }
+  }
+  return c;
+}
+
+// High-band rms of the torque per joint: the log preprocessed at its own rate (light low-pass),
+// minus its zero-phase low-pass at band_hz, over every piece.
+inline Eigen::VectorXd high_band_rms(const io::Log& log, const BacklashFitOptions& o) {
+  preprocess::Options po;
+  po.derivative_cutoff = o.light_hz;
+  const double base = log.meta.sample_time > 0 ? log.meta.sample_time : 0.001;
+  const preprocess::Samples s = preprocess::preprocess(log, base, po);
+  const auto sections = preprocess::butterworth_lowpass(4, o.band_hz, 1.0 / base);
+  const int padding = preprocess::zero_phase_padding(sections);
+  const Eigen::Index n = s.tau.cols();
+  Eigen::VectorXd sum = Eigen::VectorXd::Zero(n);
+  long count = 0;
+  for (Eigen::Index a = 0; a < s.tau.rows();) {
+    Eigen::Index b = a + 1;
+    while (b < s.tau.rows() && (s.piece.empty() || s.piece[b] == s.piece[a])) ++b;
+    if (b - a > padding + 1) {
+      preprocess::Channels low = s.tau.middleRows(a, b - a);
+      preprocess::filtfilt(sections, padding, low);
+      sum += (s.tau.middleRows(a, b - a) - low).colwise().squaredNorm().transpose();
+      count += static_cast<long>(b - a);
+    }
+    a = b;
+  }
+  return (sum / static_cast<double>(std::max(1L, count))).cwiseSqrt();
+}
+
+// `nominal`: the robot's twin configuration with the effects already diagnosed switched on and
+// every unknown one off (backlash off); `traj` and `measured` the fitting run.
+template <class Full>
+BacklashFit fit_backlash(const io::Log& measured, const trajectory::Trajectory& traj, twin::TwinConfig nominal,
+                         const BacklashFitOptions& o = {}) {
+  const int n = Full::nq;
+  BacklashFit fit;
+  fit.measured = high_band_rms(measured, o);
+  // No play anywhere to start with (a description may carry widths with backlash switched off).
+  nominal.effects.backlash = false;
+  nominal.effects.backlash_width = Eigen::VectorXd::Zero(n);
+  auto simulate = [&](const twin::TwinConfig& c, std::uint64_t seed) {
+    twin::RunOptions ro;
+    ro.robot = Full::robot_name;
+    ro.seed = seed;
+    ++fit.simulations;
+    return high_band_rms(twin::ClosedLoopTwin<Full>(c).run(traj, ro), o);
+  };
+  auto judge = [&](const twin::TwinConfig& c) {
+    Eigen::MatrixXd runs(n, o.seeds);
+    for (int k = 0; k < o.seeds; ++k) runs.col(k) = simulate(c, o.seed + static_cast<std::uint64_t>(k));
+    fit.simulated = runs.rowwise().mean();
+    fit.spread = ((runs.colwise() - fit.simulated).array().square().rowwise().sum() / std::max(1, o.seeds - 1)).sqrt();
+  };
+  twin::TwinConfig c = nominal;
+  if (c.effects.actuation_delay && c.effects.actuation_delay_time > 0) {
+    auto mismatch = [&](double d) {
+      twin::TwinConfig t = c;
+      t.effects.actuation_delay_time = d;
+      const Eigen::VectorXd h = simulate(t, o.seed);
+      double sum = 0;
+      for (int j = 0; j < n; ++j) sum += std::pow(std::log(fit.measured(j) / h(j)), 2);
+      return sum;
+    };
+    const double g = 0.5 * (std::sqrt(5.0) - 1);
+    double a = c.effects.actuation_delay_time * (1 - o.delay_range), b = c.effects.actuation_delay_time * (1 + o.delay_range);
+    double x1 = b - g * (b - a), x2 = a + g * (b - a), f1 = mismatch(x1), f2 = mismatch(x2);
+    for (int k = 0; k < o.delay_steps; ++k) {
+      if (f1 < f2) {
+        b = x2, x2 = x1, f2 = f1, x1 = b - g * (b - a), f1 = mismatch(x1);
+      } else {
+        a = x1, x1 = x2, f1 = f2, x2 = a + g * (b - a), f2 = mismatch(x2);
+      }
+    }
+    c.effects.actuation_delay_time = 0.5 * (a + b);
+    fit.delay = c.effects.actuation_delay_time;
+  }
+  judge(c);
+  for (int step = 0; step < n; ++step) {
+    // The joint with the largest significant excess, if any (joints without a rotor cannot
+    // have the twin's backlash: their play is not fitted).
+    int best = -1;
+    double best_ratio = 0;
+    for (int j = 0; j < n; ++j) {
+      if (!(c.rotor_inertia(j) > 0) || c.effects.backlash_width(j) > 0) continue;
+      const double excess = fit.measured(j) - fit.simulated(j);
+      if (excess > o.sigmas * fit.spread(j) && excess > o.relative * fit.simulated(j) &&
+          excess / fit.simulated(j) > best_ratio) {
+        best = j;
+        best_ratio = excess / fit.simulated(j);
+      }
+    }
+    if (best < 0) break;
+    BacklashFinding f;
+    f.joint = best + 1;
+    f.measured = fit.measured(best);
+    f.simulated_before = fit.simulated(best);
+    f.spread = fit.spread(best);
+    // Bisection on the width: the simulated high-band rms of this joint against the measured.
+    twin::TwinConfig trial = c;
+    trial.effects.backlash = true;
+    double lo = 0, hi = o.max_width;
+    for (int k = 0; k < o.bisection_steps; ++k) {
+      const double mid = 0.5 * (lo + hi);
+      trial.effects.backlash_width(best) = mid;
+      (simulate(trial, o.seed)(best) < f.measured ? lo : hi) = mid;
+    }
+    f.width = 0.5 * (lo + hi);
+    trial.effects.backlash_width(best) = f.width;
+    c = trial;
+    judge(c);
+    f.simulated_after = fit.simulated(best);
+    fit.findings.push_back(f);
+  }
+  return fit;
+}
+
+}  // namespace symoro::diagnose
