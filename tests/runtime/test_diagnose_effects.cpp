@@ -48,12 +48,13 @@ const symoro::trajectory::TrajectoryDesign& design() {
 
 struct Data {
   DesignStack train, heldout;
-  symoro::io::Log train_log;  // AG02 at 1 kHz, for the closed-loop high-band stage
+  symoro::io::Log train_log;    // AG02 at 1 kHz, for the closed-loop high-band stage
+  symoro::io::Log heldout_log;  // V01 at 1 kHz
 };
 
 Data simulate(const TwinConfig& c, std::uint64_t seed) {
   const symoro::twin::ClosedLoopTwin<Full> twin(c);
-  symoro::io::Log train_log;
+  symoro::io::Log train_log, heldout_log;
   auto stack = [&](const std::vector<std::string>& names) {
     std::vector<NamedSamples> runs;
     for (const auto& name : names) {
@@ -62,12 +63,14 @@ Data simulate(const TwinConfig& c, std::uint64_t seed) {
       ro.seed = seed + std::hash<std::string>{}(name) % 1000;
       const auto log = twin.run(design().build(name), ro);
       if (name == "AG02") train_log = log;
+      if (name == "V01") heldout_log = log;
       runs.push_back({name, symoro::preprocess::preprocess(log, 0.001, light_preprocessing())});
     }
     return stack_design<Full, Reduced>(runs, stacking());
   };
   Data d{stack({"AG02"}), stack({"V01", "V02", "V03"}), {}};
   d.train_log = std::move(train_log);
+  d.heldout_log = std::move(heldout_log);
   return d;
 }
 
@@ -206,6 +209,26 @@ TEST(DiagnoseTwin, Backlash) {
   EXPECT_NEAR(width[4], 0.5 * M_PI / 180, 0.2 * 0.5 * M_PI / 180);
   // With the fitted play the simulation reproduces the measured high band.
   for (const auto& f : b.findings) EXPECT_NEAR(f.simulated_after, f.measured, 0.05 * f.measured) << f.joint;
+  // And on the held-out V01, the gap between measurement and simulation shrinks once the fitted
+  // plays are in the simulation (the twin description, another noise seed).
+  TwinConfig fitted = with_selected_effects(base_config(), s);
+  fitted.effects.backlash = false;
+  fitted.effects.backlash_width.setZero();
+  const auto simulate_v01 = [&](const TwinConfig& tc) {
+    symoro::twin::RunOptions ro;
+    ro.robot = "crane_x7";
+    ro.seed = 4242;
+    return high_band_rms(symoro::twin::ClosedLoopTwin<Full>(tc).run(design().build("V01"), ro));
+  };
+  const Eigen::VectorXd measured = high_band_rms(d.heldout_log), before = simulate_v01(fitted);
+  fitted.effects.backlash = true;
+  for (const auto& f : b.findings) fitted.effects.backlash_width(f.joint - 1) = f.width;
+  const Eigen::VectorXd after = simulate_v01(fitted);
+  for (int j : {0, 3}) {
+    std::cout << fmt::format("V01 joint {}: high-band torque {:.4f} measured, {:.4f} simulated without play, {:.4f} with\n",
+                             j + 1, measured(j), before(j), after(j));
+    EXPECT_LT(std::abs(after(j) - measured(j)), 0.5 * std::abs(before(j) - measured(j))) << "joint " << j + 1;
+  }
 }
 
 TEST(DiagnoseTwin, CoulombOffsetAndDelayTogether) {

@@ -93,7 +93,7 @@ inline twin::TwinConfig with_selected_effects(twin::TwinConfig c, const Selectio
 
 // High-band rms of the torque per joint: the log preprocessed at its own rate (light low-pass),
 // minus its zero-phase low-pass at band_hz, over every piece.
-inline Eigen::VectorXd high_band_rms(const io::Log& log, const BacklashFitOptions& o) {
+inline Eigen::VectorXd high_band_rms(const io::Log& log, const BacklashFitOptions& o = {}) {
   preprocess::Options po;
   po.derivative_cutoff = o.light_hz;
   const double base = log.meta.sample_time > 0 ? log.meta.sample_time : 0.001;
