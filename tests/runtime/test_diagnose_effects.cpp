@@ -188,7 +188,8 @@ TEST(DiagnoseTwin, ActuationDelay) {
 // 1 kHz loop chatters (joint 1's torque above 40 Hz: 2.2 N m rms, 0.19 without play). The
 // high-band stage simulates the twin description with a play per joint and fits its width to
 // that chatter (backlash_fit.hpp). The elbow (joint 4) is gravity-loaded: its mesh torque
-// seldom reverses and its trace is small (7 % more high-band torque), yet above the spread.
+// seldom reverses on AG02 and its trace there is 7 % more high-band torque, less than clean
+// runs differ among themselves (up to 27 %): it is not named, and nothing else may be.
 TEST(DiagnoseTwin, Backlash) {
   TwinConfig c = base_config();
   c.effects.backlash = true;
@@ -200,13 +201,9 @@ TEST(DiagnoseTwin, Backlash) {
   print(s);
   EXPECT_TRUE(s.effects.empty()) << "the low band names " << s.effects.front().candidate.label();
   const BacklashFit b = high_band(d, s);
-  ASSERT_EQ(b.findings.size(), 2u);
-  std::map<int, double> width;
-  for (const auto& f : b.findings) width[f.joint] = f.width;
-  ASSERT_EQ(width.count(1), 1u);
-  ASSERT_EQ(width.count(4), 1u);
-  EXPECT_NEAR(width[1], 0.5 * M_PI / 180, 0.2 * 0.5 * M_PI / 180);
-  EXPECT_NEAR(width[4], 0.5 * M_PI / 180, 0.2 * 0.5 * M_PI / 180);
+  ASSERT_EQ(b.findings.size(), 1u);
+  EXPECT_EQ(b.findings[0].joint, 1);
+  EXPECT_NEAR(b.findings[0].width, 0.5 * M_PI / 180, 0.2 * 0.5 * M_PI / 180);
   // With the fitted play the simulation reproduces the measured high band.
   for (const auto& f : b.findings) EXPECT_NEAR(f.simulated_after, f.measured, 0.05 * f.measured) << f.joint;
   // And on the held-out V01, the gap between measurement and simulation shrinks once the fitted
@@ -224,7 +221,7 @@ TEST(DiagnoseTwin, Backlash) {
   fitted.effects.backlash = true;
   for (const auto& f : b.findings) fitted.effects.backlash_width(f.joint - 1) = f.width;
   const Eigen::VectorXd after = simulate_v01(fitted);
-  for (int j : {0, 3}) {
+  for (int j : {0}) {
     std::cout << fmt::format("V01 joint {}: high-band torque {:.4f} measured, {:.4f} simulated without play, {:.4f} with\n",
                              j + 1, measured(j), before(j), after(j));
     EXPECT_LT(std::abs(after(j) - measured(j)), 0.5 * std::abs(before(j) - measured(j))) << "joint " << j + 1;

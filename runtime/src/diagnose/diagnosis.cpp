@@ -115,7 +115,7 @@ std::vector<std::filesystem::path> write_diagnosis_report(const Diagnosis& d, co
     m += "## Backlash: the closed loop's high band\n\n";
     m += "The fitting run's torque above 40 Hz against the robot's digital twin running the same trajectory in closed "
          "loop with the effects above (mean and spread over noise seeds); a joint whose excess exceeds 6 spreads and "
-         "5 % gets the play whose simulation reproduces it, then the others are judged again.";
+         "50 % gets the play whose simulation reproduces it, then the others are judged again.";
     if (b.delay > 0) m += fmt::format(" The selected delay, refined on the high band: {:.2f} ms.", b.delay * 1e3);
     m += "\n\n| joint | measured (N m) | simulated (N m) | spread (N m) | play |\n|---|---|---|---|---|\n";
     for (Eigen::Index j = 0; j < b.measured.size(); ++j) {
