@@ -22,6 +22,7 @@
 #include "symoro/trajectory/design.hpp"
 #include "symoro/twin/simulator.hpp"
 #include "symoro/twin/truth.hpp"
+#include "twin_dataset.hpp"
 
 namespace {
 
@@ -52,23 +53,12 @@ std::filesystem::path temp(const std::string& what) {
 const std::filesystem::path& dataset() {
   static const std::filesystem::path dir = [] {
     const auto d = temp("data");
-    std::filesystem::remove_all(d);
-    std::filesystem::create_directories(d);
-    const twin::ClosedLoopTwin<Full> tw(hidden_effects());
-    const auto des = trajectory::TrajectoryDesign::read(
-        kRobot + "/trajectories.yaml", std::vector<JointInfo>(Full::joints.begin(), Full::joints.end()));
-    std::string manifest = "format: symoro-dataset 1\nrobot: crane_x7\nruns:\n";
     std::vector<std::string> names{"AG02"};
     names.insert(names.end(), kValid.begin(), kValid.end());
-    for (const auto& name : names) {
-      twin::RunOptions ro;
-      ro.robot = "crane_x7";
-      ro.seed = twin::run_seed(2, name, 1);
-      const auto traj = des.build(name);
-      io::write_log(d / (name + "_t1.csv"), tw.run(traj, ro));
-      manifest += "  - {trajectory: " + name + ", family: " + traj.family + ", trial: 1, file: " + name + "_t1.csv}\n";
-    }
-    io::write_file_atomically(d / "dataset.yaml", manifest);
+    test::write_twin_dataset<Full>(d, hidden_effects(),
+                                   trajectory::TrajectoryDesign::read(kRobot + "/trajectories.yaml",
+                                                                      std::vector<JointInfo>(Full::joints.begin(), Full::joints.end())),
+                                   names, 2);
     return d;
   }();
   return dir;

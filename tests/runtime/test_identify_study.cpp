@@ -16,6 +16,7 @@
 #include <symoro/crane_x7.hpp>
 
 #include "symoro/identify/study.hpp"
+#include "twin_dataset.hpp"
 #include "symoro/io/atomic_file.hpp"
 #include "symoro/trajectory/design.hpp"
 #include "symoro/twin/simulator.hpp"
@@ -40,21 +41,10 @@ const std::filesystem::path& dataset() {
   static const std::filesystem::path dir = [] {
     // Per process: ctest runs test programs in parallel.
     const auto d = std::filesystem::temp_directory_path() / ("symoro_study_test_data_" + std::to_string(::getpid()));
-    std::filesystem::remove_all(d);
-    std::filesystem::create_directories(d);
-    const twin::ClosedLoopTwin<Full> tw(twin::read_twin_config(kRobot + "/twin.yaml", Full::nq));
-    const auto des = design();
-    std::string manifest = "format: symoro-dataset 1\nrobot: crane_x7\ntwin: " + kRobot + "/twin.yaml\nruns:\n";
-    for (const auto* list : {&kIdent, &kValid})
-      for (const auto& name : *list) {
-        twin::RunOptions ro;
-        ro.robot = "crane_x7";
-        ro.seed = twin::run_seed(5, name, 1);
-        const auto traj = des.build(name);
-        io::write_log(d / (name + "_t1.csv"), tw.run(traj, ro));
-        manifest += "  - {trajectory: " + name + ", family: " + traj.family + ", trial: 1, file: " + name + "_t1.csv}\n";
-      }
-    io::write_file_atomically(d / "dataset.yaml", manifest);
+    std::vector<std::string> names = kIdent;
+    names.insert(names.end(), kValid.begin(), kValid.end());
+    test::write_twin_dataset<Full>(d, twin::read_twin_config(kRobot + "/twin.yaml", Full::nq), design(), names, 5,
+                                   kRobot + "/twin.yaml");
     return d;
   }();
   return dir;

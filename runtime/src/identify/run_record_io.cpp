@@ -6,16 +6,11 @@
 #include <yaml-cpp/yaml.h>
 
 #include "symoro/io/atomic_file.hpp"
+#include "yaml_vector.hpp"
 
 namespace symoro::identify {
 
 namespace {
-
-void put(YAML::Emitter& y, const char* key, const Eigen::VectorXd& v) {
-  y << YAML::Key << key << YAML::Value << YAML::Flow << YAML::BeginSeq;
-  for (Eigen::Index i = 0; i < v.size(); ++i) y << v(i);
-  y << YAML::EndSeq;
-}
 
 Eigen::VectorXd vec(const YAML::Node& n) {
   Eigen::VectorXd v(static_cast<Eigen::Index>(n.size()));
@@ -46,24 +41,24 @@ void save_run(const RunRecord& r, const std::string& fingerprint, const std::fil
   y << YAML::Key << "samples" << YAML::Value << r.samples;
   y << YAML::Key << "kappa" << YAML::Value << r.kappa;
   y << YAML::Key << "kappa_scaled" << YAML::Value << r.kappa_scaled;
-  put(y, "phi_ols", r.phi_ols);
-  put(y, "std_ols", r.std_ols);
+  detail::put_vector(y, "phi_ols", r.phi_ols);
+  detail::put_vector(y, "std_ols", r.std_ols);
   y << YAML::Key << "residual_rms" << YAML::Value << r.residual_rms;
   y << YAML::Key << "weighted" << YAML::Value << r.weighted;
   y << YAML::Key << "ols_lambda_min" << YAML::Value << r.ols_lambda_min;
-  put(y, "ols_worst_pose", r.ols_worst_pose);
+  detail::put_vector(y, "ols_worst_pose", r.ols_worst_pose);
   y << YAML::Key << "ols_pd" << YAML::Value << r.ols_pd;
   y << YAML::Key << "route" << YAML::Value << r.route;
   y << YAML::Key << "eps" << YAML::Value << r.eps;
   y << YAML::Key << "sdp_feasible" << YAML::Value << r.sdp_feasible;
-  put(y, "phi_sdp", r.phi_sdp);
-  put(y, "phi_clie", r.phi_clie);
+  detail::put_vector(y, "phi_sdp", r.phi_sdp);
+  detail::put_vector(y, "phi_clie", r.phi_clie);
   y << YAML::Key << "clie_success" << YAML::Value << r.clie_success;
   y << YAML::Key << "clie_termination" << YAML::Value << r.clie_termination;
   y << YAML::Key << "clie_cost_initial" << YAML::Value << r.clie_cost_initial;
   y << YAML::Key << "clie_cost_final" << YAML::Value << r.clie_cost_final;
   y << YAML::Key << "clie_iterations" << YAML::Value << r.clie_iterations;
-  put(y, "clie_rms", r.clie_rms);
+  detail::put_vector(y, "clie_rms", r.clie_rms);
   y << YAML::Key << "clie_lambda_min" << YAML::Value << r.clie_lambda_min;
   y << YAML::Key << "clie_pd" << YAML::Value << r.clie_pd;
   y << YAML::Key << "t_ols" << YAML::Value << r.t_ols;

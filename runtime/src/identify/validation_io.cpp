@@ -8,6 +8,7 @@
 
 #include "symoro/error.hpp"
 #include "symoro/io/atomic_file.hpp"
+#include "yaml_vector.hpp"
 #include "symoro/io/number_text.hpp"
 
 namespace symoro::identify {
@@ -18,12 +19,6 @@ constexpr const char* kFormat = "symoro-validation 1";
 // Per joint, in this order after the time column.
 constexpr const char* kColumns[] = {"q", "qd", "qdd", "measured", "clie", "accepted"};
 constexpr int kPerJoint = 6;
-
-void put(YAML::Emitter& y, const char* key, const Eigen::VectorXd& v) {
-  y << YAML::Key << key << YAML::Value << YAML::Flow << YAML::BeginSeq;
-  for (Eigen::Index i = 0; i < v.size(); ++i) y << v(i);
-  y << YAML::EndSeq;
-}
 
 std::string csv_name(const std::string& trajectory) { return trajectory + ".csv"; }
 
@@ -147,8 +142,8 @@ std::vector<std::filesystem::path> write_validation(const StudyResult& study, co
   y << YAML::Key << "rescued" << YAML::Value << study.rescued;
   y << YAML::Key << "names" << YAML::Value << YAML::Flow << study.names;
   y << YAML::Key << "units" << YAML::Value << YAML::Flow << study.units;
-  put(y, "parameters", study.phi_rescue);
-  if (study.truth.size() > 0) put(y, "truth", study.truth);
+  detail::put_vector(y, "parameters", study.phi_rescue);
+  if (study.truth.size() > 0) detail::put_vector(y, "truth", study.truth);
   y << YAML::Key << "trajectories" << YAML::Value << YAML::BeginSeq;
   for (const auto& v : study.validation) {
     y << YAML::BeginMap;
@@ -159,8 +154,8 @@ std::vector<std::filesystem::path> write_validation(const StudyResult& study, co
     y << YAML::Key << "rmse_accepted" << YAML::Value << v.rmse_rescue;
     y << YAML::Key << "mne_clie" << YAML::Value << v.mne_clie;
     y << YAML::Key << "mne_accepted" << YAML::Value << v.mne_rescue;
-    put(y, "rmse_joint_clie", v.rmse_joint_clie);
-    put(y, "rmse_joint_accepted", v.rmse_joint_rescue);
+    detail::put_vector(y, "rmse_joint_clie", v.rmse_joint_clie);
+    detail::put_vector(y, "rmse_joint_accepted", v.rmse_joint_rescue);
     y << YAML::Key << "series" << YAML::Value << "validation/" + csv_name(v.trajectory);
     y << YAML::EndMap;
   }
