@@ -48,6 +48,16 @@ for model in reduced reduced_diagnosed; do
     --only AG02 --interval 10 --validation V01,V02,V03
 done
 $dynid compare --robot crane_x7 --before build/gap-study-reduced --after build/gap-study-reduced_diagnosed -o build/gap
+# A payload mounted after the identification (0.2 kg, 8 cm out on the flange axis): diagnose
+# the clean study's parameters as they stand (--params holds them); it names the payload.
+cat > build/payload.yaml <<'YAML'
+effects:
+  payload: {enabled: true, mass: 0.2, com: [0, 0, 0.08]}
+YAML
+$dynid twin dataset --robot crane_x7 -o build/payload-data --trials 1 --seed 3 --only AG02 V01 V02 V03 \
+  --config build/payload.yaml
+$dynid diagnose --robot crane_x7 --data build/payload-data -o build/payload-diagnosis \
+  --params build/study/report/parameters.yaml
 
 # The hardware controller without hardware: 5 s of AG02 at 1 kHz through the real DYNAMIXEL
 # driver over a pseudo-terminal, against virtual servos that drive the digital twin.

@@ -16,6 +16,7 @@
 #include "symoro/dynamixel/virtual_bus.hpp"
 #include "symoro/hardware/config.hpp"
 #include "symoro/hardware/controller.hpp"
+#include "symoro/io/parameters_yaml.hpp"
 #include "symoro/hardware/twin_servo_backend.hpp"
 #include "symoro/robots_registry.hpp"
 #include "symoro/trajectory/design.hpp"
@@ -71,7 +72,7 @@ void control(const Common& common, const ControlCliOptions& o) {
   if (!o.params.empty()) {
     std::vector<std::string> names;
     for (const auto& p : Identified::parameters) names.emplace_back(p.name);
-    const Eigen::VectorXd phi = hardware::read_identified_parameters(o.params, names);
+    const Eigen::VectorXd phi = io::read_parameters_yaml(o.params, names);
     co.feedforward = hardware::model_feedforward<Identified>(phi);
     co.notes += "; model feedforward from " + o.params;
   }

@@ -11,6 +11,7 @@
 #include "symoro/diagnose/diagnosis.hpp"
 #include "symoro/diagnose/stack_builder.hpp"
 #include "symoro/identify/dataset.hpp"
+#include "symoro/io/parameters_yaml.hpp"
 #include "symoro/io/atomic_file.hpp"
 #include "symoro/io/log.hpp"
 #include "symoro/trajectory/design.hpp"
@@ -21,7 +22,7 @@ namespace symoro::dynid {
 namespace {
 
 struct DiagnoseOptions {
-  std::string data, out, model, variant, apply;
+  std::string data, out, model, variant, apply, params;
   bool no_backlash = false;
   std::vector<std::string> train{"AG02"}, heldout{"V01", "V02", "V03"}, only;
   int trial = 1;
@@ -47,7 +48,19 @@ void run(const Common& common, const DiagnoseOptions& o) {
     }
     return diagnose::stack_design<Full, Model>(runs, so);
   };
-  const diagnose::DesignStack train = stack(o.train), heldout = stack(o.heldout);
+  // The gap of an earlier identification as it stands: its parameters are held, not refitted
+  // (read first: a bad file is named before the logs are worked through).
+  Eigen::VectorXd held;
+  if (!o.params.empty()) {
+    std::vector<std::string> names;
+    for (const auto& p : Model::parameters) names.emplace_back(p.name);
+    held = io::read_parameters_yaml(o.params, names);
+  }
+  diagnose::DesignStack train = stack(o.train), heldout = stack(o.heldout);
+  if (held.size()) {
+    train.hold(held);
+    heldout.hold(held);
+  }
   diagnose::DiagnosisOptions dopt;
   dopt.selection.alpha = o.alpha;
   dopt.selection.min_heldout_gain = o.min_gain;
@@ -66,6 +79,7 @@ void run(const Common& common, const DiagnoseOptions& o) {
   d.robot = common.robot;
   d.model = std::string(Model::robot_name) + (std::string(Model::variant_name).empty() ? "" : "::" + std::string(Model::variant_name));
   d.cutoff = o.cutoff;
+  d.held_parameters = o.params;
   for (const auto& e : d.selection.effects)
     fmt::print("effect: {}: {} (F {:.1f}, held-out gain {:.1f} %)\n", e.candidate.label(), e.magnitude.text, e.f,
                100 * e.heldout_gain);
@@ -125,7 +139,7 @@ void add_diagnose_commands(CLI::App& app, Common& common) {
   cmd->add_option("--interval", o->interval_ms, "Diagnosis grid, ms")->check(CLI::PositiveNumber);
   cmd->add_option("--cutoff", o->cutoff, "Low-pass on every column and the torque, Hz")->check(CLI::PositiveNumber);
   cmd->add_option("--only", o->only, "Only these effects (coulomb, stribeck, offset, viscous_asymmetry, "
-                                     "position_harmonics, inertia_products, torque_constant, actuation_delay, backlash)")
+                                     "position_harmonics, inertia_products, torque_constant, actuation_delay, backlash, payload)")
       ->delimiter(',');
   cmd->add_option("--alpha", o->alpha, "Family-wise level of each step");
   cmd->add_option("--min-gain", o->min_gain, "Least relative fall of the held-out residual");
@@ -133,6 +147,10 @@ void add_diagnose_commands(CLI::App& app, Common& common) {
   cmd->add_flag("--no-backlash", o->no_backlash, "Skip the closed-loop high-band stage (backlash; simulates the twin)");
   cmd->add_option("--model", o->model, "Model whose gap is diagnosed: a robot.yaml variant, or full (default: "
                                        "robot.yaml's identified)");
+  cmd->add_option("--params", o->params, "An earlier identification (a study's report/parameters.yaml of this model): "
+                                         "hold its parameters and diagnose its gap, e.g. a payload added since; "
+                                         "default: refit the model's parameters with the effects")
+      ->check(CLI::ExistingFile);
   cmd->add_option("--variant", o->variant, "Name of the variant to write (default: <identified>_diagnosed)");
   cmd->add_flag("--apply", [o](std::int64_t) { o->apply = "yes"; }, "Add the variant to the robot's robot.yaml");
   cmd->callback([&common, o] {

@@ -66,6 +66,16 @@ expect("${out}" "no missing effect found")
 if(NOT EXISTS ${WORK}/diag/diagnosis.md OR NOT EXISTS ${WORK}/diag/figures/heldout_rmse.svg)
   message(FATAL_ERROR "no diagnosis report written")
 endif()
+# --params: an earlier identification's parameters must be this model's, named with file and line.
+file(WRITE ${WORK}/params.yaml "robot: crane_x7\nparameters:\n  - {name: ZZR1, value: 0.01}\n  - {name: XX9, value: 1}\n")
+run(1 out diagnose --robot crane_x7 --data ${ds} -o ${WORK}/diag_held --train V01 --heldout V02 --params ${WORK}/params.yaml)
+expect("${out}" "params.yaml:4: error: parameter 'XX9' is not one of the identified model's")
+file(WRITE ${WORK}/params.yaml "robot: crane_x7\nparameters:\n  - {name: ZZR1, value: 0.01}\n")
+run(1 out diagnose --robot crane_x7 --data ${ds} -o ${WORK}/diag_held --train V01 --heldout V02 --params ${WORK}/params.yaml)
+expect("${out}" "params.yaml:3: error: parameter '.*' is missing \\(39 expected\\)")
+if(EXISTS ${WORK}/diag_held)
+  message(FATAL_ERROR "a refused --params wrote a report")
+endif()
 # A dataset made with --config keeps the overrides, so its truth (the hidden effects) travels
 # with it.
 file(WRITE ${WORK}/hidden.yaml "effects:\n  torque_offset: {enabled: true, torque: [0, 0, 0, 0, 0.02, 0, 0, 0]}\n")

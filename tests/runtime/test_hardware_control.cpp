@@ -11,6 +11,7 @@
 #include <symoro/dynamixel/virtual_bus.hpp>
 #include <symoro/hardware/config.hpp>
 #include <symoro/hardware/controller.hpp>
+#include <symoro/io/parameters_yaml.hpp>
 #include <symoro/hardware/twin_servo_backend.hpp>
 #include <symoro/io/log.hpp>
 #include <symoro/io/log_stream.hpp>
@@ -372,12 +373,12 @@ TEST_F(HardwareControl, ModelFeedforwardFromAStudysParameters) {
   }
   const auto file = dir_ / "parameters.yaml";
   std::ofstream(file) << yaml;
-  const Eigen::VectorXd read = read_identified_parameters(file.string(), names);
+  const Eigen::VectorXd read = io::read_parameters_yaml(file.string(), names);
   EXPECT_EQ(read, phi);
   // A missing parameter is named with the file.
   std::ofstream(dir_ / "short.yaml") << yaml.substr(0, yaml.rfind("  - {"));
   try {
-    read_identified_parameters((dir_ / "short.yaml").string(), names);
+    io::read_parameters_yaml((dir_ / "short.yaml").string(), names);
     FAIL() << "a missing parameter was accepted";
   } catch (const DataError& e) {
     EXPECT_NE(std::string(e.what()).find("short.yaml"), std::string::npos);

@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <stdexcept>
+#include <string>
 #include <vector>
 
 #include "symoro/preprocess/butterworth.hpp"
@@ -10,6 +12,15 @@
 namespace symoro::diagnose {
 
 Eigen::VectorXd DesignStack::target() const { return stacked(tau) - tau0; }
+
+void DesignStack::hold(const Eigen::VectorXd& phi) {
+  if (held()) throw std::logic_error("DesignStack::hold: parameters are already held");
+  if (phi.size() != W.cols())
+    throw std::invalid_argument("DesignStack::hold: " + std::to_string(phi.size()) + " parameters for a model with " +
+                                std::to_string(W.cols()));
+  tau0 += W * phi;
+  held_phi = phi;
+}
 
 Eigen::VectorXd DesignStack::stacked(const Eigen::MatrixXd& m) const {
   Eigen::VectorXd v(m.rows() * m.cols());

@@ -98,6 +98,9 @@ std::vector<std::filesystem::path> write_diagnosis_report(const Diagnosis& d, co
   m += fmt::format("Robot `{}`, model `{}`. Fitted on {}; judged on the held-out {}. Grid {:g} ms, every column and "
                    "the torque through the same {:g} Hz zero-phase low-pass (parallel filtering).\n\n",
                    d.robot, d.model, join(d.train), join(d.heldout), d.interval * 1000, d.cutoff);
+  if (!d.held_parameters.empty())
+    m += "The identified parameters are held at `" + d.held_parameters +
+         "` (an earlier identification): only the effects are fitted, so what changed since (a payload) shows.\n\n";
   m += "## Effects found\n\n";
   if (s.effects.empty()) {
     m += "None: no candidate effect is significant and improves the held-out trajectories (" + s.stop_reason + ").\n\n";
@@ -212,6 +215,10 @@ std::string variant_yaml(const Diagnosis& d, const std::string& name, const std:
         break;
       case EffectKind::Backlash:
         notes += fmt::format("    # backlash on joint {} ({}): not a rigid-body term; leave out samples at mesh-torque reversals\n",
+                             c.joint, e.magnitude.text);
+        break;
+      case EffectKind::Payload:
+        notes += fmt::format("    # payload on link {} ({}): not a new term; identify again with it mounted (dynid identify)\n",
                              c.joint, e.magnitude.text);
         break;
     }

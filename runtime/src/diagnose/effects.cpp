@@ -37,6 +37,7 @@ const std::vector<EffectInfo>& effect_catalogue() {
       {EffectKind::TorqueConstant, "torque_constant", "torque-constant error", "%", true, false},
       {EffectKind::ActuationDelay, "actuation_delay", "actuation delay", "ms", false, false},
       {EffectKind::Backlash, "backlash", "backlash", "deg", true, false},
+      {EffectKind::Payload, "payload", "payload on the last link", "kg", false, false},
   };
   return v;
 }
@@ -68,7 +69,7 @@ std::string Candidate::label() const {
   std::string s = e.title;
   if (kind == EffectKind::Stribeck) s += fmt::format(" (vs = {:g} rad/s)", stribeck_velocity);
   if (kind == EffectKind::Coulomb) s += fmt::format(" (tanh width {:g} rad/s)", coulomb_velocity);
-  if (kind == EffectKind::InertiaProducts) return s + fmt::format(", link {}", joint);
+  if (kind == EffectKind::InertiaProducts || kind == EffectKind::Payload) return s + fmt::format(", link {}", joint);
   if (joint == 0) return s;
   return s + fmt::format(", joint {}", joint);
 }
@@ -128,6 +129,16 @@ std::vector<Candidate> candidates(const DesignStack& d, const CandidateOptions& 
       if (!c.full_columns.empty()) out.push_back(c);
     }
   }
+  // A payload changes the last link's inertial parameters, which a refit absorbs: it is a
+  // candidate only when the identified parameters are held.
+  if (wanted(EffectKind::Payload) && d.held() && d.payload_link > 0 && d.payload_map.cols() == 4) {
+    Candidate c;
+    c.kind = EffectKind::Payload;
+    c.joint = d.payload_link;
+    c.parameters = {"PM", "PMX", "PMY", "PMZ"};
+    c.units = {"kg", "kg*m", "kg*m", "kg*m"};
+    out.push_back(c);
+  }
   if (wanted(EffectKind::ActuationDelay)) {
     Candidate c;
     c.kind = EffectKind::ActuationDelay;
@@ -166,6 +177,9 @@ Eigen::MatrixXd effect_columns(const Candidate& c, const DesignStack& d, const F
       break;  // sample-local, above
     case EffectKind::InertiaProducts:
       for (std::size_t i = 0; i < c.full_columns.size(); ++i) X.col(i) = d.full_extra.col(c.full_columns[i]);
+      break;
+    case EffectKind::Payload:
+      X = d.W * d.payload_map;
       break;
     case EffectKind::TorqueConstant:
       for (int s = 0; s < S; ++s) X(row(s, j), 0) = -fit.tau_model(row(s, j));
@@ -232,6 +246,7 @@ bool physical(const Candidate& c, const Eigen::VectorXd& theta) {
     case EffectKind::Coulomb:
     case EffectKind::Stribeck:
     case EffectKind::Backlash:
+    case EffectKind::Payload:
       return theta(0) > 0;
     default:
       return true;
@@ -286,6 +301,20 @@ Magnitude magnitude(const Candidate& c, const Eigen::VectorXd& theta, const Eige
       m.names = {c.parameters[0]};
       m.text = pm(theta(0), sd(0), "deg", kDeg, 3);
       break;
+    case EffectKind::Payload: {
+      // The mass, then its centre in the link's frame (first moments over the mass).
+      const double mass = theta(0);
+      m.values = {mass};
+      m.names = {"mass"};
+      m.text = pm(mass, sd(0), "kg", 1, 4);
+      if (std::abs(mass) > 0) {
+        const Eigen::Vector3d p = theta.segment<3>(1) / mass;
+        m.values.insert(m.values.end(), {p(0), p(1), p(2)});
+        m.names.insert(m.names.end(), {"x", "y", "z"});
+        m.text += fmt::format(" at ({:.1f}, {:.1f}, {:.1f}) mm", 1e3 * p(0), 1e3 * p(1), 1e3 * p(2));
+      }
+      break;
+    }
   }
   return m;
 }

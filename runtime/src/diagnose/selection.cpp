@@ -32,17 +32,22 @@ Eigen::VectorXd joint_rms(const DesignStack& d, const Eigen::VectorXd& r) {
   return (m.colwise().squaredNorm() / std::max(1, d.samples())).cwiseSqrt().transpose();
 }
 
-// The current model's design on a stack: W, then each effect's columns (evaluated at `state`).
+// The identified parameters the fit estimates: all of them, or none when they are held.
+Eigen::Index free_parameters(const DesignStack& d) { return d.held() ? 0 : d.W.cols(); }
+
+// The current model's design on a stack: W (unless its parameters are held), then each
+// effect's columns (evaluated at `state`).
 Eigen::MatrixXd design(const DesignStack& d, const std::vector<Candidate>& effects, const FitState& state) {
-  Eigen::Index cols = d.W.cols();
+  const Eigen::Index np = free_parameters(d);
+  Eigen::Index cols = np;
   std::vector<Eigen::MatrixXd> blocks;
   for (const auto& e : effects) {
     blocks.push_back(effect_columns(e, d, state));
     cols += blocks.back().cols();
   }
   Eigen::MatrixXd A(d.rows(), cols);
-  A.leftCols(d.W.cols()) = d.W;
-  Eigen::Index c = d.W.cols();
+  A.leftCols(np) = d.W.leftCols(np);
+  Eigen::Index c = np;
   for (const auto& b : blocks) {
     A.middleCols(c, b.cols()) = b;
     c += b.cols();
@@ -68,6 +73,7 @@ Eigen::VectorXd unit_columns(Eigen::MatrixXd& As) {
 }
 
 Solve weighted_ls(const Eigen::MatrixXd& A, const Eigen::VectorXd& y, const Eigen::VectorXd& rw, double tau_int) {
+  if (A.cols() == 0) return {};  // nothing to fit (held parameters, no effect)
   Eigen::MatrixXd As = rw.asDiagonal() * A;
   const Eigen::VectorXd scale = unit_columns(As);
   const Eigen::VectorXd ys = rw.cwiseProduct(y);
@@ -87,14 +93,14 @@ Solve weighted_ls(const Eigen::MatrixXd& A, const Eigen::VectorXd& y, const Eige
 FitState state_of(const DesignStack& d, const Eigen::MatrixXd& A, const Eigen::VectorXd& beta, Eigen::Index np) {
   FitState f;
   f.tau_model = A * beta + d.tau0;
-  f.phi = beta.head(np);
+  f.phi = d.held() ? d.held_phi : Eigen::VectorXd(beta.head(np));
   return f;
 }
 
 FitState base_state(const DesignStack& d, const Eigen::VectorXd& phi) {
   FitState f;
-  f.tau_model = d.W * phi + d.tau0;
-  f.phi = phi;
+  f.tau_model = d.held() ? d.tau0 : Eigen::VectorXd(d.W * phi + d.tau0);
+  f.phi = d.held() ? d.held_phi : phi;
   return f;
 }
 
@@ -185,14 +191,15 @@ Eigen::VectorXd autocorrelation_time(const DesignStack& d, const Eigen::MatrixXd
 
 Fit fit_with_effects(const DesignStack& train, const DesignStack& heldout, const std::vector<Candidate>& effects,
                      const Eigen::VectorXd& weights, std::vector<Eigen::VectorXd>* theta_sd) {
-  const Eigen::Index np = train.W.cols();
+  if (heldout.held() != train.held()) throw std::invalid_argument("fit_with_effects: parameters held in one stack only");
+  const Eigen::Index np = free_parameters(train);
   const Eigen::VectorXd rw = row_weights(train, weights);
   const Eigen::VectorXd y = train.target();
   // Start from the base fit; linearized effects are re-evaluated about the latest fit.
-  Solve base = weighted_ls(train.W, y, rw, 1.0);
+  Eigen::MatrixXd A = train.W.leftCols(np);
+  Solve base = weighted_ls(A, y, rw, 1.0);
   FitState st = base_state(train, base.beta), sh = base_state(heldout, base.beta);
   Solve s = base;
-  Eigen::MatrixXd A = train.W;
   const int iterations = linearized(effects) ? 3 : 1;
   for (int it = 0; it < iterations; ++it) {
     A = design(train, effects, st);
@@ -202,12 +209,12 @@ Fit fit_with_effects(const DesignStack& train, const DesignStack& heldout, const
     sh = state_of(heldout, Ah, s.beta, np);
   }
   // Standard deviations with the residual's autocorrelation time.
-  const Eigen::VectorXd r = y - A * s.beta;
+  const Eigen::VectorXd r = A.cols() ? Eigen::VectorXd(y - A * s.beta) : y;
   const Eigen::MatrixXd rs = per_sample(train, rw.cwiseProduct(r));
   const double tau_int = pooled(autocorrelation_time(train, rs, 400));
   const Solve sd = weighted_ls(A, y, rw, tau_int);
   Fit f;
-  f.phi = s.beta.head(np);
+  f.phi = train.held() ? train.held_phi : Eigen::VectorXd(s.beta.head(np));
   Eigen::Index c = np;
   for (const auto& e : effects) {
     const Eigen::Index m = static_cast<Eigen::Index>(e.parameters.size());
@@ -230,7 +237,7 @@ Fit fit_with_effects(const DesignStack& train, const DesignStack& heldout, const
 Selection select_effects(const DesignStack& train, const DesignStack& heldout, const SelectionOptions& o) {
   Selection sel;
   const int n = train.joints;
-  const Eigen::Index np = train.W.cols();
+  const Eigen::Index np = free_parameters(train);
   // Weights from the base model's unweighted residual: 1 / std per joint.
   {
     const Fit plain = fit_with_effects(train, heldout, {}, Eigen::VectorXd::Ones(n));
@@ -256,13 +263,14 @@ Selection select_effects(const DesignStack& train, const DesignStack& heldout, c
     Eigen::MatrixXd As = rw.asDiagonal() * A;
     const Eigen::VectorXd scale = unit_columns(As);
     const Eigen::VectorXd ys = rw.cwiseProduct(y);
-    const Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(As);
-    const Eigen::VectorXd beta_s = qr.solve(ys);
-    const Eigen::VectorXd r = ys - As * beta_s;
+    // With held parameters and no effect yet the design is empty: the residual is y itself.
+    const bool empty = As.cols() == 0;
+    const Eigen::VectorXd beta_s = empty ? Eigen::VectorXd() : Eigen::VectorXd(Eigen::ColPivHouseholderQR<Eigen::MatrixXd>(As).solve(ys));
+    const Eigen::VectorXd r = empty ? ys : Eigen::VectorXd(ys - As * beta_s);
     const Eigen::VectorXd beta = beta_s.cwiseQuotient(scale);
-    const Eigen::VectorXd rh = rwh.cwiseProduct(yh - Ah * beta);
+    const Eigen::VectorXd rh = rwh.cwiseProduct(empty ? yh : Eigen::VectorXd(yh - Ah * beta));
     const Eigen::MatrixXd G = As.transpose() * As;
-    const Eigen::LDLT<Eigen::MatrixXd> Gf(G);
+    const Eigen::LDLT<Eigen::MatrixXd> Gf(empty ? Eigen::MatrixXd::Identity(1, 1) : G);
     const double rss0 = r.squaredNorm();
     const Eigen::Index N = A.rows(), p = A.cols();
 
@@ -300,7 +308,7 @@ Selection select_effects(const DesignStack& train, const DesignStack& heldout, c
       }
       for (Eigen::Index i = 0; i < m; ++i) C.col(i) /= cs(i);
       const Eigen::MatrixXd AC = As.transpose() * C;
-      const Eigen::MatrixXd K = Gf.solve(AC);
+      const Eigen::MatrixXd K = empty ? Eigen::MatrixXd(0, m) : Eigen::MatrixXd(Gf.solve(AC));
       const Eigen::MatrixXd ZZ = C.transpose() * C - AC.transpose() * K;
       const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(ZZ);
       if (!(eig.eigenvalues().minCoeff() > 1e-8)) {
@@ -328,10 +336,10 @@ Selection select_effects(const DesignStack& train, const DesignStack& heldout, c
       }
       t.significant = t.p_value < step.level;
       // Held out: the refit with the candidate, on the joints it acts on.
-      const Eigen::VectorXd dbeta = (-K * theta_s).cwiseQuotient(scale);
+      const Eigen::VectorXd dbeta = empty ? Eigen::VectorXd() : Eigen::VectorXd((-K * theta_s).cwiseQuotient(scale));
       const Eigen::VectorXd theta = theta_s.cwiseQuotient(cs);
       const Eigen::MatrixXd Ch = effect_columns(*c, heldout, csh);
-      const Eigen::VectorXd rh1 = rh - rwh.cwiseProduct(Ah * dbeta + Ch * theta);
+      const Eigen::VectorXd rh1 = rh - rwh.cwiseProduct(empty ? Eigen::VectorXd(Ch * theta) : Eigen::VectorXd(Ah * dbeta + Ch * theta));
       double sse0 = 0, sse1 = 0, total0 = 0, total1 = 0;
       std::vector<bool> acts_on(n, false);
       for (int j = 0; j < n; ++j) {

@@ -88,6 +88,13 @@ inline twin::TwinConfig with_selected_effects(twin::TwinConfig c, const Selectio
         c.effects.actuation_delay = true;
         c.effects.actuation_delay_time = v;
         break;
+      case EffectKind::Payload:
+        if (e.magnitude.values.size() == 4) {
+          c.effects.payload = true;
+          c.effects.payload_mass = v;
+          c.effects.payload_com = Eigen::Vector3d(e.magnitude.values[1], e.magnitude.values[2], e.magnitude.values[3]);
+        }
+        break;
       default: break;
     }
   }

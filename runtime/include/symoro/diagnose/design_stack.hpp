@@ -40,6 +40,19 @@ struct DesignStack {
   // Candidate effects' columns computed before the low-pass (effects.hpp: key -> samples x
   // parameters, the values on the candidate's joint).
   std::map<std::string, Eigen::MatrixXd> effect_terms;
+  // A payload on the last link with a mass parameter (`payload_link`): the base parameters
+  // that a unit of that link's standard M, MX, MY, MZ adds (np x 4, the identified model's
+  // base_from_standard), so that the payload's torque is W payload_map (m, m px, m py, m pz).
+  // Empty when the model has no such link.
+  Eigen::MatrixXd payload_map;
+  int payload_link = 0;
+  // Held parameters (`dynid diagnose --params`: the gap of an earlier identification): when
+  // set (size np), W held_phi is part of tau0 and the selection fits the effects alone, so
+  // what changed since (a payload) is not absorbed by a refit.
+  Eigen::VectorXd held_phi;
+  bool held() const { return held_phi.size() > 0; }
+  // Holds the identified parameters at phi (tau0 += W phi).
+  void hold(const Eigen::VectorXd& phi);
 
   int samples() const { return static_cast<int>(q.rows()); }
   Eigen::Index rows() const { return static_cast<Eigen::Index>(samples()) * joints; }

@@ -22,6 +22,7 @@ struct DiagnosisOptions {
 
 struct Diagnosis {
   std::string robot, model;                 // e.g. "crane_x7", "crane_x7::reduced"
+  std::string held_parameters;              // the parameters file when they were held (--params)
   std::vector<std::string> train, heldout;  // trajectory names
   double interval = 0, cutoff = 0;          // s, Hz
   SelectionOptions options;                 // what the selection was run with

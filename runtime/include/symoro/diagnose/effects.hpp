@@ -12,6 +12,11 @@
 //   viscous_asymmetry  FVA<j> (N m s/rad)               FVA |qd|   (FV + FVA forward, FV - FVA back)
 //   position_harmonics HS<j>_k, HC<j>_k (N m)           HS sin(k q) + HC cos(k q), k = 1, 2
 //   inertia_products   the full model's XY/XZ/YZ of link j (kg m^2), columns from its regressor
+//   payload            PM (kg), PMX, PMY, PMZ (kg m)   a mass m at p on the last massive link: W times
+//                      of that link (standard M, MX, MY,   the base parameters it adds (its rotational
+//                      MZ: m, m p)                          inertia m |p|^2 is second order and left out).
+//                                                       Only against held parameters (--params): a
+//                                                       refit absorbs it into the link's base parameters
 //   torque_constant    KTE<j> (1)                       tau_meas = tau / (1 + KTE): column -tau_model
 //   actuation_delay    DELAY (s), all joints            tau_meas(t) = tau(t + DELAY): column d tau_model/dt
 //   backlash           BL<j> (rad, total play)          the rotor leads the link by BL/2 sign(mesh
@@ -42,6 +47,7 @@ enum class EffectKind {
   TorqueConstant,
   ActuationDelay,
   Backlash,
+  Payload,
 };
 
 struct EffectInfo {
@@ -60,7 +66,7 @@ EffectKind effect_kind(const std::string& name);
 
 struct Candidate {
   EffectKind kind = EffectKind::Offset;
-  int joint = 0;                    // 1-based joint or link; 0 for the whole robot
+  int joint = 0;                    // 1-based joint or link (payload: its link); 0 for the whole robot
   double stribeck_velocity = 0.05;  // rad/s
   double coulomb_velocity = 0.01;   // rad/s, tanh width
   std::vector<int> orders;          // position_harmonics

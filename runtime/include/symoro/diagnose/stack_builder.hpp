@@ -7,6 +7,7 @@
 // leaves a residual on the loaded joints that looks like a missing effect.
 #pragma once
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 #include <string>
@@ -75,6 +76,21 @@ DesignStack stack_design(const std::vector<NamedSamples>& runs, const StackOptio
     const std::string fam = par.family;
     if (par.joint >= 1 && par.joint <= n && fam == "IA") d.rotor_inertia_index(par.joint - 1) = i;
     if (par.joint >= 1 && par.joint <= n && fam == "FV") d.viscous_index(par.joint - 1) = i;
+  }
+  // The payload's base parameters per unit of the last massive link's M, MX, MY, MZ.
+  for (const auto& par : Identified::standard_parameters)
+    if (std::string(par.family) == "M") d.payload_link = std::max(d.payload_link, par.joint);
+  if (d.payload_link > 0) {
+    const std::string families[] = {"M", "MX", "MY", "MZ"};
+    d.payload_map = Eigen::MatrixXd::Zero(p, 4);
+    for (int c = 0; c < 4; ++c)
+      for (int k = 0; k < Identified::ns; ++k) {
+        const auto& par = Identified::standard_parameters[k];
+        if (par.joint != d.payload_link || families[c] != par.family) continue;
+        Eigen::Matrix<double, Identified::ns, 1> unit = Eigen::Matrix<double, Identified::ns, 1>::Zero();
+        unit(k) = 1;
+        d.payload_map.col(c) = Identified::base_from_standard(unit);
+      }
   }
   std::vector<int> extra;
   for (int i = 0; i < pf; ++i) {

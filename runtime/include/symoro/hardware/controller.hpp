@@ -139,8 +139,4 @@ auto model_feedforward(const Eigen::VectorXd& phi) {
   };
 }
 
-// The `parameters:` list of a study's report/parameters.yaml as the identified model's phi
-// (names in `names` order, every one required). Throws DataError with file and line.
-Eigen::VectorXd read_identified_parameters(const std::string& path, const std::vector<std::string>& names);
-
 }  // namespace symoro::hardware

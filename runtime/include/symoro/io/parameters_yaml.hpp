@@ -1,0 +1,17 @@
+// An identification's accepted parameters read back from a study's report/parameters.yaml
+// (identify/report.hpp writes it): the controller's model feed-forward and the diagnosis of an
+// earlier identification's gap (dynid control --params, dynid diagnose --params) use it.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+namespace symoro::io {
+
+// The `parameters:` list as the identified model's phi, in `names` order; every name must be
+// there and no other. Throws DataError with the file and line.
+Eigen::VectorXd read_parameters_yaml(const std::string& path, const std::vector<std::string>& names);
+
+}  // namespace symoro::io
