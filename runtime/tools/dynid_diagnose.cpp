@@ -154,7 +154,12 @@ void add_diagnose_commands(CLI::App& app, Common& common) {
   cmd->add_option("--variant", o->variant, "Name of the variant to write (default: <identified>_diagnosed)");
   cmd->add_flag("--apply", [o](std::int64_t) { o->apply = "yes"; }, "Add the variant to the robot's robot.yaml");
   cmd->callback([&common, o] {
-    for (const auto& e : o->only) diagnose::effect_kind(e);  // unknown names: a clear error first
+    for (const auto& e : o->only) {
+      diagnose::effect_kind(e);  // unknown names: a clear error first
+      if (e == "payload" && o->params.empty())
+        throw UsageError("--only payload needs --params: a refit absorbs a payload into the last link's parameters, "
+                         "so it is judged against an earlier identification held fixed");
+    }
     with_model(common, o->model, [&](auto entry) {
       using E = decltype(entry);
       run<typename E::FullModel, typename E::IdentifiedModel>(common, *o);

@@ -73,6 +73,8 @@ expect("${out}" "params.yaml:4: error: parameter 'XX9' is not one of the identif
 file(WRITE ${WORK}/params.yaml "robot: crane_x7\nparameters:\n  - {name: ZZR1, value: 0.01}\n")
 run(1 out diagnose --robot crane_x7 --data ${ds} -o ${WORK}/diag_held --train V01 --heldout V02 --params ${WORK}/params.yaml)
 expect("${out}" "params.yaml:3: error: parameter '.*' is missing \\(39 expected\\)")
+run(2 out diagnose --robot crane_x7 --data ${ds} -o ${WORK}/diag_held --only payload)
+expect("${out}" "--only payload needs --params")
 if(EXISTS ${WORK}/diag_held)
   message(FATAL_ERROR "a refused --params wrote a report")
 endif()
