@@ -145,16 +145,22 @@ class HardwareControl : public ::testing::Test {
     return o;
   }
 
-  // Runs `traj` on a fresh rig; `inject(rig)` runs on another thread `after` s into the run.
+  // Runs `traj` on a fresh rig; `inject(rig)` runs on another thread once the controller's
+  // trajectory time reaches `after` s (its own timeline: the approach and pre-roll before t = 0
+  // take a machine-dependent wall time, so a wall-clock trigger could land before the start).
   ControlResult run(Rig& rig, const trajectory::Trajectory& traj, const std::string& csv, ControlOptions o,
                     double after = -1, std::function<void(Rig&)> inject = {}) {
+    std::atomic<double> timeline{-1e9};
+    std::atomic<bool> finished{false};
+    o.timeline = &timeline;
     std::thread injector;
     if (inject)
-      injector = std::thread([&rig, after, inject] {
-        std::this_thread::sleep_for(std::chrono::duration<double>(after));
-        inject(rig);
+      injector = std::thread([&rig, &timeline, &finished, after, inject] {
+        while (!finished.load() && timeline.load() < after) std::this_thread::sleep_for(std::chrono::microseconds(200));
+        if (!finished.load()) inject(rig);
       });
     ControlResult r = run_control(rig.bus, hw_, joints(), gains_, traj, csv, o);
+    finished = true;
     if (injector.joinable()) injector.join();
     return r;
   }
@@ -291,7 +297,7 @@ TEST_F(HardwareControl, LongCrcBurstTripsTheWatchdog) {
   ControlOptions o = options();
   o.seconds = 2.0;
   const std::string csv = (dir_ / "crc_long.csv").string();
-  const ControlResult r = run(rig, traj, csv, o, 1.0, [](Rig& g) { g.virt.corrupt_replies(1'000'000); });
+  const ControlResult r = run(rig, traj, csv, o, 0.5, [](Rig& g) { g.virt.corrupt_replies(1'000'000); });
   EXPECT_EQ(r.reason, StopReason::watchdog) << r.message;
   EXPECT_GE(r.timing.max_stale, kWatchdog);
   EXPECT_GT(r.trajectory_time, 0.2);
@@ -306,7 +312,7 @@ TEST_F(HardwareControl, TimeoutsTripTheWatchdog) {
   ControlOptions o = options();
   o.seconds = 2.0;
   const std::string csv = (dir_ / "timeouts.csv").string();
-  const ControlResult r = run(rig, traj, csv, o, 1.0, [](Rig& g) { g.virt.drop_replies(1'000'000); });
+  const ControlResult r = run(rig, traj, csv, o, 0.5, [](Rig& g) { g.virt.drop_replies(1'000'000); });
   EXPECT_EQ(r.reason, StopReason::watchdog) << r.message;
   EXPECT_GT(r.timing.bus.timeouts, 0u);
   rig.expect_safe();
@@ -319,7 +325,7 @@ TEST_F(HardwareControl, LostServoStopsAndIsNamed) {
   ControlOptions o = options();
   o.seconds = 2.0;
   const std::string csv = (dir_ / "lost.csv").string();
-  const ControlResult r = run(rig, traj, csv, o, 1.0, [](Rig& g) { g.virt.set_dead(5, true); });
+  const ControlResult r = run(rig, traj, csv, o, 0.5, [](Rig& g) { g.virt.set_dead(5, true); });
   EXPECT_EQ(r.reason, StopReason::servo_lost) << r.message;
   EXPECT_NE(r.message.find("servo ID 5 (joint 4 elbow)"), std::string::npos) << r.message;
   EXPECT_FALSE(r.torque_off_confirmed);  // the dead servo cannot confirm
@@ -337,7 +343,7 @@ TEST_F(HardwareControl, HardwareErrorStopsWithItsStatus) {
   ControlOptions o = options();
   o.seconds = 2.0;
   const std::string csv = (dir_ / "alert.csv").string();
-  const ControlResult r = run(rig, traj, csv, o, 1.0, [](Rig& g) { g.virt.set_hardware_error(7, xs::hardware_error::kOverload); });
+  const ControlResult r = run(rig, traj, csv, o, 0.5, [](Rig& g) { g.virt.set_hardware_error(7, xs::hardware_error::kOverload); });
   EXPECT_EQ(r.reason, StopReason::hardware_error) << r.message;
   EXPECT_NE(r.message.find("servo ID 7"), std::string::npos) << r.message;
   EXPECT_NE(r.message.find("overload"), std::string::npos) << r.message;
@@ -352,7 +358,7 @@ TEST_F(HardwareControl, SigintStopsSafely) {
   o.seconds = 3.0;
   const std::string csv = (dir_ / "sigint.csv").string();
   StopSignals signals;
-  const ControlResult r = run(rig, traj, csv, o, 1.0, [](Rig&) { std::raise(SIGINT); });
+  const ControlResult r = run(rig, traj, csv, o, 0.5, [](Rig&) { std::raise(SIGINT); });
   EXPECT_EQ(r.reason, StopReason::signal) << r.message;
   EXPECT_TRUE(r.torque_off_confirmed);
   EXPECT_GT(r.trajectory_time, 0.2);

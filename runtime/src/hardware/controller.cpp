@@ -442,6 +442,7 @@ class Loop {
       const bool fresh = read_state(std::max(deadline + T * 8 / 10, wake + T / 2));
       if (fresh) check_limits();
       const double t = reference(k * T_);
+      if (o_.timeline) o_.timeline->store(t, std::memory_order_relaxed);
       const Eigen::VectorXd& u = ctrl.update(q_, qr_, qdr_, qddr_);
       tau_ = u;
       if (o_.feedforward) {

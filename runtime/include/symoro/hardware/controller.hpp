@@ -89,6 +89,10 @@ struct ControlOptions {
   std::string robot, source = "robot", notes;
   int trial = 1;
   std::chrono::milliseconds log_flush{100};
+  // When set, the loop stores its trajectory time (s; negative during the approach and the
+  // pre-roll) here every cycle, so another thread can act on the controller's own timeline
+  // (tests inject faults this way, never at a wall-clock time).
+  std::atomic<double>* timeline = nullptr;
 };
 
 struct ControlResult {
