@@ -6,11 +6,13 @@
 
 #include <algorithm>
 #include <memory>
+#include <optional>
 #include <string>
 
 #include <fmt/format.h>
 
 #include "dynid_common.hpp"
+#include "symoro/control/description.hpp"
 #include "symoro/dynamixel/bus.hpp"
 #include "symoro/dynamixel/serial_port.hpp"
 #include "symoro/dynamixel/virtual_bus.hpp"
@@ -48,14 +50,25 @@ void control(const Common& common, const ControlCliOptions& o) {
   if (!std::filesystem::exists(hw_path))
     throw UsageError(fmt::format("robot '{}' has no hardware description ({} not found)", common.robot, hw_path.string()));
   const hardware::HardwareConfig hw = hardware::read_hardware_config(hw_path, joints);
-  const auto twin_path = common.robot_dir() / "twin.yaml";
-  if (!std::filesystem::exists(twin_path))
-    throw UsageError(fmt::format("robot '{}' has no twin.yaml ({} not found): it holds the FF+PD realization gains", common.robot,
-                                 twin_path.string()));
-  twin::TwinConfig tc = twin::read_twin_config(twin_path, Full::nq, o.twin_config);
-  if (o.ideal) tc.effects.disable_all();
-  control::FfpdGains gains = twin::controller_gains(tc);
+  // The gains are the lab's controller description's, on the real arm and the virtual one alike;
+  // twin.yaml (and --config, --ideal) shape only the emulated arm behind --virtual.
+  const auto controller_path = common.robot_dir() / control::controller_file_name();
+  if (!std::filesystem::exists(controller_path))
+    throw UsageError(fmt::format("robot '{}' has no controller description ({} not found): it holds the FF+PD gains",
+                                 common.robot, controller_path.string()));
+  control::FfpdGains gains = control::read_controller_description(controller_path, Full::nq).gains();
   gains.period = hw.period;
+  if (!o.virtual_bus && (!o.twin_config.empty() || o.ideal))
+    throw UsageError("--config and --ideal change the emulated arm of --virtual only; the real arm's gains come from " +
+                     controller_path.string());
+  std::optional<twin::TwinConfig> tc;
+  if (o.virtual_bus) {
+    const auto twin_path = common.robot_dir() / "twin.yaml";
+    if (!std::filesystem::exists(twin_path))
+      throw UsageError(fmt::format("--virtual needs the robot's digital twin ({} not found)", twin_path.string()));
+    tc = twin::read_twin_config(twin_path, Full::nq, o.twin_config);
+    if (o.ideal) tc->effects.disable_all();
+  }
   const trajectory::Trajectory traj =
       trajectory::TrajectoryDesign::read(common.robot_dir() / "trajectories.yaml", joints).build(o.trajectory);
 
@@ -67,7 +80,7 @@ void control(const Common& common, const ControlCliOptions& o) {
   // The emulated servos are a thread that may wait for a core on a loaded machine.
   co.watchdog_cycles = o.watchdog > 0 ? o.watchdog : (o.virtual_bus ? std::max(20, hw.safety.watchdog_cycles) : 0);
   co.source = o.virtual_bus ? "twin" : "robot";
-  co.notes = o.virtual_bus ? "dynid control --virtual: virtual DYNAMIXEL bus driving the " + twin::ClosedLoopTwin<Full>(tc).notes()
+  co.notes = o.virtual_bus ? "dynid control --virtual: virtual DYNAMIXEL bus driving the " + twin::ClosedLoopTwin<Full>(*tc).notes()
                            : "dynid control on " + o.port;
   if (!o.params.empty()) {
     std::vector<std::string> names;
@@ -95,7 +108,7 @@ void control(const Common& common, const ControlCliOptions& o) {
     }
     virt = std::make_unique<dynamixel::VirtualBus>(
         hardware::virtual_servos(hw),
-        std::make_unique<hardware::TwinServoBackend<Full>>(tc, hw, Eigen::Matrix<double, Full::nq, 1>(q)));
+        std::make_unique<hardware::TwinServoBackend<Full>>(*tc, hw, Eigen::Matrix<double, Full::nq, 1>(q)));
     if (raised) pthread_setschedparam(pthread_self(), policy, &saved);
     device = virt->device();
   }

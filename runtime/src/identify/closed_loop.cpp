@@ -10,12 +10,16 @@
 
 namespace symoro::identify {
 
-ClosedLoopSetup closed_loop_setup(const twin::TwinConfig& config, double pre_roll) {
+ClosedLoopSetup closed_loop_setup(const control::ControllerDescription& controller, double pre_roll) {
   ClosedLoopSetup s;
-  s.gains = twin::controller_gains(config);
-  s.delay = config.controller.communication_delay;
+  s.gains = controller.gains();
+  s.delay = controller.communication_delay;
   s.pre_roll = pre_roll;
   return s;
+}
+
+ClosedLoopSetup closed_loop_setup(const twin::TwinConfig& config, double pre_roll) {
+  return closed_loop_setup(config.controller, pre_roll);
 }
 
 std::string Divergence::describe() const {

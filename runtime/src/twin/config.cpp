@@ -8,6 +8,7 @@
 #include <stdexcept>
 
 #include <Eigen/Eigenvalues>
+#include <fmt/format.h>
 #include <yaml-cpp/yaml.h>
 
 #include "symoro/error.hpp"
@@ -289,7 +290,7 @@ class Reader {
       c.servos.clear();
       for (const auto& s : list) c.servos.push_back(servo(s));
     });
-    field(root, "controller", "the twin configuration", [&](const YAML::Node& v) { controller(v, c.controller); });
+    if (root["controller"].IsDefined()) controller(root["controller"], c.controller);  // else controller.yaml
     field(root, "integration", "the twin configuration", [&](const YAML::Node& v) {
       check_keys(v, "integration", {"max_step"});
       field(v, "max_step", "integration", [&](const YAML::Node& s) { c.max_step = positive(s, "max_step"); });
@@ -364,9 +365,21 @@ std::string fingerprint(const std::vector<std::filesystem::path>& files) {
 TwinConfig read_twin_config(const std::filesystem::path& path, int joints, const std::filesystem::path& override_path) {
   TwinConfig c;
   c.path = path.string();
-  c.fingerprint = override_path.empty() ? fingerprint({path}) : fingerprint({path, override_path});
-  Reader(path.string(), joints, false).apply(load(path), c);
-  if (!override_path.empty()) Reader(override_path.string(), joints, true).apply(load(override_path), c);
+  const YAML::Node root = load(path);
+  std::vector<std::filesystem::path> files{path};
+  if (!root["controller"].IsDefined()) {
+    const auto description = path.parent_path() / control::controller_file_name();
+    if (!std::filesystem::exists(description))
+      throw DataError(path.string(), 0, fmt::format("no 'controller' section and no controller description ({})", description.string()));
+    c.controller = control::read_controller_description(description, joints);
+    files.push_back(description);
+  }
+  Reader(path.string(), joints, false).apply(root, c);
+  if (!override_path.empty()) {
+    Reader(override_path.string(), joints, true).apply(load(override_path), c);
+    files.push_back(override_path);
+  }
+  c.fingerprint = fingerprint(files);
   const double T = c.controller.period;
   if (c.controller.communication_delay >= T)
     throw DataError(path.string(), 0, "controller communication_delay must be shorter than the period");

@@ -14,8 +14,10 @@
 
 #include <Eigen/Core>
 
+#include "symoro/control/description.hpp"
 #include "symoro/control/ffpd.hpp"
 #include "symoro/preprocess/channels.hpp"
+#include "symoro/trajectory/sampled_reference.hpp"
 #include "symoro/trajectory/trajectory.hpp"
 #include "symoro/twin/config.hpp"
 
@@ -33,7 +35,9 @@ struct ClosedLoopSetup {
   bool split_at_sampling = false;
 };
 
-// The controller and timing of a twin configuration (its controller section is the lab's).
+// The experiment's controller and timing, from the robot's controller description.
+ClosedLoopSetup closed_loop_setup(const control::ControllerDescription& controller, double pre_roll = 0.5);
+// The same from a twin configuration (whose controller is that description).
 ClosedLoopSetup closed_loop_setup(const twin::TwinConfig& config, double pre_roll = 0.5);
 
 // Why a simulation stopped early.

@@ -114,24 +114,24 @@ class ClosedLoopSimulator {
   using SensQ = Eigen::Matrix<double, n, np>;      // d (an n-vector) / d phi
   using SensX = Eigen::Matrix<double, 2 * n, np>;  // d (q, qd) / d phi, q rows first
 
-  ClosedLoopSimulator(ClosedLoopSetup setup, const trajectory::Trajectory& reference) : setup_(std::move(setup)) {
+  ClosedLoopSimulator(ClosedLoopSetup setup, const trajectory::Trajectory& reference)
+      : ClosedLoopSimulator(setup, trajectory::sample(reference, setup.gains.period)) {}
+
+  // References per cycle (a designed trajectory's, or a log's reference columns).
+  ClosedLoopSimulator(ClosedLoopSetup setup, const trajectory::SampledReference& reference) : setup_(std::move(setup)) {
     detail::check_setup(setup_, n);
-    if (reference.joints() != n)
-      throw std::invalid_argument("closed-loop simulation: the trajectory " + reference.name + " has " +
-                                  std::to_string(reference.joints()) + " joints, the model " + std::to_string(n));
-    const double T = period();
-    cycles_ = static_cast<int>(std::llround(reference.duration() / T)) + 1;
-    pre_cycles_ = static_cast<int>(std::llround(setup_.pre_roll / T));
-    q_ref_.resize(n, cycles_);
-    qd_ref_.resize(n, cycles_);
-    qdd_ref_.resize(n, cycles_);
-    Eigen::VectorXd q(n), qd(n), qdd(n);
-    for (int k = 0; k < cycles_; ++k) {
-      reference.evaluate(k * T, q, qd, qdd);
-      q_ref_.col(k) = q;
-      qd_ref_.col(k) = qd;
-      qdd_ref_.col(k) = qdd;
-    }
+    if (reference.q.rows() != n)
+      throw std::invalid_argument("closed-loop simulation: the reference " + reference.name + " has " +
+                                  std::to_string(reference.q.rows()) + " joints, the model " + std::to_string(n));
+    if (!(std::abs(reference.period - period()) <= 1e-9 * period()))
+      throw std::invalid_argument("closed-loop simulation: the reference " + reference.name + " is sampled every " +
+                                  std::to_string(reference.period) + " s, the controller runs every " +
+                                  std::to_string(period()) + " s");
+    cycles_ = static_cast<int>(reference.q.cols());
+    pre_cycles_ = static_cast<int>(std::llround(setup_.pre_roll / period()));
+    q_ref_ = reference.q;
+    qd_ref_ = reference.qd;
+    qdd_ref_ = reference.qdd;
   }
 
   int cycles() const { return cycles_; }

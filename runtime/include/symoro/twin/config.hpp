@@ -11,6 +11,8 @@
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 
+#include "symoro/control/description.hpp"
+
 namespace symoro::twin {
 
 struct UrdfJoint {
@@ -45,13 +47,9 @@ struct Servo {
   int encoder_counts = 0;      // per revolution
 };
 
-struct ControllerConfig {
-  double period = 0.001;
-  double pseudo_derivative_time = 0.002;
-  double communication_delay = 0.0009;
-  Eigen::VectorXd realization_inertia, realization_damping;  // M-hat, D-hat
-  Eigen::VectorXd bandwidth, damping_ratio;                  // -> K_P = w^2, K_V = 2 zeta w
-};
+// The controller that realizes the trajectories: robots/<robot>/controller.yaml (the same
+// description identification and the real arm's loop read); an override file may change it.
+using ControllerConfig = control::ControllerDescription;
 
 struct Effects {
   bool coulomb = false;
@@ -103,7 +101,8 @@ struct TwinConfig {
   Effects effects;
 };
 
-// Reads twin.yaml for a robot with `joints` joints. `override_path` (optional, may be empty):
+// Reads twin.yaml for a robot with `joints` joints, and the controller description beside it
+// (controller.yaml) unless twin.yaml has its own `controller` section. `override_path` (optional, may be empty):
 // a second YAML file whose keys replace those of the first (maps merge, other values replace),
 // for experiments that change a few effects. Errors name the file and line.
 TwinConfig read_twin_config(const std::filesystem::path& path, int joints,

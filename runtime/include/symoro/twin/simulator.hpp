@@ -29,6 +29,7 @@
 
 #include "symoro/control/ffpd.hpp"
 #include "symoro/io/log.hpp"
+#include "symoro/trajectory/sampled_reference.hpp"
 #include "symoro/trajectory/trajectory.hpp"
 #include "symoro/twin/config.hpp"
 #include "symoro/twin/plant.hpp"
@@ -77,12 +78,23 @@ class ClosedLoopTwin {
   const Truth<Model>& truth() const { return truth_; }
 
   io::Log run(const trajectory::Trajectory& traj, const RunOptions& opt, RunStats* stats = nullptr) const {
-    const auto wall0 = std::chrono::steady_clock::now();
     if (traj.joints() != n)
       throw DataError(traj.name, 0, "the trajectory has " + std::to_string(traj.joints()) + " joints, the robot " + std::to_string(n));
+    return run(trajectory::sample(traj, c_.controller.period), opt, stats);
+  }
+
+  // The same with the reference of every cycle given (e.g. a log's own references: the motion
+  // that was logged, replayed). Its period must be the controller's.
+  io::Log run(const trajectory::SampledReference& ref, const RunOptions& opt, RunStats* stats = nullptr) const {
+    const auto wall0 = std::chrono::steady_clock::now();
+    if (ref.joints() != n)
+      throw DataError(ref.name, 0, "the reference has " + std::to_string(ref.joints()) + " joints, the robot " + std::to_string(n));
+    if (!(std::abs(ref.period - c_.controller.period) <= 1e-9 * c_.controller.period) || ref.cycles() < 1)
+      throw DataError(ref.name, 0, "the reference is sampled every " + std::to_string(ref.period) + " s, the controller runs every " +
+                                       std::to_string(c_.controller.period) + " s");
     const Effects& e = c_.effects;
     const double T = c_.controller.period, d = c_.controller.communication_delay;
-    const int K = static_cast<int>(std::llround(traj.duration() / T));
+    const int K = ref.cycles() - 1;
     Random rng(opt.seed);
 
     // Servo constants.
@@ -117,7 +129,7 @@ class ClosedLoopTwin {
 
     // References per cycle (the controller steps through them by cycle count).
     Eigen::VectorXd qr(n), qdr(n), qddr(n);
-    traj.evaluate(0.0, qr, qdr, qddr);
+    qr = ref.q.col(0), qdr = ref.qd.col(0), qddr = ref.qdd.col(0);
     Plant<Model> plant(truth_, c_, Vec(qr));
     control::FfpdController ctrl(controller_gains(c_));
     Vec q_meas = encoder(plant.q());
@@ -160,7 +172,7 @@ class ClosedLoopTwin {
 
     io::Log log;
     log.meta.robot = opt.robot;
-    log.meta.trajectory = traj.name;
+    log.meta.trajectory = ref.name;
     log.meta.trial = opt.trial;
     log.meta.seed = opt.seed;
     log.meta.source = "twin";
@@ -186,7 +198,7 @@ class ClosedLoopTwin {
       drive(t_k - t_now);
       t_now = t_k;
 
-      traj.evaluate(k * T, qr, qdr, qddr);
+      qr = ref.q.col(k), qdr = ref.qd.col(k), qddr = ref.qdd.col(k);
       const Vec q_true = plant.q();
       const Vec err = Vec(qr) - q_true;
       st.max_error = st.max_error.cwiseMax(err.cwiseAbs());
