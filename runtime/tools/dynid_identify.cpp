@@ -7,6 +7,7 @@
 #include <fmt/format.h>
 
 #include "dynid_common.hpp"
+#include "symoro/control/description.hpp"
 #include "symoro/identify/report.hpp"
 #include "symoro/identify/study.hpp"
 #include "symoro/identify/validation_io.hpp"
@@ -56,13 +57,18 @@ identify::StudyResult study(const Common& common, const IdentifyOptions& o, bool
       (*progress)->done(r.id(), fmt::format("kappa {:.1f} {} lambda_min(CLIE) {:+.2e} CLIE {:.1f} s", r.kappa, r.route,
                                             r.clie_lambda_min, r.t_clie));
   };
+  // What switches on the closed-loop stages: the robot's controller description (CLIE and
+  // closed-loop validation) and its trajectory design (references for logs without them).
   const auto joints = joint_list<Model>();
-  auto design = trajectory::TrajectoryDesign::read(common.robot_dir() / "trajectories.yaml", joints);
-  const auto twin_path = common.robot_dir() / "twin.yaml";
-  if (!std::filesystem::exists(twin_path))
-    throw UsageError(fmt::format("robot '{}' has no controller description ({} not found)", common.robot, twin_path.string()));
-  const twin::TwinConfig config = twin::read_twin_config(twin_path, Model::nq);
-  identify::Study<Model> s(so, std::move(design), identify::closed_loop_setup(config));
+  identify::ClosedLoopSource loop;
+  const auto controller_path = common.robot_dir() / control::controller_file_name();
+  if (std::filesystem::exists(controller_path))
+    loop.setup = identify::closed_loop_setup(control::read_controller_description(controller_path, Model::nq));
+  else
+    loop.why = fmt::format("no controller description ({} not found)", controller_path.string());
+  const auto design_path = common.robot_dir() / "trajectories.yaml";
+  if (std::filesystem::exists(design_path)) loop.design = trajectory::TrajectoryDesign::read(design_path, joints);
+  identify::Study<Model> s(so, std::move(loop));
   identify::StudyResult result = s.run();
   // On twin data the truth is known: the twin's standard parameters mapped to the identified
   // model's base parameters (products of inertia dropped for a reduced variant), with the hidden
@@ -83,14 +89,17 @@ void run_study(const Common& common, const IdentifyOptions& o) {
   getrusage(RUSAGE_SELF, &usage);
   fmt::print("{} runs, {} threads: {:.1f} s wall ({:.1f} s of run stages summed), peak memory {:.0f} MB\n",
              r.runs.size(), r.threads, r.wall, r.wall_runs, usage.ru_maxrss / 1024.0);
+  for (const auto& line : r.stages) fmt::print("{}\n", line);
+  if (r.selection.run < 0) fmt::print("no representative: {}\n", r.selection.rule.empty() ? "no run produced a final vector" : r.selection.rule);
   if (r.selection.run >= 0) {
     const auto& sel = r.runs[r.selection.run];
     fmt::print("representative: {} ({}); {}; final audit lambda_min {:.3e} -> {}\n", sel.id(), r.selection.rule,
-               r.rescued ? "rescued (eps = 0)" : "PD without rescue", r.final_lambda_min,
-               r.accepted ? "accepted" : "NOT accepted");
+               r.rescued ? (r.rescue_feasible ? "rescued (eps = 0)" : "rescue FAILED: " + r.rescue_status) : "PD without rescue",
+               r.final_lambda_min, r.accepted ? "accepted" : "NOT accepted");
     for (const auto& v : r.validation)
-      fmt::print("validation {} at {:.0f} ms: RMSE {:.4f} / {:.4f} N m, MNE {:.4f} / {:.4f} (CLIE / rescue)\n",
-                 v.trajectory, v.interval * 1e3, v.rmse_clie, v.rmse_rescue, v.mne_clie, v.mne_rescue);
+      fmt::print("validation {} at {:.0f} ms, {}: RMSE {:.4f} / {:.4f} N m, MNE {:.4f} / {:.4f} (final / accepted){}\n",
+                 v.trajectory, v.interval * 1e3, v.kind, v.rmse_clie, v.rmse_rescue, v.mne_clie, v.mne_rescue,
+                 v.note.empty() ? "" : "; " + v.note);
   }
   // The held-out series on disk: dynid compare reads them to set two model variants side by side.
   if (!identify::write_validation(r, o.out).empty())

@@ -483,6 +483,9 @@ TEST(SdpProjection, ConditionalProjectionAdoptsTheSmallestFeasibleMargin) {
   ASSERT_EQ(none.attempts.size(), 2u);
   EXPECT_EQ(none.attempts[0].eps, 0.005);  // ascending
   EXPECT_EQ(none.attempts[1].eps, 0.01);
+  // Nothing that failed is handed on: the vector is phi_0 and no margin is adopted.
+  EXPECT_EQ(none.phi, phi0);
+  EXPECT_EQ(none.eps, 0.0);
   for (const auto& a : none.attempts) {
     EXPECT_FALSE(a.feasible);
     EXPECT_NE(a.status, "ok");

@@ -166,7 +166,7 @@ void validation_is_near_the_twins_floor() {
   const identify::ClosedLoopSimulator<Model> sim(setup(), design().build("V02"));
   const auto log = io::read_log(dataset() / "V02_t1.csv");
   const auto s = preprocess::preprocess(log, v.interval);
-  const auto floor = identify::validate_trajectory<Model>(sim, s, truth, truth, identify::ClieOptions{});
+  const auto floor = identify::validate_trajectory<Model>(&sim, s, truth, truth, identify::ClieOptions{});
   std::printf("V02 at %.0f ms: RMSE accepted %.4f, CLIE %.4f, truth floor %.4f N m; MNE %.4f / floor %.4f\n",
               v.interval * 1e3, v.rmse_rescue, v.rmse_clie, floor.rmse_clie, v.mne_rescue, floor.mne_clie);
   EXPECT_LT(v.rmse_rescue, 1.5 * floor.rmse_clie);

@@ -27,7 +27,12 @@ double median(std::vector<double> v) {
 
 PcaClouds pca_clouds(const std::vector<RunRecord>& runs, int components) {
   if (runs.empty()) throw std::invalid_argument("pca: no runs");
-  const Eigen::Index p = runs.front().phi_ols.size();
+  Eigen::Index p = 0;  // from the first run that did not fail (a failed run has no vectors)
+  for (const RunRecord& r : runs)
+    if (!r.failed && r.phi_ols.size() > 0) {
+      p = r.phi_ols.size();
+      break;
+    }
   std::vector<const Eigen::VectorXd*> pooled;
   for (const RunRecord& r : runs)
     for (const Eigen::VectorXd* v : {&r.phi_ols, &r.phi_sdp, &r.phi_clie})
@@ -84,12 +89,19 @@ Selection select_central(const std::vector<RunRecord>& runs, const PcaClouds& pc
   int k = 0;
   while (k < available && cumulative < variance_fraction) cumulative += pca.explained(k++);
   s.components = std::max(k, 1);
+  // A run's final vector: CLIE's where it ran and succeeded, the SDP (or OLS) estimate where
+  // CLIE did not run; never a failed run's.
   std::vector<int> candidates;
-  for (int i = 0; i < static_cast<int>(runs.size()); ++i)
-    if (runs[i].clie_success && pca.clie.row(i).allFinite()) candidates.push_back(i);
+  bool any_clie = false;
+  for (int i = 0; i < static_cast<int>(runs.size()); ++i) {
+    const RunRecord& r = runs[i];
+    if (r.failed || !(r.clie_ran ? r.clie_success : true) || !pca.clie.row(i).allFinite()) continue;
+    candidates.push_back(i);
+    any_clie = any_clie || r.clie_ran;
+  }
   s.centrality.assign(runs.size(), std::numeric_limits<double>::infinity());
   if (candidates.empty()) {
-    s.rule = "no run's CLIE succeeded: nothing to select";
+    s.rule = "no run produced a final vector (CLIE failed or every run failed): nothing to select";
     return s;
   }
   Eigen::VectorXd centre(s.components), spread(s.components);
@@ -112,9 +124,10 @@ Selection select_central(const std::vector<RunRecord>& runs, const PcaClouds& pc
     }
   }
   s.rule = fmt::format(
-      "most central of {} CLIE vectors: smallest distance to the cloud's median over the first {} principal "
+      "most central of {} {}: smallest distance to the cloud's median over the first {} principal "
       "scores ({:.0f} % of the pooled variance), each scaled by its robust spread (1.4826 MAD)",
-      candidates.size(), s.components, 100 * cumulative);
+      candidates.size(), any_clie ? "CLIE vectors" : "final vectors (SDP, or OLS where PD; CLIE not run)", s.components,
+      100 * cumulative);
   return s;
 }
 

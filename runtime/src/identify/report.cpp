@@ -198,15 +198,21 @@ std::string summary(const StudyResult& study) {
   if (sel) {
     out += fmt::format("- **Accepted model**: {}, {}; final all-pose audit λ_min = {} at the worst pose {} deg: {}.\n",
                        sel->id(),
-                       study.rescued ? fmt::format("PD-rescued (ε = {})", sig(study.rescue_eps, 3))
-                                     : std::string("the CLIE candidate as is (no rescue needed)"),
+                       study.rescued ? (study.rescue_feasible ? fmt::format("PD-rescued (ε = {})", sig(study.rescue_eps, 3))
+                                                              : "the rescue's projection FAILED (" + study.rescue_status + ")")
+                                     : std::string("the run's final vector as is (no rescue needed)"),
                        sig(study.final_lambda_min, 4), degrees(study.final_worst_pose),
                        study.accepted ? "**accepted**" : "**not accepted** (the final audit failed)");
     out += fmt::format("- **Selection**: {}{}.\n", study.selection.rule.empty() ? "by centrality" : study.selection.rule,
                        study.selection.components > 0 ? fmt::format(" ({} PCA components)", study.selection.components)
                                                       : std::string());
   } else {
-    out += "- **Accepted model**: none; no representative was selected.\n";
+    out += fmt::format("- **Accepted model**: none; no representative was selected ({}).\n",
+                       study.selection.rule.empty() ? "no run produced a final vector" : study.selection.rule);
+  }
+  if (!study.stages.empty()) {
+    out += "- **Stages**:\n";
+    for (const auto& line : study.stages) out += "  - " + line + "\n";
   }
   if (!study.validation.empty()) {
     double sums[4] = {0, 0, 0, 0};
@@ -216,8 +222,13 @@ std::string summary(const StudyResult& study) {
       names += (names.empty() ? "" : ", ") + v.trajectory;
     }
     const double n = static_cast<double>(study.validation.size());
-    out += fmt::format("- **Validation** (mean over {}): RMSE {} N m (CLIE) / {} N m (rescue); MNE {} / {}.\n", names,
-                       sig(sums[0] / n, 5), sig(sums[1] / n, 5), sig(sums[2] / n, 5), sig(sums[3] / n, 5));
+    std::string kinds;
+    for (const auto& v : study.validation)
+      if (kinds.find(v.kind) == std::string::npos) kinds += (kinds.empty() ? "" : " and ") + v.kind;
+    out += fmt::format("- **Validation** ({}; mean over {}): RMSE {} N m (final) / {} N m (accepted); MNE {} / {}.\n", kinds,
+                       names, sig(sums[0] / n, 5), sig(sums[1] / n, 5), sig(sums[2] / n, 5), sig(sums[3] / n, 5));
+    for (const auto& v : study.validation)
+      if (!v.note.empty()) out += fmt::format("  - {}: {}\n", v.trajectory, v.note);
   } else {
     out += "- **Validation**: no held-out records.\n";
   }
@@ -228,8 +239,8 @@ std::string summary(const StudyResult& study) {
     if (std::find(trajectories.begin(), trajectories.end(), r.trajectory) == trajectories.end())
       trajectories.push_back(r.trajectory);
     converged += r.clie_success;
-    pd += r.clie_pd;
-    if (!r.clie_success) failed.push_back(r.id());
+    pd += r.clie_ran && r.clie_pd;
+    if (r.clie_ran && !r.clie_success) failed.push_back(r.id());
     t[0] += r.t_ols, t[1] += r.t_audit, t[2] += r.t_sdp, t[3] += r.t_clie;
   }
   std::string ms;

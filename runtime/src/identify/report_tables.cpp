@@ -310,11 +310,11 @@ std::string rescue_delta_table(const StudyResult& study, int count) {
 std::string validation_table(const StudyResult& study) {
   std::string out = "## Table VII: validation on held-out trajectories\n\n";
   if (study.validation.empty()) return out + "No validation records.\n\n";
-  MarkdownTable table({"Trajectory", "T_s [ms]", "CLIE RMSE [N m]", "Rescue RMSE [N m]", "CLIE MNE", "Rescue MNE"});
+  MarkdownTable table({"Trajectory", "T_s [ms]", "Kind", "Final RMSE [N m]", "Accepted RMSE [N m]", "Final MNE", "Accepted MNE"});
   double sums[4] = {0, 0, 0, 0};
   for (const auto& v : study.validation) {
     const double values[4] = {v.rmse_clie, v.rmse_rescue, v.mne_clie, v.mne_rescue};
-    std::vector<std::string> row{v.trajectory, std::to_string(interval_ms(v.interval))};
+    std::vector<std::string> row{v.trajectory, std::to_string(interval_ms(v.interval)), v.kind};
     for (int k = 0; k < 4; ++k) {
       row.push_back(sig(values[k], 6));
       sums[k] += values[k];
@@ -322,8 +322,13 @@ std::string validation_table(const StudyResult& study) {
     table.row(row);
   }
   const double n = static_cast<double>(study.validation.size());
-  table.row({"Mean", "", sig(sums[0] / n, 6), sig(sums[1] / n, 6), sig(sums[2] / n, 6), sig(sums[3] / n, 6)});
-  out += table.str() + "\nRMSE over all joints and samples; MNE: mean over joints of ‖e_j‖ / ‖τ_m,j‖.\n\n";
+  table.row({"Mean", "", "", sig(sums[0] / n, 6), sig(sums[1] / n, 6), sig(sums[2] / n, 6), sig(sums[3] / n, 6)});
+  out += table.str() +
+         "\nFinal: the representative run's last stage (CLIE, or SDP where CLIE did not run); accepted: after the rescue. "
+         "Closed loop: the model under the experiment's controller; open loop: the model's inverse dynamics on the measured "
+         "motion. RMSE over all joints and samples; MNE: mean over joints of ‖e_j‖ / ‖τ_m,j‖.\n\n";
+  for (const auto& v : study.validation)
+    if (!v.note.empty()) out += fmt::format("- {}: {}\n", v.trajectory, v.note);
 
   // Per joint, when the records carry it.
   int joints = 0;
@@ -334,13 +339,14 @@ std::string validation_table(const StudyResult& study) {
   for (int j = 0; j < joints; ++j) header.push_back(fmt::format("J{}", j + 1));
   MarkdownTable per_joint(header);
   for (const auto& v : study.validation)
-    for (const auto& [model, rmse] : {std::pair{"CLIE", &v.rmse_joint_clie}, std::pair{"rescue", &v.rmse_joint_rescue}}) {
+    for (const auto& [model, rmse] : {std::pair{"final RMSE [N m]", &v.rmse_joint_clie}, std::pair{"accepted RMSE [N m]", &v.rmse_joint_rescue},
+                                      std::pair{"accepted NRMSE", &v.nrmse_joint_rescue}}) {
       if (rmse->size() == 0) continue;
       std::vector<std::string> row{v.trajectory, model};
       for (int j = 0; j < joints; ++j) row.push_back(j < rmse->size() ? sig((*rmse)(j), 4) : "--");
       per_joint.row(row);
     }
-  return out + "Per-joint RMSE [N m]:\n\n" + per_joint.str() + "\n";
+  return out + "Per joint (NRMSE: RMSE_j / rms(τ_m,j)):\n\n" + per_joint.str() + "\n";
 }
 
 std::string dispersion_table(const StudyResult& study) {

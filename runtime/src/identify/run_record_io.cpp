@@ -32,12 +32,27 @@ std::string fingerprint_of(const std::string& text) {
 
 void save_run(const RunRecord& r, const std::string& fingerprint, const std::filesystem::path& file) {
   YAML::Emitter y;
+  if (r.failed) {  // the reason only: a rerun with the same inputs fails the same way
+    y << YAML::BeginMap;
+    y << YAML::Key << "format" << YAML::Value << "symoro-identification-run 1";
+    y << YAML::Key << "fingerprint" << YAML::Value << fingerprint;
+    y << YAML::Key << "trajectory" << YAML::Value << r.trajectory;
+    y << YAML::Key << "interval" << YAML::Value << r.interval;
+    y << YAML::Key << "failed" << YAML::Value << true;
+    y << YAML::Key << "failure" << YAML::Value << r.failure;
+    y << YAML::EndMap;
+    io::write_file_atomically(file, std::string(y.c_str()) + "\n");
+    return;
+  }
   y.SetDoublePrecision(17);
   y << YAML::BeginMap;
   y << YAML::Key << "format" << YAML::Value << "symoro-identification-run 1";
   y << YAML::Key << "fingerprint" << YAML::Value << fingerprint;
   y << YAML::Key << "trajectory" << YAML::Value << r.trajectory;
   y << YAML::Key << "interval" << YAML::Value << r.interval;
+  y << YAML::Key << "failed" << YAML::Value << r.failed;
+  y << YAML::Key << "failure" << YAML::Value << r.failure;
+  y << YAML::Key << "clie_ran" << YAML::Value << r.clie_ran;
   y << YAML::Key << "samples" << YAML::Value << r.samples;
   y << YAML::Key << "kappa" << YAML::Value << r.kappa;
   y << YAML::Key << "kappa_scaled" << YAML::Value << r.kappa_scaled;
@@ -77,6 +92,10 @@ std::optional<RunRecord> load_run(const std::filesystem::path& file, const std::
     RunRecord r;
     r.trajectory = n["trajectory"].as<std::string>();
     r.interval = n["interval"].as<double>();
+    r.failed = n["failed"] ? n["failed"].as<bool>() : false;
+    r.failure = n["failure"] ? n["failure"].as<std::string>() : "";
+    r.clie_ran = n["clie_ran"] ? n["clie_ran"].as<bool>() : true;
+    if (r.failed) return r;  // nothing else was computed
     r.samples = n["samples"].as<int>();
     r.kappa = n["kappa"].as<double>();
     r.kappa_scaled = n["kappa_scaled"].as<double>();

@@ -378,14 +378,8 @@ ConditionalProjection conditional_projection(const InertiaFunction& m, const Eig
       return c;
     }
   }
-  // No margin worked: hand on the attempt that came closest to PD (still not feasible).
-  if (!c.attempts.empty()) {
-    const auto best = std::max_element(c.attempts.begin(), c.attempts.end(), [](const auto& a, const auto& b) {
-      return a.lambda_min < b.lambda_min;
-    });
-    c.eps = best->eps;
-    c.phi = best->phi;
-  }
+  // No margin worked: nothing is handed on (c.phi stays phi0, eps 0); the attempts say how
+  // close each came. A vector that failed its audit must not become anyone's starting point.
   return c;
 }
 

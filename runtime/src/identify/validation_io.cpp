@@ -149,6 +149,8 @@ std::vector<std::filesystem::path> write_validation(const StudyResult& study, co
     y << YAML::BeginMap;
     y << YAML::Key << "trajectory" << YAML::Value << v.trajectory;
     y << YAML::Key << "interval" << YAML::Value << v.interval;
+    y << YAML::Key << "kind" << YAML::Value << v.kind;
+    y << YAML::Key << "note" << YAML::Value << v.note;
     y << YAML::Key << "joints" << YAML::Value << static_cast<int>(v.tau_measured.cols());
     y << YAML::Key << "rmse_clie" << YAML::Value << v.rmse_clie;
     y << YAML::Key << "rmse_accepted" << YAML::Value << v.rmse_rescue;
@@ -156,6 +158,7 @@ std::vector<std::filesystem::path> write_validation(const StudyResult& study, co
     y << YAML::Key << "mne_accepted" << YAML::Value << v.mne_rescue;
     detail::put_vector(y, "rmse_joint_clie", v.rmse_joint_clie);
     detail::put_vector(y, "rmse_joint_accepted", v.rmse_joint_rescue);
+    detail::put_vector(y, "nrmse_joint_accepted", v.nrmse_joint_rescue);
     y << YAML::Key << "series" << YAML::Value << "validation/" + csv_name(v.trajectory);
     y << YAML::EndMap;
   }
@@ -200,6 +203,10 @@ StudyValidation read_validation(const std::filesystem::path& study_dir) {
     ValidationRecord v;
     v.trajectory = as<std::string>(t, "trajectory", file);
     v.interval = as<double>(t, "interval", file);
+    v.kind = t["kind"] ? as<std::string>(t, "kind", file) : "closed-loop";  // studies before open-loop validation
+    v.note = t["note"] ? as<std::string>(t, "note", file) : "";
+    if (v.kind != "closed-loop" && v.kind != "open-loop")
+      throw DataError(file, line_of(t["kind"]), fmt::format("'kind' must be closed-loop or open-loop, not '{}'", v.kind));
     const int joints = as<int>(t, "joints", file);
     if (joints < 1) throw DataError(file, line_of(t["joints"]), "'joints' must be positive");
     v.rmse_clie = as<double>(t, "rmse_clie", file);
@@ -208,6 +215,7 @@ StudyValidation read_validation(const std::filesystem::path& study_dir) {
     v.mne_rescue = as<double>(t, "mne_accepted", file);
     v.rmse_joint_clie = vec(t, "rmse_joint_clie", file);
     v.rmse_joint_rescue = vec(t, "rmse_joint_accepted", file);
+    v.nrmse_joint_rescue = vec(t, "nrmse_joint_accepted", file, true);
     read_series(study_dir / as<std::string>(t, "series", file), joints, v);
     s.records.push_back(std::move(v));
   }

@@ -69,14 +69,14 @@ ProjectionResult project_on_poses(const InertiaFunction& m, const Eigen::VectorX
 
 // The paper's conditional step (Algorithm 1, lines 4-15): audit phi0; when it is not PD,
 // project with the margins in ascending order and adopt the first one whose projection passes
-// the all-pose audit. When none does: feasible = false, with phi and eps of the attempt that
-// came closest (largest lambda_min).
+// the all-pose audit. When none does: feasible = false, phi = phi0 and eps = 0 (a failed
+// projection is never handed on); the attempts keep what each margin reached.
 struct ConditionalProjection {
   AuditResult audit;            // of phi0
   bool projected = false;       // false: phi0 was PD and is returned unchanged
   bool feasible = false;        // phi is PD over the box
   double eps = 0;               // the adopted margin (0 when not projected)
-  Eigen::VectorXd phi;          // the CLIE starting point
+  Eigen::VectorXd phi;          // the CLIE starting point (phi0 when not feasible)
   std::vector<ProjectionResult> attempts;  // one per margin tried
 };
 

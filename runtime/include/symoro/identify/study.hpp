@@ -4,6 +4,14 @@
 // centrality, the post-CLIE rescue (eps = 0) when the representative is not PD, a final
 // all-pose audit, and validation on the held-out trajectories.
 //
+// A chain of stages: OLS / WLS, the audit and the SDP run for any robot with only its robots/
+// folder. CLIE and closed-loop validation need the experiment's controller (a ClosedLoopSetup,
+// from the robot's controller description) and each run's reference: the log's reference
+// columns, else the trajectory design's trajectory of that name. Where either is missing CLIE
+// is skipped (the run's record and StudyResult::stages say why), the representative is chosen
+// among the SDP vectors and validation is open loop. A run that fails (a log too short for an
+// interval, a solver's exception) is recorded with its reason and the study goes on.
+//
 // Runs go to a pool of threads, one trajectory (its log read once, every interval) per task,
 // longest first. Each run's record is saved atomically under <out>/runs/ as soon as it ends;
 // a rerun skips the runs whose saved fingerprint matches (same data, model and options).
@@ -13,6 +21,9 @@
 #include <atomic>
 #include <chrono>
 #include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <memory>
 #include <functional>
 #include <mutex>
 #include <optional>
@@ -21,6 +32,7 @@
 #include <vector>
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include "symoro/error.hpp"
 #include "symoro/identify/clie.hpp"
@@ -50,9 +62,10 @@ inline double seconds_since(std::chrono::steady_clock::time_point t0) {
 }
 
 // One trajectory at one interval, from its log.
+// sim: the run's closed loop, or nullptr (CLIE is skipped; `no_clie` says why).
 template <class Model>
-RunRecord identify_run(const io::Log& log, const ClosedLoopSimulator<Model>& sim, double interval,
-                       const StudyOptions& o, const InertiaFunction& inertia, const AuditDomain& domain) {
+RunRecord identify_run(const io::Log& log, const ClosedLoopSimulator<Model>* sim, const std::string& no_clie,
+                       double interval, const StudyOptions& o, const InertiaFunction& inertia, const AuditDomain& domain) {
   RunRecord r;
   r.trajectory = log.meta.trajectory;
   r.interval = interval;
@@ -83,14 +96,32 @@ RunRecord identify_run(const io::Log& log, const ClosedLoopSimulator<Model>& sim
   r.route = cp.projected ? "O-S-C" : "O-C";
   r.eps = cp.projected ? cp.eps : 0.0;
   r.sdp_feasible = cp.feasible;
-  r.phi_sdp = cp.phi;
   r.t_audit = cp.audit.wall;
   r.t_sdp = std::max(0.0, conditional_wall - cp.audit.wall);
-
+  if (!cp.feasible) {
+    // No margin gave a PD vector: the run has no SDP vector and no final one; its OLS stays in
+    // the OLS cloud. Nothing downstream starts from a failed projection.
+    r.clie_ran = false;
+    std::string why;
+    for (const ProjectionResult& a : cp.attempts)
+      why += fmt::format("{}eps {:g}: lambda_min {:.3g} ({})", why.empty() ? "" : "; ", a.eps, a.lambda_min, a.status);
+    r.clie_termination = "not run: the SDP projection failed at every margin (" + why + ")";
+    return r;
+  }
+  r.phi_sdp = cp.phi;
+  if (!sim) {
+    // The chain ends at the SDP (or the PD OLS estimate): that is the run's final vector.
+    r.clie_ran = false;
+    r.clie_termination = "not run: " + no_clie;
+    r.phi_clie = r.phi_sdp;
+    r.clie_lambda_min = cp.projected ? cp.attempts.back().lambda_min : r.ols_lambda_min;
+    r.clie_pd = true;
+    return r;
+  }
   t = std::chrono::steady_clock::now();
   ClieOptions co = o.clie;
   co.preprocess = o.preprocess;
-  const ClieResult c = clie<Model>(sim, s, cp.phi, co);
+  const ClieResult c = clie<Model>(*sim, s, cp.phi, co);
   r.t_clie = seconds_since(t);
   r.clie_success = c.success;
   r.clie_termination = c.start_divergence.diverged ? "start diverged: " + c.start_divergence.describe() : c.termination;
@@ -110,12 +141,23 @@ RunRecord identify_run(const io::Log& log, const ClosedLoopSimulator<Model>& sim
 
 }  // namespace detail
 
+// What switches on the closed-loop stages: the experiment's controller (from the robot's
+// controller description) and, optionally, the trajectory design (references for logs without
+// reference columns). Without a controller, `why` says what is missing, for the report.
+struct ClosedLoopSource {
+  std::optional<ClosedLoopSetup> setup;
+  std::optional<trajectory::TrajectoryDesign> design;
+  std::string why;  // e.g. "no controller description (robots/x/controller.yaml not found)"
+};
+
 template <class Model>
 class Study {
  public:
+  Study(StudyOptions options, ClosedLoopSource closed_loop)
+      : o_(std::move(options)), loop_(std::move(closed_loop)), inertia_(make_inertia_function<Model>()),
+        domain_(audit_domain<Model>()) {}
   Study(StudyOptions options, trajectory::TrajectoryDesign design, ClosedLoopSetup setup)
-      : o_(std::move(options)), design_(std::move(design)), setup_(std::move(setup)),
-        inertia_(make_inertia_function<Model>()), domain_(audit_domain<Model>()) {}
+      : Study(std::move(options), ClosedLoopSource{std::move(setup), std::move(design), ""}) {}
 
   StudyResult run() {
     const auto t0 = std::chrono::steady_clock::now();
@@ -157,8 +199,9 @@ class Study {
           todo.push_back(name);
           break;
         }
+    // Longest first (the log's size stands for its duration), so no thread ends on a long one.
     std::stable_sort(todo.begin(), todo.end(), [&](const std::string& a, const std::string& b) {
-      return design_.build(a).duration() > design_.build(b).duration();
+      return std::filesystem::file_size(data.find(a, o_.trial).file) > std::filesystem::file_size(data.find(b, o_.trial).file);
     });
     const int skipped = static_cast<int>(std::count_if(slots.begin(), slots.end(), [](const Slot& s) { return s.record.has_value(); }));
     if (o_.on_start) o_.on_start(static_cast<int>(slots.size()), skipped);
@@ -168,35 +211,55 @@ class Study {
     out.threads = threads;
     std::atomic<size_t> next{0};
     std::mutex m;
-    std::string first_error;
+    auto finish = [&](Slot& s, RunRecord r) {
+      if (!r.failed) save_run(r, s.fingerprint, s.file);  // a failed run is tried again by a rerun
+      std::lock_guard<std::mutex> lock(m);
+      s.record = std::move(r);
+      if (o_.on_run) o_.on_run(*s.record);
+    };
+    auto failed = [](const Slot& s, const std::string& why) {
+      RunRecord r;
+      r.trajectory = s.trajectory;
+      r.interval = s.interval;
+      r.failed = true;
+      r.failure = why;
+      return r;
+    };
     auto work = [&] {
       for (size_t i; (i = next++) < todo.size();) {
+        const std::string& name = todo[i];
+        io::Log log;
+        std::unique_ptr<ClosedLoopSimulator<Model>> sim;
+        std::string no_clie;
         try {
-          const std::string& name = todo[i];
-          const io::Log log = io::read_log(data.find(name, o_.trial).file);
-          const ClosedLoopSimulator<Model> sim(setup_, design_.build(name));
-          for (Slot& s : slots) {
-            if (s.trajectory != name || s.record) continue;
-            RunRecord r = detail::identify_run<Model>(log, sim, s.interval, o_, *inertia_, domain_);
-            save_run(r, s.fingerprint, s.file);
-            std::lock_guard<std::mutex> lock(m);
-            s.record = std::move(r);
-            if (o_.on_run) o_.on_run(*s.record);
-          }
+          log = load_log(data.find(name, o_.trial));
+          sim = closed_loop(name, log, no_clie);
         } catch (const std::exception& e) {
-          std::lock_guard<std::mutex> lock(m);
-          if (first_error.empty()) first_error = e.what();
-          next = todo.size();
+          for (Slot& s : slots)
+            if (s.trajectory == name && !s.record) finish(s, failed(s, e.what()));
+          continue;
+        }
+        for (Slot& s : slots) {
+          if (s.trajectory != name || s.record) continue;
+          try {
+            finish(s, detail::identify_run<Model>(log, sim.get(), no_clie, s.interval, o_, *inertia_, domain_));
+          } catch (const std::exception& e) {
+            finish(s, failed(s, e.what()));
+          }
         }
       }
     };
     std::vector<std::thread> pool;
     for (int w = 0; w < threads; ++w) pool.emplace_back(work);
     for (auto& t : pool) t.join();
-    if (!first_error.empty()) throw std::runtime_error(first_error);
 
     for (Slot& s : slots) out.runs.push_back(std::move(*s.record));
-    for (const RunRecord& r : out.runs) out.wall_runs += r.t_ols + r.t_audit + r.t_sdp + r.t_clie;
+    int failures = 0;
+    for (const RunRecord& r : out.runs) {
+      out.wall_runs += r.t_ols + r.t_audit + r.t_sdp + r.t_clie;
+      failures += r.failed;
+    }
+    describe_stages(out, failures);
 
     select_and_accept(out);
     if (out.selection.run >= 0) validate(data, valid, out);
@@ -205,32 +268,117 @@ class Study {
   }
 
  private:
+  // Names in order, each once: a repeated name would give one run to two threads.
+  static std::vector<std::string> unique(const std::vector<std::string>& names) {
+    std::vector<std::string> v;
+    for (const auto& n : names)
+      if (std::find(v.begin(), v.end(), n) == v.end()) v.push_back(n);
+    return v;
+  }
   std::vector<std::string> identification_names(const Dataset& d) const {
-    if (!o_.trajectories.empty()) return o_.trajectories;
+    if (!o_.trajectories.empty()) return unique(o_.trajectories);
     std::vector<std::string> v;
     for (const DatasetRun& r : d.runs)
       if (r.trial == o_.trial && r.family != o_.validation_family) v.push_back(r.trajectory);
-    return v;
+    return unique(v);
   }
   std::vector<std::string> validation_names(const Dataset& d) const {
-    if (!o_.validation.empty()) return o_.validation;
+    if (!o_.validation.empty()) return unique(o_.validation);
     std::vector<std::string> v;
     for (const DatasetRun& r : d.runs)
       if (r.trial == o_.trial && r.family == o_.validation_family) v.push_back(r.trajectory);
-    return v;
+    return unique(v);
+  }
+
+  // A run's log, its time counted from its first stamp (a controller's log may start at any t;
+  // the closed loop's cycle 0 is the first row).
+  static io::Log load_log(const DatasetRun& run) {
+    io::Log log = read_run_log(run);
+    if (log.samples() > 0) log.time.array() -= log.time(0);
+    return log;
+  }
+
+  // The closed loop of one run, or nullptr with the reason: the log's reference columns first,
+  // else the design's trajectory of that name.
+  std::unique_ptr<ClosedLoopSimulator<Model>> closed_loop(const std::string& name, const io::Log& log,
+                                                          std::string& why) const {
+    if (!loop_.setup) {
+      why = loop_.why.empty() ? "no controller description" : loop_.why;
+      return nullptr;
+    }
+    if (log.has_references())
+      return std::make_unique<ClosedLoopSimulator<Model>>(*loop_.setup, trajectory::sampled_reference(log, loop_.setup->gains.period));
+    if (loop_.design) {
+      const auto names = loop_.design->names();
+      if (std::find(names.begin(), names.end(), name) != names.end())
+        return std::make_unique<ClosedLoopSimulator<Model>>(*loop_.setup, loop_.design->build(name));
+    }
+    why = fmt::format("the log of {} has no reference columns{}", name,
+                      loop_.design ? " and the trajectory design has no trajectory of that name" : " and the robot has no trajectory design");
+    return nullptr;
+  }
+
+  void describe_stages(StudyResult& out, int failures) const {
+    int clie = 0, skipped = 0;
+    std::string why;
+    for (const RunRecord& r : out.runs) {
+      if (r.failed) continue;
+      if (r.clie_ran) {
+        ++clie;
+      } else {
+        ++skipped;
+        if (why.empty()) why = r.clie_termination;
+      }
+    }
+    out.stages.push_back(fmt::format("OLS{}, all-pose PD audit, conditional SDP projection: {} runs", o_.least_squares.weighted ? " (WLS)" : "",
+                                     out.runs.size() - failures));
+    if (skipped == 0)
+      out.stages.push_back(fmt::format("CLIE: {} runs", clie));
+    else
+      out.stages.push_back(fmt::format("CLIE: {} runs; skipped in {} ({}){}", clie, skipped, why,
+                                       clie == 0 ? "; each run's final vector is its SDP (or PD OLS) estimate" : ""));
+    if (failures > 0) {
+      std::string list;
+      for (const RunRecord& r : out.runs)
+        if (r.failed) list += fmt::format("{}{}: {}", list.empty() ? "" : "; ", r.id(), r.failure);
+      out.stages.push_back(fmt::format("failed runs: {} ({})", failures, list));
+    }
   }
 
   // What a run's result depends on: the model, the log (its sidecar identifies the data and its
-  // size guards against a replaced file), the interval and every option of every stage.
+  // size guards against a replaced file), the window, the interval, every option of every stage
+  // and the closed loop (controller and the design's file, when given).
   std::string run_inputs(const DatasetRun& run, double interval) const {
     const auto meta = io::read_log_metadata(run.file);
-    return fmt::format("{}/{} | {} {} {} {} {} | {} | {}", Model::robot_name, Model::variant_name, run.file.filename().string(),
-                       std::filesystem::file_size(run.file), meta.seed, meta.notes, meta.trial, interval,
-                       o_.describe());
+    std::string loop = "open";
+    if (loop_.setup) {
+      const ClosedLoopSetup& c = *loop_.setup;
+      loop = fmt::format("{} {} {} {} {} | {} {} {} {}", c.gains.period, c.gains.pseudo_derivative_time, c.delay, c.pre_roll,
+                         c.substeps, fmt::join(c.gains.inertia, " "), fmt::join(c.gains.damping, " "),
+                         fmt::join(c.gains.kp, " "), fmt::join(c.gains.kv, " "));
+      if (loop_.design) loop += " | " + design_text();
+    }
+    return fmt::format("{}/{} {} | {} {} {} {} {} [{}, {}] | {} | {} | {}", Model::robot_name, Model::variant_name,
+                       model_text(), run.file.filename().string(), std::filesystem::file_size(run.file), meta.seed,
+                       meta.notes, meta.trial, run.window_start, run.window_end, interval, o_.describe(), loop);
+  }
+  // The compiled model: its parameters and joints (a regenerated model with other names or
+  // limits is another model).
+  static std::string model_text() {
+    std::string t;
+    for (const auto& p : Model::parameters) t += std::string(p.name) + " ";
+    for (const auto& j : Model::joints) t += fmt::format("{} {} {} ", j.name, j.lower, j.upper);
+    return t;
+  }
+  std::string design_text() const {
+    std::ifstream in(loop_.design->path(), std::ios::binary);
+    return fingerprint_of(std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()));
   }
 
   void select_and_accept(StudyResult& out) const {
-    if (out.runs.empty()) return;
+    int usable = 0;
+    for (const RunRecord& r : out.runs) usable += !r.failed && r.phi_clie.size() > 0;
+    if (usable == 0) return;
     if (out.runs.size() == 1) {  // one run (--only X --interval h): it is the candidate, no cloud
       out.selection.run = 0;
       out.selection.centrality = {0.0};
@@ -250,6 +398,8 @@ class Study {
       out.phi_rescue = p.phi;
       out.rescued = true;
       out.rescue_eps = 0;
+      out.rescue_feasible = p.feasible;
+      out.rescue_status = p.status;
     }
     // The final audit: denser and with another seed than the ones the pipeline used.
     AuditOptions fa = o_.audit;
@@ -268,17 +418,21 @@ class Study {
     ClieOptions co = o_.clie;
     co.preprocess = o_.preprocess;
     for (const auto& name : names) {
-      const io::Log log = io::read_log(data.find(name, o_.trial).file);
-      const preprocess::Samples s = preprocess::preprocess(log, h, o_.preprocess);
-      const ClosedLoopSimulator<Model> sim(setup_, design_.build(name));
-      out.validation.push_back(validate_trajectory<Model>(sim, s, sel.phi_clie, out.phi_rescue, co));
-      out.validation.back().trajectory = name;
+      try {
+        const io::Log log = load_log(data.find(name, o_.trial));
+        const preprocess::Samples s = preprocess::preprocess(log, h, o_.preprocess);
+        std::string why;
+        const auto sim = closed_loop(name, log, why);
+        out.validation.push_back(validate_trajectory<Model>(sim.get(), s, sel.phi_clie, out.phi_rescue, co, why));
+        out.validation.back().trajectory = name;
+      } catch (const std::exception& e) {
+        out.stages.push_back(fmt::format("validation of {}: failed: {}", name, e.what()));
+      }
     }
   }
 
   StudyOptions o_;
-  trajectory::TrajectoryDesign design_;
-  ClosedLoopSetup setup_;
+  ClosedLoopSource loop_;
   std::unique_ptr<InertiaFunction> inertia_;
   AuditDomain domain_;
 };

@@ -13,6 +13,10 @@ namespace symoro::identify {
 // One trajectory at one sampling interval: OLS -> audit -> (SDP) -> CLIE.
 struct RunRecord {
   std::string trajectory;    // e.g. "AG02"
+  // A run that could not be done (its log too short at this interval, a solver's exception):
+  // recorded with the reason, left out of the clouds and the selection; the study goes on.
+  bool failed = false;
+  std::string failure;
   double interval = 0;       // s
   int samples = 0;           // target-grid samples (rows of W are samples x joints)
   // OLS
@@ -30,7 +34,11 @@ struct RunRecord {
   double eps = 0;            // adopted margin, 0 when skipped
   bool sdp_feasible = true;  // false: no margin gave a PD projection (CLIE starts from the last)
   Eigen::VectorXd phi_sdp;   // the CLIE starting point (= phi_ols on O-C)
-  // CLIE
+  // CLIE. Without a controller description (or without reference columns in the log) CLIE
+  // does not run: clie_ran is false, clie_termination says why, and phi_clie, clie_lambda_min
+  // and clie_pd hold the run's final vector, the SDP (or, on O-C, the OLS) estimate, so that the
+  // clouds, the selection and the rescue work on what the chain produced.
+  bool clie_ran = true;
   Eigen::VectorXd phi_clie;
   bool clie_success = false;
   std::string clie_termination;   // Ceres' termination, or the start's divergence
@@ -61,10 +69,17 @@ struct Selection {
   std::string rule;                // one line: how it was chosen
 };
 
-// Held-out validation of one trajectory: closed-loop simulated vs measured torque.
+// Held-out validation of one trajectory: simulated vs measured torque. Closed loop (the model
+// under the experiment's controller, the paper's Table VII) where a controller description and
+// the log's references allow it; otherwise, or where that simulation diverges, open loop: the
+// model's inverse dynamics on the measured motion against the measured torque.
 struct ValidationRecord {
   std::string trajectory;
+  std::string kind = "closed-loop";  // or "open-loop"
+  std::string note;                  // why open loop, or where a simulation diverged ("" if neither)
   double interval = 0;
+  // Per joint rmse_j / rms(tau_m,j) of the accepted (rescue) vector: comparable across joints.
+  Eigen::VectorXd nrmse_joint_rescue;
   double rmse_clie = 0, rmse_rescue = 0;   // N m, over all joints and samples
   double mne_clie = 0, mne_rescue = 0;     // mean over joints of |e_j| / |tau_m,j| (2-norms)
   Eigen::VectorXd rmse_joint_clie, rmse_joint_rescue;
@@ -85,12 +100,17 @@ struct StudyResult {
   Eigen::VectorXd phi_rescue;
   bool rescued = false;                   // false: the CLIE candidate was PD, accepted as is
   double rescue_eps = 0;
+  bool rescue_feasible = true;            // false: the rescue's projection failed (rescue_status says why)
+  std::string rescue_status;
   double final_lambda_min = 0;
   Eigen::VectorXd final_worst_pose;
   bool accepted = false;                  // final audit passed
   std::vector<ValidationRecord> validation;
   Eigen::VectorXd truth;                  // the twin's true parameters (empty for real data)
   std::string data_source;                // e.g. "twin (robots/crane_x7/twin.yaml, config ...)"
+  // What the chain did and skipped, one line each (e.g. "CLIE: not run: no controller
+  // description (robots/x/controller.yaml)"), for the report.
+  std::vector<std::string> stages;
   int threads = 1;
   double wall = 0;                        // s, whole study (runs done in this invocation)
   double wall_runs = 0;                   // s, sum of the runs' stage times

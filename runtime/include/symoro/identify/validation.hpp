@@ -1,11 +1,15 @@
 // Held-out validation (paper Table VII): the closed-loop simulated torque of a parameter vector
-// against the measured torque of a trajectory not used for identification, at one interval.
+// against the measured torque of a trajectory not used for identification, at one interval;
+// open loop (the model's torque on the measured motion) where the closed loop cannot be run.
 //   RMSE = sqrt(mean over samples and joints of e^2)   (N m)
 //   MNE  = mean over joints of |e_j| / |tau_m,j|        (2-norms over the samples)
 #pragma once
 
 #include <cmath>
 #include <limits>
+#include <string>
+
+#include <fmt/format.h>
 
 #include <Eigen/Core>
 
@@ -33,10 +37,29 @@ inline TorqueError torque_error(const Eigen::MatrixXd& measured, const Eigen::Ma
   return t;
 }
 
+// The model's torque on the measured motion (open loop): ID(q, qd, qdd; phi) per sample.
 template <class Model>
-ValidationRecord validate_trajectory(const ClosedLoopSimulator<Model>& sim, const preprocess::Samples& measured,
+Eigen::MatrixXd open_loop_torque(const preprocess::Samples& s, const Eigen::VectorXd& phi) {
+  using Vec = Eigen::Matrix<double, Model::nq, 1>;
+  using Phi = Eigen::Matrix<double, Model::np, 1>;
+  const Phi p = phi;
+  Eigen::MatrixXd tau(s.q.rows(), Model::nq);
+  Vec out;
+  for (Eigen::Index i = 0; i < s.q.rows(); ++i) {
+    Model::inverse_dynamics(Vec(s.q.row(i).transpose()), Vec(s.qd.row(i).transpose()), Vec(s.qdd.row(i).transpose()), p, out);
+    tau.row(i) = out.transpose();
+  }
+  return tau;
+}
+
+// Held-out validation of the run's final vector (phi_clie) and the accepted one (phi_rescue).
+// sim: the closed loop of the experiment, or nullptr (then open loop, `why_open` says why). A
+// closed-loop simulation that diverges falls back to open loop for that vector, and the note
+// names the vector, time, joint and reason: a validation never reports NaN without a reason.
+template <class Model>
+ValidationRecord validate_trajectory(const ClosedLoopSimulator<Model>* sim, const preprocess::Samples& measured,
                                      const Eigen::VectorXd& phi_clie, const Eigen::VectorXd& phi_rescue,
-                                     const ClieOptions& options) {
+                                     const ClieOptions& options, const std::string& why_open = "") {
   ValidationRecord v;
   v.interval = measured.interval;
   v.time = measured.time;
@@ -44,22 +67,37 @@ ValidationRecord validate_trajectory(const ClosedLoopSimulator<Model>& sim, cons
   v.q = measured.q;
   v.qd = measured.qd;
   v.qdd = measured.qdd;
-  Divergence why;
+  v.kind = sim ? "closed-loop" : "open-loop";
+  if (!sim) v.note = "open loop: " + why_open;
   const Eigen::Index n = measured.tau.cols();
-  auto run = [&](const Eigen::VectorXd& phi, Eigen::MatrixXd& tau, double& rmse, double& mne, Eigen::VectorXd& joint) {
-    if (phi.size() == 0 || !simulated_samples<Model>(sim, measured, phi, options, tau, &why)) {
+  auto run = [&](const char* which, const Eigen::VectorXd& phi, Eigen::MatrixXd& tau, double& rmse, double& mne,
+                 Eigen::VectorXd& joint) {
+    rmse = mne = std::numeric_limits<double>::quiet_NaN();
+    if (phi.size() == 0) {
       tau = Eigen::MatrixXd::Constant(measured.tau.rows(), n, std::numeric_limits<double>::quiet_NaN());
       joint = Eigen::VectorXd::Constant(n, std::numeric_limits<double>::quiet_NaN());
       return;
+    }
+    Divergence why;
+    if (!sim || !simulated_samples<Model>(*sim, measured, phi, options, tau, &why)) {
+      if (sim) {
+        v.kind = "open-loop";
+        v.note += fmt::format("{}the closed loop of the {} vector {}; open-loop values", v.note.empty() ? "" : "; ", which,
+                              why.describe());
+      }
+      tau = open_loop_torque<Model>(measured, phi);
     }
     const TorqueError e = torque_error(measured.tau, tau);
     rmse = e.rmse;
     mne = e.mne;
     joint = e.rmse_joint;
   };
-  v.rmse_clie = v.mne_clie = v.rmse_rescue = v.mne_rescue = std::numeric_limits<double>::quiet_NaN();
-  run(phi_clie, v.tau_clie, v.rmse_clie, v.mne_clie, v.rmse_joint_clie);
-  run(phi_rescue, v.tau_rescue, v.rmse_rescue, v.mne_rescue, v.rmse_joint_rescue);
+  run("final", phi_clie, v.tau_clie, v.rmse_clie, v.mne_clie, v.rmse_joint_clie);
+  run("accepted", phi_rescue, v.tau_rescue, v.rmse_rescue, v.mne_rescue, v.rmse_joint_rescue);
+  if (v.rmse_joint_rescue.size() == n) {
+    const Eigen::VectorXd rms = (measured.tau.colwise().squaredNorm() / std::max<double>(1, measured.tau.rows())).cwiseSqrt().transpose();
+    v.nrmse_joint_rescue = v.rmse_joint_rescue.cwiseQuotient(rms.cwiseMax(1e-300));
+  }
   return v;
 }
 
