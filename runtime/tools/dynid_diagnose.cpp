@@ -2,7 +2,10 @@
 // every candidate effect on the fitting trajectories, keeps those that are significant and
 // improve the held-out ones (forward stepwise), localizes the residual before and after, and
 // writes a report and the robot.yaml variant that compiles the effects in (--apply adds it).
+#include <algorithm>
 #include <fstream>
+#include <regex>
+#include <utility>
 #include <sstream>
 
 #include <fmt/format.h>
@@ -14,7 +17,7 @@
 #include "symoro/io/parameters_yaml.hpp"
 #include "symoro/io/atomic_file.hpp"
 #include "symoro/io/log.hpp"
-#include "symoro/trajectory/design.hpp"
+#include "symoro/trajectory/sampled_reference.hpp"
 #include "symoro/twin/config.hpp"
 
 namespace symoro::dynid {
@@ -24,25 +27,55 @@ namespace {
 struct DiagnoseOptions {
   std::string data, out, model, variant, apply, params;
   bool no_backlash = false;
-  std::vector<std::string> train{"AG02"}, heldout{"V01", "V02", "V03"}, only;
+  std::vector<std::string> train, heldout, only;  // empty: from the dataset's families
   int trial = 1;
   double interval_ms = 10, cutoff = 5, alpha = 1e-3, min_gain = 0.02, min_torque = 0.003;
 };
 
+// The fitting and held-out runs: as named, else the dataset's (held out: family V, as a split
+// at import records it; fitting: every other run of the trial).
+std::pair<std::vector<std::string>, std::vector<std::string>> run_names(const identify::Dataset& data, const DiagnoseOptions& o) {
+  auto pick = [&](bool heldout) {
+    std::vector<std::string> v;
+    for (const auto& r : data.runs)
+      if (r.trial == o.trial && (r.family == "V") == heldout && std::find(v.begin(), v.end(), r.trajectory) == v.end())
+        v.push_back(r.trajectory);
+    return v;
+  };
+  std::vector<std::string> train = o.train.empty() ? pick(false) : o.train, heldout = o.heldout.empty() ? pick(true) : o.heldout;
+  std::string all;
+  for (const auto& r : data.runs) all += fmt::format("{}{} (family {}, trial {})", all.empty() ? "" : ", ", r.trajectory, r.family, r.trial);
+  const auto manifest = (data.dir / "dataset.yaml").string();
+  if (train.empty())
+    throw UsageError(fmt::format("{}: no fitting run for trial {} (runs: {}); name them with --train", manifest, o.trial, all));
+  if (heldout.empty())
+    throw UsageError(fmt::format("{}: no held-out run (family V) for trial {} (runs: {}); name them with --heldout, or split "
+                                 "a long run at import (dynid import --split 0.7)", manifest, o.trial, all));
+  for (const auto* list : {&train, &heldout})
+    for (const auto& name : *list) {
+      bool found = false;
+      for (const auto& r : data.runs) found = found || (r.trajectory == name && r.trial == o.trial);
+      if (!found)
+        throw UsageError(fmt::format("{}: no run {} of trial {} to {} (runs: {}); choose others with --train / --heldout",
+                                     manifest, name, o.trial, list == &train ? "fit" : "hold out", all));
+    }
+  return {train, heldout};
+}
+
 template <class Full, class Model>
 void run(const Common& common, const DiagnoseOptions& o) {
   const identify::Dataset data = identify::read_dataset(o.data);
+  const auto [train_names, heldout_names] = run_names(data, o);
   diagnose::StackOptions so;
   so.interval = o.interval_ms / 1000;
   so.cutoff = o.cutoff;
   so.candidates.only = o.only;
   io::Log first_train;  // the backlash stage's run
-  auto stack = [&](const std::vector<std::string>& names) {
+  auto stack = [&](const std::vector<std::string>& names, bool fitting) {
     std::vector<diagnose::NamedSamples> runs;
     for (const auto& name : names) {
-      const auto& r = data.find(name, o.trial);
-      io::Log log = io::read_log(r.file);
-      if (&names == &o.train && name == o.train.front()) first_train = log;
+      io::Log log = identify::read_run_log(data.find(name, o.trial));
+      if (fitting && name == names.front()) first_train = log;
       runs.push_back({name, preprocess::preprocess(log, log.meta.sample_time > 0 ? log.meta.sample_time : 0.001,
                                                    diagnose::light_preprocessing())});
     }
@@ -56,7 +89,7 @@ void run(const Common& common, const DiagnoseOptions& o) {
     for (const auto& p : Model::parameters) names.emplace_back(p.name);
     held = io::read_parameters_yaml(o.params, names);
   }
-  diagnose::DesignStack train = stack(o.train), heldout = stack(o.heldout);
+  diagnose::DesignStack train = stack(train_names, true), heldout = stack(heldout_names, false);
   if (held.size()) {
     train.hold(held);
     heldout.hold(held);
@@ -67,15 +100,30 @@ void run(const Common& common, const DiagnoseOptions& o) {
   dopt.selection.min_effect_torque = o.min_torque;
   dopt.selection.candidates = so.candidates;
   diagnose::Diagnosis d = diagnose::diagnose(train, heldout, dopt);
-  // Backlash from the closed loop's high band, against the robot's digital twin description.
+  // Backlash from the closed loop's high band: the robot's digital twin replays the fitting
+  // run's own references. A stage that cannot run, or fails, is said in the report; what the
+  // selection found stands either way.
   const auto twin_path = common.robot_dir() / "twin.yaml";
-  if (!o.no_backlash && std::filesystem::exists(twin_path)) {
-    const auto design = trajectory::TrajectoryDesign::read(common.robot_dir() / "trajectories.yaml", joint_list<Full>());
-    const twin::TwinConfig nominal =
-        diagnose::with_selected_effects(twin::read_twin_config(twin_path, Full::nq), d.selection);
-    d.backlash = diagnose::fit_backlash<Full>(first_train, design.build(o.train.front()), nominal);
-    d.backlash_judged = true;
+  if (o.no_backlash) {
+    d.backlash_note = "Not run (--no-backlash).";
+  } else if (!std::filesystem::exists(twin_path)) {
+    d.backlash_note = fmt::format("Not run: the stage simulates the robot's digital twin, and {} has none ({} not found).",
+                                  common.robot, twin_path.string());
+  } else if (!first_train.has_references()) {
+    d.backlash_note = fmt::format("Not run: the log of {} has no reference columns (q_ref, qd_ref, qdd_ref) for the twin to "
+                                  "replay.", train_names.front());
+  } else {
+    try {
+      const twin::TwinConfig nominal =
+          diagnose::with_selected_effects(twin::read_twin_config(twin_path, Full::nq), d.selection);
+      const auto reference = trajectory::sampled_reference(first_train, nominal.controller.period);
+      d.backlash = diagnose::fit_backlash<Full>(first_train, reference, nominal);
+      d.backlash_judged = true;
+    } catch (const std::exception& e) {
+      d.backlash_note = fmt::format("Failed after the selection, so no play is named: {}", e.what());
+    }
   }
+  if (!d.backlash_note.empty()) fmt::print("backlash stage: {}\n", d.backlash_note);
   d.robot = common.robot;
   d.model = std::string(Model::robot_name) + (std::string(Model::variant_name).empty() ? "" : "::" + std::string(Model::variant_name));
   d.cutoff = o.cutoff;
@@ -133,8 +181,10 @@ void add_diagnose_commands(CLI::App& app, Common& common) {
   cmd->add_option("--robots-dir", common.robots_dir, "Where the robot folders are");
   cmd->add_option("--data", o->data, "Dataset folder (dataset.yaml and logs)")->required()->check(CLI::ExistingDirectory);
   cmd->add_option("-o,--out", o->out, "Report folder")->required();
-  cmd->add_option("--train", o->train, "Trajectories the effects are fitted on")->delimiter(',');
-  cmd->add_option("--heldout", o->heldout, "Held-out trajectories that judge them")->delimiter(',');
+  cmd->add_option("--train", o->train, "Runs the effects are fitted on (default: the dataset's runs of families other "
+                                       "than V, e.g. the fitting part of a split run)")->delimiter(',');
+  cmd->add_option("--heldout", o->heldout, "Held-out runs that judge them (default: the dataset's family V, e.g. the "
+                                           "held-out part of a split run)")->delimiter(',');
   cmd->add_option("--trial", o->trial, "Which trial of each trajectory");
   cmd->add_option("--interval", o->interval_ms, "Diagnosis grid, ms")->check(CLI::PositiveNumber);
   cmd->add_option("--cutoff", o->cutoff, "Low-pass on every column and the torque, Hz")->check(CLI::PositiveNumber);
@@ -154,6 +204,10 @@ void add_diagnose_commands(CLI::App& app, Common& common) {
   cmd->add_option("--variant", o->variant, "Name of the variant to write (default: <identified>_diagnosed)");
   cmd->add_flag("--apply", [o](std::int64_t) { o->apply = "yes"; }, "Add the variant to the robot's robot.yaml");
   cmd->callback([&common, o] {
+    // symoroc's rule for variant names, checked before any work.
+    static const std::regex lower_id("^[a-z][a-z0-9_]*$");
+    if (!o->variant.empty() && (!std::regex_match(o->variant, lower_id) || o->variant == "full" || o->variant == "param"))
+      throw UsageError("--variant '" + o->variant + "' must be a lower-case identifier other than 'full' and 'param' (symoroc's rule)");
     for (const auto& e : o->only) {
       diagnose::effect_kind(e);  // unknown names: a clear error first
       if (e == "payload" && o->params.empty())

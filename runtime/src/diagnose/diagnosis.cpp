@@ -130,7 +130,10 @@ std::vector<std::filesystem::path> write_diagnosis_report(const Diagnosis& d, co
                        b.measured(j), b.simulated(j), b.spread(j), play.empty() ? "—" : play);
     }
     m += b.findings.empty() ? "\nNo backlash found.\n\n" : "\n";
+    for (const auto& note : b.notes) m += "- " + note + "\n";
+    if (!b.notes.empty()) m += "\n";
   }
+  if (!d.backlash_note.empty()) m += "## Backlash: the closed loop's high band\n\n" + d.backlash_note + "\n\n";
   m += "## The gap before and after (held-out trajectories)\n\n";
   m += "| joint | rms before (N m) | rms after (N m) | change |\n|---|---|---|---|\n";
   for (Eigen::Index j = 0; j < s.before.heldout_rmse.size(); ++j) {
@@ -164,6 +167,14 @@ std::vector<std::filesystem::path> write_diagnosis_report(const Diagnosis& d, co
       m += fmt::format("| {} | {:.1f} | {:.1e} | {:.2f} % | {:.4f} | {} |\n", t.label, t.f, t.p_value, 100 * t.heldout_gain,
                        t.effect_rms, flags(t));
     }
+    // Candidates the model's own columns already span (e.g. a spring k sin q on a joint whose
+    // axis makes it a gravity term): said, not dropped, since the model may hold them already.
+    std::string absorbed;
+    for (const auto& t : st.tests)
+      if (t.absorbed) absorbed += (absorbed.empty() ? "" : ", ") + t.label;
+    if (!absorbed.empty())
+      m += "\nAbsorbed (its columns lie in the span of the model's own, or are not excited by these data; the model "
+           "can already represent it, and it cannot be judged apart): " + absorbed + ".\n";
     m += "\n";
   }
   const auto before_figs = write_localization_figures(d.before_series, d.before, dir / "figures", "before");

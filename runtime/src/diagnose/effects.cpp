@@ -96,8 +96,11 @@ std::vector<Candidate> candidates(const DesignStack& d, const CandidateOptions& 
       out.push_back(c);
       return &out.back();
     };
-    for (double vc : o.coulomb_velocities)
-      if (Candidate* c = add(EffectKind::Coulomb, {fmt::format("FS{}", j)}, {"N*m"})) c->coulomb_velocity = vc;
+    // Named as the variant compiles it (smooth_coulomb: FC<j>); not a candidate where the model
+    // already has Coulomb friction on the joint (OpenSYMORO's FS<j>, or a compiled FC<j>).
+    if (!has_parameter(d, fmt::format("FS{}", j)))
+      for (double vc : o.coulomb_velocities)
+        if (Candidate* c = add(EffectKind::Coulomb, {fmt::format("FC{}", j)}, {"N*m"})) c->coulomb_velocity = vc;
     for (double vs : o.stribeck_velocities)
       if (Candidate* c = add(EffectKind::Stribeck, {fmt::format("FST{}", j)}, {"N*m"})) c->stribeck_velocity = vs;
     add(EffectKind::Offset, {fmt::format("OFF{}", j)}, {"N*m"});

@@ -191,8 +191,13 @@ GapComparison compare_studies(const StudyValidation& before, const StudyValidati
           b.trajectory, b.tau_measured.rows(), b.interval * 1e3, a->tau_measured.rows(), a->interval * 1e3));
     if (b.tau_measured.rows() > 0 && (b.tau_measured - a->tau_measured).cwiseAbs().maxCoeff() > 1e-9)
       throw std::invalid_argument(b.trajectory + ": the measured torques differ: the studies used other data");
+    if (a->kind != b.kind)
+      throw std::invalid_argument(fmt::format("{} was validated {} before and {} after: the errors are not comparable ({}{})",
+                                              b.trajectory, b.kind, a->kind, b.note.empty() ? a->note : b.note,
+                                              b.note.empty() || a->note.empty() ? "" : "; " + a->note));
     GapTrajectory t;
     t.trajectory = b.trajectory;
+    t.kind = b.kind;
     t.interval = b.interval;
     int rows_b = 0, rows_a = 0;
     const Eigen::VectorXd sb = sum_squares(b, rows_b), sa = sum_squares(*a, rows_a);
@@ -232,9 +237,10 @@ std::vector<std::filesystem::path> write_gap_report(const StudyValidation& befor
 
   std::string md = fmt::format("# Model gap on held-out trajectories: {} → {}\n\n", c.before_model, c.after_model);
   md += fmt::format(
-      "Robot {}. Each model was identified by its own study (OLS, PD audit, conditional SDP, CLIE, rescue) and its "
-      "accepted parameters drive the closed-loop simulation of each held-out trajectory (the experiment's FF+PD "
-      "controller); the error is measured minus simulated joint torque.\n\n",
+      "Robot {}. Each model was identified by its own study (OLS, PD audit, conditional SDP, CLIE where the robot has a "
+      "controller description, rescue) and its accepted parameters give each held-out trajectory's torque: closed loop "
+      "(the model under the experiment's FF+PD controller) or open loop (the model's inverse dynamics on the measured "
+      "motion), as the table below says; the error is measured minus model torque.\n\n",
       c.robot);
   md += "| | model | parameters | selected run | final audit |\n|---|---|---|---|---|\n";
   for (const auto* s : {&before, &after})
@@ -255,10 +261,10 @@ std::vector<std::filesystem::path> write_gap_report(const StudyValidation& befor
                         return v;
                       }(), ", "));
 
-  md += "## Per trajectory\n\n| trajectory | interval | samples | rms before [N m] | rms after [N m] | change |\n"
-        "|---|---|---|---|---|---|\n";
+  md += "## Per trajectory\n\n| trajectory | kind | interval | samples | rms before [N m] | rms after [N m] | change |\n"
+        "|---|---|---|---|---|---|---|\n";
   for (const auto& t : c.trajectories)
-    md += fmt::format("| {} | {:g} ms | {} | {:.4f} | {:.4f} | {} |\n", t.trajectory, t.interval * 1e3, t.samples,
+    md += fmt::format("| {} | {} | {:g} ms | {} | {:.4f} | {:.4f} | {} |\n", t.trajectory, t.kind, t.interval * 1e3, t.samples,
                       t.rmse_before, t.rmse_after, pct(t.rmse_before, t.rmse_after));
 
   md += "\n## Per joint\n\n| joint | rms before [N m] | rms after [N m] | change |\n|---|---|---|---|\n";

@@ -21,11 +21,14 @@
 
 #include <Eigen/Core>
 
+#include <fmt/format.h>
+
 #include "symoro/diagnose/selection.hpp"
+#include "symoro/error.hpp"
 #include "symoro/preprocess/butterworth.hpp"
 #include "symoro/preprocess/preprocess.hpp"
 #include "symoro/preprocess/zero_phase.hpp"
-#include "symoro/trajectory/design.hpp"
+#include "symoro/trajectory/sampled_reference.hpp"
 #include "symoro/twin/config.hpp"
 #include "symoro/twin/simulator.hpp"
 
@@ -64,6 +67,7 @@ struct BacklashFit {
   std::vector<BacklashFinding> findings;
   double delay = 0;               // s, the refined actuation delay (0: none was selected)
   int simulations = 0;
+  std::vector<std::string> notes; // joints the twin cannot give play (said in the report)
 };
 
 // The twin description with the effects the selection named that the twin can play: Coulomb
@@ -128,9 +132,10 @@ inline Eigen::VectorXd high_band_rms(const io::Log& log, const BacklashFitOption
 }
 
 // `nominal`: the robot's twin configuration with the effects already diagnosed switched on and
-// every unknown one off (backlash off); `traj` and `measured` the fitting run.
+// every unknown one off (backlash off); `measured` the fitting run and `reference` its
+// reference at every cycle (the log's own references: the motion that was logged).
 template <class Full>
-BacklashFit fit_backlash(const io::Log& measured, const trajectory::Trajectory& traj, twin::TwinConfig nominal,
+BacklashFit fit_backlash(const io::Log& measured, const trajectory::SampledReference& reference, twin::TwinConfig nominal,
                          const BacklashFitOptions& o = {}) {
   const int n = Full::nq;
   BacklashFit fit;
@@ -143,7 +148,7 @@ BacklashFit fit_backlash(const io::Log& measured, const trajectory::Trajectory& 
     ro.robot = Full::robot_name;
     ro.seed = seed;
     ++fit.simulations;
-    return high_band_rms(twin::ClosedLoopTwin<Full>(c).run(traj, ro), o);
+    return high_band_rms(twin::ClosedLoopTwin<Full>(c).run(reference, ro), o);
   };
   auto judge = [&](const twin::TwinConfig& c) {
     Eigen::MatrixXd runs(n, o.seeds);
@@ -175,13 +180,14 @@ BacklashFit fit_backlash(const io::Log& measured, const trajectory::Trajectory& 
     fit.delay = c.effects.actuation_delay_time;
   }
   judge(c);
+  std::vector<bool> refused(n, false);  // joints whose play the twin's plant cannot model
   for (int step = 0; step < n; ++step) {
     // The joint with the largest significant excess, if any (joints without a rotor cannot
     // have the twin's backlash: their play is not fitted).
     int best = -1;
     double best_ratio = 0;
     for (int j = 0; j < n; ++j) {
-      if (!(c.rotor_inertia(j) > 0) || c.effects.backlash_width(j) > 0) continue;
+      if (!(c.rotor_inertia(j) > 0) || c.effects.backlash_width(j) > 0 || refused[j]) continue;
       const double excess = fit.measured(j) - fit.simulated(j);
       if (excess > o.sigmas * fit.spread(j) && excess > o.relative * fit.simulated(j) &&
           excess / fit.simulated(j) > best_ratio) {
@@ -199,10 +205,18 @@ BacklashFit fit_backlash(const io::Log& measured, const trajectory::Trajectory& 
     twin::TwinConfig trial = c;
     trial.effects.backlash = true;
     double lo = 0, hi = o.max_width;
-    for (int k = 0; k < o.bisection_steps; ++k) {
-      const double mid = 0.5 * (lo + hi);
-      trial.effects.backlash_width(best) = mid;
-      (simulate(trial, o.seed)(best) < f.measured ? lo : hi) = mid;
+    try {
+      for (int k = 0; k < o.bisection_steps; ++k) {
+        const double mid = 0.5 * (lo + hi);
+        trial.effects.backlash_width(best) = mid;
+        (simulate(trial, o.seed)(best) < f.measured ? lo : hi) = mid;
+      }
+    } catch (const DataError& e) {  // e.g. a joint whose link side has no inertia in the twin
+      refused[best] = true;
+      fit.notes.push_back(fmt::format("joint {}: high-band excess {:.3g} N m not judged ({})", best + 1,
+                                      f.measured - f.simulated_before, e.what()));
+      --step;
+      continue;
     }
     f.width = 0.5 * (lo + hi);
     // A width at the bisection's floor: any play at all overshoots, so play does not explain it.

@@ -33,6 +33,9 @@ struct Diagnosis {
   // the robot's twin description): play per joint and the refined delay.
   bool backlash_judged = false;
   BacklashFit backlash;
+  // When the stage did not run or failed: why (no twin, no references in the log, the
+  // simulation refused the robot...). The stages before it are reported all the same.
+  std::string backlash_note;
 };
 
 // The stack's segments as residual series, with the stacked model torque.

@@ -17,6 +17,7 @@ namespace symoro::diagnose {
 // One held-out trajectory in both studies.
 struct GapTrajectory {
   std::string trajectory;
+  std::string kind;          // closed-loop or open-loop (the same in both studies)
   double interval = 0;                     // s
   int samples = 0;
   double rmse_before = 0, rmse_after = 0;  // N m, accepted parameters, all joints
