@@ -1,8 +1,19 @@
 # Installs symoro as a CMake package: find_package(symoro) gives symoro::core and one
-# symoro::<robot> target per generated robot, header-only over Eigen.
+# symoro::<robot> target per generated robot (header-only over Eigen), and the runtime's stages
+# as static libraries: symoro::io (logs, import), symoro::trajectory, symoro::preprocess,
+# symoro::control, symoro::twin, symoro::identify (OLS, audit, SDP, CLIE, the study),
+# symoro::diagnose, symoro::dynamixel, symoro::hardware, and symoro::runtime (all of them).
 include(CMakePackageConfigHelpers)
 
 install(TARGETS symoro_core EXPORT symoroTargets)
+set(_symoro_exported symoro_runtime)
+foreach(area IN LISTS SYMORO_RUNTIME_AREAS)
+  list(APPEND _symoro_exported symoro_${area})
+  set_target_properties(symoro_${area} PROPERTIES EXPORT_NAME ${area})
+endforeach()
+set_target_properties(symoro_runtime PROPERTIES EXPORT_NAME runtime)
+install(TARGETS ${_symoro_exported} EXPORT symoroTargets
+  ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR})
 install(DIRECTORY "${PROJECT_SOURCE_DIR}/runtime/include/" DESTINATION ${CMAKE_INSTALL_INCLUDEDIR})
 install(EXPORT symoroTargets
   NAMESPACE symoro::
