@@ -25,6 +25,7 @@ int main(int argc, char** argv) {
   app.footer("Robots: " + known);
   add_trajectory_commands(app, common);
   add_twin_commands(app, common);
+  add_import_commands(app, common);
   add_preprocess_commands(app, common);
   add_identify_commands(app, common);
   add_diagnose_commands(app, common);

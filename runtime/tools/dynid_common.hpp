@@ -80,5 +80,6 @@ void add_preprocess_commands(CLI::App& app, Common& common);
 void add_identify_commands(CLI::App& app, Common& common);
 void add_diagnose_commands(CLI::App& app, Common& common);
 void add_control_commands(CLI::App& app, Common& common);
+void add_import_commands(CLI::App& app, Common& common);
 
 }  // namespace symoro::dynid

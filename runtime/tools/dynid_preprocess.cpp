@@ -71,6 +71,11 @@ void add_preprocess_commands(CLI::App& app, Common& common) {
   cmd->add_option("-o,--output", o->out, "Write <log>_<interval>ms.csv samples here");
   cmd->add_option("--cutoff", o->options.derivative_cutoff, "Low-pass cutoff for the derivatives, Hz");
   cmd->add_option("--max-gap", o->options.max_gap, "Longest gap bridged by interpolation, s");
+  cmd->add_option("--base-period", o->options.base_period,
+                  "Grid period, s (default: each log's sample_time, else its median stamp interval)");
+  cmd->add_flag("!--keep-stale", o->options.drop_stale, "Keep stale rows (a state logged twice) in the regression");
+  cmd->add_flag("--logged-velocity", o->options.use_logged_velocity,
+                "qd from the log's qd (filtered), qdd from its differences, instead of both from q");
   cmd->callback([&common, o] { run(common, *o); });
 }
 

@@ -74,7 +74,7 @@ double rms(const Eigen::MatrixXd& a) { return std::sqrt(a.squaredNorm() / static
 Channels lowpassed(Channels x, double interval) {
   const preprocess::Options o;
   const double cutoff = std::min(o.derivative_cutoff, o.anti_alias_fraction * 0.5 / interval);
-  const auto sections = preprocess::butterworth_lowpass(o.filter_order, cutoff, 1 / o.base_period);
+  const auto sections = preprocess::butterworth_lowpass(o.filter_order, cutoff, 1 / 0.001);  // the twin's 1 kHz
   preprocess::filtfilt(sections, preprocess::zero_phase_padding(sections), x);
   return x;
 }

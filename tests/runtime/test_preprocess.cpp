@@ -759,6 +759,184 @@ TEST(PreprocessReport, SummaryIsOneLine) {
   std::printf("  %s\n", line.c_str());
 }
 
+// ---- Stale rows, the base period from the log, the logged velocity ------------------------------
+
+namespace {
+
+// q = 0.8 sin(pi t) rad on exact 1 ms stamps from t = 0, qd its derivative, a smooth tau.
+symoro::io::Log clean_sine_log(double seconds) {
+  const int n = static_cast<int>(std::lround(seconds / kH)) + 1;
+  symoro::io::Log log;
+  log.meta.trajectory = "sine";
+  log.meta.sample_time = kH;
+  log.time.resize(n);
+  log.q.resize(n, 1);
+  log.qd.resize(n, 1);
+  log.tau.resize(n, 1);
+  for (int k = 0; k < n; ++k) {
+    const double t = k * kH;
+    log.time[k] = t;
+    log.q(k, 0) = 0.8 * std::sin(kPi * t);
+    log.qd(k, 0) = 0.8 * kPi * std::cos(kPi * t);
+    log.tau(k, 0) = 1 + 0.3 * std::sin(2 * kPi * 0.7 * t);
+  }
+  return log;
+}
+
+}  // namespace
+
+// A logger hiccup: rows 2001-2005 repeat row 2000 (t = 2 s, where qd = 0.8 pi = 2.51 rad/s and
+// qdd = 0). Kept, they hold q back by qd * i h at the i-th: a raw error of area
+// h * sum_i (q(2) - q(2 + i h)) = -qd h^2 (1 + ... + 5) = -3.77e-5 rad s to first order (the sum
+// itself is the reference). The zero-phase filter has unit DC gain, so the filtered q error keeps
+// that area, spread into a velocity dip. Left out, the 6 ms hole is bridged linearly between
+// t = 2 and 2.006 s, where qdd = 0: the bridge errs by about q3 g^3 / 16 ~ 3e-7 rad at most.
+TEST(PreprocessStale, LeavingOutStaleRowsRemovesTheVelocityDip) {
+  symoro::io::Log log = clean_sine_log(6.0);
+  const int burst = 2000;
+  for (int i = 1; i <= 5; ++i) {
+    log.q.row(burst + i) = log.q.row(burst);
+    log.qd.row(burst + i) = log.qd.row(burst);
+    log.tau.row(burst + i) = log.tau.row(burst);
+  }
+  double expected_area = 0;
+  for (int i = 1; i <= 5; ++i) expected_area += kH * (0.8 * std::sin(kPi * 2.0) - 0.8 * std::sin(kPi * (2.0 + i * kH)));
+  EXPECT_NEAR(expected_area, -0.8 * kPi * kH * kH * 15, 1e-9);
+
+  struct Outcome {
+    double area = 0, qd_max = 0;
+    pp::Report report;
+  };
+  const auto run = [&](bool drop) {
+    pp::Options o;
+    o.drop_stale = drop;
+    const pp::Samples s = pp::preprocess(log, kH, o);
+    Outcome out;
+    out.report = s.report;
+    for (int i = 0; i < s.time.size(); ++i) {
+      const double t = s.time[i];
+      if (t < 0.5 || t > 5.5) continue;  // 18 filter time constants from either end
+      if (std::abs(t - 2.0025) < 0.3) out.area += kH * (s.q(i, 0) - 0.8 * std::sin(kPi * t));
+      out.qd_max = std::max(out.qd_max, std::abs(s.qd(i, 0) - 0.8 * kPi * std::cos(kPi * t)));
+    }
+    return out;
+  };
+  const Outcome kept = run(false), dropped = run(true);
+  EXPECT_EQ(kept.report.stale_rows, 0);
+  EXPECT_EQ(dropped.report.stale_rows, 5);
+  EXPECT_EQ(dropped.report.missing_samples, 5);
+  EXPECT_EQ(dropped.report.gaps_bridged, 1);
+  EXPECT_EQ(dropped.report.raw_samples, 6001);
+  EXPECT_NE(dropped.report.summary().find("5 stale rows left out"), std::string::npos) << dropped.report.summary();
+  // Kept: the hand-derived area, to 1 % (the tails beyond 0.3 s are e^-10 of it).
+  EXPECT_NEAR(kept.area / expected_area, 1.0, 0.01);
+  EXPECT_GT(kept.qd_max, 0.02);
+  // Left out: no area and no dip (the filtered sine's own error is ~1e-12).
+  EXPECT_LT(std::abs(dropped.area), 1e-3 * std::abs(expected_area));
+  EXPECT_LT(dropped.qd_max, 1e-3);
+  std::printf("  stale burst: area %.3g (hand %.3g) -> %.2g; qd max error %.3g -> %.2g rad/s\n", kept.area,
+              expected_area, dropped.area, kept.qd_max, dropped.qd_max);
+}
+
+// An arm at rest repeats q, tau and a zero qd: not a stale read, nothing is left out.
+TEST(PreprocessStale, RestIsNotStale) {
+  symoro::io::Log log = clean_sine_log(2.0);
+  log.q.setConstant(0.25);
+  log.qd.setZero();
+  log.tau.setConstant(1.5);
+  const pp::Samples s = pp::preprocess(log, 0.010);
+  EXPECT_EQ(s.report.stale_rows, 0);
+  EXPECT_EQ(s.report.pieces, 1);
+  EXPECT_EQ(s.report.kept_samples, 201);
+  EXPECT_LT((s.q.array() - 0.25).abs().maxCoeff(), 1e-12);
+}
+
+// A 500 Hz log: the grid is its sample_time (2 ms), and 10 ms keeps every 5th grid sample. The
+// same log without a sample_time gets the same period from its stamps (every 4th is off by
+// 30 us, so half the intervals are 2 ms: the median rounds to 2 ms). q = 0.5 sin(2 pi 0.4 t):
+// linear interpolation of the jitter errs by at most qdd h^2 / 8 = 8e-7 rad.
+TEST(PreprocessBasePeriod, FromTheLogsSampleTime) {
+  const double h = 0.002, w = 2 * kPi * 0.4;
+  const int n = 5001;  // 10 s
+  symoro::io::Log log;
+  log.meta.trajectory = "slow";
+  log.meta.sample_time = h;
+  log.time.resize(n);
+  log.q.resize(n, 1);
+  log.qd.resize(n, 1);
+  log.tau.resize(n, 1);
+  for (int k = 0; k < n; ++k) {
+    const double t = k * h + (k % 4 == 2 ? 30e-6 : 0.0);
+    log.time[k] = t;
+    log.q(k, 0) = 0.5 * std::sin(w * t);
+    log.qd(k, 0) = 0.5 * w * std::cos(w * t);
+    log.tau(k, 0) = std::cos(w * t);
+  }
+  const pp::Samples s = pp::preprocess(log, 0.010);
+  EXPECT_EQ(s.report.base_period, 0.002);
+  ASSERT_EQ(s.time.size(), 1001);  // 0, 10, ..., 10000 ms
+  double q_error = 0, qd_error = 0;
+  for (int i = 0; i < s.time.size(); ++i) {
+    EXPECT_NEAR(s.time[i], i * 0.010, 1e-12);
+    if (s.time[i] < 0.5 || s.time[i] > 9.5) continue;
+    q_error = std::max(q_error, std::abs(s.q(i, 0) - 0.5 * std::sin(w * s.time[i])));
+    qd_error = std::max(qd_error, std::abs(s.qd(i, 0) - 0.5 * w * std::cos(w * s.time[i])));
+  }
+  EXPECT_LT(q_error, 1e-5);
+  EXPECT_LT(qd_error, 1e-3);
+
+  symoro::io::Log unstated = log;
+  unstated.meta.sample_time = 0;
+  const pp::Samples u = pp::preprocess(unstated, 0.010);
+  EXPECT_EQ(u.report.base_period, 0.002);
+  EXPECT_EQ(u.q, s.q);
+
+  pp::Options forced;
+  forced.base_period = 0.001;  // a flag may force a period; here it contradicts the stamps
+  EXPECT_THROW(pp::preprocess(log, 0.010, forced), DataError);
+  try {
+    pp::preprocess(log, 0.011);
+    ADD_FAILURE() << "11 ms accepted on a 2 ms grid";
+  } catch (const DataError& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("base period 0.002 s (the log's sample_time); nearest valid intervals: 0.01 s and 0.012 s"),
+              std::string::npos)
+        << what;
+  }
+}
+
+// qd from the log (exact here) instead of differences of a 12-bit q: the filtered logged
+// velocity errs by the jitter's interpolation, qd'' h^2 / 8 = 3e-6 rad/s, times the filter's
+// ||h||_1 = 1.38; differentiating the quantized q leaves ~4e-3 rad/s of noise instead.
+TEST(PreprocessLoggedVelocity, FollowsTheAnalyticVelocity) {
+  Motion m;
+  m.sinusoids = {{0.8, 0.5, 0.3}};
+  Recording r;
+  r.duration = 8;
+  const symoro::io::Log log = record({m}, r);
+  pp::Options logged;
+  logged.use_logged_velocity = true;
+  const pp::Samples a = pp::preprocess(log, 0.010, logged), b = pp::preprocess(log, 0.010);
+  double qd_logged = 0, qdd_logged = 0, qd_differenced = 0;
+  for (int i = 0; i < a.time.size(); ++i) {
+    const double t = a.time[i] - r.start;
+    if (t < 0.5 || t > r.duration - 0.5) continue;
+    qd_logged = std::max(qd_logged, std::abs(a.qd(i, 0) - m.eval(t, 1)));
+    qdd_logged = std::max(qdd_logged, std::abs(a.qdd(i, 0) - m.eval(t, 2)));
+    qd_differenced = std::max(qd_differenced, std::abs(b.qd(i, 0) - m.eval(t, 1)));
+  }
+  EXPECT_LT(qd_logged, 1e-5);
+  EXPECT_LT(qdd_logged, 1e-3);
+  EXPECT_GT(qd_differenced, 10 * qd_logged);
+  EXPECT_EQ(a.q, b.q);  // q is unaffected
+  std::printf("  logged velocity: qd max error %.2g, qdd %.2g; from q: qd %.2g rad/s\n", qd_logged, qdd_logged,
+              qd_differenced);
+
+  symoro::io::Log differentiated = log;
+  differentiated.meta.velocity = symoro::io::Velocity::differentiated;
+  EXPECT_THROW(pp::preprocess(differentiated, 0.010, logged), DataError);
+}
+
 // ---- Speed (run with --gtest_also_run_disabled_tests; no timed assertion) -----------------------
 
 TEST(PreprocessSpeed, DISABLED_EightJointsHundredTenSeconds) {

@@ -33,9 +33,11 @@ SampleGrid sample_grid(const preprocess::Samples& measured, double period, int c
 
   // Exactly the low-pass preprocess() applied to the measured tau (preprocess.cpp).
   const preprocess::Options& o = options.preprocess;
-  if (!(std::abs(period - o.base_period) <= 1e-9 * period))
+  // The period the samples were preprocessed on (the log's own unless the options force one).
+  const double base = measured.report.base_period > 0 ? measured.report.base_period : o.base_period;
+  if (!(std::abs(period - base) <= 1e-9 * period))
     throw std::invalid_argument(fmt::format("CLIE: the control period {} s differs from the preprocessing base period {} s",
-                                            period, o.base_period));
+                                            period, base));
   const double cutoff = std::min(o.derivative_cutoff, o.anti_alias_fraction * 0.5 / measured.interval);
   if (measured.report.cutoff > 0 && !(std::abs(measured.report.cutoff - cutoff) <= 1e-9 * cutoff))
     throw std::invalid_argument(fmt::format(

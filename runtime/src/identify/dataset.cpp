@@ -1,11 +1,25 @@
 #include "symoro/identify/dataset.hpp"
 
+#include <cmath>
+
 #include <fmt/format.h>
 #include <yaml-cpp/yaml.h>
 
 #include "symoro/error.hpp"
+#include "symoro/io/number_text.hpp"
 
 namespace symoro::identify {
+
+namespace {
+
+// The given rows of `m`, in order.
+Eigen::MatrixXd rows_of(const Eigen::MatrixXd& m, const std::vector<Eigen::Index>& rows) {
+  Eigen::MatrixXd out(static_cast<Eigen::Index>(rows.size()), m.cols());
+  for (std::size_t i = 0; i < rows.size(); ++i) out.row(static_cast<Eigen::Index>(i)) = m.row(rows[i]);
+  return out;
+}
+
+}  // namespace
 
 const DatasetRun& Dataset::find(const std::string& trajectory, int trial) const {
   for (const DatasetRun& r : runs)
@@ -16,7 +30,7 @@ const DatasetRun& Dataset::find(const std::string& trajectory, int trial) const 
 Dataset read_dataset(const std::filesystem::path& dir) {
   const auto manifest = dir / "dataset.yaml";
   if (!std::filesystem::exists(manifest))
-    throw DataError(manifest.string(), 0, "not found: a dataset folder holds dataset.yaml (made by dynid twin dataset)");
+    throw DataError(manifest.string(), 0, "not found: a dataset folder holds dataset.yaml (made by dynid twin dataset or dynid import)");
   Dataset d;
   d.dir = std::filesystem::absolute(dir);
   YAML::Node root;
@@ -29,7 +43,9 @@ Dataset read_dataset(const std::filesystem::path& dir) {
   try {
     if (!root["runs"] || !root["runs"].IsSequence()) throw DataError(manifest.string(), line(root), "'runs' list missing");
     d.robot = root["robot"] ? root["robot"].as<std::string>() : "";
+    if (root["robot"]) d.robot_line = line(root["robot"]);
     d.twin = root["twin"] ? root["twin"].as<std::string>() : "";
+    d.source = root["source"] ? root["source"].as<std::string>() : "";
     if (root["twin_overrides"]) {  // kept in the dataset folder, so the hidden effects travel with it
       d.twin_overrides = (d.dir / root["twin_overrides"].as<std::string>()).string();
       if (!std::filesystem::exists(d.twin_overrides))
@@ -43,12 +59,48 @@ Dataset read_dataset(const std::filesystem::path& dir) {
                      d.dir / r["file"].as<std::string>()};
       if (!std::filesystem::exists(run.file))
         throw DataError(manifest.string(), line(r), fmt::format("listed file {} does not exist", run.file.string()));
+      if (const YAML::Node w = r["window"]) {
+        if (!w.IsSequence() || w.size() != 2)
+          throw DataError(manifest.string(), line(w), "window: expected [start, end] in seconds of log time");
+        run.window_start = w[0].as<double>();
+        run.window_end = w[1].as<double>();
+        if (std::isnan(run.window_start) || std::isnan(run.window_end) || !(run.window_start < run.window_end))
+          throw DataError(manifest.string(), line(w),
+                          fmt::format("window: [{}, {}] is not an interval (start < end)",
+                                      io::number_text(run.window_start), io::number_text(run.window_end)));
+      }
       d.runs.push_back(std::move(run));
     }
   } catch (const YAML::Exception& e) {
     throw DataError(manifest.string(), e.mark.line + 1, e.msg);
   }
   return d;
+}
+
+io::Log read_run_log(const DatasetRun& run) {
+  io::Log log = io::read_log(run.file);
+  const bool whole = std::isinf(run.window_start) && run.window_start < 0 && std::isinf(run.window_end) && run.window_end > 0;
+  log.meta.trajectory = run.trajectory;
+  if (whole) return log;
+  std::vector<Eigen::Index> rows;
+  for (Eigen::Index k = 0; k < log.samples(); ++k)
+    if (run.window_start <= log.time[k] && log.time[k] < run.window_end) rows.push_back(k);
+  if (rows.empty())
+    throw DataError(run.file.string(), 0,
+                    fmt::format("run {}: its window [{}, {}) s holds none of the log's samples ({} to {} s)",
+                                run.trajectory, io::number_text(run.window_start), io::number_text(run.window_end),
+                                io::number_text(log.time[0]), io::number_text(log.time[log.samples() - 1])));
+  Eigen::VectorXd time(static_cast<Eigen::Index>(rows.size()));
+  for (std::size_t i = 0; i < rows.size(); ++i) time[static_cast<Eigen::Index>(i)] = log.time[rows[i]];
+  log.time = std::move(time);
+  for (Eigen::MatrixXd* m : {&log.q, &log.qd, &log.tau, &log.q_ref, &log.qd_ref, &log.qdd_ref}) *m = rows_of(*m, rows);
+  return log;
+}
+
+void check_dataset_robot(const Dataset& dataset, const std::string& robot) {
+  if (dataset.robot.empty() || dataset.robot == robot) return;
+  throw DataError((dataset.dir / "dataset.yaml").string(), dataset.robot_line,
+                  fmt::format("the dataset was made for robot '{}', not '{}'", dataset.robot, robot));
 }
 
 }  // namespace symoro::identify

@@ -19,11 +19,12 @@ namespace symoro::io::detail {
 
 namespace {
 
-constexpr std::array<std::string_view, 11> sidecar_keys = {"format",      "robot",   "trajectory", "trial",
-                                                           "seed",        "source",  "sample_time", "samples",
-                                                           "joints",      "units",   "notes"};
+constexpr std::array<std::string_view, 12> sidecar_keys = {"format",  "robot",  "trajectory",  "trial",
+                                                           "seed",    "source", "sample_time", "samples",
+                                                           "joints",  "units",  "notes",       "velocity"};
 // Keys a sidecar may leave out (everything else the writer always writes is required).
-constexpr std::array<std::string_view, 1> optional_keys = {"notes"};
+// "velocity" is written only when differentiated, so older sidecars stay byte for byte the same.
+constexpr std::array<std::string_view, 2> optional_keys = {"notes", "velocity"};
 
 int line_of(const YAML::Node& node) {
   const YAML::Mark mark = node.Mark();
@@ -130,6 +131,15 @@ Sidecar read_sidecar(const std::filesystem::path& yaml) {
   if (meta.sample_time <= 0)
     reader.fail(value("sample_time"), fmt::format("sample_time: {} s is not positive", number_text(meta.sample_time)));
   if (values.count("notes")) meta.notes = reader.text(value("notes"), "notes");
+  if (values.count("velocity")) {
+    const std::string velocity = reader.text(value("velocity"), "velocity");
+    if (velocity == "measured")
+      meta.velocity = Velocity::measured;
+    else if (velocity == "differentiated")
+      meta.velocity = Velocity::differentiated;
+    else
+      reader.fail(value("velocity"), fmt::format("velocity: '{}' is neither measured nor differentiated", velocity));
+  }
 
   const YAML::Node samples = value("samples");
   sidecar.samples = reader.integer<long long>(samples, "samples");
@@ -190,6 +200,8 @@ std::string sidecar_text(const Log& log, const std::string& file) {
   for (Group g : groups_of(log)) out << YAML::Key << std::string(group_name(g)) << YAML::Value << std::string(group_unit(g));
   out << YAML::EndMap;
   out << YAML::Key << "notes" << YAML::Value << YAML::DoubleQuoted << meta.notes;
+  if (meta.velocity == Velocity::differentiated)
+    out << YAML::Key << "velocity" << YAML::Value << "differentiated";
   out << YAML::EndMap;
   if (!out.good()) throw DataError(file, 0, "cannot write the metadata sidecar: " + out.GetLastError());
   return std::string(out.c_str()) + "\n";

@@ -2,12 +2,14 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <stdexcept>
 #include <utility>
 
 #include <fmt/format.h>
 
 #include "symoro/error.hpp"
+#include "symoro/io/import.hpp"
 #include "symoro/preprocess/butterworth.hpp"
 #include "symoro/preprocess/channels.hpp"
 #include "symoro/preprocess/derivatives.hpp"
@@ -20,11 +22,52 @@ namespace symoro::preprocess {
 namespace {
 
 void validate_options(const Options& o) {
-  if (!(o.base_period > 0) || !(o.max_gap > 0) || o.filter_order < 1 ||
+  if (!(o.base_period >= 0) || !std::isfinite(o.base_period) || !(o.max_gap > 0) || o.filter_order < 1 ||
       !(o.derivative_cutoff > 0) || !(o.anti_alias_fraction > 0) || !(o.anti_alias_fraction <= 1))
     throw std::invalid_argument(
-        "preprocess options: base_period, max_gap, derivative_cutoff must be positive, "
-        "filter_order >= 1 and anti_alias_fraction in (0, 1]");
+        "preprocess options: base_period >= 0 (0: the log's), max_gap, derivative_cutoff "
+        "positive, filter_order >= 1 and anti_alias_fraction in (0, 1]");
+}
+
+bool same_row(const Eigen::MatrixXd& m, Eigen::Index k) {
+  for (Eigen::Index j = 0; j < m.cols(); ++j)
+    if (std::memcmp(&m.coeffRef(k, j), &m.coeffRef(k - 1, j), sizeof(double)) != 0) return false;
+  return true;
+}
+
+// Rows that repeat the previous one (Options::drop_stale). qd decides only when measured: a
+// differentiated qd says nothing about the read.
+std::vector<bool> stale_rows(const io::Log& log) {
+  const bool measured_qd = log.meta.velocity == io::Velocity::measured && log.qd.cols() == log.q.cols() &&
+                           log.qd.rows() == log.q.rows();
+  std::vector<bool> stale(static_cast<std::size_t>(log.samples()), false);
+  for (Eigen::Index k = 1; k < log.samples(); ++k) {
+    if (!same_row(log.q, k) || !same_row(log.tau, k)) continue;
+    if (measured_qd && (!same_row(log.qd, k) || (log.qd.row(k).array() == 0).all())) continue;  // moved, or at rest
+    stale[static_cast<std::size_t>(k)] = true;
+  }
+  return stale;
+}
+
+// The log without the flagged rows (only what preprocessing reads).
+io::Log without_rows(const io::Log& log, const std::vector<bool>& drop, bool with_qd) {
+  std::vector<Eigen::Index> keep;
+  for (Eigen::Index k = 0; k < log.samples(); ++k)
+    if (!drop[static_cast<std::size_t>(k)]) keep.push_back(k);
+  io::Log out;
+  out.meta = log.meta;
+  const auto n = static_cast<Eigen::Index>(keep.size());
+  out.time.resize(n);
+  out.q.resize(n, log.q.cols());
+  out.tau.resize(n, log.tau.cols());
+  if (with_qd) out.qd.resize(n, log.qd.cols());
+  for (Eigen::Index i = 0; i < n; ++i) {
+    out.time[i] = log.time[keep[i]];
+    out.q.row(i) = log.q.row(keep[i]);
+    out.tau.row(i) = log.tau.row(keep[i]);
+    if (with_qd) out.qd.row(i) = log.qd.row(keep[i]);
+  }
+  return out;
 }
 
 void validate_signals(const io::Log& log, const std::string& source) {
@@ -55,18 +98,43 @@ struct PieceSamples {
 
 }  // namespace
 
-Samples preprocess(const io::Log& log, double interval, const Options& options) {
-  const std::string source = log.meta.trajectory.empty() ? "log" : log.meta.trajectory;
+double base_period(const io::Log& log, const Options& options) {
+  if (options.base_period > 0) return options.base_period;
+  if (log.meta.sample_time > 0) return log.meta.sample_time;
+  return io::median_sample_time(log.time, log.meta.trajectory.empty() ? "log" : log.meta.trajectory);
+}
+
+Samples preprocess(const io::Log& raw, double interval, const Options& options) {
+  const std::string source = raw.meta.trajectory.empty() ? "log" : raw.meta.trajectory;
   validate_options(options);
-  const int stride = target_stride(interval, options.base_period, source);
-  validate_signals(log, source);
+  const double period = base_period(raw, options);
+  const std::string origin = options.base_period > 0  ? "set in the options"
+                             : raw.meta.sample_time > 0 ? "the log's sample_time"
+                                                        : "the log's median stamp interval";
+  const int stride = target_stride(interval, period, source, origin);
+  validate_signals(raw, source);
+  if (options.use_logged_velocity) {
+    if (raw.meta.velocity == io::Velocity::differentiated)
+      throw DataError(source, 0, "the log's velocity was differentiated from q at import, not measured: "
+                                 "it cannot stand for a logged velocity (use_logged_velocity)");
+    if (raw.qd.cols() != raw.q.cols() || raw.qd.rows() != raw.q.rows() || !raw.qd.allFinite())
+      throw DataError(source, 0, "use_logged_velocity: the log's qd is missing, of another shape than q, or not finite");
+  }
 
   Samples out;
   out.interval = interval;
   Report& report = out.report;
-  report.raw_samples = log.samples();
-  const StampAnalysis stamps =
-      analyse_stamps(log.time, options.base_period, options.max_gap, source);
+  report.raw_samples = raw.samples();
+  report.base_period = period;
+  // Stale rows become missing samples of the time axis: the rest of the pipeline never sees them.
+  io::Log fresh_log;
+  if (options.drop_stale) {
+    const std::vector<bool> stale = stale_rows(raw);
+    report.stale_rows = static_cast<int>(std::count(stale.begin(), stale.end(), true));
+    if (report.stale_rows > 0) fresh_log = without_rows(raw, stale, options.use_logged_velocity);
+  }
+  const io::Log& log = report.stale_rows > 0 ? fresh_log : raw;
+  const StampAnalysis stamps = analyse_stamps(log.time, period, options.max_gap, source);
   report.irregular_stamps = stamps.irregular_stamps;
   report.gaps_bridged = stamps.gaps_bridged;
   report.missing_samples = stamps.missing_samples;
@@ -75,8 +143,7 @@ Samples preprocess(const io::Log& log, double interval, const Options& options) 
 
   // One filter for q and tau alike, so the regressor and the torque see the same low-pass.
   report.cutoff = std::min(options.derivative_cutoff, options.anti_alias_fraction * 0.5 / interval);
-  const auto sections =
-      butterworth_lowpass(options.filter_order, report.cutoff, 1 / options.base_period);
+  const auto sections = butterworth_lowpass(options.filter_order, report.cutoff, 1 / period);
   const int padding = zero_phase_padding(sections);
   const int min_samples = std::max(padding + 1, 4);  // padding < length; 4 for the differences
 
@@ -99,7 +166,15 @@ Samples preprocess(const io::Log& log, double interval, const Options& options) 
     filtfilt(sections, padding, tau);
 
     const std::vector<int> rows = target_rows(piece.first_index, piece.grid_samples(), stride);
-    Derivatives d = finite_differences(q, options.base_period, rows);
+    Derivatives d = finite_differences(q, period, rows);
+    if (options.use_logged_velocity) {
+      // The logged velocity through the filter q had; its difference is the acceleration.
+      Channels qd = interpolation.apply(log.qd);
+      filtfilt(sections, padding, qd);
+      Derivatives v = finite_differences(qd, period, rows);
+      for (std::size_t i = 0; i < rows.size(); ++i) d.first.row(static_cast<Eigen::Index>(i)) = qd.row(rows[i]);
+      d.second = std::move(v.first);
+    }
     PieceSamples p;
     p.piece = static_cast<int>(k);
     p.q.resize(rows.size(), joints);
@@ -117,7 +192,7 @@ Samples preprocess(const io::Log& log, double interval, const Options& options) 
     throw DataError(source, 0,
                     fmt::format("log too short for the filter: the longest piece has {} samples "
                                 "of {} s, a {:.3g} Hz order-{} zero-phase filter needs at least {}",
-                                longest, options.base_period, report.cutoff, options.filter_order,
+                                longest, period, report.cutoff, options.filter_order,
                                 min_samples));
 
   Eigen::Index total = 0;
@@ -146,10 +221,10 @@ Samples preprocess(const io::Log& log, double interval, const Options& options) 
 
 std::string Report::summary() const {
   std::string line = fmt::format(
-      "{} raw samples (stamps within {:.3f} ms of the grid, {} irregular intervals), {} gaps "
-      "bridged ({} samples filled in), {} piece{}",
-      raw_samples, max_stamp_deviation * 1e3, irregular_stamps, gaps_bridged, missing_samples,
-      pieces, pieces == 1 ? "" : "s");
+      "{} raw samples on a {:.6g} ms grid (stamps within {:.3f} ms of it, {} irregular "
+      "intervals), {} stale rows left out, {} gaps bridged ({} samples filled in), {} piece{}",
+      raw_samples, base_period * 1e3, max_stamp_deviation * 1e3, irregular_stamps, stale_rows,
+      gaps_bridged, missing_samples, pieces, pieces == 1 ? "" : "s");
   if (dropped_pieces > 0)
     line += fmt::format(" ({} too short for the filter dropped with {} samples)", dropped_pieces,
                         dropped_samples);

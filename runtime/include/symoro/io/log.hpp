@@ -2,7 +2,8 @@
 //
 //   <name>.csv        time,q1..qn,qd1..qdn,tau1..taun[,q_ref1..,qd_ref1..,qdd_ref1..]
 //   <name>.meta.yaml  format: symoro-log 1, robot, trajectory, trial, seed, source,
-//                     sample_time, samples (the CSV's row count), joints, units, notes
+//                     sample_time, samples (the CSV's row count), joints, units, notes,
+//                     velocity (optional: measured | differentiated; absent = measured)
 //
 // Columns may come in any order; they are matched by name. The three reference groups come
 // together or not at all. Units are SI: s, rad (m for a prismatic joint), rad/s, N m (N); the
@@ -33,6 +34,10 @@
 
 namespace symoro::io {
 
+// Where a log's qd columns come from. The format requires them; a log imported without
+// velocities has them differentiated from q, which preprocessing must not take for a measurement.
+enum class Velocity { measured, differentiated };
+
 struct LogMetadata {
   std::string robot;        // robots/<robot>
   std::string trajectory;   // e.g. "AG02"
@@ -42,6 +47,7 @@ struct LogMetadata {
   double sample_time = 0;   // nominal control period, s (e.g. 0.001)
   std::vector<std::string> joints;  // joint names, in column order 1..n
   std::string notes;        // free text (e.g. the twin configuration used)
+  Velocity velocity = Velocity::measured;  // sidecar key written only when differentiated
 };
 
 // Samples are rows: time(k), q(k, j). Reference matrices have 0 columns when the log has none.

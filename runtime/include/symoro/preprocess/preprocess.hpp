@@ -13,7 +13,9 @@
 namespace symoro::preprocess {
 
 struct Options {
-  double base_period = 0.001;  // s, the uniform grid of the corrected time axis
+  // s, the uniform grid of the corrected time axis. 0: the log's sidecar sample_time, or when
+  // it has none its median stamp interval rounded to the microsecond; > 0 forces a period.
+  double base_period = 0;
   // Gaps (dropped samples) up to this length are bridged by interpolation; longer gaps split
   // the log into separately processed pieces. Both are counted in the Report.
   double max_gap = 0.01;  // s (bridging error grows as gap^3: 0.08 rad/s^2 of qdd at 10 ms)
@@ -22,10 +24,26 @@ struct Options {
   // same filter): cutoff = min(derivative_cutoff, anti_alias_fraction * target Nyquist).
   double derivative_cutoff = 15.0;    // Hz
   double anti_alias_fraction = 0.8;
+  // Rows whose q, qd and tau repeat the previous row bit for bit (qd compared only when it
+  // was measured) are the logger reading one state twice: their stamp is not the state's
+  // instant. They are left out as missing samples (bridged, or splitting the log when their
+  // run is longer than max_gap). A repeat with every measured qd exactly 0 is the arm at rest,
+  // not a stale read, and stays.
+  bool drop_stale = true;
+  // qd from the log's qd (through the same interpolation and filter as q) and qdd from its
+  // differences, instead of both from q. DataError when the log's velocity was differentiated
+  // at import (no measurement to use).
+  bool use_logged_velocity = false;
 };
+
+// The base period preprocess() uses for `log`: options.base_period when positive, else the
+// sidecar's sample_time, else the median stamp interval rounded to 1 us.
+double base_period(const io::Log& log, const Options& options);
 
 struct Report {
   int raw_samples = 0;
+  double base_period = 0;     // s, the grid used (see base_period())
+  int stale_rows = 0;         // repeated rows left out (Options::drop_stale)
   int irregular_stamps = 0;   // intervals deviating from base_period by more than 10 %
   int gaps_bridged = 0;       // gaps longer than 1.5 base periods and up to max_gap
   int missing_samples = 0;    // base-grid samples filled in across bridged gaps
@@ -50,7 +68,7 @@ struct Samples {
 };
 
 // Throws DataError when the log cannot give samples at this interval (too short, interval
-// not a multiple of base_period) or is inconsistent: time not strictly increasing, a value not
+// not a multiple of the base period: the message lists the nearest valid ones) or is inconsistent: time not strictly increasing, a value not
 // finite, q and tau of different shapes, stamps whose median interval is not base_period within
 // 10 %. The error names meta.trajectory (or "log") with line 0. Options outside their ranges
 // throw std::invalid_argument. Stages: preprocess/time_axis.hpp, butterworth.hpp,

@@ -9,8 +9,10 @@
 namespace symoro::preprocess {
 
 // Base periods per target interval. Throws DataError(source, 0, ...) unless interval is a
-// positive integer multiple of base_period within 1e-9 (relative to base_period).
-int target_stride(double interval, double base_period, const std::string& source);
+// positive integer multiple of base_period within 1e-9 (relative to base_period); the message
+// names the nearest valid intervals and, when given, where the period came from.
+int target_stride(double interval, double base_period, const std::string& source,
+                  const std::string& period_origin = "");
 
 // Rows of a piece (its first row at grid index first_index, `rows` rows) whose grid index is a
 // multiple of stride: the piece's samples on the target grid, in order.

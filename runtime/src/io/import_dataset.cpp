@@ -1,0 +1,154 @@
+// A dataset folder from imported files: one log per input, import.yaml (the mapping and what
+// each input gave), dataset.yaml last (docs/dataset.md). Every input is checked before the
+// first file is written, and no existing file is replaced.
+#include <cmath>
+#include <limits>
+#include <set>
+
+#include <fmt/format.h>
+
+#include "symoro/error.hpp"
+#include "symoro/io/atomic_file.hpp"
+#include "symoro/io/import.hpp"
+#include "symoro/io/number_text.hpp"
+
+namespace symoro::io {
+
+namespace {
+
+// A YAML double-quoted string.
+std::string quoted(const std::string& s) {
+  std::string out = "\"";
+  for (char c : s) {
+    if (c == '"' || c == '\\') out += '\\';
+    if (c == '\n') {
+      out += "\\n";
+      continue;
+    }
+    out += c;
+  }
+  return out + "\"";
+}
+
+// Shortest round-trip text; infinities as YAML writes them.
+std::string yaml_number(double v) {
+  if (std::isinf(v)) return v > 0 ? ".inf" : "-.inf";
+  return number_text(v);
+}
+
+std::string line_list(const std::vector<int>& lines) {
+  std::string out = "[";
+  for (std::size_t i = 0; i < lines.size(); ++i) out += (i ? ", " : "") + std::to_string(lines[i]);
+  return out + "]";
+}
+
+bool valid_name(const std::string& name) {
+  if (name.empty() || name == "." || name == "..") return false;
+  for (char c : name)
+    if (c == '/' || c == '\\' || static_cast<unsigned char>(c) < 0x20) return false;
+  return true;
+}
+
+}  // namespace
+
+DatasetImportResult import_dataset(const std::filesystem::path& out, const DatasetImport& import) {
+  namespace fs = std::filesystem;
+  if (import.inputs.empty()) throw DataError(out.string(), 0, "nothing to import: no input files");
+  if (!(import.split >= 0 && import.split < 1))
+    throw DataError(import.mapping.origin, 0, fmt::format("split {} is not a fraction in (0, 1) (0: no split)", import.split));
+
+  DatasetImportResult result;
+  std::set<std::string> names;
+  for (const ImportInput& in : import.inputs) {
+    ImportedLog imported = import_log(in.file, import.mapping, import.target);
+    const std::string name = in.name.empty() ? in.file.stem().string() : in.name;
+    if (!valid_name(name)) throw DataError(in.file.string(), 0, fmt::format("'{}' cannot name a run (a file name)", name));
+    imported.log.meta.trajectory = name;
+    const fs::path csv = out / (name + ".csv");
+    const bool split = import.split > 0 && !in.heldout;
+    for (const std::string& run : split ? std::vector<std::string>{name, name + "_heldout"} : std::vector<std::string>{name})
+      if (!names.insert(run).second)
+        throw DataError(in.file.string(), 0, fmt::format("run name '{}' is used twice (name the inputs apart)", run));
+    const Log& log = imported.log;
+    if (!split) {
+      result.runs.push_back({name, in.heldout ? "V" : "F", csv, -std::numeric_limits<double>::infinity(),
+                             std::numeric_limits<double>::infinity()});
+    } else {
+      // By time: the first `split` of the run's span fits, the rest is held out.
+      const double t0 = log.time[0], t1 = log.time[log.samples() - 1];
+      const double cut = t0 + import.split * (t1 - t0);
+      const Eigen::Index fitting = (log.time.array() < cut).count();
+      if (fitting == 0 || fitting == log.samples())
+        throw DataError(in.file.string(), 0,
+                        fmt::format("split {} at {} s leaves an empty part of the {} samples", import.split,
+                                    number_text(cut), log.samples()));
+      result.runs.push_back({name, "F", csv, t0, cut});
+      result.runs.push_back({name + "_heldout", "V", csv, cut, std::numeric_limits<double>::infinity()});
+    }
+    result.logs.push_back(std::move(imported));
+  }
+
+  // Never replace a file: an earlier import or recording in this folder stays as it was.
+  const fs::path manifest = out / "dataset.yaml", record = out / "import.yaml";
+  std::vector<fs::path> targets{manifest, record};
+  for (const ImportedLog& l : result.logs) {
+    const fs::path csv = out / (l.log.meta.trajectory + ".csv");
+    targets.push_back(csv);
+    targets.push_back(metadata_path(csv));
+  }
+  for (const fs::path& t : targets)
+    if (fs::exists(t)) throw DataError(t.string(), 0, "exists already; the importer never replaces a file (choose a new folder)");
+  std::error_code ec;
+  fs::create_directories(out, ec);
+  if (ec) throw DataError(out.string(), 0, "cannot create the dataset folder: " + ec.message());
+
+  for (const ImportedLog& l : result.logs) write_log(out / (l.log.meta.trajectory + ".csv"), l.log);
+
+  // import.yaml: the mapping (reusable as --mapping) and what each input gave.
+  std::string text = import_mapping_yaml(import.mapping);
+  text += fmt::format("imported:\n  robot: {}\n  split: {}\n  inputs:\n", quoted(import.target.robot),
+                      number_text(import.split));
+  for (const ImportedLog& l : result.logs) {
+    text += fmt::format("    - input: {}\n      log: {}\n      rows: {}\n      written: {}\n", quoted(fs::absolute(l.input).string()),
+                        quoted(l.log.meta.trajectory + ".csv"), l.rows, l.log.samples());
+    text += fmt::format("      stale_rows: {}\n      stale_lines: {}\n", l.stale_lines.size(), line_list(l.stale_lines));
+    text += fmt::format("      duplicate_rows: {}\n      duplicate_lines: {}\n", l.duplicate_lines.size(),
+                        line_list(l.duplicate_lines));
+    text += fmt::format("      sample_time: {}\n      velocity: {}\n      columns:\n", number_text(l.log.meta.sample_time),
+                        l.log.meta.velocity == Velocity::measured ? "measured" : "differentiated");
+    for (const auto& [column, source] : l.columns) text += fmt::format("        {}: {}\n", column, quoted(source));
+  }
+  write_file_atomically(record, text);
+
+  // dataset.yaml last: it lists only files already in place.
+  int rows = 0, written = 0, stale = 0, duplicates = 0;
+  for (const ImportedLog& l : result.logs) {
+    rows += l.rows;
+    written += l.log.samples();
+    stale += static_cast<int>(l.stale_lines.size());
+    duplicates += static_cast<int>(l.duplicate_lines.size());
+  }
+  text = fmt::format("format: symoro-dataset 1\nrobot: {}\nsource: imported\n", quoted(import.target.robot));
+  if (import.split > 0) text += fmt::format("split: {}\n", number_text(import.split));
+  text += fmt::format("import: {{inputs: {}, rows: {}, written: {}, stale_rows: {}, duplicate_rows: {}}}\n",
+                      result.logs.size(), rows, written, stale, duplicates);
+  text += "imported:\n";
+  for (const ImportedLog& l : result.logs)
+    text += fmt::format("  - {{file: {}, rows: {}, stale_rows: {}, duplicate_rows: {}, sample_time: {}, velocity: {}}}\n",
+                        quoted(l.log.meta.trajectory + ".csv"), l.rows, l.stale_lines.size(), l.duplicate_lines.size(),
+                        number_text(l.log.meta.sample_time),
+                        l.log.meta.velocity == Velocity::measured ? "measured" : "differentiated");
+  text += "runs:\n";
+  for (const DatasetImportResult::Run& r : result.runs) {
+    text += fmt::format("  - {{trajectory: {}, family: {}, trial: 1, file: {}", quoted(r.trajectory), r.family,
+                        quoted(r.file.filename().string()));
+    if (std::isfinite(r.window_start) || std::isfinite(r.window_end))
+      text += fmt::format(", window: [{}, {}]", yaml_number(r.window_start), yaml_number(r.window_end));
+    text += "}\n";
+  }
+  write_file_atomically(manifest, text);
+  result.dataset = manifest;
+  return result;
+}
+
+}  // namespace symoro::io

@@ -1,0 +1,489 @@
+// Importing controller exports: synthetic files written here from known motions (degrees,
+// milliseconds, irregular stamps, stale rows, a duplicate stamp), imported, read back with
+// io::read_log and compared bit for bit with the known values converted by the documented
+// formulas (t / 1000, deg * (pi / 180), tau * scale); the differentiated velocity against the
+// exact derivative of a quadratic; every rejected input by its line.
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include "symoro/error.hpp"
+#include "symoro/identify/dataset.hpp"
+#include "symoro/io/import.hpp"
+#include "symoro/io/log.hpp"
+#include "symoro/io/number_text.hpp"
+
+namespace fs = std::filesystem;
+namespace io = symoro::io;
+using symoro::DataError;
+
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+void write_text(const fs::path& p, const std::string& content) {
+  std::ofstream out(p, std::ios::binary);
+  out << content;
+}
+
+std::string read_text(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  std::ostringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+std::string num(double v) { return io::number_text(v); }
+
+class Import : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() /
+           ("symoro_import_" + std::to_string(::getpid()) + "_" +
+            ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+  }
+  void TearDown() override {
+    if (!HasFailure()) fs::remove_all(dir_);
+  }
+  fs::path dir_;
+};
+
+// ---- The 6-joint export: degrees, milliseconds, mN m, a header, comments, a text column ------
+
+io::ImportTarget six_joints() {
+  return {"arm6", {"j1", "j2", "j3", "j4", "j5", "j6"}, {}};
+}
+
+io::ImportMapping six_mapping() {
+  io::ImportMapping m;
+  m.time = "time_ms";
+  m.q = "pos_*";
+  m.qd = "vel_%";  // this exporter numbers velocities from 0
+  m.tau = "eff_*";
+  m.time_unit = io::TimeUnit::ms;
+  m.angle_unit = io::AngleUnit::deg;
+  m.torque_scale = 0.001;  // mN m
+  return m;
+}
+
+// What the exporter wrote (the parsed values of its text), and where.
+struct Export6 {
+  std::vector<double> t_ms;                          // per written log row
+  std::vector<std::vector<double>> pos, vel, eff;    // [row][joint], as written (deg, deg/s, mN m)
+  std::vector<int> stale_lines, duplicate_lines;
+};
+
+// Joint j: A sin(w t + p) deg with A = 20 + 5 j, w = 2 pi (0.3 + 0.1 j), p = 0.4 j.
+// Stamps: k ms, every 4th one off by -30..30 us; every 20th row (5 %) repeats the previous row's
+// data with its own stamp; row 1000 is written twice (same stamp, same values).
+Export6 write_six(const fs::path& file, int rows) {
+  Export6 e;
+  std::string text = "# exported by the arm's controller\n# 2 comment lines, then the header\n";
+  text += "time_ms";
+  for (const char* g : {"pos_", "eff_"})
+    for (int j = 1; j <= 6; ++j) text += "," + std::string(g) + std::to_string(j);
+  for (int j = 0; j < 6; ++j) text += ",vel_" + std::to_string(j);
+  text += ",mode\n";
+  int line = 3;
+  for (int k = 0; k < rows; ++k) {
+    const double t_ms = k + (k % 4 == 2 ? ((k * 37) % 7 - 3) * 0.01 : 0.0);
+    std::vector<double> pos(6), vel(6), eff(6);
+    const bool stale = k % 20 == 19;
+    for (int j = 0; j < 6; ++j) {
+      const double t = t_ms / 1000, a = 20 + 5 * j, w = 2 * kPi * (0.3 + 0.1 * j), p = 0.4 * j;
+      pos[j] = stale ? e.pos.back()[j] : a * std::sin(w * t + p);
+      vel[j] = stale ? e.vel.back()[j] : a * w * std::cos(w * t + p);
+      eff[j] = stale ? e.eff.back()[j] : 1500 * std::sin(w * t) + 100 * j;
+    }
+    std::string row = num(t_ms);
+    for (double v : pos) row += "," + num(v);
+    for (double v : eff) row += "," + num(v);
+    for (double v : vel) row += "," + num(v);
+    row += k % 2 ? ",run\n" : ",RUN\n";  // an unmapped text column is never parsed
+    text += row;
+    ++line;
+    if (stale) e.stale_lines.push_back(line);
+    e.t_ms.push_back(t_ms);
+    e.pos.push_back(pos);
+    e.vel.push_back(vel);
+    e.eff.push_back(eff);
+    if (k == 1000) {
+      text += row;
+      e.duplicate_lines.push_back(++line);
+    }
+  }
+  write_text(file, text);
+  return e;
+}
+
+// ---- The 2-joint export: seconds, whitespace, no header, no velocity -------------------------
+
+// q1 = 0.3 + 0.5 t - 0.2 t^2, q2 = -1 + 2 t + 0.7 t^2 (rad), at 1 kHz with irregular stamps
+// (0.6 to 1.4 ms apart), every 20th row stale, row 300 written twice.
+struct Export2 {
+  std::vector<double> t;
+  std::vector<int> stale_rows;  // log rows that are stale
+  std::vector<int> stale_lines, duplicate_lines;
+};
+
+double q2_exact(int j, double t, int derivative) {
+  const double c0 = j == 0 ? 0.3 : -1, c1 = j == 0 ? 0.5 : 2, c2 = j == 0 ? -0.2 : 0.7;
+  return derivative == 0 ? c0 + c1 * t + c2 * t * t : c1 + 2 * c2 * t;
+}
+
+Export2 write_two(const fs::path& file, int rows, double t0 = 100.0) {
+  Export2 e;
+  std::string text = "# t q1 q2 tau1 tau2\n";
+  int line = 1;
+  double t = t0, previous_q[2] = {0, 0};
+  for (int k = 0; k < rows; ++k) {
+    if (k > 0) t += 0.001 + ((k * 13) % 9 - 4) * 1e-4;
+    const bool stale = k % 20 == 19;
+    double q[2];
+    for (int j = 0; j < 2; ++j) q[j] = stale ? previous_q[j] : q2_exact(j, t - t0, 0);
+    // Constant torques: whether a row is stale is decided by q.
+    const std::string row = num(t) + "  " + num(q[0]) + "\t" + num(q[1]) + "   0 1.5\n";
+    text += row;
+    ++line;
+    if (stale) {
+      e.stale_lines.push_back(line);
+      e.stale_rows.push_back(static_cast<int>(e.t.size()));
+    }
+    e.t.push_back(t);
+    previous_q[0] = q[0];
+    previous_q[1] = q[1];
+    if (k == 300) {
+      text += "# a comment between rows\n" + row;
+      line += 2;
+      e.duplicate_lines.push_back(line);
+    }
+  }
+  write_text(file, text);
+  return e;
+}
+
+io::ImportMapping two_mapping() {
+  io::ImportMapping m;
+  m.time = "1";
+  m.q = "2-3";
+  m.tau = "4,5";
+  return m;
+}
+
+io::ImportTarget two_joints() { return {"arm2", {"shoulder", "elbow"}, {}}; }
+
+// Each rejected input: file, line and a piece of the message.
+void expect_error(const std::function<void()>& f, const std::string& file, int line, const std::string& part) {
+  try {
+    f();
+    ADD_FAILURE() << "accepted; expected " << part;
+  } catch (const DataError& e) {
+    EXPECT_EQ(e.file(), file) << e.what();
+    EXPECT_EQ(e.line(), line) << e.what();
+    EXPECT_NE(std::string(e.what()).find(part), std::string::npos) << e.what();
+  }
+}
+
+}  // namespace
+
+TEST_F(Import, SixJointsInDegreesAndMillisecondsReadBackExactly) {
+  const fs::path input = dir_ / "arm_run.csv";
+  const int rows = 3000;
+  const Export6 e = write_six(input, rows);
+  io::DatasetImport di;
+  di.target = six_joints();
+  di.mapping = six_mapping();
+  di.inputs = {{input, "", false}};
+  const io::DatasetImportResult r = io::import_dataset(dir_ / "data", di);
+  ASSERT_EQ(r.logs.size(), 1u);
+  const io::ImportedLog& imported = r.logs[0];
+  EXPECT_EQ(imported.rows, rows + 1);
+  EXPECT_EQ(imported.stale_lines, e.stale_lines);
+  EXPECT_EQ(imported.stale_lines.size(), 150u);  // 5 % of 3000
+  EXPECT_EQ(imported.duplicate_lines, std::vector<int>{1005});  // row 1000 is on line 1004
+  EXPECT_EQ(imported.columns.at("q1"), "'pos_1' (column 2)");
+  EXPECT_EQ(imported.columns.at("qd1"), "'vel_0' (column 14)");
+
+  const io::Log log = io::read_log(dir_ / "data" / "arm_run.csv");
+  ASSERT_EQ(log.samples(), rows);
+  ASSERT_EQ(log.joints(), 6);
+  EXPECT_EQ(log.meta.robot, "arm6");
+  EXPECT_EQ(log.meta.trajectory, "arm_run");
+  EXPECT_EQ(log.meta.source, "robot");
+  EXPECT_EQ(log.meta.joints, six_joints().joints);
+  EXPECT_EQ(log.meta.velocity, io::Velocity::measured);
+  // Half the intervals are 1 ms (to rounding), the others 1 ms -+ the jitter of every 4th
+  // stamp: the median is 1 ms to the microsecond.
+  EXPECT_EQ(log.meta.sample_time, 0.001);
+  EXPECT_FALSE(log.has_references());
+  for (int k = 0; k < rows; ++k) {
+    ASSERT_EQ(log.time[k], e.t_ms[k] / 1000) << k;  // kept as logged
+    for (int j = 0; j < 6; ++j) {
+      ASSERT_EQ(log.q(k, j), e.pos[k][j] * (kPi / 180)) << k << " " << j;
+      ASSERT_EQ(log.qd(k, j), e.vel[k][j] * (kPi / 180)) << k << " " << j;
+      ASSERT_EQ(log.tau(k, j), e.eff[k][j] * 0.001) << k << " " << j;
+    }
+  }
+  // Against the motion itself: the exporter's text is the shortest round trip, so the log is
+  // the sinusoid to rounding (stale rows hold the previous row's values by design).
+  const int k = 1234;
+  EXPECT_NEAR(log.q(k, 2), 30 * kPi / 180 * std::sin(2 * kPi * 0.5 * log.time[k] + 0.8), 1e-14);
+  EXPECT_NEAR(log.qd(k, 2), 30 * kPi / 180 * 2 * kPi * 0.5 * std::cos(2 * kPi * 0.5 * log.time[k] + 0.8), 1e-13);
+
+  // The dataset manifest and the record of the import.
+  const symoro::identify::Dataset d = symoro::identify::read_dataset(dir_ / "data");
+  EXPECT_EQ(d.robot, "arm6");
+  EXPECT_EQ(d.source, "imported");
+  ASSERT_EQ(d.runs.size(), 1u);
+  EXPECT_EQ(d.runs[0].trajectory, "arm_run");
+  EXPECT_EQ(d.runs[0].family, "F");
+  EXPECT_TRUE(std::isinf(d.runs[0].window_start) && std::isinf(d.runs[0].window_end));
+  const std::string manifest = read_text(dir_ / "data" / "dataset.yaml");
+  EXPECT_NE(manifest.find("import: {inputs: 1, rows: 3001, written: 3000, stale_rows: 150, duplicate_rows: 1}"),
+            std::string::npos)
+      << manifest;
+  const io::ImportMapping again = io::read_import_mapping(dir_ / "data" / "import.yaml");
+  EXPECT_EQ(again.time, "time_ms");
+  EXPECT_EQ(again.q, "pos_*");
+  EXPECT_EQ(again.qd, "vel_%");
+  EXPECT_EQ(again.tau, "eff_*");
+  EXPECT_EQ(again.time_unit, io::TimeUnit::ms);
+  EXPECT_EQ(again.angle_unit, io::AngleUnit::deg);
+  EXPECT_EQ(again.torque_scale, 0.001);
+  EXPECT_NE(read_text(dir_ / "data" / "import.yaml").find("duplicate_lines: [1005]"), std::string::npos);
+
+  // The same import again: nothing is replaced.
+  const std::string before = read_text(dir_ / "data" / "arm_run.csv");
+  expect_error([&] { io::import_dataset(dir_ / "data", di); }, (dir_ / "data" / "dataset.yaml").string(), 0,
+               "never replaces a file");
+  EXPECT_EQ(read_text(dir_ / "data" / "arm_run.csv"), before);
+}
+
+// Without qd the velocity is the derivative of the parabola through each row and its fresh
+// neighbours: exact for a quadratic whatever the spacing, so it matches c1 + 2 c2 t to
+// rounding (the stamps are ~100 s, so t carries ~1.4e-14 s of rounding, times 1/h: 1e-9).
+TEST_F(Import, TwoJointsWhitespaceWithoutHeaderDifferentiatesVelocity) {
+  const fs::path input = dir_ / "two.txt";
+  const int rows = 2000;
+  const Export2 e = write_two(input, rows);
+  const io::ImportedLog imported = io::import_log(input, two_mapping(), two_joints());
+  EXPECT_EQ(imported.rows, rows + 1);
+  EXPECT_EQ(imported.stale_lines, e.stale_lines);
+  EXPECT_EQ(imported.duplicate_lines, e.duplicate_lines);
+  EXPECT_EQ(imported.duplicate_lines, std::vector<int>{304});
+  const io::Log& log = imported.log;
+  ASSERT_EQ(log.samples(), rows);
+  EXPECT_EQ(log.meta.velocity, io::Velocity::differentiated);
+  std::vector<bool> stale(rows, false);
+  for (int k : e.stale_rows) stale[k] = true;
+  double worst = 0;
+  for (int k = 0; k < rows; ++k) {
+    ASSERT_EQ(log.time[k], e.t[k]);
+    ASSERT_EQ(log.tau(k, 1), 1.5);
+    for (int j = 0; j < 2; ++j) {
+      if (stale[k]) {
+        // A stale row repeats the previous state, velocity included.
+        ASSERT_EQ(log.qd(k, j), log.qd(k - 1, j)) << k;
+        ASSERT_EQ(log.q(k, j), log.q(k - 1, j)) << k;
+      } else {
+        ASSERT_EQ(log.q(k, j), q2_exact(j, e.t[k] - 100.0, 0));
+        worst = std::max(worst, std::abs(log.qd(k, j) - q2_exact(j, e.t[k] - 100.0, 1)));
+      }
+    }
+  }
+  EXPECT_LT(worst, 1e-9);
+
+  // Through a log file: the sidecar says the velocity was differentiated.
+  const fs::path csv = dir_ / "out.csv";
+  io::write_log(csv, log);
+  EXPECT_NE(read_text(io::metadata_path(csv)).find("velocity: differentiated"), std::string::npos);
+  EXPECT_EQ(io::read_log_metadata(csv).velocity, io::Velocity::differentiated);
+}
+
+// By hand: t = 0, 1, 3 with q = t^2 (a parabola through the three points is q itself):
+// qd = 0, 2, 6; a stale row at t = 2 (q repeated) is skipped and repeats qd = 2.
+TEST(ImportDifferentiation, ParabolaThroughIrregularPointsByHand) {
+  Eigen::VectorXd t(4);
+  t << 0, 1, 2, 3;
+  Eigen::MatrixXd q(4, 1);
+  q << 0, 1, 1, 9;
+  const Eigen::MatrixXd qd = io::differentiate_positions(t, q, {false, false, true, false});
+  EXPECT_DOUBLE_EQ(qd(0, 0), 0);
+  EXPECT_DOUBLE_EQ(qd(1, 0), 2);
+  EXPECT_EQ(qd(2, 0), qd(1, 0));
+  EXPECT_DOUBLE_EQ(qd(3, 0), 6);
+}
+
+TEST(ImportSampleTime, MedianRoundedToTheMicrosecond) {
+  Eigen::VectorXd t(6);
+  t << 0, 0.0019996, 0.0040003, 0.0060001, 0.0080007, 0.0100004;  // 1.9996 .. 2.0006 ms apart
+  EXPECT_EQ(io::median_sample_time(t, "x"), 0.002);
+  Eigen::VectorXd one(1);
+  one << 1;
+  EXPECT_THROW(io::median_sample_time(one, "x"), DataError);
+}
+
+// --split 0.7: each run by time into its first 70 % (family F) and the rest (V), recorded in
+// dataset.yaml; read_run_log gives each window's rows, and they partition the log.
+TEST_F(Import, SplitRecordsWindowsThatPartitionEachRun) {
+  write_six(dir_ / "a.csv", 1500);
+  write_six(dir_ / "b.csv", 800);
+  io::DatasetImport di;
+  di.target = six_joints();
+  di.mapping = six_mapping();
+  di.inputs = {{dir_ / "a.csv", "", false}, {dir_ / "b.csv", "second", false}};
+  di.split = 0.7;
+  io::import_dataset(dir_ / "data", di);
+  const symoro::identify::Dataset d = symoro::identify::read_dataset(dir_ / "data");
+  ASSERT_EQ(d.runs.size(), 4u);
+  const std::vector<std::pair<std::string, std::string>> expected{
+      {"a", "F"}, {"a_heldout", "V"}, {"second", "F"}, {"second_heldout", "V"}};
+  for (std::size_t i = 0; i < 4; ++i) {
+    EXPECT_EQ(d.runs[i].trajectory, expected[i].first);
+    EXPECT_EQ(d.runs[i].family, expected[i].second);
+  }
+  for (int pair = 0; pair < 2; ++pair) {
+    const auto& fit = d.runs[2 * pair];
+    const auto& held = d.runs[2 * pair + 1];
+    EXPECT_EQ(fit.file, held.file);
+    const io::Log whole = io::read_log(fit.file);
+    const double t0 = whole.time[0], t1 = whole.time[whole.samples() - 1];
+    const double cut = t0 + 0.7 * (t1 - t0);
+    EXPECT_EQ(fit.window_start, t0);
+    EXPECT_EQ(fit.window_end, cut);
+    EXPECT_EQ(held.window_start, cut);
+    EXPECT_TRUE(std::isinf(held.window_end));
+    const io::Log a = symoro::identify::read_run_log(fit), b = symoro::identify::read_run_log(held);
+    EXPECT_EQ(a.meta.trajectory, fit.trajectory);
+    EXPECT_EQ(b.meta.trajectory, held.trajectory);
+    ASSERT_EQ(a.samples() + b.samples(), whole.samples());
+    EXPECT_LT(a.time[a.samples() - 1], cut);
+    EXPECT_GE(b.time[0], cut);
+    // Stamps kept as logged, rows unchanged.
+    EXPECT_EQ(a.time[0], whole.time[0]);
+    EXPECT_EQ(b.time[0], whole.time[a.samples()]);
+    EXPECT_EQ(b.q.row(0), whole.q.row(a.samples()));
+    EXPECT_EQ(b.tau.row(b.samples() - 1), whole.tau.row(whole.samples() - 1));
+  }
+  // 1500 rows of ~1 ms: the cut is at 0.7 * 1499 ms, so the fitting part has 1050 rows (0..1049 ms).
+  EXPECT_EQ(symoro::identify::read_run_log(d.runs[0]).samples(), 1050);
+  EXPECT_NE(read_text(dir_ / "data" / "dataset.yaml").find("split: 0.7\n"), std::string::npos);
+
+  // The dataset belongs to arm6; another robot is refused at the line of robot:.
+  EXPECT_NO_THROW(symoro::identify::check_dataset_robot(d, "arm6"));
+  expect_error([&] { symoro::identify::check_dataset_robot(d, "crane_x7"); }, (d.dir / "dataset.yaml").string(), 2,
+               "made for robot 'arm6', not 'crane_x7'");
+}
+
+TEST_F(Import, DatasetWindowsAreChecked) {
+  write_six(dir_ / "a.csv", 300);
+  io::DatasetImport di;
+  di.target = six_joints();
+  di.mapping = six_mapping();
+  di.inputs = {{dir_ / "a.csv", "", false}};
+  io::import_dataset(dir_ / "data", di);
+  const fs::path manifest = dir_ / "data" / "dataset.yaml";
+  std::string text = read_text(manifest);
+  const std::size_t runs = text.find("runs:\n");
+  write_text(manifest, text.substr(0, runs) + "runs:\n  - {trajectory: a, family: F, trial: 1, file: a.csv,\n"
+                                              "     window: [2, 1]}\n");
+  const int window_line = static_cast<int>(std::count(text.begin(), text.begin() + runs, '\n')) + 3;
+  expect_error([&] { symoro::identify::read_dataset(dir_ / "data"); }, manifest.string(), window_line, "not an interval");
+  write_text(manifest, text.substr(0, runs) + "runs:\n  - {trajectory: a, family: F, trial: 1, file: a.csv, window: [5, 6]}\n");
+  const symoro::identify::Dataset d = symoro::identify::read_dataset(dir_ / "data");
+  expect_error([&] { symoro::identify::read_run_log(d.runs[0]); }, d.runs[0].file.string(), 0, "holds none of the log's samples");
+}
+
+// ---- Rejected inputs, each at its line ---------------------------------------------------------
+
+TEST_F(Import, ErrorsNameTheLine) {
+  const fs::path f = dir_ / "bad.txt";
+  const auto import = [&](const std::string& text, const io::ImportMapping& m = two_mapping()) {
+    write_text(f, text);
+    return [m, f] { io::import_log(f, m, two_joints()); };
+  };
+  const std::string good = "0 0 0 0 0\n0.001 1 1 1 1\n0.002 2 2 2 2\n";
+  expect_error(import(good + "0.0015 3 3 3 3\n"), f.string(), 4, "time goes backwards: 0.0015 s here, 0.002 s on line 3");
+  expect_error(import(good + "0.002 2 2.5 2 2\n"), f.string(), 4,
+               "same time stamp as line 3 (0.002 s) but other values: column 3 is 2.5 here, 2 there");
+  expect_error(import("# c\n" + good + "0.003 3 nan 3 3\n"), f.string(), 5, "column 3 holds 'nan', not a finite number");
+  expect_error(import(good + "0.003 3 3 abc 3\n"), f.string(), 4, "'abc' in column 4 is not a number");
+  expect_error(import(good + "0.003 3 3 3\n"), f.string(), 4, "row has 4 fields, the first row (line 1) has 5");
+  expect_error(import(good + "0.003 3 inf 3 3\n"), f.string(), 4, "not a finite number");
+
+  // The joint count: the robot has 2 joints.
+  io::ImportMapping named;
+  named.time = "t";
+  named.q = "pos_*";
+  named.tau = "eff_*";
+  const std::string three = "# comment\n\nt,pos_1,pos_2,pos_3,eff_1,eff_2\n0,1,2,3,4,5\n0.001,1,2,3,4,5\n";
+  expect_error(import(three, named), f.string(), 3, "matches 3 columns numbered 1..3, but the robot 'arm2' has 2 joints");
+  const std::string one = "t,pos_1,eff_1,eff_2\n0,1,4,5\n0.001,1,4,5\n";
+  expect_error(import(one, named), f.string(), 1, "no column 'pos_2' for joint 2");
+  io::ImportMapping positions = two_mapping();
+  positions.q = "2-4";
+  expect_error(import(good, positions), f.string(), 1, "selects 3 columns but the robot 'arm2' has 2 joints");
+  positions.q = "2-3";
+  positions.tau = "4-6";
+  expect_error(import(good, positions), f.string(), 1, "column 6 does not exist: the file has 5 columns");
+  expect_error(import(good, named), f.string(), 1, "selects columns by name, but the file has no header row");
+  io::ImportMapping overlap = two_mapping();
+  overlap.tau = "3-4";
+  expect_error(import(good, overlap), f.string(), 1, "q and tau both select column 3");
+  io::ImportMapping partial = two_mapping();
+  partial.q_ref = "2-3";
+  expect_error(import(good, partial), "command line", 0, "q_ref, qd_ref and qdd_ref come together");
+  // CSV with a header: the field count of a row against the header's, text in a named column.
+  const std::string csv = "t;pos_1;pos_2;eff_1;eff_2\n0;0;0;0;0\n0.001;x;1;1;1\n";
+  expect_error(import(csv, named), f.string(), 3, "'x' in 'pos_1' (column 2) is not a number");
+}
+
+TEST_F(Import, MappingFileErrorsNameTheirLine) {
+  const fs::path m = dir_ / "map.yaml";
+  write_text(m, "time: t\nq: \"pos_*\"\ntau: [e1, e2]\nunits: {time: ms, angle: deg, torque_scale: 2}\nheader: yes\n");
+  const io::ImportMapping read = io::read_import_mapping(m);
+  EXPECT_EQ(read.tau, "e1,e2");
+  EXPECT_EQ(read.time_unit, io::TimeUnit::ms);
+  EXPECT_EQ(read.torque_scale, 2);
+  EXPECT_EQ(read.header, io::HeaderRow::present);
+  EXPECT_EQ(read.lines.at("tau"), 3);
+  write_text(m, "time: t\nq: \"pos_*\"\ntau: e\nunits:\n  time: minutes\n");
+  expect_error([&] { io::read_import_mapping(m); }, m.string(), 5, "units.time: 'minutes' is not one of s, ms, us, ns");
+  write_text(m, "time: t\nqq: \"pos_*\"\n");
+  expect_error([&] { io::read_import_mapping(m); }, m.string(), 2, "unknown key 'qq'");
+  // A selector that does not fit names the mapping file's line in the message.
+  write_text(m, "time: 1\nq: 2-4\ntau: 4-5\n");
+  const fs::path f = dir_ / "data.txt";
+  write_text(f, "0 0 0 0 0\n0.001 1 1 1 1\n");
+  expect_error([&] { io::import_log(f, io::read_import_mapping(m), two_joints()); }, f.string(), 1,
+               "q: '2-4' (" + m.string() + ":2): selects 3 columns");
+}
+
+// The sidecar key is optional: a measured log's sidecar is as before, an unknown value is refused.
+TEST_F(Import, SidecarVelocityKey) {
+  const fs::path input = dir_ / "two.txt";
+  write_two(input, 50);
+  io::ImportMapping m = two_mapping();
+  io::Log log = io::import_log(input, m, two_joints()).log;
+  log.meta.velocity = io::Velocity::measured;
+  const fs::path csv = dir_ / "log.csv";
+  io::write_log(csv, log);
+  std::string sidecar = read_text(io::metadata_path(csv));
+  EXPECT_EQ(sidecar.find("velocity"), std::string::npos) << sidecar;
+  EXPECT_EQ(io::read_log(csv).meta.velocity, io::Velocity::measured);
+  write_text(io::metadata_path(csv), sidecar + "velocity: guessed\n");
+  const int line = static_cast<int>(std::count(sidecar.begin(), sidecar.end(), '\n')) + 1;
+  expect_error([&] { io::read_log_metadata(csv); }, io::metadata_path(csv).string(), line,
+               "velocity: 'guessed' is neither measured nor differentiated");
+}
