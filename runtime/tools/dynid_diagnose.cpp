@@ -65,6 +65,7 @@ std::pair<std::vector<std::string>, std::vector<std::string>> run_names(const id
 template <class Full, class Model>
 void run(const Common& common, const DiagnoseOptions& o) {
   const identify::Dataset data = identify::read_dataset(o.data);
+  identify::check_dataset_robot(data, Model::robot_name);
   const auto [train_names, heldout_names] = run_names(data, o);
   diagnose::StackOptions so;
   so.interval = o.interval_ms / 1000;
@@ -74,7 +75,7 @@ void run(const Common& common, const DiagnoseOptions& o) {
   auto stack = [&](const std::vector<std::string>& names, bool fitting) {
     std::vector<diagnose::NamedSamples> runs;
     for (const auto& name : names) {
-      io::Log log = identify::read_run_log(data.find(name, o.trial));
+      io::Log log = identify::read_run_log(data.find(name, o.trial), Model::robot_name, Model::nq);
       if (fitting && name == names.front()) first_train = log;
       runs.push_back({name, preprocess::preprocess(log, log.meta.sample_time > 0 ? log.meta.sample_time : 0.001,
                                                    diagnose::light_preprocessing())});

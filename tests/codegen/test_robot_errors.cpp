@@ -188,13 +188,13 @@ TEST_F(BrokenRobot, BaseVariantChainsFixedPatternsAndEffects) {
 }
 
 TEST_F(BrokenRobot, PrismaticJointsTakePrismaticUnits) {
-  start_from("stanford_rrp");  // joint 3 is prismatic
+  start_from("stanford_rrp");  // joint 3 is prismatic; robot.yaml ends with `variants:` (rigid)
   std::ofstream(dir_ / "robot.yaml", std::ios::app)
-      << "variants:\n  gap:\n    effects:\n      offset: [1, 3]\n      viscous_asymmetry: [3]\n";
+      << "  gap:\n    effects:\n      offset: [1, 3]\n      viscous_asymmetry: [3]\n";
   RobotModel r = load_robot(dir_.string());
   const Generation gen = generate_robot(r);
-  ASSERT_EQ(gen.models.size(), 2u);
-  const auto& ps = gen.models[1].identified;
+  ASSERT_EQ(gen.models.size(), 3u);  // full, rigid, gap
+  const auto& ps = gen.models[2].identified;
   ASSERT_GE(ps.size(), 3u);
   const std::vector<ParameterRef> added(ps.end() - 3, ps.end());
   EXPECT_EQ(names_of(added), (std::vector<std::string>{"OFF1", "OFF3", "FVA3"}));

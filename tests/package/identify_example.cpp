@@ -1,8 +1,8 @@
 // Uses the runtime's stages through the installed package (symoro::identify): a log of the
 // CRANE-X7 reduced model written in memory from its generated inverse dynamics (a multi-sine
-// motion, no noise), preprocessed, stacked and solved by OLS. Exits non-zero unless the
-// torque the estimate predicts matches the log's to 1e-6 N m and the parameters that the
-// motion excites well come back.
+// motion, no noise), preprocessed, stacked and solved by OLS. Exits non-zero unless the torque
+// the estimate predicts on the samples is within 1 % of the true parameters' (what filtering q
+// before the nonlinear model costs is well below that).
 #include <cmath>
 #include <cstdio>
 
@@ -44,12 +44,8 @@ int main() {
   const symoro::preprocess::Samples s = symoro::preprocess::preprocess(log, 0.010);
   const symoro::identify::Regression r = symoro::identify::stack_regression<Model>(s);
   const symoro::identify::LeastSquaresResult ls = symoro::identify::least_squares(r);
-  // Filtering q and tau alike is not exact for a nonlinear model: the residual is small, not 0.
-  const double rms = ls.residual_rms;
-  std::printf("OLS on %d samples: residual rms %.2e N m, kappa %.1f\n", r.samples, rms, ls.kappa);
-  if (!(rms < 1e-3)) {
-    std::printf("residual too large\n");
-    return 1;
-  }
-  return 0;
+  const double relative = (r.W * (ls.phi - Eigen::VectorXd(phi))).norm() / (r.W * Eigen::VectorXd(phi)).norm();
+  std::printf("OLS on %d samples: residual rms %.2e N m, kappa %.1f, predicted torque off by %.2e (relative)\n",
+              r.samples, ls.residual_rms, ls.kappa, relative);
+  return relative < 1e-2 ? 0 : 1;
 }

@@ -58,8 +58,13 @@ expect("${out}" "dataset.yaml:3: error: listed file .*AG02_t1.csv does not exist
 # diagnose: the dataset above has V01 and V02 only; unknown effects and missing runs are named.
 run(1 out diagnose --robot crane_x7 --data ${ds} -o ${WORK}/diag --only friction)
 expect("${out}" "unknown effect 'friction'")
-run(1 out diagnose --robot crane_x7 --data ${ds} -o ${WORK}/diag)
-expect("${out}" "dataset.yaml.*AG02")
+# Without --train the fitting runs are the dataset's non-V families: there are none here.
+run(2 out diagnose --robot crane_x7 --data ${ds} -o ${WORK}/diag)
+expect("${out}" "dataset.yaml: no fitting run for trial 1 \\(runs: V01 \\(family V, trial 1\\).*name them with --train")
+run(2 out diagnose --robot crane_x7 --data ${ds} -o ${WORK}/diag --train AG02 --heldout V02)
+expect("${out}" "no run AG02 of trial 1 to fit .*choose others with --train / --heldout")
+run(2 out diagnose --robot crane_x7 --data ${ds} -o ${WORK}/diag --train V01 --heldout V02 --apply --variant Upper)
+expect("${out}" "--variant 'Upper' must be a lower-case identifier")
 # Fitted on V01, judged on V02 (clean twin data): a report, and no effect named.
 run(0 out diagnose --robot crane_x7 --data ${ds} -o ${WORK}/diag --train V01 --heldout V02)
 expect("${out}" "no missing effect found")
@@ -103,6 +108,15 @@ run(0 out control --robot crane_x7 --virtual --trajectory AG02 --seconds 1 -o ${
 expect("${out}" "completed; torque off confirmed")
 expect("${out}" "overruns")
 run(0 out preprocess --robot crane_x7 ${WORK}/control/run.csv --interval 40 -o ${WORK}/control/samples)
+# A log the controller wrote (its time starts after the approach and pre-roll, at t > 0; its
+# reference columns are the controller's) through identify with CLIE: the closed loop replays
+# the log's own references, from its first stamp.
+# V02 whole (18 s): every axis moves, so every parameter is excited.
+run(0 out control --robot crane_x7 --virtual --trajectory V02 -o ${WORK}/control/V02.csv)
+file(WRITE ${WORK}/control/dataset.yaml "format: symoro-dataset 1\nrobot: crane_x7\nruns:\n  - {trajectory: V02, family: AG, trial: 1, file: V02.csv}\n")
+run(0 out identify --robot crane_x7 --data ${WORK}/control -o ${WORK}/control/study --interval 20)
+expect("${out}" "CLIE: 1 runs\n")
+expect("${out}" "representative: V02@20ms")
 run(1 out control --robot crane_x7 --port ${WORK}/no_such_tty --seconds 1 -o ${WORK}/control/real.csv)
 expect("${out}" "no_such_tty")
 file(REMOVE_RECURSE ${WORK})

@@ -79,7 +79,7 @@ TwinConfig base_config() { return symoro::twin::read_twin_config(kRobot + "/twin
 // The closed-loop high-band stage on AG02: the robot's twin description (robots/crane_x7/twin.yaml,
 // none of the hidden effects) plus what the selection named.
 BacklashFit high_band(const Data& d, const Selection& s) {
-  const BacklashFit b = fit_backlash<Full>(d.train_log, trajectory::sampled_reference(d.train_log, 0.001), with_selected_effects(base_config(), s));
+  const BacklashFit b = fit_backlash<Full>(d.train_log, symoro::trajectory::sampled_reference(d.train_log, 0.001), with_selected_effects(base_config(), s));
   if (std::getenv("SYMORO_DIAGNOSE_VERBOSE")) {
     for (const auto& f : b.findings)
       std::cout << fmt::format("  -> backlash joint {}: {:.3f} deg ({:.4f} measured, {:.4f} +- {:.4f} before, {:.4f} after)\n",

@@ -150,13 +150,15 @@ std::vector<std::filesystem::path> write_diagnosis_report(const Diagnosis& d, co
   m += fmt::format("Weights per joint (1/N m): {}. Each step refits the model with each candidate; F is a score test with the "
                    "residual's autocorrelation (effective sample size per candidate), the level ({:g} per step) is Bonferroni-corrected, "
                    "and a candidate must also lower the held-out residual of its joints by at least {:.0f} % and matter (at least {:g} N m "
-                   "of torque; a delay at least {:g} log periods); the one removing most of the whole held-out residual is taken.\n\n",
+                   "of torque; a delay at least {:g} log periods); the one removing most of the whole held-out residual is taken, or one "
+                   "with fewer parameters that removes within {:.0f} % as much.\n\n",
                    [&] {
                      std::string w;
                      for (Eigen::Index j = 0; j < s.weights.size(); ++j) w += fmt::format("{}{:.3g}", j ? ", " : "", s.weights(j));
                      return w;
                    }(),
-                   d.options.alpha, 100 * d.options.min_heldout_gain, d.options.min_effect_torque, d.options.min_delay_periods);
+                   d.options.alpha, 100 * d.options.min_heldout_gain, d.options.min_effect_torque, d.options.min_delay_periods,
+                   100 * d.options.parsimony);
   for (std::size_t i = 0; i < s.steps.size(); ++i) {
     const auto& st = s.steps[i];
     m += fmt::format("Step {}: autocorrelation time {:.1f} samples, level {:.1e}; {}.\n\n", i + 1, st.autocorrelation_time,

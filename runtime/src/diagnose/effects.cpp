@@ -250,6 +250,9 @@ bool physical(const Candidate& c, const Eigen::VectorXd& theta) {
     case EffectKind::Stribeck:
     case EffectKind::Backlash:
     case EffectKind::Payload:
+    // A torque cannot answer its command before it is sent: a negative delay is another
+    // misfit's shape (seen against a study's accepted parameters: -3.39 ms), not a delay.
+    case EffectKind::ActuationDelay:
       return theta(0) > 0;
     default:
       return true;

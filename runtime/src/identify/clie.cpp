@@ -34,7 +34,11 @@ SampleGrid sample_grid(const preprocess::Samples& measured, double period, int c
   // Exactly the low-pass preprocess() applied to the measured tau (preprocess.cpp).
   const preprocess::Options& o = options.preprocess;
   // The period the samples were preprocessed on (the log's own unless the options force one).
-  const double base = measured.report.base_period > 0 ? measured.report.base_period : o.base_period;
+  // Samples made without preprocess() (no report, no forced period) are taken at the control
+  // period.
+  const double base = measured.report.base_period > 0 ? measured.report.base_period
+                      : o.base_period > 0             ? o.base_period
+                                                      : period;
   if (!(std::abs(period - base) <= 1e-9 * period))
     throw std::invalid_argument(fmt::format("CLIE: the control period {} s differs from the preprocessing base period {} s",
                                             period, base));

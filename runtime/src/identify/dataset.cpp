@@ -97,6 +97,17 @@ io::Log read_run_log(const DatasetRun& run) {
   return log;
 }
 
+io::Log read_run_log(const DatasetRun& run, const std::string& robot, int joints) {
+  io::Log log = read_run_log(run);
+  if (!log.meta.robot.empty() && log.meta.robot != robot)
+    throw DataError(io::metadata_path(run.file).string(), 0,
+                    fmt::format("run {}: the log is of robot '{}', the model of '{}'", run.trajectory, log.meta.robot, robot));
+  if (log.joints() != joints)
+    throw DataError(run.file.string(), 0,
+                    fmt::format("run {}: the log has {} joints, the model {}", run.trajectory, log.joints(), joints));
+  return log;
+}
+
 void check_dataset_robot(const Dataset& dataset, const std::string& robot) {
   if (dataset.robot.empty() || dataset.robot == robot) return;
   throw DataError((dataset.dir / "dataset.yaml").string(), dataset.robot_line,

@@ -5,12 +5,13 @@
 #include <tuple>
 
 #include "symoro/rx90/all.hpp"
+#include "symoro/rx90/rigid/all.hpp"
 
 namespace symoro::rx90 {
 
 // The identified model by default (robot.yaml 'identified').
 using IdentifiedModel = ::symoro::rx90::Model;
 // The full model first, then every variant.
-using Models = std::tuple<::symoro::rx90::Model>;
+using Models = std::tuple<::symoro::rx90::Model, ::symoro::rx90::rigid::Model>;
 
 }  // namespace symoro::rx90

@@ -5,12 +5,13 @@
 #include <tuple>
 
 #include "symoro/stanford_rrp/all.hpp"
+#include "symoro/stanford_rrp/rigid/all.hpp"
 
 namespace symoro::stanford_rrp {
 
 // The identified model by default (robot.yaml 'identified').
 using IdentifiedModel = ::symoro::stanford_rrp::Model;
 // The full model first, then every variant.
-using Models = std::tuple<::symoro::stanford_rrp::Model>;
+using Models = std::tuple<::symoro::stanford_rrp::Model, ::symoro::stanford_rrp::rigid::Model>;
 
 }  // namespace symoro::stanford_rrp

@@ -105,7 +105,8 @@ void effect_terms(const Candidate& c, double q, double qd, double* out);
 Eigen::MatrixXd effect_columns(const Candidate& c, const DesignStack& d, const FitState& fit);
 
 // False when fitted parameters contradict the effect's physics (negative Coulomb or Stribeck
-// level, negative play): such a fit is absorbing some other misfit and is not an effect.
+// level, negative play, a negative payload mass or actuation delay): such a fit is absorbing
+// some other misfit and is not an effect.
 bool physical(const Candidate& c, const Eigen::VectorXd& theta);
 
 // The candidate's magnitude from its fitted parameters, in its unit (e.g. the amplitude of

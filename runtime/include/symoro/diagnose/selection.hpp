@@ -31,6 +31,9 @@ namespace symoro::diagnose {
 struct SelectionOptions {
   double alpha = 1e-3;             // family-wise level of each step
   double min_heldout_gain = 0.02;  // relative fall of the held-out weighted SSE
+  // A candidate with fewer parameters whose held-out reduction is within this fraction of the
+  // best one's is taken instead (parsimony between near-equals).
+  double parsimony = 0.05;
   // An effect whose torque is smaller than this on every joint it acts on (rms over the
   // held-out samples) does not matter: about half a current step of a DYNAMIXEL X servo.
   double min_effect_torque = 0.003;  // N m

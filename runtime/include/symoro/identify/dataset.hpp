@@ -42,6 +42,10 @@ Dataset read_dataset(const std::filesystem::path& dir);
 // run's name, so that later errors name the run). DataError if the window is empty.
 io::Log read_run_log(const DatasetRun& run);
 
+// The same, checked against the model it is for: the log's robot (when its sidecar names one)
+// and its joint count. DataError naming the log (its sidecar for the robot) otherwise.
+io::Log read_run_log(const DatasetRun& run, const std::string& robot, int joints);
+
 // DataError(dataset.yaml, line of robot:) when the dataset was made for another robot. A
 // dataset that names no robot passes.
 void check_dataset_robot(const Dataset& dataset, const std::string& robot);

@@ -162,6 +162,7 @@ class Study {
   StudyResult run() {
     const auto t0 = std::chrono::steady_clock::now();
     const Dataset data = read_dataset(o_.data);
+    check_dataset_robot(data, Model::robot_name);
     StudyResult out;
     out.robot = Model::robot_name;
     out.model = Model::variant_name;
@@ -293,7 +294,7 @@ class Study {
   // A run's log, its time counted from its first stamp (a controller's log may start at any t;
   // the closed loop's cycle 0 is the first row).
   static io::Log load_log(const DatasetRun& run) {
-    io::Log log = read_run_log(run);
+    io::Log log = read_run_log(run, Model::robot_name, Model::nq);
     if (log.samples() > 0) log.time.array() -= log.time(0);
     return log;
   }

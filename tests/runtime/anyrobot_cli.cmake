@@ -1,0 +1,72 @@
+# The README's "Your robot, your logs" commands on robots with only their robots/ folder (no
+# twin.yaml, trajectories.yaml or controller.yaml): a controller's CSV export (write_export:
+# degrees, milliseconds, its own column names, stale rows, Coulomb friction and an offset on the
+# last joint) of the RX-90 and the Stanford RRP arm (a prismatic joint, left in m) is imported
+# with a 70/30 split, identified with the model without Coulomb friction (`rigid`) and the full
+# one (CLIE skipped and said, open-loop validation on the held-out part), diagnosed (names the
+# friction and the offset) and compared. Run with -DDYNID, -DWRITE_EXPORT, -DWORK.
+file(REMOVE_RECURSE ${WORK})
+file(MAKE_DIRECTORY ${WORK})
+
+function(run expect_code out_var)
+  execute_process(COMMAND ${DYNID} ${ARGN} RESULT_VARIABLE code OUTPUT_VARIABLE out ERROR_VARIABLE err)
+  if(NOT code EQUAL expect_code)
+    message(FATAL_ERROR "dynid ${ARGN}: exit ${code}, expected ${expect_code}\n${out}\n${err}")
+  endif()
+  set(${out_var} "${out}${err}" PARENT_SCOPE)
+endfunction()
+
+function(expect text pattern)
+  if(NOT text MATCHES "${pattern}")
+    message(FATAL_ERROR "expected /${pattern}/ in:\n${text}")
+  endif()
+endfunction()
+
+foreach(robot rx90 stanford_rrp)
+  set(w ${WORK}/${robot})
+  file(MAKE_DIRECTORY ${w})
+  set(before rigid)
+  set(after full)
+  execute_process(COMMAND ${WRITE_EXPORT} ${robot} ${w}/export.csv 60 5 RESULT_VARIABLE code)
+  if(NOT code EQUAL 0)
+    message(FATAL_ERROR "write_export ${robot} failed")
+  endif()
+  run(0 out import --robot ${robot} -o ${w}/data ${w}/export.csv --name arm --time stamp_ms --time-unit ms
+      --q "{name}_pos" --qd "{name}_vel" --tau "{name}_eff" --angle deg --split 0.7)
+  expect("${out}" "stale")
+  file(READ ${w}/data/dataset.yaml manifest)
+  expect("${manifest}" "trajectory: \"?arm_heldout\"?, family: V")
+  # Importing again never replaces what is there.
+  run(1 out import --robot ${robot} -o ${w}/data ${w}/export.csv --name arm --time stamp_ms --time-unit ms
+      --q "{name}_pos" --qd "{name}_vel" --tau "{name}_eff" --angle deg --split 0.7)
+  # A dataset of another robot is refused, naming the manifest.
+  if(robot STREQUAL "rx90")
+    run(1 out identify --robot stanford_rrp --data ${w}/data -o ${w}/wrong)
+    expect("${out}" "dataset.yaml:[0-9]+: error: the dataset was made for robot 'rx90', not 'stanford_rrp'")
+  endif()
+
+  foreach(model ${before} ${after})
+    run(0 out identify --robot ${robot} --model ${model} --data ${w}/data -o ${w}/study-${model} --interval 10)
+    expect("${out}" "CLIE: 0 runs; skipped in 1 \\(not run: no controller description")
+    expect("${out}" "validation arm_heldout at 10 ms, open-loop")
+    expect("${out}" "accepted")
+    if(NOT EXISTS ${w}/study-${model}/report/report.md OR NOT EXISTS ${w}/study-${model}/validation.yaml)
+      message(FATAL_ERROR "${robot} ${model}: no report or validation written")
+    endif()
+    file(READ ${w}/study-${model}/report/report.md report)
+    expect("${report}" "CLIE: 0 runs; skipped")
+  endforeach()
+
+  # The fitting and held-out runs come from the dataset's split; no twin: no backlash stage.
+  run(0 out diagnose --robot ${robot} --model ${before} --data ${w}/data -o ${w}/diagnosis)
+  expect("${out}" "effect: Coulomb friction \\(tanh width [0-9.]+ rad/s\\), joint 1")
+  expect("${out}" "effect: constant torque offset, joint")
+  expect("${out}" "backlash stage: Not run: the stage simulates the robot's digital twin")
+  file(READ ${w}/diagnosis/diagnosis.md diagnosis)
+  expect("${diagnosis}" "Fitted on arm; judged on the held-out arm_heldout")
+
+  run(0 out compare --robot ${robot} --before ${w}/study-${before} --after ${w}/study-${after} -o ${w}/gap)
+  file(READ ${w}/gap/gap.md gap)
+  expect("${gap}" "\\| arm_heldout \\| open-loop \\|")
+endforeach()
+file(REMOVE_RECURSE ${WORK})

@@ -1,0 +1,88 @@
+// Logs a robot's own controller could have written, synthesized from a generated model: a
+// smooth multi-sine excitation through each joint's range (three sines, 35 % of the range),
+// stamps 1 ms apart with +-0.15 ms of jitter starting at 12.5 s (a controller's clock), 5 % stale
+// rows (the previous state again under a new stamp), the model's torque at the truth plus
+// effects the code under test is not told about (a constant offset per joint) and white noise.
+#pragma once
+
+#include <random>
+#include <string>
+
+#include <Eigen/Core>
+
+#include "symoro/io/log.hpp"
+
+namespace symoro::test {
+
+// A constant offset on one joint (1-based), zero on the others.
+template <class Model>
+Eigen::VectorXd offset_on(int joint, double value) {
+  Eigen::VectorXd v = Eigen::VectorXd::Zero(Model::nq);
+  v(joint - 1) = value;
+  return v;
+}
+
+// One synthesized log: q(t) a sum of three sines per joint around the middle of its range.
+template <class Model>
+io::Log synthesize(const std::string& name, const Eigen::Matrix<double, Model::np, 1>& phi, double seconds,
+                   unsigned seed, double noise, const Eigen::VectorXd& offset = {}) {
+  constexpr double kPi = 3.14159265358979323846;
+  using Vec = Eigen::Matrix<double, Model::nq, 1>;
+  std::mt19937 gen(seed);
+  std::uniform_real_distribution<double> u(0, 1);
+  std::normal_distribution<double> gauss(0, 1);
+  constexpr int n = Model::nq, waves = 3;
+  Eigen::MatrixXd amp(n, waves), freq(n, waves), phase(n, waves);
+  Eigen::VectorXd mid(n);
+  for (int j = 0; j < n; ++j) {
+    const auto& J = Model::joints[j];
+    mid(j) = 0.5 * (J.lower + J.upper);
+    for (int k = 0; k < waves; ++k) {
+      amp(j, k) = 0.35 * 0.5 * (J.upper - J.lower) / waves * (0.6 + 0.4 * u(gen));
+      freq(j, k) = 2 * kPi * (0.15 + 0.5 * u(gen));
+      phase(j, k) = 2 * kPi * u(gen);
+    }
+  }
+  const int rows = static_cast<int>(seconds / 0.001);
+  io::Log log;
+  log.meta.robot = Model::robot_name;
+  log.meta.trajectory = name;
+  log.meta.trial = 1;
+  log.meta.source = "robot";
+  log.meta.sample_time = 0.001;
+  for (const auto& J : Model::joints) log.meta.joints.emplace_back(J.name);
+  log.time.resize(rows);
+  log.q.resize(rows, n);
+  log.qd.resize(rows, n);
+  log.tau.resize(rows, n);
+  Vec q, qd, qdd, tau;
+  for (int i = 0; i < rows; ++i) {
+    // Stamps: 1 ms apart with +-0.15 ms of jitter; the log starts at 12.5 s (a controller's clock).
+    log.time(i) = 12.5 + 0.001 * i + (i > 0 ? 0.00015 * (2 * u(gen) - 1) : 0.0);
+    if (i > 0 && u(gen) < 0.05) {  // a stale row: the previous state again, under a new stamp
+      log.q.row(i) = log.q.row(i - 1);
+      log.qd.row(i) = log.qd.row(i - 1);
+      log.tau.row(i) = log.tau.row(i - 1);
+      continue;
+    }
+    const double t = log.time(i);
+    for (int j = 0; j < n; ++j) {
+      q(j) = mid(j), qd(j) = 0, qdd(j) = 0;
+      for (int k = 0; k < waves; ++k) {
+        const double w = freq(j, k), a = amp(j, k), arg = w * t + phase(j, k);
+        q(j) += a * std::sin(arg);
+        qd(j) += a * w * std::cos(arg);
+        qdd(j) -= a * w * w * std::sin(arg);
+      }
+    }
+    Model::inverse_dynamics(q, qd, qdd, phi, tau);
+    if (offset.size() == Model::nq) tau += offset;
+    for (int j = 0; j < n; ++j) tau(j) += noise * gauss(gen);
+    log.q.row(i) = q.transpose();
+    log.qd.row(i) = qd.transpose();
+    log.tau.row(i) = tau.transpose();
+  }
+  return log;
+}
+
+}  // namespace symoro::test
