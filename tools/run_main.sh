@@ -7,7 +7,9 @@
 # PCA selection, rescue, final audit, validation on V01-V03) with its report in
 # build/study/report/report.md. Both steps are resumable: a rerun skips what is finished.
 # Then the model-gap workflow on twin data with hidden effects (build/diagnosis/, build/gap/),
-# and 5 s of the 1 kHz controller against virtual servos (build/control-virtual.csv).
+# 5 s of the 1 kHz controller against virtual servos (build/control-virtual.csv), and a robot
+# with only its robots/ folder (the RX-90) from a CSV its controller could have exported:
+# import, identify, diagnose, compare (build/rx90-*).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash tools/install_deps.sh
@@ -20,6 +22,7 @@ cmake --install build --prefix "$prefix" >/dev/null
 cmake -S tests/package -B build/example -G Ninja -DCMAKE_PREFIX_PATH="$prefix" >/dev/null
 cmake --build build/example
 build/example/crane_x7_example
+build/example/identify_example
 
 dynid=build/runtime/tools/dynid
 $dynid trajectories --robot crane_x7
@@ -62,3 +65,16 @@ $dynid diagnose --robot crane_x7 --data build/payload-data -o build/payload-diag
 # The hardware controller without hardware: 5 s of AG02 at 1 kHz through the real DYNAMIXEL
 # driver over a pseudo-terminal, against virtual servos that drive the digital twin.
 $dynid control --robot crane_x7 --virtual --trajectory AG02 --seconds 5 -o build/control-virtual.csv
+
+# Your robot, your logs: the RX-90 has no twin, trajectory design or controller description.
+# Its export (synthesized from its model: degrees, ms, its own column names, stale rows, Coulomb
+# friction and an offset that its `rigid` model lacks) goes through the README's commands.
+build/tests/runtime/write_export rx90 build/rx90-export.csv 60 5
+rm -rf build/rx90-data  # import never replaces files
+$dynid import --robot rx90 -o build/rx90-data build/rx90-export.csv --name arm --time stamp_ms --time-unit ms \
+  --q '{name}_pos' --qd '{name}_vel' --tau '{name}_eff' --angle deg --split 0.7
+for model in rigid full; do
+  $dynid identify --robot rx90 --model $model --data build/rx90-data -o build/rx90-study-$model --interval 10
+done
+$dynid diagnose --robot rx90 --model rigid --data build/rx90-data -o build/rx90-diagnosis
+$dynid compare --robot rx90 --before build/rx90-study-rigid --after build/rx90-study-full -o build/rx90-gap

@@ -54,8 +54,11 @@ identify::StudyResult study(const Common& common, const IdentifyOptions& o, bool
   };
   so.on_run = [progress](const identify::RunRecord& r) {
     if (*progress)
-      (*progress)->done(r.id(), fmt::format("kappa {:.1f} {} lambda_min(CLIE) {:+.2e} CLIE {:.1f} s", r.kappa, r.route,
-                                            r.clie_lambda_min, r.t_clie));
+      (*progress)->done(r.id(), r.failed ? "FAILED: " + r.failure
+                                : r.clie_ran ? fmt::format("kappa {:.1f} {} lambda_min(CLIE) {:+.2e} CLIE {:.1f} s", r.kappa, r.route,
+                                                           r.clie_lambda_min, r.t_clie)
+                                             : fmt::format("kappa {:.1f} {} lambda_min(final, no CLIE) {:+.2e}", r.kappa, r.route,
+                                                           r.clie_lambda_min));
   };
   // What switches on the closed-loop stages: the robot's controller description (CLIE and
   // closed-loop validation) and its trajectory design (references for logs without them).

@@ -41,6 +41,7 @@ std::string termination(const RunRecord& r) {
 }
 
 std::string clie_status(const RunRecord& r) {
+  if (!r.clie_ran) return termination(r);  // "not run: ..."
   if (r.clie_success) return fmt::format("ok, {} it", r.clie_iterations);
   return "failed: " + termination(r);
 }
@@ -217,7 +218,7 @@ std::string routing_table(const StudyResult& study) {
       else ++other;
       if (is_o_s_c(r) && !r.sdp_feasible) ++infeasible;
       if (r.clie_success) ++converged;
-      if (r.clie_pd) ++pd;
+      if (r.clie_ran && r.clie_pd) ++pd;
     }
     std::vector<std::string> row{label, std::to_string(oc), std::to_string(osc)};
     if (any_other) row.push_back(std::to_string(other));
@@ -231,9 +232,13 @@ std::string routing_table(const StudyResult& study) {
 
 std::string route_examples_table(const StudyResult& study, const ReportOptions& options) {
   std::string out = "## Table IV: route examples\n\n";
+  // The paper's example trajectories where this study has them (a robot's own logs have other
+  // names), and the selected one.
   std::vector<std::string> shown;
   for (const auto& t : options.examples)
-    if (std::find(shown.begin(), shown.end(), t) == shown.end()) shown.push_back(t);
+    if (std::find(shown.begin(), shown.end(), t) == shown.end() &&
+        std::any_of(study.runs.begin(), study.runs.end(), [&](const RunRecord& r) { return r.trajectory == t; }))
+      shown.push_back(t);
   if (const RunRecord* sel = selected_run(study))
     if (std::find(shown.begin(), shown.end(), sel->trajectory) == shown.end()) shown.push_back(sel->trajectory);
   if (shown.empty() || study.runs.empty()) return out + "No trajectories to compare.\n\n";
@@ -270,9 +275,9 @@ std::string transition_table(const StudyResult& study) {
                                              : "No margin gave a PD projection; CLIE started from the last";
   table.row({"SDP", is_o_s_c(*r) ? yes_no(r->sdp_feasible) : "--", r->route.empty() ? "n/a" : r->route,
              eps_text(*r), "--", sdp_remark});
-  std::string clie_remark = r->clie_success
-                                ? fmt::format("Converged ({} iterations, cost {} lower)", r->clie_iterations, cost_reduction(*r))
-                                : "CLIE failed: " + termination(*r);
+  std::string clie_remark = !r->clie_ran    ? "CLIE " + termination(*r) + "; the SDP (or PD OLS) vector is the final one"
+                            : r->clie_success ? fmt::format("Converged ({} iterations, cost {} lower)", r->clie_iterations, cost_reduction(*r))
+                                              : "CLIE failed: " + termination(*r);
   if (r->clie_success && !r->clie_pd) clie_remark += "; statistically central but non-PD";
   table.row({"CLIE", yes_no(r->clie_pd), "--", "--", sig(r->clie_lambda_min, 4), clie_remark});
   std::string final_remark = study.rescued ? (study.accepted ? "Final accepted model" : "Rescued, but the final audit failed")
