@@ -9,6 +9,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <random>
 #include <string>
 
@@ -19,7 +20,10 @@
 #include <symoro/planar2r.hpp>
 #include <symoro/rx90.hpp>
 
+#include "symoro/control/ffpd.hpp"
+#include "symoro/identify/report.hpp"
 #include "symoro/identify/study.hpp"
+#include "symoro/trajectory/sampled_reference.hpp"
 #include "symoro/io/atomic_file.hpp"
 #include "symoro/io/log.hpp"
 #include "synthetic_log.hpp"
@@ -165,6 +169,88 @@ TYPED_TEST(AnyRobotStudy, AFailingRunIsRecordedAndTheStudyGoesOn) {
   for (const auto& s : r.stages) stages += s + "\n";
   EXPECT_NE(stages.find("failed runs: 1 (R3@10ms"), std::string::npos) << stages;
   EXPECT_FALSE(std::filesystem::exists(this->dir_ / "study" / "runs" / "R3@10ms.yaml"));  // tried again next time
+}
+
+// An unstable controller (bandwidth far above the 1 kHz loop's reach, a tiny M-hat): its closed
+// loop diverges at once. Reference: the measured motion, per 1 ms cycle.
+template <class Model>
+identify::ClosedLoopSetup unstable_setup() {
+  identify::ClosedLoopSetup c;
+  const Eigen::VectorXd ones = Eigen::VectorXd::Ones(Model::nq);
+  c.gains = control::FfpdGains::from_bandwidth(0.001, 0.002, 10.0 * ones, 0.0 * ones, 5000.0 * ones, ones);
+  c.delay = 0.0009;
+  return c;
+}
+
+TYPED_TEST(AnyRobotStudy, ADivergingClosedLoopValidationFallsBackToOpenLoopWithItsReason) {
+  using Model = TypeParam;
+  io::Log log = test::synthesize<Model>("H", this->truth_, 5.0, 9, this->kNoise);
+  log.time.array() -= log.time(0);  // cycle 0 at the first row, as the study counts
+  preprocess::Options po;
+  po.drop_stale = false;  // every row a cycle of the reference below
+  const preprocess::Samples s = preprocess::preprocess(log, 0.010, po);
+  trajectory::SampledReference ref;
+  ref.name = "H";
+  ref.period = 0.001;
+  const int cycles = static_cast<int>(std::llround(log.time(log.samples() - 1) / 0.001)) + 1;
+  ref.q = log.q.topRows(cycles).transpose();
+  ref.qd = log.qd.topRows(cycles).transpose();
+  ref.qdd = Eigen::MatrixXd::Zero(Model::nq, cycles);
+  const identify::ClosedLoopSimulator<Model> sim(unstable_setup<Model>(), ref);
+  identify::ClieOptions co;
+  co.preprocess = po;
+  const identify::ValidationRecord v = identify::validate_trajectory<Model>(&sim, s, this->truth_, this->truth_, co);
+  EXPECT_EQ(v.kind, "open-loop");
+  EXPECT_NE(v.note.find("the closed loop of the accepted vector diverged at t = "), std::string::npos) << v.note;
+  ASSERT_TRUE(std::isfinite(v.rmse_rescue)) << v.note;
+  EXPECT_NEAR(v.rmse_rescue, identify::torque_error(s.tau, identify::open_loop_torque<Model>(s, this->truth_)).rmse, 1e-12);
+}
+
+TYPED_TEST(AnyRobotStudy, TheControllerDescriptionIsPartOfARunsFingerprint) {
+  using Model = TypeParam;
+  int skipped = -1;
+  auto run = [&](identify::ClosedLoopSource source) {
+    identify::StudyOptions o = this->options();
+    o.intervals = {0.020};
+    o.on_start = [&](int, int k) { skipped = k; };
+    identify::Study<Model>(o, std::move(source)).run();
+  };
+  run(this->no_controller());
+  run(this->no_controller());
+  EXPECT_EQ(skipped, 2);  // the same inputs: both runs loaded
+  identify::ClosedLoopSource with;
+  with.setup = unstable_setup<Model>();
+  run(std::move(with));   // a controller now (CLIE still skipped: the logs have no references)
+  EXPECT_EQ(skipped, 0);  // another controller: every run redone
+}
+
+TYPED_TEST(AnyRobotStudy, AOneRunStudyWhoseClieDivergedEndsWithAReport) {
+  using Model = TypeParam;
+  // R4 with reference columns (the measured motion as the reference), so that CLIE runs; the
+  // unstable controller makes its start diverge.
+  io::Log log = test::synthesize<Model>("R4", this->truth_, 10.0, 4, this->kNoise);
+  log.q_ref = log.q;
+  log.qd_ref = log.qd;
+  log.qdd_ref = Eigen::MatrixXd::Zero(log.samples(), Model::nq);
+  io::write_log(this->dir_ / "data" / "R4.csv", log);
+  std::ofstream(this->dir_ / "data" / "dataset.yaml", std::ios::app) << "  - {trajectory: R4, family: F, trial: 1, file: R4.csv}\n";
+  identify::StudyOptions o = this->options();
+  o.trajectories = {"R4"};
+  o.intervals = {0.020};
+  identify::ClosedLoopSource source;
+  source.setup = unstable_setup<Model>();
+  const identify::StudyResult r = identify::Study<Model>(o, std::move(source)).run();
+  ASSERT_EQ(r.runs.size(), 1u);
+  EXPECT_TRUE(r.runs[0].clie_ran);
+  EXPECT_FALSE(r.runs[0].clie_success);
+  EXPECT_NE(r.runs[0].clie_termination.find("start diverged"), std::string::npos) << r.runs[0].clie_termination;
+  EXPECT_LT(r.selection.run, 0);
+  std::vector<std::filesystem::path> files;
+  ASSERT_NO_THROW(files = identify::write_report(r, this->dir_ / "report"));
+  std::ifstream in(this->dir_ / "report" / "report.md");
+  const std::string md((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  EXPECT_NE(md.find("**Accepted model**: none"), std::string::npos);
+  EXPECT_NE(md.find("start diverged"), std::string::npos);
 }
 
 }  // namespace
