@@ -116,6 +116,7 @@ std::vector<EffectSpec> read_effects(const Reader& r, const YAML::Node& effects,
     YAML::Node list;
     list.reset(kv.second);  // reset, not =: assigning a YAML::Node rebinds what it refers to
     double velocity = 0;
+    std::vector<double> velocities;  // one per listed joint, when `velocity` is a list
     std::vector<int> orders;
     if (effect_has_velocity(*kind) || *kind == EffectKind::PositionHarmonics) {
       const bool stribeck = effect_has_velocity(*kind);
@@ -130,8 +131,21 @@ std::vector<EffectSpec> read_effects(const Reader& r, const YAML::Node& effects,
       if (stribeck) {
         velocity = *kind == EffectKind::Stribeck ? kDefaultStribeckVelocity : kDefaultSmoothCoulombVelocity;
         if (const auto vel = kv.second["velocity"]) {
-          velocity = r.number(vel, what_velocity);
-          if (!(velocity > 0)) r.fail(vel, effect + ": " + what_velocity + " must be positive (rad/s), not " + vel.Scalar());
+          // A number for every joint, or a list with one per joint (dynid diagnose selects a
+          // tanh width per joint).
+          auto positive = [&](const YAML::Node& v) {
+            const double x = r.number(v, what_velocity);
+            if (!(x > 0)) r.fail(v, effect + ": " + what_velocity + " must be positive (rad/s), not " + v.Scalar());
+            return x;
+          };
+          if (vel.IsSequence()) {
+            if (!list.IsSequence() || vel.size() != list.size())
+              r.fail(vel, effect + ": a list of velocities needs one per joint (" + std::to_string(vel.size()) + " for " +
+                              std::to_string(list.IsSequence() ? list.size() : 0) + " joints)");
+            for (const auto& v : vel) velocities.push_back(positive(v));
+          } else {
+            velocity = positive(vel);
+          }
         }
       } else {
         const auto o = kv.second["orders"];
@@ -140,9 +154,11 @@ std::vector<EffectSpec> read_effects(const Reader& r, const YAML::Node& effects,
         std::sort(orders.begin(), orders.end());
       }
     }
+    std::size_t k = 0;
     for (const auto& [j, node] : whole_numbers(r, list, what, 1, kMaxJoints, effect)) {
       const YAML::Mark m = node.Mark();
-      out.push_back({*kind, j, velocity, orders, m.line + 1, m.column + 1});
+      out.push_back({*kind, j, velocities.empty() ? velocity : velocities.at(k), orders, m.line + 1, m.column + 1});
+      ++k;
     }
   }
   return out;

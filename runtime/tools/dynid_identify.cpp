@@ -28,6 +28,7 @@ struct IdentifyOptions {
   bool weighted = false, no_report = false, fresh = false;
   int clie_iterations = 25;
   double validation_ms = 0;
+  double torque_delay_ms = 0;
 };
 
 template <class Full, class Model>
@@ -45,6 +46,7 @@ identify::StudyResult study(const Common& common, const IdentifyOptions& o, bool
     for (double ms : o.intervals_ms) so.intervals.push_back(ms / 1000);
   }
   so.least_squares.weighted = o.weighted;
+  so.preprocess.torque_delay = o.torque_delay_ms / 1000;
   so.clie.max_iterations = o.clie_iterations;
   so.validation_interval = o.validation_ms / 1000;
   auto progress = std::make_shared<std::unique_ptr<Progress>>();
@@ -131,6 +133,8 @@ void add_identify_commands(CLI::App& app, Common& common) {
   cmd->add_option("--trial", o->trial, "Which trial of each trajectory");
   cmd->add_option("-j,--jobs", o->threads, "Worker threads (default: every core)");
   cmd->add_flag("--wls", o->weighted, "Weighted least squares (per-joint weights) instead of OLS");
+  cmd->add_option("--torque-delay", o->torque_delay_ms, "ms the logged torque lags the links' (an actuation delay "
+                                                        "dynid diagnose named): the torque is read that much later");
   cmd->add_option("--clie-iterations", o->clie_iterations, "CLIE iteration limit");
   cmd->add_option("--validation-interval", o->validation_ms, "Validation interval in ms (default: the selected run's)");
   cmd->add_flag("--no-report", o->no_report, "Do not write the report");

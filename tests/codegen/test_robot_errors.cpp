@@ -241,6 +241,23 @@ TEST_F(BrokenRobot, SmoothCoulombVelocityMustBePositive) {
   expect_error(R"(robot\.yaml:31:47: error: variant bad, effect smooth_coulomb: the velocity scale of tanh\(qd/v\) must be positive)");
 }
 
+TEST_F(BrokenRobot, SmoothCoulombTakesAVelocityPerJoint) {
+  // dynid diagnose selects a tanh width per joint: a variant keeps each.
+  add_variants("  widths:\n    fixed: {\"FS*\": 0}\n    effects:\n      smooth_coulomb: {joints: [2, 1], velocity: [0.05, 0.02]}\n");
+  RobotModel r = load_robot(dir_.string());
+  const Generation gen = generate_robot(r);
+  ASSERT_EQ(gen.models.size(), 3u);
+  const ModelSummary& m = gen.models[2];
+  ASSERT_EQ(m.effects.size(), 2u);
+  EXPECT_EQ(m.effects[0], (std::pair<std::string, std::string>{"FC1", "tanh(QP1/0.02)"}));
+  EXPECT_EQ(m.effects[1], (std::pair<std::string, std::string>{"FC2", "tanh(QP2/0.05)"}));
+}
+
+TEST_F(BrokenRobot, SmoothCoulombVelocitiesOnePerJoint) {
+  add_variants("  bad:\n    effects:\n      smooth_coulomb: {joints: [1, 2], velocity: [0.05]}\n");
+  expect_error(R"(robot\.yaml:31:50: error: variant bad, effect smooth_coulomb: a list of velocities needs one per joint \(1 for 2 joints\))");
+}
+
 TEST_F(BrokenRobot, OneCoulombTermPerJoint) {
   add_variants("  bad:\n    effects:\n      coulomb: [2]\n      smooth_coulomb: {joints: [2], velocity: 0.03}\n");
   expect_error(R"(robot\.yaml:32:[0-9]+: error: variant bad: joint 2 has both coulomb and smooth_coulomb)");

@@ -239,3 +239,27 @@ TYPED_TEST(AnyRobotGap, AControllersCsvThroughImportIdentifyDiagnoseAndCompare) 
 }
 
 }  // namespace
+
+namespace {
+
+// --apply keeps every selected effect: Coulomb friction selected with different tanh widths on
+// two joints becomes one smooth_coulomb entry with a width per joint (a variant holds one
+// entry per effect; the second width used to become a comment, and the applied model lost it).
+TEST(DiagnoseVariant, EverySelectedWidthIsKept) {
+  using symoro::diagnose::EffectKind;
+  symoro::diagnose::Diagnosis d;
+  for (const auto& [kind, joint, width] : {std::tuple{EffectKind::Coulomb, 4, 0.01}, std::tuple{EffectKind::Offset, 5, 0.0},
+                                           std::tuple{EffectKind::Coulomb, 2, 0.03}}) {
+    symoro::diagnose::SelectedEffect e;
+    e.candidate.kind = kind;
+    e.candidate.joint = joint;
+    e.candidate.coulomb_velocity = width;
+    d.selection.effects.push_back(e);
+  }
+  const std::string y = symoro::diagnose::variant_yaml(d, "reduced_diagnosed", "reduced");
+  EXPECT_NE(y.find("      smooth_coulomb: {joints: [2, 4], velocity: [0.03, 0.01]}\n"), std::string::npos) << y;
+  EXPECT_NE(y.find("      offset: [5]\n"), std::string::npos) << y;
+  EXPECT_EQ(y.find("# also"), std::string::npos) << y;
+}
+
+}  // namespace

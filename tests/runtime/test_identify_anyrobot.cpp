@@ -253,4 +253,25 @@ TYPED_TEST(AnyRobotStudy, AOneRunStudyWhoseClieDivergedEndsWithAReport) {
   EXPECT_NE(md.find("start diverged"), std::string::npos);
 }
 
+TYPED_TEST(AnyRobotStudy, ALoggedTorqueThatLagsIsReadLater) {
+  using Model = TypeParam;
+  // The servo reports the current it was commanded, which acts 4 ms later: row i logs the
+  // torque of row i - 4.
+  const io::Log log = test::synthesize<Model>("D", this->truth_, 10.0, 11, 0.0);
+  io::Log lagged = log;
+  for (int i = 4; i < log.samples(); ++i) lagged.tau.row(i) = log.tau.row(i - 4);
+  auto truth_error = [&](const io::Log& l, double delay) {
+    preprocess::Options po;
+    po.drop_stale = false;  // a lagged torque hides which rows are stale
+    po.torque_delay = delay;
+    const preprocess::Samples s = preprocess::preprocess(l, 0.010, po);
+    return identify::torque_error(s.tau, identify::open_loop_torque<Model>(s, this->truth_)).rmse;
+  };
+  // The truth's error on the log without the lag is the floor (filtered Coulomb steps, stale
+  // rows); the lag adds to it, the shift takes (nearly) all of that back.
+  const double floor = truth_error(log, 0), plain = truth_error(lagged, 0), shifted = truth_error(lagged, 0.004);
+  EXPECT_LT(shifted - floor, 0.2 * (plain - floor)) << floor << ": " << plain << " -> " << shifted;
+  EXPECT_GT(truth_error(lagged, -0.004), plain);  // the other way round is worse
+}
+
 }  // namespace

@@ -112,6 +112,12 @@ std::vector<std::filesystem::path> write_diagnosis_report(const Diagnosis& d, co
                        join(e.candidate.parameters), e.magnitude.text, e.f, e.p_value, 100 * e.heldout_gain);
     }
     m += "\nStopped: " + s.stop_reason + ".\n\n";
+    for (const auto& e : s.effects)
+      if (e.candidate.kind == EffectKind::ActuationDelay && !e.magnitude.values.empty())
+        m += fmt::format("The actuation delay is not a model term: identify with the logged torque read {0:.2f} ms later "
+                         "(`dynid identify --torque-delay {0:.2f}`, preprocess::Options::torque_delay) and add it to the "
+                         "controller description's communication_delay for the closed loop.\n\n",
+                         e.magnitude.values[0] * 1e3);
   }
   if (d.backlash_judged) {
     const BacklashFit& b = d.backlash;
@@ -197,21 +203,20 @@ std::string variant_yaml(const Diagnosis& d, const std::string& name, const std:
   std::map<std::string, std::vector<int>> joints;
   // Effects written {joints: [...], <parameter>}: joints grouped by (effect, parameter text).
   std::map<std::string, std::map<std::string, std::vector<int>>> shaped;
+  // Effects with a velocity scale per joint ({joints: [...], velocity: v or [v1, ...]}): every
+  // selected joint keeps the width it was selected with.
+  std::map<std::string, std::map<int, double>> scaled;
   std::string notes;
   for (const auto& e : d.selection.effects) {
     const Candidate& c = e.candidate;
     switch (c.kind) {
       // Coulomb friction as the diagnosis fitted it, tanh(qd / width): the files' sign(qd)
       // column is biased towards 0 by velocity noise at slow motion.
-      case EffectKind::Coulomb:
-        shaped["smooth_coulomb"][fmt::format("velocity: {:g}", c.coulomb_velocity)].push_back(c.joint);
-        break;
+      case EffectKind::Coulomb: scaled["smooth_coulomb"][c.joint] = c.coulomb_velocity; break;
       case EffectKind::Offset: joints["offset"].push_back(c.joint); break;
       case EffectKind::ViscousAsymmetry: joints["viscous_asymmetry"].push_back(c.joint); break;
       case EffectKind::InertiaProducts: joints["inertia_products"].push_back(c.joint); break;
-      case EffectKind::Stribeck:
-        shaped["stribeck"][fmt::format("velocity: {:g}", c.stribeck_velocity)].push_back(c.joint);
-        break;
+      case EffectKind::Stribeck: scaled["stribeck"][c.joint] = c.stribeck_velocity; break;
       case EffectKind::PositionHarmonics: {
         std::string orders;
         for (int k : c.orders) orders += (orders.empty() ? "" : ", ") + std::to_string(k);
@@ -220,7 +225,8 @@ std::string variant_yaml(const Diagnosis& d, const std::string& name, const std:
       }
       case EffectKind::ActuationDelay:
         notes += "    # actuation delay " + e.magnitude.text +
-                 ": not a model term; shift the logged torque by it in preprocessing and add it to the closed-loop delay\n";
+                 ": not a model term; identify with the torque shifted by it (dynid identify --torque-delay " +
+                 fmt::format("{:.2f}", e.magnitude.values.empty() ? 0.0 : e.magnitude.values[0] * 1e3) + ")\n";
         break;
       case EffectKind::TorqueConstant:
         notes += fmt::format("    # torque-constant error on joint {} ({}): calibrate the servo's torque constant\n", c.joint,
@@ -244,6 +250,18 @@ std::string variant_yaml(const Diagnosis& d, const std::string& name, const std:
   };
   std::string effects;
   for (auto& [key, js] : joints) effects += "      " + key + ": [" + list(js) + "]\n";
+  for (const auto& [key, widths] : scaled) {
+    std::vector<int> js;
+    std::string values;
+    bool same = true;
+    for (const auto& [j, v] : widths) {
+      js.push_back(j);
+      values += fmt::format("{}{:g}", values.empty() ? "" : ", ", v);
+      same = same && v == widths.begin()->second;
+    }
+    effects += "      " + key + ": {joints: [" + list(js) + "], velocity: " +
+               (same ? fmt::format("{:g}", widths.begin()->second) : "[" + values + "]") + "}\n";
+  }
   for (auto& [key, groups] : shaped) {
     // A variant holds one entry per effect: the group with the most joints; the others noted.
     auto best = groups.begin();

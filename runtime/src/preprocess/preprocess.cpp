@@ -22,7 +22,8 @@ namespace symoro::preprocess {
 namespace {
 
 void validate_options(const Options& o) {
-  if (!(o.base_period >= 0) || !std::isfinite(o.base_period) || !(o.max_gap > 0) || o.filter_order < 1 ||
+  if (!(o.base_period >= 0) || !std::isfinite(o.base_period) || !std::isfinite(o.torque_delay) || !(o.max_gap > 0) ||
+      o.filter_order < 1 ||
       !(o.derivative_cutoff > 0) || !(o.anti_alias_fraction > 0) || !(o.anti_alias_fraction <= 1))
     throw std::invalid_argument(
         "preprocess options: base_period >= 0 (0: the log's), max_gap, derivative_cutoff "
@@ -68,6 +69,19 @@ io::Log without_rows(const io::Log& log, const std::vector<bool>& drop, bool wit
     if (with_qd) out.qd.row(i) = log.qd.row(keep[i]);
   }
   return out;
+}
+
+// x(k) := x(k + shift) on the grid (shift in samples, any sign), linear between samples and held
+// at the ends: the torque read `shift` samples later (Options::torque_delay).
+void shift_later(Channels& x, double shift) {
+  const Channels y = x;
+  const Eigen::Index n = y.rows();
+  for (Eigen::Index k = 0; k < n; ++k) {
+    const double at = std::clamp(static_cast<double>(k) + shift, 0.0, static_cast<double>(n - 1));
+    const Eigen::Index i = std::min<Eigen::Index>(static_cast<Eigen::Index>(at), n - 2 < 0 ? 0 : n - 2);
+    const double w = n > 1 ? at - static_cast<double>(i) : 0.0;
+    x.row(k) = n > 1 ? Eigen::RowVectorXd((1 - w) * y.row(i) + w * y.row(i + 1)) : Eigen::RowVectorXd(y.row(0));
+  }
 }
 
 void validate_signals(const io::Log& log, const std::string& source) {
@@ -164,6 +178,7 @@ Samples preprocess(const io::Log& raw, double interval, const Options& options) 
     Channels tau = interpolation.apply(log.tau);
     filtfilt(sections, padding, q);
     filtfilt(sections, padding, tau);
+    if (options.torque_delay != 0) shift_later(tau, options.torque_delay / period);
 
     const std::vector<int> rows = target_rows(piece.first_index, piece.grid_samples(), stride);
     Derivatives d = finite_differences(q, period, rows);

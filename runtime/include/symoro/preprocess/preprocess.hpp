@@ -34,6 +34,11 @@ struct Options {
   // differences, instead of both from q. DataError when the log's velocity was differentiated
   // at import (no measurement to use).
   bool use_logged_velocity = false;
+  // s: the logged torque lags the torque acting on the links by this much (an actuation delay
+  // dynid diagnose named: the servo reports the current it was commanded, which acts later).
+  // The torque channel is read this much later (tau(t) := tau_logged(t + delay), on the
+  // filtered grid, linear between grid points) so that it lines up with the motion. 0: none.
+  double torque_delay = 0;
 };
 
 // The base period preprocess() uses for `log`: options.base_period when positive, else the
