@@ -15,6 +15,7 @@
 
 #include <unistd.h>
 
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 
 #include <symoro/planar2r.hpp>
@@ -272,6 +273,46 @@ TYPED_TEST(AnyRobotStudy, ALoggedTorqueThatLagsIsReadLater) {
   const double floor = truth_error(log, 0), plain = truth_error(lagged, 0), shifted = truth_error(lagged, 0.004);
   EXPECT_LT(shifted - floor, 0.2 * (plain - floor)) << floor << ": " << plain << " -> " << shifted;
   EXPECT_GT(truth_error(lagged, -0.004), plain);  // the other way round is worse
+}
+
+TYPED_TEST(AnyRobotStudy, ALogOfAnotherRobotOrJointCountIsNamed) {
+  using Model = TypeParam;
+  // R5: another robot's sidecar; R6: one joint fewer than the model.
+  io::Log other = test::synthesize<Model>("R5", this->truth_, 2.0, 5, this->kNoise);
+  other.meta.robot = "some_other_arm";
+  io::write_log(this->dir_ / "data" / "R5.csv", other);
+  io::Log fewer = test::synthesize<Model>("R6", this->truth_, 2.0, 6, this->kNoise);
+  const int n = Model::nq - 1;
+  fewer.meta.joints.resize(n);
+  for (Eigen::MatrixXd* m : {&fewer.q, &fewer.qd, &fewer.tau}) *m = m->leftCols(n).eval();
+  io::write_log(this->dir_ / "data" / "R6.csv", fewer);
+  std::ofstream(this->dir_ / "data" / "dataset.yaml", std::ios::app)
+      << "  - {trajectory: R5, family: F, trial: 1, file: R5.csv}\n  - {trajectory: R6, family: F, trial: 1, file: R6.csv}\n";
+  const identify::Dataset data = identify::read_dataset(this->dir_ / "data");
+  try {
+    identify::read_run_log(data.find("R5", 1), Model::robot_name, Model::nq);
+    FAIL() << "another robot's log was accepted";
+  } catch (const DataError& e) {
+    EXPECT_NE(std::string(e.what()).find("R5.meta.yaml: error: run R5: the log is of robot 'some_other_arm'"), std::string::npos)
+        << e.what();
+  }
+  try {
+    identify::read_run_log(data.find("R6", 1), Model::robot_name, Model::nq);
+    FAIL() << "a log with another joint count was accepted";
+  } catch (const DataError& e) {
+    EXPECT_NE(std::string(e.what()).find(fmt::format("R6.csv: error: run R6: the log has {} joints, the model {}", n, Model::nq)),
+              std::string::npos)
+        << e.what();
+  }
+  // In a study they are failed runs with those reasons; the others go on.
+  identify::StudyOptions o = this->options();
+  o.trajectories = {"R1", "R5", "R6"};
+  o.intervals = {0.020};
+  const identify::StudyResult r = identify::Study<Model>(o, this->no_controller()).run();
+  ASSERT_EQ(r.runs.size(), 3u);
+  EXPECT_FALSE(r.runs[0].failed);
+  EXPECT_TRUE(r.runs[1].failed && r.runs[2].failed);
+  EXPECT_GE(r.selection.run, 0);
 }
 
 }  // namespace
