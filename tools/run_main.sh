@@ -64,6 +64,7 @@ $dynid diagnose --robot crane_x7 --data build/payload-data -o build/payload-diag
 
 # The hardware controller without hardware: 5 s of AG02 at 1 kHz through the real DYNAMIXEL
 # driver over a pseudo-terminal, against virtual servos that drive the digital twin.
+rm -f build/control-virtual.csv build/control-virtual.meta.yaml  # a run never overwrites a log
 $dynid control --robot crane_x7 --virtual --trajectory AG02 --seconds 5 -o build/control-virtual.csv
 
 # Your robot, your logs: the RX-90 has no twin, trajectory design or controller description.

@@ -5,6 +5,7 @@
 #include <sched.h>
 
 #include <algorithm>
+#include <filesystem>
 #include <memory>
 #include <optional>
 #include <string>
@@ -18,6 +19,7 @@
 #include "symoro/dynamixel/virtual_bus.hpp"
 #include "symoro/hardware/config.hpp"
 #include "symoro/hardware/controller.hpp"
+#include "symoro/io/log.hpp"
 #include "symoro/io/parameters_yaml.hpp"
 #include "symoro/hardware/twin_servo_backend.hpp"
 #include "symoro/robots_registry.hpp"
@@ -41,10 +43,28 @@ struct ControlCliOptions {
   int trial = 1;
   int priority = 30;  // SCHED_FIFO when the system allows it (else normal scheduling, said once)
   int watchdog = 0;
+  bool unaccepted_params = false;  // drive with parameters whose identification was not accepted
+  std::string if_exists = "refuse";  // or "new-name": the log never overwrites one
 };
+
+// The log's path: -o as given when free; with "new-name" the first free <stem>-<k><ext>.
+std::filesystem::path free_log_path(const std::filesystem::path& out, const std::string& if_exists) {
+  auto taken = [](const std::filesystem::path& p) {
+    return std::filesystem::exists(p) || std::filesystem::exists(io::metadata_path(p));
+  };
+  if (!taken(out)) return out;
+  if (if_exists != "new-name")
+    throw UsageError(fmt::format("{} exists: a run never overwrites a log; choose another -o, or --if-exists new-name",
+                                 out.string()));
+  for (int k = 1;; ++k) {
+    const auto p = out.parent_path() / fmt::format("{}-{}{}", out.stem().string(), k, out.extension().string());
+    if (!taken(p)) return p;
+  }
+}
 
 template <class Full, class Identified>
 void control(const Common& common, const ControlCliOptions& o) {
+  const std::string out = free_log_path(o.out, o.if_exists).string();  // before anything moves
   const std::vector<JointInfo> joints = joint_list<Full>();
   const auto hw_path = o.hardware.empty() ? common.robot_dir() / "hardware.yaml" : std::filesystem::path(o.hardware);
   if (!std::filesystem::exists(hw_path))
@@ -86,6 +106,16 @@ void control(const Common& common, const ControlCliOptions& o) {
     std::vector<std::string> names;
     for (const auto& p : Identified::parameters) names.emplace_back(p.name);
     const Eigen::VectorXd phi = io::read_parameters_yaml(o.params, names);
+    // Parameters whose final audit failed may not be positive definite everywhere: their
+    // inverse dynamics is no feed-forward for a real arm unless the user says so, and the log
+    // records it.
+    if (!io::parameters_accepted(o.params)) {
+      if (!o.unaccepted_params)
+        throw UsageError(fmt::format("{}: the identification was not accepted (its final all-pose audit failed, or the "
+                                     "file has no 'accepted: true'); --unaccepted-params drives with it anyway",
+                                     o.params));
+      co.notes += "; PARAMETERS NOT ACCEPTED (--unaccepted-params)";
+    }
     co.feedforward = hardware::model_feedforward<Identified>(phi);
     co.notes += "; model feedforward from " + o.params;
   }
@@ -115,8 +145,8 @@ void control(const Common& common, const ControlCliOptions& o) {
   dynamixel::SerialPort port(device, hw.baud);
   dynamixel::Bus bus(port);
   hardware::StopSignals signals;
-  const hardware::ControlResult r = hardware::run_control(bus, hw, joints, gains, traj, o.out, co);
-  fmt::print("{}: {} rows, {:.3f} s of {}; max |q_ref - q| per joint (deg):", o.out, r.rows, r.trajectory_time, o.trajectory);
+  const hardware::ControlResult r = hardware::run_control(bus, hw, joints, gains, traj, out, co);
+  fmt::print("{}: {} rows, {:.3f} s of {}; max |q_ref - q| per joint (deg):", out, r.rows, r.trajectory_time, o.trajectory);
   for (int j = 0; j < r.max_error.size(); ++j) fmt::print(" {:.3f}", r.max_error(j) * 180 / 3.14159265358979323846);
   fmt::print("\n{}\n", r.timing.summary());
   if (r.reason != hardware::StopReason::completed)
@@ -139,6 +169,10 @@ void add_control_commands(CLI::App& app, Common& common) {
   cmd->add_option("-o,--output", o->out, "Log file (CSV; its .meta.yaml sidecar next to it)")->required();
   cmd->add_option("--params", o->params, "A study's report/parameters.yaml: add the identified model's inverse dynamics "
                                          "as feedforward")->check(CLI::ExistingFile);
+  cmd->add_flag("--unaccepted-params", o->unaccepted_params, "Drive with --params whose identification was not "
+                                                             "accepted (recorded in the log)");
+  cmd->add_option("--if-exists", o->if_exists, "When -o exists: refuse (default) or new-name (<stem>-<k>.csv)")
+      ->check(CLI::IsMember({"refuse", "new-name"}));
   cmd->add_option("--seconds", o->seconds, "Run only this much of the trajectory")->check(CLI::PositiveNumber);
   cmd->add_option("--hardware", o->hardware, "Hardware description (default robots/<robot>/hardware.yaml)")->check(CLI::ExistingFile);
   cmd->add_option("--config", o->twin_config, "--virtual: a YAML file overriding parts of twin.yaml")->check(CLI::ExistingFile);

@@ -31,6 +31,7 @@
 #include <filesystem>
 #include <fstream>
 #include <functional>
+#include <limits>
 #include <memory>
 #include <string>
 #include <thread>
@@ -347,6 +348,28 @@ TEST_F(HardwareControl, HardwareErrorStopsWithItsStatus) {
   EXPECT_EQ(r.reason, StopReason::hardware_error) << r.message;
   EXPECT_NE(r.message.find("servo ID 7"), std::string::npos) << r.message;
   EXPECT_NE(r.message.find("overload"), std::string::npos) << r.message;
+  rig.expect_safe();
+  expect_log(r, csv);
+}
+
+TEST_F(HardwareControl, ANonFiniteCommandStopsAndIsNamed) {
+  const trajectory::Trajectory traj = first_seconds("AG02", 2.0);
+  Rig rig(twin_, hw_, traj);
+  ControlOptions o = options();
+  o.seconds = 2.0;
+  // A feedforward model that returns NaN on joint 3 from its 1500th call on (the approach and
+  // pre-roll call it too): never a silent zero or a saturated command.
+  auto calls = std::make_shared<int>(0);
+  o.feedforward = [calls](const Eigen::VectorXd& q, const Eigen::VectorXd&, const Eigen::VectorXd&, Eigen::VectorXd& tau) {
+    tau = Eigen::VectorXd::Zero(q.size());
+    if (++*calls >= 1500) tau(2) = std::numeric_limits<double>::quiet_NaN();
+  };
+  const std::string csv = (dir_ / "nan.csv").string();
+  const ControlResult r = run(rig, traj, csv, o);
+  EXPECT_EQ(r.reason, StopReason::invalid_command) << r.message;
+  EXPECT_NE(r.message.find("joint 3"), std::string::npos) << r.message;
+  EXPECT_NE(r.message.find("nan"), std::string::npos) << r.message;
+  EXPECT_TRUE(r.torque_off_confirmed);
   rig.expect_safe();
   expect_log(r, csv);
 }

@@ -38,6 +38,7 @@ const char* to_string(StopReason reason) {
     case StopReason::position_limit: return "position_limit";
     case StopReason::velocity_limit: return "velocity_limit";
     case StopReason::current_limit: return "current_limit";
+    case StopReason::invalid_command: return "invalid_command";
     case StopReason::setup_failed: return "setup_failed";
     case StopReason::error: return "error";
   }
@@ -453,10 +454,12 @@ class Loop {
       for (int j = 0; j < n_; ++j) {
         const double raw = std::round(hw_.joints[j].direction * tau_(j) / kt_(j) / unit_(j));
         const double bound = limit_raw_[j];
-        if (std::isnan(raw)) {
-          command_[j] = 0;
-          continue;
-        }
+        // A command that is not a number is a fault upstream (the feedforward model, the
+        // controller's state): stopping says so, where a silent 0 or a saturation would not.
+        if (!std::isfinite(raw))
+          throw StopNow{StopReason::invalid_command,
+                        fmt::format("joint {} {}: the torque command is {} (feedforward {}) at trajectory time {:.3f} s", j + 1,
+                                    joints_[j].name, tau_(j), o_.feedforward ? fmt::format("{}", ff_(j)) : "none", t)};
         if (std::abs(raw) >= bound) saturated = true;
         command_[j] = static_cast<std::int32_t>(std::clamp(raw, -bound, bound));
       }

@@ -47,4 +47,22 @@ Eigen::VectorXd read_parameters_yaml(const std::string& path, const std::vector<
   return phi;
 }
 
+bool parameters_accepted(const std::string& path) {
+  YAML::Node root;
+  try {
+    root = YAML::LoadFile(path);
+  } catch (const YAML::BadFile&) {
+    throw DataError(path, 0, "not found");
+  } catch (const YAML::Exception& e) {
+    throw DataError(path, e.mark.is_null() ? 0 : e.mark.line + 1, "invalid YAML: " + e.msg);
+  }
+  const YAML::Node flag = root["accepted"];
+  if (!flag) return false;
+  try {
+    return flag.as<bool>();
+  } catch (const YAML::Exception&) {
+    throw DataError(path, flag.Mark().line + 1, "accepted: expected true or false");
+  }
+}
+
 }  // namespace symoro::io

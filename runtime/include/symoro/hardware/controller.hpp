@@ -46,6 +46,7 @@ enum class StopReason {
   position_limit,
   velocity_limit,
   current_limit,
+  invalid_command,  // a torque or current command not finite (NaN, inf): named, never zeroed
   setup_failed,    // a servo missing, of the wrong model, or refusing the configuration
   error,           // an exception (serial port failure, log write failure)
 };

@@ -14,4 +14,9 @@ namespace symoro::io {
 // there and no other. Throws DataError with the file and line.
 Eigen::VectorXd read_parameters_yaml(const std::string& path, const std::vector<std::string>& names);
 
+// The file's `accepted:` flag: whether the identification's final all-pose audit passed. A file
+// without it is not accepted. Throws DataError with the file and line on a flag that is not a
+// boolean.
+bool parameters_accepted(const std::string& path);
+
 }  // namespace symoro::io
