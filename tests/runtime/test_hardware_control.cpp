@@ -24,6 +24,7 @@
 #include <sched.h>
 #include <unistd.h>
 
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <csignal>
@@ -36,6 +37,7 @@
 #include <string>
 #include <thread>
 
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 
 namespace symoro::hardware {
@@ -150,7 +152,7 @@ class HardwareControl : public ::testing::Test {
   // trajectory time reaches `after` s (its own timeline: the approach and pre-roll before t = 0
   // take a machine-dependent wall time, so a wall-clock trigger could land before the start).
   ControlResult run(Rig& rig, const trajectory::Trajectory& traj, const std::string& csv, ControlOptions o,
-                    double after = -1, std::function<void(Rig&)> inject = {}) {
+                    double after = -1, std::function<void(Rig&)> inject = {}, std::vector<JointInfo> limits = joints()) {
     std::atomic<double> timeline{-1e9};
     std::atomic<bool> finished{false};
     o.timeline = &timeline;
@@ -160,7 +162,7 @@ class HardwareControl : public ::testing::Test {
         while (!finished.load() && timeline.load() < after) std::this_thread::sleep_for(std::chrono::microseconds(200));
         if (!finished.load()) inject(rig);
       });
-    ControlResult r = run_control(rig.bus, hw_, joints(), gains_, traj, csv, o);
+    ControlResult r = run_control(rig.bus, hw_, limits, gains_, traj, csv, o);
     finished = true;
     if (injector.joinable()) injector.join();
     return r;
@@ -371,6 +373,119 @@ TEST_F(HardwareControl, ANonFiniteCommandStopsAndIsNamed) {
   EXPECT_NE(r.message.find("nan"), std::string::npos) << r.message;
   EXPECT_TRUE(r.torque_off_confirmed);
   rig.expect_safe();
+  expect_log(r, csv);
+}
+
+// The robot's joints with joint j's position limit moved to where the reference crosses it
+// at trajectory time `t` (beyond the safety tolerance): the arm reaches it during the run.
+std::vector<JointInfo> limit_crossed(const trajectory::Trajectory& traj, int j, double t, double tolerance) {
+  std::vector<JointInfo> js = joints();
+  Eigen::VectorXd q0(Model::nq), q1(Model::nq), v(Model::nq), a(Model::nq);
+  traj.evaluate(0, q0, v, a);
+  traj.evaluate(t, q1, v, a);
+  if (q1(j) > q0(j)) js[j].upper = q1(j) - tolerance;
+  else js[j].lower = q1(j) + tolerance;
+  return js;
+}
+
+// The joint that moves most over the first `t` seconds.
+int moving_joint(const trajectory::Trajectory& traj, double t) {
+  Eigen::VectorXd q0(Model::nq), q1(Model::nq), v(Model::nq), a(Model::nq);
+  traj.evaluate(0, q0, v, a);
+  traj.evaluate(t, q1, v, a);
+  int j = 0;
+  (q1 - q0).cwiseAbs().maxCoeff(&j);
+  return j;
+}
+
+TEST_F(HardwareControl, PositionLimitStops) {
+  const trajectory::Trajectory traj = first_seconds("AG02", 2.0);
+  const int j = moving_joint(traj, 1.0);
+  Rig rig(twin_, hw_, traj);
+  ControlOptions o = options();
+  o.seconds = 2.0;
+  const std::string csv = (dir_ / "position.csv").string();
+  const ControlResult r = run(rig, traj, csv, o, -1, {}, limit_crossed(traj, j, 0.8, hw_.safety.position_tolerance));
+  EXPECT_EQ(r.reason, StopReason::position_limit) << r.message;
+  EXPECT_NE(r.message.find(fmt::format("joint {} ", j + 1)), std::string::npos) << r.message;
+  EXPECT_GT(r.trajectory_time, 0.5);  // the arm follows the reference with a lag: after 0.8 s
+  EXPECT_TRUE(r.torque_off_confirmed);
+  rig.expect_safe();
+  expect_log(r, csv);
+}
+
+TEST_F(HardwareControl, VelocityLimitStops) {
+  const trajectory::Trajectory traj = first_seconds("AG02", 2.0);
+  const int j = moving_joint(traj, 1.0);
+  Rig rig(twin_, hw_, traj);
+  ControlOptions o = options();
+  o.seconds = 2.0;
+  std::vector<JointInfo> js = joints();
+  double peak = 0;  // the reference's fastest over the run
+  Eigen::VectorXd q(Model::nq), v(Model::nq), a(Model::nq);
+  for (double t = 0; t < 2.0; t += 0.01) {
+    traj.evaluate(t, q, v, a);
+    peak = std::max(peak, std::abs(v(j)));
+  }
+  js[j].velocity = 0.5 * peak / hw_.safety.velocity_factor;
+  const std::string csv = (dir_ / "velocity.csv").string();
+  const ControlResult r = run(rig, traj, csv, o, -1, {}, js);
+  EXPECT_EQ(r.reason, StopReason::velocity_limit) << r.message;
+  EXPECT_NE(r.message.find(fmt::format("joint {} ", j + 1)), std::string::npos) << r.message;
+  EXPECT_TRUE(r.torque_off_confirmed);
+  rig.expect_safe();
+  expect_log(r, csv);
+}
+
+TEST_F(HardwareControl, CurrentLimitStops) {
+  const trajectory::Trajectory traj = first_seconds("AG02", 2.0);
+  // Trip at half of joint 1's current limit; the other joints' limits (and trip levels) raised
+  // fourfold, so that only joint 1 can trip (the shoulder holds gravity at over half of its own).
+  hw_.safety.current_trip_factor = 0.5;
+  std::vector<JointInfo> js = joints();
+  for (int j = 1; j < Model::nq; ++j) {
+    hw_.joints[j].current_limit *= 4;
+    js[j].effort = 1e3;  // the limit is min(current limit, effort / kt): the current limit's
+  }
+  Rig rig(twin_, hw_, traj);
+  ControlOptions o = options();
+  o.seconds = 2.0;
+  // From trajectory time 0.5 s a feedforward asks joint 1 for far more than its current limit:
+  // the command saturates at the limit, and the present current passes the trip level.
+  std::atomic<double> timeline{-1e9};
+  auto* clock = &timeline;
+  o.feedforward = [clock](const Eigen::VectorXd& q, const Eigen::VectorXd&, const Eigen::VectorXd&, Eigen::VectorXd& tau) {
+    tau = Eigen::VectorXd::Zero(q.size());
+    if (clock->load() >= 0.5) tau(0) = 100;
+  };
+  const std::string csv = (dir_ / "current.csv").string();
+  o.timeline = &timeline;
+  const ControlResult r = run_control(rig.bus, hw_, js, gains_, traj, csv, o);
+  EXPECT_EQ(r.reason, StopReason::current_limit) << r.message;
+  EXPECT_NE(r.message.find("joint 1 "), std::string::npos) << r.message;
+  EXPECT_GT(r.trajectory_time, 0.45);
+  EXPECT_TRUE(r.torque_off_confirmed);
+  rig.expect_safe();
+  expect_log(r, csv);
+}
+
+TEST_F(HardwareControl, ALimitIsCheckedWhileAServoDoesNotAnswer) {
+  // Servo 5 (joint 4) stops answering at trajectory time 0.3 s; the watchdog is long (2 s), so
+  // the stale state lasts while the moving joint crosses its limit at 0.8 s: the limit stops
+  // the arm, not the watchdog.
+  const trajectory::Trajectory traj = first_seconds("AG02", 2.0);
+  int j = moving_joint(traj, 1.0);
+  ASSERT_NE(j, 3) << "the moving joint must not be the silent one";
+  Rig rig(twin_, hw_, traj);
+  ControlOptions o = options();
+  o.seconds = 2.0;
+  o.watchdog_cycles = 2000;
+  const std::string csv = (dir_ / "stale_limit.csv").string();
+  const ControlResult r = run(rig, traj, csv, o, 0.3, [](Rig& g) { g.virt.set_dead(5, true); },
+                             limit_crossed(traj, j, 0.8, hw_.safety.position_tolerance));
+  EXPECT_EQ(r.reason, StopReason::position_limit) << r.message;
+  EXPECT_GT(r.timing.max_stale, 100);  // the limit was found while joint 4's state was stale
+  rig.expect_safe(5);
   expect_log(r, csv);
 }
 

@@ -441,7 +441,9 @@ class Loop {
       if (*stop_) return {StopReason::signal, "stop requested (SIGINT/SIGTERM)"};
 
       const bool fresh = read_state(std::max(deadline + T * 8 / 10, wake + T / 2));
-      if (fresh) check_limits();
+      // Every cycle, on what is known: a servo that did not answer keeps its last state (its
+      // staleness is counted by the watchdog), the others are current.
+      check_limits();
       const double t = reference(k * T_);
       if (o_.timeline) o_.timeline->store(t, std::memory_order_relaxed);
       const Eigen::VectorXd& u = ctrl.update(q_, qr_, qdr_, qddr_);
