@@ -98,6 +98,9 @@ void control(const Common& common, const ControlCliOptions& o) {
   co.seconds = o.seconds;
   co.realtime_priority = o.priority;
   // The emulated servos are a thread that may wait for a core on a loaded machine.
+  if (!o.virtual_bus && o.watchdog > hardware::kMaxWatchdogCycles)
+    throw UsageError(fmt::format("--watchdog {}: at most {} cycles on a real port (the arm runs blind that long)", o.watchdog,
+                                 hardware::kMaxWatchdogCycles));
   co.watchdog_cycles = o.watchdog > 0 ? o.watchdog : (o.virtual_bus ? std::max(20, hw.safety.watchdog_cycles) : 0);
   co.source = o.virtual_bus ? "twin" : "robot";
   co.notes = o.virtual_bus ? "dynid control --virtual: virtual DYNAMIXEL bus driving the " + twin::ClosedLoopTwin<Full>(*tc).notes()

@@ -141,7 +141,7 @@ HardwareConfig read_hardware_config(const std::filesystem::path& path, const std
 
   if (const YAML::Node s = root["safety"]) {
     r.keys(s, {"watchdog_cycles", "position_tolerance", "velocity_factor", "current_trip_factor", "approach_speed", "pre_roll"}, "safety");
-    if (s["watchdog_cycles"]) c.safety.watchdog_cycles = static_cast<int>(r.integer(s["watchdog_cycles"], "safety.watchdog_cycles", 1, 1000));
+    if (s["watchdog_cycles"]) c.safety.watchdog_cycles = static_cast<int>(r.integer(s["watchdog_cycles"], "safety.watchdog_cycles", 1, kMaxWatchdogCycles));
     if (s["position_tolerance"]) c.safety.position_tolerance = r.number(s["position_tolerance"], "safety.position_tolerance");
     if (s["velocity_factor"]) c.safety.velocity_factor = r.positive(s["velocity_factor"], "safety.velocity_factor");
     if (s["current_trip_factor"]) c.safety.current_trip_factor = r.positive(s["current_trip_factor"], "safety.current_trip_factor");

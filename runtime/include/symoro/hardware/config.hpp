@@ -33,6 +33,10 @@ struct JointHardware {
   double current_limit = 0;  // A, commands saturate here (<= the model's limit)
 };
 
+// The most consecutive failed reads a real arm may run blind on: 50 cycles, 50 ms at 1 kHz
+// (hardware.yaml's watchdog_cycles and dynid control --watchdog on a real port).
+inline constexpr int kMaxWatchdogCycles = 50;
+
 struct Safety {
   int watchdog_cycles = 3;            // consecutive failed sync reads that stop the arm
   double position_tolerance = 0.05;   // rad a joint may pass its robot.yaml limit by
