@@ -238,6 +238,17 @@ LmiSolution LmiProblem::solve(const LmiSettings& settings) const {
   {
     std::lock_guard<std::mutex> lock(csdp_mutex());
     initsoln(w.n, k, w.C, w.a, w.constraints, &w.X, &w.y, &w.Z);
+    if (settings.identity_start) {
+      for (int b = 1; b <= nb; ++b) {
+        const int size = w.X.blocks[b].blocksize;
+        for (int i = 1; i <= size; ++i)
+          for (int j = 1; j <= size; ++j) {
+            w.X.blocks[b].data.mat[ijtok(i, j, size)] = i == j ? 1.0 : 0.0;
+            w.Z.blocks[b].data.mat[ijtok(i, j, size)] = i == j ? 1.0 : 0.0;
+          }
+      }
+      for (int v = 1; v <= k; ++v) w.y[v] = 0;
+    }
     alloc_mat(w.C, &w.work1);
     alloc_mat(w.C, &w.work2);
     alloc_mat(w.C, &w.work3);

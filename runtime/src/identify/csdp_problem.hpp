@@ -17,6 +17,11 @@ struct LmiSettings {
   // the solution itself is only accurate to about the square root of that.
   double tolerance = 1e-13;
   int max_iterations = 100;
+  // Start from X = Z = I, y = 0 instead of CSDP's X = 10 alpha I, Z = 10 beta I, where alpha
+  // grows with the total block size: for a problem scaled so that its solution's X, Z and y are
+  // O(1), CSDP's start with 40 or more pose blocks is 1e3 times too large and it spends its
+  // iterations walking back (lack of progress, or the iteration limit).
+  bool identity_start = false;
 };
 
 struct LmiSolution {

@@ -28,7 +28,8 @@ struct ProjectionOptions {
   // audit's shortfall shrinks by a small factor per round. When > 0, each round also raises the
   // SDP's margin by this fraction of the audit's shortfall (accumulated): fewer rounds for a
   // slightly larger distance (CRANE-X7, eps = 0.001: 0.5 ends in 2 rounds instead of about 6,
-  // the distance about 1e-4 larger in relative terms). 0: the plain exchange.
+  // the distance about 1e-4 larger in relative terms). The raise stays below max(eps, 1 % of
+  // phi0's violation): a large shortfall is a new basin, not drift. 0: the plain exchange.
   double shortfall_raise = 0;
   AuditOptions audit;          // the audit run after each solve
   // Diagonal weights of the distance (empty: the paper's plain Euclidean norm).
