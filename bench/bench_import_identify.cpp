@@ -4,7 +4,6 @@
 // description (OLS, all-pose audit, conditional SDP, selection, final audit). Wall time:
 //   build/bench/bench_import_identify --benchmark_min_time=1x   (Iterations(3) below)
 #include <filesystem>
-#include <fstream>
 
 #include <unistd.h>
 
@@ -33,18 +32,7 @@ const std::filesystem::path& export_csv() {
     const Eigen::Matrix<double, Full::np, 1> phi = symoro::twin::make_truth<Full>(twin).phi;
     const symoro::io::Log log = symoro::test::synthesize<Full>("arm", phi, 20.0, 3, 0.01);
     const auto f = kDir / "export.csv";
-    std::ofstream out(f);
-    out << "t_ms";
-    for (const char* what : {"pos", "vel", "eff"})
-      for (int j = 1; j <= Full::nq; ++j) out << fmt::format(",{}{}", what, j);
-    out << "\n";
-    for (int i = 0; i < log.samples(); ++i) {
-      out << fmt::format("{:.17g}", log.time(i) * 1e3);
-      for (const Eigen::MatrixXd* m : {&log.q, &log.qd})
-        for (int j = 0; j < Full::nq; ++j) out << fmt::format(",{:.17g}", (*m)(i, j) * 180 / 3.14159265358979323846);
-      for (int j = 0; j < Full::nq; ++j) out << fmt::format(",{:.17g}", log.tau(i, j));
-      out << "\n";
-    }
+    symoro::test::write_export_csv<Full>(log, f);
     return f;
   }();
   return file;
@@ -54,10 +42,10 @@ symoro::io::DatasetImport import_spec() {
   symoro::io::DatasetImport im;
   im.target.robot = "crane_x7";
   for (const auto& J : Full::joints) im.target.joints.emplace_back(J.name);
-  im.mapping.time = "t_ms";
-  im.mapping.q = "pos*";
-  im.mapping.qd = "vel*";
-  im.mapping.tau = "eff*";
+  im.mapping.time = "stamp_ms";
+  im.mapping.q = "{name}_pos";
+  im.mapping.qd = "{name}_vel";
+  im.mapping.tau = "{name}_eff";
   im.mapping.time_unit = symoro::io::TimeUnit::ms;
   im.mapping.angle_unit = symoro::io::AngleUnit::deg;
   im.inputs.push_back({export_csv(), "arm", false});

@@ -5,12 +5,17 @@
 // effects the code under test is not told about (a constant offset per joint) and white noise.
 #pragma once
 
+#include <filesystem>
+#include <fstream>
 #include <random>
+#include <stdexcept>
 #include <string>
 
 #include <Eigen/Core>
+#include <fmt/format.h>
 
 #include "symoro/io/log.hpp"
+#include "symoro/model_info.hpp"
 
 namespace symoro::test {
 
@@ -83,6 +88,28 @@ io::Log synthesize(const std::string& name, const Eigen::Matrix<double, Model::n
     log.tau.row(i) = tau.transpose();
   }
   return log;
+}
+
+// The log as a robot's controller could export it: a comment line, then stamp_ms, mode (a text
+// column), <joint>_pos and _vel (deg, deg/s; m, m/s for a prismatic joint), <joint>_eff (N m; N),
+// every number in its shortest round-trip form.
+template <class Model>
+void write_export_csv(const io::Log& log, const std::filesystem::path& file) {
+  constexpr double kPi = 3.14159265358979323846;
+  auto unit = [](int j) { return Model::joints[j].type == JointType::Prismatic ? 1.0 : 180 / kPi; };
+  std::ofstream out(file);
+  out << "# exported by the arm's controller\nstamp_ms,mode";
+  for (const char* what : {"pos", "vel", "eff"})
+    for (const auto& J : Model::joints) out << "," << J.name << "_" << what;
+  out << "\n";
+  for (int i = 0; i < log.samples(); ++i) {
+    out << fmt::format("{:.17g},run", log.time(i) * 1e3);
+    for (int j = 0; j < Model::nq; ++j) out << fmt::format(",{:.17g}", log.q(i, j) * unit(j));
+    for (int j = 0; j < Model::nq; ++j) out << fmt::format(",{:.17g}", log.qd(i, j) * unit(j));
+    for (int j = 0; j < Model::nq; ++j) out << fmt::format(",{:.17g}", log.tau(i, j));
+    out << "\n";
+  }
+  if (!out) throw std::runtime_error("cannot write " + file.string());
 }
 
 }  // namespace symoro::test

@@ -115,28 +115,13 @@ TYPED_TEST(AnyRobotGap, AControllersCsvThroughImportIdentifyDiagnoseAndCompare) 
   using Before = typename TypeParam::Before;
   using After = typename TypeParam::After;
   constexpr int n = Full::nq;
-  constexpr double kPi = 3.14159265358979323846;
   const int offset_joint = n;  // the last joint, -0.06 N m
   const io::Log log = test::synthesize<Full>("arm", this->truth_, 60.0, 5, 0.05, test::offset_on<Full>(offset_joint, -0.06));
 
   // The controller's export: milliseconds, degrees (m for a prismatic joint), its own column
   // names, a text column.
-  auto unit = [](int j) { return Full::joints[j].type == JointType::Prismatic ? 1.0 : 180 / kPi; };
   const auto csv = this->dir_ / "export.csv";
-  {
-    std::ofstream out(csv);
-    out << "# exported by the arm's controller\nstamp_ms,mode";
-    for (const char* what : {"pos", "vel", "eff"})
-      for (const auto& J : Full::joints) out << "," << J.name << "_" << what;
-    out << "\n";
-    for (int i = 0; i < log.samples(); ++i) {
-      out << fmt::format("{:.17g},run", log.time(i) * 1e3);
-      for (int j = 0; j < n; ++j) out << fmt::format(",{:.17g}", log.q(i, j) * unit(j));
-      for (int j = 0; j < n; ++j) out << fmt::format(",{:.17g}", log.qd(i, j) * unit(j));
-      for (int j = 0; j < n; ++j) out << fmt::format(",{:.17g}", log.tau(i, j));
-      out << "\n";
-    }
-  }
+  test::write_export_csv<Full>(log, csv);
   io::DatasetImport im;
   im.target.robot = Full::robot_name;
   for (const auto& J : Full::joints) {

@@ -20,25 +20,12 @@ namespace {
 
 template <class Model>
 int write(const std::string& file, double seconds, unsigned seed) {
-  constexpr double kPi = 3.14159265358979323846;
   symoro::test::Random rng(23);
   const Eigen::Matrix<double, Model::np, 1> truth = Model::base_from_standard(symoro::test::random_standard_parameters<Model>(rng).s);
   const symoro::io::Log log =
       symoro::test::synthesize<Model>("export", truth, seconds, seed, 0.05, symoro::test::offset_on<Model>(Model::nq, -0.06));
-  auto unit = [](int j) { return Model::joints[j].type == symoro::JointType::Prismatic ? 1.0 : 180 / kPi; };
-  std::ofstream out(file);
-  out << "stamp_ms,mode";
-  for (const char* what : {"pos", "vel", "eff"})
-    for (const auto& J : Model::joints) out << "," << J.name << "_" << what;
-  out << "\n";
-  for (int i = 0; i < log.samples(); ++i) {
-    out << fmt::format("{:.17g},run", log.time(i) * 1e3);
-    for (int j = 0; j < Model::nq; ++j) out << fmt::format(",{:.17g}", log.q(i, j) * unit(j));
-    for (int j = 0; j < Model::nq; ++j) out << fmt::format(",{:.17g}", log.qd(i, j) * unit(j));
-    for (int j = 0; j < Model::nq; ++j) out << fmt::format(",{:.17g}", log.tau(i, j));
-    out << "\n";
-  }
-  return out ? 0 : 1;
+  symoro::test::write_export_csv<Model>(log, file);
+  return 0;
 }
 
 }  // namespace
