@@ -184,11 +184,13 @@ class Study {
       std::optional<RunRecord> record;
     };
     std::vector<Slot> slots;
+    const StudyInputs inputs = study_inputs();  // once: the design file is read for its hash
     for (const auto& name : ident) {
       const DatasetRun& run = data.find(name, o_.trial);
+      const io::LogMetadata meta = io::read_log_metadata(run.file);
       for (double h : o_.intervals) {
         Slot s{name, h, o_.out / "runs" / fmt::format("{}@{}ms.yaml", name, std::lround(h * 1e3)), {}, {}};
-        s.fingerprint = fingerprint_of(run_inputs(run, h));
+        s.fingerprint = fingerprint_of(run_inputs(inputs, run, meta, h));
         if (!o_.fresh) s.record = load_run(s.file, s.fingerprint);
         slots.push_back(std::move(s));
       }
@@ -348,32 +350,35 @@ class Study {
 
   // What a run's result depends on: the model, the log (its sidecar identifies the data and its
   // size guards against a replaced file), the window, the interval, every option of every stage
-  // and the closed loop (controller and the design's file, when given).
-  std::string run_inputs(const DatasetRun& run, double interval) const {
-    const auto meta = io::read_log_metadata(run.file);
-    std::string loop = "open";
+  // and the closed loop (controller and the design's file, when given). The parts shared by
+  // every run are made once per study.
+  struct StudyInputs {
+    std::string model, loop;
+  };
+  StudyInputs study_inputs() const {
+    StudyInputs in;
+    // The compiled model: its parameters and joints (a regenerated model with other names or
+    // limits is another model).
+    in.model = fmt::format("{}/{} ", Model::robot_name, Model::variant_name);
+    for (const auto& p : Model::parameters) in.model += std::string(p.name) + " ";
+    for (const auto& j : Model::joints) in.model += fmt::format("{} {} {} ", j.name, j.lower, j.upper);
+    in.loop = "open";
     if (loop_.setup) {
       const ClosedLoopSetup& c = *loop_.setup;
-      loop = fmt::format("{} {} {} {} {} | {} {} {} {}", c.gains.period, c.gains.pseudo_derivative_time, c.delay, c.pre_roll,
-                         c.substeps, fmt::join(c.gains.inertia, " "), fmt::join(c.gains.damping, " "),
-                         fmt::join(c.gains.kp, " "), fmt::join(c.gains.kv, " "));
-      if (loop_.design) loop += " | " + design_text();
+      in.loop = fmt::format("{} {} {} {} {} | {} {} {} {}", c.gains.period, c.gains.pseudo_derivative_time, c.delay, c.pre_roll,
+                            c.substeps, fmt::join(c.gains.inertia, " "), fmt::join(c.gains.damping, " "),
+                            fmt::join(c.gains.kp, " "), fmt::join(c.gains.kv, " "));
+      if (loop_.design) {
+        std::ifstream file(loop_.design->path(), std::ios::binary);
+        in.loop += " | " + fingerprint_of(std::string(std::istreambuf_iterator<char>(file), std::istreambuf_iterator<char>()));
+      }
     }
-    return fmt::format("{}/{} {} | {} {} {} {} {} [{}, {}] | {} | {} | {}", Model::robot_name, Model::variant_name,
-                       model_text(), run.file.filename().string(), std::filesystem::file_size(run.file), meta.seed,
-                       meta.notes, meta.trial, run.window_start, run.window_end, interval, o_.describe(), loop);
+    return in;
   }
-  // The compiled model: its parameters and joints (a regenerated model with other names or
-  // limits is another model).
-  static std::string model_text() {
-    std::string t;
-    for (const auto& p : Model::parameters) t += std::string(p.name) + " ";
-    for (const auto& j : Model::joints) t += fmt::format("{} {} {} ", j.name, j.lower, j.upper);
-    return t;
-  }
-  std::string design_text() const {
-    std::ifstream in(loop_.design->path(), std::ios::binary);
-    return fingerprint_of(std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()));
+  std::string run_inputs(const StudyInputs& in, const DatasetRun& run, const io::LogMetadata& meta, double interval) const {
+    return fmt::format("{}| {} {} {} {} {} [{}, {}] | {} | {} | {}", in.model, run.file.filename().string(),
+                       std::filesystem::file_size(run.file), meta.seed, meta.notes, meta.trial, run.window_start,
+                       run.window_end, interval, o_.describe(), in.loop);
   }
 
   void select_and_accept(StudyResult& out) const {
