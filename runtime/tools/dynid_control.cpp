@@ -45,6 +45,8 @@ struct ControlCliOptions {
   int watchdog = 0;
   bool unaccepted_params = false;  // drive with parameters whose identification was not accepted
   std::string if_exists = "refuse";  // or "new-name": the log never overwrites one
+  std::string at_stop;   // "", "hold" or "torque-off": overrides hardware.yaml's safety.at_stop
+  double hold_time = 0;  // s; 0: hardware.yaml's safety.hold_time
 };
 
 // The log's path: -o as given when free; with "new-name" the first free <stem>-<k><ext>.
@@ -69,7 +71,20 @@ void control(const Common& common, const ControlCliOptions& o) {
   const auto hw_path = o.hardware.empty() ? common.robot_dir() / "hardware.yaml" : std::filesystem::path(o.hardware);
   if (!std::filesystem::exists(hw_path))
     throw UsageError(fmt::format("robot '{}' has no hardware description ({} not found)", common.robot, hw_path.string()));
-  const hardware::HardwareConfig hw = hardware::read_hardware_config(hw_path, joints);
+  hardware::HardwareConfig hw = hardware::read_hardware_config(hw_path, joints);
+  // What happens at a stop is the lab's choice in hardware.yaml; an override is said and logged.
+  std::string stop_override;
+  if (!o.at_stop.empty()) {
+    hw.safety.at_stop = o.at_stop == "hold" ? hardware::StopAction::hold : hardware::StopAction::torque_off;
+    stop_override = fmt::format("--at-stop {}", o.at_stop);
+  }
+  if (o.hold_time > 0) {
+    hw.safety.hold_time = o.hold_time;
+    stop_override += fmt::format("{}--hold-time {}", stop_override.empty() ? "" : " ", o.hold_time);
+  }
+  if (!stop_override.empty())
+    fmt::print(stderr, "control: at a stop: {} for {} s then torque off ({} overrides {})\n", hardware::to_string(hw.safety.at_stop),
+               hw.safety.hold_time, stop_override, hw_path.string());
   // The gains are the lab's controller description's, on the real arm and the virtual one alike;
   // twin.yaml (and --config, --ideal) shape only the emulated arm behind --virtual.
   const auto controller_path = common.robot_dir() / control::controller_file_name();
@@ -105,6 +120,9 @@ void control(const Common& common, const ControlCliOptions& o) {
   co.source = o.virtual_bus ? "twin" : "robot";
   co.notes = o.virtual_bus ? "dynid control --virtual: virtual DYNAMIXEL bus driving the " + twin::ClosedLoopTwin<Full>(*tc).notes()
                            : "dynid control on " + o.port;
+  co.notes += fmt::format("; at stop: {}{}", hardware::to_string(hw.safety.at_stop),
+                          hw.safety.at_stop == hardware::StopAction::hold ? fmt::format(" {} s then torque off", hw.safety.hold_time) : "");
+  if (!stop_override.empty()) co.notes += " (" + stop_override + ")";
   if (!o.params.empty()) {
     std::vector<std::string> names;
     for (const auto& p : Identified::parameters) names.emplace_back(p.name);
@@ -151,7 +169,7 @@ void control(const Common& common, const ControlCliOptions& o) {
   const hardware::ControlResult r = hardware::run_control(bus, hw, joints, gains, traj, out, co);
   fmt::print("{}: {} rows, {:.3f} s of {}; max |q_ref - q| per joint (deg):", out, r.rows, r.trajectory_time, o.trajectory);
   for (int j = 0; j < r.max_error.size(); ++j) fmt::print(" {:.3f}", r.max_error(j) * 180 / 3.14159265358979323846);
-  fmt::print("\n{}\n", r.timing.summary());
+  fmt::print("\nat stop: {}\n{}\n", r.at_stop, r.timing.summary());
   if (r.reason != hardware::StopReason::completed)
     throw std::runtime_error(fmt::format("run stopped ({}): {}; torque off {}", hardware::to_string(r.reason), r.message,
                                          r.torque_off_confirmed ? "confirmed" : "NOT confirmed for every servo"));
@@ -183,6 +201,11 @@ void add_control_commands(CLI::App& app, Common& common) {
   cmd->add_option("--trial", o->trial, "Trial number in the log")->check(CLI::PositiveNumber);
   cmd->add_option("--watchdog", o->watchdog, "Consecutive failed reads that stop the arm (default: hardware.yaml's; "
                                              "--virtual: at least 20)")->check(CLI::PositiveNumber);
+  cmd->add_option("--at-stop", o->at_stop, "At a stop with torque on: hold the stop pose for the hold time, then torque off; "
+                                           "or torque-off at once (default: hardware.yaml's safety.at_stop; logged)")
+      ->check(CLI::IsMember({"hold", "torque-off"}));
+  cmd->add_option("--hold-time", o->hold_time, "Seconds of hold at a stop (default: hardware.yaml's safety.hold_time; logged)")
+      ->check(CLI::PositiveNumber);
   cmd->add_option("--rt-priority", o->priority, "SCHED_FIFO priority of the loop (default 30; 0: normal scheduling; refused: normal, with a note)");
   cmd->callback([&common, o] {
     if (!with_robot(common.robot, [&](auto e) {

@@ -20,7 +20,9 @@
 #include <symoro/twin/simulator.hpp>
 #include <symoro/twin/tracking_bound.hpp>
 
+#include <fcntl.h>
 #include <pthread.h>
+#include <sys/stat.h>
 #include <sched.h>
 #include <unistd.h>
 
@@ -132,6 +134,10 @@ class HardwareControl : public ::testing::Test {
   void SetUp() override {
     twin_ = ideal_twin();
     hw_ = read_hardware_config(kRobot / "hardware.yaml", joints());
+    // The bundled file holds for 2 s at a stop; a short hold keeps the fault tests short (the
+    // hold itself is tested below with its own time).
+    EXPECT_EQ(hw_.safety.at_stop, StopAction::hold);
+    hw_.safety.hold_time = 0.2;
     gains_ = twin::controller_gains(twin_);
     dir_ = temp_dir();
   }
@@ -168,10 +174,26 @@ class HardwareControl : public ::testing::Test {
     return r;
   }
 
-  // The log on disk is complete and readable, and ends where the run stopped.
+  // The log on disk is complete and readable, ends where the run stopped, and says what was
+  // done at the stop. A run stopped before the trajectory's first row leaves no samples: its
+  // sidecar is readable and read_log's refusal gives the notes.
   void expect_log(const ControlResult& r, const std::string& csv) {
+    EXPECT_FALSE(r.at_stop.empty());
+    if (r.rows == 0) {
+      const io::LogMetadata meta = io::read_log_metadata(csv);
+      EXPECT_NE(meta.notes.find(std::string("stop: ") + to_string(r.reason)), std::string::npos) << meta.notes;
+      EXPECT_NE(meta.notes.find("at stop: " + r.at_stop), std::string::npos) << meta.notes;
+      try {
+        io::read_log(csv);
+        ADD_FAILURE() << "a log without samples was read";
+      } catch (const DataError& e) {
+        EXPECT_NE(std::string(e.what()).find(std::string("stop: ") + to_string(r.reason)), std::string::npos) << e.what();
+      }
+      return;
+    }
     io::Log log;
     ASSERT_NO_THROW(log = io::read_log(csv));
+    EXPECT_NE(log.meta.notes.find("at stop: " + r.at_stop), std::string::npos) << log.meta.notes;
     EXPECT_EQ(log.samples(), r.rows);
     EXPECT_EQ(log.meta.source, "twin");
     EXPECT_NE(log.meta.notes.find(std::string("stop: ") + to_string(r.reason)), std::string::npos) << log.meta.notes;
@@ -218,6 +240,8 @@ TEST_F(HardwareControl, TracksFiveSecondsOverThePtyLikeTheTwin) {
   rig.expect_safe();
   expect_log(r, csv);
   const io::Log log = io::read_log(csv);
+  EXPECT_EQ(r.stop_action, StopAction::hold) << r.at_stop;  // the end of a run is a stop too
+  EXPECT_NEAR(r.held, hw_.safety.hold_time, 1e-9) << r.at_stop;
   const int expected = static_cast<int>(std::llround(traj.duration() / 0.001)) + 1;
   EXPECT_GE(log.samples(), expected * 90 / 100);  // cycles lost to a loaded machine are dropped rows
   EXPECT_GT(r.timing.cycles, expected);
@@ -229,10 +253,29 @@ TEST_F(HardwareControl, TracksFiveSecondsOverThePtyLikeTheTwin) {
   ro.robot = "crane_x7";
   twin::RunStats st;
   const io::Log ref = sim.run(traj, ro, &st);
+  // What the loop could control: a row is judged only when the 1 kHz loop ran undisturbed over
+  // the settling time before it (5 / w of the slowest joint's error dynamics, K_P = w^2: a
+  // disturbance has decayed to under 1 %). A stall of a loaded machine (a skipped deadline, a
+  // failed sync read: the arm runs on held currents meanwhile) shows in the log as a gap in the
+  // time stamps, since only fresh cycles write a row. The bounds below never change; a machine
+  // that stalls too often to leave half of the rows to judge fails the test, saying so.
+  const double settle = 5 / gains_.kp.cwiseSqrt().minCoeff();
+  std::vector<bool> judged(log.samples(), false);
+  double last_gap = -1e9;
+  int judged_rows = 0;
+  for (int k = 1; k < log.samples(); ++k) {
+    if (log.time(k) - log.time(k - 1) > 1.5e-3) last_gap = log.time(k);
+    judged[k] = log.time(k) - last_gap >= settle;
+    judged_rows += judged[k];
+  }
+  std::printf("rows judged: %d of %d (undisturbed for %.0f ms before; %lld failed reads, %lld skipped deadlines)\n", judged_rows,
+              log.samples(), settle * 1e3, static_cast<long long>(r.timing.read_failures), static_cast<long long>(r.timing.skipped));
+  ASSERT_GE(judged_rows, log.samples() / 2) << "the machine stalled the loop too often to judge its tracking";
+
   // Joint paths agree sample by sample (reference interpolated at the bus run's times).
-  double worst = 0;
-  Eigen::VectorXd worst_joint = Eigen::VectorXd::Zero(Model::nq);
+  Eigen::VectorXd worst_joint = Eigen::VectorXd::Zero(Model::nq), max_error = Eigen::VectorXd::Zero(Model::nq);
   for (int k = 0; k < log.samples(); ++k) {
+    if (!judged[k]) continue;
     const double t = log.time(k);
     const double x = std::clamp(t / 0.001, 0.0, static_cast<double>(ref.samples() - 1));
     const int i = std::min(static_cast<int>(x), ref.samples() - 2);
@@ -243,16 +286,18 @@ TEST_F(HardwareControl, TracksFiveSecondsOverThePtyLikeTheTwin) {
       const double e_bus = log.q_ref(k, j) - log.q(k, j);
       const double e_ref = (1 - w) * (ref.q_ref(i, j) - ref.q(i, j)) + w * (ref.q_ref(i + 1, j) - ref.q(i + 1, j));
       worst_joint(j) = std::max(worst_joint(j), std::abs(e_bus - e_ref));
+      max_error(j) = std::max(max_error(j), std::abs(e_bus));
     }
   }
-  worst = worst_joint.maxCoeff();
   std::printf("bus run: max |q_ref - q| per joint (deg):");
   for (int j = 0; j < Model::nq; ++j) std::printf(" %.3f", r.max_error(j) * kDeg);
+  std::printf("\n  over the judged rows:                 ");
+  for (int j = 0; j < Model::nq; ++j) std::printf(" %.3f", max_error(j) * kDeg);
   std::printf("\ntwin run (no bus):                     ");
   for (int j = 0; j < Model::nq; ++j) std::printf(" %.3f", st.max_error(j) * kDeg);
   std::printf("\nmax |e_bus - e_twin| per joint (deg):  ");
   for (int j = 0; j < Model::nq; ++j) std::printf(" %.3f", worst_joint(j) * kDeg);
-  std::printf("\n%s\n", r.timing.summary().c_str());
+  std::printf("\n");
   // The tracking-error bound of the twin's loop (with its 0.9 ms delay: the bus is faster here).
   const Eigen::VectorXd sup_w = twin::unmodeled_torque(twin_, traj, [&](const Eigen::VectorXd& q, const Eigen::VectorXd& qd, const Eigen::VectorXd& qdd) {
     Eigen::Matrix<double, Model::nq, 1> tau;
@@ -264,20 +309,13 @@ TEST_F(HardwareControl, TracksFiveSecondsOverThePtyLikeTheTwin) {
   std::printf("tracking-error bound (deg):            ");
   for (int j = 0; j < Model::nq; ++j) std::printf(" %.3f", bound(j) * kDeg);
   std::printf("\n");
-  // The reference assumes a steady 1 kHz; stalls of a loaded machine (deadlines skipped, reads
-  // lost: the arm runs on held currents meanwhile) add their own error, allowed for here. One
-  // stall is enough: a clean-clone CI run with 17 lost reads (at most 4 in a row) and one
-  // skipped deadline left joint 1 at 0.345 deg against 0.318 allowed without stalls.
-  const bool stalled = r.timing.skipped + r.timing.read_failures > 0;
-  const double stall_allowance = stalled ? 0.5 / kDeg : 0.0;
-  if (stalled) std::printf("the run had stalls: %.1f deg allowed on top\n", stall_allowance * kDeg);
   for (int j = 0; j < Model::nq; ++j) {
     const double lsb = 2 * 3.14159265358979323846 / 4096;
-    // The bound holds for the twin's fixed timing; the bus run on a loaded machine sees stalls.
-    EXPECT_LE(r.max_error(j), 2 * bound(j) + 2 * lsb + stall_allowance) << "joint " << j + 1 << " bound " << bound(j) * kDeg << " deg";
+    // The bound holds for the twin's fixed timing; the bus's own timing differs a little.
+    EXPECT_LE(max_error(j), 2 * bound(j) + 2 * lsb) << "joint " << j + 1 << " bound " << bound(j) * kDeg << " deg";
     // Same loop, same plant: the errors agree to a fraction of the error itself plus a few
     // encoder steps (the bus's delay and timing differ from the twin's fixed 0.9 ms).
-    EXPECT_LE(worst_joint(j), 0.5 * st.max_error(j) + 4 * lsb + stall_allowance) << "joint " << j + 1;
+    EXPECT_LE(worst_joint(j), 0.5 * st.max_error(j) + 4 * lsb) << "joint " << j + 1;
   }
 }
 
@@ -303,6 +341,8 @@ TEST_F(HardwareControl, LongCrcBurstTripsTheWatchdog) {
   const ControlResult r = run(rig, traj, csv, o, 0.5, [](Rig& g) { g.virt.corrupt_replies(1'000'000); });
   EXPECT_EQ(r.reason, StopReason::watchdog) << r.message;
   EXPECT_GE(r.timing.max_stale, kWatchdog);
+  EXPECT_EQ(r.stop_action, StopAction::torque_off);  // no state to hold with
+  EXPECT_NE(r.at_stop.find("state is lost"), std::string::npos) << r.at_stop;
   EXPECT_GT(r.trajectory_time, 0.2);
   EXPECT_LT(r.trajectory_time, 1.5);
   rig.expect_safe();
@@ -330,6 +370,7 @@ TEST_F(HardwareControl, LostServoStopsAndIsNamed) {
   const std::string csv = (dir_ / "lost.csv").string();
   const ControlResult r = run(rig, traj, csv, o, 0.5, [](Rig& g) { g.virt.set_dead(5, true); });
   EXPECT_EQ(r.reason, StopReason::servo_lost) << r.message;
+  EXPECT_EQ(r.stop_action, StopAction::torque_off);
   EXPECT_NE(r.message.find("servo ID 5 (joint 4 elbow)"), std::string::npos) << r.message;
   EXPECT_FALSE(r.torque_off_confirmed);  // the dead servo cannot confirm
   rig.expect_safe(5);                     // every other servo is off
@@ -348,6 +389,7 @@ TEST_F(HardwareControl, HardwareErrorStopsWithItsStatus) {
   const std::string csv = (dir_ / "alert.csv").string();
   const ControlResult r = run(rig, traj, csv, o, 0.5, [](Rig& g) { g.virt.set_hardware_error(7, xs::hardware_error::kOverload); });
   EXPECT_EQ(r.reason, StopReason::hardware_error) << r.message;
+  EXPECT_EQ(r.stop_action, StopAction::torque_off);
   EXPECT_NE(r.message.find("servo ID 7"), std::string::npos) << r.message;
   EXPECT_NE(r.message.find("overload"), std::string::npos) << r.message;
   rig.expect_safe();
@@ -369,6 +411,9 @@ TEST_F(HardwareControl, ANonFiniteCommandStopsAndIsNamed) {
   const std::string csv = (dir_ / "nan.csv").string();
   const ControlResult r = run(rig, traj, csv, o);
   EXPECT_EQ(r.reason, StopReason::invalid_command) << r.message;
+  // Held on PD alone: the feedforward that failed is not asked for gravity.
+  EXPECT_EQ(r.stop_action, StopAction::hold);
+  EXPECT_NE(r.at_stop.find("(PD;"), std::string::npos) << r.at_stop;
   EXPECT_NE(r.message.find("joint 3"), std::string::npos) << r.message;
   EXPECT_NE(r.message.find("nan"), std::string::npos) << r.message;
   EXPECT_TRUE(r.torque_off_confirmed);
@@ -408,6 +453,7 @@ TEST_F(HardwareControl, PositionLimitStops) {
   const ControlResult r = run(rig, traj, csv, o, -1, {}, limit_crossed(traj, j, 0.8, hw_.safety.position_tolerance));
   EXPECT_EQ(r.reason, StopReason::position_limit) << r.message;
   EXPECT_NE(r.message.find(fmt::format("joint {} ", j + 1)), std::string::npos) << r.message;
+  EXPECT_EQ(r.stop_action, StopAction::hold);
   EXPECT_GT(r.trajectory_time, 0.5);  // the arm follows the reference with a lag: after 0.8 s
   EXPECT_TRUE(r.torque_off_confirmed);
   rig.expect_safe();
@@ -431,6 +477,7 @@ TEST_F(HardwareControl, VelocityLimitStops) {
   const std::string csv = (dir_ / "velocity.csv").string();
   const ControlResult r = run(rig, traj, csv, o, -1, {}, js);
   EXPECT_EQ(r.reason, StopReason::velocity_limit) << r.message;
+  EXPECT_EQ(r.stop_action, StopAction::hold);
   EXPECT_NE(r.message.find(fmt::format("joint {} ", j + 1)), std::string::npos) << r.message;
   EXPECT_TRUE(r.torque_off_confirmed);
   rig.expect_safe();
@@ -462,6 +509,7 @@ TEST_F(HardwareControl, CurrentLimitStops) {
   o.timeline = &timeline;
   const ControlResult r = run_control(rig.bus, hw_, js, gains_, traj, csv, o);
   EXPECT_EQ(r.reason, StopReason::current_limit) << r.message;
+  EXPECT_EQ(r.stop_action, StopAction::torque_off);  // a servo past its current is not obeying
   EXPECT_NE(r.message.find("joint 1 "), std::string::npos) << r.message;
   EXPECT_GT(r.trajectory_time, 0.45);
   EXPECT_TRUE(r.torque_off_confirmed);
@@ -498,9 +546,129 @@ TEST_F(HardwareControl, SigintStopsSafely) {
   StopSignals signals;
   const ControlResult r = run(rig, traj, csv, o, 0.5, [](Rig&) { std::raise(SIGINT); });
   EXPECT_EQ(r.reason, StopReason::signal) << r.message;
+  EXPECT_EQ(r.stop_action, StopAction::hold);
   EXPECT_TRUE(r.torque_off_confirmed);
   EXPECT_GT(r.trajectory_time, 0.2);
   EXPECT_LT(r.trajectory_time, 1.5);
+  rig.expect_safe();
+  expect_log(r, csv);
+}
+
+// Keeps the bus busy (pings) for `seconds` of wall time: the twin's plant integrates up to each
+// instruction's arrival, so this lets the arm move as its servos' state (torque off) says.
+void let_time_pass(Rig& rig, double seconds) {
+  const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(seconds);
+  while (std::chrono::steady_clock::now() < end) {
+    rig.bus.ping(rig.hw.ids()[0], std::chrono::steady_clock::now() + std::chrono::milliseconds(50));
+    std::this_thread::sleep_for(std::chrono::milliseconds(2));
+  }
+}
+
+// How far the arm moved from the last logged pose (deg, the largest joint).
+double moved_deg(const Rig& rig, const std::string& csv) {
+  const io::Log log = io::read_log(csv);
+  const int last = log.samples() - 1;
+  double worst = 0;
+  for (int j = 0; j < Model::nq; ++j) worst = std::max(worst, std::abs(rig.backend->q()(j) - log.q(last, j)));
+  return worst * kDeg;
+}
+
+// Why hold is the default: the same SIGINT stop, torque off at once, hold on PD alone, and hold
+// with the model's gravity (a model feedforward holding the twin's true parameters). The twin's
+// arm is gravity-loaded: with torque off it falls within a fraction of a second; held, it stays
+// where it stopped for the hold time (the servos' positions and the plant's own say so) and falls
+// only after. On PD alone it sags by the PD's static error: gravity / (M_hat K_P) per joint (the
+// true gravity at the stop pose), plus the stop of its motion, |qd| / (e w) for critically
+// damped error dynamics (K_P = w^2); with gravity fed forward only the motion's part is left.
+TEST_F(HardwareControl, HoldKeepsAGravityLoadedArmWhereTorqueOffLetsItFall) {
+  const trajectory::Trajectory traj = first_seconds("AG02", 2.0);
+  const double lsb = 2 * 3.14159265358979323846 / 4096;
+  struct Case {
+    const char* name;
+    StopAction action;
+    bool gravity;
+  };
+  for (const Case& c : {Case{"torque_off", StopAction::torque_off, false}, Case{"hold_pd", StopAction::hold, false},
+                        Case{"hold_gravity", StopAction::hold, true}}) {
+    SCOPED_TRACE(c.name);
+    hw_.safety.at_stop = c.action;
+    hw_.safety.hold_time = 0.6;
+    Rig rig(twin_, hw_, traj);
+    ControlOptions o = options();
+    o.seconds = 2.0;
+    if (c.gravity) o.feedforward = model_feedforward<Model>(rig.backend->truth().phi);
+    const std::string csv = (dir_ / fmt::format("at_stop_{}.csv", c.name)).string();
+    StopSignals signals;
+    const ControlResult r = run(rig, traj, csv, o, 0.5, [](Rig&) { std::raise(SIGINT); });
+    ASSERT_EQ(r.reason, StopReason::signal) << r.message;
+    EXPECT_EQ(r.stop_action, c.action) << r.at_stop;
+    EXPECT_TRUE(r.torque_off_confirmed);
+    rig.expect_safe();
+    expect_log(r, csv);
+    const io::Log log = io::read_log(csv);
+    const int last = log.samples() - 1;
+    // The sag the PD allows at the stop pose, from the twin's true gravity.
+    Eigen::Matrix<double, Model::nq, 1> q_stop = log.q.row(last).transpose(), g;
+    Model::inverse_dynamics(q_stop, Eigen::Matrix<double, Model::nq, 1>::Zero(), Eigen::Matrix<double, Model::nq, 1>::Zero(),
+                            rig.backend->truth().phi, g);
+    double allowed = 0;
+    for (int j = 0; j < Model::nq; ++j) {
+      const double w = std::sqrt(gains_.kp(j));
+      const double sag = c.gravity ? 0.0 : std::abs(g(j)) / (gains_.inertia(j) * gains_.kp(j));
+      allowed = std::max(allowed, 1.25 * (sag + std::abs(log.qd(last, j)) / (std::exp(1.0) * w)) + 2 * lsb);
+    }
+    const double at_torque_off = moved_deg(rig, csv);  // the plant when torque went off
+    let_time_pass(rig, 0.4);
+    const double later = moved_deg(rig, csv);
+    std::printf("%s: %s; the plant moved %.2f deg from the stop pose by torque off, %.2f deg 0.4 s later (allowed while "
+                "held: %.2f deg)\n",
+                c.name, r.at_stop.c_str(), at_torque_off, later, allowed * kDeg);
+    if (c.action == StopAction::hold) {
+      EXPECT_NEAR(r.held, 0.6, 1e-9) << r.at_stop;
+      EXPECT_LE(r.hold_deviation, allowed) << r.at_stop;
+      EXPECT_LE(at_torque_off, allowed * kDeg);
+    }
+    EXPECT_GT(later, 10.0);  // unheld, the arm falls: tens of degrees in 0.4 s
+    EXPECT_GT(later, 5 * at_torque_off);
+  }
+}
+
+TEST_F(HardwareControl, ASecondSigintEndsTheHold) {
+  const trajectory::Trajectory traj = first_seconds("AG02", 2.0);
+  hw_.safety.hold_time = 30;  // only the second request can end it within the test's time
+  Rig rig(twin_, hw_, traj);
+  ControlOptions o = options();
+  o.seconds = 2.0;
+  const std::string csv = (dir_ / "second_sigint.csv").string();
+  StopSignals signals;
+  const ControlResult r = run(rig, traj, csv, o, 0.5, [](Rig&) {
+    std::raise(SIGINT);
+    std::this_thread::sleep_for(std::chrono::milliseconds(300));
+    std::raise(SIGINT);
+  });
+  EXPECT_EQ(r.reason, StopReason::signal) << r.message;
+  EXPECT_EQ(r.stop_action, StopAction::hold);
+  EXPECT_NE(r.at_stop.find("a further stop request"), std::string::npos) << r.at_stop;
+  EXPECT_LT(r.held, 20.0);
+  EXPECT_TRUE(r.torque_off_confirmed);
+  rig.expect_safe();
+  expect_log(r, csv);
+}
+
+// A stop in the pre-roll, before the trajectory's first row: torque was on, so the pose is held;
+// the log has no rows, its sidecar says why.
+TEST_F(HardwareControl, AStopBeforeTheTrajectoryLeavesAnEmptyLogThatSaysWhy) {
+  const trajectory::Trajectory traj = first_seconds("AG02", 2.0);
+  Rig rig(twin_, hw_, traj);
+  ControlOptions o = options();
+  o.seconds = 2.0;
+  const std::string csv = (dir_ / "pre_roll.csv").string();
+  StopSignals signals;
+  const ControlResult r = run(rig, traj, csv, o, -0.3, [](Rig&) { std::raise(SIGINT); });
+  EXPECT_EQ(r.reason, StopReason::signal) << r.message;
+  EXPECT_EQ(r.rows, 0);
+  EXPECT_EQ(r.stop_action, StopAction::hold);
+  EXPECT_TRUE(r.torque_off_confirmed);
   rig.expect_safe();
   expect_log(r, csv);
 }
@@ -573,6 +741,63 @@ TEST(LogStream, EveryFlushLeavesAReadableLog) {
   EXPECT_EQ(log.samples(), 80);
   EXPECT_EQ(log.meta.notes, "done");
   EXPECT_EQ(log.qd_ref(79, 1), -0.25);
+  std::filesystem::remove_all(dir);
+}
+
+// The loop's side of the log never waits for the writer: with the writer stuck in write() (the
+// CSV is a pipe nobody reads yet), append() goes on accepting rows into the queue until it is
+// full and then drops and counts them; once the pipe is read, every accepted row is on disk, in
+// order, and the count adds up.
+TEST(LogStream, AStalledWriterNeitherBlocksAppendNorLosesAnAcceptedRow) {
+  const auto dir = temp_dir();
+  const auto csv = dir / "pipe.csv";
+  ASSERT_EQ(::mkfifo(csv.c_str(), 0644), 0);
+  std::atomic<bool> go{false};
+  std::string text;
+  std::thread reader([&] {
+    const int fd = ::open(csv.c_str(), O_RDONLY);
+    if (fd < 0) return;
+    ::fcntl(fd, F_SETPIPE_SZ, 4096);  // a small pipe: the writer blocks early
+    while (!go.load()) std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    char buf[4096];
+    for (ssize_t r; (r = ::read(fd, buf, sizeof buf)) > 0;) text.append(buf, static_cast<std::size_t>(r));
+    ::close(fd);
+  });
+  io::LogMetadata meta;
+  meta.robot = "crane_x7";
+  meta.trajectory = "T";
+  meta.source = "robot";
+  meta.sample_time = 0.001;
+  for (int j = 0; j < 10; ++j) meta.joints.push_back(fmt::format("j{}", j));
+  constexpr int kCapacity = 16, kAttempts = 400;
+  std::int64_t accepted = 0;
+  {
+    io::LogStream s(csv, meta, true, std::chrono::milliseconds(1), kCapacity);
+    std::vector<double> v(10);
+    for (int k = 0; k < kAttempts; ++k) {
+      for (int j = 0; j < 10; ++j) v[j] = 0.123456789 * (k + 1) + j;  // ~900 bytes a row
+      accepted += s.append(k * 0.001, v.data(), v.data(), v.data(), v.data(), v.data(), v.data());
+      if (k % 16 == 0) std::this_thread::sleep_for(std::chrono::milliseconds(2));  // the writer drains, then sticks
+    }
+    EXPECT_EQ(s.appended(), accepted);
+    EXPECT_EQ(s.appended() + s.overflowed(), kAttempts);
+    // The writer holds at most a batch, the queue and what fits the pipe: the rest overflowed.
+    EXPECT_GT(s.overflowed(), 0);
+    EXPECT_LE(accepted, 2 * kCapacity + 8);
+    go = true;  // the pipe is read; close() writes the rest
+  }
+  reader.join();
+  // The text the pipe carried: header and one line per accepted row, times increasing.
+  std::vector<std::string> lines;
+  for (std::size_t a = 0, b; (b = text.find('\n', a)) != std::string::npos; a = b + 1) lines.push_back(text.substr(a, b - a));
+  ASSERT_EQ(static_cast<std::int64_t>(lines.size()), accepted + 1);
+  double previous = -1;
+  for (std::size_t i = 1; i < lines.size(); ++i) {
+    const double t = std::stod(lines[i].substr(0, lines[i].find(',')));
+    EXPECT_GT(t, previous);
+    previous = t;
+    EXPECT_EQ(std::count(lines[i].begin(), lines[i].end(), ','), 60);
+  }
   std::filesystem::remove_all(dir);
 }
 

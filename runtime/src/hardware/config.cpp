@@ -68,6 +68,8 @@ struct Reader {
 
 }  // namespace
 
+const char* to_string(StopAction action) { return action == StopAction::hold ? "hold" : "torque_off"; }
+
 HardwareConfig read_hardware_config(const std::filesystem::path& path, const std::vector<JointInfo>& robot_joints) {
   HardwareConfig c;
   c.path = path.string();
@@ -140,13 +142,21 @@ HardwareConfig read_hardware_config(const std::filesystem::path& path, const std
   }
 
   if (const YAML::Node s = root["safety"]) {
-    r.keys(s, {"watchdog_cycles", "position_tolerance", "velocity_factor", "current_trip_factor", "approach_speed", "pre_roll"}, "safety");
+    r.keys(s, {"watchdog_cycles", "position_tolerance", "velocity_factor", "current_trip_factor", "approach_speed", "pre_roll", "at_stop", "hold_time"},
+           "safety");
     if (s["watchdog_cycles"]) c.safety.watchdog_cycles = static_cast<int>(r.integer(s["watchdog_cycles"], "safety.watchdog_cycles", 1, kMaxWatchdogCycles));
     if (s["position_tolerance"]) c.safety.position_tolerance = r.number(s["position_tolerance"], "safety.position_tolerance");
     if (s["velocity_factor"]) c.safety.velocity_factor = r.positive(s["velocity_factor"], "safety.velocity_factor");
     if (s["current_trip_factor"]) c.safety.current_trip_factor = r.positive(s["current_trip_factor"], "safety.current_trip_factor");
     if (s["approach_speed"]) c.safety.approach_speed = r.positive(s["approach_speed"], "safety.approach_speed");
     if (s["pre_roll"]) c.safety.pre_roll = r.number(s["pre_roll"], "safety.pre_roll");
+    if (s["at_stop"]) {
+      const std::string a = r.text(s["at_stop"], "safety.at_stop");
+      if (a == "hold") c.safety.at_stop = StopAction::hold;
+      else if (a == "torque_off") c.safety.at_stop = StopAction::torque_off;
+      else r.fail(s["at_stop"], fmt::format("safety.at_stop: '{}', expected hold or torque_off", a));
+    }
+    if (s["hold_time"]) c.safety.hold_time = r.positive(s["hold_time"], "safety.hold_time");
     if (c.safety.position_tolerance < 0) r.fail(s["position_tolerance"], "safety.position_tolerance: must not be negative");
     if (c.safety.pre_roll < 0) r.fail(s["pre_roll"], "safety.pre_roll: must not be negative");
   }

@@ -239,7 +239,9 @@ Log read_log(const std::filesystem::path& csv) {
   // Every line after the header is a sample (a blank one is an error), so the line count sizes
   // the matrices exactly.
   const Eigen::Index rows = std::count(text.begin(), text.end(), '\n') + (text.back() != '\n' ? 1 : 0) - 1;
-  if (rows == 0) throw DataError(file, 2, "no data rows after the header");
+  if (rows == 0)
+    throw DataError(file, 2, sidecar.meta.notes.empty() ? std::string("no data rows after the header")
+                                                        : "no data rows after the header; the sidecar's notes: " + sidecar.meta.notes);
   const Eigen::Index joints = static_cast<Eigen::Index>(log.meta.joints.size());
   log.time.resize(rows);
   for (Group g : groups)

@@ -144,7 +144,8 @@ Sidecar read_sidecar(const std::filesystem::path& yaml) {
   const YAML::Node samples = value("samples");
   sidecar.samples = reader.integer<long long>(samples, "samples");
   sidecar.samples_line = key_lines["samples"];
-  if (sidecar.samples <= 0) reader.fail(samples, fmt::format("samples: {} is not positive", sidecar.samples));
+  // 0 is a run that stopped before its first row (its notes say why); read_log refuses it then.
+  if (sidecar.samples < 0) reader.fail(samples, fmt::format("samples: {} is negative", sidecar.samples));
 
   const YAML::Node joints = value("joints");
   if (!joints.IsSequence() || joints.size() == 0) reader.fail(joints, "joints: expected a non-empty list of joint names");

@@ -1,5 +1,5 @@
-// The streaming log writer: rows into a double buffer, a thread that formats and appends them to
-// the CSV, then rewrites the sidecar with the count on disk.
+// The streaming log writer: rows into a lock-free queue, a thread that drains, formats and
+// appends them to the CSV, then rewrites the sidecar with the count on disk.
 #include "symoro/io/log_stream.hpp"
 
 #include <fcntl.h>
@@ -28,14 +28,15 @@ LogStream::LogStream(std::filesystem::path csv, LogMetadata meta, bool reference
       n_(static_cast<int>(meta_.joints.size())),
       width_(1 + static_cast<std::size_t>(n_) * (references ? 6 : 3)),
       flush_every_(flush_every),
-      capacity_(capacity < 16 ? 16 : capacity) {
+      capacity_(capacity < 16 ? 16 : capacity),
+      queue_(capacity_ * width_) {
   if (n_ == 0) throw DataError(csv_.string(), 0, "a streamed log needs joint names");
   if (meta_.source != "twin" && meta_.source != "robot")
     throw DataError(csv_.string(), 0, "a streamed log's source is 'robot' or 'twin', not '" + meta_.source + "'");
   if (!(meta_.sample_time > 0) || !std::isfinite(meta_.sample_time))
     throw DataError(csv_.string(), 0, "a streamed log needs a positive sample_time");
-  front_.resize(capacity_ * width_);
-  back_.resize(capacity_ * width_);
+  row_.resize(width_);
+  rows_.resize(capacity_ * width_);
   text_.reserve(1 << 20);
   notes_ = meta_.notes;
   if (!csv_.parent_path().empty()) std::filesystem::create_directories(csv_.parent_path());
@@ -65,6 +66,7 @@ LogStream::~LogStream() {
 
 bool LogStream::append(double time, const double* q, const double* qd, const double* tau, const double* q_ref,
                        const double* qd_ref, const double* qdd_ref) {
+  // Wait-free: no lock, no allocation, no I/O (the producer owns row_, last_time_, has_last_).
   const double* groups[] = {q, qd, tau, q_ref, qd_ref, qdd_ref};
   const int count = references_ ? 6 : 3;
   bool finite = std::isfinite(time);
@@ -75,24 +77,22 @@ bool LogStream::append(double time, const double* q, const double* qd, const dou
     }
     for (int j = 0; j < n_; ++j) finite = finite && std::isfinite(groups[g][j]);
   }
-  std::lock_guard<std::mutex> lock(mutex_);
-  if (closed_ || !finite || (has_last_ && !(time > last_time_))) {
-    ++rejected_;
+  if (closed_.load(std::memory_order_acquire) || !finite || (has_last_ && !(time > last_time_))) {
+    rejected_.fetch_add(1, std::memory_order_relaxed);
     return false;
   }
-  if (front_rows_ >= capacity_) {
-    ++overflowed_;
+  if (queue_.write_available() < width_) {
+    overflowed_.fetch_add(1, std::memory_order_relaxed);
     return false;
   }
-  double* out = front_.data() + front_rows_ * width_;
+  double* out = row_.data();
   *out++ = time;
   for (int g = 0; g < count; ++g)
     for (int j = 0; j < n_; ++j) *out++ = groups[g][j];
-  ++front_rows_;
-  ++appended_;
+  queue_.push(row_.data(), width_);  // one publication: the writer sees whole rows
+  appended_.fetch_add(1, std::memory_order_relaxed);
   last_time_ = time;
   has_last_ = true;
-  if (front_rows_ >= capacity_ / 2) wake_.notify_one();
   return true;
 }
 
@@ -105,14 +105,12 @@ void LogStream::run() {
   std::unique_lock<std::mutex> lock(mutex_);
   for (;;) {
     const std::uint64_t requested = flush_requests_;
-    wake_.wait_for(lock, flush_every_, [&] { return stop_ || flush_requests_ != requested || front_rows_ >= capacity_ / 2; });
+    wake_.wait_for(lock, flush_every_, [&] { return stop_ || flush_requests_ != requested; });
     const std::uint64_t serving = flush_requests_;
-    const std::size_t rows = front_rows_;
-    std::swap(front_, back_);
-    front_rows_ = 0;
     const bool stopping = stop_;
     lock.unlock();
-    if (rows > 0 || serving != flushes_done_) write_out(back_, rows);
+    const std::size_t rows = drain();
+    if (rows == 0 && serving != flushes_done_) write_out(rows_, 0);  // a flush rewrites the sidecar (its notes)
     lock.lock();
     flushes_done_ = serving;
     done_.notify_all();
@@ -120,7 +118,19 @@ void LogStream::run() {
   }
 }
 
-void LogStream::write_out(std::vector<double>& rows, std::size_t count) {
+std::size_t LogStream::drain() {
+  std::size_t total = 0;
+  for (;;) {
+    const std::size_t available = queue_.read_available() / width_ * width_;
+    if (available == 0) return total;
+    const std::size_t take = std::min(available, rows_.size());
+    const std::size_t got = queue_.pop(rows_.data(), take);
+    write_out(rows_, got / width_);
+    total += got / width_;
+  }
+}
+
+void LogStream::write_out(const std::vector<double>& rows, std::size_t count) {
   text_.clear();
   char number[max_number_chars];
   for (std::size_t r = 0; r < count; ++r) {
@@ -142,12 +152,7 @@ void LogStream::write_out(std::vector<double>& rows, std::size_t count) {
     }
     done += static_cast<std::size_t>(w);
   }
-  std::int64_t total;
-  {
-    std::lock_guard<std::mutex> lock(mutex_);
-    written_ += static_cast<std::int64_t>(count);
-    total = written_;
-  }
+  const std::int64_t total = written_.fetch_add(static_cast<std::int64_t>(count)) + static_cast<std::int64_t>(count);
   try {
     write_sidecar(total);
   } catch (const std::exception& e) {
@@ -185,30 +190,18 @@ void LogStream::flush() {
 }
 
 void LogStream::close() {
+  if (closed_.exchange(true, std::memory_order_acq_rel)) return;
   {
     std::lock_guard<std::mutex> lock(mutex_);
-    if (closed_) return;
-    closed_ = true;
     stop_ = true;
   }
   wake_.notify_one();
   if (thread_.joinable()) thread_.join();
-  // The writer's last pass took what was buffered when it stopped; append() refuses rows now,
-  // but a row may have come in between: write it, then the final sidecar.
-  std::size_t rows;
-  {
-    std::lock_guard<std::mutex> lock(mutex_);
-    rows = front_rows_;
-    front_rows_ = 0;
-  }
-  if (rows > 0) write_out(front_, rows);
-  std::int64_t total;
-  {
-    std::lock_guard<std::mutex> lock(mutex_);
-    total = written_;
-  }
+  // The writer is gone: this thread is the queue's only consumer now. Rows appended after its
+  // last pass are written, then the final sidecar.
+  drain();
   try {
-    write_sidecar(total);
+    write_sidecar(written_.load());
   } catch (const std::exception& e) {
     std::lock_guard<std::mutex> lock(mutex_);
     if (error_.empty()) error_ = e.what();
@@ -224,21 +217,9 @@ void LogStream::close() {
   if (!error.empty()) throw DataError(csv_.string(), 0, error);
 }
 
-std::int64_t LogStream::appended() const {
-  std::lock_guard<std::mutex> lock(mutex_);
-  return appended_;
-}
-std::int64_t LogStream::written() const {
-  std::lock_guard<std::mutex> lock(mutex_);
-  return written_;
-}
-std::int64_t LogStream::rejected() const {
-  std::lock_guard<std::mutex> lock(mutex_);
-  return rejected_;
-}
-std::int64_t LogStream::overflowed() const {
-  std::lock_guard<std::mutex> lock(mutex_);
-  return overflowed_;
-}
+std::int64_t LogStream::appended() const { return appended_.load(); }
+std::int64_t LogStream::written() const { return written_.load(); }
+std::int64_t LogStream::rejected() const { return rejected_.load(); }
+std::int64_t LogStream::overflowed() const { return overflowed_.load(); }
 
 }  // namespace symoro::io

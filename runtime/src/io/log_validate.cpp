@@ -47,7 +47,10 @@ void validate_log(const Log& log, const std::string& file) {
   check_metadata(meta, file);
   const Eigen::Index samples = log.time.size();
   const Eigen::Index joints = static_cast<Eigen::Index>(meta.joints.size());
-  if (samples == 0) throw DataError(file, 0, "the log has no samples");
+  // A run that stopped before its first row (dynid control) leaves a valid, empty log whose
+  // notes say why: the message carries them.
+  if (samples == 0)
+    throw DataError(file, 0, meta.notes.empty() ? std::string("the log has no samples") : "the log has no samples; its notes: " + meta.notes);
 
   const bool reference = meta.source == detail::reference_source;
   for (Group g : detail::measured_groups) {

@@ -37,6 +37,14 @@ struct JointHardware {
 // (hardware.yaml's watchdog_cycles and dynid control --watchdog on a real port).
 inline constexpr int kMaxWatchdogCycles = 50;
 
+// What the loop does at every stop once torque is on (docs/safety.md). A gravity-loaded arm falls
+// when its torque goes off, so the default holds: the stop pose with the run's PD gains (and the
+// model feedforward's gravity, when it has one and it is finite) for hold_time, then torque off.
+// Stops that leave nothing to hold with (watchdog, a lost servo, a hardware error, a current
+// trip) turn torque off at once whatever the choice; a new fault during the hold ends it.
+enum class StopAction { hold, torque_off };
+const char* to_string(StopAction action);
+
 struct Safety {
   int watchdog_cycles = 3;            // consecutive failed sync reads that stop the arm
   double position_tolerance = 0.05;   // rad a joint may pass its robot.yaml limit by
@@ -44,6 +52,8 @@ struct Safety {
   double current_trip_factor = 1.5;   // stop when |present current| > factor * current_limit
   double approach_speed = 0.3;        // rad/s, the move to the trajectory's start posture
   double pre_roll = 0.5;              // s holding the start posture before the trajectory
+  StopAction at_stop = StopAction::hold;  // safety.at_stop: hold | torque_off
+  double hold_time = 2.0;             // s of hold before torque off (safety.hold_time, > 0)
 };
 
 struct HardwareConfig {

@@ -14,9 +14,13 @@
 //
 // Safe stop, whatever ends the run (completion, SIGINT/SIGTERM through the stop flag, watchdog:
 // watchdog_cycles consecutive failed sync reads, a servo's hardware alert, a servo that stops
-// answering, a joint beyond its position, velocity or current limit, an exception): Goal
-// Current 0 to every servo, Torque Enable 0 broadcast (both repeated), the log flushed and
-// closed with the reason and timing statistics in its sidecar notes, the reason returned.
+// answering, a joint beyond its position, velocity or current limit, a non-finite command, an
+// exception): first what hardware.yaml's safety.at_stop says (hold the stop pose with the run's
+// gains for hold_time, or nothing; never after a stop that leaves no state or no obedient
+// servo), then Goal Current 0 to every servo, Torque Enable 0 broadcast (both repeated) and read
+// back, the log closed with the reason, the action at stop and timing statistics in its sidecar
+// notes, the reason returned. The loop never waits on a lock: the log rows go to the writer
+// thread through a lock-free queue (io::LogStream). docs/safety.md says all of it in one page.
 #pragma once
 
 #include <atomic>
@@ -72,8 +76,10 @@ struct TimingStats {
 
 struct ControlOptions {
   double seconds = 0;  // run only this much of the trajectory (0: all of it)
-  // The stop flag; nullptr: the process's SIGINT/SIGTERM flag (stop_requested()).
-  const volatile std::sig_atomic_t* stop = nullptr;
+  // Stop requests, counted (a signal handler may touch a lock-free atomic): one more than at
+  // the start stops the run, a further one ends the hold at once. nullptr: the process's
+  // SIGINT/SIGTERM count (stop_flag()).
+  const std::atomic<int>* stop = nullptr;
   // Extra joint torque added to FF+PD (N m), from the references: e.g. model_feedforward.
   // When set, the FF+PD's own realization feedforward (M-hat qdd_ref + D-hat qd_ref) is
   // replaced by it (the PD part remains).
@@ -104,11 +110,16 @@ struct ControlResult {
   double trajectory_time = 0;  // s of the trajectory run
   Eigen::VectorXd max_error;   // max |q_ref - q| per joint over the logged rows, rad
   bool torque_off_confirmed = false;  // every answering servo read back Torque Enable 0
+  // What the arm did between the stop and torque off (hardware.yaml safety.at_stop):
+  StopAction stop_action = StopAction::torque_off;  // hold: the stop pose was held first
+  double held = 0;            // s of hold (less than safety.hold_time when a fault ended it)
+  double hold_deviation = 0;  // max |q - q_stop| over the hold, rad, from the servos' positions
+  std::string at_stop;        // one line: what was done and why (also in the log's notes)
 };
 
-// The process-wide stop flag, set by stop_signal_handler (installed by StopSignals).
-volatile std::sig_atomic_t& stop_flag();
-// Installs SIGINT and SIGTERM handlers that only set stop_flag() (clearing it first), and
+// The process-wide count of stop requests, raised by the SIGINT/SIGTERM handler of StopSignals.
+std::atomic<int>& stop_flag();
+// Installs SIGINT and SIGTERM handlers that only count in stop_flag() (clearing it first), and
 // restores the previous handlers when destroyed.
 class StopSignals {
  public:

@@ -1,9 +1,12 @@
 // A log written while it is recorded (a control loop's run): the same files as write_log (CSV +
-// .meta.yaml sidecar, log.hpp), streamed. append() copies one row into memory and never does I/O
-// or allocates (after construction); a background thread writes the rows out every
-// `flush_every` and then rewrites the sidecar (atomically) with the row count written so far,
-// so that the files on disk are always a log read_log accepts, up to the last flush. close()
-// (also from the destructor) writes the rest and the final sidecar (with the notes set last).
+// .meta.yaml sidecar, log.hpp), streamed. append() copies one row into a lock-free
+// single-producer single-consumer queue (boost::lockfree::spsc_queue): it never does I/O,
+// allocates, takes a lock or waits, so a real-time loop can call it. A background thread drains
+// the queue every `flush_every` and then rewrites the sidecar (atomically) with the row count
+// written so far, so that the files on disk are always a log read_log accepts, up to the last
+// flush. close() (also from the destructor) writes the rest and the final sidecar (with the
+// notes set last). append() and close() belong to one thread (the producer); flush(),
+// set_notes() and the counters may be called from any.
 //
 //   io::LogStream log("run.csv", meta, /*references=*/true);
 //   log.append(t, q, qd, tau, q_ref, qd_ref, qdd_ref);   // in the loop, n values each
@@ -15,6 +18,7 @@
 // behind by `capacity` rows, further rows are dropped and counted (overflowed()).
 #pragma once
 
+#include <atomic>
 #include <chrono>
 #include <condition_variable>
 #include <cstdint>
@@ -23,6 +27,8 @@
 #include <string>
 #include <thread>
 #include <vector>
+
+#include <boost/lockfree/spsc_queue.hpp>
 
 #include "symoro/io/log.hpp"
 
@@ -59,7 +65,8 @@ class LogStream {
 
  private:
   void run();
-  void write_out(std::vector<double>& rows, std::size_t count);  // writer thread / close()
+  std::size_t drain();  // pops whole rows into rows_ and writes them (the writer thread / close())
+  void write_out(const std::vector<double>& rows, std::size_t count);
   void write_sidecar(std::int64_t samples);
 
   std::filesystem::path csv_;
@@ -70,19 +77,24 @@ class LogStream {
   std::chrono::milliseconds flush_every_;
   std::size_t capacity_;
 
-  mutable std::mutex mutex_;  // front_, counters, notes_, flags
-  std::condition_variable wake_, done_;
-  std::vector<double> front_, back_;
-  std::size_t front_rows_ = 0;
-  std::int64_t appended_ = 0, written_ = 0, rejected_ = 0, overflowed_ = 0;
-  std::uint64_t flush_requests_ = 0, flushes_done_ = 0;
+  // The producer's side (append): its queue end, its row buffer, the last time it took.
+  boost::lockfree::spsc_queue<double> queue_;  // whole rows of width_ values
+  std::vector<double> row_;
   double last_time_ = 0;
   bool has_last_ = false;
-  bool stop_ = false, closed_ = false;
+  std::atomic<bool> closed_{false};
+  std::atomic<std::int64_t> appended_{0}, rejected_{0}, overflowed_{0}, written_{0};
+
+  // Between the writer thread and flush()/set_notes()/close() (never the producer's path).
+  mutable std::mutex mutex_;
+  std::condition_variable wake_, done_;
+  std::uint64_t flush_requests_ = 0, flushes_done_ = 0;
+  bool stop_ = false;
   std::string notes_;
   std::string error_;  // first I/O error of the writer
   int fd_ = -1;
-  std::string text_;  // writer's formatting buffer
+  std::vector<double> rows_;  // the writer's batch
+  std::string text_;          // the writer's formatting buffer
   std::thread thread_;
 };
 

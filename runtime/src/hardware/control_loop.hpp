@@ -1,0 +1,96 @@
+// The control loop's internals (controller.hpp is its public face): one Loop per run_control,
+// its phases in control_loop.cpp (setup, approach, pre-roll, trajectory) and stop_hold.cpp (the
+// hold at a stop, before torque off).
+#pragma once
+
+#include <array>
+#include <atomic>
+#include <chrono>
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "symoro/control/ffpd.hpp"
+#include "symoro/dynamixel/bus.hpp"
+#include "symoro/hardware/config.hpp"
+#include "symoro/hardware/controller.hpp"
+#include "symoro/io/log_stream.hpp"
+
+namespace symoro::hardware::detail {
+
+using Clock = std::chrono::steady_clock;
+
+inline double seconds(Clock::duration d) { return std::chrono::duration<double>(d).count(); }
+
+// Sleeps until `t` (absolute, CLOCK_MONOTONIC); a signal wakes it early only when the stop
+// requests have passed `seen`.
+void sleep_until(Clock::time_point t, const std::atomic<int>& stop, int seen);
+
+// Outside the 1 kHz loop (start, stop) transactions may take their time: a servo (or, on the
+// virtual bus, the emulating thread) that answers late is waited for and retried.
+class PatientBus {
+ public:
+  explicit PatientBus(dynamixel::Bus& bus);
+  ~PatientBus();
+  PatientBus(const PatientBus&) = delete;
+  PatientBus& operator=(const PatientBus&) = delete;
+
+ private:
+  dynamixel::Bus& bus_;
+  dynamixel::BusOptions saved_;
+};
+
+// Thrown inside the loop: what stops the run.
+struct StopNow {
+  StopReason reason;
+  std::string message;
+};
+
+class Loop {
+ public:
+  Loop(dynamixel::Bus& bus, const HardwareConfig& hw, const std::vector<JointInfo>& joints, const control::FfpdGains& gains,
+       const trajectory::Trajectory& traj, const ControlOptions& o);
+  ControlResult run(const std::string& csv);
+
+ private:
+  std::string joint_name(int j) const;
+  void setup();
+  bool read_state(Clock::time_point deadline, bool setup = false);
+  void check_limits();
+  void check_current();
+  double reference(double s);
+  StopNow loop();
+  void finish_timing();
+  // stop_hold.cpp: what the arm does between the stop and torque off (result.at_stop says).
+  void at_stop(const StopNow& stop, ControlResult& result);
+  std::string hold(const Eigen::VectorXd& gravity, ControlResult& result);
+
+  dynamixel::Bus& bus_;
+  const HardwareConfig& hw_;
+  const std::vector<JointInfo>& joints_;
+  const control::FfpdGains& gains_;
+  const trajectory::Trajectory& traj_;
+  const ControlOptions& o_;
+  int n_;
+  std::vector<std::uint8_t> ids_;
+  const std::atomic<int>* stop_ = nullptr;
+  int stops_seen_ = 0;  // stop requests before the run: a request counts when it comes after
+  double T_ = 0.001, approach_ = 0, traj_time_ = 0;
+  Eigen::VectorXd q_, qd_servo_, current_, tau_, qr_, qdr_, qddr_, ff_, q0_, qr0_, kt_, limit_, unit_, max_error_;
+  std::vector<double> tau_meas_;
+  std::vector<std::int32_t> limit_raw_, command_;
+  std::vector<int> stale_;
+  std::int64_t stale_cycles_ = 0;
+  int watchdog_ = 3;
+  int alert_id_ = -1;
+  bool torque_on_ = false;  // Torque Enable 1 was written to every servo
+  std::optional<control::FfpdController> ctrl_;  // the run's controller: the hold continues it
+  TimingStats timing_;
+  std::array<double, 5> period_stats_{};
+  io::LogStream* log_ = nullptr;
+};
+
+}  // namespace symoro::hardware::detail
