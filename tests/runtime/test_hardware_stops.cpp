@@ -1,0 +1,262 @@
+// The controller's stops (hardware_rig.hpp): position, velocity and current limits (also while a
+// servo is silent), SIGINT, and what the arm does at a stop (hardware.yaml safety.at_stop: hold
+// the stop pose, then torque off; or torque off at once), each read back from the emulated servos.
+#include "hardware_rig.hpp"
+
+namespace symoro::hardware {
+namespace {
+
+// The robot's joints with joint j's position limit moved to where the reference crosses it
+// at trajectory time `t` (beyond the safety tolerance): the arm reaches it during the run.
+std::vector<JointInfo> limit_crossed(const trajectory::Trajectory& traj, int j, double t, double tolerance) {
+  std::vector<JointInfo> js = joints();
+  Eigen::VectorXd q0(Model::nq), q1(Model::nq), v(Model::nq), a(Model::nq);
+  traj.evaluate(0, q0, v, a);
+  traj.evaluate(t, q1, v, a);
+  if (q1(j) > q0(j)) js[j].upper = q1(j) - tolerance;
+  else js[j].lower = q1(j) + tolerance;
+  return js;
+}
+
+// The joint that moves most over the first `t` seconds.
+int moving_joint(const trajectory::Trajectory& traj, double t) {
+  Eigen::VectorXd q0(Model::nq), q1(Model::nq), v(Model::nq), a(Model::nq);
+  traj.evaluate(0, q0, v, a);
+  traj.evaluate(t, q1, v, a);
+  int j = 0;
+  (q1 - q0).cwiseAbs().maxCoeff(&j);
+  return j;
+}
+
+TEST_F(HardwareControl, PositionLimitStops) {
+  const trajectory::Trajectory traj = first_seconds("AG02", 2.0);
+  const int j = moving_joint(traj, 1.0);
+  Rig rig(twin_, hw_, traj);
+  ControlOptions o = options();
+  o.seconds = 2.0;
+  const std::string csv = (dir_ / "position.csv").string();
+  const ControlResult r = run(rig, traj, csv, o, -1, {}, limit_crossed(traj, j, 0.8, hw_.safety.position_tolerance));
+  EXPECT_EQ(r.reason, StopReason::position_limit) << r.message;
+  EXPECT_NE(r.message.find(fmt::format("joint {} ", j + 1)), std::string::npos) << r.message;
+  EXPECT_EQ(r.stop_action, StopAction::hold);
+  EXPECT_GT(r.trajectory_time, 0.5);  // the arm follows the reference with a lag: after 0.8 s
+  EXPECT_TRUE(r.torque_off_confirmed);
+  rig.expect_safe();
+  expect_log(r, csv);
+}
+
+TEST_F(HardwareControl, VelocityLimitStops) {
+  const trajectory::Trajectory traj = first_seconds("AG02", 2.0);
+  const int j = moving_joint(traj, 1.0);
+  Rig rig(twin_, hw_, traj);
+  ControlOptions o = options();
+  o.seconds = 2.0;
+  std::vector<JointInfo> js = joints();
+  double peak = 0;  // the reference's fastest over the run
+  Eigen::VectorXd q(Model::nq), v(Model::nq), a(Model::nq);
+  for (double t = 0; t < 2.0; t += 0.01) {
+    traj.evaluate(t, q, v, a);
+    peak = std::max(peak, std::abs(v(j)));
+  }
+  js[j].velocity = 0.5 * peak / hw_.safety.velocity_factor;
+  const std::string csv = (dir_ / "velocity.csv").string();
+  const ControlResult r = run(rig, traj, csv, o, -1, {}, js);
+  EXPECT_EQ(r.reason, StopReason::velocity_limit) << r.message;
+  EXPECT_EQ(r.stop_action, StopAction::hold);
+  EXPECT_NE(r.message.find(fmt::format("joint {} ", j + 1)), std::string::npos) << r.message;
+  EXPECT_TRUE(r.torque_off_confirmed);
+  rig.expect_safe();
+  expect_log(r, csv);
+}
+
+TEST_F(HardwareControl, CurrentLimitStops) {
+  const trajectory::Trajectory traj = first_seconds("AG02", 2.0);
+  // Trip at half of joint 1's current limit; the other joints' limits (and trip levels) raised
+  // fourfold, so that only joint 1 can trip (the shoulder holds gravity at over half of its own).
+  hw_.safety.current_trip_factor = 0.5;
+  std::vector<JointInfo> js = joints();
+  for (int j = 1; j < Model::nq; ++j) {
+    hw_.joints[j].current_limit *= 4;
+    js[j].effort = 1e3;  // the limit is min(current limit, effort / kt): the current limit's
+  }
+  Rig rig(twin_, hw_, traj);
+  ControlOptions o = options();
+  o.seconds = 2.0;
+  // From trajectory time 0.5 s a feedforward asks joint 1 for far more than its current limit:
+  // the command saturates at the limit, and the present current passes the trip level.
+  std::atomic<double> timeline{-1e9};
+  auto* clock = &timeline;
+  o.feedforward = [clock](const Eigen::VectorXd& q, const Eigen::VectorXd&, const Eigen::VectorXd&, Eigen::VectorXd& tau) {
+    tau = Eigen::VectorXd::Zero(q.size());
+    if (clock->load() >= 0.5) tau(0) = 100;
+  };
+  const std::string csv = (dir_ / "current.csv").string();
+  o.timeline = &timeline;
+  const ControlResult r = run_control(rig.bus, hw_, js, gains_, traj, csv, o);
+  EXPECT_EQ(r.reason, StopReason::current_limit) << r.message;
+  EXPECT_EQ(r.stop_action, StopAction::torque_off);  // a servo past its current is not obeying
+  EXPECT_NE(r.message.find("joint 1 "), std::string::npos) << r.message;
+  EXPECT_GT(r.trajectory_time, 0.45);
+  EXPECT_TRUE(r.torque_off_confirmed);
+  rig.expect_safe();
+  expect_log(r, csv);
+}
+
+TEST_F(HardwareControl, ALimitIsCheckedWhileAServoDoesNotAnswer) {
+  // Servo 5 (joint 4) stops answering at trajectory time 0.3 s; the watchdog is long (2 s), so
+  // the stale state lasts while the moving joint crosses its limit at 0.8 s: the limit stops
+  // the arm, not the watchdog.
+  const trajectory::Trajectory traj = first_seconds("AG02", 2.0);
+  int j = moving_joint(traj, 1.0);
+  ASSERT_NE(j, 3) << "the moving joint must not be the silent one";
+  Rig rig(twin_, hw_, traj);
+  ControlOptions o = options();
+  o.seconds = 2.0;
+  o.watchdog_cycles = 2000;
+  const std::string csv = (dir_ / "stale_limit.csv").string();
+  const ControlResult r = run(rig, traj, csv, o, 0.3, [](Rig& g) { g.virt.set_dead(5, true); },
+                             limit_crossed(traj, j, 0.8, hw_.safety.position_tolerance));
+  EXPECT_EQ(r.reason, StopReason::position_limit) << r.message;
+  EXPECT_GT(r.timing.max_stale, 100);  // the limit was found while joint 4's state was stale
+  rig.expect_safe(5);
+  expect_log(r, csv);
+}
+
+TEST_F(HardwareControl, SigintStopsSafely) {
+  const trajectory::Trajectory traj = first_seconds("AG02", 3.0);
+  Rig rig(twin_, hw_, traj);
+  ControlOptions o = options();
+  o.seconds = 3.0;
+  const std::string csv = (dir_ / "sigint.csv").string();
+  StopSignals signals;
+  const ControlResult r = run(rig, traj, csv, o, 0.5, [](Rig&) { std::raise(SIGINT); });
+  EXPECT_EQ(r.reason, StopReason::signal) << r.message;
+  EXPECT_EQ(r.stop_action, StopAction::hold);
+  EXPECT_TRUE(r.torque_off_confirmed);
+  EXPECT_GT(r.trajectory_time, 0.2);
+  EXPECT_LT(r.trajectory_time, 1.5);
+  rig.expect_safe();
+  expect_log(r, csv);
+}
+
+// Keeps the bus busy (pings) for `seconds` of wall time: the twin's plant integrates up to each
+// instruction's arrival, so this lets the arm move as its servos' state (torque off) says.
+void let_time_pass(Rig& rig, double seconds) {
+  const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(seconds);
+  while (std::chrono::steady_clock::now() < end) {
+    rig.bus.ping(rig.hw.ids()[0], std::chrono::steady_clock::now() + std::chrono::milliseconds(50));
+    std::this_thread::sleep_for(std::chrono::milliseconds(2));
+  }
+}
+
+// How far the arm moved from the last logged pose (deg, the largest joint).
+double moved_deg(const Rig& rig, const std::string& csv) {
+  const io::Log log = io::read_log(csv);
+  const int last = log.samples() - 1;
+  double worst = 0;
+  for (int j = 0; j < Model::nq; ++j) worst = std::max(worst, std::abs(rig.backend->q()(j) - log.q(last, j)));
+  return worst * kDeg;
+}
+
+// Why hold is the default: the same SIGINT stop, torque off at once, hold on PD alone, and hold
+// with the model's gravity (a model feedforward holding the twin's true parameters). The twin's
+// arm is gravity-loaded: with torque off it falls within a fraction of a second; held, it stays
+// where it stopped for the hold time (the servos' positions and the plant's own say so) and falls
+// only after. On PD alone it sags by the PD's static error: gravity / (M_hat K_P) per joint (the
+// true gravity at the stop pose), plus the stop of its motion, |qd| / (e w) for critically
+// damped error dynamics (K_P = w^2); with gravity fed forward only the motion's part is left.
+TEST_F(HardwareControl, HoldKeepsAGravityLoadedArmWhereTorqueOffLetsItFall) {
+  const trajectory::Trajectory traj = first_seconds("AG02", 2.0);
+  const double lsb = 2 * 3.14159265358979323846 / 4096;
+  struct Case {
+    const char* name;
+    StopAction action;
+    bool gravity;
+  };
+  for (const Case& c : {Case{"torque_off", StopAction::torque_off, false}, Case{"hold_pd", StopAction::hold, false},
+                        Case{"hold_gravity", StopAction::hold, true}}) {
+    SCOPED_TRACE(c.name);
+    hw_.safety.at_stop = c.action;
+    hw_.safety.hold_time = 0.6;
+    Rig rig(twin_, hw_, traj);
+    ControlOptions o = options();
+    o.seconds = 2.0;
+    if (c.gravity) o.feedforward = model_feedforward<Model>(rig.backend->truth().phi);
+    const std::string csv = (dir_ / fmt::format("at_stop_{}.csv", c.name)).string();
+    StopSignals signals;
+    const ControlResult r = run(rig, traj, csv, o, 0.5, [](Rig&) { std::raise(SIGINT); });
+    ASSERT_EQ(r.reason, StopReason::signal) << r.message;
+    EXPECT_EQ(r.stop_action, c.action) << r.at_stop;
+    EXPECT_TRUE(r.torque_off_confirmed);
+    rig.expect_safe();
+    expect_log(r, csv);
+    const io::Log log = io::read_log(csv);
+    const int last = log.samples() - 1;
+    // The sag the PD allows at the stop pose, from the twin's true gravity.
+    Eigen::Matrix<double, Model::nq, 1> q_stop = log.q.row(last).transpose(), g;
+    Model::inverse_dynamics(q_stop, Eigen::Matrix<double, Model::nq, 1>::Zero(), Eigen::Matrix<double, Model::nq, 1>::Zero(),
+                            rig.backend->truth().phi, g);
+    double allowed = 0;
+    for (int j = 0; j < Model::nq; ++j) {
+      const double w = std::sqrt(gains_.kp(j));
+      const double sag = c.gravity ? 0.0 : std::abs(g(j)) / (gains_.inertia(j) * gains_.kp(j));
+      allowed = std::max(allowed, 1.25 * (sag + std::abs(log.qd(last, j)) / (std::exp(1.0) * w)) + 2 * lsb);
+    }
+    const double at_torque_off = moved_deg(rig, csv);  // the plant when torque went off
+    let_time_pass(rig, 0.4);
+    const double later = moved_deg(rig, csv);
+    std::printf("%s: %s; the plant moved %.2f deg from the stop pose by torque off, %.2f deg 0.4 s later (allowed while "
+                "held: %.2f deg)\n",
+                c.name, r.at_stop.c_str(), at_torque_off, later, allowed * kDeg);
+    if (c.action == StopAction::hold) {
+      EXPECT_NEAR(r.held, 0.6, 1e-9) << r.at_stop;
+      EXPECT_LE(r.hold_deviation, allowed) << r.at_stop;
+      EXPECT_LE(at_torque_off, allowed * kDeg);
+    }
+    EXPECT_GT(later, 10.0);  // unheld, the arm falls: tens of degrees in 0.4 s
+    EXPECT_GT(later, 5 * at_torque_off);
+  }
+}
+
+TEST_F(HardwareControl, ASecondSigintEndsTheHold) {
+  const trajectory::Trajectory traj = first_seconds("AG02", 2.0);
+  hw_.safety.hold_time = 30;  // only the second request can end it within the test's time
+  Rig rig(twin_, hw_, traj);
+  ControlOptions o = options();
+  o.seconds = 2.0;
+  const std::string csv = (dir_ / "second_sigint.csv").string();
+  StopSignals signals;
+  const ControlResult r = run(rig, traj, csv, o, 0.5, [](Rig&) {
+    std::raise(SIGINT);
+    std::this_thread::sleep_for(std::chrono::milliseconds(300));
+    std::raise(SIGINT);
+  });
+  EXPECT_EQ(r.reason, StopReason::signal) << r.message;
+  EXPECT_EQ(r.stop_action, StopAction::hold);
+  EXPECT_NE(r.at_stop.find("a further stop request"), std::string::npos) << r.at_stop;
+  EXPECT_LT(r.held, 20.0);
+  EXPECT_TRUE(r.torque_off_confirmed);
+  rig.expect_safe();
+  expect_log(r, csv);
+}
+
+// A stop in the pre-roll, before the trajectory's first row: torque was on, so the pose is held;
+// the log has no rows, its sidecar says why.
+TEST_F(HardwareControl, AStopBeforeTheTrajectoryLeavesAnEmptyLogThatSaysWhy) {
+  const trajectory::Trajectory traj = first_seconds("AG02", 2.0);
+  Rig rig(twin_, hw_, traj);
+  ControlOptions o = options();
+  o.seconds = 2.0;
+  const std::string csv = (dir_ / "pre_roll.csv").string();
+  StopSignals signals;
+  const ControlResult r = run(rig, traj, csv, o, -0.3, [](Rig&) { std::raise(SIGINT); });
+  EXPECT_EQ(r.reason, StopReason::signal) << r.message;
+  EXPECT_EQ(r.rows, 0);
+  EXPECT_EQ(r.stop_action, StopAction::hold);
+  EXPECT_TRUE(r.torque_off_confirmed);
+  rig.expect_safe();
+  expect_log(r, csv);
+}
+
+}  // namespace
+}  // namespace symoro::hardware
