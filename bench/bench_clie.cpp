@@ -1,5 +1,6 @@
 // CLIE's cost: the closed-loop simulation in simulated seconds per wall second, with and
-// without forward sensitivities (the paper's 39-parameter model on AG02), and one complete
+// without forward sensitivities (the paper's 39-parameter model on AG02; the sensitivities'
+// derivatives generated, or from Jets as before: the *Jet benchmarks), and one complete
 // CLIE refinement of AG02 at 40 ms on data from the default twin, from the truth perturbed by
 // 20 % (alternating signs).
 //
@@ -30,6 +31,14 @@ struct Fixture {
           .build("AG02");
   Eigen::VectorXd truth = Reduced::from_parent(symoro::twin::make_truth<Full>(config).phi);
   identify::ClosedLoopSimulator<Reduced> sim{identify::closed_loop_setup(config), trajectory};
+  // The same with the sensitivities' derivatives from Jets (ClosedLoopSetup::jet_derivatives).
+  identify::ClosedLoopSimulator<Reduced> sim_jet{jet_setup(config), trajectory};
+
+  static identify::ClosedLoopSetup jet_setup(const symoro::twin::TwinConfig& c) {
+    identify::ClosedLoopSetup s = identify::closed_loop_setup(c);
+    s.jet_derivatives = true;
+    return s;
+  }
 };
 
 const Fixture& fixture() {
@@ -37,13 +46,14 @@ const Fixture& fixture() {
   return f;
 }
 
-void simulate(benchmark::State& state, bool sensitivities) {
+void simulate(benchmark::State& state, bool sensitivities, bool jet = false) {
   const Fixture& f = fixture();
+  const auto& sim = jet ? f.sim_jet : f.sim;
   symoro::preprocess::Channels tau, dtau;
   double simulated = 0;
   for (auto _ : state) {
-    if (!f.sim.simulate(f.truth, tau, sensitivities ? &dtau : nullptr, nullptr)) state.SkipWithError("diverged");
-    simulated += (f.sim.cycles() - 1) * f.sim.period();
+    if (!sim.simulate(f.truth, tau, sensitivities ? &dtau : nullptr, nullptr)) state.SkipWithError("diverged");
+    simulated += (sim.cycles() - 1) * sim.period();
   }
   state.counters["sim_s_per_wall_s"] = benchmark::Counter(simulated, benchmark::Counter::kIsRate);
 }
@@ -51,9 +61,11 @@ void simulate(benchmark::State& state, bool sensitivities) {
 void BM_Simulate(benchmark::State& s) { simulate(s, false); }
 void BM_SimulateWithSensitivities(benchmark::State& s) { simulate(s, true); }
 BENCHMARK(BM_Simulate)->Unit(benchmark::kMillisecond)->UseRealTime();
+void BM_SimulateWithSensitivitiesJet(benchmark::State& s) { simulate(s, true, true); }
 BENCHMARK(BM_SimulateWithSensitivities)->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(3);
+BENCHMARK(BM_SimulateWithSensitivitiesJet)->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(3);
 
-void BM_ClieAG02At40ms(benchmark::State& state) {
+void clie_ag02(benchmark::State& state, bool jet) {
   const Fixture& f = fixture();
   symoro::twin::RunOptions run;
   run.robot = "crane_x7";
@@ -64,7 +76,7 @@ void BM_ClieAG02At40ms(benchmark::State& state) {
   for (int i = 0; i < phi0.size(); ++i) phi0(i) *= i % 2 ? 1.2 : 0.8;
   identify::ClieResult r;
   for (auto _ : state) {
-    r = identify::clie<Reduced>(f.sim, samples, phi0, options);
+    r = identify::clie<Reduced>(jet ? f.sim_jet : f.sim, samples, phi0, options);
     if (!r.success) state.SkipWithError(r.termination.c_str());
   }
   state.counters["iterations"] = r.iterations;
@@ -77,6 +89,9 @@ void BM_ClieAG02At40ms(benchmark::State& state) {
   state.counters["wall_s"] = r.wall;
   state.SetLabel(r.termination.substr(0, 60));
 }
+void BM_ClieAG02At40ms(benchmark::State& s) { clie_ag02(s, false); }
+void BM_ClieAG02At40msJet(benchmark::State& s) { clie_ag02(s, true); }
 BENCHMARK(BM_ClieAG02At40ms)->Unit(benchmark::kSecond)->UseRealTime()->Iterations(1);
+BENCHMARK(BM_ClieAG02At40msJet)->Unit(benchmark::kSecond)->UseRealTime()->Iterations(1);
 
 }  // namespace

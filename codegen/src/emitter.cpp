@@ -21,13 +21,8 @@ std::string cpp_literal(double v) {
 
 namespace {
 
-// Operator precedence of an emitted operand, to place parentheses only where needed.
-enum Prec { kSum = 1, kProduct = 2, kUnary = 3, kAtom = 4 };
-
-struct Text {
-  std::string s;
-  int prec = kAtom;
-};
+using Text = BodyEmitter::Text;
+enum Prec { kSum = BodyEmitter::kSum, kProduct = BodyEmitter::kProduct, kUnary = BodyEmitter::kUnary, kAtom = BodyEmitter::kAtom };
 
 std::string wrap(const Text& t, int min_prec) { return t.prec >= min_prec ? t.s : "(" + t.s + ")"; }
 
@@ -35,44 +30,41 @@ constexpr std::size_t kMaxInlineLength = 90;
 
 }  // namespace
 
-std::string emit_body(const ExprGraph& g, const std::map<std::string, std::string>& inputs,
-                      const std::vector<Assignment>& outputs, const std::string& indent) {
+BodyEmitter::BodyEmitter(const ExprGraph& g, std::map<std::string, std::string> inputs, const std::vector<NodeId>& all_roots,
+                         std::string indent)
+    : g_(g), inputs_(std::move(inputs)), indent_(std::move(indent)) {
+  for (NodeId id : reachable(g_, all_roots)) {
+    const Node& n = g_.node(id);
+    if (n.a >= 0) ++uses_[n.a];
+    if (n.b >= 0) ++uses_[n.b];
+    if (n.op == Op::Pow) pow_operand_.insert(n.a);  // a power's operand is always named: x*x repeats it
+  }
+  for (NodeId r : all_roots) ++uses_[r];
+}
+
+std::string BodyEmitter::emit(const std::vector<Assignment>& outputs) {
+  static const std::regex plain_name("^[A-Za-z][A-Za-z0-9_]*$");
+  static const std::regex reserved("^(t[0-9]+|Scalar|q|qd|qdd|tau|phi|s|out|[A-Z]|M|W|T|J|h|basis|sin|cos|sign|pow|exp|int|do|if|for|new|and|or|not|xor|auto|case|char|long|this|true|false|void|ldlt|stage_[a-z_]+)$");
   std::vector<NodeId> roots;
   for (const auto& o : outputs) roots.push_back(o.value);
-  const std::vector<NodeId> order = reachable(g, roots);
-
-  std::unordered_map<NodeId, int> uses;
-  for (NodeId id : order) {
-    const Node& n = g.node(id);
-    if (n.a >= 0) ++uses[n.a];
-    if (n.b >= 0) ++uses[n.b];
-  }
-  for (NodeId r : roots) ++uses[r];
-  std::unordered_map<NodeId, bool> pow_operand;  // a power's operand is always named: x*x repeats it
-  for (NodeId id : order)
-    if (g.node(id).op == Op::Pow) pow_operand[g.node(id).a] = true;
-  int temps = 0;
-
-  static const std::regex plain_name("^[A-Za-z][A-Za-z0-9_]*$");
-  static const std::regex reserved("^(t[0-9]+|Scalar|q|qd|qdd|tau|phi|s|out|[A-Z]|M|W|T|J|h|basis|sin|cos|sign|pow|exp|int|do|if|for|new|and|or|not|xor|auto|case|char|long|this|true|false|void)$");
   std::string body;
-  std::unordered_map<NodeId, Text> text;
-  for (NodeId id : order) {
-    const Node& n = g.node(id);
+  for (NodeId id : reachable(g_, roots)) {
+    if (text_.count(id)) continue;  // computed by an earlier stage
+    const Node& n = g_.node(id);
     if (n.op == Op::Symbol) {
-      const std::string& name = g.symbol_name(n.symbol);
-      auto it = inputs.find(name);
-      if (it == inputs.end()) throw std::logic_error("symbol '" + name + "' is not an input of this function");
+      const std::string& name = g_.symbol_name(n.symbol);
+      auto it = inputs_.find(name);
+      if (it == inputs_.end()) throw std::logic_error("symbol '" + name + "' is not an input of this function");
       std::string local = std::regex_match(name, plain_name) && !std::regex_match(name, reserved) ? name : "s_" + name;
-      body += indent + "const Scalar " + local + "(" + it->second + ");\n";
-      text[id] = {local, kAtom};
+      body += indent_ + "const Scalar " + local + "(" + it->second + ");\n";
+      text_[id] = {local, kAtom};
       continue;
     }
     if (n.op == Op::Constant) {
-      text[id] = {cpp_literal(n.value), n.value < 0 ? kUnary : kAtom};
+      text_[id] = {cpp_literal(n.value), n.value < 0 ? kUnary : kAtom};
       continue;
     }
-    auto arg = [&](NodeId c) -> const Text& { return text.at(c); };
+    auto arg = [&](NodeId c) -> const Text& { return text_.at(c); };
     Text t;
     switch (n.op) {
       case Op::Add: t = {wrap(arg(n.a), kSum) + " + " + wrap(arg(n.b), kProduct), kSum}; break;
@@ -101,20 +93,28 @@ std::string emit_body(const ExprGraph& g, const std::map<std::string, std::strin
       case Op::Symbol: break;
     }
     // A node used once is written inline into its user.
-    if (uses[id] == 1 && t.s.size() <= kMaxInlineLength && !pow_operand.count(id)) {
-      text[id] = t;
+    if (uses_[id] == 1 && t.s.size() <= kMaxInlineLength && !pow_operand_.count(id)) {
+      text_[id] = t;
     } else {
-      const std::string name = "t" + std::to_string(temps++);
-      body += indent + "const Scalar " + name + " = " + t.s + ";\n";
-      text[id] = {name, kAtom};
+      const std::string name = "t" + std::to_string(temps_++);
+      body += indent_ + "const Scalar " + name + " = " + t.s + ";\n";
+      text_[id] = {name, kAtom};
     }
   }
   for (const auto& o : outputs) {
-    const Node& n = g.node(o.value);
-    const std::string v = n.op == Op::Constant ? "Scalar(" + cpp_literal(n.value) + ")" : text.at(o.value).s;
-    body += indent + o.target + " = " + v + ";\n";
+    const Node& n = g_.node(o.value);
+    const std::string v = n.op == Op::Constant ? "Scalar(" + cpp_literal(n.value) + ")" : text_.at(o.value).s;
+    body += indent_ + o.target + " = " + v + ";\n";
   }
   return body;
+}
+
+std::string emit_body(const ExprGraph& g, const std::map<std::string, std::string>& inputs,
+                      const std::vector<Assignment>& outputs, const std::string& indent) {
+  std::vector<NodeId> roots;
+  for (const auto& o : outputs) roots.push_back(o.value);
+  BodyEmitter e(g, inputs, roots, indent);
+  return e.emit(outputs);
 }
 
 }  // namespace symoro::codegen

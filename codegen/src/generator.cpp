@@ -4,6 +4,7 @@
 #include <set>
 #include <sstream>
 
+#include "derivative_functions.hpp"
 #include "symoro/codegen/effects.hpp"
 #include "symoro/codegen/emitter.hpp"
 
@@ -77,6 +78,8 @@ class ModelWriter {
     add(out, "inertia.hpp", inertia_header());
     add(out, "nonlinear_effects.hpp", nonlinear_effects_header());
     add(out, "forward_dynamics.hpp", forward_dynamics_header());
+    add(out, "inverse_dynamics_derivatives.hpp", inverse_dynamics_derivatives_header());
+    add(out, "forward_dynamics_derivatives.hpp", forward_dynamics_derivatives_header());
     add(out, "forward_kinematics.hpp", forward_kinematics_header());
     add(out, "jacobian.hpp", jacobian_header());
     add(out, "all.hpp", all_header());
@@ -353,11 +356,20 @@ class ModelWriter {
   }
 
   // ---------------------------------------------------------------- regressor.hpp
-  std::string regressor_header() {
-    std::vector<std::vector<NodeId>> W(r_.n), tau0(r_.n);
+  // [joint][identified parameter]: the regressor's entries, effect terms last.
+  std::vector<std::vector<NodeId>> regressor_entries() {
+    std::vector<std::vector<NodeId>> W(r_.n);
     for (int j = 0; j < r_.n; ++j) {
       for (int p : identified_) W[j].push_back(r_.dim[j][p]);
       for (std::size_t e = 0; e < effects_.size(); ++e) W[j].push_back(effects_[e].joint == j + 1 ? effect_terms_[e] : g_.zero());
+    }
+    return W;
+  }
+
+  std::string regressor_header() {
+    const std::vector<std::vector<NodeId>> W = regressor_entries();
+    std::vector<std::vector<NodeId>> tau0(r_.n);
+    for (int j = 0; j < r_.n; ++j) {
       NodeId sum = g_.zero();
       for (const auto& [p, v] : fixed_index_) sum = g_.add(sum, g_.mul(g_.constant(v), r_.dim[j][p]));
       tau0[j] = {sum};
@@ -426,11 +438,11 @@ class ModelWriter {
   }
 
   // ---------------------------------------------------------------- inertia.hpp
-  std::string inertia_header() {
+  // M(q; phi): the derivative of the factored Newton-Euler torque (idm.txt) with respect to qdd,
+  // far cheaper than summing the basis.
+  std::vector<std::vector<NodeId>> inertia_entries() {
     const int n = r_.n;
-    // M(q; phi): the derivative of the factored Newton-Euler torque (idm.txt) with respect to
-    // qdd, far cheaper than summing the basis. The basis below comes from the DIM.
-    std::vector<std::vector<NodeId>> M(n, std::vector<NodeId>(n)), M0(n, std::vector<NodeId>(n));
+    std::vector<std::vector<NodeId>> M(n, std::vector<NodeId>(n));
     const auto tau = specialize(r_.idm);
     std::map<std::string, NodeId> at_rest;
     for (const auto& s : r_.qd) at_rest[s] = g_.zero();
@@ -442,6 +454,49 @@ class ModelWriter {
         if (std::find(r_.q.begin(), r_.q.end(), s) == r_.q.end() && !is_identified(s))
           throw InputError(r_.dir + "/idm.txt", 0, 0, "the inertia matrix depends on " + s + ": the IDM is not linear in the accelerations");
     }
+    return M;
+  }
+
+  // ---------------------------------------------------------------- *_derivatives.hpp
+  detail::DerivativeModel derivative_model() {
+    detail::DerivativeModel m;
+    m.graph = &g_;
+    m.n = r_.n;
+    m.np = np();
+    m.q = r_.q;
+    m.qd = r_.qd;
+    m.qdd = r_.qdd;
+    m.tau = r_.tau;
+    m.phi = identified_names();
+    m.id = plus_effects(specialize(r_.idm));
+    m.M = inertia_entries();
+    m.h = plus_effects(specialize(r_.ccg));
+    m.W = regressor_entries();
+    return m;
+  }
+
+  std::string inverse_dynamics_derivatives_header() {
+    std::string s = banner("Inverse dynamics and its derivatives d tau / d(q, qd), differentiated on the expression graph.");
+    s += kinematic_includes() + open();
+    s += detail::inverse_dynamics_derivatives_code(derivative_model(), summary_->functions);
+    s += close();
+    return s;
+  }
+
+  std::string forward_dynamics_derivatives_header() {
+    std::string s = banner("Forward dynamics with d qdd / d(q, qd, tau, phi) in one pass (one LDL^T of M).");
+    s += kinematic_includes() + "#include \"symoro/spd_inverse.hpp\"\n\n" + open();
+    s += detail::forward_dynamics_derivatives_code(derivative_model(), summary_->functions);
+    s += close();
+    return s;
+  }
+
+  std::string inertia_header() {
+    const int n = r_.n;
+    // M(q; phi): the derivative of the factored Newton-Euler torque (idm.txt) with respect to
+    // qdd, far cheaper than summing the basis. The basis below comes from the DIM.
+    const std::vector<std::vector<NodeId>> M = inertia_entries();
+    std::vector<std::vector<NodeId>> M0(n, std::vector<NodeId>(n));
     std::map<int, double> fixed(fixed_index_.begin(), fixed_index_.end());
     for (int j = 0; j < n; ++j)
       for (int k = 0; k <= j; ++k) {
@@ -488,7 +543,8 @@ class ModelWriter {
   std::string all_header() const {
     std::string s = banner("The whole model and `Model`, a type that names it for generic code.");
     for (const char* f : {"model.hpp", "base_parameters.hpp", "regressor.hpp", "inverse_dynamics.hpp", "inertia.hpp",
-                          "nonlinear_effects.hpp", "forward_dynamics.hpp", "forward_kinematics.hpp", "jacobian.hpp"})
+                          "nonlinear_effects.hpp", "forward_dynamics.hpp", "inverse_dynamics_derivatives.hpp",
+                          "forward_dynamics_derivatives.hpp", "forward_kinematics.hpp", "jacobian.hpp"})
       s += include_self(f);
     s += "\n#include <utility>\n";
     if (!variant_.empty()) s += "#include \"symoro/" + r_.name + "/all.hpp\"\n";
@@ -507,10 +563,11 @@ class ModelWriter {
     if (ne() > 0) s += "  static constexpr const auto& effect_parameters = " + ns_ + "::effect_parameters;\n";
     s += "  // The robot's full model (this type itself for the full model).\n";
     s += "  using Parent = " + (variant_.empty() ? std::string("Model") : "::symoro::" + r_.name + "::Model") + ";\n";
-    s += "  template <class Scalar>\n  using InertiaBasis = " + ns_ + "::InertiaBasis<Scalar>;\n";
+    for (const char* t : {"InertiaBasis", "InverseDynamicsDerivatives", "ForwardDynamicsDerivatives"})
+      s += "  template <class Scalar>\n  using " + std::string(t) + " = " + ns_ + "::" + t + "<Scalar>;\n";
     for (const char* f : {"base_from_standard", "to_parent", "from_parent", "regressor", "fixed_torque", "inverse_dynamics",
-                          "inertia", "inertia_basis", "nonlinear_effects", "forward_dynamics", "forward_kinematics",
-                          "jacobian"}) {
+                          "inertia", "inertia_basis", "nonlinear_effects", "forward_dynamics",
+                          "inverse_dynamics_derivatives", "forward_dynamics_derivatives", "forward_kinematics", "jacobian"}) {
       const std::string fn = f;
       s += "  template <class... A>\n  static auto " + fn + "(A&&... a) -> decltype(" + ns_ + "::" + fn +
            "(std::forward<A>(a)...)) {\n    return " + ns_ + "::" + fn + "(std::forward<A>(a)...);\n  }\n";

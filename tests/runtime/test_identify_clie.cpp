@@ -6,6 +6,7 @@
 #include <cmath>
 #include <iostream>
 #include <string>
+#include <type_traits>
 #include <vector>
 
 #include <Eigen/SVD>
@@ -175,6 +176,59 @@ TEST(ClosedLoopSimulator, SensitivitiesMatchCentralDifferencesWithStepsSplitAtSa
   setup.split_at_sampling = true;
   setup.substeps = 2;
   check_sensitivities(setup);
+}
+
+// The generated forward_dynamics_derivatives and the Jet path (ClosedLoopSetup::jet_derivatives)
+// compute the same sensitivities in a different order of operations: they agree to round-off,
+// on the reduced and the full model (Coulomb friction included), and CLIE takes the same steps.
+TEST(ClosedLoopSimulator, GeneratedDerivativesAndJetsGiveTheSameSensitivitiesAndClie) {
+  identify::ClosedLoopSetup generated = identify::closed_loop_setup(ideal_config());
+  identify::ClosedLoopSetup jet = generated;
+  jet.jet_derivatives = true;
+  const auto compare = [&](const auto& model_tag, const Eigen::VectorXd& phi) {
+    using M = std::decay_t<decltype(model_tag)>;
+    Channels tau_g, dtau_g, tau_j, dtau_j;
+    ASSERT_TRUE(ClosedLoopSimulator<M>(generated, short_trajectory()).simulate(phi, tau_g, &dtau_g, nullptr));
+    ASSERT_TRUE(ClosedLoopSimulator<M>(jet, short_trajectory()).simulate(phi, tau_j, &dtau_j, nullptr));
+    const double tau_error = (tau_g - tau_j).cwiseAbs().maxCoeff() / tau_j.cwiseAbs().maxCoeff();
+    const double dtau_error = (dtau_g - dtau_j).cwiseAbs().maxCoeff() / dtau_j.cwiseAbs().maxCoeff();
+    std::cout << "  " << M::np << " parameters: tau differs by " << tau_error << ", d tau / d phi by " << dtau_error
+              << " of its largest entry\n";
+    EXPECT_LT(tau_error, 1e-10);
+    EXPECT_LT(dtau_error, 1e-9);
+  };
+  compare(Reduced{}, reduced_truth());
+  compare(Full{}, twin::make_truth<Full>(ideal_config()).phi);
+
+  // CLIE both ways from the same start on the same data: the same solution.
+  const ClosedLoopSimulator<Reduced> sim_g(generated, short_trajectory()), sim_j(jet, short_trajectory());
+  Channels tau, q;
+  ASSERT_TRUE(sim_g.simulate(reduced_truth(), tau, nullptr, nullptr, &q));
+  io::Log log;
+  log.meta.robot = "crane_x7";
+  log.meta.trajectory = short_trajectory().name;
+  log.meta.source = "twin";
+  log.meta.sample_time = sim_g.period();
+  for (const auto& j : Full::joints) log.meta.joints.push_back(j.name);
+  log.time = Eigen::VectorXd::LinSpaced(sim_g.cycles(), 0, (sim_g.cycles() - 1) * sim_g.period());
+  log.q = q;
+  log.qd = Eigen::MatrixXd::Zero(sim_g.cycles(), n);
+  log.tau = tau;
+  twin::Random rng(5);
+  for (Eigen::Index k = 0; k < log.tau.size(); ++k) log.tau.data()[k] += 1e-3 * rng.normal();
+  identify::ClieOptions options;
+  options.max_iterations = 8;
+  const preprocess::Samples samples = preprocess::preprocess(log, 0.04, options.preprocess);
+  Eigen::VectorXd phi0 = reduced_truth();
+  for (int i = 0; i < Reduced::np; ++i) phi0(i) *= (i % 2 ? 1.2 : 0.8);
+  const identify::ClieResult rg = identify::clie<Reduced>(sim_g, samples, phi0, options);
+  const identify::ClieResult rj = identify::clie<Reduced>(sim_j, samples, phi0, options);
+  std::cout << "  CLIE generated: " << rg.iterations << " iterations, cost " << rg.final_cost << ", " << rg.wall
+            << " s; Jet: " << rj.iterations << " iterations, cost " << rj.final_cost << ", " << rj.wall << " s\n";
+  ASSERT_TRUE(rg.success && rj.success);
+  EXPECT_EQ(rg.iterations, rj.iterations);
+  EXPECT_NEAR(rg.final_cost, rj.final_cost, 1e-8 * rj.final_cost);
+  EXPECT_LT((rg.phi - rj.phi).norm(), 1e-7 * rj.phi.norm());
 }
 
 // The full model at the twin's truth reproduces the ideal twin's log: exactly up to the

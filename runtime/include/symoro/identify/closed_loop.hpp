@@ -33,6 +33,10 @@ struct ClosedLoopSetup {
   // holds) instead of spanning each hold with q(t_k) read inside the step
   // (closed_loop_model.hpp): twice the work for no accuracy that matters.
   bool split_at_sampling = false;
+  // The sensitivities' d qdd / d(q, qd, tau, phi) from the generated forward_dynamics_derivatives
+  // (default), or the older way, a ceres::Jet over (q, qd) through the generated inverse dynamics
+  // (kept to compare the two; the results agree to round-off).
+  bool jet_derivatives = false;
 };
 
 // The experiment's controller and timing, from the robot's controller description.

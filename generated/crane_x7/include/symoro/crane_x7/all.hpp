@@ -10,6 +10,8 @@
 #include "symoro/crane_x7/inertia.hpp"
 #include "symoro/crane_x7/nonlinear_effects.hpp"
 #include "symoro/crane_x7/forward_dynamics.hpp"
+#include "symoro/crane_x7/inverse_dynamics_derivatives.hpp"
+#include "symoro/crane_x7/forward_dynamics_derivatives.hpp"
 #include "symoro/crane_x7/forward_kinematics.hpp"
 #include "symoro/crane_x7/jacobian.hpp"
 
@@ -36,6 +38,10 @@ struct Model {
   using Parent = Model;
   template <class Scalar>
   using InertiaBasis = symoro::crane_x7::InertiaBasis<Scalar>;
+  template <class Scalar>
+  using InverseDynamicsDerivatives = symoro::crane_x7::InverseDynamicsDerivatives<Scalar>;
+  template <class Scalar>
+  using ForwardDynamicsDerivatives = symoro::crane_x7::ForwardDynamicsDerivatives<Scalar>;
   template <class... A>
   static auto base_from_standard(A&&... a) -> decltype(symoro::crane_x7::base_from_standard(std::forward<A>(a)...)) {
     return symoro::crane_x7::base_from_standard(std::forward<A>(a)...);
@@ -75,6 +81,14 @@ struct Model {
   template <class... A>
   static auto forward_dynamics(A&&... a) -> decltype(symoro::crane_x7::forward_dynamics(std::forward<A>(a)...)) {
     return symoro::crane_x7::forward_dynamics(std::forward<A>(a)...);
+  }
+  template <class... A>
+  static auto inverse_dynamics_derivatives(A&&... a) -> decltype(symoro::crane_x7::inverse_dynamics_derivatives(std::forward<A>(a)...)) {
+    return symoro::crane_x7::inverse_dynamics_derivatives(std::forward<A>(a)...);
+  }
+  template <class... A>
+  static auto forward_dynamics_derivatives(A&&... a) -> decltype(symoro::crane_x7::forward_dynamics_derivatives(std::forward<A>(a)...)) {
+    return symoro::crane_x7::forward_dynamics_derivatives(std::forward<A>(a)...);
   }
   template <class... A>
   static auto forward_kinematics(A&&... a) -> decltype(symoro::crane_x7::forward_kinematics(std::forward<A>(a)...)) {

@@ -10,6 +10,8 @@
 #include "symoro/crane_x7_reduced/inertia.hpp"
 #include "symoro/crane_x7_reduced/nonlinear_effects.hpp"
 #include "symoro/crane_x7_reduced/forward_dynamics.hpp"
+#include "symoro/crane_x7_reduced/inverse_dynamics_derivatives.hpp"
+#include "symoro/crane_x7_reduced/forward_dynamics_derivatives.hpp"
 #include "symoro/crane_x7_reduced/forward_kinematics.hpp"
 #include "symoro/crane_x7_reduced/jacobian.hpp"
 
@@ -36,6 +38,10 @@ struct Model {
   using Parent = Model;
   template <class Scalar>
   using InertiaBasis = symoro::crane_x7_reduced::InertiaBasis<Scalar>;
+  template <class Scalar>
+  using InverseDynamicsDerivatives = symoro::crane_x7_reduced::InverseDynamicsDerivatives<Scalar>;
+  template <class Scalar>
+  using ForwardDynamicsDerivatives = symoro::crane_x7_reduced::ForwardDynamicsDerivatives<Scalar>;
   template <class... A>
   static auto base_from_standard(A&&... a) -> decltype(symoro::crane_x7_reduced::base_from_standard(std::forward<A>(a)...)) {
     return symoro::crane_x7_reduced::base_from_standard(std::forward<A>(a)...);
@@ -75,6 +81,14 @@ struct Model {
   template <class... A>
   static auto forward_dynamics(A&&... a) -> decltype(symoro::crane_x7_reduced::forward_dynamics(std::forward<A>(a)...)) {
     return symoro::crane_x7_reduced::forward_dynamics(std::forward<A>(a)...);
+  }
+  template <class... A>
+  static auto inverse_dynamics_derivatives(A&&... a) -> decltype(symoro::crane_x7_reduced::inverse_dynamics_derivatives(std::forward<A>(a)...)) {
+    return symoro::crane_x7_reduced::inverse_dynamics_derivatives(std::forward<A>(a)...);
+  }
+  template <class... A>
+  static auto forward_dynamics_derivatives(A&&... a) -> decltype(symoro::crane_x7_reduced::forward_dynamics_derivatives(std::forward<A>(a)...)) {
+    return symoro::crane_x7_reduced::forward_dynamics_derivatives(std::forward<A>(a)...);
   }
   template <class... A>
   static auto forward_kinematics(A&&... a) -> decltype(symoro::crane_x7_reduced::forward_kinematics(std::forward<A>(a)...)) {

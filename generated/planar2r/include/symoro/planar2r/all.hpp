@@ -10,6 +10,8 @@
 #include "symoro/planar2r/inertia.hpp"
 #include "symoro/planar2r/nonlinear_effects.hpp"
 #include "symoro/planar2r/forward_dynamics.hpp"
+#include "symoro/planar2r/inverse_dynamics_derivatives.hpp"
+#include "symoro/planar2r/forward_dynamics_derivatives.hpp"
 #include "symoro/planar2r/forward_kinematics.hpp"
 #include "symoro/planar2r/jacobian.hpp"
 
@@ -36,6 +38,10 @@ struct Model {
   using Parent = Model;
   template <class Scalar>
   using InertiaBasis = symoro::planar2r::InertiaBasis<Scalar>;
+  template <class Scalar>
+  using InverseDynamicsDerivatives = symoro::planar2r::InverseDynamicsDerivatives<Scalar>;
+  template <class Scalar>
+  using ForwardDynamicsDerivatives = symoro::planar2r::ForwardDynamicsDerivatives<Scalar>;
   template <class... A>
   static auto base_from_standard(A&&... a) -> decltype(symoro::planar2r::base_from_standard(std::forward<A>(a)...)) {
     return symoro::planar2r::base_from_standard(std::forward<A>(a)...);
@@ -75,6 +81,14 @@ struct Model {
   template <class... A>
   static auto forward_dynamics(A&&... a) -> decltype(symoro::planar2r::forward_dynamics(std::forward<A>(a)...)) {
     return symoro::planar2r::forward_dynamics(std::forward<A>(a)...);
+  }
+  template <class... A>
+  static auto inverse_dynamics_derivatives(A&&... a) -> decltype(symoro::planar2r::inverse_dynamics_derivatives(std::forward<A>(a)...)) {
+    return symoro::planar2r::inverse_dynamics_derivatives(std::forward<A>(a)...);
+  }
+  template <class... A>
+  static auto forward_dynamics_derivatives(A&&... a) -> decltype(symoro::planar2r::forward_dynamics_derivatives(std::forward<A>(a)...)) {
+    return symoro::planar2r::forward_dynamics_derivatives(std::forward<A>(a)...);
   }
   template <class... A>
   static auto forward_kinematics(A&&... a) -> decltype(symoro::planar2r::forward_kinematics(std::forward<A>(a)...)) {

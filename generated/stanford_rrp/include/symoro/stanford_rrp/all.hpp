@@ -10,6 +10,8 @@
 #include "symoro/stanford_rrp/inertia.hpp"
 #include "symoro/stanford_rrp/nonlinear_effects.hpp"
 #include "symoro/stanford_rrp/forward_dynamics.hpp"
+#include "symoro/stanford_rrp/inverse_dynamics_derivatives.hpp"
+#include "symoro/stanford_rrp/forward_dynamics_derivatives.hpp"
 #include "symoro/stanford_rrp/forward_kinematics.hpp"
 #include "symoro/stanford_rrp/jacobian.hpp"
 
@@ -36,6 +38,10 @@ struct Model {
   using Parent = Model;
   template <class Scalar>
   using InertiaBasis = symoro::stanford_rrp::InertiaBasis<Scalar>;
+  template <class Scalar>
+  using InverseDynamicsDerivatives = symoro::stanford_rrp::InverseDynamicsDerivatives<Scalar>;
+  template <class Scalar>
+  using ForwardDynamicsDerivatives = symoro::stanford_rrp::ForwardDynamicsDerivatives<Scalar>;
   template <class... A>
   static auto base_from_standard(A&&... a) -> decltype(symoro::stanford_rrp::base_from_standard(std::forward<A>(a)...)) {
     return symoro::stanford_rrp::base_from_standard(std::forward<A>(a)...);
@@ -75,6 +81,14 @@ struct Model {
   template <class... A>
   static auto forward_dynamics(A&&... a) -> decltype(symoro::stanford_rrp::forward_dynamics(std::forward<A>(a)...)) {
     return symoro::stanford_rrp::forward_dynamics(std::forward<A>(a)...);
+  }
+  template <class... A>
+  static auto inverse_dynamics_derivatives(A&&... a) -> decltype(symoro::stanford_rrp::inverse_dynamics_derivatives(std::forward<A>(a)...)) {
+    return symoro::stanford_rrp::inverse_dynamics_derivatives(std::forward<A>(a)...);
+  }
+  template <class... A>
+  static auto forward_dynamics_derivatives(A&&... a) -> decltype(symoro::stanford_rrp::forward_dynamics_derivatives(std::forward<A>(a)...)) {
+    return symoro::stanford_rrp::forward_dynamics_derivatives(std::forward<A>(a)...);
   }
   template <class... A>
   static auto forward_kinematics(A&&... a) -> decltype(symoro::stanford_rrp::forward_kinematics(std::forward<A>(a)...)) {

@@ -10,6 +10,8 @@
 #include "symoro/crane_x7/reduced_diagnosed/inertia.hpp"
 #include "symoro/crane_x7/reduced_diagnosed/nonlinear_effects.hpp"
 #include "symoro/crane_x7/reduced_diagnosed/forward_dynamics.hpp"
+#include "symoro/crane_x7/reduced_diagnosed/inverse_dynamics_derivatives.hpp"
+#include "symoro/crane_x7/reduced_diagnosed/forward_dynamics_derivatives.hpp"
 #include "symoro/crane_x7/reduced_diagnosed/forward_kinematics.hpp"
 #include "symoro/crane_x7/reduced_diagnosed/jacobian.hpp"
 
@@ -39,6 +41,10 @@ struct Model {
   using Parent = ::symoro::crane_x7::Model;
   template <class Scalar>
   using InertiaBasis = symoro::crane_x7::reduced_diagnosed::InertiaBasis<Scalar>;
+  template <class Scalar>
+  using InverseDynamicsDerivatives = symoro::crane_x7::reduced_diagnosed::InverseDynamicsDerivatives<Scalar>;
+  template <class Scalar>
+  using ForwardDynamicsDerivatives = symoro::crane_x7::reduced_diagnosed::ForwardDynamicsDerivatives<Scalar>;
   template <class... A>
   static auto base_from_standard(A&&... a) -> decltype(symoro::crane_x7::reduced_diagnosed::base_from_standard(std::forward<A>(a)...)) {
     return symoro::crane_x7::reduced_diagnosed::base_from_standard(std::forward<A>(a)...);
@@ -78,6 +84,14 @@ struct Model {
   template <class... A>
   static auto forward_dynamics(A&&... a) -> decltype(symoro::crane_x7::reduced_diagnosed::forward_dynamics(std::forward<A>(a)...)) {
     return symoro::crane_x7::reduced_diagnosed::forward_dynamics(std::forward<A>(a)...);
+  }
+  template <class... A>
+  static auto inverse_dynamics_derivatives(A&&... a) -> decltype(symoro::crane_x7::reduced_diagnosed::inverse_dynamics_derivatives(std::forward<A>(a)...)) {
+    return symoro::crane_x7::reduced_diagnosed::inverse_dynamics_derivatives(std::forward<A>(a)...);
+  }
+  template <class... A>
+  static auto forward_dynamics_derivatives(A&&... a) -> decltype(symoro::crane_x7::reduced_diagnosed::forward_dynamics_derivatives(std::forward<A>(a)...)) {
+    return symoro::crane_x7::reduced_diagnosed::forward_dynamics_derivatives(std::forward<A>(a)...);
   }
   template <class... A>
   static auto forward_kinematics(A&&... a) -> decltype(symoro::crane_x7::reduced_diagnosed::forward_kinematics(std::forward<A>(a)...)) {

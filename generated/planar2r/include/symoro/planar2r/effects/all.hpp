@@ -10,6 +10,8 @@
 #include "symoro/planar2r/effects/inertia.hpp"
 #include "symoro/planar2r/effects/nonlinear_effects.hpp"
 #include "symoro/planar2r/effects/forward_dynamics.hpp"
+#include "symoro/planar2r/effects/inverse_dynamics_derivatives.hpp"
+#include "symoro/planar2r/effects/forward_dynamics_derivatives.hpp"
 #include "symoro/planar2r/effects/forward_kinematics.hpp"
 #include "symoro/planar2r/effects/jacobian.hpp"
 
@@ -39,6 +41,10 @@ struct Model {
   using Parent = ::symoro::planar2r::Model;
   template <class Scalar>
   using InertiaBasis = symoro::planar2r::effects::InertiaBasis<Scalar>;
+  template <class Scalar>
+  using InverseDynamicsDerivatives = symoro::planar2r::effects::InverseDynamicsDerivatives<Scalar>;
+  template <class Scalar>
+  using ForwardDynamicsDerivatives = symoro::planar2r::effects::ForwardDynamicsDerivatives<Scalar>;
   template <class... A>
   static auto base_from_standard(A&&... a) -> decltype(symoro::planar2r::effects::base_from_standard(std::forward<A>(a)...)) {
     return symoro::planar2r::effects::base_from_standard(std::forward<A>(a)...);
@@ -78,6 +84,14 @@ struct Model {
   template <class... A>
   static auto forward_dynamics(A&&... a) -> decltype(symoro::planar2r::effects::forward_dynamics(std::forward<A>(a)...)) {
     return symoro::planar2r::effects::forward_dynamics(std::forward<A>(a)...);
+  }
+  template <class... A>
+  static auto inverse_dynamics_derivatives(A&&... a) -> decltype(symoro::planar2r::effects::inverse_dynamics_derivatives(std::forward<A>(a)...)) {
+    return symoro::planar2r::effects::inverse_dynamics_derivatives(std::forward<A>(a)...);
+  }
+  template <class... A>
+  static auto forward_dynamics_derivatives(A&&... a) -> decltype(symoro::planar2r::effects::forward_dynamics_derivatives(std::forward<A>(a)...)) {
+    return symoro::planar2r::effects::forward_dynamics_derivatives(std::forward<A>(a)...);
   }
   template <class... A>
   static auto forward_kinematics(A&&... a) -> decltype(symoro::planar2r::effects::forward_kinematics(std::forward<A>(a)...)) {

@@ -10,6 +10,8 @@
 #include "symoro/rx90/rigid/inertia.hpp"
 #include "symoro/rx90/rigid/nonlinear_effects.hpp"
 #include "symoro/rx90/rigid/forward_dynamics.hpp"
+#include "symoro/rx90/rigid/inverse_dynamics_derivatives.hpp"
+#include "symoro/rx90/rigid/forward_dynamics_derivatives.hpp"
 #include "symoro/rx90/rigid/forward_kinematics.hpp"
 #include "symoro/rx90/rigid/jacobian.hpp"
 
@@ -37,6 +39,10 @@ struct Model {
   using Parent = ::symoro::rx90::Model;
   template <class Scalar>
   using InertiaBasis = symoro::rx90::rigid::InertiaBasis<Scalar>;
+  template <class Scalar>
+  using InverseDynamicsDerivatives = symoro::rx90::rigid::InverseDynamicsDerivatives<Scalar>;
+  template <class Scalar>
+  using ForwardDynamicsDerivatives = symoro::rx90::rigid::ForwardDynamicsDerivatives<Scalar>;
   template <class... A>
   static auto base_from_standard(A&&... a) -> decltype(symoro::rx90::rigid::base_from_standard(std::forward<A>(a)...)) {
     return symoro::rx90::rigid::base_from_standard(std::forward<A>(a)...);
@@ -76,6 +82,14 @@ struct Model {
   template <class... A>
   static auto forward_dynamics(A&&... a) -> decltype(symoro::rx90::rigid::forward_dynamics(std::forward<A>(a)...)) {
     return symoro::rx90::rigid::forward_dynamics(std::forward<A>(a)...);
+  }
+  template <class... A>
+  static auto inverse_dynamics_derivatives(A&&... a) -> decltype(symoro::rx90::rigid::inverse_dynamics_derivatives(std::forward<A>(a)...)) {
+    return symoro::rx90::rigid::inverse_dynamics_derivatives(std::forward<A>(a)...);
+  }
+  template <class... A>
+  static auto forward_dynamics_derivatives(A&&... a) -> decltype(symoro::rx90::rigid::forward_dynamics_derivatives(std::forward<A>(a)...)) {
+    return symoro::rx90::rigid::forward_dynamics_derivatives(std::forward<A>(a)...);
   }
   template <class... A>
   static auto forward_kinematics(A&&... a) -> decltype(symoro::rx90::rigid::forward_kinematics(std::forward<A>(a)...)) {

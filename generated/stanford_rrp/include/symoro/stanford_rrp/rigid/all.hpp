@@ -10,6 +10,8 @@
 #include "symoro/stanford_rrp/rigid/inertia.hpp"
 #include "symoro/stanford_rrp/rigid/nonlinear_effects.hpp"
 #include "symoro/stanford_rrp/rigid/forward_dynamics.hpp"
+#include "symoro/stanford_rrp/rigid/inverse_dynamics_derivatives.hpp"
+#include "symoro/stanford_rrp/rigid/forward_dynamics_derivatives.hpp"
 #include "symoro/stanford_rrp/rigid/forward_kinematics.hpp"
 #include "symoro/stanford_rrp/rigid/jacobian.hpp"
 
@@ -37,6 +39,10 @@ struct Model {
   using Parent = ::symoro::stanford_rrp::Model;
   template <class Scalar>
   using InertiaBasis = symoro::stanford_rrp::rigid::InertiaBasis<Scalar>;
+  template <class Scalar>
+  using InverseDynamicsDerivatives = symoro::stanford_rrp::rigid::InverseDynamicsDerivatives<Scalar>;
+  template <class Scalar>
+  using ForwardDynamicsDerivatives = symoro::stanford_rrp::rigid::ForwardDynamicsDerivatives<Scalar>;
   template <class... A>
   static auto base_from_standard(A&&... a) -> decltype(symoro::stanford_rrp::rigid::base_from_standard(std::forward<A>(a)...)) {
     return symoro::stanford_rrp::rigid::base_from_standard(std::forward<A>(a)...);
@@ -76,6 +82,14 @@ struct Model {
   template <class... A>
   static auto forward_dynamics(A&&... a) -> decltype(symoro::stanford_rrp::rigid::forward_dynamics(std::forward<A>(a)...)) {
     return symoro::stanford_rrp::rigid::forward_dynamics(std::forward<A>(a)...);
+  }
+  template <class... A>
+  static auto inverse_dynamics_derivatives(A&&... a) -> decltype(symoro::stanford_rrp::rigid::inverse_dynamics_derivatives(std::forward<A>(a)...)) {
+    return symoro::stanford_rrp::rigid::inverse_dynamics_derivatives(std::forward<A>(a)...);
+  }
+  template <class... A>
+  static auto forward_dynamics_derivatives(A&&... a) -> decltype(symoro::stanford_rrp::rigid::forward_dynamics_derivatives(std::forward<A>(a)...)) {
+    return symoro::stanford_rrp::rigid::forward_dynamics_derivatives(std::forward<A>(a)...);
   }
   template <class... A>
   static auto forward_kinematics(A&&... a) -> decltype(symoro::stanford_rrp::rigid::forward_kinematics(std::forward<A>(a)...)) {

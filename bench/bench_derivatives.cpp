@@ -1,0 +1,176 @@
+// Nanoseconds per call of the generated derivatives against their values and the Jet path, per
+// robot model (issue 16):
+//   id_value       inverse_dynamics, double
+//   id_derivatives inverse_dynamics_derivatives (tau, d tau / d q, d tau / d qd), double
+//   id_jet         inverse_dynamics in ceres::Jet<double, 2 nq> seeded on (q, qd): the same
+//                  derivatives the way CLIE took them before
+//   fd_value       forward_dynamics (ddm.txt), double
+//   fd_derivatives forward_dynamics_derivatives (qdd, d qdd / d q, d qdd / d qd, M^-1,
+//                  d qdd / d phi), double
+//   fd_jet_path    the same four blocks the Jet way: M, h, LDLT, qdd, the Jet<2 nq> inverse
+//                  dynamics, the regressor, M^-1 and the three products
+//
+//   bench_derivatives --benchmark_filter=crane_x7
+#include <symoro/crane_x7.hpp>
+#include <symoro/planar2r.hpp>
+#include <symoro/rx90.hpp>
+#include <symoro/stanford_rrp.hpp>
+
+#include <array>
+#include <random>
+
+#include <Eigen/Cholesky>
+#include <Eigen/Core>
+#include <benchmark/benchmark.h>
+#include <ceres/jet.h>
+
+namespace {
+
+// Random states inside the joint limits, cycled so that no call sees the previous one's inputs;
+// parameters from a physically consistent-looking draw (positive diagonal terms dominate).
+template <class Model>
+struct Inputs {
+  static constexpr int kCount = 16;
+  struct One {
+    Eigen::Matrix<double, Model::nq, 1> q, qd, qdd, tau;
+    Eigen::Matrix<double, Model::np, 1> phi;
+  };
+  std::array<One, kCount> states;
+  std::size_t next = 0;
+
+  Inputs() {
+    std::mt19937 gen(7);
+    const auto uniform = [&](double lo, double hi) { return std::uniform_real_distribution<double>(lo, hi)(gen); };
+    for (auto& s : states) {
+      for (int i = 0; i < Model::nq; ++i) {
+        const double lo = Model::joints[i].lower, hi = Model::joints[i].upper;
+        s.q(i) = hi > lo ? uniform(lo, hi) : uniform(-1, 1);
+        s.qd(i) = uniform(-2, 2);
+        s.qdd(i) = uniform(-3, 3);
+        s.tau(i) = uniform(-2, 2);
+      }
+      for (int i = 0; i < Model::np; ++i) s.phi(i) = uniform(0.005, 0.02);
+    }
+  }
+  const One& operator()() { return states[next++ % kCount]; }
+};
+
+template <class Model>
+void id_value(benchmark::State& state) {
+  Inputs<Model> in;
+  Eigen::Matrix<double, Model::nq, 1> tau;
+  for (auto _ : state) {
+    const auto& x = in();
+    Model::inverse_dynamics(x.q, x.qd, x.qdd, x.phi, tau);
+    benchmark::DoNotOptimize(tau.data());
+    benchmark::ClobberMemory();
+  }
+}
+
+template <class Model>
+void id_derivatives(benchmark::State& state) {
+  Inputs<Model> in;
+  typename Model::template InverseDynamicsDerivatives<double> d;
+  for (auto _ : state) {
+    const auto& x = in();
+    Model::inverse_dynamics_derivatives(x.q, x.qd, x.qdd, x.phi, d);
+    benchmark::DoNotOptimize(d.dq.data());
+    benchmark::ClobberMemory();
+  }
+}
+
+template <class Model>
+void id_jet(benchmark::State& state) {
+  constexpr int n = Model::nq;
+  using Jet = ceres::Jet<double, 2 * n>;
+  Inputs<Model> in;
+  Eigen::Matrix<Jet, n, 1> q, qd, tau;
+  Eigen::Matrix<double, n, 2 * n> J;
+  for (auto _ : state) {
+    const auto& x = in();
+    for (int i = 0; i < n; ++i) {
+      q(i) = Jet(x.q(i), i);
+      qd(i) = Jet(x.qd(i), n + i);
+    }
+    Model::inverse_dynamics(q, qd, x.qdd, x.phi, tau);
+    for (int j = 0; j < n; ++j) J.row(j) = tau(j).v.transpose();
+    benchmark::DoNotOptimize(J.data());
+    benchmark::ClobberMemory();
+  }
+}
+
+template <class Model>
+void fd_value(benchmark::State& state) {
+  Inputs<Model> in;
+  Eigen::Matrix<double, Model::nq, 1> qdd;
+  for (auto _ : state) {
+    const auto& x = in();
+    Model::forward_dynamics(x.q, x.qd, x.tau, x.phi, qdd);
+    benchmark::DoNotOptimize(qdd.data());
+    benchmark::ClobberMemory();
+  }
+}
+
+template <class Model>
+void fd_derivatives(benchmark::State& state) {
+  Inputs<Model> in;
+  typename Model::template ForwardDynamicsDerivatives<double> d;
+  for (auto _ : state) {
+    const auto& x = in();
+    benchmark::DoNotOptimize(Model::forward_dynamics_derivatives(x.q, x.qd, x.tau, x.phi, d));
+    benchmark::DoNotOptimize(d.dphi.data());
+    benchmark::ClobberMemory();
+  }
+}
+
+template <class Model>
+void fd_jet_path(benchmark::State& state) {
+  constexpr int n = Model::nq, np = Model::np;
+  using Mat = Eigen::Matrix<double, n, n>;
+  using Vec = Eigen::Matrix<double, n, 1>;
+  using Jet = ceres::Jet<double, 2 * n>;
+  Inputs<Model> in;
+  Eigen::Matrix<Jet, n, 1> q, qd, tau;
+  Eigen::Matrix<double, n, 2 * n> J;
+  Eigen::Matrix<double, n, np> W, dphi;
+  Mat M, M_inv, dq, dqd;
+  Vec h, qdd;
+  for (auto _ : state) {
+    const auto& x = in();
+    Model::inertia(x.q, x.phi, M);
+    Model::nonlinear_effects(x.q, x.qd, x.phi, h);
+    const Eigen::LDLT<Mat> ldlt(M);
+    qdd = ldlt.solve(x.tau - h);
+    for (int i = 0; i < n; ++i) {
+      q(i) = Jet(x.q(i), i);
+      qd(i) = Jet(x.qd(i), n + i);
+    }
+    Model::inverse_dynamics(q, qd, qdd, x.phi, tau);
+    for (int j = 0; j < n; ++j) J.row(j) = tau(j).v.transpose();
+    Model::regressor(x.q, x.qd, qdd, W);
+    M_inv = ldlt.solve(Mat::Identity());
+    dq = -M_inv.lazyProduct(J.template leftCols<n>());
+    dqd = -M_inv.lazyProduct(J.template rightCols<n>());
+    dphi = -M_inv.lazyProduct(W);
+    benchmark::DoNotOptimize(dphi.data());
+    benchmark::DoNotOptimize(dq.data());
+    benchmark::DoNotOptimize(dqd.data());
+    benchmark::ClobberMemory();
+  }
+}
+
+#define SYMORO_BENCH_MODEL(label, M)                  \
+  BENCHMARK_TEMPLATE(id_value, M)->Name(label "/id_value");             \
+  BENCHMARK_TEMPLATE(id_derivatives, M)->Name(label "/id_derivatives"); \
+  BENCHMARK_TEMPLATE(id_jet, M)->Name(label "/id_jet");                 \
+  BENCHMARK_TEMPLATE(fd_value, M)->Name(label "/fd_value");             \
+  BENCHMARK_TEMPLATE(fd_derivatives, M)->Name(label "/fd_derivatives"); \
+  BENCHMARK_TEMPLATE(fd_jet_path, M)->Name(label "/fd_jet_path");
+
+SYMORO_BENCH_MODEL("crane_x7", symoro::crane_x7::Model)
+SYMORO_BENCH_MODEL("crane_x7::reduced", symoro::crane_x7::reduced::Model)
+SYMORO_BENCH_MODEL("rx90", symoro::rx90::Model)
+SYMORO_BENCH_MODEL("stanford_rrp", symoro::stanford_rrp::Model)
+SYMORO_BENCH_MODEL("planar2r", symoro::planar2r::Model)
+
+}  // namespace
