@@ -10,6 +10,12 @@
 //   fd_jet_path    the same four blocks the Jet way: M, h, LDLT, qdd, the Jet<2 nq> inverse
 //                  dynamics, the regressor, M^-1 and the three products
 //
+//   m_derivatives  inertia_derivatives (M and d M / d q_k), double: the PD audit's gradients
+//   m_jet          inertia in ceres::Jet<double, nq> seeded on q: the same, the way the audit
+//                  took them before
+//   m_second       inertia_derivatives in Jet<double, nq>: d2 M / d q2 as well (the audit's
+//                  Hessians)
+//
 //   bench_derivatives --benchmark_filter=crane_x7
 #include <symoro/crane_x7.hpp>
 #include <symoro/planar2r.hpp>
@@ -17,6 +23,7 @@
 #include <symoro/stanford_rrp.hpp>
 
 #include <array>
+#include <memory>
 #include <random>
 
 #include <Eigen/Cholesky>
@@ -159,7 +166,54 @@ void fd_jet_path(benchmark::State& state) {
   }
 }
 
+template <class Model>
+void m_derivatives(benchmark::State& state) {
+  Inputs<Model> in;
+  typename Model::template InertiaDerivatives<double> d;
+  for (auto _ : state) {
+    const auto& x = in();
+    Model::inertia_derivatives(x.q, x.phi, d);
+    benchmark::DoNotOptimize(d.dq.data());
+    benchmark::ClobberMemory();
+  }
+}
+
+template <class Model>
+void m_jet(benchmark::State& state) {
+  constexpr int n = Model::nq;
+  using Jet = ceres::Jet<double, n>;
+  Inputs<Model> in;
+  Eigen::Matrix<Jet, n, 1> q;
+  Eigen::Matrix<Jet, Eigen::Dynamic, Eigen::Dynamic> M(n, n);
+  for (auto _ : state) {
+    const auto& x = in();
+    for (int i = 0; i < n; ++i) q(i) = Jet(x.q(i), i);
+    Model::inertia(q, x.phi, M);
+    benchmark::DoNotOptimize(M.data());
+    benchmark::ClobberMemory();
+  }
+}
+
+template <class Model>
+void m_second(benchmark::State& state) {
+  constexpr int n = Model::nq;
+  using Jet = ceres::Jet<double, n>;
+  Inputs<Model> in;
+  Eigen::Matrix<Jet, n, 1> q;
+  auto d = std::make_unique<typename Model::template InertiaDerivatives<Jet>>();
+  for (auto _ : state) {
+    const auto& x = in();
+    for (int i = 0; i < n; ++i) q(i) = Jet(x.q(i), i);
+    Model::inertia_derivatives(q, x.phi, *d);
+    benchmark::DoNotOptimize(d->dq.data());
+    benchmark::ClobberMemory();
+  }
+}
+
 #define SYMORO_BENCH_MODEL(label, M)                  \
+  BENCHMARK_TEMPLATE(m_derivatives, M)->Name(label "/m_derivatives");   \
+  BENCHMARK_TEMPLATE(m_jet, M)->Name(label "/m_jet");                   \
+  BENCHMARK_TEMPLATE(m_second, M)->Name(label "/m_second");             \
   BENCHMARK_TEMPLATE(id_value, M)->Name(label "/id_value");             \
   BENCHMARK_TEMPLATE(id_derivatives, M)->Name(label "/id_derivatives"); \
   BENCHMARK_TEMPLATE(id_jet, M)->Name(label "/id_jet");                 \

@@ -160,4 +160,47 @@ std::string forward_dynamics_derivatives_code(const DerivativeModel& m, std::vec
   return s;
 }
 
+std::string inertia_derivatives_code(const DerivativeModel& m, std::vector<FunctionSummary>& summary) {
+  ExprGraph& g = *m.graph;
+  std::vector<NodeId> lower;  // M's lower triangle, row by row
+  for (int j = 0; j < m.n; ++j)
+    for (int k = 0; k <= j; ++k) lower.push_back(m.M[j][k]);
+  std::vector<Assignment> out;
+  std::vector<NodeId> roots;
+  // Both triangles of a symmetric matrix from its lower one.
+  const auto assign = [&](const std::string& target, const std::vector<NodeId>& entries) {
+    std::size_t i = 0;
+    for (int j = 0; j < m.n; ++j)
+      for (int k = 0; k <= j; ++k, ++i) {
+        const NodeId v = entries[i];
+        roots.push_back(v);
+        if (g.is_constant(v, 0.0)) continue;
+        out.push_back({target + "(" + str(j) + ", " + str(k) + ")", v});
+        if (j != k) out.push_back({target + "(" + str(k) + ", " + str(j) + ")", v});
+      }
+  };
+  assign("d.M", lower);
+  for (int k = 0; k < m.n; ++k) assign("d.dq[" + str(k) + "]", differentiate(g, lower, m.q[k]));
+  summary.push_back({"inertia_derivatives", count_operations(g, roots)});
+  std::map<std::string, std::string> inputs;
+  bind_symbols(inputs, m.q, "q");
+  bind_symbols(inputs, m.phi, "phi");
+
+  std::string s;
+  s += "// The inertia matrix and its derivatives along q, d M / d q_k for every k (the PD audit's\n"
+       "// gradients); in ceres::Jet scalars seeded on q it gives d2 M / d q_k d q_l as well.\n";
+  s += "template <class Scalar>\nstruct InertiaDerivatives {\n";
+  s += "  Eigen::Matrix<Scalar, nq, nq> M;\n";
+  s += "  std::array<Eigen::Matrix<Scalar, nq, nq>, nq> dq;  // dq[k] = d M / d q_k\n};\n\n";
+  s += "template <class Q, class Phi, class Scalar>\n";
+  s += "inline void inertia_derivatives(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<Phi>& phi,\n"
+       "                                InertiaDerivatives<Scalar>& d) {\n";
+  s += usings(g, roots);
+  s += size_checks({{"q", m.q.size()}, {"phi", m.phi.size()}});
+  s += "  d.M.setZero();\n  for (auto& x : d.dq) x.setZero();\n";
+  s += emit_body(g, inputs, out, "  ");
+  s += "}\n\n";
+  return s;
+}
+
 }  // namespace symoro::codegen::detail

@@ -32,4 +32,8 @@ std::string inverse_dynamics_derivatives_code(const DerivativeModel& m, std::vec
 // d ID / d(q, qd) and W at the computed qdd.
 std::string forward_dynamics_derivatives_code(const DerivativeModel& m, std::vector<FunctionSummary>& summary);
 
+// The struct InertiaDerivatives<Scalar> and the function filling it (M and d M / d q_k for every
+// k), for the PD audit's gradients; in Jets over q it gives the second derivatives too.
+std::string inertia_derivatives_code(const DerivativeModel& m, std::vector<FunctionSummary>& summary);
+
 }  // namespace symoro::codegen::detail

@@ -80,6 +80,7 @@ class ModelWriter {
     add(out, "forward_dynamics.hpp", forward_dynamics_header());
     add(out, "inverse_dynamics_derivatives.hpp", inverse_dynamics_derivatives_header());
     add(out, "forward_dynamics_derivatives.hpp", forward_dynamics_derivatives_header());
+    add(out, "inertia_derivatives.hpp", inertia_derivatives_header());
     add(out, "forward_kinematics.hpp", forward_kinematics_header());
     add(out, "jacobian.hpp", jacobian_header());
     add(out, "all.hpp", all_header());
@@ -491,6 +492,14 @@ class ModelWriter {
     return s;
   }
 
+  std::string inertia_derivatives_header() {
+    std::string s = banner("The inertia matrix M(q; phi) with d M / d q, differentiated on the expression graph.");
+    s += "#include <array>\n" + kinematic_includes() + open();
+    s += detail::inertia_derivatives_code(derivative_model(), summary_->functions);
+    s += close();
+    return s;
+  }
+
   std::string inertia_header() {
     const int n = r_.n;
     // M(q; phi): the derivative of the factored Newton-Euler torque (idm.txt) with respect to
@@ -544,7 +553,8 @@ class ModelWriter {
     std::string s = banner("The whole model and `Model`, a type that names it for generic code.");
     for (const char* f : {"model.hpp", "base_parameters.hpp", "regressor.hpp", "inverse_dynamics.hpp", "inertia.hpp",
                           "nonlinear_effects.hpp", "forward_dynamics.hpp", "inverse_dynamics_derivatives.hpp",
-                          "forward_dynamics_derivatives.hpp", "forward_kinematics.hpp", "jacobian.hpp"})
+                          "forward_dynamics_derivatives.hpp", "inertia_derivatives.hpp", "forward_kinematics.hpp",
+                          "jacobian.hpp"})
       s += include_self(f);
     s += "\n#include <utility>\n";
     if (!variant_.empty()) s += "#include \"symoro/" + r_.name + "/all.hpp\"\n";
@@ -563,11 +573,12 @@ class ModelWriter {
     if (ne() > 0) s += "  static constexpr const auto& effect_parameters = " + ns_ + "::effect_parameters;\n";
     s += "  // The robot's full model (this type itself for the full model).\n";
     s += "  using Parent = " + (variant_.empty() ? std::string("Model") : "::symoro::" + r_.name + "::Model") + ";\n";
-    for (const char* t : {"InertiaBasis", "InverseDynamicsDerivatives", "ForwardDynamicsDerivatives"})
+    for (const char* t : {"InertiaBasis", "InertiaDerivatives", "InverseDynamicsDerivatives", "ForwardDynamicsDerivatives"})
       s += "  template <class Scalar>\n  using " + std::string(t) + " = " + ns_ + "::" + t + "<Scalar>;\n";
     for (const char* f : {"base_from_standard", "to_parent", "from_parent", "regressor", "fixed_torque", "inverse_dynamics",
                           "inertia", "inertia_basis", "nonlinear_effects", "forward_dynamics",
-                          "inverse_dynamics_derivatives", "forward_dynamics_derivatives", "forward_kinematics", "jacobian"}) {
+                          "inverse_dynamics_derivatives", "forward_dynamics_derivatives", "inertia_derivatives",
+                          "forward_kinematics", "jacobian"}) {
       const std::string fn = f;
       s += "  template <class... A>\n  static auto " + fn + "(A&&... a) -> decltype(" + ns_ + "::" + fn +
            "(std::forward<A>(a)...)) {\n    return " + ns_ + "::" + fn + "(std::forward<A>(a)...);\n  }\n";

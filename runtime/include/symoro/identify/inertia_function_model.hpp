@@ -1,6 +1,6 @@
 // InertiaFunction for a generated Model (Model::inertia, Model::inertia_basis): values in
-// double, dM/dq in ceres::Jet<double, nq>, d2M/dq2 in a small second-order forward-mode number
-// (ceres Jets do not nest through the generated code: it builds scalars from double and int).
+// double, dM/dq from the generated inertia_derivatives (differentiated on the expression graph),
+// d2M/dq2 from the same function in ceres::Jet<double, nq> seeded on q.
 #pragma once
 
 #include <cmath>
@@ -17,90 +17,6 @@
 namespace symoro::identify {
 namespace detail {
 
-// A value with its gradient and Hessian in N seeded variables: enough arithmetic (+ - *, sin,
-// cos, comparisons on the value) for the generated inertia code, which divides nowhere.
-template <int N>
-struct SecondOrder {
-  using Gradient = Eigen::Matrix<double, N, 1>;
-  using Hessian = Eigen::Matrix<double, N, N>;
-  double a = 0;
-  Gradient g = Gradient::Zero();
-  Hessian h = Hessian::Zero();
-
-  SecondOrder() = default;
-  SecondOrder(double value) : a(value) {}  // NOLINT: constants in generated code convert implicitly
-  // The variable k of N at `value`.
-  static SecondOrder variable(double value, int k) {
-    SecondOrder x(value);
-    x.g(k) = 1;
-    return x;
-  }
-
-  SecondOrder& operator+=(const SecondOrder& y) {
-    a += y.a;
-    g += y.g;
-    h += y.h;
-    return *this;
-  }
-  SecondOrder& operator-=(const SecondOrder& y) {
-    a -= y.a;
-    g -= y.g;
-    h -= y.h;
-    return *this;
-  }
-  SecondOrder& operator*=(const SecondOrder& y) { return *this = *this * y; }
-
-  // f(x) from f(a), f'(a), f''(a).
-  SecondOrder chain(double f, double d1, double d2) const {
-    SecondOrder r(f);
-    r.g = d1 * g;
-    r.h = d1 * h + d2 * g * g.transpose();
-    return r;
-  }
-
-  friend SecondOrder operator+(const SecondOrder& x) { return x; }
-  friend SecondOrder operator-(const SecondOrder& x) { return x * -1.0; }
-  friend SecondOrder operator+(SecondOrder x, const SecondOrder& y) { return x += y; }
-  friend SecondOrder operator-(SecondOrder x, const SecondOrder& y) { return x -= y; }
-  friend SecondOrder operator+(SecondOrder x, double s) {
-    x.a += s;
-    return x;
-  }
-  friend SecondOrder operator+(double s, const SecondOrder& x) { return x + s; }
-  friend SecondOrder operator-(const SecondOrder& x, double s) { return x + (-s); }
-  friend SecondOrder operator-(double s, const SecondOrder& x) { return s + (-x); }
-  friend SecondOrder operator*(const SecondOrder& x, const SecondOrder& y) {
-    SecondOrder r(x.a * y.a);
-    r.g = x.a * y.g + y.a * x.g;
-    const Hessian cross = x.g * y.g.transpose();
-    r.h = x.a * y.h + y.a * x.h + cross + cross.transpose();
-    return r;
-  }
-  friend SecondOrder operator*(SecondOrder x, double s) {
-    x.a *= s;
-    x.g *= s;
-    x.h *= s;
-    return x;
-  }
-  friend SecondOrder operator*(double s, SecondOrder x) { return x * s; }
-
-  friend SecondOrder sin(const SecondOrder& x) {
-    const double s = std::sin(x.a), c = std::cos(x.a);
-    return x.chain(s, c, -s);
-  }
-  friend SecondOrder cos(const SecondOrder& x) {
-    const double s = std::sin(x.a), c = std::cos(x.a);
-    return x.chain(c, -s, -c);
-  }
-
-  friend bool operator<(const SecondOrder& x, const SecondOrder& y) { return x.a < y.a; }
-  friend bool operator>(const SecondOrder& x, const SecondOrder& y) { return x.a > y.a; }
-  friend bool operator<=(const SecondOrder& x, const SecondOrder& y) { return x.a <= y.a; }
-  friend bool operator>=(const SecondOrder& x, const SecondOrder& y) { return x.a >= y.a; }
-  friend bool operator==(const SecondOrder& x, const SecondOrder& y) { return x.a == y.a; }
-  friend bool operator!=(const SecondOrder& x, const SecondOrder& y) { return x.a != y.a; }
-};
-
 inline void check_size(const char* what, Eigen::Index size, int expected) {
   if (size != expected)
     throw std::invalid_argument(std::string("InertiaFunction: ") + what + " has " + std::to_string(size) +
@@ -114,7 +30,6 @@ class ModelInertiaFunction final : public InertiaFunction {
  public:
   static constexpr int n = Model::nq;
   using Jet = ceres::Jet<double, n>;
-  using Second = detail::SecondOrder<n>;
 
   int joints() const override { return n; }
   int parameters() const override { return Model::np; }
@@ -137,38 +52,33 @@ class ModelInertiaFunction final : public InertiaFunction {
   void inertia_derivatives(const Eigen::VectorXd& q, const Eigen::VectorXd& phi, Eigen::MatrixXd& M,
                            std::vector<Eigen::MatrixXd>& dM_dq) const override {
     check(q, phi);
-    Eigen::Matrix<Jet, n, 1> qj;
-    for (int k = 0; k < n; ++k) qj(k) = Jet(q(k), k);
-    // Dynamic output: fixed-size Jet matrices hit Eigen's stack limit for large models.
-    Eigen::Matrix<Jet, Eigen::Dynamic, Eigen::Dynamic> Mj;
-    Model::inertia(qj, phi, Mj);
-    M.resize(n, n);
-    dM_dq.assign(n, Eigen::MatrixXd(n, n));
-    for (int i = 0; i < n; ++i)
-      for (int j = 0; j < n; ++j) {
-        M(i, j) = Mj(i, j).a;
-        for (int k = 0; k < n; ++k) dM_dq[k](i, j) = Mj(i, j).v(k);
-      }
+    // Generated, differentiated on the expression graph (inertia_derivatives.hpp); kept off a
+    // worker thread's stack like the basis.
+    auto d = std::make_unique<typename Model::template InertiaDerivatives<double>>();
+    Model::inertia_derivatives(q, phi, *d);
+    M = d->M;
+    dM_dq.assign(d->dq.begin(), d->dq.end());
   }
 
   bool inertia_second_derivatives(const Eigen::VectorXd& q, const Eigen::VectorXd& phi, Eigen::MatrixXd& M,
                                   std::vector<Eigen::MatrixXd>& dM_dq,
                                   std::vector<Eigen::MatrixXd>& d2M_dq2) const override {
     check(q, phi);
-    Eigen::Matrix<Second, Eigen::Dynamic, 1> qs(n);
-    for (int k = 0; k < n; ++k) qs(k) = Second::variable(q(k), k);
-    Eigen::Matrix<Second, Eigen::Dynamic, Eigen::Dynamic> Ms;
-    Model::inertia(qs, phi, Ms);
+    // The generated first derivatives in Jets seeded on q: their derivative parts are d2M.
+    Eigen::Matrix<Jet, n, 1> qj;
+    for (int k = 0; k < n; ++k) qj(k) = Jet(q(k), k);
+    auto d = std::make_unique<typename Model::template InertiaDerivatives<Jet>>();
+    Model::inertia_derivatives(qj, phi, *d);
     M.resize(n, n);
     dM_dq.assign(n, Eigen::MatrixXd(n, n));
     d2M_dq2.assign(n * n, Eigen::MatrixXd(n, n));
     for (int i = 0; i < n; ++i)
       for (int j = 0; j < n; ++j) {
-        const Second& e = Ms(i, j);
-        M(i, j) = e.a;
+        M(i, j) = d->M(i, j).a;
         for (int k = 0; k < n; ++k) {
-          dM_dq[k](i, j) = e.g(k);
-          for (int l = 0; l < n; ++l) d2M_dq2[k * n + l](i, j) = e.h(k, l);
+          const Jet& e = d->dq[k](i, j);
+          dM_dq[k](i, j) = e.a;
+          for (int l = 0; l < n; ++l) d2M_dq2[k * n + l](i, j) = e.v(l);
         }
       }
     return true;
@@ -187,23 +97,3 @@ std::unique_ptr<InertiaFunction> make_inertia_function() {
 }
 
 }  // namespace symoro::identify
-
-// Eigen needs to know SecondOrder is a real, non-integer number to hold it in matrices.
-namespace Eigen {
-template <int N>
-struct NumTraits<symoro::identify::detail::SecondOrder<N>> : NumTraits<double> {
-  using Real = symoro::identify::detail::SecondOrder<N>;
-  using NonInteger = Real;
-  using Nested = Real;
-  using Literal = Real;
-  enum {
-    IsComplex = 0,
-    IsInteger = 0,
-    IsSigned = 1,
-    RequireInitialization = 1,
-    ReadCost = 1 + N + N * N,
-    AddCost = 1 + N + N * N,
-    MulCost = 3 * (1 + N + N * N),
-  };
-};
-}  // namespace Eigen

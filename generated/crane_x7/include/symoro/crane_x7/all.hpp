@@ -12,6 +12,7 @@
 #include "symoro/crane_x7/forward_dynamics.hpp"
 #include "symoro/crane_x7/inverse_dynamics_derivatives.hpp"
 #include "symoro/crane_x7/forward_dynamics_derivatives.hpp"
+#include "symoro/crane_x7/inertia_derivatives.hpp"
 #include "symoro/crane_x7/forward_kinematics.hpp"
 #include "symoro/crane_x7/jacobian.hpp"
 
@@ -38,6 +39,8 @@ struct Model {
   using Parent = Model;
   template <class Scalar>
   using InertiaBasis = symoro::crane_x7::InertiaBasis<Scalar>;
+  template <class Scalar>
+  using InertiaDerivatives = symoro::crane_x7::InertiaDerivatives<Scalar>;
   template <class Scalar>
   using InverseDynamicsDerivatives = symoro::crane_x7::InverseDynamicsDerivatives<Scalar>;
   template <class Scalar>
@@ -89,6 +92,10 @@ struct Model {
   template <class... A>
   static auto forward_dynamics_derivatives(A&&... a) -> decltype(symoro::crane_x7::forward_dynamics_derivatives(std::forward<A>(a)...)) {
     return symoro::crane_x7::forward_dynamics_derivatives(std::forward<A>(a)...);
+  }
+  template <class... A>
+  static auto inertia_derivatives(A&&... a) -> decltype(symoro::crane_x7::inertia_derivatives(std::forward<A>(a)...)) {
+    return symoro::crane_x7::inertia_derivatives(std::forward<A>(a)...);
   }
   template <class... A>
   static auto forward_kinematics(A&&... a) -> decltype(symoro::crane_x7::forward_kinematics(std::forward<A>(a)...)) {

@@ -12,6 +12,7 @@
 #include "symoro/crane_x7_reduced/forward_dynamics.hpp"
 #include "symoro/crane_x7_reduced/inverse_dynamics_derivatives.hpp"
 #include "symoro/crane_x7_reduced/forward_dynamics_derivatives.hpp"
+#include "symoro/crane_x7_reduced/inertia_derivatives.hpp"
 #include "symoro/crane_x7_reduced/forward_kinematics.hpp"
 #include "symoro/crane_x7_reduced/jacobian.hpp"
 
@@ -38,6 +39,8 @@ struct Model {
   using Parent = Model;
   template <class Scalar>
   using InertiaBasis = symoro::crane_x7_reduced::InertiaBasis<Scalar>;
+  template <class Scalar>
+  using InertiaDerivatives = symoro::crane_x7_reduced::InertiaDerivatives<Scalar>;
   template <class Scalar>
   using InverseDynamicsDerivatives = symoro::crane_x7_reduced::InverseDynamicsDerivatives<Scalar>;
   template <class Scalar>
@@ -89,6 +92,10 @@ struct Model {
   template <class... A>
   static auto forward_dynamics_derivatives(A&&... a) -> decltype(symoro::crane_x7_reduced::forward_dynamics_derivatives(std::forward<A>(a)...)) {
     return symoro::crane_x7_reduced::forward_dynamics_derivatives(std::forward<A>(a)...);
+  }
+  template <class... A>
+  static auto inertia_derivatives(A&&... a) -> decltype(symoro::crane_x7_reduced::inertia_derivatives(std::forward<A>(a)...)) {
+    return symoro::crane_x7_reduced::inertia_derivatives(std::forward<A>(a)...);
   }
   template <class... A>
   static auto forward_kinematics(A&&... a) -> decltype(symoro::crane_x7_reduced::forward_kinematics(std::forward<A>(a)...)) {

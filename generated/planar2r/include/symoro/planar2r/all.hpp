@@ -12,6 +12,7 @@
 #include "symoro/planar2r/forward_dynamics.hpp"
 #include "symoro/planar2r/inverse_dynamics_derivatives.hpp"
 #include "symoro/planar2r/forward_dynamics_derivatives.hpp"
+#include "symoro/planar2r/inertia_derivatives.hpp"
 #include "symoro/planar2r/forward_kinematics.hpp"
 #include "symoro/planar2r/jacobian.hpp"
 
@@ -38,6 +39,8 @@ struct Model {
   using Parent = Model;
   template <class Scalar>
   using InertiaBasis = symoro::planar2r::InertiaBasis<Scalar>;
+  template <class Scalar>
+  using InertiaDerivatives = symoro::planar2r::InertiaDerivatives<Scalar>;
   template <class Scalar>
   using InverseDynamicsDerivatives = symoro::planar2r::InverseDynamicsDerivatives<Scalar>;
   template <class Scalar>
@@ -89,6 +92,10 @@ struct Model {
   template <class... A>
   static auto forward_dynamics_derivatives(A&&... a) -> decltype(symoro::planar2r::forward_dynamics_derivatives(std::forward<A>(a)...)) {
     return symoro::planar2r::forward_dynamics_derivatives(std::forward<A>(a)...);
+  }
+  template <class... A>
+  static auto inertia_derivatives(A&&... a) -> decltype(symoro::planar2r::inertia_derivatives(std::forward<A>(a)...)) {
+    return symoro::planar2r::inertia_derivatives(std::forward<A>(a)...);
   }
   template <class... A>
   static auto forward_kinematics(A&&... a) -> decltype(symoro::planar2r::forward_kinematics(std::forward<A>(a)...)) {

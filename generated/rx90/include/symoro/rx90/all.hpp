@@ -12,6 +12,7 @@
 #include "symoro/rx90/forward_dynamics.hpp"
 #include "symoro/rx90/inverse_dynamics_derivatives.hpp"
 #include "symoro/rx90/forward_dynamics_derivatives.hpp"
+#include "symoro/rx90/inertia_derivatives.hpp"
 #include "symoro/rx90/forward_kinematics.hpp"
 #include "symoro/rx90/jacobian.hpp"
 
@@ -38,6 +39,8 @@ struct Model {
   using Parent = Model;
   template <class Scalar>
   using InertiaBasis = symoro::rx90::InertiaBasis<Scalar>;
+  template <class Scalar>
+  using InertiaDerivatives = symoro::rx90::InertiaDerivatives<Scalar>;
   template <class Scalar>
   using InverseDynamicsDerivatives = symoro::rx90::InverseDynamicsDerivatives<Scalar>;
   template <class Scalar>
@@ -89,6 +92,10 @@ struct Model {
   template <class... A>
   static auto forward_dynamics_derivatives(A&&... a) -> decltype(symoro::rx90::forward_dynamics_derivatives(std::forward<A>(a)...)) {
     return symoro::rx90::forward_dynamics_derivatives(std::forward<A>(a)...);
+  }
+  template <class... A>
+  static auto inertia_derivatives(A&&... a) -> decltype(symoro::rx90::inertia_derivatives(std::forward<A>(a)...)) {
+    return symoro::rx90::inertia_derivatives(std::forward<A>(a)...);
   }
   template <class... A>
   static auto forward_kinematics(A&&... a) -> decltype(symoro::rx90::forward_kinematics(std::forward<A>(a)...)) {

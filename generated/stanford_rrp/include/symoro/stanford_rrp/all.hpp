@@ -12,6 +12,7 @@
 #include "symoro/stanford_rrp/forward_dynamics.hpp"
 #include "symoro/stanford_rrp/inverse_dynamics_derivatives.hpp"
 #include "symoro/stanford_rrp/forward_dynamics_derivatives.hpp"
+#include "symoro/stanford_rrp/inertia_derivatives.hpp"
 #include "symoro/stanford_rrp/forward_kinematics.hpp"
 #include "symoro/stanford_rrp/jacobian.hpp"
 
@@ -38,6 +39,8 @@ struct Model {
   using Parent = Model;
   template <class Scalar>
   using InertiaBasis = symoro::stanford_rrp::InertiaBasis<Scalar>;
+  template <class Scalar>
+  using InertiaDerivatives = symoro::stanford_rrp::InertiaDerivatives<Scalar>;
   template <class Scalar>
   using InverseDynamicsDerivatives = symoro::stanford_rrp::InverseDynamicsDerivatives<Scalar>;
   template <class Scalar>
@@ -89,6 +92,10 @@ struct Model {
   template <class... A>
   static auto forward_dynamics_derivatives(A&&... a) -> decltype(symoro::stanford_rrp::forward_dynamics_derivatives(std::forward<A>(a)...)) {
     return symoro::stanford_rrp::forward_dynamics_derivatives(std::forward<A>(a)...);
+  }
+  template <class... A>
+  static auto inertia_derivatives(A&&... a) -> decltype(symoro::stanford_rrp::inertia_derivatives(std::forward<A>(a)...)) {
+    return symoro::stanford_rrp::inertia_derivatives(std::forward<A>(a)...);
   }
   template <class... A>
   static auto forward_kinematics(A&&... a) -> decltype(symoro::stanford_rrp::forward_kinematics(std::forward<A>(a)...)) {

@@ -12,6 +12,7 @@
 #include "symoro/crane_x7/reduced/forward_dynamics.hpp"
 #include "symoro/crane_x7/reduced/inverse_dynamics_derivatives.hpp"
 #include "symoro/crane_x7/reduced/forward_dynamics_derivatives.hpp"
+#include "symoro/crane_x7/reduced/inertia_derivatives.hpp"
 #include "symoro/crane_x7/reduced/forward_kinematics.hpp"
 #include "symoro/crane_x7/reduced/jacobian.hpp"
 
@@ -39,6 +40,8 @@ struct Model {
   using Parent = ::symoro::crane_x7::Model;
   template <class Scalar>
   using InertiaBasis = symoro::crane_x7::reduced::InertiaBasis<Scalar>;
+  template <class Scalar>
+  using InertiaDerivatives = symoro::crane_x7::reduced::InertiaDerivatives<Scalar>;
   template <class Scalar>
   using InverseDynamicsDerivatives = symoro::crane_x7::reduced::InverseDynamicsDerivatives<Scalar>;
   template <class Scalar>
@@ -90,6 +93,10 @@ struct Model {
   template <class... A>
   static auto forward_dynamics_derivatives(A&&... a) -> decltype(symoro::crane_x7::reduced::forward_dynamics_derivatives(std::forward<A>(a)...)) {
     return symoro::crane_x7::reduced::forward_dynamics_derivatives(std::forward<A>(a)...);
+  }
+  template <class... A>
+  static auto inertia_derivatives(A&&... a) -> decltype(symoro::crane_x7::reduced::inertia_derivatives(std::forward<A>(a)...)) {
+    return symoro::crane_x7::reduced::inertia_derivatives(std::forward<A>(a)...);
   }
   template <class... A>
   static auto forward_kinematics(A&&... a) -> decltype(symoro::crane_x7::reduced::forward_kinematics(std::forward<A>(a)...)) {

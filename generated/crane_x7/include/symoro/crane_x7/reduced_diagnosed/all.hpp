@@ -12,6 +12,7 @@
 #include "symoro/crane_x7/reduced_diagnosed/forward_dynamics.hpp"
 #include "symoro/crane_x7/reduced_diagnosed/inverse_dynamics_derivatives.hpp"
 #include "symoro/crane_x7/reduced_diagnosed/forward_dynamics_derivatives.hpp"
+#include "symoro/crane_x7/reduced_diagnosed/inertia_derivatives.hpp"
 #include "symoro/crane_x7/reduced_diagnosed/forward_kinematics.hpp"
 #include "symoro/crane_x7/reduced_diagnosed/jacobian.hpp"
 
@@ -41,6 +42,8 @@ struct Model {
   using Parent = ::symoro::crane_x7::Model;
   template <class Scalar>
   using InertiaBasis = symoro::crane_x7::reduced_diagnosed::InertiaBasis<Scalar>;
+  template <class Scalar>
+  using InertiaDerivatives = symoro::crane_x7::reduced_diagnosed::InertiaDerivatives<Scalar>;
   template <class Scalar>
   using InverseDynamicsDerivatives = symoro::crane_x7::reduced_diagnosed::InverseDynamicsDerivatives<Scalar>;
   template <class Scalar>
@@ -92,6 +95,10 @@ struct Model {
   template <class... A>
   static auto forward_dynamics_derivatives(A&&... a) -> decltype(symoro::crane_x7::reduced_diagnosed::forward_dynamics_derivatives(std::forward<A>(a)...)) {
     return symoro::crane_x7::reduced_diagnosed::forward_dynamics_derivatives(std::forward<A>(a)...);
+  }
+  template <class... A>
+  static auto inertia_derivatives(A&&... a) -> decltype(symoro::crane_x7::reduced_diagnosed::inertia_derivatives(std::forward<A>(a)...)) {
+    return symoro::crane_x7::reduced_diagnosed::inertia_derivatives(std::forward<A>(a)...);
   }
   template <class... A>
   static auto forward_kinematics(A&&... a) -> decltype(symoro::crane_x7::reduced_diagnosed::forward_kinematics(std::forward<A>(a)...)) {

@@ -12,6 +12,7 @@
 #include "symoro/planar2r/effects/forward_dynamics.hpp"
 #include "symoro/planar2r/effects/inverse_dynamics_derivatives.hpp"
 #include "symoro/planar2r/effects/forward_dynamics_derivatives.hpp"
+#include "symoro/planar2r/effects/inertia_derivatives.hpp"
 #include "symoro/planar2r/effects/forward_kinematics.hpp"
 #include "symoro/planar2r/effects/jacobian.hpp"
 
@@ -41,6 +42,8 @@ struct Model {
   using Parent = ::symoro::planar2r::Model;
   template <class Scalar>
   using InertiaBasis = symoro::planar2r::effects::InertiaBasis<Scalar>;
+  template <class Scalar>
+  using InertiaDerivatives = symoro::planar2r::effects::InertiaDerivatives<Scalar>;
   template <class Scalar>
   using InverseDynamicsDerivatives = symoro::planar2r::effects::InverseDynamicsDerivatives<Scalar>;
   template <class Scalar>
@@ -92,6 +95,10 @@ struct Model {
   template <class... A>
   static auto forward_dynamics_derivatives(A&&... a) -> decltype(symoro::planar2r::effects::forward_dynamics_derivatives(std::forward<A>(a)...)) {
     return symoro::planar2r::effects::forward_dynamics_derivatives(std::forward<A>(a)...);
+  }
+  template <class... A>
+  static auto inertia_derivatives(A&&... a) -> decltype(symoro::planar2r::effects::inertia_derivatives(std::forward<A>(a)...)) {
+    return symoro::planar2r::effects::inertia_derivatives(std::forward<A>(a)...);
   }
   template <class... A>
   static auto forward_kinematics(A&&... a) -> decltype(symoro::planar2r::effects::forward_kinematics(std::forward<A>(a)...)) {

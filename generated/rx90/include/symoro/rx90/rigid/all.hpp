@@ -12,6 +12,7 @@
 #include "symoro/rx90/rigid/forward_dynamics.hpp"
 #include "symoro/rx90/rigid/inverse_dynamics_derivatives.hpp"
 #include "symoro/rx90/rigid/forward_dynamics_derivatives.hpp"
+#include "symoro/rx90/rigid/inertia_derivatives.hpp"
 #include "symoro/rx90/rigid/forward_kinematics.hpp"
 #include "symoro/rx90/rigid/jacobian.hpp"
 
@@ -39,6 +40,8 @@ struct Model {
   using Parent = ::symoro::rx90::Model;
   template <class Scalar>
   using InertiaBasis = symoro::rx90::rigid::InertiaBasis<Scalar>;
+  template <class Scalar>
+  using InertiaDerivatives = symoro::rx90::rigid::InertiaDerivatives<Scalar>;
   template <class Scalar>
   using InverseDynamicsDerivatives = symoro::rx90::rigid::InverseDynamicsDerivatives<Scalar>;
   template <class Scalar>
@@ -90,6 +93,10 @@ struct Model {
   template <class... A>
   static auto forward_dynamics_derivatives(A&&... a) -> decltype(symoro::rx90::rigid::forward_dynamics_derivatives(std::forward<A>(a)...)) {
     return symoro::rx90::rigid::forward_dynamics_derivatives(std::forward<A>(a)...);
+  }
+  template <class... A>
+  static auto inertia_derivatives(A&&... a) -> decltype(symoro::rx90::rigid::inertia_derivatives(std::forward<A>(a)...)) {
+    return symoro::rx90::rigid::inertia_derivatives(std::forward<A>(a)...);
   }
   template <class... A>
   static auto forward_kinematics(A&&... a) -> decltype(symoro::rx90::rigid::forward_kinematics(std::forward<A>(a)...)) {

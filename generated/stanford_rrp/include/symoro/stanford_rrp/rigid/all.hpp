@@ -12,6 +12,7 @@
 #include "symoro/stanford_rrp/rigid/forward_dynamics.hpp"
 #include "symoro/stanford_rrp/rigid/inverse_dynamics_derivatives.hpp"
 #include "symoro/stanford_rrp/rigid/forward_dynamics_derivatives.hpp"
+#include "symoro/stanford_rrp/rigid/inertia_derivatives.hpp"
 #include "symoro/stanford_rrp/rigid/forward_kinematics.hpp"
 #include "symoro/stanford_rrp/rigid/jacobian.hpp"
 
@@ -39,6 +40,8 @@ struct Model {
   using Parent = ::symoro::stanford_rrp::Model;
   template <class Scalar>
   using InertiaBasis = symoro::stanford_rrp::rigid::InertiaBasis<Scalar>;
+  template <class Scalar>
+  using InertiaDerivatives = symoro::stanford_rrp::rigid::InertiaDerivatives<Scalar>;
   template <class Scalar>
   using InverseDynamicsDerivatives = symoro::stanford_rrp::rigid::InverseDynamicsDerivatives<Scalar>;
   template <class Scalar>
@@ -90,6 +93,10 @@ struct Model {
   template <class... A>
   static auto forward_dynamics_derivatives(A&&... a) -> decltype(symoro::stanford_rrp::rigid::forward_dynamics_derivatives(std::forward<A>(a)...)) {
     return symoro::stanford_rrp::rigid::forward_dynamics_derivatives(std::forward<A>(a)...);
+  }
+  template <class... A>
+  static auto inertia_derivatives(A&&... a) -> decltype(symoro::stanford_rrp::rigid::inertia_derivatives(std::forward<A>(a)...)) {
+    return symoro::stanford_rrp::rigid::inertia_derivatives(std::forward<A>(a)...);
   }
   template <class... A>
   static auto forward_kinematics(A&&... a) -> decltype(symoro::stanford_rrp::rigid::forward_kinematics(std::forward<A>(a)...)) {
