@@ -11,7 +11,7 @@
 namespace symoro::dynid {
 
 struct TwinOptions {
-  enum class Mode { run, dataset, bench } mode = Mode::run;  // the subcommand
+  enum class Mode { run, dataset, bench } mode = Mode::run;  // which subcommand (one entry for all three)
   std::string config;                 // override YAML
   std::vector<std::string> effects;   // enable
   std::vector<std::string> without;   // disable
