@@ -2,6 +2,31 @@
 # headers: the committed ones in generated/<name>/ when present, otherwise headers symoroc
 # writes into the build tree (a robot just dropped into robots/ builds with no other change).
 
+# symoro_robot_model_count(<robot.yaml> <out var>): 1 (the full model) + the variants robot.yaml
+# lists in block style (`variants:`, then one `  <name>:` line each; flow style counts 0). Only
+# how dynid splits its units (runtime/tools): a count that is off still compiles every model.
+function(symoro_robot_model_count yaml out)
+  file(STRINGS "${yaml}" lines)
+  set(count 1)
+  set(in_variants FALSE)
+  set(indent "")
+  foreach(line IN LISTS lines)
+    if(line MATCHES "^variants:[ \t]*(#.*)?$")
+      set(in_variants TRUE)
+    elseif(in_variants AND line MATCHES "^[^ \t#]")
+      break()  # the next top-level key
+    elseif(in_variants AND line MATCHES "^( +)[a-z][a-z0-9_]*:")
+      if(indent STREQUAL "")
+        set(indent "${CMAKE_MATCH_1}")
+      endif()
+      if(CMAKE_MATCH_1 STREQUAL indent)
+        math(EXPR count "${count} + 1")
+      endif()
+    endif()
+  endforeach()
+  set(${out} ${count} PARENT_SCOPE)
+endfunction()
+
 # symoro_add_robot(<name> <robot dir>)
 function(symoro_add_robot name robot_dir)
   set(committed "${PROJECT_SOURCE_DIR}/generated/${name}/include")
@@ -32,6 +57,10 @@ function(symoro_add_robot name robot_dir)
   install(TARGETS ${target} EXPORT symoroTargets)
   install(DIRECTORY "${include_dir}/" DESTINATION ${CMAKE_INSTALL_INCLUDEDIR})
   set_property(GLOBAL APPEND PROPERTY SYMORO_ROBOTS ${name})
+  # A variant added to robot.yaml reconfigures, so it gets its own dynid units.
+  symoro_robot_model_count("${robot_dir}/robot.yaml" models)
+  set_property(GLOBAL PROPERTY SYMORO_ROBOT_MODELS_${name} ${models})
+  set_property(DIRECTORY "${PROJECT_SOURCE_DIR}" APPEND PROPERTY CMAKE_CONFIGURE_DEPENDS "${robot_dir}/robot.yaml")
 endfunction()
 
 # symoro_add_all_robots(<robots dir>): one target per robot folder; sets SYMORO_ROBOTS.

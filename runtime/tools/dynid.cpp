@@ -8,8 +8,8 @@
 #include <CLI/CLI.hpp>
 
 #include "dynid_common.hpp"
+#include "dynid_dispatch.hpp"
 #include "symoro/error.hpp"
-#include "symoro/robots_registry.hpp"
 
 namespace symoro::dynid {
 bool Progress::isatty_stderr() { return ::isatty(2) == 1; }
@@ -21,7 +21,7 @@ int main(int argc, char** argv) {
   app.require_subcommand(1);
   Common common;
   std::string known;
-  for (const auto& r : symoro::robot_names()) known += (known.empty() ? "" : ", ") + r;
+  for (const auto& r : robot_names()) known += (known.empty() ? "" : ", ") + r;
   app.footer("Robots: " + known);
   add_trajectory_commands(app, common);
   add_twin_commands(app, common);

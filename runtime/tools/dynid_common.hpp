@@ -1,5 +1,5 @@
-// Shared pieces of the dynid subcommands: where robot folders are, how a robot is looked up,
-// and a progress display for long batches.
+// Shared pieces of the dynid subcommands: where robot folders are, usage errors, and a progress
+// display for long batches. Included by every generated unit: CLI11 is only forward-declared.
 #pragma once
 
 #include <chrono>
@@ -8,12 +8,14 @@
 #include <mutex>
 #include <stdexcept>
 #include <string>
+#include <utility>
 #include <vector>
 
-#include <CLI/CLI.hpp>
-
 #include "symoro/model_info.hpp"
-#include "symoro/robots_registry.hpp"
+
+namespace CLI {
+class App;
+}  // namespace CLI
 
 namespace symoro::dynid {
 
@@ -58,20 +60,6 @@ class Progress {
   bool tty_ = isatty_stderr();
   static bool isatty_stderr();
 };
-
-// f(RobotEntry<Full, Model>) for the robot's compiled model named `model` (a robot.yaml variant,
-// or "full"; empty: robot.yaml's `identified`); a usage error naming the robot's models if none.
-template <class F>
-void with_model(const Common& common, const std::string& model, F&& f) {
-  if (with_robot_variant(common.robot, model, [&](auto entry) { f(entry); })) return;
-  const auto names = variant_names(common.robot);
-  if (names.empty()) throw UsageError("unknown robot '" + common.robot + "'");
-  std::string list;
-  for (const auto& n : names) list += (list.empty() ? "" : ", ") + n;
-  throw UsageError("robot '" + common.robot + "' has no compiled model '" + model + "' (it has: " + list +
-                   "); a variant just added to robot.yaml must be generated (symoroc generate robots/" + common.robot +
-                   " -o generated) and dynid rebuilt");
-}
 
 void add_compare_commands(CLI::App& app, Common& common);
 void add_twin_commands(CLI::App& app, Common& common);

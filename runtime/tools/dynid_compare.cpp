@@ -3,6 +3,7 @@
 // side on their held-out validation trajectories: rms torque error per trajectory and joint,
 // the parameters the second model adds, and torque figures. Reads only the studies' folders,
 // so neither model needs to be compiled into this dynid.
+#include <CLI/CLI.hpp>
 #include <fmt/format.h>
 
 #include "dynid_common.hpp"

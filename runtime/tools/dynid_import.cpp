@@ -1,90 +1,19 @@
 // dynid import: logs exported by a robot's own controller (CSV, ';' or whitespace, any rate)
 // into a dataset folder the other commands read: one project log per input, import.yaml (the
 // mapping used) and dataset.yaml, with an optional fitting / held-out split recorded there.
-#include <algorithm>
-#include <cmath>
+#include <string>
 
-#include <fmt/format.h>
+#include <CLI/CLI.hpp>
 
-#include "dynid_common.hpp"
-#include "symoro/error.hpp"
-#include "symoro/io/import.hpp"
+#include "dynid_import.hpp"
 
 namespace symoro::dynid {
 
 namespace {
 
-struct ImportOptions {
-  std::vector<std::string> inputs, names, heldout;
-  std::string out, mapping, time, q, qd, tau, q_ref, qd_ref, qdd_ref;
-  std::string time_unit, angle, header, delimiter;
-  double torque_scale = 0, split = 0;
-};
-
 constexpr const char* selector_help =
     "header name, pattern ('pos_*': joint 1..n, 'pos_%': 0..n-1, '{name}_pos': the robot's joint names), "
     "list 'a,b,c', or 1-based positions ('2-8', '2,4,6')";
-
-// The command line's settings over the mapping file's (or the defaults).
-io::ImportMapping mapping_of(const ImportOptions& o) {
-  io::ImportMapping m = o.mapping.empty() ? io::ImportMapping{} : io::read_import_mapping(o.mapping);
-  for (const auto& [text, target] : std::vector<std::pair<const std::string*, std::string*>>{
-           {&o.time, &m.time}, {&o.q, &m.q}, {&o.qd, &m.qd}, {&o.tau, &m.tau},
-           {&o.q_ref, &m.q_ref}, {&o.qd_ref, &m.qd_ref}, {&o.qdd_ref, &m.qdd_ref}})
-    if (!text->empty()) *target = *text;
-  if (!o.time_unit.empty())
-    m.time_unit = o.time_unit == "ms" ? io::TimeUnit::ms : o.time_unit == "us" ? io::TimeUnit::us
-                  : o.time_unit == "ns" ? io::TimeUnit::ns : io::TimeUnit::s;
-  if (!o.angle.empty()) m.angle_unit = o.angle == "deg" ? io::AngleUnit::deg : io::AngleUnit::rad;
-  if (o.torque_scale != 0) m.torque_scale = o.torque_scale;
-  if (!o.header.empty())
-    m.header = o.header == "yes" ? io::HeaderRow::present : o.header == "no" ? io::HeaderRow::absent : io::HeaderRow::automatic;
-  if (!o.delimiter.empty())
-    m.delimiter = o.delimiter == "comma" ? io::Delimiter::comma : o.delimiter == "semicolon" ? io::Delimiter::semicolon
-                  : o.delimiter == "whitespace" ? io::Delimiter::whitespace : io::Delimiter::automatic;
-  if (m.time.empty() || m.q.empty() || m.tau.empty())
-    throw UsageError("say which columns hold time, q and tau: --time, --q, --tau, or --mapping map.yaml");
-  return m;
-}
-
-template <class Model>
-void run(const Common& common, const ImportOptions& o) {
-  io::DatasetImport di;
-  di.target.robot = common.robot;
-  for (const JointInfo& j : Model::joints) {
-    di.target.joints.emplace_back(j.name);
-    di.target.prismatic.push_back(j.type == JointType::Prismatic);
-  }
-  di.mapping = mapping_of(o);
-  di.split = o.split;
-  if (!o.names.empty() && o.names.size() != o.inputs.size())
-    throw UsageError(fmt::format("--name: {} names for {} input files", o.names.size(), o.inputs.size()));
-  for (const std::string& h : o.heldout)
-    if (std::find(o.inputs.begin(), o.inputs.end(), h) == o.inputs.end())
-      throw UsageError(fmt::format("--heldout {}: not one of the input files", h));
-  for (std::size_t i = 0; i < o.inputs.size(); ++i)
-    di.inputs.push_back({o.inputs[i], o.names.empty() ? "" : o.names[i],
-                         std::find(o.heldout.begin(), o.heldout.end(), o.inputs[i]) != o.heldout.end()});
-  const io::DatasetImportResult r = io::import_dataset(o.out, di);
-  for (const io::ImportedLog& l : r.logs) {
-    const io::Log& log = l.log;
-    fmt::print("{}: {} rows -> {}.csv: {} samples over {:.3f} s, sample time {:g} ms (median), {} stale rows kept, "
-               "{} duplicates dropped, velocity {}\n",
-               l.input.string(), l.rows, log.meta.trajectory, log.samples(), log.time[log.samples() - 1] - log.time[0],
-               log.meta.sample_time * 1e3, l.stale_lines.size(), l.duplicate_lines.size(),
-               log.meta.velocity == io::Velocity::measured ? "measured" : "differentiated from q");
-    if (!l.stale_lines.empty())
-      fmt::print("  stale rows (same state as the row before, new stamp) on lines {}{}\n", l.stale_lines.front(),
-                 l.stale_lines.size() > 1 ? fmt::format(" .. {}", l.stale_lines.back()) : "");
-  }
-  for (const auto& run : r.runs) {
-    fmt::print("run {} (family {}): {}", run.trajectory, run.family, run.file.filename().string());
-    if (std::isfinite(run.window_start) || std::isfinite(run.window_end))
-      fmt::print(", window [{:.6g}, {:.6g}) s", run.window_start, run.window_end);
-    fmt::print("\n");
-  }
-  fmt::print("dataset: {} (mapping kept in import.yaml)\n", r.dataset.string());
-}
 
 }  // namespace
 
@@ -128,12 +57,7 @@ void add_import_commands(CLI::App& app, Common& common) {
       ->check(CLI::Range(0.0, 1.0));
   cmd->add_option("--name", o->names, "Run names, one per input (default: the file names' stems)")->delimiter(',');
   cmd->add_option("--heldout", o->heldout, "Inputs held out whole (family V)")->delimiter(',');
-  cmd->callback([&common, o] {
-    with_model(common, "", [&](auto entry) {
-      using E = decltype(entry);
-      run<typename E::IdentifiedModel>(common, *o);
-    });
-  });
+  cmd->callback([&common, o] { import_units().robot(common)(common, *o); });
 }
 
 }  // namespace symoro::dynid

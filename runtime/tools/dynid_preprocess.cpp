@@ -1,6 +1,7 @@
 // dynid preprocess: a log through the preprocessing at the paper's intervals (or chosen ones):
 // prints what was corrected, bridged, split and kept, and optionally writes the regression-
 // ready samples as CSV (time, q, qd, qdd, tau per joint) for inspection.
+#include <CLI/CLI.hpp>
 #include <fmt/format.h>
 
 #include "dynid_common.hpp"

@@ -1,49 +1,10 @@
 // dynid trajectories: list the robot's designed identification trajectories or write them as
 // reference files (time, q_ref, qd_ref, qdd_ref at the control period).
-#include <fmt/format.h>
+#include <CLI/CLI.hpp>
 
-#include "dynid_common.hpp"
-#include "symoro/io/log.hpp"
-#include "symoro/robots_registry.hpp"
-#include "symoro/trajectory/design.hpp"
+#include "dynid_trajectories.hpp"
 
 namespace symoro::dynid {
-
-namespace {
-
-struct TrajectoryOptions {
-  std::string out;
-  std::vector<std::string> only;
-  double period = 0.001;
-};
-
-template <class Model>
-void run_trajectories(const Common& common, const TrajectoryOptions& o) {
-  const auto design = trajectory::TrajectoryDesign::read(common.robot_dir() / "trajectories.yaml", joint_list<Model>());
-  const std::vector<std::string> names = o.only.empty() ? design.names() : o.only;
-  std::vector<std::string> joint_names;
-  for (const auto& j : Model::joints) joint_names.push_back(j.name);
-  if (o.out.empty()) {
-    fmt::print("{:<6} {:<4} {:>9}  {}\n", "name", "fam", "duration", "description");
-    double total = 0;
-    for (const auto& name : names) {
-      const auto t = design.build(name);
-      total += t.duration();
-      fmt::print("{:<6} {:<4} {:>8.1f}s  {}\n", t.name, t.family, t.duration(), t.description);
-    }
-    fmt::print("{} trajectories, {:.1f} s in all\n", names.size(), total);
-    return;
-  }
-  std::filesystem::create_directories(o.out);
-  Progress progress(static_cast<int>(names.size()), "reference");
-  for (const auto& name : names) {
-    const auto t = design.build(name);
-    io::write_log(std::filesystem::path(o.out) / (name + ".csv"), trajectory::reference_log(t, o.period, common.robot, joint_names));
-    progress.done(name, fmt::format("{:.1f} s", t.duration()));
-  }
-}
-
-}  // namespace
 
 void add_trajectory_commands(CLI::App& app, Common& common) {
   auto o = std::make_shared<TrajectoryOptions>();
@@ -53,10 +14,7 @@ void add_trajectory_commands(CLI::App& app, Common& common) {
   cmd->add_option("-o,--output", o->out, "Write <name>.csv and <name>.meta.yaml here (default: list only)");
   cmd->add_option("--only", o->only, "Only these trajectories");
   cmd->add_option("--period", o->period, "Sample period of the reference files, s")->check(CLI::PositiveNumber);
-  cmd->callback([&common, o] {
-    if (!with_robot(common.robot, [&](auto entry) { run_trajectories<typename decltype(entry)::FullModel>(common, *o); }))
-      throw UsageError("unknown robot '" + common.robot + "'");
-  });
+  cmd->callback([&common, o] { trajectories_units().robot(common)(common, *o); });
 }
 
 }  // namespace symoro::dynid
