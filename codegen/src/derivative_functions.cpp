@@ -11,17 +11,6 @@ namespace {
 
 std::string str(int v) { return std::to_string(v); }
 
-// The `using` declarations a body needs (exp and tanh only where used).
-std::string usings(const ExprGraph& g, const std::vector<NodeId>& roots) {
-  bool exp = false, tanh = false;
-  for (NodeId id : reachable(g, roots)) {
-    exp = exp || g.node(id).op == Op::Exp;
-    tanh = tanh || g.node(id).op == Op::Tanh;
-  }
-  return std::string("  using std::cos;\n") + (exp ? "  using std::exp;\n" : "") + "  using std::pow;\n  using std::sin;\n" +
-         (tanh ? "  using std::tanh;\n" : "") + "  using ::symoro::sign;\n";
-}
-
 void bind_symbols(std::map<std::string, std::string>& inputs, const std::vector<std::string>& symbols, const std::string& vector) {
   for (std::size_t k = 0; k < symbols.size(); ++k) inputs[symbols[k]] = vector + "[" + str(static_cast<int>(k)) + "]";
 }
@@ -81,7 +70,7 @@ std::string inverse_dynamics_derivatives_code(const DerivativeModel& m, std::vec
   s += "inline void inverse_dynamics_derivatives(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<QD>& qd,\n"
        "                                         const Eigen::MatrixBase<QDD>& qdd, const Eigen::MatrixBase<Phi>& phi,\n"
        "                                         InverseDynamicsDerivatives<Scalar>& d) {\n";
-  s += usings(g, roots);
+  s += math_usings(g, roots);
   s += size_checks({{"q", m.q.size()}, {"qd", m.qd.size()}, {"qdd", m.qdd.size()}, {"phi", m.phi.size()}});
   s += "  d.tau.setZero();\n  d.dq.setZero();\n  d.dqd.setZero();\n";
   s += emit_body(g, inputs, out, "  ");
@@ -140,7 +129,7 @@ std::string forward_dynamics_derivatives_code(const DerivativeModel& m, std::vec
   s += "inline bool forward_dynamics_derivatives(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<QD>& qd,\n"
        "                                         const Eigen::MatrixBase<Tau>& tau, const Eigen::MatrixBase<Phi>& phi,\n"
        "                                         ForwardDynamicsDerivatives<Scalar>& d) {\n";
-  s += usings(g, all);
+  s += math_usings(g, all);
   s += size_checks({{"q", m.q.size()}, {"qd", m.qd.size()}, {"tau", m.tau.size()}, {"phi", m.phi.size()}});
   s += "  " + mat + " stage_M;\n  Eigen::Matrix<Scalar, nq, 1> stage_h;\n  stage_M.setZero();\n  stage_h.setZero();\n";
   s += emitter.emit(first);
@@ -195,7 +184,7 @@ std::string inertia_derivatives_code(const DerivativeModel& m, std::vector<Funct
   s += "template <class Q, class Phi, class Scalar>\n";
   s += "inline void inertia_derivatives(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<Phi>& phi,\n"
        "                                InertiaDerivatives<Scalar>& d) {\n";
-  s += usings(g, roots);
+  s += math_usings(g, roots);
   s += size_checks({{"q", m.q.size()}, {"phi", m.phi.size()}});
   s += "  d.M.setZero();\n  for (auto& x : d.dq) x.setZero();\n";
   s += emit_body(g, inputs, out, "  ");

@@ -109,6 +109,16 @@ std::string BodyEmitter::emit(const std::vector<Assignment>& outputs) {
   return body;
 }
 
+std::string math_usings(const ExprGraph& g, const std::vector<NodeId>& roots) {
+  bool exp = false, tanh = false;
+  for (NodeId id : reachable(g, roots)) {
+    exp = exp || g.node(id).op == Op::Exp;
+    tanh = tanh || g.node(id).op == Op::Tanh;
+  }
+  return std::string("  using std::cos;\n") + (exp ? "  using std::exp;\n" : "") + "  using std::pow;\n  using std::sin;\n" +
+         (tanh ? "  using std::tanh;\n" : "") + "  using ::symoro::sign;\n";
+}
+
 std::string emit_body(const ExprGraph& g, const std::map<std::string, std::string>& inputs,
                       const std::vector<Assignment>& outputs, const std::string& indent) {
   std::vector<NodeId> roots;

@@ -139,17 +139,7 @@ class ModelWriter {
     return tau;
   }
 
-  // The `using` declarations of a function body: exp and tanh only where they are needed, so
-  // that models without effects read as before.
-  std::string usings(const std::vector<NodeId>& roots) const {
-    bool exp = false, tanh = false;
-    for (NodeId id : reachable(g_, roots)) {
-      exp = exp || g_.node(id).op == Op::Exp;
-      tanh = tanh || g_.node(id).op == Op::Tanh;
-    }
-    return std::string("  using std::cos;\n") + (exp ? "  using std::exp;\n" : "") +
-           "  using std::pow;\n  using std::sin;\n" + (tanh ? "  using std::tanh;\n" : "") + "  using ::symoro::sign;\n";
-  }
+  std::string usings(const std::vector<NodeId>& roots) const { return math_usings(g_, roots); }
 
   Input q_in() const { return {"Q", "q", r_.q}; }
   Input qd_in() const { return {"QD", "qd", r_.qd}; }

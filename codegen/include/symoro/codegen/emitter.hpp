@@ -51,6 +51,10 @@ class BodyEmitter {
   int temps_ = 0;
 };
 
+// The `using` declarations of a function body that evaluates `roots` (std::exp and std::tanh
+// only where the body needs them, so models without effects read as before).
+std::string math_usings(const ExprGraph& g, const std::vector<NodeId>& roots);
+
 // A double as a C++ literal that reads back to the same value ("0.25", "2.0", "1e-05").
 std::string cpp_literal(double v);
 
