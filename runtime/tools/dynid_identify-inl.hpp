@@ -39,6 +39,8 @@ identify::StudyResult study(const Common& common, const IdentifyOptions& o, bool
   so.least_squares.weighted = o.weighted;
   so.preprocess.torque_delay = o.torque_delay_ms / 1000;
   so.clie.max_iterations = o.clie_iterations;
+  so.clie.std_bound = o.clie_std_bound;
+  so.projection_metric = identify::projection_metric_from_string(o.projection_metric);
   so.validation_interval = o.validation_ms / 1000;
   auto progress = std::make_shared<std::unique_ptr<Progress>>();
   so.on_start = [progress, quiet](int total, int skipped) {

@@ -27,6 +27,15 @@ void add_identify_commands(CLI::App& app, Common& common) {
   cmd->add_option("--torque-delay", o->torque_delay_ms, "ms the logged torque lags the links' (an actuation delay "
                                                         "dynid diagnose named): the torque is read that much later");
   cmd->add_option("--clie-iterations", o->clie_iterations, "CLIE iteration limit");
+  cmd->add_option("--projection-metric", o->projection_metric,
+                  "Metric of the SDP projection and the rescue: euclidean (the paper's) or information (the run's "
+                  "W'W: the smallest change of the predicted torque)")
+      ->check(CLI::IsMember({"euclidean", "information"}))
+      ->capture_default_str();
+  cmd->add_option("--clie-std-bound", o->clie_std_bound,
+                  "CLIE bounds of +-K standard deviations of the run's OLS estimate around its start (0: off)")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
   cmd->add_option("--validation-interval", o->validation_ms, "Validation interval in ms (default: the selected run's)");
   cmd->add_flag("--no-report", o->no_report, "Do not write the report");
   cmd->add_flag("--fresh", o->fresh, "Redo every run, even finished ones (to time the whole study)");

@@ -18,6 +18,8 @@ struct IdentifyOptions {
   int clie_iterations = 25;
   double validation_ms = 0;
   double torque_delay_ms = 0;
+  std::string projection_metric = "information";
+  double clie_std_bound = 10;
 };
 
 struct IdentifyCommand {

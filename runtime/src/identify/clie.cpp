@@ -70,17 +70,23 @@ Bounds parameter_bounds(const Eigen::VectorXd& phi0, const std::vector<bool>& ro
   if (!(options.bound_factor >= 0) || !(options.min_bound > 0) || !(options.min_rotor_inertia >= 0))
     throw std::invalid_argument("CLIE: bound_factor >= 0, min_bound > 0 and min_rotor_inertia >= 0 needed");
   if (!phi0.allFinite()) throw std::invalid_argument("CLIE: the starting phi is not finite");
+  if (!(options.std_bound >= 0)) throw std::invalid_argument("CLIE: std_bound must be >= 0");
+  const bool by_std = options.std_bound > 0;
+  if (by_std && (options.scale.size() != phi0.size() || !(options.scale.array() > 0).all() || !options.scale.allFinite()))
+    throw std::invalid_argument(fmt::format("CLIE: std_bound needs {} positive standard deviations, got {}", phi0.size(),
+                                            options.scale.size()));
   Bounds b;
   b.lower.resize(phi0.size());
   b.upper.resize(phi0.size());
   for (Eigen::Index i = 0; i < phi0.size(); ++i) {
-    const double half = std::max(options.bound_factor * std::abs(phi0(i)), options.min_bound);
+    double half = std::max(options.bound_factor * std::abs(phi0(i)), options.min_bound);
+    if (by_std) half = std::min(half, options.std_bound * options.scale(i));
     b.lower(i) = phi0(i) - half;
     b.upper(i) = phi0(i) + half;
     if (rotor_inertia[static_cast<std::size_t>(i)]) {
       // Rotor inertias are searched on the positive side only (paper Sec. IV-C).
       b.lower(i) = std::max(b.lower(i), options.min_rotor_inertia);
-      b.upper(i) = std::max(b.upper(i), b.lower(i) + options.min_bound);
+      b.upper(i) = std::max(b.upper(i), b.lower(i) + (by_std ? half : options.min_bound));
     }
   }
   return b;

@@ -22,6 +22,7 @@ Eigen::VectorXd singular_values(const Eigen::MatrixXd& W) {
 
 struct Solve {
   Eigen::VectorXd phi, std_dev;
+  Eigen::MatrixXd information;
 };
 
 // Least squares through Householder QR, and the covariance from R: (W'W)^-1 = R^-1 R^-T.
@@ -38,6 +39,7 @@ Solve solve(const Eigen::MatrixXd& W, const Eigen::VectorXd& y) {
   const double sigma2 = (y - W * s.phi).squaredNorm() / static_cast<double>(m - p);
   const Eigen::MatrixXd Rinv = R.triangularView<Eigen::Upper>().solve(Eigen::MatrixXd::Identity(p, p));
   s.std_dev = (sigma2 * Rinv.rowwise().squaredNorm()).cwiseSqrt();
+  s.information = (R.transpose() * R) / sigma2;
   return s;
 }
 
@@ -92,6 +94,7 @@ LeastSquaresResult least_squares(const Regression& r, const LeastSquaresOptions&
   }
   out.phi = s.phi;
   out.std_dev = s.std_dev;
+  out.information = std::move(s.information);
   out.joint_rms = joint_rms(s.phi);
   out.residual_rms = std::sqrt(out.joint_rms.squaredNorm() / r.joints);
   return out;

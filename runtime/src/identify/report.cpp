@@ -10,6 +10,7 @@
 #include <fmt/ranges.h>
 
 #include "report_tables.hpp"
+#include "symoro/identify/reproduction.hpp"
 #include "symoro/identify/svg_plot.hpp"
 #include "symoro/io/atomic_file.hpp"
 #include "symoro/io/number_text.hpp"
@@ -255,6 +256,19 @@ std::string summary(const StudyResult& study) {
   return out;
 }
 
+// The paper's findings next to this study's, each computed (reproduction.hpp).
+std::string reproduction_section(const StudyResult& study) {
+  std::string out = "## Reproduction of the paper's findings\n\n";
+  MarkdownTable table({"Finding", "Paper (CRANE-X7, real arm)", "This study", "Verdict", "Note"});
+  for (const Finding& f : paper_findings(study)) table.row({f.name, f.paper, f.study, f.verdict, f.note});
+  out += table.str();
+  out += "\ntr Σ_z: the trace of the sample covariance of the standardized parameters (the cloud figure's "
+         "standardization; smaller is tighter). The paper's values are from its tables; this study's are computed from "
+         "its run records; the clouds are drawn under Parameter clouds. docs/identification.md explains the findings "
+         "that differ.\n\n";
+  return out;
+}
+
 std::string clouds_section(const StudyResult& study, bool figure) {
   std::string out = "## Parameter clouds\n\n";
   if (figure)
@@ -378,6 +392,7 @@ std::vector<std::filesystem::path> write_report(const StudyResult& study, const 
                                study.model.empty() ? "model" : study.model);
   if (!study.data_source.empty()) md += "Data source: " + study.data_source + "\n\n";
   md += summary(study);
+  md += reproduction_section(study);
   md += routing_table(study);
   if (routing) md += "![Routing per sampling interval](figures/routing.svg)\n\n";
   md += route_examples_table(study, options);

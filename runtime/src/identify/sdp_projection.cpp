@@ -6,6 +6,7 @@
 #include <limits>
 #include <stdexcept>
 
+#include <Eigen/Cholesky>
 #include <Eigen/Eigenvalues>
 #include <fmt/format.h>
 
@@ -19,10 +20,67 @@ using Clock = std::chrono::steady_clock;
 
 double seconds_since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
 
-// M's constant term and parameter coefficients at one pose.
+// The distance's metric as a change of variables phi = phi0 + T u with |u| the distance:
+// T = diag(1 / w) for weights, T = R^-1 for a metric A = R'R.
+struct Metric {
+  bool diagonal = true;
+  Eigen::VectorXd w;  // diagonal
+  Eigen::MatrixXd R;  // full: upper triangular, A = R'R
+  Eigen::MatrixXd T;  // full: R^-1
+
+  double distance(const Eigen::VectorXd& d) const {
+    return diagonal ? (w.array() * d.array()).matrix().norm() : (R.triangularView<Eigen::Upper>() * d).norm();
+  }
+  // The coefficient of u_j in M at a pose: sum_i T_ij L_i.
+  Eigen::MatrixXd coefficient(const std::vector<Eigen::MatrixXd>& linear, int j) const {
+    if (diagonal) return linear[static_cast<std::size_t>(j)] / w(j);
+    Eigen::MatrixXd C = Eigen::MatrixXd::Zero(linear[0].rows(), linear[0].cols());
+    for (int i = 0; i <= j; ++i)  // T is upper triangular
+      if (T(i, j) != 0 && !linear[static_cast<std::size_t>(i)].isZero(0)) C += T(i, j) * linear[static_cast<std::size_t>(i)];
+    return C;
+  }
+  // phi0 + s T_{:,j} y_j over the free columns.
+  Eigen::VectorXd step(const Eigen::VectorXd& phi0, const std::vector<int>& free, const Eigen::VectorXd& y, double s) const {
+    Eigen::VectorXd phi = phi0;
+    for (std::size_t j = 0; j < free.size(); ++j) {
+      const int c = free[j];
+      if (diagonal)
+        phi(c) += s * y(static_cast<Eigen::Index>(j)) / w(c);
+      else
+        phi.head(c + 1) += (s * y(static_cast<Eigen::Index>(j))) * T.col(c).head(c + 1);
+    }
+    return phi;
+  }
+};
+
+Metric make_metric(const Eigen::VectorXd& weights, const Eigen::MatrixXd& metric, int n, const char* who) {
+  Metric m;
+  if (metric.size() == 0) {
+    m.w = weights.size() == 0 ? Eigen::VectorXd::Ones(n) : weights;
+    if (m.w.size() != n) throw std::invalid_argument(fmt::format("{}: {} weights for {} parameters", who, weights.size(), n));
+    for (int i = 0; i < n; ++i)
+      if (!(m.w(i) > 0) || !std::isfinite(m.w(i)))
+        throw std::invalid_argument(fmt::format("{}: weight {} must be positive and finite", who, i));
+    return m;
+  }
+  if (weights.size() != 0) throw std::invalid_argument(fmt::format("{}: give weights or a metric, not both", who));
+  if (metric.rows() != n || metric.cols() != n || !metric.allFinite())
+    throw std::invalid_argument(fmt::format("{}: the metric must be a finite {} x {} matrix, got {} x {}", who, n, n,
+                                            metric.rows(), metric.cols()));
+  const Eigen::MatrixXd sym = 0.5 * (metric + metric.transpose());
+  const Eigen::LLT<Eigen::MatrixXd> llt(sym);
+  if (llt.info() != Eigen::Success) throw std::invalid_argument(fmt::format("{}: the metric is not positive definite", who));
+  m.diagonal = false;
+  m.R = llt.matrixU();
+  m.T = m.R.triangularView<Eigen::Upper>().solve(Eigen::MatrixXd::Identity(n, n));
+  return m;
+}
+
+// M's constant term and parameter coefficients at one pose, and the coefficients of the
+// metric's variables u (see Metric).
 struct PoseBasis {
   Eigen::MatrixXd constant;
-  std::vector<Eigen::MatrixXd> linear;
+  std::vector<Eigen::MatrixXd> linear, coef;
 
   Eigen::MatrixXd inertia(const Eigen::VectorXd& phi) const {
     Eigen::MatrixXd M = constant;
@@ -46,12 +104,12 @@ struct ScaledSolve {
   detail::LmiSolution lmi;
 };
 
-// One CSDP solve of  min |W(phi - phi0)|^2  s.t.  M(q_k; phi) >= target I  for the free
-// parameters, in scaled units: W(phi - phi0) = s z (z is O(1) when s is the distance) and each
-// pose block divided by its size c_k, so that CSDP's relative tolerances mean the same thing
-// whatever the magnitudes of the parameters and of M.
-ScaledSolve solve_scaled(const std::vector<PoseBasis>& bases, const Eigen::VectorXd& phi0,
-                         const Eigen::VectorXd& w, const std::vector<int>& free, double target, double s) {
+// One CSDP solve of  min |u|^2  s.t.  M(q_k; phi0 + T u) >= target I  over the free columns of
+// T, in scaled units: u = s z (z is O(1) when s is the distance) and each pose block divided by
+// its size c_k, so that CSDP's relative tolerances mean the same thing whatever the magnitudes
+// of the parameters and of M.
+ScaledSolve solve_scaled(const std::vector<PoseBasis>& bases, const Eigen::VectorXd& phi0, const Metric& metric,
+                         const std::vector<int>& free, double target, double s) {
   const int nf = static_cast<int>(free.size());
   detail::LmiProblem lmi(nf + 1);  // z, then t >= |z|^2
 
@@ -69,13 +127,13 @@ ScaledSolve solve_scaled(const std::vector<PoseBasis>& bases, const Eigen::Vecto
     const int nq = static_cast<int>(b.constant.rows());
     const Eigen::MatrixXd A = b.inertia(phi0) - target * Eigen::MatrixXd::Identity(nq, nq);
     double c = A.norm();
-    for (int j = 0; j < nf; ++j) c = std::max(c, s / w(free[j]) * b.linear[free[j]].norm());
+    for (int j = 0; j < nf; ++j) c = std::max(c, s * b.coef[free[j]].norm());
     if (!(c > 0)) c = 1;
     const int k = lmi.add_block(A / c);
     for (int j = 0; j < nf; ++j) {
-      const Eigen::MatrixXd& L = b.linear[free[j]];
+      const Eigen::MatrixXd& L = b.coef[free[j]];
       if (L.isZero(0)) continue;
-      lmi.set_coefficient(k, j, (s / (w(free[j]) * c)) * L);
+      lmi.set_coefficient(k, j, (s / c) * L);
     }
   }
 
@@ -97,15 +155,14 @@ ScaledSolve solve_scaled(const std::vector<PoseBasis>& bases, const Eigen::Vecto
     }
     if (out.lmi.code <= 3) break;
   }
-  out.phi = phi0;
-  for (int j = 0; j < nf; ++j) out.phi(free[j]) += s * out.lmi.y(j) / w(free[j]);
+  out.phi = metric.step(phi0, free, out.lmi.y.head(nf), s);
   return out;
 }
 
 // The linearized distance to the margin at the worst violated pose: the step along the gradient
 // of lambda_min that would close the violation. A lower-bound-like estimate of the answer's size.
-double distance_estimate(const std::vector<PoseBasis>& bases, const Eigen::VectorXd& phi0,
-                         const Eigen::VectorXd& w, const std::vector<int>& free, double target) {
+double distance_estimate(const std::vector<PoseBasis>& bases, const Eigen::VectorXd& phi0, const std::vector<int>& free,
+                         double target) {
   double est = 0;
   for (const PoseBasis& b : bases) {
     Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> es(b.inertia(phi0));
@@ -113,7 +170,7 @@ double distance_estimate(const std::vector<PoseBasis>& bases, const Eigen::Vecto
     if (violation <= 0) continue;
     const Eigen::VectorXd v = es.eigenvectors().col(0);
     double g2 = 0;
-    for (int i : free) g2 += std::pow(v.dot(b.linear[i] * v) / w(i), 2);
+    for (int j : free) g2 += std::pow(v.dot(b.coef[j] * v), 2);
     if (g2 > 0) est = std::max(est, violation / std::sqrt(g2));
   }
   return est;
@@ -125,25 +182,10 @@ void check_phi(const InertiaFunction& m, const Eigen::VectorXd& phi0, const char
   if (!phi0.allFinite()) throw std::invalid_argument(fmt::format("{}: phi0 is not finite", who));
 }
 
-Eigen::VectorXd distance_weights(const Eigen::VectorXd& weights, int n, const char* who) {
-  if (weights.size() == 0) return Eigen::VectorXd::Ones(n);
-  if (weights.size() != n)
-    throw std::invalid_argument(fmt::format("{}: {} weights for {} parameters", who, weights.size(), n));
-  for (int i = 0; i < n; ++i)
-    if (!(weights(i) > 0) || !std::isfinite(weights(i)))
-      throw std::invalid_argument(fmt::format("{}: weight {} must be positive and finite", who, i));
-  return weights;
-}
-
-}  // namespace
-
 ProjectionResult project_on_poses(const InertiaFunction& m, const Eigen::VectorXd& phi0,
-                                  const std::vector<Eigen::VectorXd>& poses, double eps,
-                                  const Eigen::VectorXd& weights) {
+                                  const std::vector<Eigen::VectorXd>& poses, double eps, const Metric& metric) {
   const auto t0 = Clock::now();
-  check_phi(m, phi0, "project_on_poses");
   const int n = m.parameters();
-  const Eigen::VectorXd w = distance_weights(weights, n, "project_on_poses");
   if (!std::isfinite(eps)) throw std::invalid_argument("project_on_poses: eps is not finite");
 
   std::vector<PoseBasis> bases(poses.size());
@@ -151,11 +193,14 @@ ProjectionResult project_on_poses(const InertiaFunction& m, const Eigen::VectorX
     if (poses[k].size() != m.joints() || !poses[k].allFinite())
       throw std::invalid_argument(fmt::format("project_on_poses: pose {} is not a finite {}-vector", k, m.joints()));
     m.basis(poses[k], bases[k].constant, bases[k].linear);
+    bases[k].coef.resize(static_cast<std::size_t>(n));
+    for (int j = 0; j < n; ++j) bases[k].coef[static_cast<std::size_t>(j)] = metric.coefficient(bases[k].linear, j);
   }
-  // Parameters in no L_i(q_k) (e.g. viscous friction) do not enter the SDP: they stay at phi0.
+  // Variables in no coefficient (diagonal metric: parameters such as viscous friction that no
+  // L_i(q_k) holds) do not enter the SDP: they stay at 0.
   std::vector<int> free;
   for (int i = 0; i < n; ++i)
-    if (std::any_of(bases.begin(), bases.end(), [&](const PoseBasis& b) { return !b.linear[i].isZero(0); }))
+    if (std::any_of(bases.begin(), bases.end(), [&](const PoseBasis& b) { return !b.coef[i].isZero(0); }))
       free.push_back(i);
 
   ProjectionResult r;
@@ -172,7 +217,7 @@ ProjectionResult project_on_poses(const InertiaFunction& m, const Eigen::VectorX
         r.worst_pose = poses[k];
       }
     }
-    r.distance = (w.array() * (phi - phi0).array()).matrix().norm();
+    r.distance = metric.distance(phi - phi0);
   };
 
   evaluate(phi0);
@@ -191,12 +236,12 @@ ProjectionResult project_on_poses(const InertiaFunction& m, const Eigen::VectorX
   // Scale from the linearized estimate, refined once the first solution shows the real
   // distance; solving again with a slightly raised target when CSDP's residual leaves a pose
   // just under eps (its feasibility tolerance is relative to the problem's norms).
-  double s = distance_estimate(bases, phi0, w, free, eps);
-  if (!(s > 0)) s = std::max(1e-12, 1e-3 * (w.array() * phi0.array()).matrix().norm());
+  double s = distance_estimate(bases, phi0, free, eps);
+  if (!(s > 0)) s = std::max(1e-12, 1e-3 * metric.distance(phi0));
   double target = eps;
   ScaledSolve sol;
   for (int attempt = 0; attempt < 6; ++attempt) {
-    sol = solve_scaled(bases, phi0, w, free, target, s);
+    sol = solve_scaled(bases, phi0, metric, free, target, s);
     ++r.rounds;
     if (!sol.lmi.solved()) {
       evaluate(sol.phi);
@@ -223,6 +268,26 @@ ProjectionResult project_on_poses(const InertiaFunction& m, const Eigen::VectorX
                         : fmt::format("the solution misses the margin by {:.3g} at a working-set pose", eps - r.lambda_min);
   r.wall = seconds_since(t0);
   return r;
+}
+
+}  // namespace
+
+ProjectionResult project_on_poses(const InertiaFunction& m, const Eigen::VectorXd& phi0,
+                                  const std::vector<Eigen::VectorXd>& poses, double eps,
+                                  const Eigen::VectorXd& weights, const Eigen::MatrixXd& metric) {
+  check_phi(m, phi0, "project_on_poses");
+  return project_on_poses(m, phi0, poses, eps, make_metric(weights, metric, m.parameters(), "project_on_poses"));
+}
+
+Eigen::MatrixXd information_metric(const Eigen::MatrixXd& information, double ridge) {
+  if (information.rows() != information.cols() || information.rows() == 0 || !information.allFinite())
+    throw std::invalid_argument("information_metric: the information matrix must be square, non-empty and finite");
+  if (!(ridge >= 0)) throw std::invalid_argument("information_metric: the ridge must be >= 0");
+  Eigen::MatrixXd A = 0.5 * (information + information.transpose());
+  const double mean_diagonal = A.diagonal().mean();
+  if (!(mean_diagonal > 0)) throw std::invalid_argument("information_metric: the information matrix has no positive diagonal");
+  A.diagonal().array() += ridge * mean_diagonal;
+  return A;
 }
 
 namespace {
@@ -262,10 +327,6 @@ class WorkingSet {
   mutable std::vector<Eigen::MatrixXd> linear_;
 };
 
-double weighted_distance(const Eigen::VectorXd& phi, const Eigen::VectorXd& phi0, const Eigen::VectorXd& w) {
-  return (w.array() * (phi - phi0).array()).matrix().norm();
-}
-
 }  // namespace
 
 ProjectionResult project_pd(const InertiaFunction& m, const Eigen::VectorXd& phi0, const AuditDomain& domain,
@@ -282,7 +343,7 @@ ProjectionResult project_pd(const InertiaFunction& m, const Eigen::VectorXd& phi
                             const ProjectionOptions& options, const AuditResult& phi0_audit) {
   const auto t0 = Clock::now();
   check_phi(m, phi0, "project_pd");
-  const Eigen::VectorXd w = distance_weights(options.weights, m.parameters(), "project_pd");
+  const Metric metric = make_metric(options.weights, options.metric, m.parameters(), "project_pd");
   if (!(options.eps >= 0) || !std::isfinite(options.eps)) throw std::invalid_argument("project_pd: eps must be >= 0");
   if (domain.joints() != m.joints() || domain.upper.size() != m.joints())
     throw std::invalid_argument("project_pd: the domain does not match the model's joints");
@@ -306,7 +367,7 @@ ProjectionResult project_pd(const InertiaFunction& m, const Eigen::VectorXd& phi
   auto finish = [&](bool feasible, std::string status) {
     r.feasible = feasible;
     r.status = std::move(status);
-    r.distance = weighted_distance(r.phi, phi0, w);
+    r.distance = metric.distance(r.phi - phi0);
     r.wall = seconds_since(t0);
     return r;
   };
@@ -327,7 +388,7 @@ ProjectionResult project_pd(const InertiaFunction& m, const Eigen::VectorXd& phi
   std::vector<Eigen::VectorXd> seen;
   for (const AuditPose& p : phi0_audit.minima) seen.push_back(p.q);
   for (int round = 1; round <= options.max_rounds; ++round) {
-    const ProjectionResult sol = project_on_poses(m, phi0, set.poses(), target + raise, w);
+    const ProjectionResult sol = project_on_poses(m, phi0, set.poses(), target + raise, metric);
     r.rounds = round;
     r.poses = set.size();
     r.phi = sol.phi;

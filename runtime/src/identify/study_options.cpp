@@ -3,7 +3,17 @@
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 
+#include <stdexcept>
+
 namespace symoro::identify {
+
+const char* to_string(ProjectionMetric m) { return m == ProjectionMetric::information ? "information" : "euclidean"; }
+
+ProjectionMetric projection_metric_from_string(const std::string& s) {
+  if (s == "euclidean") return ProjectionMetric::euclidean;
+  if (s == "information") return ProjectionMetric::information;
+  throw std::invalid_argument("projection metric '" + s + "': expected euclidean or information");
+}
 
 std::string StudyOptions::describe() const {
   const auto& p = preprocess;
@@ -11,13 +21,14 @@ std::string StudyOptions::describe() const {
   const auto& c = clie;
   return fmt::format(
       "pre {} {} {} {} {} {} {} {} | ls {} {} | audit {} {} {} {} {} | proj {} {} {} {} {} {} | margins {} | "
-      "clie {} {} {} {} {} {} {} {}",
+      "clie {} {} {} {} {} {} {} {} {} | metric {} {}",
       p.base_period, p.max_gap, p.filter_order, p.derivative_cutoff, p.anti_alias_fraction, p.drop_stale,
       p.use_logged_velocity, p.torque_delay, least_squares.weighted,
       least_squares.wls_iterations, a.samples, a.starts, a.seed, a.max_iterations, a.tolerance, projection.accept_slack,
       projection.rescue_floor, projection.max_rounds, projection.poses_per_round, projection.weights.size(), projection.shortfall_raise,
       fmt::join(margins, ","), c.max_iterations, c.function_tolerance, c.parameter_tolerance, c.gradient_tolerance,
-      c.bound_factor, c.min_bound, c.min_rotor_inertia, c.filter);
+      c.bound_factor, c.min_bound, c.min_rotor_inertia, c.filter, c.std_bound, to_string(projection_metric),
+      information_ridge);
 }
 
 }  // namespace symoro::identify

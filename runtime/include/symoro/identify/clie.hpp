@@ -4,7 +4,9 @@
 // simulation (closed_loop.hpp) passed through the same zero-phase low-pass the measurement
 // went through in preprocessing, so both sides see the same filter; the Jacobian is the
 // simulation's forward sensitivities through that (linear) filter: exact, no finite
-// differences. Bounds: about +-bound_factor times each initial value, rotor inertias positive.
+// differences. Bounds: about +-bound_factor times each initial value, rotor inertias positive;
+// optionally also +-std_bound standard deviations of the run's OLS estimate (`scale`), so that
+// CLIE cannot wander far along directions its data barely sees (docs/identification.md).
 // A trial point whose simulation diverges is rejected (Ceres shrinks its step); a starting
 // point that diverges ends the refinement with a clear report.
 #pragma once
@@ -27,6 +29,10 @@ struct ClieOptions {
   double bound_factor = 100;          // bounds phi0_i -+ bound_factor |phi0_i|
   double min_bound = 1e-4;            // bound half-width floor for phi0_i near 0 (in the parameter's unit)
   double min_rotor_inertia = 1e-6;    // kg m^2: lower bound of IA parameters
+  // When std_bound > 0 and scale holds one value per parameter (the run's OLS standard
+  // deviations): bounds phi0_i -+ std_bound scale_i as well, the tighter of the two applying.
+  double std_bound = 0;
+  Eigen::VectorXd scale;
   bool filter = true;                 // the measurement's low-pass on tau_s (off: raw samples)
   preprocess::Options preprocess;     // must be the options that produced the measured samples
 };

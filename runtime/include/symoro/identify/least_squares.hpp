@@ -19,6 +19,8 @@ struct LeastSquaresResult {
   Eigen::VectorXd phi;
   // sqrt(diag(sigma^2 (W'W)^-1)) with sigma^2 = |r|^2 / (rows - np) (weighted rows for WLS).
   Eigen::VectorXd std_dev;
+  // W'W / sigma^2 (weighted rows for WLS): the inverse of the estimate's covariance.
+  Eigen::MatrixXd information;
   double kappa = 0;          // sigma_max / sigma_min of W (unweighted, as the paper reports it)
   double kappa_scaled = 0;   // the same with unit-norm columns
   double residual_rms = 0;   // N m, of y - W phi over all rows

@@ -1,5 +1,8 @@
 // The PD-feasible projection (paper eqs. sdp_projection and sdp_rescue):
 //   min |phi - phi0|^2  s.t.  M(q_k; phi) >= eps I  for the poses q_k of a working set,
+// in the Euclidean norm (the paper's; optionally diagonally weighted) or in a metric
+// (phi - phi0)' A (phi - phi0), e.g. the run's information matrix, so that the projection
+// changes the predicted torque as little as possible (information_metric below),
 // solved as a semidefinite program with CSDP (the distance through a Schur-complement block),
 // inside an exchange loop: the all-pose audit looks for poses where the solution still has
 // lambda_min below the margin, the worst of them join the working set, and the SDP is solved
@@ -34,7 +37,16 @@ struct ProjectionOptions {
   AuditOptions audit;          // the audit run after each solve
   // Diagonal weights of the distance (empty: the paper's plain Euclidean norm).
   Eigen::VectorXd weights;
+  // A symmetric positive definite np x np metric A: the distance is sqrt(d' A d), d = phi - phi0
+  // (empty: weights). With a full A every parameter may move, friction included: the ones M does
+  // not contain then absorb what the projection does to the torque.
+  Eigen::MatrixXd metric;
 };
+
+// The information metric of a regression: W'W / sigma^2 (W the stacked, weighted rows), with a
+// ridge of `ridge` times its mean diagonal so that it is positive definite even where W barely
+// excites a direction. The distance in it is the change of the predicted torque in noise units.
+Eigen::MatrixXd information_metric(const Eigen::MatrixXd& information, double ridge = 1e-9);
 
 struct ProjectionResult {
   Eigen::VectorXd phi;
@@ -60,13 +72,14 @@ ProjectionResult project_pd(const InertiaFunction& m, const Eigen::VectorXd& phi
                             const ProjectionOptions& options, const AuditResult& phi0_audit);
 
 // The SDP on a fixed set of poses: min |W(phi - phi0)|^2 s.t. M(q_k; phi) >= eps I for every
-// pose q_k (W = diag(weights); empty: identity). feasible: CSDP solved it and every pose reaches
+// pose q_k (W = diag(weights); empty: identity; or W'W = metric when a metric is given).
+// feasible: CSDP solved it and every pose reaches
 // eps within 1e-10; lambda_min and worst_pose are over these poses only; rounds counts the CSDP
 // solves (the scaling and accuracy refinements); rounds = 0 when phi0 already satisfies them.
-// Parameters that enter M at none of the poses keep their phi0 values exactly.
+// Without a metric, parameters that enter M at none of the poses keep their phi0 values exactly.
 ProjectionResult project_on_poses(const InertiaFunction& m, const Eigen::VectorXd& phi0,
                                   const std::vector<Eigen::VectorXd>& poses, double eps,
-                                  const Eigen::VectorXd& weights = {});
+                                  const Eigen::VectorXd& weights = {}, const Eigen::MatrixXd& metric = {});
 
 // The paper's conditional step (Algorithm 1, lines 4-15): audit phi0; when it is not PD,
 // project with the margins in ascending order and adopt the first one whose projection passes

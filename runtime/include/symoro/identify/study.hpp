@@ -88,7 +88,9 @@ RunRecord identify_run(const io::Log& log, const ClosedLoopSimulator<Model>* sim
   r.t_ols = seconds_since(t);
 
   t = std::chrono::steady_clock::now();
-  const ConditionalProjection cp = conditional_projection(inertia, ls.phi, domain, o.margins, o.projection);
+  ProjectionOptions po = o.projection;
+  if (o.projection_metric == ProjectionMetric::information) po.metric = information_metric(ls.information, o.information_ridge);
+  const ConditionalProjection cp = conditional_projection(inertia, ls.phi, domain, o.margins, po);
   const double conditional_wall = seconds_since(t);
   r.ols_lambda_min = cp.audit.lambda_min;
   r.ols_worst_pose = cp.audit.worst_pose;
@@ -121,6 +123,7 @@ RunRecord identify_run(const io::Log& log, const ClosedLoopSimulator<Model>* sim
   t = std::chrono::steady_clock::now();
   ClieOptions co = o.clie;
   co.preprocess = o.preprocess;
+  if (co.std_bound > 0) co.scale = ls.std_dev;
   const ClieResult c = clie<Model>(*sim, s, cp.phi, co);
   r.t_clie = seconds_since(t);
   r.clie_success = c.success;
@@ -264,7 +267,7 @@ class Study {
     }
     describe_stages(out, failures);
 
-    select_and_accept(out);
+    select_and_accept(data, out);
     if (out.selection.run >= 0) validate(data, valid, out);
     out.wall = detail::seconds_since(t0);
     return out;
@@ -335,8 +338,12 @@ class Study {
     }
     out.stages.push_back(fmt::format("OLS{}, all-pose PD audit, conditional SDP projection: {} runs", o_.least_squares.weighted ? " (WLS)" : "",
                                      out.runs.size() - failures));
+    out.stages.push_back(fmt::format("SDP projection and rescue in the {} metric{}", to_string(o_.projection_metric),
+                                     o_.projection_metric == ProjectionMetric::information ? " (the run's W'W / sigma^2)" : ""));
+    const std::string bounds =
+        o_.clie.std_bound > 0 ? fmt::format(" (bounds: +-{:g} OLS standard deviations around the start)", o_.clie.std_bound) : "";
     if (skipped == 0)
-      out.stages.push_back(fmt::format("CLIE: {} runs", clie));
+      out.stages.push_back(fmt::format("CLIE: {} runs{}", clie, bounds));
     else
       out.stages.push_back(fmt::format("CLIE: {} runs; skipped in {} ({}){}", clie, skipped, why,
                                        clie == 0 ? "; each run's final vector is its SDP (or PD OLS) estimate" : ""));
@@ -381,7 +388,13 @@ class Study {
                        run.window_end, interval, o_.describe(), in.loop);
   }
 
-  void select_and_accept(StudyResult& out) const {
+  // The information matrix of a run (the rescue's metric): its regression stacked again.
+  Eigen::MatrixXd information(const Dataset& data, const RunRecord& r) const {
+    const preprocess::Samples s = preprocess::preprocess(load_log(data.find(r.trajectory, o_.trial)), r.interval, o_.preprocess);
+    return least_squares(stack_regression<Model>(s), o_.least_squares).information;
+  }
+
+  void select_and_accept(const Dataset& data, StudyResult& out) const {
     int usable = 0;
     for (const RunRecord& r : out.runs) usable += !r.failed && r.phi_clie.size() > 0;
     if (usable == 0) return;
@@ -400,6 +413,8 @@ class Study {
     if (!sel.clie_pd) {
       ProjectionOptions po = o_.projection;
       po.eps = 0;  // the paper's rescue: a minimal feasibility correction
+      if (o_.projection_metric == ProjectionMetric::information)
+        po.metric = information_metric(information(data, sel), o_.information_ridge);
       const ProjectionResult p = project_pd(*inertia_, sel.phi_clie, domain_, po);
       out.phi_rescue = p.phi;
       out.rescued = true;

@@ -15,6 +15,15 @@
 
 namespace symoro::identify {
 
+// The metric of the SDP projections (pre-CLIE and the rescue): the paper's Euclidean distance
+// in parameter space, or the run's information matrix W'W / sigma^2 (ridge-regularized), in
+// which the projection changes the predicted torque as little as possible and moves mostly
+// along the directions the data barely excites (docs/identification.md compares the two).
+enum class ProjectionMetric { euclidean, information };
+const char* to_string(ProjectionMetric m);
+// "euclidean" or "information"; throws std::invalid_argument naming the choices otherwise.
+ProjectionMetric projection_metric_from_string(const std::string& s);
+
 struct StudyOptions {
   std::filesystem::path data;   // dataset folder (dataset.yaml and its logs)
   std::filesystem::path out;    // study folder: runs/ (one file per run) and the report
@@ -36,12 +45,18 @@ struct StudyOptions {
     return p;
   }();
   std::vector<double> margins = paper_margins();
+  // The information metric: measured on the twin's 160-run study (docs/identification.md).
+  ProjectionMetric projection_metric = ProjectionMetric::information;
+  double information_ridge = 1e-9;  // times the information matrix's mean diagonal
   // Its preprocess options are the study's. Stopping rule of MATLAB's lsqnonlin (the paper's):
-  // relative cost change 1e-6; at most 25 steps.
+  // relative cost change 1e-6; at most 25 steps. Bounds of +-10 OLS standard deviations around
+  // the start (docs/identification.md: without them CLIE walked up to 700 sigma along directions
+  // its run barely excites).
   ClieOptions clie = [] {
     ClieOptions c;
     c.function_tolerance = 1e-6;
     c.max_iterations = 25;
+    c.std_bound = 10;
     return c;
   }();
   int pca_components = 5;

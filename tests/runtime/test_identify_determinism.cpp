@@ -1,0 +1,104 @@
+// The solvers behind the study give the same bits whatever the heap looks like and whichever
+// thread calls them: the all-pose audit (Ipopt, MUMPS) and the SDP projection (CSDP, BLAS) on
+// CRANE-X7 and the RX-90, called again after allocations that shift every later malloc's
+// address, and from another thread. (BLAS kernels take different paths for differently aligned
+// data, so a result may otherwise depend on which thread ran what before.)
+#include <atomic>
+#include <cstdlib>
+#include <memory>
+#include <random>
+#include <thread>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include <symoro/crane_x7.hpp>
+#include <symoro/rx90.hpp>
+
+#include "symoro/identify/inertia_function_model.hpp"
+#include "symoro/identify/sdp_projection.hpp"
+#include "symoro/twin/config.hpp"
+#include "symoro/twin/truth.hpp"
+#include "test_support.hpp"
+
+namespace {
+
+using namespace symoro::identify;
+
+struct Outcome {
+  AuditResult audit;
+  ProjectionResult projection;
+};
+
+// Blocks of 8 to 120 bytes kept alive, so that later allocations land elsewhere.
+std::vector<std::unique_ptr<char[]>> shift_heap(unsigned seed) {
+  std::mt19937 rng(seed);
+  std::vector<std::unique_ptr<char[]>> keep;
+  for (int i = 0; i < 37; ++i) keep.emplace_back(new char[8 * (1 + rng() % 15)]);
+  return keep;
+}
+
+template <class Model>
+void same_bits_whatever_the_heap(const Eigen::VectorXd& truth, const Eigen::VectorXd& direction) {
+  const auto m = make_inertia_function<Model>();
+  const AuditDomain domain = audit_domain<Model>();
+  Eigen::VectorXd phi0 = truth;
+  for (double t = 0.05; audit_pd(*m, phi0, domain).positive_definite(); t *= 1.5) phi0 = truth + t * direction;
+  ProjectionOptions po;
+  po.shortfall_raise = 0.5;
+  auto solve = [&] {
+    Outcome o;
+    o.audit = audit_pd(*m, phi0, domain);
+    o.projection = project_pd(*m, phi0, domain, po);
+    return o;
+  };
+  const Outcome first = solve();
+  ASSERT_TRUE(first.projection.feasible) << first.projection.status;
+  std::vector<Outcome> again;
+  for (unsigned seed : {1u, 2u, 3u}) {
+    const auto keep = shift_heap(seed);
+    again.push_back(solve());
+  }
+  std::thread([&] {
+    const auto keep = shift_heap(4);
+    again.push_back(solve());
+  }).join();
+  // While another thread audits and projects another vector: the two interleave their
+  // (serialized) Ipopt and CSDP calls in an order the scheduler picks.
+  std::atomic<bool> stop{false};
+  std::thread other([&] {
+    const Eigen::VectorXd phi1 = phi0 + 0.3 * (phi0 - truth);
+    while (!stop) {
+      audit_pd(*m, phi1, domain);
+      project_pd(*m, phi1, domain, po);
+    }
+  });
+  for (int k = 0; k < 3; ++k) again.push_back(solve());
+  stop = true;
+  other.join();
+  for (const Outcome& o : again) {
+    EXPECT_EQ(o.audit.lambda_min, first.audit.lambda_min);
+    EXPECT_EQ(o.audit.worst_pose, first.audit.worst_pose);
+    EXPECT_EQ(o.projection.phi, first.projection.phi) << (o.projection.phi - first.projection.phi).norm();
+    EXPECT_EQ(o.projection.lambda_min, first.projection.lambda_min);
+  }
+}
+
+TEST(Determinism, CraneX7ReducedAuditAndProjection) {
+  using Model = symoro::crane_x7::reduced::Model;
+  const auto tc = symoro::twin::read_twin_config(SYMORO_ROBOTS_DIR "/crane_x7/twin.yaml", symoro::crane_x7::Model::nq);
+  const Eigen::VectorXd truth = Model::base_from_standard(symoro::twin::make_truth<symoro::crane_x7::Model>(tc).standard);
+  symoro::test::Random rng(3);
+  const Eigen::VectorXd dir = rng.vector<Eigen::VectorXd>(Model::np, -1, 1).cwiseProduct(truth.cwiseAbs());
+  same_bits_whatever_the_heap<Model>(truth, dir);
+}
+
+TEST(Determinism, Rx90AuditAndProjection) {
+  using Model = symoro::rx90::Model;
+  symoro::test::Random rng(17);
+  const Eigen::VectorXd truth = Model::base_from_standard(symoro::test::random_standard_parameters<Model>(rng).s);
+  const Eigen::VectorXd dir = rng.vector<Eigen::VectorXd>(Model::np, -1, 1).cwiseProduct(truth.cwiseAbs());
+  same_bits_whatever_the_heap<Model>(truth, dir);
+}
+
+}  // namespace
