@@ -19,7 +19,7 @@ struct IdentifyOptions {
   double validation_ms = 0;
   double torque_delay_ms = 0;
   std::string projection_metric = "information";
-  double clie_std_bound = 10;
+  double clie_std_bound = 0;
 };
 
 struct IdentifyCommand {

@@ -415,3 +415,29 @@ TEST(Clie, DivergentStartIsReportedWithoutSolving) {
 }
 
 }  // namespace
+
+namespace {
+
+// The bounds by standard deviations: the tighter of +-bound_factor |phi0| and +-K sigma applies
+// per parameter; a rotor inertia keeps its positive floor; a missing or bad sigma is refused.
+TEST(Clie, StdBoundsTakeTheTighterHalfWidth) {
+  Eigen::VectorXd phi0(3), sigma(3);
+  phi0 << 0.5, -0.002, 0.01;
+  sigma << 0.001, 0.1, 0.02;
+  identify::ClieOptions o;
+  o.std_bound = 10;
+  o.scale = sigma;
+  const auto b = identify::detail::parameter_bounds(phi0, {false, false, true}, o);
+  EXPECT_DOUBLE_EQ(b.lower(0), 0.5 - 0.01);  // 10 sigma = 0.01 < 100 |phi0| = 50
+  EXPECT_DOUBLE_EQ(b.upper(0), 0.5 + 0.01);
+  EXPECT_DOUBLE_EQ(b.lower(1), -0.002 - 0.2);  // 100 |phi0| = 0.2 < 10 sigma = 1
+  EXPECT_DOUBLE_EQ(b.upper(1), -0.002 + 0.2);
+  EXPECT_DOUBLE_EQ(b.lower(2), o.min_rotor_inertia);  // 0.01 - 0.2 < 0: the rotor floor
+  EXPECT_DOUBLE_EQ(b.upper(2), 0.01 + 0.2);
+  o.scale = Eigen::VectorXd::Ones(2);
+  EXPECT_THROW(identify::detail::parameter_bounds(phi0, {false, false, true}, o), std::invalid_argument);
+  o.scale = Eigen::Vector3d(1, 0, 1);
+  EXPECT_THROW(identify::detail::parameter_bounds(phi0, {false, false, true}, o), std::invalid_argument);
+}
+
+}  // namespace

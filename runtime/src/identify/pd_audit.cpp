@@ -63,6 +63,17 @@ void validate(const InertiaFunction& m, const VectorXd& phi, const AuditDomain& 
 
 VectorXd clip(const VectorXd& q, const AuditDomain& d) { return q.cwiseMax(d.lower).cwiseMin(d.upper); }
 
+// Ipopt's pose rounded to a grid of 2^-20 rad (1e-6): Ipopt with MUMPS keeps state from one
+// solve to the next (its automatic ordering and scaling), so the same local search could end
+// 1e-15 apart depending on the searches before it, and a study's SDP vectors then depended on
+// which runs its thread had done (test_identify_determinism.cpp). On the grid those endings are
+// the same pose except with probability ~1e-9 per coordinate; at a minimum of lambda_min the
+// rounding costs O(1e-12) in lambda.
+VectorXd snap(const VectorXd& q) {
+  constexpr double grid = 1048576.0;  // 2^20
+  return (q * grid).array().round().matrix() / grid;
+}
+
 // Smallest eigenvalue of a symmetric matrix, reusing the solver's workspace.
 class SmallestEigen {
  public:
@@ -334,7 +345,7 @@ VectorXd minimize_locally(const InertiaFunction& m, const VectorXd& phi, const A
   if (app->Initialize("") != Ipopt::Solve_Succeeded) return {};  // "": no ipopt.opt from the cwd
   app->OptimizeTNLP(owner);
   if (problem->solution().size() != 2 * m.joints() || !problem->solution().allFinite()) return {};
-  return clip(problem->solution().head(m.joints()), d);
+  return clip(snap(problem->solution().head(m.joints())), d);
 }
 
 // Projected steepest descent of lambda_min(q) in joint coordinates scaled to the box (its

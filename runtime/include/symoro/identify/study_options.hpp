@@ -49,14 +49,13 @@ struct StudyOptions {
   ProjectionMetric projection_metric = ProjectionMetric::information;
   double information_ridge = 1e-9;  // times the information matrix's mean diagonal
   // Its preprocess options are the study's. Stopping rule of MATLAB's lsqnonlin (the paper's):
-  // relative cost change 1e-6; at most 25 steps. Bounds of +-10 OLS standard deviations around
-  // the start (docs/identification.md: without them CLIE walked up to 700 sigma along directions
-  // its run barely excites).
+  // relative cost change 1e-6; at most 25 steps. No bounds by OLS standard deviations
+  // (clie.std_bound 0): they also block CLIE's correction of OLS's bias, which can be many
+  // sigma (docs/identification.md: FC2 moved 70 sigma, to the truth).
   ClieOptions clie = [] {
     ClieOptions c;
     c.function_tolerance = 1e-6;
     c.max_iterations = 25;
-    c.std_bound = 10;
     return c;
   }();
   int pca_components = 5;
