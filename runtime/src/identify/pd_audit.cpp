@@ -492,7 +492,12 @@ AuditResult audit_pd(const InertiaFunction& m, const VectorXd& phi, const AuditD
       m.inertia(q0, phi, M);
       VectorXd v0;
       eigen.value(M, v0);
-      AuditPose best = descended[i];
+      // Both candidates on the grid (see snap): the comparison below then decides between two
+      // poses that do not depend on Ipopt's history; with the descent's pose off the grid it
+      // could go either way by 1e-12 after different histories.
+      AuditPose best{clip(snap(q0), domain), 0};
+      m.inertia(best.q, phi, M);
+      best.lambda_min = eigen.value(M);
       const VectorXd q1 = minimize_locally(m, phi, domain, q0, v0, exact_hessian, options);
       ++r.local_searches;
       if (q1.size() == n) {
