@@ -45,12 +45,10 @@ using namespace symoro::identify;
 // far below anything a study's decisions see, far above those last bits -- and the bit-identical
 // count is printed.
 int identical = 0, compared = 0;
-template <class A, class B>
-void same(const A& a, const B& b, const char* what) {
+void same(const Eigen::VectorXd& a, const Eigen::VectorXd& b, const char* what) {
   ++compared;
   identical += a == b;
-  const double scale = std::max(1.0, std::sqrt(static_cast<double>((Eigen::VectorXd(b.array())).squaredNorm())));
-  EXPECT_LE(std::sqrt(static_cast<double>((Eigen::VectorXd((a - b).array())).squaredNorm())), 1e-9 * scale) << what;
+  EXPECT_LE((a - b).norm(), 1e-9 * std::max(1.0, b.norm())) << what;
 }
 void same(double a, double b, const char* what) {
   ++compared;

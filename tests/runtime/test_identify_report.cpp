@@ -22,6 +22,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include "symoro/identify/report.hpp"
+#include "symoro/identify/reproduction.hpp"
 #include "symoro/identify/svg_plot.hpp"
 
 namespace {
@@ -762,6 +763,40 @@ TEST(ReportMissingData, MismatchedParameterVectorIsRejected) {
   EXPECT_THROW(write_report(s.study, dir / "report"), std::invalid_argument);
   EXPECT_FALSE(fs::exists(dir / "report" / "report.md"));
   fs::remove_all(dir);
+}
+
+}  // namespace
+
+namespace {
+
+// A robot without a controller description: CLIE skipped, validation open loop by design.
+// The reproduction table must say "n/a", not that the paper's findings failed.
+TEST(Reproduction, WithoutAControllerTheClosedLoopFindingsAreNotApplicable) {
+  using namespace symoro::identify;
+  StudyResult s;
+  for (int i = 0; i < 3; ++i) {
+    RunRecord r;
+    r.trajectory = "arm" + std::to_string(i);
+    r.interval = 0.01;
+    r.clie_ran = false;
+    r.phi_ols = r.phi_sdp = r.phi_clie = Eigen::VectorXd::Constant(2, 1.0 + i);
+    s.runs.push_back(r);
+  }
+  ValidationRecord v;
+  v.trajectory = "arm_heldout";
+  v.kind = "open-loop";
+  v.note = "open loop: no controller description";
+  v.rmse_clie = v.rmse_rescue = 0.06;
+  s.validation.push_back(v);
+  const std::vector<Finding> f = paper_findings(s);
+  ASSERT_GE(f.size(), 3u);
+  EXPECT_EQ(f[0].verdict, "n/a") << f[0].note;  // clouds
+  EXPECT_NE(f[0].note.find("CLIE did not run"), std::string::npos);
+  EXPECT_EQ(f[2].verdict, "n/a") << f[2].note;  // validation
+  EXPECT_EQ(f[2].study, "1 of 1 finite, 0 closed loop");
+  // A closed loop that diverged into the open-loop fallback is a failed finding.
+  s.validation[0].note = "the closed loop of the final vector diverged at t = 1 s; open-loop values";
+  EXPECT_EQ(paper_findings(s)[2].verdict, "not reproduced");
 }
 
 }  // namespace
