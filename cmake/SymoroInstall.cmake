@@ -1,7 +1,7 @@
 # Installs symoro as a CMake package: find_package(symoro) gives symoro::core and one
 # symoro::<robot> target per generated robot (header-only over Eigen), and the runtime's stages
 # as static libraries: symoro::io (logs, import), symoro::trajectory, symoro::preprocess,
-# symoro::control, symoro::twin, symoro::identify (OLS, audit, SDP, CLIE, the study),
+# symoro::control, symoro::parallel (the task farm, MPI or threads), symoro::twin, symoro::identify (OLS, audit, SDP, CLIE, the study),
 # symoro::diagnose, symoro::dynamixel, symoro::hardware, and symoro::runtime (all of them).
 include(CMakePackageConfigHelpers)
 

@@ -6,6 +6,7 @@ packages=(
   libeigen3-dev libboost-dev libfmt-dev libcli11-dev libyaml-cpp-dev
   libceres-dev coinor-libipopt-dev libsdp-dev
   libgtest-dev libgmock-dev libbenchmark-dev
+  libopenmpi-dev openmpi-bin  # optional: the MPI farm and its test (docs/scaling.md)
 )
 missing=()
 for p in "${packages[@]}"; do

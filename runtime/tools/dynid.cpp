@@ -10,6 +10,7 @@
 #include "dynid_common.hpp"
 #include "dynid_dispatch.hpp"
 #include "symoro/error.hpp"
+#include "symoro/parallel/farm.hpp"
 
 namespace symoro::dynid {
 bool Progress::isatty_stderr() { return ::isatty(2) == 1; }
@@ -37,12 +38,15 @@ int main(int argc, char** argv) {
     return app.exit(e);
   } catch (const symoro::DataError& e) {
     std::fprintf(stderr, "%s\n", e.what());
+    symoro::parallel::abort_job(1);  // under mpirun the other ranks would wait for this one
     return 1;
   } catch (const UsageError& e) {
     std::fprintf(stderr, "dynid: error: %s\n", e.what());
+    symoro::parallel::abort_job(2);
     return 2;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "dynid: error: %s\n", e.what());
+    symoro::parallel::abort_job(1);
     return 1;
   }
   return 0;

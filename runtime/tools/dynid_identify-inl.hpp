@@ -14,6 +14,7 @@
 #include "symoro/identify/report.hpp"
 #include "symoro/identify/study.hpp"
 #include "symoro/identify/validation_io.hpp"
+#include "symoro/parallel/farm.hpp"
 #include "symoro/trajectory/design.hpp"
 #include "symoro/twin/config.hpp"
 #include "symoro/twin/truth.hpp"
@@ -30,6 +31,7 @@ identify::StudyResult study(const Common& common, const IdentifyOptions& o, bool
   so.trial = o.trial;
   so.threads = o.threads;
   so.fresh = o.fresh;
+  so.isolate = !o.in_process;
   so.trajectories = o.only;
   so.validation = o.validation;
   if (!o.intervals_ms.empty()) {
@@ -85,10 +87,14 @@ template <class Full, class Model>
 void IdentifyCommand::run(const Common& common, const IdentifyOptions& o) {
   if (o.out.empty()) throw UsageError("--out is required");
   const identify::StudyResult r = identify_detail::study<Full, Model>(common, o, false);
+  if (!parallel::place().coordinator()) return;  // rank 0 reports
   rusage usage{};
   getrusage(RUSAGE_SELF, &usage);
-  fmt::print("{} runs, {} threads: {:.1f} s wall ({:.1f} s of run stages summed), peak memory {:.0f} MB\n",
-             r.runs.size(), r.threads, r.wall, r.wall_runs, usage.ru_maxrss / 1024.0);
+  fmt::print("{} runs, {}{} threads: {:.1f} s wall ({:.1f} s of run stages summed), peak memory {:.0f} MB{}\n", r.runs.size(),
+             r.ranks > 1 ? fmt::format("{} ranks x ", r.ranks) : "", r.threads, r.wall, r.wall_runs, usage.ru_maxrss / 1024.0,
+             r.worker_peak_mb > 0 ? fmt::format(" (this process), {:.0f} MB (a trajectory's process, largest: {})", r.worker_peak_mb,
+                                                r.worker_peak_trajectory)
+                                  : "");
   for (const auto& line : r.stages) fmt::print("{}\n", line);
   if (r.selection.run < 0) fmt::print("no representative: {}\n", r.selection.rule.empty() ? "no run produced a final vector" : r.selection.rule);
   if (r.selection.run >= 0) {

@@ -1,7 +1,8 @@
 // dynid identify: the whole identification study on a dataset (paper Algorithm 1 over every
 // trajectory and interval, PCA selection, rescue, final audit, validation) and its report;
 // resumable: finished runs are kept in <out>/runs/ and skipped by a rerun. --only and
-// --interval narrow it to a few runs (e.g. --only AG02 --interval 40 to inspect one).
+// --interval narrow it to a few runs (e.g. --only AG02 --interval 40 to inspect one). Under
+// mpirun the runs spread over the ranks and rank 0 writes the study (docs/scaling.md).
 #include <CLI/CLI.hpp>
 
 #include "dynid_identify.hpp"
@@ -22,7 +23,10 @@ void add_identify_commands(CLI::App& app, Common& common) {
   cmd->add_option("--only", o->only, "Identification trajectories (default: every family but V)")->delimiter(',');
   cmd->add_option("--validation", o->validation, "Validation trajectories (default: family V)")->delimiter(',');
   cmd->add_option("--trial", o->trial, "Which trial of each trajectory");
-  cmd->add_option("-j,--jobs", o->threads, "Worker threads (default: every core)");
+  cmd->add_option("-j,--jobs", o->threads, "Worker threads per rank (default: the cores, shared among the MPI ranks on "
+                                            "a machine)");
+  cmd->add_flag("--in-process", o->in_process, "Run the trajectories in threads of this process instead of a process "
+                                               "each (for a debugger or a profiler; a crash then ends the study)");
   cmd->add_flag("--wls", o->weighted, "Weighted least squares (per-joint weights) instead of OLS");
   cmd->add_option("--torque-delay", o->torque_delay_ms, "ms the logged torque lags the links' (an actuation delay "
                                                         "dynid diagnose named): the torque is read that much later");

@@ -14,7 +14,7 @@ struct IdentifyOptions {
   std::vector<double> intervals_ms;
   std::vector<std::string> only, validation;
   int threads = 0, trial = 1;
-  bool weighted = false, no_report = false, fresh = false;
+  bool weighted = false, no_report = false, fresh = false, in_process = false;
   int clie_iterations = 25;
   double validation_ms = 0;
   double torque_delay_ms = 0;

@@ -3,10 +3,10 @@
 #pragma once
 
 #include <algorithm>
-#include <atomic>
+#include <chrono>
 #include <fstream>
+#include <optional>
 #include <sstream>
-#include <thread>
 
 #include <fmt/format.h>
 #include <yaml-cpp/yaml.h>
@@ -14,6 +14,7 @@
 #include "dynid_twin.hpp"
 #include "symoro/io/atomic_file.hpp"
 #include "symoro/io/log.hpp"
+#include "symoro/parallel/farm.hpp"
 #include "symoro/trajectory/design.hpp"
 #include "symoro/twin/simulator.hpp"
 
@@ -104,42 +105,50 @@ void twin_dataset(const Common& common, const TwinOptions& o) {
     }
   // Longest runs first: better load balance across workers.
   std::stable_sort(jobs.begin(), jobs.end(), [&](const Job& a, const Job& b) { return trajs[a.traj].duration() > trajs[b.traj].duration(); });
-  if (skipped > 0) fmt::print(stderr, "{} runs already finished in {} (same seed and twin): skipped\n", skipped, o.out);
+  if (skipped > 0 && parallel::place().coordinator()) fmt::print(stderr, "{} runs already finished in {} (same seed and twin): skipped\n", skipped, o.out);
 
-  const int workers = std::max(1, std::min<int>(o.jobs > 0 ? o.jobs : std::thread::hardware_concurrency(), jobs.size()));
-  Progress progress(static_cast<int>(jobs.size()), "twin");
-  std::atomic<size_t> next{0};
-  std::mutex error_mutex;
-  std::string first_error;
+  // The runs on the farm (threads here, or MPI ranks under mpirun): each worker writes its run's
+  // log (atomically, a file of its own) and sends rank 0 what it simulated.
+  std::vector<std::string> tasks;
+  for (const Job& j : jobs) tasks.push_back(fmt::format("{} {}", j.traj, j.trial));
+  const bool coordinator = parallel::place().coordinator();
+  std::optional<Progress> progress;
+  if (coordinator) progress.emplace(static_cast<int>(jobs.size()), "twin");
+  std::string errors;
   double simulated = 0;
-  auto work = [&] {
-    for (size_t i; (i = next++) < jobs.size();) {
-      const Job& j = jobs[i];
-      try {
-        twin::RunOptions ro;
-        ro.robot = common.robot;
-        ro.trial = j.trial;
-        ro.seed = twin::run_seed(o.seed, names[j.traj], j.trial);
-        twin::RunStats st;
-        const io::Log log = sim.run(trajs[j.traj], ro, &st);
-        io::write_log(std::filesystem::path(o.out) / run_file(names[j.traj], j.trial), log);
-        {
-          std::lock_guard<std::mutex> lock(error_mutex);
-          simulated += st.simulated;
-        }
-        progress.done(fmt::format("{} t{}", names[j.traj], j.trial), describe(st));
-      } catch (const std::exception& e) {
-        std::lock_guard<std::mutex> lock(error_mutex);
-        if (first_error.empty()) first_error = e.what();
-        next = jobs.size();
-      }
-    }
+  parallel::Farm farm;
+  farm.work = [&](const std::string& task, const std::function<void(const std::string&)>& emit) {
+    std::istringstream in(task);
+    Job j{};
+    in >> j.traj >> j.trial;
+    twin::RunOptions ro;
+    ro.robot = common.robot;
+    ro.trial = j.trial;
+    ro.seed = twin::run_seed(o.seed, names[j.traj], j.trial);
+    twin::RunStats st;
+    const io::Log log = sim.run(trajs[j.traj], ro, &st);
+    io::write_log(std::filesystem::path(o.out) / run_file(names[j.traj], j.trial), log);
+    emit(fmt::format("{:.17g} {}", st.simulated, describe(st)));
   };
+  farm.on_result = [&](std::size_t i, const std::string& text) {
+    std::istringstream in(text);
+    double s = 0;
+    in >> s;
+    simulated += s;
+    std::string rest;
+    std::getline(in, rest);
+    progress->done(fmt::format("{} t{}", names[jobs[i].traj], jobs[i].trial), rest.empty() ? rest : rest.substr(1));
+  };
+  farm.on_end = [&](const parallel::TaskEnd& e) {
+    if (e.failed) errors += fmt::format("{}{} t{}: {}", errors.empty() ? "" : "; ", names[jobs[e.task].traj], jobs[e.task].trial, e.failure);
+  };
+  parallel::FarmOptions fo;
+  fo.workers = o.jobs;
   const auto t0 = std::chrono::steady_clock::now();
-  std::vector<std::thread> pool;
-  for (int w = 0; w < workers; ++w) pool.emplace_back(work);
-  for (auto& t : pool) t.join();
-  if (!first_error.empty()) throw std::runtime_error(first_error);
+  const parallel::FarmSummary farmed = parallel::run_farm(tasks, farm, fo);
+  if (!coordinator) return;
+  // The finished runs stay on disk: a rerun does only the failed ones.
+  if (!errors.empty()) throw std::runtime_error("twin dataset: failed runs (the others are written): " + errors);
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 
   // The manifest: what the dataset holds and how it was made (written last, atomically).
@@ -165,8 +174,9 @@ void twin_dataset(const Common& common, const TwinOptions& o) {
         << YAML::Value << run_file(names[t], k) << YAML::EndMap;
   y << YAML::EndSeq << YAML::EndMap;
   io::write_file_atomically(std::filesystem::path(o.out) / "dataset.yaml", std::string(y.c_str()) + "\n");
-  fmt::print("{} runs ({} new, {} skipped) in {}: {:.0f} s simulated in {:.1f} s wall on {} workers\n",
-             trajs.size() * o.trials, jobs.size(), skipped, o.out, simulated, wall, workers);
+  fmt::print("{} runs ({} new, {} skipped) in {}: {:.0f} s simulated in {:.1f} s wall on {}{} workers\n",
+             trajs.size() * o.trials, jobs.size(), skipped, o.out, simulated, wall,
+             farmed.ranks > 1 ? fmt::format("{} ranks x ", farmed.ranks) : "", farmed.workers);
 }
 
 template <class Model>

@@ -42,7 +42,7 @@ void add_twin_commands(CLI::App& app, Common& common) {
   data->add_option("-o,--output", o->out, "Output directory")->required();
   data->add_option("--trials", o->trials, "Repeated trials per trajectory")->check(CLI::PositiveNumber);
   data->add_option("--seed", o->seed, "Dataset seed");
-  data->add_option("--jobs", o->jobs, "Parallel workers (default: all cores)");
+  data->add_option("--jobs", o->jobs, "Worker threads per rank (default: the cores, shared among the MPI ranks on a machine)");
   data->add_option("--only", o->only, "Only these trajectories");
   data->callback([&common, o] {
     o->mode = TwinOptions::Mode::dataset;

@@ -249,10 +249,14 @@ std::string summary(const StudyResult& study) {
   out += fmt::format("- **Runs**: {} ({} trajectories × intervals {} ms); CLIE converged in {}, PD after CLIE in {}{}.\n",
                      study.runs.size(), trajectories.size(), ms.empty() ? "none" : ms, converged, pd,
                      failed.empty() ? std::string() : fmt::format("; CLIE failed for {}", fmt::join(failed, ", ")));
-  out += fmt::format("- **Wall time**: {} s for this invocation on {} thread{}; run stages sum to {} s "
-                     "(OLS {}, audit {}, SDP {}, CLIE {}).\n\n",
-                     fixed(study.wall, 1), study.threads, study.threads == 1 ? "" : "s", fixed(study.wall_runs, 1),
-                     fixed(t[0], 1), fixed(t[1], 1), fixed(t[2], 1), fixed(t[3], 1));
+  out += fmt::format("- **Wall time**: {} s for this invocation on {}{} thread{}; run stages sum to {} s "
+                     "(OLS {}, audit {}, SDP {}, CLIE {}){}.\n\n",
+                     fixed(study.wall, 1), study.ranks > 1 ? fmt::format("{} MPI ranks x ", study.ranks) : "", study.threads,
+                     study.threads == 1 ? "" : "s", fixed(study.wall_runs, 1), fixed(t[0], 1), fixed(t[1], 1), fixed(t[2], 1),
+                     fixed(t[3], 1),
+                     study.worker_peak_mb > 0 ? fmt::format("; peak memory of a trajectory's process {} MB ({})", fixed(study.worker_peak_mb, 0),
+                                                            study.worker_peak_trajectory)
+                                              : "");
   return out;
 }
 

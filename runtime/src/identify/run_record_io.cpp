@@ -1,6 +1,7 @@
 #include "symoro/identify/run_record_io.hpp"
 
 #include <cstdint>
+#include <stdexcept>
 
 #include <fmt/format.h>
 #include <yaml-cpp/yaml.h>
@@ -30,8 +31,9 @@ std::string fingerprint_of(const std::string& text) {
   return fmt::format("{:016x}", h);
 }
 
-void save_run(const RunRecord& r, const std::string& fingerprint, const std::filesystem::path& file) {
+std::string run_record_text(const RunRecord& r, const std::string& fingerprint) {
   YAML::Emitter y;
+  y.SetDoublePrecision(17);
   if (r.failed) {  // the reason only: a rerun with the same inputs fails the same way
     y << YAML::BeginMap;
     y << YAML::Key << "format" << YAML::Value << "symoro-identification-run 1";
@@ -41,10 +43,8 @@ void save_run(const RunRecord& r, const std::string& fingerprint, const std::fil
     y << YAML::Key << "failed" << YAML::Value << true;
     y << YAML::Key << "failure" << YAML::Value << r.failure;
     y << YAML::EndMap;
-    io::write_file_atomically(file, std::string(y.c_str()) + "\n");
-    return;
+    return std::string(y.c_str()) + "\n";
   }
-  y.SetDoublePrecision(17);
   y << YAML::BeginMap;
   y << YAML::Key << "format" << YAML::Value << "symoro-identification-run 1";
   y << YAML::Key << "fingerprint" << YAML::Value << fingerprint;
@@ -81,7 +81,61 @@ void save_run(const RunRecord& r, const std::string& fingerprint, const std::fil
   y << YAML::Key << "t_sdp" << YAML::Value << r.t_sdp;
   y << YAML::Key << "t_clie" << YAML::Value << r.t_clie;
   y << YAML::EndMap;
-  io::write_file_atomically(file, std::string(y.c_str()) + "\n");
+  return std::string(y.c_str()) + "\n";
+}
+
+void save_run(const RunRecord& r, const std::string& fingerprint, const std::filesystem::path& file) {
+  io::write_file_atomically(file, run_record_text(r, fingerprint));
+}
+
+namespace {
+
+RunRecord parse(const YAML::Node& n) {
+  RunRecord r;
+  r.trajectory = n["trajectory"].as<std::string>();
+  r.interval = n["interval"].as<double>();
+  r.failed = n["failed"] ? n["failed"].as<bool>() : false;
+  r.failure = n["failure"] ? n["failure"].as<std::string>() : "";
+  r.clie_ran = n["clie_ran"] ? n["clie_ran"].as<bool>() : true;
+  if (r.failed) return r;  // nothing else was computed
+  r.samples = n["samples"].as<int>();
+  r.kappa = n["kappa"].as<double>();
+  r.kappa_scaled = n["kappa_scaled"].as<double>();
+  r.phi_ols = vec(n["phi_ols"]);
+  r.std_ols = vec(n["std_ols"]);
+  r.residual_rms = n["residual_rms"].as<double>();
+  r.weighted = n["weighted"].as<bool>();
+  r.ols_lambda_min = n["ols_lambda_min"].as<double>();
+  r.ols_worst_pose = vec(n["ols_worst_pose"]);
+  r.ols_pd = n["ols_pd"].as<bool>();
+  r.route = n["route"].as<std::string>();
+  r.eps = n["eps"].as<double>();
+  r.sdp_feasible = n["sdp_feasible"].as<bool>();
+  r.phi_sdp = vec(n["phi_sdp"]);
+  r.phi_clie = vec(n["phi_clie"]);
+  r.clie_success = n["clie_success"].as<bool>();
+  r.clie_termination = n["clie_termination"].as<std::string>();
+  r.clie_cost_initial = n["clie_cost_initial"].as<double>();
+  r.clie_cost_final = n["clie_cost_final"].as<double>();
+  r.clie_iterations = n["clie_iterations"].as<int>();
+  r.clie_rms = vec(n["clie_rms"]);
+  r.clie_lambda_min = n["clie_lambda_min"].as<double>();
+  r.clie_pd = n["clie_pd"].as<bool>();
+  r.t_ols = n["t_ols"].as<double>();
+  r.t_audit = n["t_audit"].as<double>();
+  r.t_sdp = n["t_sdp"].as<double>();
+  r.t_clie = n["t_clie"].as<double>();
+  return r;
+}
+
+}  // namespace
+
+RunRecord run_record_from_text(const std::string& text) {
+  try {
+    return parse(YAML::Load(text));
+  } catch (const YAML::Exception& e) {
+    throw std::runtime_error(std::string("a run record that does not parse: ") + e.what());
+  }
 }
 
 std::optional<RunRecord> load_run(const std::filesystem::path& file, const std::string& fingerprint) {
@@ -89,41 +143,7 @@ std::optional<RunRecord> load_run(const std::filesystem::path& file, const std::
   try {
     const YAML::Node n = YAML::LoadFile(file.string());
     if (n["fingerprint"].as<std::string>() != fingerprint) return std::nullopt;
-    RunRecord r;
-    r.trajectory = n["trajectory"].as<std::string>();
-    r.interval = n["interval"].as<double>();
-    r.failed = n["failed"] ? n["failed"].as<bool>() : false;
-    r.failure = n["failure"] ? n["failure"].as<std::string>() : "";
-    r.clie_ran = n["clie_ran"] ? n["clie_ran"].as<bool>() : true;
-    if (r.failed) return r;  // nothing else was computed
-    r.samples = n["samples"].as<int>();
-    r.kappa = n["kappa"].as<double>();
-    r.kappa_scaled = n["kappa_scaled"].as<double>();
-    r.phi_ols = vec(n["phi_ols"]);
-    r.std_ols = vec(n["std_ols"]);
-    r.residual_rms = n["residual_rms"].as<double>();
-    r.weighted = n["weighted"].as<bool>();
-    r.ols_lambda_min = n["ols_lambda_min"].as<double>();
-    r.ols_worst_pose = vec(n["ols_worst_pose"]);
-    r.ols_pd = n["ols_pd"].as<bool>();
-    r.route = n["route"].as<std::string>();
-    r.eps = n["eps"].as<double>();
-    r.sdp_feasible = n["sdp_feasible"].as<bool>();
-    r.phi_sdp = vec(n["phi_sdp"]);
-    r.phi_clie = vec(n["phi_clie"]);
-    r.clie_success = n["clie_success"].as<bool>();
-    r.clie_termination = n["clie_termination"].as<std::string>();
-    r.clie_cost_initial = n["clie_cost_initial"].as<double>();
-    r.clie_cost_final = n["clie_cost_final"].as<double>();
-    r.clie_iterations = n["clie_iterations"].as<int>();
-    r.clie_rms = vec(n["clie_rms"]);
-    r.clie_lambda_min = n["clie_lambda_min"].as<double>();
-    r.clie_pd = n["clie_pd"].as<bool>();
-    r.t_ols = n["t_ols"].as<double>();
-    r.t_audit = n["t_audit"].as<double>();
-    r.t_sdp = n["t_sdp"].as<double>();
-    r.t_clie = n["t_clie"].as<double>();
-    return r;
+    return parse(n);
   } catch (const YAML::Exception&) {
     return std::nullopt;  // unreadable: the run is done again
   }

@@ -11,6 +11,12 @@
 
 namespace symoro::identify {
 
+// The record as the file holds it (YAML, doubles to 17 digits: read back bit for bit), and back;
+// the second throws std::runtime_error on a text that does not parse. Records travel this way
+// from a run's process or rank to the one that saves them.
+std::string run_record_text(const RunRecord& run, const std::string& fingerprint);
+RunRecord run_record_from_text(const std::string& text);
+
 void save_run(const RunRecord& run, const std::string& fingerprint, const std::filesystem::path& file);
 
 // The record, or nothing when the file is missing, unreadable or made from other inputs.

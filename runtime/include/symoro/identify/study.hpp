@@ -12,23 +12,23 @@
 // among the SDP vectors and validation is open loop. A run that fails (a log too short for an
 // interval, a solver's exception) is recorded with its reason and the study goes on.
 //
-// Runs go to a pool of threads, one trajectory (its log read once, every interval) per task,
-// longest first. Each run's record is saved atomically under <out>/runs/ as soon as it ends;
-// a rerun skips the runs whose saved fingerprint matches (same data, model and options).
+// Runs go to a farm (symoro/parallel/farm.hpp: threads here, or MPI ranks under mpirun), one
+// trajectory (its log read once, every interval) per task, longest first, each in a process of
+// its own by default (StudyOptions::isolate). Each run's record is saved atomically under
+// <out>/runs/ by the coordinator (rank 0) as soon as it arrives; a rerun, with any rank count,
+// skips the runs whose saved fingerprint matches (same data, model and options).
 #pragma once
 
 #include <algorithm>
-#include <atomic>
 #include <chrono>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
 #include <memory>
 #include <functional>
-#include <mutex>
 #include <optional>
+#include <sstream>
 #include <string>
-#include <thread>
 #include <vector>
 
 #include <fmt/format.h>
@@ -50,6 +50,7 @@
 #include "symoro/identify/study_result.hpp"
 #include "symoro/identify/validation.hpp"
 #include "symoro/io/log.hpp"
+#include "symoro/parallel/farm.hpp"
 #include "symoro/preprocess/preprocess.hpp"
 #include "symoro/trajectory/design.hpp"
 
@@ -210,54 +211,71 @@ class Study {
       return std::filesystem::file_size(data.find(a, o_.trial).file) > std::filesystem::file_size(data.find(b, o_.trial).file);
     });
     const int skipped = static_cast<int>(std::count_if(slots.begin(), slots.end(), [](const Slot& s) { return s.record.has_value(); }));
-    if (o_.on_start) o_.on_start(static_cast<int>(slots.size()), skipped);
+    if (o_.on_start && parallel::place().coordinator()) o_.on_start(static_cast<int>(slots.size()), skipped);
 
-    const int threads = std::max(1, std::min<int>(o_.threads > 0 ? o_.threads : std::thread::hardware_concurrency(),
-                                                  static_cast<int>(todo.size())));
-    out.threads = threads;
-    std::atomic<size_t> next{0};
-    std::mutex m;
-    auto finish = [&](Slot& s, RunRecord r) {
-      if (!r.failed) save_run(r, s.fingerprint, s.file);  // a failed run is tried again by a rerun
-      std::lock_guard<std::mutex> lock(m);
-      s.record = std::move(r);
-      if (o_.on_run) o_.on_run(*s.record);
-    };
-    auto failed = [](const Slot& s, const std::string& why) {
+    // One task per trajectory (its log read once, its missing intervals in order), on the
+    // farm: this machine's threads, or MPI ranks when started by mpirun.
+    std::vector<std::string> tasks;
+    for (const auto& name : todo) {
+      std::string task = name;
+      for (const Slot& s : slots)
+        if (s.trajectory == name && !s.record) task += fmt::format("\n{:.17g}", s.interval);  // 17 digits: exact
+      tasks.push_back(std::move(task));
+    }
+    auto failed = [](const std::string& trajectory, double interval, const std::string& why) {
       RunRecord r;
-      r.trajectory = s.trajectory;
-      r.interval = s.interval;
+      r.trajectory = trajectory;
+      r.interval = interval;
       r.failed = true;
       r.failure = why;
       return r;
     };
-    auto work = [&] {
-      for (size_t i; (i = next++) < todo.size();) {
-        const std::string& name = todo[i];
-        io::Log log;
-        std::unique_ptr<ClosedLoopSimulator<Model>> sim;
-        std::string no_clie;
+    auto finish = [&](Slot& s, RunRecord r) {
+      if (!r.failed) save_run(r, s.fingerprint, s.file);  // a failed run is tried again by a rerun
+      s.record = std::move(r);
+      if (o_.on_run) o_.on_run(*s.record);
+    };
+    parallel::Farm farm;
+    farm.work = [&](const std::string& task, const std::function<void(const std::string&)>& emit) {
+      std::istringstream in(task);
+      std::string name, line;
+      std::getline(in, name);
+      const io::Log log = load_log(data.find(name, o_.trial));
+      std::string no_clie;
+      const auto sim = closed_loop(name, log, no_clie);
+      while (std::getline(in, line)) {
+        const double h = std::stod(line);
+        RunRecord r;
         try {
-          log = load_log(data.find(name, o_.trial));
-          sim = closed_loop(name, log, no_clie);
+          r = detail::identify_run<Model>(log, sim.get(), no_clie, h, o_, *inertia_, domain_);
         } catch (const std::exception& e) {
-          for (Slot& s : slots)
-            if (s.trajectory == name && !s.record) finish(s, failed(s, e.what()));
-          continue;
+          r = failed(name, h, e.what());
         }
-        for (Slot& s : slots) {
-          if (s.trajectory != name || s.record) continue;
-          try {
-            finish(s, detail::identify_run<Model>(log, sim.get(), no_clie, s.interval, o_, *inertia_, domain_));
-          } catch (const std::exception& e) {
-            finish(s, failed(s, e.what()));
-          }
-        }
+        emit(run_record_text(r, ""));
       }
     };
-    std::vector<std::thread> pool;
-    for (int w = 0; w < threads; ++w) pool.emplace_back(work);
-    for (auto& t : pool) t.join();
+    farm.on_result = [&](std::size_t, const std::string& text) {
+      RunRecord r = run_record_from_text(text);
+      for (Slot& s : slots)
+        if (!s.record && s.trajectory == r.trajectory && s.interval == r.interval) return finish(s, std::move(r));
+    };
+    farm.on_end = [&](const parallel::TaskEnd& e) {
+      const std::string& name = todo[e.task];
+      if (e.peak_memory_mb > out.worker_peak_mb) {
+        out.worker_peak_mb = e.peak_memory_mb;
+        out.worker_peak_trajectory = name;
+      }
+      if (!e.failed) return;
+      for (Slot& s : slots)  // the runs the task did not finish
+        if (s.trajectory == name && !s.record) finish(s, failed(s.trajectory, s.interval, e.failure));
+    };
+    parallel::FarmOptions fo;
+    fo.workers = o_.threads;
+    fo.isolate = o_.isolate;
+    const parallel::FarmSummary farmed = parallel::run_farm(tasks, farm, fo);
+    out.threads = farmed.workers;
+    out.ranks = farmed.ranks;
+    if (!parallel::place().coordinator()) return out;  // rank 0 gathers the records and goes on
 
     for (Slot& s : slots) out.runs.push_back(std::move(*s.record));
     int failures = 0;

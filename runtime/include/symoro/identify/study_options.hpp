@@ -34,6 +34,10 @@ struct StudyOptions {
   std::vector<double> intervals = preprocess::paper_intervals();
   int threads = 0;              // 0: every core
   bool fresh = false;           // redo every run, even those finished (benchmarks)
+  // Each trajectory's runs in a process of their own (symoro/parallel/farm.hpp): a crash or an
+  // out-of-memory kill fails those runs only, and every run starts from the same solver state,
+  // so the records do not depend on the thread or rank count or on which runs went before.
+  bool isolate = true;
   preprocess::Options preprocess;
   LeastSquaresOptions least_squares;
   AuditOptions audit;

@@ -111,7 +111,12 @@ struct StudyResult {
   // What the chain did and skipped, one line each (e.g. "CLIE: not run: no controller
   // description (robots/x/controller.yaml)"), for the report.
   std::vector<std::string> stages;
-  int threads = 1;
+  int threads = 1;                        // worker threads per rank
+  int ranks = 1;                          // MPI ranks (1: this machine alone)
+  // The largest peak resident memory of a trajectory's process (isolated runs; 0 otherwise) and
+  // that trajectory: what one worker needs.
+  double worker_peak_mb = 0;
+  std::string worker_peak_trajectory;
   double wall = 0;                        // s, whole study (runs done in this invocation)
   double wall_runs = 0;                   // s, sum of the runs' stage times
 };

@@ -1,0 +1,24 @@
+// One task of a farm, run in this thread or in a forked process of its own (farm.cpp), and the
+// MPI farm (farm_mpi.cpp, MPI builds only).
+#pragma once
+
+#include <cstddef>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "symoro/parallel/farm.hpp"
+
+namespace symoro::parallel::detail {
+
+// Runs `task`, passing each result it emits to `result` (in the calling thread). The returned
+// end has its failure, wall time and (isolated) peak memory; its task index and rank are the
+// caller's to set.
+TaskEnd run_task(const Farm& farm, const std::string& task, bool isolate, const std::function<void(const std::string&)>& result);
+
+// Worker threads per rank: the option, else this machine's cores shared among the ranks on it.
+int worker_count(const FarmOptions& o, int ranks_on_this_machine);
+
+FarmSummary run_farm_mpi(const std::vector<std::string>& tasks, const Farm& farm, const FarmOptions& o);
+
+}  // namespace symoro::parallel::detail
