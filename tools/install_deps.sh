@@ -5,6 +5,7 @@ packages=(
   build-essential cmake ninja-build clang libclang-rt-14-dev
   libeigen3-dev libboost-dev libfmt-dev libcli11-dev libyaml-cpp-dev
   libceres-dev coinor-libipopt-dev libsdp-dev
+  libblas3 liblapack3  # the reference BLAS/LAPACK every program links (CMakeLists.txt says why)
   libgtest-dev libgmock-dev libbenchmark-dev
   libopenmpi-dev openmpi-bin  # optional: the MPI farm and its test (docs/scaling.md)
 )

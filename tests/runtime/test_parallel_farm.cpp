@@ -2,6 +2,9 @@
 // the order emitted, failures that stay with their task (an exception, a process killed by a
 // signal), isolation that starts every task from the same state, and the peak memory of an
 // isolated task's own process.
+#include <sched.h>
+
+#include <algorithm>
 #include <csignal>
 #include <cstdlib>
 #include <cstring>
@@ -152,6 +155,27 @@ TEST(Farm, AnIsolatedTasksPeakMemoryIsItsOwn) {
   EXPECT_EQ(c.results[0].at(0), "1");
   EXPECT_GE(s.tasks[0].peak_memory_mb, 300);
   EXPECT_LT(s.tasks[1].peak_memory_mb, 200);  // the parent never held the 300 MB
+}
+
+TEST(Farm, ByDefaultAsManyWorkersAsCoresTheProcessMayUse) {
+  Farm farm;
+  farm.work = [](const std::string& t, const std::function<void(const std::string&)>& emit) { emit(t); };
+  cpu_set_t all, one;
+  ASSERT_EQ(sched_getaffinity(0, sizeof all, &all), 0);
+  Collected c;
+  const int cores = CPU_COUNT(&all);
+  EXPECT_EQ(run(numbered(64), farm, false, 0, c).workers, std::min(cores, 64));
+  // Bound to one core (as mpirun binds a rank when it starts two or fewer): one worker.
+  CPU_ZERO(&one);
+  for (int cpu = 0; cpu < CPU_SETSIZE; ++cpu)
+    if (CPU_ISSET(cpu, &all)) {
+      CPU_SET(cpu, &one);
+      break;
+    }
+  ASSERT_EQ(sched_setaffinity(0, sizeof one, &one), 0);
+  const int bound = run(numbered(64), farm, false, 0, c).workers;
+  ASSERT_EQ(sched_setaffinity(0, sizeof all, &all), 0);
+  EXPECT_EQ(bound, 1);
 }
 
 TEST(Farm, WithoutALauncherTheJobIsOneRank) {

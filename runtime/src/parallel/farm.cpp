@@ -1,5 +1,6 @@
 #include "symoro/parallel/farm.hpp"
 
+#include <sched.h>
 #include <sys/resource.h>
 #include <sys/types.h>
 #include <sys/wait.h>
@@ -166,6 +167,11 @@ TaskEnd run_task(const Farm& farm, const std::string& task, bool isolate, const 
 int worker_count(const FarmOptions& o, int ranks_on_this_machine) {
   if (o.workers > 0) return o.workers;
   const int cores = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+  // A process bound to fewer cores (mpirun binds each rank to a core when it starts two or
+  // fewer; Slurm's --cpus-per-task) gets as many workers as it may use cores.
+  cpu_set_t mask;
+  CPU_ZERO(&mask);
+  if (::sched_getaffinity(0, sizeof mask, &mask) == 0 && CPU_COUNT(&mask) < cores) return std::max(1, CPU_COUNT(&mask));
   return std::max(1, cores / std::max(1, ranks_on_this_machine));
 }
 

@@ -16,7 +16,8 @@ namespace symoro::parallel::detail {
 // caller's to set.
 TaskEnd run_task(const Farm& farm, const std::string& task, bool isolate, const std::function<void(const std::string&)>& result);
 
-// Worker threads per rank: the option, else this machine's cores shared among the ranks on it.
+// Worker threads per rank: the option, else the cores this process may run on (its affinity), or
+// this machine's cores shared among the ranks on it when it is not bound.
 int worker_count(const FarmOptions& o, int ranks_on_this_machine);
 
 FarmSummary run_farm_mpi(const std::vector<std::string>& tasks, const Farm& farm, const FarmOptions& o);

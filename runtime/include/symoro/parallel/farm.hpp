@@ -38,8 +38,11 @@ bool mpi_built();
 // others would wait for it forever), else nothing (the caller returns its exit code).
 void abort_job(int code);
 
+// Worker threads by default: as many as the cores the process is bound to (mpirun binds a rank
+// to one core when it starts two ranks or fewer: then one worker), else the machine's cores
+// shared among its ranks.
 struct FarmOptions {
-  int workers = 0;       // worker threads per rank; 0: every core of the machine
+  int workers = 0;       // worker threads per rank; 0: the cores this rank may use (below)
   bool isolate = false;  // each task in a forked process of its own (see above)
 };
 
