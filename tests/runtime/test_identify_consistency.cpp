@@ -244,6 +244,16 @@ TEST(PhysicalConsistency, InfeasibleBaseVectorIsReported) {
   EXPECT_LE((base_of<Crane>(r.s) - r.phi_consistent).cwiseAbs().maxCoeff(), 1e-12);
   EXPECT_GE(smallest_link_eigenvalue<Crane>(r.s), -1e-12);
   EXPECT_GE(r.phi_consistent(symoro::crane_x7::param::ZZ7), 0);
+  // Nearest: no farther than the truth's base vector (phi with ZZ7 put back; bound within the
+  // solver's regularization towards the prior), in the documented default metric rebuilt here.
+  const auto st = symoro::identify::consistency_structure<Crane>();
+  const VectorXd scale = symoro::identify::default_consistency_weights(st, truth).cwiseInverse();
+  const int zz7 = symoro::crane_x7::param::ZZ7;
+  const double wb = 1 / (st.B.row(zz7) * scale.asDiagonal()).norm();
+  const double via_truth = wb * std::abs(base_of<Crane>(truth)(zz7) - phi(zz7));
+  std::printf("  distance %.6g, via the truth %.6g\n", r.base_distance, via_truth);
+  EXPECT_LE(r.base_distance, via_truth * (1 + 1e-4));
+  EXPECT_GE(r.base_distance, wb * 0.01);  // ZZ7 >= 0 for every consistent set
   // The change is where phi was impossible: the other identifiable-alone entries barely move.
   EXPECT_NEAR(r.phi_consistent(symoro::crane_x7::param::FV3), phi(symoro::crane_x7::param::FV3), 1e-6);
   // phi_c admits a consistent set: solved again, consistent and mapping onto it.
