@@ -10,6 +10,7 @@
 
 #include <symoro/crane_x7.hpp>
 #include <symoro/rx90.hpp>
+#include <symoro/stanford_rrp.hpp>
 
 #include "symoro/identify/physical_consistency.hpp"
 #include "symoro/identify/physical_consistency_model.hpp"
@@ -26,6 +27,7 @@ using symoro::identify::ConsistencyStatus;
 using Crane = symoro::crane_x7::Model;
 using Reduced = symoro::crane_x7::reduced::Model;
 using Rx90 = symoro::rx90::Model;
+using Rrp = symoro::stanford_rrp::Model;
 
 // The pseudo-inertia of link `link` from the names in Model::standard_parameters (not from the
 // library's index tables): I about the origin, h, m; J = [[tr(I)/2 - I, h], [h', m]].
@@ -178,6 +180,13 @@ TEST(PhysicalConsistency, RandomConsistentRoundTripRx90) {
   for (unsigned seed = 1; seed <= 5; ++seed) {
     symoro::test::Random rng(seed);
     round_trip<Rx90>(symoro::test::random_standard_parameters<Rx90>(rng).s, 300 + seed, 1e-6);
+  }
+}
+
+TEST(PhysicalConsistency, RandomConsistentRoundTripStanfordRrp) {  // a prismatic joint
+  for (unsigned seed = 1; seed <= 3; ++seed) {
+    symoro::test::Random rng(seed);
+    round_trip<Rrp>(symoro::test::random_standard_parameters<Rrp>(rng).s, 400 + seed, 1e-6);
   }
 }
 
