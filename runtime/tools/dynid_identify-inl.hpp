@@ -32,6 +32,7 @@ identify::StudyResult study(const Common& common, const IdentifyOptions& o, bool
   so.threads = o.threads;
   so.fresh = o.fresh;
   so.isolate = !o.in_process;
+  so.rank_timeout = o.rank_timeout;
   so.trajectories = o.only;
   so.validation = o.validation;
   if (!o.intervals_ms.empty()) {

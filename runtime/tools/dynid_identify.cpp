@@ -25,6 +25,11 @@ void add_identify_commands(CLI::App& app, Common& common) {
   cmd->add_option("--trial", o->trial, "Which trial of each trajectory");
   cmd->add_option("-j,--jobs", o->threads, "Worker threads per rank (default: the cores, shared among the MPI ranks on "
                                             "a machine)");
+  cmd->add_option("--rank-timeout", o->rank_timeout, "MPI: seconds of silence after which a rank is taken as lost and "
+                                                    "its runs in flight fail (needs a launcher that keeps the job "
+                                                    "alive, e.g. mpirun --mca orte_enable_recovery 1)")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
   cmd->add_flag("--in-process", o->in_process, "Run the trajectories in threads of this process instead of a process "
                                                "each (for a debugger or a profiler; a crash then ends the study)");
   cmd->add_flag("--wls", o->weighted, "Weighted least squares (per-joint weights) instead of OLS");

@@ -20,6 +20,7 @@ struct IdentifyOptions {
   double torque_delay_ms = 0;
   std::string projection_metric = "information";
   double clie_std_bound = 0;
+  double rank_timeout = 60;
 };
 
 struct IdentifyCommand {

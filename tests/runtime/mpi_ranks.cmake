@@ -5,7 +5,9 @@
 # - RX-90 (no twin, no controller): a study of three synthesized controller exports, the same.
 # - Faults and resume: a trajectory whose log is broken fails its runs (the file and line named)
 #   while the other runs finish, on other ranks, with the same records as before; a rerun on 2
-#   ranks with one more trajectory keeps every finished run and does only the new ones.
+#   ranks with one more trajectory keeps every finished run and does only the new ones; a rank
+#   killed while it runs a trajectory fails that trajectory's runs, the others finish, and a
+#   rerun does the rest.
 # Run with -DDYNID, -DWRITE_EXPORT, -DMPIEXEC, -DNP_FLAG, -DWORK.
 file(REMOVE_RECURSE ${WORK})
 file(MAKE_DIRECTORY ${WORK})
@@ -136,6 +138,55 @@ expect("${out}" "10 runs, 2 ranks x")
 file(TIMESTAMP ${w}/study3/runs/PA06@40ms.yaml after "%s")
 if(NOT before STREQUAL after OR NOT EXISTS ${w}/study3/runs/PC09@80ms.yaml)
   message(FATAL_ERROR "the rerun did not keep the finished runs or did not add PC09")
+endif()
+
+# A rank lost while it runs a trajectory (its process killed; Open MPI told to keep the job
+# alive): that trajectory's runs fail with the reason, the others finish and the study is
+# written; a rerun on 2 ranks does the failed runs only.
+set(lost ${w}/lost-study)
+string(REPLACE ";" " " LAUNCH "${mpi3}")
+string(REPLACE ";" " " ONLY "${only}")
+set(DATA ${w}/data1)
+string(CONFIGURE [=[
+@LAUNCH@ --mca orte_enable_recovery 1 @DYNID@ identify --robot crane_x7 --data @DATA@ --interval 40 80 \
+  --validation V02 --only @ONLY@ -o @lost@ -j 1 --rank-timeout 10 > @lost@.log 2>&1 &
+launcher=$!
+# rank 2's own process, once it runs a trajectory (it has a child: the trajectory's process)
+for i in $(seq 1 400); do
+  for p in $(pgrep -f 'dynid identify'); do
+    if tr '\0' '\n' < /proc/$p/environ 2>/dev/null | grep -qx OMPI_COMM_WORLD_RANK=2 &&
+       [ "$(ps -o comm= -p $(ps -o ppid= -p $p))" != dynid ] && pgrep -P $p > /dev/null; then
+      kill -9 $p
+      wait $launcher
+      exit 0
+    fi
+  done
+  sleep 0.05
+done
+echo 'rank 2 never ran a trajectory'
+kill $launcher
+exit 1
+]=] script @ONLY)
+file(WRITE ${w}/lose_rank.sh "${script}")
+execute_process(COMMAND bash ${w}/lose_rank.sh RESULT_VARIABLE code OUTPUT_VARIABLE out ERROR_VARIABLE err)
+file(READ ${lost}.log log)
+if(NOT code EQUAL 0)
+  message(FATAL_ERROR "${out}${err}\n${log}")
+endif()
+expect("${log}" "FAILED: rank 2 stopped answering for 10 s while running this task")
+expect("${log}" "representative: ")
+if(NOT EXISTS ${lost}/report/report.md)
+  message(FATAL_ERROR "the study with a lost rank wrote no report:\n${log}")
+endif()
+file(GLOB saved ${lost}/runs/*.yaml)
+list(LENGTH saved n_saved)
+run(0 out ${mpi2} ${DYNID} identify --robot crane_x7 --data ${w}/data1 --interval 40 80 --validation V02 --only ${only}
+    -o ${lost})
+expect("${out}" "${n_saved} of 8 runs already finished")
+file(GLOB saved ${lost}/runs/*.yaml)
+list(LENGTH saved n_saved)
+if(NOT n_saved EQUAL 8)
+  message(FATAL_ERROR "the rerun left ${n_saved} of 8 runs")
 endif()
 
 # --- RX-90: three controller exports, no twin and no controller -------------------------------

@@ -16,10 +16,15 @@
 #ifdef SYMORO_WITH_MPI
 #include <mpi.h>
 
+#include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cstdio>
 #include <mutex>
 #include <thread>
+#include <utility>
+
+#include <fmt/format.h>
 #endif
 
 namespace symoro::parallel {
@@ -51,6 +56,7 @@ struct Session {
   Place place;
   int ranks_on_node = 1;
   bool active = false;
+  bool lost_rank = false;  // MPI_Finalize would wait for it
   Session() {
     if (!launched()) return;
     int provided = 0;
@@ -68,7 +74,7 @@ struct Session {
     MPI_Comm_free(&node);
   }
   ~Session() {
-    if (active) MPI_Finalize();
+    if (active && !lost_rank) MPI_Finalize();
   }
 };
 
@@ -77,8 +83,10 @@ Session& session() {
   return s;
 }
 
-constexpr int kRequest = 1, kResult = 2, kBye = 3, kTaskBase = 100;
+constexpr int kRequest = 1, kResult = 2, kBye = 3, kBeat = 4, kEnd = 5, kTaskBase = 100;
 constexpr auto kPoll = std::chrono::milliseconds(2);
+constexpr auto kBeatEvery = std::chrono::seconds(1);
+using Clock = std::chrono::steady_clock;
 
 template <class T>
 void put(std::string& b, T v) {
@@ -147,21 +155,55 @@ FarmSummary coordinate(const std::vector<std::string>& tasks, const Farm& farm, 
   std::vector<std::thread> pool;
   for (int w = 0; w < summary.workers; ++w) pool.emplace_back(worker);
 
+  // Every other rank sends something at least every second (kBeat); one silent for longer than
+  // rank_timeout is taken as lost (its process or node died; the job goes on only when the
+  // launcher lets it, e.g. Open MPI's --mca orte_enable_recovery 1): its tasks in flight fail
+  // with that reason and the others finish.
   int byes = 0;
+  std::vector<Clock::time_point> heard(s.place.ranks, Clock::now());
+  std::vector<bool> done(s.place.ranks, false), lost(s.place.ranks, false);  // done: said bye, or lost
+  std::vector<std::pair<std::int64_t, int>> running;  // (task, rank) handed to other ranks
+  const auto timeout = std::chrono::duration<double>(o.rank_timeout);
   std::string b;
   MPI_Status st;
   while (byes < s.place.ranks - 1) {
     if (!receive(MPI_ANY_SOURCE, MPI_ANY_TAG, b, st)) {
+      const auto now = Clock::now();
+      for (int r = 1; r < s.place.ranks; ++r) {
+        if (done[r] || now - heard[r] < timeout) continue;
+        done[r] = lost[r] = true;
+        ++byes;
+        session().lost_rank = true;
+        for (auto t = running.begin(); t != running.end();) {
+          if (t->second != r) {
+            ++t;
+            continue;
+          }
+          TaskEnd e;
+          e.task = static_cast<std::size_t>(t->first);
+          e.rank = r;
+          e.failed = true;
+          e.failure = fmt::format("rank {} stopped answering for {:g} s while running this task (its process or node was lost)",
+                                  r, o.rank_timeout);
+          ended(e);
+          t = running.erase(t);
+        }
+      }
       std::this_thread::sleep_for(kPoll);
       continue;
     }
+    heard[st.MPI_SOURCE] = Clock::now();
+    if (lost[st.MPI_SOURCE]) continue;  // a rank taken as lost that was only slow: too late
     std::size_t at = 0;
     if (st.MPI_TAG == kRequest) {
       const auto slot = take<std::int32_t>(b, at);
       const std::int64_t i = take_next();
       std::string reply;
       put<std::int64_t>(reply, i);
-      if (i >= 0) reply += tasks[i];
+      if (i >= 0) {
+        reply += tasks[i];
+        running.emplace_back(i, st.MPI_SOURCE);
+      }
       send(reply, st.MPI_SOURCE, kTaskBase + slot);
     } else if (st.MPI_TAG == kResult) {
       const char kind = b[at++];
@@ -177,13 +219,22 @@ FarmSummary coordinate(const std::vector<std::string>& tasks, const Farm& farm, 
         e.wall = take<double>(b, at);
         e.peak_memory_mb = take<double>(b, at);
         e.failure = b.substr(at);
+        running.erase(std::remove(running.begin(), running.end(), std::make_pair(static_cast<std::int64_t>(i), st.MPI_SOURCE)),
+                      running.end());
         ended(e);
       }
     } else if (st.MPI_TAG == kBye) {
+      done[st.MPI_SOURCE] = true;
       ++byes;
     }
   }
   for (auto& t : pool) t.join();
+  // The end, to every rank still there, with whether one was lost: then no rank calls
+  // MPI_Finalize, which would wait for the lost one forever.
+  std::string end;
+  put<std::int32_t>(end, session().lost_rank);
+  for (int r = 1; r < s.place.ranks; ++r)
+    if (!lost[r]) send(end, r, kEnd);
   return summary;
 }
 
@@ -224,9 +275,26 @@ void serve(const Farm& farm, const FarmOptions& o) {
   };
   std::vector<std::thread> pool;
   const int workers = detail::worker_count(o, s.ranks_on_node);
-  for (int w = 0; w < workers; ++w) pool.emplace_back(worker, w);
+  std::atomic<int> finished{0};
+  for (int w = 0; w < workers; ++w)
+    pool.emplace_back([&, w] {
+      worker(w);
+      ++finished;
+    });
+  // This rank is alive: a beat every second while its workers run (a task can take minutes).
+  for (auto last = Clock::now(); finished < workers; std::this_thread::sleep_for(std::chrono::milliseconds(50))) {
+    if (Clock::now() - last < kBeatEvery) continue;
+    last = Clock::now();
+    std::lock_guard<std::mutex> lock(mpi);
+    send(std::string(), 0, kBeat);
+  }
   for (auto& t : pool) t.join();
   send(std::string(), 0, kBye);
+  std::string end;
+  MPI_Status st;
+  while (!receive(0, kEnd, end, st)) std::this_thread::sleep_for(kPoll);
+  std::size_t at = 0;
+  if (take<std::int32_t>(end, at) != 0) session().lost_rank = true;
 }
 
 }  // namespace

@@ -272,6 +272,7 @@ class Study {
     parallel::FarmOptions fo;
     fo.workers = o_.threads;
     fo.isolate = o_.isolate;
+    fo.rank_timeout = o_.rank_timeout;
     const parallel::FarmSummary farmed = parallel::run_farm(tasks, farm, fo);
     out.threads = farmed.workers;
     out.ranks = farmed.ranks;

@@ -38,6 +38,7 @@ struct StudyOptions {
   // out-of-memory kill fails those runs only, and every run starts from the same solver state,
   // so the records do not depend on the thread or rank count or on which runs went before.
   bool isolate = true;
+  double rank_timeout = 60;  // s: MPI only (parallel::FarmOptions::rank_timeout)
   preprocess::Options preprocess;
   LeastSquaresOptions least_squares;
   AuditOptions audit;

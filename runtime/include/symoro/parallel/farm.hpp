@@ -44,6 +44,11 @@ void abort_job(int code);
 struct FarmOptions {
   int workers = 0;       // worker threads per rank; 0: the cores this rank may use (below)
   bool isolate = false;  // each task in a forked process of its own (see above)
+  // MPI: a rank silent this long (it sends a beat every second) is taken as lost and its tasks in
+  // flight fail with that reason; the others finish. Takes effect only where the launcher keeps
+  // the job alive after a process dies (Open MPI: --mca orte_enable_recovery 1); by default
+  // mpirun ends the whole job, and a rerun resumes.
+  double rank_timeout = 60;  // s
 };
 
 // What became of one task, on rank 0.
