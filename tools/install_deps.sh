@@ -7,6 +7,7 @@ packages=(
   libceres-dev coinor-libipopt-dev libsdp-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   libopenmpi-dev openmpi-bin  # optional: the MPI farm and its test (docs/scaling.md)
+  liburdfdom-dev liburdfdom-tools  # optional: dynid export --urdf's tests read the URDF back (urdfdom, check_urdf)
 )
 missing=()
 for p in "${packages[@]}"; do
