@@ -124,8 +124,9 @@ void ExportCommand::run(const Common& common, const ExportOptions& o) {
     export_detail::write_text(yaml, identify::standard_parameters_yaml(d, header));
     export_detail::write_text(csv, identify::standard_parameters_csv(d));
     if (nearest) fmt::print("WARNING: {}; exported the nearest base vector with a consistent set ({:.4g} away)\n", r.message, r.base_distance);
-    fmt::print("consistent standard parameters: {}; max |B s - phi| = {:.3g}, lambda_min = {:.4g}, prior {}\n", r.message,
-               residual, r.lambda_min, prior_what);
+    fmt::print("{}: {}; max |B s - phi| = {:.3g}, lambda_min = {:.4g}, prior {}\n",
+               nearest ? "standard parameters of the nearest consistent base vector" : "consistent standard parameters",
+               r.message, residual, r.lambda_min, prior_what);
     fmt::print("urdf: {}\nstandard parameters: {}, {}\n", urdf.string(), yaml.string(), csv.string());
   }
 }
