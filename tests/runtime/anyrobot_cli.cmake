@@ -4,7 +4,9 @@
 # last joint) of the RX-90 and the Stanford RRP arm (a prismatic joint, left in m) is imported
 # with a 70/30 split, identified with the model without Coulomb friction (`rigid`) and the full
 # one (CLIE skipped and said, open-loop validation on the held-out part), diagnosed (names the
-# friction and the offset) and compared. Run with -DDYNID, -DWRITE_EXPORT, -DWORK.
+# friction and the offset) and compared; the full model's study is exported as a URDF (dynid export
+# --urdf; no twin.yaml, so --prior is required) and, when -DCHECK_URDF names urdfdom's check_urdf,
+# read back with it. Run with -DDYNID, -DWRITE_EXPORT, -DWORK [-DCHECK_URDF].
 file(REMOVE_RECURSE ${WORK})
 file(MAKE_DIRECTORY ${WORK})
 
@@ -68,5 +70,32 @@ foreach(robot rx90 stanford_rrp)
   run(0 out compare --robot ${robot} --before ${w}/study-${before} --after ${w}/study-${after} -o ${w}/gap)
   file(READ ${w}/gap/gap.md gap)
   expect("${gap}" "\\| arm_heldout \\| open-loop \\|")
+
+  # URDF export: a robot without twin.yaml has no prior to take, so it must be given.
+  run(2 out export --robot ${robot} --study ${w}/study-${after} --urdf ${w}/urdf/${robot}.urdf)
+  expect("${out}" "has no twin.yaml to take a prior from: give --prior")
+  run(2 out export --robot ${robot} --model ${before} --study ${w}/study-${after} --urdf ${w}/urdf/${robot}.urdf)
+  expect("${out}" "holds the parameters of model full")
+  run(0 out export --robot ${robot} --study ${w}/study-${after} --urdf ${w}/urdf/${robot}.urdf --prior zero --nearest)
+  expect("${out}" "urdf: .*${robot}.urdf")
+  foreach(f ${robot}.urdf ${robot}.standard.yaml ${robot}.standard.csv)
+    if(NOT EXISTS ${w}/urdf/${f})
+      message(FATAL_ERROR "dynid export wrote no ${f}")
+    endif()
+  endforeach()
+  file(READ ${w}/urdf/${robot}.urdf urdf)
+  expect("${urdf}" "modified Denavit-Hartenberg frame")
+  expect("${urdf}" "<robot name=\"${robot}\">")
+  expect("${urdf}" "<dynamics damping=")
+  # The export's standard parameters are read back as a prior.
+  run(0 out export --robot ${robot} --study ${w}/study-${after} --urdf ${w}/urdf/again.urdf
+      --prior ${w}/urdf/${robot}.standard.yaml --nearest)
+  if(CHECK_URDF)
+    execute_process(COMMAND ${CHECK_URDF} ${w}/urdf/${robot}.urdf RESULT_VARIABLE code OUTPUT_VARIABLE out ERROR_VARIABLE err)
+    if(NOT code EQUAL 0)
+      message(FATAL_ERROR "check_urdf ${w}/urdf/${robot}.urdf: exit ${code}\n${out}\n${err}")
+    endif()
+    expect("${out}" "Successfully Parsed XML")
+  endif()
 endforeach()
 file(REMOVE_RECURSE ${WORK})

@@ -1,0 +1,134 @@
+// dynid export's body for one model (included by the generated units only): the study's
+// accepted base vector -> the physically consistent standard parameters nearest the prior that
+// map onto it exactly -> URDF + standard-parameter YAML/CSV.
+#pragma once
+
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include <fmt/format.h>
+#include <yaml-cpp/yaml.h>
+
+#include "dynid_export.hpp"
+#include "symoro/identify/physical_consistency_model.hpp"
+#include "symoro/identify/urdf_export.hpp"
+#include "symoro/io/parameters_yaml.hpp"
+#include "symoro/twin/config.hpp"
+#include "symoro/twin/truth.hpp"
+
+namespace symoro::dynid {
+
+namespace export_detail {
+
+inline void write_text(const std::filesystem::path& file, const std::string& text) {
+  if (file.has_parent_path()) std::filesystem::create_directories(file.parent_path());
+  std::FILE* f = std::fopen(file.string().c_str(), "wb");
+  if (!f) throw UsageError("cannot write " + file.string());
+  const bool ok = std::fwrite(text.data(), 1, text.size(), f) == text.size();
+  if (std::fclose(f) != 0 || !ok) throw UsageError("cannot write " + file.string());
+}
+
+}  // namespace export_detail
+
+template <class Full, class Model>
+void ExportCommand::run(const Common& common, const ExportOptions& o) {
+  if constexpr (identify::detail::HasEffects<Model>::value) {
+    throw UsageError(fmt::format("model '{}' has model-gap effect parameters, which have no URDF counterpart and no "
+                                 "standard-parameter form: export a study of a model without effects",
+                                 Model::variant_name));
+  } else {
+    using Parent = typename Model::Parent;
+    const std::filesystem::path params = std::filesystem::path(o.study) / "report" / "parameters.yaml";
+    {
+      const YAML::Node root = YAML::LoadFile(params.string());
+      const std::string robot = root["robot"] ? root["robot"].as<std::string>() : std::string();
+      if (!robot.empty() && robot != common.robot)
+        throw UsageError(fmt::format("--robot {}, but {} is a study of '{}'", common.robot, params.string(), robot));
+    }
+    std::vector<std::string> names;
+    for (const auto& p : Model::parameters) names.emplace_back(p.name);
+    const Eigen::VectorXd phi = io::read_parameters_yaml(params.string(), names);
+    const bool accepted = io::parameters_accepted(params.string());
+    if (!accepted && !o.not_accepted)
+      throw UsageError(params.string() + ": the study's final audit did not accept these parameters (accepted: false); "
+                                         "--not-accepted exports them anyway");
+
+    // The prior.
+    std::vector<std::string> standard_names;
+    for (const auto& p : Model::standard_parameters) standard_names.emplace_back(p.name);
+    Eigen::VectorXd prior;
+    std::string prior_what;
+    const auto twin_path = common.robot_dir() / "twin.yaml";
+    if (o.prior == "zero") {
+      prior = Eigen::VectorXd::Zero(Model::ns);
+      prior_what = "zero (the consistent set nearest 0)";
+    } else if (!o.prior.empty()) {
+      prior = io::read_parameters_yaml(o.prior, standard_names);
+      prior_what = o.prior;
+    } else if (std::filesystem::exists(twin_path)) {
+      const twin::TwinConfig tc = twin::read_twin_config(twin_path, Model::nq);
+      prior = twin::make_truth<Parent>(tc).standard;
+      prior_what = twin_path.string() + " (CAD truth)";
+    } else {
+      throw UsageError(fmt::format("robot '{}' has no twin.yaml to take a prior from: give --prior <standard-parameter "
+                                   "YAML> or --prior zero (see dynid export --help)",
+                                   common.robot));
+    }
+
+    identify::ConsistencyOptions co;
+    co.margin = o.margin;
+    const identify::ConsistencyResult r = identify::consistent_standard_parameters<Model>(phi, prior, co);
+    const bool nearest = r.status == identify::ConsistencyStatus::NoConsistentSet && o.nearest;
+    if (!r.ok() && !nearest) {
+      std::string why = fmt::format("no URDF written: {} ({})", r.message, identify::to_string(r.status));
+      if (r.status == identify::ConsistencyStatus::NoConsistentSet)
+        why += fmt::format("; the nearest base vector with a consistent set is {:.4g} away (weighted): --nearest "
+                           "exports that one",
+                           r.base_distance);
+      throw std::runtime_error(why);
+    }
+    // Checked here, independently of the solver's own report.
+    const Eigen::VectorXd target = identify::consistency_target<Model>(phi);
+    const Eigen::VectorXd back = Parent::base_from_standard(Eigen::Matrix<double, Parent::ns, 1>(r.s));
+    const double residual = (back - target).cwiseAbs().maxCoeff();
+
+    identify::UrdfDescription d = identify::urdf_description<Model>(r.s);
+    const std::string model_label = std::string(Model::variant_name).empty() ? "full" : Model::variant_name;
+    d.notes.push_back(fmt::format("Model: {} ({}), {} base parameters. Study: {}{}.", Model::robot_name, model_label,
+                                  Model::np, std::filesystem::absolute(o.study).lexically_normal().string(),
+                                  accepted ? "" : " (NOT accepted by its final audit)"));
+    if (nearest)
+      d.notes.push_back(fmt::format("WARNING: no consistent set reproduces the accepted base parameters ({}); these "
+                                    "inertials reproduce the nearest base vector that has one, {:.4g} away (weighted): "
+                                    "max |B s - phi| below is against the accepted vector.",
+                                    r.message, r.base_distance));
+    d.notes.push_back(fmt::format("Inertials: the physically consistent standard parameters (pseudo-inertia >= {} I per "
+                                  "link) nearest the prior {} that reproduce {}: max |B s - phi| = {:.3g} (phi the "
+                                  "accepted vector), smallest pseudo-inertia eigenvalue {:.6g}.",
+                                  o.margin, prior_what,
+                                  nearest ? "the nearest consistent base vector" : "the accepted base parameters",
+                                  residual, r.lambda_min));
+    const std::filesystem::path urdf = o.urdf;
+    std::filesystem::path stem = urdf;
+    stem.replace_extension();
+    const std::filesystem::path yaml = stem.string() + ".standard.yaml", csv = stem.string() + ".standard.csv";
+
+    std::string header = "# Physically consistent standard parameters (dynid export) reproducing a study's accepted base\n"
+                         "# parameters; the URDF " + urdf.filename().string() + " holds them but for IA.\n";
+    header += fmt::format("robot: \"{}\"\nmodel: \"{}\"\nstudy: \"{}\"\nprior: \"{}\"\naccepted: {}\nnearest_consistent_base: {}\nmargin: {}\n"
+                          "lambda_min: {}\nbase_residual: {}\n",
+                          Model::robot_name, model_label, o.study, prior_what, accepted, nearest, o.margin,
+                          r.lambda_min, residual);
+    export_detail::write_text(urdf, identify::urdf_text(d));
+    export_detail::write_text(yaml, identify::standard_parameters_yaml(d, header));
+    export_detail::write_text(csv, identify::standard_parameters_csv(d));
+    if (nearest) fmt::print("WARNING: {}; exported the nearest base vector with a consistent set ({:.4g} away)\n", r.message, r.base_distance);
+    fmt::print("{}: {}; max |B s - phi| = {:.3g}, lambda_min = {:.4g}, prior {}\n",
+               nearest ? "standard parameters of the nearest consistent base vector" : "consistent standard parameters",
+               r.message, residual, r.lambda_min, prior_what);
+    fmt::print("urdf: {}\nstandard parameters: {}, {}\n", urdf.string(), yaml.string(), csv.string());
+  }
+}
+
+}  // namespace symoro::dynid

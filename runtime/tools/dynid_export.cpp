@@ -1,0 +1,70 @@
+// dynid export --urdf: a study's accepted base parameters as a URDF of the robot with
+// physically consistent inertials (identify/physical_consistency.hpp, identify/urdf_export.hpp),
+// and the standard parameters beside it (<name>.standard.yaml, <name>.standard.csv).
+#include <filesystem>
+
+#include <CLI/CLI.hpp>
+#include <fmt/format.h>
+#include <yaml-cpp/yaml.h>
+
+#include "dynid_export.hpp"
+
+namespace symoro::dynid {
+
+namespace {
+
+// The model label the study was identified with (report/parameters.yaml `model:`; "" is the
+// full model), to pick the instantiation when --model is not given.
+std::string study_model(const std::string& file) {
+  try {
+    const YAML::Node root = YAML::LoadFile(file);
+    const std::string m = root["model"] ? root["model"].as<std::string>() : std::string();
+    return m.empty() ? "full" : m;
+  } catch (const YAML::BadFile&) {
+    throw UsageError(file + ": not found (is --study a dynid identify folder with its report?)");
+  } catch (const YAML::Exception& e) {
+    throw UsageError(file + ": invalid YAML: " + e.what());
+  }
+}
+
+}  // namespace
+
+void add_export_commands(CLI::App& app, Common& common) {
+  auto o = std::make_shared<ExportOptions>();
+  auto* cmd = app.add_subcommand(
+      "export",
+      "A study's accepted base parameters as a URDF with physically consistent inertials (one link per modified-DH "
+      "frame of the model), joint damping/friction from FV/FS, and the standard parameters as YAML and CSV");
+  cmd->add_option("--robot", common.robot, "Robot folder name under robots/")->required();
+  cmd->add_option("--robots-dir", common.robots_dir, "Where the robot folders are");
+  cmd->add_option("--study", o->study, "Study folder of dynid identify (reads report/parameters.yaml)")
+      ->required()
+      ->check(CLI::ExistingDirectory);
+  cmd->add_option("--urdf", o->urdf, "URDF file to write; <stem>.standard.yaml and <stem>.standard.csv go beside it")
+      ->required();
+  cmd->add_option("--model", o->model, "Model the study identified (checked; default: the study's own)");
+  cmd->add_option("--prior", o->prior,
+                  "Standard parameters the consistent set is drawn towards where the base parameters leave it free: "
+                  "a YAML with every standard parameter (e.g. an earlier export's .standard.yaml), or `zero` "
+                  "(the consistent set nearest 0: smallest masses and inertias, a generic choice with no physical "
+                  "meaning for the unidentifiable part). Default: the CAD truth of robots/<robot>/twin.yaml; a robot "
+                  "without twin.yaml needs --prior");
+  cmd->add_option("--margin", o->margin, "Strictness of the consistency: every link's pseudo-inertia >= margin I "
+                                         "(kg m^2 / kg)")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
+  cmd->add_flag("--not-accepted", o->not_accepted, "Export even when the study's final audit did not accept its "
+                                                   "parameters");
+  cmd->add_flag("--nearest", o->nearest, "When no consistent set reproduces the accepted base parameters, export the "
+                                         "consistent set of the nearest base vector that has one (said in the files) "
+                                         "instead of failing");
+  cmd->callback([&common, o] {
+    const std::string file = (std::filesystem::path(o->study) / "report" / "parameters.yaml").string();
+    const std::string label = study_model(file);
+    if (!o->model.empty() && o->model != label)
+      throw UsageError(fmt::format("--model {}, but {} holds the parameters of model {}", o->model, file, label));
+    export_units().model(common, label)(common, *o);
+  });
+}
+
+}  // namespace symoro::dynid

@@ -1,0 +1,25 @@
+// dynid export's options and its entry, compiled per model of each robot (any variant:
+// --model) in generated units; the body is in dynid_export-inl.hpp.
+#pragma once
+
+#include <string>
+
+#include "dynid_dispatch.hpp"
+
+namespace symoro::dynid {
+
+struct ExportOptions {
+  std::string study, urdf, model, prior;
+  double margin = 0;
+  bool not_accepted = false, nearest = false;
+};
+
+struct ExportCommand {
+  using Options = ExportOptions;
+  template <class Full, class Model>
+  static void run(const Common& common, const Options& o);
+};
+
+const CommandTable<ExportOptions>& export_units();  // generated: dynid_tables.cpp
+
+}  // namespace symoro::dynid
