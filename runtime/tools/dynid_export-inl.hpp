@@ -3,6 +3,8 @@
 // map onto it exactly -> URDF + standard-parameter YAML/CSV.
 #pragma once
 
+#include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <string>
 #include <vector>
@@ -11,7 +13,11 @@
 #include <yaml-cpp/yaml.h>
 
 #include "dynid_export.hpp"
+#include "symoro/identify/dataset.hpp"
 #include "symoro/identify/physical_consistency_model.hpp"
+#include "symoro/identify/regression.hpp"
+#include "symoro/io/atomic_file.hpp"
+#include "symoro/preprocess/preprocess.hpp"
 #include "symoro/identify/urdf_export.hpp"
 #include "symoro/io/parameters_yaml.hpp"
 #include "symoro/twin/config.hpp"
@@ -23,10 +29,31 @@ namespace export_detail {
 
 inline void write_text(const std::filesystem::path& file, const std::string& text) {
   if (file.has_parent_path()) std::filesystem::create_directories(file.parent_path());
-  std::FILE* f = std::fopen(file.string().c_str(), "wb");
-  if (!f) throw UsageError("cannot write " + file.string());
-  const bool ok = std::fwrite(text.data(), 1, text.size(), f) == text.size();
-  if (std::fclose(f) != 0 || !ok) throw UsageError("cannot write " + file.string());
+  io::write_file_atomically(file, text);
+}
+
+// What the nearest consistent base vector costs on the study's fitting data: the representative
+// run (parameters.yaml's source_run, e.g. "PA11@10ms") of the dataset, preprocessed with the
+// default options, through the full model's regression (a variant's fixed parameters included).
+template <class Full>
+std::string torque_cost(const std::filesystem::path& params, const std::string& data_dir, int trial,
+                        const Eigen::VectorXd& phi_full, const Eigen::VectorXd& phi_consistent_full) {
+  const std::string run_id = YAML::LoadFile(params.string())["source_run"].as<std::string>("");
+  const auto at = run_id.find('@');
+  if (at == std::string::npos || run_id.size() < at + 4)
+    throw UsageError(fmt::format("{}: no source_run like PA11@10ms to measure the torque on", params.string()));
+  const std::string name = run_id.substr(0, at);
+  const double interval = std::stod(run_id.substr(at + 1)) / 1000;
+  const identify::Dataset data = identify::read_dataset(data_dir);
+  io::Log log = identify::read_run_log(data.find(name, trial), Full::robot_name, Full::nq);
+  if (log.samples() > 0) log.time.array() -= log.time(0);
+  const identify::Regression reg = identify::stack_regression<Full>(preprocess::preprocess(log, interval, {}));
+  auto rms = [](const Eigen::VectorXd& v) { return std::sqrt(v.squaredNorm() / std::max<Eigen::Index>(1, v.size())); };
+  const Eigen::VectorXd change = reg.W * (phi_consistent_full - phi_full);
+  return fmt::format("on {} (trial {}, {} samples), the nearest consistent vector changes the predicted torque by RMS "
+                     "{:.4g} N m (max {:.4g}); the fit's RMS residual goes from {:.4g} to {:.4g} N m",
+                     run_id, trial, reg.samples, rms(change), change.cwiseAbs().maxCoeff(), rms(reg.y - reg.W * phi_full),
+                     rms(reg.y - reg.W * phi_consistent_full));
 }
 
 }  // namespace export_detail
@@ -80,16 +107,20 @@ void ExportCommand::run(const Common& common, const ExportOptions& o) {
     co.margin = o.margin;
     const identify::ConsistencyResult r = identify::consistent_standard_parameters<Model>(phi, prior, co);
     const bool nearest = r.status == identify::ConsistencyStatus::NoConsistentSet && o.nearest;
+    // Checked here, independently of the solver's own report.
+    const Eigen::VectorXd target = identify::consistency_target<Model>(phi);
+    std::string cost;
+    if (r.status == identify::ConsistencyStatus::NoConsistentSet)
+      cost = o.data.empty() ? "--data <the study's dataset> measures the torque it costs on the fitting data"
+                            : export_detail::torque_cost<Parent>(params, o.data, o.trial, target, r.phi_consistent);
     if (!r.ok() && !nearest) {
       std::string why = fmt::format("no URDF written: {} ({})", r.message, identify::to_string(r.status));
       if (r.status == identify::ConsistencyStatus::NoConsistentSet)
         why += fmt::format("; the nearest base vector with a consistent set is {:.4g} away (weighted): --nearest "
-                           "exports that one",
-                           r.base_distance);
+                           "exports that one; {}",
+                           r.base_distance, cost);
       throw std::runtime_error(why);
     }
-    // Checked here, independently of the solver's own report.
-    const Eigen::VectorXd target = identify::consistency_target<Model>(phi);
     const Eigen::VectorXd back = Parent::base_from_standard(Eigen::Matrix<double, Parent::ns, 1>(r.s));
     const double residual = (back - target).cwiseAbs().maxCoeff();
 
@@ -101,8 +132,8 @@ void ExportCommand::run(const Common& common, const ExportOptions& o) {
     if (nearest)
       d.notes.push_back(fmt::format("WARNING: no consistent set reproduces the accepted base parameters ({}); these "
                                     "inertials reproduce the nearest base vector that has one, {:.4g} away (weighted): "
-                                    "max |B s - phi| below is against the accepted vector.",
-                                    r.message, r.base_distance));
+                                    "max |B s - phi| below is against the accepted vector. {}.",
+                                    r.message, r.base_distance, cost));
     d.notes.push_back(fmt::format("Inertials: the physically consistent standard parameters (pseudo-inertia >= {} I per "
                                   "link) nearest the prior {} that reproduce {}: max |B s - phi| = {:.3g} (phi the "
                                   "accepted vector), smallest pseudo-inertia eigenvalue {:.6g}.",
@@ -123,7 +154,9 @@ void ExportCommand::run(const Common& common, const ExportOptions& o) {
     export_detail::write_text(urdf, identify::urdf_text(d));
     export_detail::write_text(yaml, identify::standard_parameters_yaml(d, header));
     export_detail::write_text(csv, identify::standard_parameters_csv(d));
-    if (nearest) fmt::print("WARNING: {}; exported the nearest base vector with a consistent set ({:.4g} away)\n", r.message, r.base_distance);
+    if (nearest)
+      fmt::print("WARNING: {}; exported the nearest base vector with a consistent set ({:.4g} away); {}\n", r.message,
+                 r.base_distance, cost);
     fmt::print("{}: {}; max |B s - phi| = {:.3g}, lambda_min = {:.4g}, prior {}\n",
                nearest ? "standard parameters of the nearest consistent base vector" : "consistent standard parameters",
                r.message, residual, r.lambda_min, prior_what);

@@ -9,8 +9,9 @@
 namespace symoro::dynid {
 
 struct ExportOptions {
-  std::string study, urdf, model, prior;
+  std::string study, urdf, model, prior, data;
   double margin = 0;
+  int trial = 1;
   bool not_accepted = false, nearest = false;
 };
 

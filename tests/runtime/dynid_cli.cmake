@@ -117,6 +117,20 @@ file(WRITE ${WORK}/control/dataset.yaml "format: symoro-dataset 1\nrobot: crane_
 run(0 out identify --robot crane_x7 --data ${WORK}/control -o ${WORK}/control/study --interval 20)
 expect("${out}" "CLIE: 1 runs\n")
 expect("${out}" "representative: V02@20ms")
+# export: this one-run study's accepted vector has no physically consistent standard set (it
+# is PD over the audit box, which is necessary, not sufficient): no URDF, the nearest consistent
+# vector's distance and the torque it costs on the fitting run; --nearest writes that one, said
+# in the URDF.
+run(1 out export --robot crane_x7 --study ${WORK}/control/study --urdf ${WORK}/control/crane.urdf --data ${WORK}/control)
+expect("${out}" "no URDF written: no consistent standard set maps onto phi")
+expect("${out}" "on V02@20ms \\(trial 1, [0-9]+ samples\\), the nearest consistent vector changes the predicted torque by RMS [0-9.e-]+ N m")
+if(EXISTS ${WORK}/control/crane.urdf)
+  message(FATAL_ERROR "a refused export wrote its URDF")
+endif()
+run(0 out export --robot crane_x7 --study ${WORK}/control/study --urdf ${WORK}/control/crane.urdf --data ${WORK}/control --nearest)
+file(READ ${WORK}/control/crane.urdf urdf)
+expect("${urdf}" "WARNING: no consistent set reproduces the accepted base parameters")
+expect("${urdf}" "<robot name=\"crane_x7\"")
 # A log is never overwritten: refused, or written under a new name.
 run(2 out control --robot crane_x7 --virtual --trajectory AG02 --seconds 1 -o ${WORK}/control/run.csv)
 expect("${out}" "control/run.csv exists: a run never overwrites a log")
