@@ -143,11 +143,13 @@ endif()
 # A rank lost while it runs a trajectory (its process killed; Open MPI told to keep the job
 # alive): that trajectory's runs fail with the reason, the others finish and the study is
 # written; a rerun on 2 ranks does the failed runs only.
-set(lost ${w}/lost-study)
-string(REPLACE ";" " " LAUNCH "${mpi3}")
-string(REPLACE ";" " " ONLY "${only}")
-set(DATA ${w}/data1)
-string(CONFIGURE [=[
+# (orte_enable_recovery is Open MPI 4's; Open MPI 5 has ULFM instead: not covered here.)
+if(version MATCHES "(Open MPI|OpenRTE)\\) 4\\.")
+  set(lost ${w}/lost-study)
+  string(REPLACE ";" " " LAUNCH "${mpi3}")
+  string(REPLACE ";" " " ONLY "${only}")
+  set(DATA ${w}/data1)
+  string(CONFIGURE [=[
 @LAUNCH@ --mca orte_enable_recovery 1 @DYNID@ identify --robot crane_x7 --data @DATA@ --interval 40 80 \
   --validation V02 --only @ONLY@ -o @lost@ -j 1 --rank-timeout 10 > @lost@.log 2>&1 &
 launcher=$!
@@ -167,26 +169,30 @@ echo 'rank 2 never ran a trajectory'
 kill $launcher
 exit 1
 ]=] script @ONLY)
-file(WRITE ${w}/lose_rank.sh "${script}")
-execute_process(COMMAND bash ${w}/lose_rank.sh RESULT_VARIABLE code OUTPUT_VARIABLE out ERROR_VARIABLE err)
-file(READ ${lost}.log log)
-if(NOT code EQUAL 0)
-  message(FATAL_ERROR "${out}${err}\n${log}")
-endif()
-expect("${log}" "FAILED: rank 2 stopped answering for 10 s while running this task")
-expect("${log}" "representative: ")
-if(NOT EXISTS ${lost}/report/report.md)
-  message(FATAL_ERROR "the study with a lost rank wrote no report:\n${log}")
-endif()
-file(GLOB saved ${lost}/runs/*.yaml)
-list(LENGTH saved n_saved)
-run(0 out ${mpi2} ${DYNID} identify --robot crane_x7 --data ${w}/data1 --interval 40 80 --validation V02 --only ${only}
-    -o ${lost})
-expect("${out}" "${n_saved} of 8 runs already finished")
-file(GLOB saved ${lost}/runs/*.yaml)
-list(LENGTH saved n_saved)
-if(NOT n_saved EQUAL 8)
-  message(FATAL_ERROR "the rerun left ${n_saved} of 8 runs")
+  file(WRITE ${w}/lose_rank.sh "${script}")
+  execute_process(COMMAND bash ${w}/lose_rank.sh RESULT_VARIABLE code OUTPUT_VARIABLE out ERROR_VARIABLE err)
+  file(READ ${lost}.log log)
+  if(NOT code EQUAL 0)
+    message(FATAL_ERROR "${out}${err}\n${log}")
+  endif()
+  expect("${log}" "FAILED: rank 2 stopped answering for 10 s while running this task")
+  expect("${log}" "representative: ")
+  if(NOT EXISTS ${lost}/report/report.md)
+    message(FATAL_ERROR "the study with a lost rank wrote no report:\n${log}")
+  endif()
+  file(GLOB saved ${lost}/runs/*.yaml)
+  list(LENGTH saved n_saved)
+  run(0 out ${mpi2} ${DYNID} identify --robot crane_x7 --data ${w}/data1 --interval 40 80 --validation V02 --only ${only}
+      -o ${lost})
+  expect("${out}" "${n_saved} of 8 runs already finished")
+  file(GLOB saved ${lost}/runs/*.yaml)
+  list(LENGTH saved n_saved)
+  if(NOT n_saved EQUAL 8)
+    message(FATAL_ERROR "the rerun left ${n_saved} of 8 runs")
+  endif()
+
+else()
+  message(STATUS "lost-rank check skipped: it needs Open MPI 4's orte_enable_recovery")
 endif()
 
 # --- RX-90: three controller exports, no twin and no controller -------------------------------
