@@ -6,9 +6,11 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <vector>
 
+#include <Eigen/QR>
 #include <fmt/format.h>
 #include <yaml-cpp/yaml.h>
 
@@ -32,28 +34,44 @@ inline void write_text(const std::filesystem::path& file, const std::string& tex
   io::write_file_atomically(file, text);
 }
 
-// What the nearest consistent base vector costs on the study's fitting data: the representative
-// run (parameters.yaml's source_run, e.g. "PA11@10ms") of the dataset, preprocessed with the
-// default options, through the full model's regression (a variant's fixed parameters included).
+// The study's fitting data: its representative run (parameters.yaml's source_run, e.g.
+// "PA11@10ms") of the dataset, preprocessed with the default options, through the full model's
+// regression (a variant's fixed parameters included).
+struct FittingRun {
+  std::string id;
+  int trial = 1;
+  identify::Regression reg;
+};
+
 template <class Full>
-std::string torque_cost(const std::filesystem::path& params, const std::string& data_dir, int trial,
-                        const Eigen::VectorXd& phi_full, const Eigen::VectorXd& phi_consistent_full) {
-  const std::string run_id = YAML::LoadFile(params.string())["source_run"].as<std::string>("");
-  const auto at = run_id.find('@');
-  if (at == std::string::npos || run_id.size() < at + 4)
+FittingRun fitting_run(const std::filesystem::path& params, const std::string& data_dir, int trial) {
+  FittingRun f;
+  f.id = YAML::LoadFile(params.string())["source_run"].as<std::string>("");
+  f.trial = trial;
+  const auto at = f.id.find('@');
+  if (at == std::string::npos || f.id.size() < at + 4)
     throw UsageError(fmt::format("{}: no source_run like PA11@10ms to measure the torque on", params.string()));
-  const std::string name = run_id.substr(0, at);
-  const double interval = std::stod(run_id.substr(at + 1)) / 1000;
   const identify::Dataset data = identify::read_dataset(data_dir);
-  io::Log log = identify::read_run_log(data.find(name, trial), Full::robot_name, Full::nq);
+  io::Log log = identify::read_run_log(data.find(f.id.substr(0, at), trial), Full::robot_name, Full::nq);
   if (log.samples() > 0) log.time.array() -= log.time(0);
-  const identify::Regression reg = identify::stack_regression<Full>(preprocess::preprocess(log, interval, {}));
+  f.reg = identify::stack_regression<Full>(preprocess::preprocess(log, std::stod(f.id.substr(at + 1)) / 1000, {}));
+  return f;
+}
+
+// R with |R d| = the RMS over the run's rows of W d: the metric of the predicted torque.
+inline Eigen::MatrixXd torque_metric_root(const identify::Regression& reg) {
+  const Eigen::MatrixXd W = reg.W / std::sqrt(static_cast<double>(std::max<Eigen::Index>(1, reg.W.rows())));
+  return Eigen::HouseholderQR<Eigen::MatrixXd>(W).matrixQR().topRows(W.cols()).triangularView<Eigen::Upper>();
+}
+
+inline std::string torque_cost(const FittingRun& f, const Eigen::VectorXd& phi, const Eigen::VectorXd& phi_consistent) {
   auto rms = [](const Eigen::VectorXd& v) { return std::sqrt(v.squaredNorm() / std::max<Eigen::Index>(1, v.size())); };
-  const Eigen::VectorXd change = reg.W * (phi_consistent_full - phi_full);
-  return fmt::format("on {} (trial {}, {} samples), the nearest consistent vector changes the predicted torque by RMS "
-                     "{:.4g} N m (max {:.4g}); the fit's RMS residual goes from {:.4g} to {:.4g} N m",
-                     run_id, trial, reg.samples, rms(change), change.cwiseAbs().maxCoeff(), rms(reg.y - reg.W * phi_full),
-                     rms(reg.y - reg.W * phi_consistent_full));
+  const Eigen::VectorXd change = f.reg.W * (phi_consistent - phi);
+  return fmt::format("on {} (trial {}, {} samples), the nearest consistent vector (nearest in this run's predicted "
+                     "torque) changes the predicted torque by RMS {:.4g} N m (max {:.4g}); the fit's RMS residual "
+                     "goes from {:.4g} to {:.4g} N m",
+                     f.id, f.trial, f.reg.samples, rms(change), change.cwiseAbs().maxCoeff(), rms(f.reg.y - f.reg.W * phi),
+                     rms(f.reg.y - f.reg.W * phi_consistent));
 }
 
 }  // namespace export_detail
@@ -105,14 +123,20 @@ void ExportCommand::run(const Common& common, const ExportOptions& o) {
 
     identify::ConsistencyOptions co;
     co.margin = o.margin;
+    std::optional<export_detail::FittingRun> fitting;
+    if (!o.data.empty()) {
+      fitting = export_detail::fitting_run<Parent>(params, o.data, o.trial);
+      co.base_metric_root = export_detail::torque_metric_root(fitting->reg);
+    }
     const identify::ConsistencyResult r = identify::consistent_standard_parameters<Model>(phi, prior, co);
     const bool nearest = r.status == identify::ConsistencyStatus::NoConsistentSet && o.nearest;
     // Checked here, independently of the solver's own report.
     const Eigen::VectorXd target = identify::consistency_target<Model>(phi);
     std::string cost;
     if (r.status == identify::ConsistencyStatus::NoConsistentSet)
-      cost = o.data.empty() ? "--data <the study's dataset> measures the torque it costs on the fitting data"
-                            : export_detail::torque_cost<Parent>(params, o.data, o.trial, target, r.phi_consistent);
+      cost = fitting ? export_detail::torque_cost(*fitting, target, r.phi_consistent)
+                     : "--data <the study's dataset> measures the torque it costs on the fitting data (and takes the "
+                       "nearest vector in that metric)";
     if (!r.ok() && !nearest) {
       std::string why = fmt::format("no URDF written: {} ({})", r.message, identify::to_string(r.status));
       if (r.status == identify::ConsistencyStatus::NoConsistentSet)

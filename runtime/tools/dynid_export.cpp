@@ -56,7 +56,8 @@ void add_export_commands(CLI::App& app, Common& common) {
   cmd->add_flag("--not-accepted", o->not_accepted, "Export even when the study's final audit did not accept its "
                                                    "parameters");
   cmd->add_option("--data", o->data, "The study's dataset: when no consistent set reproduces the accepted parameters, "
-                                     "the torque the nearest consistent vector costs on the fitting run")
+                                     "the nearest consistent vector is the one that changes the predicted torque on "
+                                     "the study's fitting run least, and that change is reported")
       ->check(CLI::ExistingDirectory);
   cmd->add_option("--trial", o->trial, "Which trial of the fitting run (with --data)")->capture_default_str();
   cmd->add_flag("--nearest", o->nearest, "When no consistent set reproduces the accepted base parameters, export the "

@@ -270,6 +270,36 @@ TEST(PhysicalConsistency, InfeasibleBaseVectorIsReported) {
   expect_consistent<Crane>(again, r.phi_consistent, 0);
 }
 
+// The nearest consistent base vector in a full metric (base_metric_root R, e.g. a regression's
+// R factor: the predicted torque): its distance is |R (phi_c - phi)|, and it is no farther in R's
+// metric than the default metric's answer (and that one no farther in the default metric).
+TEST(PhysicalConsistency, InfeasibleBaseVectorInAFullMetric) {
+  symoro::test::Random rng(7);
+  const VectorXd truth = symoro::test::random_standard_parameters<Crane>(rng).s;
+  VectorXd phi = base_of<Crane>(truth);
+  phi(symoro::crane_x7::param::ZZ7) = -0.01;
+  const ConsistencyResult d = symoro::identify::consistent_standard_parameters<Crane>(phi, truth);
+  ASSERT_EQ(d.status, ConsistencyStatus::NoConsistentSet) << d.message;
+  // A random well-conditioned R, rows coupling every base parameter.
+  Eigen::MatrixXd R = Eigen::MatrixXd::Identity(Crane::np, Crane::np);
+  for (int i = 0; i < Crane::np; ++i)
+    for (int j = 0; j < Crane::np; ++j) R(i, j) += 0.3 * rng.uniform(-1, 1);
+  symoro::identify::ConsistencyOptions o;
+  o.base_metric_root = R;
+  const ConsistencyResult m = symoro::identify::consistent_standard_parameters<Crane>(phi, truth, o);
+  ASSERT_EQ(m.status, ConsistencyStatus::NoConsistentSet) << m.message;
+  EXPECT_NEAR(m.base_distance, (R * (m.phi_consistent - phi)).norm(), 1e-12 * (1 + m.base_distance));
+  EXPECT_LE((base_of<Crane>(m.s) - m.phi_consistent).cwiseAbs().maxCoeff(), 1e-12);
+  EXPECT_GE(smallest_link_eigenvalue<Crane>(m.s), -1e-12);
+  const double in_r_default = (R * (d.phi_consistent - phi)).norm();
+  std::printf("  R metric: its answer %.6g, the default metric's answer %.6g\n", m.base_distance, in_r_default);
+  EXPECT_LE(m.base_distance, in_r_default * (1 + 1e-4));
+  const ConsistencyResult again = symoro::identify::consistent_standard_parameters<Crane>(m.phi_consistent, truth);
+  expect_consistent<Crane>(again, m.phi_consistent, 0);
+  o.base_metric_root = Eigen::MatrixXd::Identity(3, 4);
+  EXPECT_THROW(symoro::identify::consistent_standard_parameters<Crane>(phi, truth, o), std::invalid_argument);
+}
+
 // A parameter B fixes on its own out of its bounds (FV3 < 0): no set, and the message says which.
 TEST(PhysicalConsistency, FixedParameterOutOfBounds) {
   symoro::test::Random rng(6);

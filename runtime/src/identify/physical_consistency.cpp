@@ -218,34 +218,40 @@ std::vector<double> targets(const Setup& S, double relative) {
 // in u = W (s - s0) = sigma v, sigma the size of the prior's gap so that v is O(1).
 void nearest_consistent(const Setup& S, const ConsistencyOptions& o, ConsistencyResult& r) {
   const Eigen::Index ns = S.s0.size(), np = S.phi.size();
-  Eigen::VectorXd wb = o.base_weights;
-  if (!wb.size()) {
-    wb.resize(np);
-    for (Eigen::Index i = 0; i < np; ++i) {
-      const double n = S.Bt.row(i).norm();
-      wb(i) = n > 0 ? 1 / n : 1;
+  // W_b: the full base metric's root when given, else the diagonal weights.
+  Eigen::MatrixXd Wb = o.base_metric_root;
+  if (!Wb.size()) {
+    Eigen::VectorXd wb = o.base_weights;
+    if (!wb.size()) {
+      wb.resize(np);
+      for (Eigen::Index i = 0; i < np; ++i) {
+        const double n = S.Bt.row(i).norm();
+        wb(i) = n > 0 ? 1 / n : 1;
+      }
     }
+    Wb = wb.asDiagonal();
   }
-  const Eigen::VectorXd gap = wb.cwiseProduct(S.st.B * S.s0 - S.phi);
+  const Eigen::Index nr = Wb.rows();
+  const Eigen::VectorXd gap = Wb * (S.st.B * S.s0 - S.phi);
   const double sigma = std::max({gap.norm(), S.up.norm(), 1e-9});
-  const Eigen::MatrixXd A = wb.asDiagonal() * S.Bt;  // d(weighted residual) / du
+  const Eigen::MatrixXd A = Wb * S.Bt;  // d(weighted residual) / du
 
   const int nv = static_cast<int>(ns), t1 = nv, t2 = nv + 1;
   detail::LmiProblem lmi(nv + 2);
   {  // tau1 >= |gap / sigma + A v|^2
-    Eigen::MatrixXd C = Eigen::MatrixXd::Identity(np + 1, np + 1);
-    C(np, np) = 0;
-    C.col(np).head(np) = gap / sigma;
-    C.row(np).head(np) = (gap / sigma).transpose();
+    Eigen::MatrixXd C = Eigen::MatrixXd::Identity(nr + 1, nr + 1);
+    C(nr, nr) = 0;
+    C.col(nr).head(nr) = gap / sigma;
+    C.row(nr).head(nr) = (gap / sigma).transpose();
     const int b = lmi.add_block(C);
     for (int j = 0; j < nv; ++j) {
-      Eigen::MatrixXd E = Eigen::MatrixXd::Zero(np + 1, np + 1);
-      E.col(np).head(np) = A.col(j);
-      E.row(np).head(np) = A.col(j).transpose();
+      Eigen::MatrixXd E = Eigen::MatrixXd::Zero(nr + 1, nr + 1);
+      E.col(nr).head(nr) = A.col(j);
+      E.row(nr).head(nr) = A.col(j).transpose();
       if (!E.isZero(0)) lmi.set_coefficient(b, j, E);
     }
-    Eigen::MatrixXd E = Eigen::MatrixXd::Zero(np + 1, np + 1);
-    E(np, np) = 1;
+    Eigen::MatrixXd E = Eigen::MatrixXd::Zero(nr + 1, nr + 1);
+    E(nr, nr) = 1;
     lmi.set_coefficient(b, t1, E);
   }
   add_norm_block(lmi, 0, nv, t2);  // tau2 >= |v|^2
@@ -265,7 +271,7 @@ void nearest_consistent(const Setup& S, const ConsistencyOptions& o, Consistency
   const Eigen::VectorXd s = S.standard(sigma * sol.y.head(nv));
   r.phi_consistent = S.st.B * s;
   evaluate(S, s, S.phi, r);
-  r.base_distance = wb.cwiseProduct(r.phi_consistent - S.phi).norm();
+  r.base_distance = (Wb * (r.phi_consistent - S.phi)).norm();
   r.message = fmt::format(
       "no consistent standard set maps onto phi (phase 1: the best smallest-eigenvalue margin is {:.3g} of the "
       "links' size); the nearest base vector that has one is phi_consistent, at distance {:.6g} (max |change| {:.3g}); "
@@ -333,6 +339,9 @@ ConsistencyResult consistent_standard_parameters(const ConsistencyStructure& st,
   require(!o.upper.size() || o.upper.size() == ns, "upper must have one entry per standard parameter");
   require(!o.base_weights.size() || (o.base_weights.size() == np && (o.base_weights.array() > 0).all()),
           "base_weights must be positive, one per base parameter");
+  require(!o.base_metric_root.size() || (o.base_metric_root.cols() == np && o.base_metric_root.allFinite() &&
+                                         o.base_metric_root.rows() > 0),
+          "base_metric_root must have one column per base parameter and finite entries");
   require(std::isfinite(o.margin) && o.margin >= 0, "the margin must be >= 0");
 
   const Setup S(st, phi, prior, o);

@@ -51,6 +51,11 @@ struct ConsistencyOptions {
   // consistent set (size np); empty: 1 / |row i of B diag(1 / weights)|, i.e. each base
   // parameter in the scale of the standard parameters it combines.
   Eigen::VectorXd base_weights;
+  // A full metric instead (it wins over base_weights): distance |R (phi_c - phi)|, R with one
+  // column per base parameter. With R = the R factor of a run's regression W / sqrt(rows), the
+  // distance is the RMS change of the predicted torque on that run, and phi_c the consistent
+  // base vector that changes it least (dynid export --data).
+  Eigen::MatrixXd base_metric_root;
   // A phase-1 verdict t >= -feasibility_tolerance (t: the smallest eigenvalue margin relative to
   // each link's size) counts as feasible; the solve then asks for margin + t (a touch below).
   double feasibility_tolerance = 1e-10;
@@ -85,7 +90,8 @@ struct ConsistencyResult {
   // already consistent).
   double feasibility = 0;
 
-  // NoConsistentSet only: phi_consistent = B s, and |W_b (phi_consistent - phi)|.
+  // NoConsistentSet only: phi_consistent = B s, and |W_b (phi_consistent - phi)| (|R (...)| with
+  // base_metric_root).
   Eigen::VectorXd phi_consistent;
   double base_distance = 0;
 
