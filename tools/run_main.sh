@@ -5,7 +5,8 @@
 # 43 designed trajectories, one trial, seed 1; resumable) and run the whole identification
 # study on it (40 trajectories x 4 intervals: OLS, all-pose PD audit, conditional SDP, CLIE,
 # PCA selection, rescue, final audit, validation on V01-V03) with its report in
-# build/study/report/report.md. Both steps are resumable: a rerun skips what is finished.
+# build/study/report/report.md, and the identified arm as a URDF (build/crane_x7_identified.urdf).
+# Both steps are resumable: a rerun skips what is finished.
 # Then the model-gap workflow on twin data with hidden effects (build/diagnosis/, build/gap/),
 # 5 s of the 1 kHz controller against virtual servos (build/control-virtual.csv), and a robot
 # with only its robots/ folder (the RX-90) from a CSV its controller could have exported:
@@ -32,6 +33,11 @@ $dynid twin dataset --robot crane_x7 -o build/twin-data --trials 1 --seed 1
 $dynid preprocess --robot crane_x7 build/twin-data/AG02_t1.csv
 $dynid twin bench --robot crane_x7 --seconds 3
 $dynid identify --robot crane_x7 --data build/twin-data -o build/study
+# The identified arm as a URDF (modified-DH link frames, consistent inertials nearest the CAD
+# prior). The accepted vector admits no physically consistent standard set (docs/identification.md,
+# URDF export): --nearest writes the consistent vector nearest in the fitting run's predicted
+# torque (--data) and says what it costs.
+$dynid export --robot crane_x7 --study build/study --urdf build/crane_x7_identified.urdf --data build/twin-data --nearest
 
 # The model-gap workflow: a twin dataset with hidden Coulomb friction (joints 2 and 4) and a
 # torque offset (joint 5), which dynid diagnose is not told about; it names them, writes
@@ -81,3 +87,4 @@ for model in rigid full; do
 done
 $dynid diagnose --robot rx90 --model rigid --data build/rx90-data -o build/rx90-diagnosis
 $dynid compare --robot rx90 --before build/rx90-study-rigid --after build/rx90-study-full -o build/rx90-gap
+$dynid export --robot rx90 --model full --study build/rx90-study-full --urdf build/rx90_identified.urdf --prior zero
