@@ -8,6 +8,7 @@ packages=(
   libblas3 liblapack3  # the reference BLAS/LAPACK every program links (CMakeLists.txt says why)
   libgtest-dev libgmock-dev libbenchmark-dev
   libopenmpi-dev openmpi-bin  # optional: the MPI farm and its test (docs/scaling.md)
+  procps  # pgrep/ps: the MPI test finds the rank it kills
   liburdfdom-dev liburdfdom-tools  # optional: dynid export --urdf's tests read the URDF back (urdfdom, check_urdf)
 )
 missing=()
