@@ -161,6 +161,9 @@ FarmSummary coordinate(const std::vector<std::string>& tasks, const Farm& farm, 
   // with that reason and the others finish.
   int byes = 0;
   std::vector<Clock::time_point> heard(s.place.ranks, Clock::now());
+  // Before its first message a rank gets ten times as long: it may still be reading the study's
+  // inputs (a study's finished records, on a slow shared file system).
+  std::vector<bool> spoke(s.place.ranks, false);
   std::vector<bool> done(s.place.ranks, false), lost(s.place.ranks, false);  // done: said bye, or lost
   std::vector<std::pair<std::int64_t, int>> running;  // (task, rank) handed to other ranks
   const auto timeout = std::chrono::duration<double>(o.rank_timeout);
@@ -170,7 +173,7 @@ FarmSummary coordinate(const std::vector<std::string>& tasks, const Farm& farm, 
     if (!receive(MPI_ANY_SOURCE, MPI_ANY_TAG, b, st)) {
       const auto now = Clock::now();
       for (int r = 1; r < s.place.ranks; ++r) {
-        if (done[r] || now - heard[r] < timeout) continue;
+        if (done[r] || now - heard[r] < (spoke[r] ? 1 : 10) * timeout) continue;
         done[r] = lost[r] = true;
         ++byes;
         session().lost_rank = true;
@@ -193,6 +196,7 @@ FarmSummary coordinate(const std::vector<std::string>& tasks, const Farm& farm, 
       continue;
     }
     heard[st.MPI_SOURCE] = Clock::now();
+    spoke[st.MPI_SOURCE] = true;
     if (lost[st.MPI_SOURCE]) continue;  // a rank taken as lost that was only slow: too late
     std::size_t at = 0;
     if (st.MPI_TAG == kRequest) {
