@@ -1,6 +1,7 @@
 #include "symoro/parallel/farm.hpp"
 
 #include <sched.h>
+#include <sys/prctl.h>
 #include <sys/resource.h>
 #include <sys/types.h>
 #include <sys/wait.h>
@@ -101,6 +102,7 @@ TaskEnd run_isolated(const Farm& farm, const std::string& task, const std::funct
     std::lock_guard<std::mutex> lock(fork_mutex);
     if (::pipe(fd) != 0) throw std::system_error(errno, std::generic_category(), "pipe for a task's process");
     std::fflush(nullptr);  // else the child would print again what the parent had buffered
+    const pid_t parent = ::getpid();
     pid = ::fork();
     if (pid < 0) {
       const int e = errno;
@@ -109,6 +111,10 @@ TaskEnd run_isolated(const Farm& farm, const std::string& task, const std::funct
       throw std::system_error(e, std::generic_category(), "fork of a task's process");
     }
     if (pid == 0) {
+      // A task whose rank died (killed, lost with its node) is of no use: it dies too, instead of
+      // computing on, orphaned, beside whatever runs next.
+      ::prctl(PR_SET_PDEATHSIG, SIGKILL);
+      if (::getppid() != parent) ::_exit(4);
       ::close(fd[0]);
       run_child(farm, task, fd[1]);
     }
