@@ -4,18 +4,10 @@
 file(REMOVE_RECURSE ${WORK})
 file(MAKE_DIRECTORY ${WORK})
 
-function(run expect_code out_var)
-  execute_process(COMMAND ${DYNID} ${ARGN} RESULT_VARIABLE code OUTPUT_VARIABLE out ERROR_VARIABLE err)
-  if(NOT code EQUAL expect_code)
-    message(FATAL_ERROR "dynid ${ARGN}: exit ${code}, expected ${expect_code}\n${out}\n${err}")
-  endif()
-  set(${out_var} "${out}${err}" PARENT_SCOPE)
-endfunction()
-
-function(expect text pattern)
-  if(NOT text MATCHES "${pattern}")
-    message(FATAL_ERROR "expected /${pattern}/ in:\n${text}")
-  endif()
+include(${CMAKE_CURRENT_LIST_DIR}/cli_test_helpers.cmake)
+function(run expect_code out_var)  # dynid <arguments>
+  run_command(${expect_code} out ${DYNID} ${ARGN})
+  set(${out_var} "${out}" PARENT_SCOPE)
 endfunction()
 
 set(ds ${WORK}/data)

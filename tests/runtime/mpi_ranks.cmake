@@ -18,19 +18,7 @@ if(version MATCHES "Open MPI|OpenRTE")
   set(oversubscribe --oversubscribe)  # 3 ranks on a 2-core CI machine
 endif()
 
-function(run expect_code out_var)
-  execute_process(COMMAND ${ARGN} RESULT_VARIABLE code OUTPUT_VARIABLE out ERROR_VARIABLE err)
-  if(NOT code EQUAL expect_code)
-    message(FATAL_ERROR "${ARGN}: exit ${code}, expected ${expect_code}\n${out}\n${err}")
-  endif()
-  set(${out_var} "${out}${err}" PARENT_SCOPE)
-endfunction()
-
-function(expect text pattern)
-  if(NOT text MATCHES "${pattern}")
-    message(FATAL_ERROR "expected /${pattern}/ in:\n${text}")
-  endif()
-endfunction()
+include(${CMAKE_CURRENT_LIST_DIR}/cli_test_helpers.cmake)
 
 # A study's file with what depends on the machine's speed taken out: a run record's stage times
 # (t_*), the report's wall time line and its run table's four time columns (Appendix A).
@@ -89,8 +77,8 @@ set(mpi2 ${MPIEXEC} ${NP_FLAG} 2 ${oversubscribe})
 # --- CRANE-X7: dataset and study --------------------------------------------------------------
 set(w ${WORK}/crane_x7)
 set(only PA06 PB09 PC06 PA09)
-run(0 out ${DYNID} twin dataset --robot crane_x7 -o ${w}/data1 --trials 1 --seed 3 --only ${only} V02)
-run(0 out ${mpi3} ${DYNID} twin dataset --robot crane_x7 -o ${w}/data3 --trials 1 --seed 3 --only ${only} V02)
+run_command(0 out ${DYNID} twin dataset --robot crane_x7 -o ${w}/data1 --trials 1 --seed 3 --only ${only} V02)
+run_command(0 out ${mpi3} ${DYNID} twin dataset --robot crane_x7 -o ${w}/data3 --trials 1 --seed 3 --only ${only} V02)
 expect("${out}" "on 3 ranks x [0-9]+ workers")
 file(GLOB data_files RELATIVE ${w}/data1 ${w}/data1/*)
 list(LENGTH data_files n)
@@ -106,8 +94,8 @@ foreach(f IN LISTS data_files)
 endforeach()
 
 set(study --robot crane_x7 --interval 40 80 --validation V02 --only ${only})
-run(0 one ${DYNID} identify ${study} --data ${w}/data1 -o ${w}/study1)
-run(0 three ${mpi3} ${DYNID} identify ${study} --data ${w}/data1 -o ${w}/study3)
+run_command(0 one ${DYNID} identify ${study} --data ${w}/data1 -o ${w}/study1)
+run_command(0 three ${mpi3} ${DYNID} identify ${study} --data ${w}/data1 -o ${w}/study3)
 expect("${three}" "8 runs, 3 ranks x [0-9]+ threads")
 expect("${three}" "validation V02 at [0-9]+ ms, closed-loop")
 same_study(${w}/study1 ${w}/study3)
@@ -117,7 +105,7 @@ file(COPY ${w}/data1/ DESTINATION ${w}/broken)
 file(STRINGS ${w}/broken/PB09_t1.csv head LIMIT_COUNT 40)
 list(JOIN head "\n" head)
 file(WRITE ${w}/broken/PB09_t1.csv "${head}\n0.04,not-a-number\n")
-run(0 out ${mpi3} ${DYNID} identify ${study} --data ${w}/broken -o ${w}/broken-study)
+run_command(0 out ${mpi3} ${DYNID} identify ${study} --data ${w}/broken -o ${w}/broken-study)
 expect("${out}" "PB09@40ms +FAILED: [^\n]*PB09_t1.csv:[0-9]+")
 expect("${out}" "failed runs: 2")
 foreach(f PA06@40ms PA06@80ms PC06@40ms PC06@80ms PA09@40ms PA09@80ms)
@@ -129,9 +117,9 @@ foreach(f PA06@40ms PA06@80ms PC06@40ms PC06@80ms PA09@40ms PA09@80ms)
 endforeach()
 
 # Resume on another rank count: the 3-rank study plus one trajectory, on 2 ranks.
-run(0 out ${DYNID} twin dataset --robot crane_x7 -o ${w}/data1 --trials 1 --seed 3 --only ${only} PC09 V02)
+run_command(0 out ${DYNID} twin dataset --robot crane_x7 -o ${w}/data1 --trials 1 --seed 3 --only ${only} PC09 V02)
 file(TIMESTAMP ${w}/study3/runs/PA06@40ms.yaml before "%s")
-run(0 out ${mpi2} ${DYNID} identify --robot crane_x7 --data ${w}/data1 --interval 40 80 --validation V02
+run_command(0 out ${mpi2} ${DYNID} identify --robot crane_x7 --data ${w}/data1 --interval 40 80 --validation V02
     --only ${only} PC09 -o ${w}/study3)
 expect("${out}" "8 of 10 runs already finished \\(same inputs\\): skipped")
 expect("${out}" "10 runs, 2 ranks x")
@@ -182,7 +170,7 @@ exit 1
   endif()
   file(GLOB saved ${lost}/runs/*.yaml)
   list(LENGTH saved n_saved)
-  run(0 out ${mpi2} ${DYNID} identify --robot crane_x7 --data ${w}/data1 --interval 40 80 --validation V02 --only ${only}
+  run_command(0 out ${mpi2} ${DYNID} identify --robot crane_x7 --data ${w}/data1 --interval 40 80 --validation V02 --only ${only}
       -o ${lost})
   expect("${out}" "${n_saved} of 8 runs already finished")
   file(GLOB saved ${lost}/runs/*.yaml)
@@ -204,11 +192,11 @@ foreach(seed 1 2 3 4)
     message(FATAL_ERROR "write_export rx90 failed")
   endif()
 endforeach()
-run(0 out ${DYNID} import --robot rx90 -o ${w}/data ${w}/run1.csv ${w}/run2.csv ${w}/run3.csv ${w}/run4.csv
+run_command(0 out ${DYNID} import --robot rx90 -o ${w}/data ${w}/run1.csv ${w}/run2.csv ${w}/run3.csv ${w}/run4.csv
     --name a,b,c,held --heldout ${w}/run4.csv --time stamp_ms --time-unit ms --q "{name}_pos" --qd "{name}_vel"
     --tau "{name}_eff" --angle deg)
-run(0 one ${DYNID} identify --robot rx90 --data ${w}/data --interval 10 20 -o ${w}/study1)
-run(0 three ${mpi3} ${DYNID} identify --robot rx90 --data ${w}/data --interval 10 20 -o ${w}/study3)
+run_command(0 one ${DYNID} identify --robot rx90 --data ${w}/data --interval 10 20 -o ${w}/study1)
+run_command(0 three ${mpi3} ${DYNID} identify --robot rx90 --data ${w}/data --interval 10 20 -o ${w}/study3)
 expect("${three}" "6 runs, 3 ranks x")
 expect("${three}" "validation held at 10 ms, open-loop")
 same_study(${w}/study1 ${w}/study3)
