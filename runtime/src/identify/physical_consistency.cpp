@@ -7,6 +7,7 @@
 #include <stdexcept>
 
 #include <Eigen/Eigenvalues>
+#include <Eigen/QR>
 #include <Eigen/SVD>
 #include <fmt/format.h>
 
@@ -59,7 +60,7 @@ struct Setup {
         const ConsistencyOptions& o)
       : st(s), phi(phi_), s0(prior), margin(o.margin) {
     const Eigen::Index ns = s.B.cols();
-    w = o.weights.size() ? o.weights : default_consistency_weights(s, prior);
+    w = o.weights.size() ? o.weights : default_consistency_weights(s, prior, phi_);
     scale = w.cwiseInverse();
     lower = o.lower.size() ? o.lower : Eigen::VectorXd::Constant(ns, -kInf);
     upper = o.upper.size() ? o.upper : Eigen::VectorXd::Constant(ns, kInf);
@@ -232,13 +233,37 @@ void nearest_consistent(const Setup& S, const ConsistencyOptions& o, Consistency
     Wb = wb.asDiagonal();
   }
   const Eigen::Index nr = Wb.rows();
-  const Eigen::VectorXd gap = Wb * (S.st.B * S.s0 - S.phi);
-  const double sigma = std::max({gap.norm(), S.up.norm(), 1e-9});
   const Eigen::MatrixXd A = Wb * S.Bt;  // d(weighted residual) / du
+  // The held rows hold exactly: u = u_h + N_h w, u_h the smallest u meeting them, N_h an
+  // orthonormal basis of what leaves them unchanged (everything when none are held).
+  Eigen::VectorXd uh = Eigen::VectorXd::Zero(ns);
+  Eigen::MatrixXd Nh = Eigen::MatrixXd::Identity(ns, ns);
+  if (!o.held_rows.empty()) {
+    const auto nh = static_cast<Eigen::Index>(o.held_rows.size());
+    Eigen::MatrixXd Bh(nh, ns);
+    Eigen::VectorXd rh(nh);
+    const Eigen::VectorXd Bs0 = S.st.B * S.s0;
+    for (Eigen::Index i = 0; i < nh; ++i) {
+      const int row = o.held_rows[static_cast<std::size_t>(i)];
+      Bh.row(i) = S.Bt.row(row);
+      rh(i) = S.phi(row) - Bs0(row);
+    }
+    const Eigen::JacobiSVD<Eigen::MatrixXd> svd(Bh, Eigen::ComputeFullU | Eigen::ComputeFullV);
+    const Eigen::VectorXd sv = svd.singularValues();
+    const double tol = 1e-12 * (sv.size() ? sv(0) : 0.0) * static_cast<double>(std::max(nh, ns));
+    Eigen::Index rank = 0;
+    while (rank < sv.size() && sv(rank) > tol) ++rank;
+    uh = svd.matrixV().leftCols(rank) * sv.head(rank).cwiseInverse().asDiagonal() *
+         svd.matrixU().leftCols(rank).transpose() * rh;
+    Nh = svd.matrixV().rightCols(ns - rank);
+  }
+  const Eigen::VectorXd gap = Wb * (S.st.B * S.s0 - S.phi) + A * uh;
+  const double sigma = std::max({gap.norm(), S.up.norm(), 1e-9});
+  const Eigen::MatrixXd AN = A * Nh;
 
-  const int nv = static_cast<int>(ns), t1 = nv, t2 = nv + 1;
+  const int nv = static_cast<int>(Nh.cols()), t1 = nv, t2 = nv + 1;
   detail::LmiProblem lmi(nv + 2);
-  {  // tau1 >= |gap / sigma + A v|^2
+  {  // tau1 >= |gap / sigma + A N_h v|^2
     Eigen::MatrixXd C = Eigen::MatrixXd::Identity(nr + 1, nr + 1);
     C(nr, nr) = 0;
     C.col(nr).head(nr) = gap / sigma;
@@ -246,8 +271,8 @@ void nearest_consistent(const Setup& S, const ConsistencyOptions& o, Consistency
     const int b = lmi.add_block(C);
     for (int j = 0; j < nv; ++j) {
       Eigen::MatrixXd E = Eigen::MatrixXd::Zero(nr + 1, nr + 1);
-      E.col(nr).head(nr) = A.col(j);
-      E.row(nr).head(nr) = A.col(j).transpose();
+      E.col(nr).head(nr) = AN.col(j);
+      E.row(nr).head(nr) = AN.col(j).transpose();
       if (!E.isZero(0)) lmi.set_coefficient(b, j, E);
     }
     Eigen::MatrixXd E = Eigen::MatrixXd::Zero(nr + 1, nr + 1);
@@ -255,20 +280,20 @@ void nearest_consistent(const Setup& S, const ConsistencyOptions& o, Consistency
     lmi.set_coefficient(b, t1, E);
   }
   add_norm_block(lmi, 0, nv, t2);  // tau2 >= |v|^2
-  const Eigen::MatrixXd G = sigma * S.scale.asDiagonal();
+  const Eigen::MatrixXd G = sigma * S.scale.asDiagonal() * Nh;
   std::vector<double> target = targets(S, o.infeasible_clearance);
   Eigen::VectorXd b = Eigen::VectorXd::Zero(nv + 2);
   b(t1) = 1;
   b(t2) = o.prior_regularization;
   lmi.set_objective(b);
-  add_constraints(lmi, S, S.s0, G, target, -1);
+  add_constraints(lmi, S, S.standard(uh), G, target, -1);
   const detail::LmiSolution sol = solve(lmi, r.solves);
   if (!sol.solved()) {
     r.message = fmt::format("no consistent standard set maps onto phi (phase 1: t = {:.3g}); the search for the nearest "
                             "base vector that has one failed: {}", r.feasibility, sol.message());
     return;
   }
-  const Eigen::VectorXd s = S.standard(sigma * sol.y.head(nv));
+  const Eigen::VectorXd s = S.standard(uh + sigma * Nh * sol.y.head(nv));
   r.phi_consistent = S.st.B * s;
   evaluate(S, s, S.phi, r);
   r.base_distance = (Wb * (r.phi_consistent - S.phi)).norm();
@@ -299,21 +324,31 @@ Eigen::Matrix4d pseudo_inertia(const Eigen::VectorXd& s, const LinkInertialIndic
   return J;
 }
 
-Eigen::VectorXd default_consistency_weights(const ConsistencyStructure& st, const Eigen::VectorXd& prior) {
+Eigen::VectorXd default_consistency_weights(const ConsistencyStructure& st, const Eigen::VectorXd& prior,
+                                            const Eigen::VectorXd& phi) {
   const Eigen::Index ns = st.B.cols();
   if (prior.size() != ns || static_cast<Eigen::Index>(st.group.size()) != ns)
     throw std::invalid_argument("default_consistency_weights: the prior or the groups do not match B's columns");
+  if (phi.size() && phi.size() != st.B.rows())
+    throw std::invalid_argument("default_consistency_weights: phi does not match B's rows");
   constexpr int groups = static_cast<int>(StandardGroup::Other) + 1;
-  double sum[groups] = {}, count[groups] = {};
-  for (Eigen::Index k = 0; k < ns; ++k) {
-    const int g = static_cast<int>(st.group[static_cast<std::size_t>(k)]);
-    sum[g] += prior(k) * prior(k);
-    count[g] += 1;
-  }
+  auto group_rms = [&](const Eigen::VectorXd& v, double* rms) {
+    double sum[groups] = {}, count[groups] = {};
+    for (Eigen::Index k = 0; k < ns; ++k) {
+      const int g = static_cast<int>(st.group[static_cast<std::size_t>(k)]);
+      sum[g] += v(k) * v(k);
+      count[g] += 1;
+    }
+    for (int g = 0; g < groups; ++g) rms[g] = count[g] > 0 ? std::sqrt(sum[g] / count[g]) : 0;
+  };
+  double scale[groups], fallback[groups] = {};
+  group_rms(prior, scale);
+  if (phi.size() && std::any_of(scale, scale + groups, [](double x) { return x == 0; }))
+    group_rms(st.B.completeOrthogonalDecomposition().solve(phi), fallback);
   Eigen::VectorXd w(ns);
   for (Eigen::Index k = 0; k < ns; ++k) {
     const int g = static_cast<int>(st.group[static_cast<std::size_t>(k)]);
-    const double rms = std::sqrt(sum[g] / count[g]);
+    const double rms = scale[g] > 0 ? scale[g] : fallback[g];
     w(k) = rms > 0 ? 1 / rms : 1;
   }
   return w;
@@ -342,6 +377,7 @@ ConsistencyResult consistent_standard_parameters(const ConsistencyStructure& st,
   require(!o.base_metric_root.size() || (o.base_metric_root.cols() == np && o.base_metric_root.allFinite() &&
                                          o.base_metric_root.rows() > 0),
           "base_metric_root must have one column per base parameter and finite entries");
+  for (int row : o.held_rows) require(row >= 0 && row < np, "a held row is out of range");
   require(std::isfinite(o.margin) && o.margin >= 0, "the margin must be >= 0");
 
   const Setup S(st, phi, prior, o);
@@ -398,13 +434,28 @@ ConsistencyResult consistent_standard_parameters(const ConsistencyStructure& st,
     t_star = sol.y(nz);
     z1 = R * sol.y.head(nz);
   }
-  r.feasibility = std::min(t_star, fixed.constant_min);
+  // Constraints the base vector fixes count when they are violated; one met exactly (FS fixed
+  // at its bound 0 by a variant) would otherwise pin the margin at 0 whatever the links'.
+  r.feasibility = fixed.constant_min < 0 ? std::min(t_star, fixed.constant_min) : t_star;
   if (r.feasibility < -o.feasibility_tolerance) {
     r.status = ConsistencyStatus::NoConsistentSet;
     if (fixed.constant_min < -o.feasibility_tolerance) r.feasibility = fixed.constant_min;
-    nearest_consistent(S, o, r);
+    if (o.feasibility_only) {
+      evaluate(S, S.refine(S.standard(S.up + S.N * z1)), phi, r);
+      r.message = fmt::format("no consistent standard set maps onto phi (phase 1: the best smallest-eigenvalue margin is "
+                              "{:.3g} of the links' size)", r.feasibility);
+    } else {
+      nearest_consistent(S, o, r);
+    }
     if (fixed.constant_min < -o.feasibility_tolerance)
       r.message += fmt::format(" (violated whatever the other parameters: {})", fixed.constant_what);
+    return finish();
+  }
+
+  if (o.feasibility_only) {
+    evaluate(S, S.refine(S.standard(S.up + S.N * z1)), phi, r);
+    r.status = ConsistencyStatus::Consistent;
+    r.message = fmt::format("consistent (phase 1 margin {:.3g} of the links' size)", r.feasibility);
     return finish();
   }
 

@@ -43,7 +43,7 @@ struct ConsistencyOptions {
   // block and kg on the mass: meant as a small strictness guard (e.g. 1e-6), not as a physical
   // bound; use lower/upper for those.
   double margin = 0;
-  // Diagonal metric of |W (s - s0)| (size ns); empty: default_consistency_weights(prior).
+  // Diagonal metric of |W (s - s0)| (size ns); empty: default_consistency_weights(prior, phi).
   Eigen::VectorXd weights;
   // Bounds on s (size ns each, +-inf for none); empty: 0 below for `nonnegative`, nothing else.
   Eigen::VectorXd lower, upper;
@@ -56,6 +56,10 @@ struct ConsistencyOptions {
   // distance is the RMS change of the predicted torque on that run, and phi_c the consistent
   // base vector that changes it least (dynid export --data).
   Eigen::MatrixXd base_metric_root;
+  // No consistent set: entries of phi that phi_consistent keeps exactly (0-based rows of B), e.g.
+  // the parameters a variant fixes (the study's physical projection of crane_x7::reduced keeps
+  // its products of inertia at 0); the base metric then weighs the other rows only.
+  std::vector<int> held_rows;
   // A phase-1 verdict t >= -feasibility_tolerance (t: the smallest eigenvalue margin relative to
   // each link's size) counts as feasible; the solve then asks for margin + t (a touch below).
   double feasibility_tolerance = 1e-10;
@@ -67,6 +71,9 @@ struct ConsistencyOptions {
   // regularized towards the prior with this relative weight.
   double infeasible_clearance = 1e-7;
   double prior_regularization = 1e-6;
+  // Only ask whether phi has a consistent set (phase 1): s is then phase 1's set (consistent, but
+  // not the one nearest the prior) and, when there is none, the nearest base vector is not sought.
+  bool feasibility_only = false;
 };
 
 enum class ConsistencyStatus {
@@ -102,10 +109,12 @@ struct ConsistencyResult {
 const char* to_string(ConsistencyStatus s);
 
 // The default metric: one scale per group (mass; first moments; XX..ZZ; rotor inertia; FV; FS;
-// other), the root mean square of the prior's entries of that group (1 when they are all 0);
-// weight = 1 / scale. Masses, first moments and inertias then weigh alike: a 10 % change of a
-// typical value costs the same in each.
-Eigen::VectorXd default_consistency_weights(const ConsistencyStructure& structure, const Eigen::VectorXd& prior);
+// other), the root mean square of the prior's entries of that group; where they are all 0 (a
+// zero prior), of that group's entries in the smallest standard vector mapping onto phi
+// (B^+ phi; without phi, or when those are 0 too: 1); weight = 1 / scale. Masses, first moments
+// and inertias then weigh alike: a 10 % change of a typical value costs the same in each.
+Eigen::VectorXd default_consistency_weights(const ConsistencyStructure& structure, const Eigen::VectorXd& prior,
+                                            const Eigen::VectorXd& phi = {});
 
 // J_k of one link for a standard vector s.
 Eigen::Matrix4d pseudo_inertia(const Eigen::VectorXd& s, const LinkInertialIndices& link);
