@@ -50,7 +50,7 @@ void add_export_commands(CLI::App& app, Common& common) {
                   "meaning for the unidentifiable part). Default: the CAD truth of robots/<robot>/twin.yaml; a robot "
                   "without twin.yaml needs --prior");
   cmd->add_option("--margin", o->margin, "Strictness of the consistency: every link's pseudo-inertia >= margin I "
-                                         "(kg m^2 / kg)")
+                                         "(kg m^2 / kg; 0 allows singular links)")
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
   cmd->add_flag("--not-accepted", o->not_accepted, "Export even when the study's final audit did not accept its "

@@ -10,7 +10,9 @@ namespace symoro::dynid {
 
 struct ExportOptions {
   std::string study, urdf, model, prior, data;
-  double margin = 0;
+  // Strictly inside the consistent set, above rounding: a singular pseudo-inertia (lambda_min
+  // -2e-17 measured with 0) is a body some simulators reject.
+  double margin = 1e-9;
   int trial = 1;
   bool not_accepted = false, nearest = false;
 };

@@ -44,6 +44,11 @@ identify::StudyResult study(const Common& common, const IdentifyOptions& o, bool
   so.clie.max_iterations = o.clie_iterations;
   so.clie.std_bound = o.clie_std_bound;
   so.projection_metric = identify::projection_metric_from_string(o.projection_metric);
+  so.consistency = identify::consistency_from_string(o.consistency);
+  so.physical_start = o.physical_start;
+  so.rescue_metric_all_runs = o.rescue_metric == "all";
+  if (o.physical_start && so.consistency != identify::Consistency::physical)
+    throw UsageError("--physical-start needs --consistency physical");
   so.validation_interval = o.validation_ms / 1000;
   auto progress = std::make_shared<std::unique_ptr<Progress>>();
   so.on_start = [progress, quiet](int total, int skipped) {
@@ -101,8 +106,11 @@ void IdentifyCommand::run(const Common& common, const IdentifyOptions& o) {
   if (r.selection.run >= 0) {
     const auto& sel = r.runs[r.selection.run];
     fmt::print("representative: {} ({}); {}; final audit lambda_min {:.3e} -> {}\n", sel.id(), r.selection.rule,
-               r.rescued ? (r.rescue_feasible ? "rescued (eps = 0)" : "rescue FAILED: " + r.rescue_status) : "PD without rescue",
+               r.rescued ? (r.rescue_feasible ? (r.consistency == "physical" ? "rescued onto the consistent set" : "rescued (eps = 0)")
+                                                           : "rescue FAILED: " + r.rescue_status) : "PD without rescue",
                r.final_lambda_min, r.accepted ? "accepted" : "NOT accepted");
+    fmt::print("physical consistency of the accepted vector: {}\n",
+               r.final_consistency_note.empty() ? "not checked" : r.final_consistency_note);
     for (const auto& v : r.validation)
       fmt::print("validation {} at {:.0f} ms, {}: RMSE {:.4f} / {:.4f} N m, MNE {:.4f} / {:.4f} (final / accepted){}\n",
                  v.trajectory, v.interval * 1e3, v.kind, v.rmse_clie, v.rmse_rescue, v.mne_clie, v.mne_rescue,

@@ -41,6 +41,21 @@ void add_identify_commands(CLI::App& app, Common& common) {
                   "W'W: the smallest change of the predicted torque)")
       ->check(CLI::IsMember({"euclidean", "information"}))
       ->capture_default_str();
+  cmd->add_option("--consistency", o->consistency,
+                  "What makes a parameter vector admissible: pd (the paper's: M(q) positive definite at every pose, "
+                  "sampled) or physical (also a physically consistent set of link inertials maps onto it: per-link "
+                  "LMIs; the rescue projects onto such vectors, and dynid export --urdf reproduces the accepted one "
+                  "exactly)")
+      ->check(CLI::IsMember({"pd", "physical"}))
+      ->capture_default_str();
+  cmd->add_option("--rescue-metric", o->rescue_metric,
+                  "With --consistency physical: the rescue moves the representative onto the consistent set changing "
+                  "least the torque predicted on all the identification trajectories (all) or on its own run (run)")
+      ->check(CLI::IsMember({"all", "run"}))
+      ->capture_default_str();
+  cmd->add_flag("--physical-start", o->physical_start,
+                "With --consistency physical: project each OLS estimate onto the consistent set before CLIE instead "
+                "of the paper's PD projection (slower: CLIE walks back out of the set; docs/identification.md)");
   cmd->add_option("--clie-std-bound", o->clie_std_bound,
                   "CLIE bounds of +-K standard deviations of the run's OLS estimate around its start (0: off)")
       ->check(CLI::NonNegativeNumber)

@@ -14,11 +14,13 @@ struct IdentifyOptions {
   std::vector<double> intervals_ms;
   std::vector<std::string> only, validation;
   int threads = 0, trial = 1;
-  bool weighted = false, no_report = false, fresh = false, in_process = false;
+  bool weighted = false, no_report = false, fresh = false, in_process = false, physical_start = false;
   int clie_iterations = 25;
   double validation_ms = 0;
   double torque_delay_ms = 0;
   std::string projection_metric = "information";
+  std::string consistency = "pd";
+  std::string rescue_metric = "all";
   double clie_std_bound = 0;
   double rank_timeout = 60;
 };

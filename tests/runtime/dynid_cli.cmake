@@ -123,6 +123,23 @@ run(0 out export --robot crane_x7 --study ${WORK}/control/study --urdf ${WORK}/c
 file(READ ${WORK}/control/crane.urdf urdf)
 expect("${urdf}" "WARNING: no consistent set reproduces the accepted base parameters")
 expect("${urdf}" "<robot name=\"crane_x7\"")
+# The same run identified on the physical path: its final vector (the paper's CLIE) has no
+# consistent set either, so the rescue projects it onto the vectors that have one; the export then
+# reproduces the accepted vector itself (no --nearest, no warning).
+run(2 out identify --robot crane_x7 --data ${WORK}/control -o ${WORK}/control/study-physical --interval 20 --physical-start)
+expect("${out}" "--physical-start needs --consistency physical")
+run(0 out identify --robot crane_x7 --data ${WORK}/control -o ${WORK}/control/study-physical --interval 20
+    --consistency physical)
+expect("${out}" "representative: V02@20ms \\([^\n]*\\); rescued onto the consistent set; final audit lambda_min [0-9.e+-]+ -> accepted")
+expect("${out}" "physical consistency of the accepted vector: consistent")
+file(READ ${WORK}/control/study-physical/report/parameters.yaml params)
+expect("${params}" "consistency: \"physical\"\nphysically_consistent: true")
+run(0 out export --robot crane_x7 --study ${WORK}/control/study-physical --urdf ${WORK}/control/crane-physical.urdf)
+expect("${out}" "max \\|B s - phi\\| = [0-9.e-]+")
+file(READ ${WORK}/control/crane-physical.urdf urdf)
+if(urdf MATCHES "WARNING")
+  message(FATAL_ERROR "the physical study's export warns:\n${urdf}")
+endif()
 # A log is never overwritten: refused, or written under a new name.
 run(2 out control --robot crane_x7 --virtual --trajectory AG02 --seconds 1 -o ${WORK}/control/run.csv)
 expect("${out}" "control/run.csv exists: a run never overwrites a log")

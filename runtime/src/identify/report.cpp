@@ -199,11 +199,23 @@ std::string summary(const StudyResult& study) {
   if (sel) {
     out += fmt::format("- **Accepted model**: {}, {}; final all-pose audit λ_min = {} at the worst pose {} deg: {}.\n",
                        sel->id(),
-                       study.rescued ? (study.rescue_feasible ? fmt::format("PD-rescued (ε = {})", sig(study.rescue_eps, 3))
+                       study.rescued ? (study.rescue_feasible ? (study.consistency == "physical"
+                                                                     ? fmt::format("rescued onto the physically consistent set (clearance {} of each link's size)", sig(study.rescue_eps, 3))
+                                                                     : fmt::format("PD-rescued (ε = {})", sig(study.rescue_eps, 3)))
                                                               : "the rescue's projection FAILED (" + study.rescue_status + ")")
                                      : std::string("the run's final vector as is (no rescue needed)"),
                        sig(study.final_lambda_min, 4), degrees(study.final_worst_pose),
-                       study.accepted ? "**accepted**" : "**not accepted** (the final audit failed)");
+                       study.accepted ? "**accepted**"
+                                      : study.consistency == "physical" && !study.final_consistent
+                                            ? "**not accepted** (no physically consistent set maps onto it)"
+                                            : "**not accepted** (the final audit failed)");
+    out += fmt::format("- **Physical consistency** of the accepted vector ({} path): {}.\n",
+                       study.consistency == "physical" ? "the physical" : "the paper's PD",
+                       study.final_consistency_note.empty() ? std::string("not checked")
+                       : study.final_consistent
+                           ? fmt::format("a consistent set of link inertials maps onto it ({}): `dynid export --urdf` "
+                                         "reproduces it exactly", study.final_consistency_note)
+                           : study.final_consistency_note);
     out += fmt::format("- **Selection**: {}{}.\n", study.selection.rule.empty() ? "by centrality" : study.selection.rule,
                        study.selection.components > 0 ? fmt::format(" ({} PCA components)", study.selection.components)
                                                       : std::string());
@@ -249,6 +261,17 @@ std::string summary(const StudyResult& study) {
   out += fmt::format("- **Runs**: {} ({} trajectories × intervals {} ms); CLIE converged in {}, PD after CLIE in {}{}.\n",
                      study.runs.size(), trajectories.size(), ms.empty() ? "none" : ms, converged, pd,
                      failed.empty() ? std::string() : fmt::format("; CLIE failed for {}", fmt::join(failed, ", ")));
+  int checked = 0, ols_pd = 0, ols_consistent = 0, final_pd = 0, final_consistent = 0;
+  for (const auto& r : study.runs) {
+    if (r.failed || !r.physical) continue;
+    ++checked;
+    ols_pd += r.ols_pd, ols_consistent += r.ols_consistent;
+    final_pd += r.phi_clie.size() > 0 && r.clie_pd, final_consistent += r.phi_clie.size() > 0 && r.clie_consistent;
+  }
+  if (checked > 0)
+    out += fmt::format("- **Physical consistency of the runs** (a consistent set of link inertials maps onto the vector; "
+                       "all-pose PD is necessary, not sufficient): OLS {} of {} (PD {}), final vectors {} (PD {}).\n",
+                       ols_consistent, checked, ols_pd, final_consistent, final_pd);
   out += fmt::format("- **Wall time**: {} s for this invocation on {}{} thread{}; run stages sum to {} s "
                      "(OLS {}, audit {}, SDP {}, CLIE {}){}.\n\n",
                      fixed(study.wall, 1), study.ranks > 1 ? fmt::format("{} MPI ranks x ", study.ranks) : "", study.threads,
@@ -344,6 +367,8 @@ void write_parameters_yaml(const StudyResult& study, const std::filesystem::path
     y += (i ? ", " : "") + yaml_number(study.final_worst_pose(i) * deg_per_rad);
   y += "]\n";
   y += fmt::format("accepted: {}\n", study.accepted);
+  y += "consistency: " + yaml_quoted(study.consistency) + "\n";
+  y += fmt::format("physically_consistent: {}\n", study.final_consistent);
   y += phi.size() == 0 ? "parameters: []\n" : "parameters:\n";
   for (Eigen::Index i = 0; i < phi.size(); ++i)
     y += fmt::format("  - {{name: {}, unit: {}, value: {}}}\n", yaml_quoted(name_of(study, static_cast<int>(i))),

@@ -280,28 +280,36 @@ std::string transition_table(const StudyResult& study) {
                                               : "CLIE failed: " + termination(*r);
   if (r->clie_success && !r->clie_pd) clie_remark += "; statistically central but non-PD";
   table.row({"CLIE", yes_no(r->clie_pd), "--", "--", sig(r->clie_lambda_min, 4), clie_remark});
-  std::string final_remark = study.rescued ? (study.accepted ? "Final accepted model" : "Rescued, but the final audit failed")
-                                           : (study.accepted ? "Not needed: the CLIE candidate was PD and is accepted as is"
-                                                             : "Not rescued; the final audit failed");
-  table.row({"PD-rescue", yes_no(study.accepted), "--", study.rescued ? sig(study.rescue_eps, 3) : "--",
+  const bool physical = study.consistency == "physical";
+  std::string final_remark =
+      study.rescued ? (study.accepted ? (physical ? "Projected onto the physically consistent set; final accepted model"
+                                                  : "Final accepted model")
+                                      : (physical ? "Rescued, but the final checks failed" : "Rescued, but the final audit failed"))
+                    : (study.accepted ? (physical ? "Not needed: the CLIE candidate has a consistent set and is accepted as is"
+                                                  : "Not needed: the CLIE candidate was PD and is accepted as is")
+                                      : (physical ? "Not rescued; the final checks failed" : "Not rescued; the final audit failed"));
+  table.row({physical ? "Physical rescue" : "PD-rescue", yes_no(study.accepted), "--", study.rescued ? sig(study.rescue_eps, 3) : "--",
              sig(study.final_lambda_min, 4), final_remark});
   return out + table.str() + "\nλ_min: smallest eigenvalue of M(θ; φ) found by the all-pose audit.\n\n";
 }
 
 std::string rescue_delta_table(const StudyResult& study, int count) {
   const RunRecord* r = selected_run(study);
-  std::string out = "## Table VI: largest parameter changes, CLIE → PD-rescue";
+  const std::string rescue = study.consistency == "physical" ? "physical rescue" : "PD-rescue";
+  std::string out = "## Table VI: largest parameter changes, CLIE → " + rescue;
   out += r ? fmt::format(" ({})\n\n", r->id()) : "\n\n";
   const int np = parameter_count(study);
   if (!r || r->phi_clie.size() != np || study.phi_rescue.size() != np || np == 0)
     return out + "No CLIE and rescued parameter vectors to compare.\n\n";
   if (!study.rescued)
-    return out + "The CLIE candidate passed the final audit and was accepted unchanged: no rescue.\n\n";
+    return out + (study.consistency == "physical" ? "The CLIE candidate passed the final checks and was accepted unchanged: no rescue.\n\n"
+                                                  : "The CLIE candidate passed the final audit and was accepted unchanged: no rescue.\n\n");
   std::vector<int> order(np);
   std::iota(order.begin(), order.end(), 0);
   const Eigen::VectorXd delta = study.phi_rescue - r->phi_clie;
   std::stable_sort(order.begin(), order.end(), [&](int a, int b) { return std::abs(delta(a)) > std::abs(delta(b)); });
-  MarkdownTable table({"Parameter", "Unit", "CLIE", "PD-rescue", "Δ = rescue − CLIE"});
+  MarkdownTable table({"Parameter", "Unit", "CLIE", study.consistency == "physical" ? "Physical rescue" : "PD-rescue",
+                       "Δ = rescue − CLIE"});
   for (int k = 0; k < std::min(count, np); ++k) {
     const int i = order[k];
     table.row({name_of(study, i), unit_of(study, i), sig(r->phi_clie(i), 6), sig(study.phi_rescue(i), 6),
@@ -450,7 +458,9 @@ std::string parameter_table(const StudyResult& study) {
     table.row(row);
   }
   out += r ? fmt::format("OLS, SDP and CLIE of the representative {}; Accepted: ", r->id()) : "Accepted: ";
-  out += study.rescued ? "the PD-rescued vector" : "the CLIE vector as accepted";
+  out += study.rescued ? (study.consistency == "physical" ? "the vector rescued onto the physically consistent set"
+                                                          : "the PD-rescued vector")
+                       : "the CLIE vector as accepted";
   out += " (full precision in parameters.yaml / parameters.csv).\n\n" + table.str() + "\n";
   if (truth && study.phi_rescue.size() == np)
     out += fmt::format("‖φ − φ_true‖₂ / ‖φ_true‖₂ = {}.\n\n",

@@ -76,6 +76,12 @@ std::string run_record_text(const RunRecord& r, const std::string& fingerprint) 
   detail::put_vector(y, "clie_rms", r.clie_rms);
   y << YAML::Key << "clie_lambda_min" << YAML::Value << r.clie_lambda_min;
   y << YAML::Key << "clie_pd" << YAML::Value << r.clie_pd;
+  if (r.physical) {  // the physical path only: the PD path's records are as they were
+    y << YAML::Key << "ols_consistent" << YAML::Value << r.ols_consistent;
+    y << YAML::Key << "ols_consistency" << YAML::Value << r.ols_consistency;
+    y << YAML::Key << "clie_consistent" << YAML::Value << r.clie_consistent;
+    y << YAML::Key << "clie_consistency" << YAML::Value << r.clie_consistency;
+  }
   y << YAML::Key << "t_ols" << YAML::Value << r.t_ols;
   y << YAML::Key << "t_audit" << YAML::Value << r.t_audit;
   y << YAML::Key << "t_sdp" << YAML::Value << r.t_sdp;
@@ -121,6 +127,13 @@ RunRecord parse(const YAML::Node& n) {
   r.clie_rms = vec(n["clie_rms"]);
   r.clie_lambda_min = n["clie_lambda_min"].as<double>();
   r.clie_pd = n["clie_pd"].as<bool>();
+  if (n["ols_consistent"]) {
+    r.physical = true;
+    r.ols_consistent = n["ols_consistent"].as<bool>();
+    r.ols_consistency = n["ols_consistency"].as<double>();
+    r.clie_consistent = n["clie_consistent"].as<bool>();
+    r.clie_consistency = n["clie_consistency"].as<double>();
+  }
   r.t_ols = n["t_ols"].as<double>();
   r.t_audit = n["t_audit"].as<double>();
   r.t_sdp = n["t_sdp"].as<double>();

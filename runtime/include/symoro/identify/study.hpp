@@ -24,6 +24,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <limits>
 #include <memory>
 #include <functional>
 #include <optional>
@@ -43,6 +44,7 @@
 #include "symoro/identify/least_squares.hpp"
 #include "symoro/identify/pca.hpp"
 #include "symoro/identify/pd_audit.hpp"
+#include "symoro/identify/physical_projection.hpp"
 #include "symoro/identify/regression.hpp"
 #include "symoro/identify/run_record_io.hpp"
 #include "symoro/identify/sdp_projection.hpp"
@@ -60,6 +62,82 @@ namespace detail {
 
 inline double seconds_since(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+// The run's predicted-torque metric W'W / rows (the information matrix is W'W / sigma^2,
+// sigma^2 = |r|^2 / (rows - np)): distances in it are RMS changes of the fitted torque, N m.
+inline Eigen::MatrixXd torque_metric(const LeastSquaresResult& ls, double ridge) {
+  return information_metric(ls.information, ridge) *
+         (ls.residual_rms * ls.residual_rms / static_cast<double>(ls.rows - ls.phi.size()));
+}
+
+// CLIE's starting point, with its PD margin.
+struct ClieStart {
+  Eigen::VectorXd phi;
+  double lambda_min = 0;
+};
+
+// The paper's pre-CLIE step (Algorithm 1, lines 4-15): the all-pose audit of the OLS estimate
+// and, when it is not PD, the conditional SDP projection. Fills the record's audit and route.
+inline ClieStart pd_start(const LeastSquaresResult& ls, const StudyOptions& o, const InertiaFunction& inertia,
+                                const AuditDomain& domain, RunRecord& r) {
+  const auto t = std::chrono::steady_clock::now();
+  ProjectionOptions po = o.projection;
+  if (o.projection_metric == ProjectionMetric::information) po.metric = information_metric(ls.information, o.information_ridge);
+  const ConditionalProjection cp = conditional_projection(inertia, ls.phi, domain, o.margins, po);
+  const double conditional_wall = seconds_since(t);
+  r.ols_lambda_min = cp.audit.lambda_min;
+  r.ols_worst_pose = cp.audit.worst_pose;
+  r.ols_pd = cp.audit.positive_definite();
+  r.route = cp.projected ? "O-S-C" : "O-C";
+  r.eps = cp.projected ? cp.eps : 0.0;
+  r.sdp_feasible = cp.feasible;
+  r.t_audit = cp.audit.wall;
+  r.t_sdp = std::max(0.0, conditional_wall - cp.audit.wall);
+  if (!cp.feasible) {
+    // No margin gave a PD vector: the run has no SDP vector and no final one; its OLS stays in
+    // the OLS cloud. Nothing downstream starts from a failed projection.
+    r.clie_ran = false;
+    std::string why;
+    for (const ProjectionResult& a : cp.attempts)
+      why += fmt::format("{}eps {:g}: lambda_min {:.3g} ({})", why.empty() ? "" : "; ", a.eps, a.lambda_min, a.status);
+    r.clie_termination = "not run: the SDP projection failed at every margin (" + why + ")";
+  }
+  return {cp.phi, cp.projected ? cp.attempts.back().lambda_min : r.ols_lambda_min};
+}
+
+// The physical path's pre-CLIE step when asked (StudyOptions::physical_start): the all-pose audit
+// (for the record) and, when the OLS estimate has no consistent standard set, the nearest base
+// vector that has one in the run's predicted-torque metric (physical_projection.hpp).
+template <class Model>
+ClieStart physical_start(const LeastSquaresResult& ls, const StudyOptions& o, const InertiaFunction& inertia,
+                               const AuditDomain& domain, RunRecord& r) {
+  const AuditResult a = audit_pd(inertia, ls.phi, domain, o.audit);
+  r.ols_lambda_min = a.lambda_min;
+  r.ols_worst_pose = a.worst_pose;
+  r.ols_pd = a.positive_definite();
+  r.t_audit = a.wall;
+  const PhysicalProjection p =
+      physical_projection<Model>(ls.phi, {}, torque_metric(ls, o.information_ridge), o.physical_clearance);
+  r.physical = true;
+  r.ols_consistent = p.consistent;
+  r.ols_consistency = p.check.feasibility;
+  r.route = p.projected ? "O-S-C" : "O-C";
+  r.eps = p.projected ? o.physical_clearance : 0.0;
+  r.sdp_feasible = p.feasible;
+  r.t_sdp = p.wall;
+  if (!p.feasible) {
+    r.clie_ran = false;
+    r.clie_termination = "not run: the physical projection failed (" + p.status + ")";
+    return {p.phi, 0.0};
+  }
+  ClieStart start{p.phi, r.ols_lambda_min};
+  if (p.projected) {  // the start's PD margin (no CLIE: the run's final one)
+    const AuditResult b = audit_pd(inertia, p.phi, domain, o.audit);
+    start.lambda_min = b.lambda_min;
+    r.t_audit += b.wall;
+  }
+  return start;
 }
 
 // One trajectory at one interval, from its log.
@@ -88,44 +166,43 @@ RunRecord identify_run(const io::Log& log, const ClosedLoopSimulator<Model>* sim
   r.weighted = ls.weighted;
   r.t_ols = seconds_since(t);
 
-  t = std::chrono::steady_clock::now();
-  ProjectionOptions po = o.projection;
-  if (o.projection_metric == ProjectionMetric::information) po.metric = information_metric(ls.information, o.information_ridge);
-  const ConditionalProjection cp = conditional_projection(inertia, ls.phi, domain, o.margins, po);
-  const double conditional_wall = seconds_since(t);
-  r.ols_lambda_min = cp.audit.lambda_min;
-  r.ols_worst_pose = cp.audit.worst_pose;
-  r.ols_pd = cp.audit.positive_definite();
-  r.route = cp.projected ? "O-S-C" : "O-C";
-  r.eps = cp.projected ? cp.eps : 0.0;
-  r.sdp_feasible = cp.feasible;
-  r.t_audit = cp.audit.wall;
-  r.t_sdp = std::max(0.0, conditional_wall - cp.audit.wall);
-  if (!cp.feasible) {
-    // No margin gave a PD vector: the run has no SDP vector and no final one; its OLS stays in
-    // the OLS cloud. Nothing downstream starts from a failed projection.
-    r.clie_ran = false;
-    std::string why;
-    for (const ProjectionResult& a : cp.attempts)
-      why += fmt::format("{}eps {:g}: lambda_min {:.3g} ({})", why.empty() ? "" : "; ", a.eps, a.lambda_min, a.status);
-    r.clie_termination = "not run: the SDP projection failed at every margin (" + why + ")";
-    return r;
+  const bool physical = o.consistency == Consistency::physical;
+  const ClieStart start = physical && o.physical_start ? physical_start<Model>(ls, o, inertia, domain, r)
+                                                       : pd_start(ls, o, inertia, domain, r);
+  if (physical && !o.physical_start) {
+    const auto tc = std::chrono::steady_clock::now();
+    const ConsistencyResult k = physical_check<Model>(ls.phi);
+    r.physical = true;
+    r.ols_consistent = k.ok();
+    r.ols_consistency = k.feasibility;
+    r.t_sdp += seconds_since(tc);
   }
-  r.phi_sdp = cp.phi;
+  // The run's final vector (CLIE's, or the start without CLIE) checked for a consistent set.
+  auto check_final = [&](const Eigen::VectorXd& phi) {
+    if (!physical) return;
+    const auto tc = std::chrono::steady_clock::now();
+    const ConsistencyResult k = physical_check<Model>(phi);
+    r.clie_consistent = k.ok();
+    r.clie_consistency = k.feasibility;
+    r.t_sdp += seconds_since(tc);
+  };
+  if (!r.sdp_feasible) return r;  // no admissible start: no SDP vector, no final one (r says why)
+  r.phi_sdp = start.phi;
   if (!sim) {
-    // The chain ends at the SDP (or the PD OLS estimate): that is the run's final vector.
+    // The chain ends at the SDP (or the admissible OLS estimate): that is the run's final vector.
     r.clie_ran = false;
     r.clie_termination = "not run: " + no_clie;
     r.phi_clie = r.phi_sdp;
-    r.clie_lambda_min = cp.projected ? cp.attempts.back().lambda_min : r.ols_lambda_min;
+    r.clie_lambda_min = start.lambda_min;
     r.clie_pd = true;
+    check_final(r.phi_clie);
     return r;
   }
   t = std::chrono::steady_clock::now();
   ClieOptions co = o.clie;
   co.preprocess = o.preprocess;
   if (co.std_bound > 0) co.scale = ls.std_dev;
-  const ClieResult c = clie<Model>(*sim, s, cp.phi, co);
+  const ClieResult c = clie<Model>(*sim, s, start.phi, co);
   r.t_clie = seconds_since(t);
   r.clie_success = c.success;
   r.clie_termination = c.start_divergence.diverged ? "start diverged: " + c.start_divergence.describe() : c.termination;
@@ -139,6 +216,7 @@ RunRecord identify_run(const io::Log& log, const ClosedLoopSimulator<Model>* sim
     r.clie_lambda_min = a.lambda_min;
     r.clie_pd = a.positive_definite();
     r.t_audit += a.wall;
+    check_final(c.phi);
   }
   return r;
 }
@@ -165,11 +243,15 @@ class Study {
 
   StudyResult run() {
     const auto t0 = std::chrono::steady_clock::now();
+    if (o_.consistency == Consistency::physical && !supports_physical_consistency<Model>())
+      throw std::invalid_argument(fmt::format("--consistency physical: the {} model has effect parameters (not standard "
+                                              "inertial parameters); identify it with the PD path", Model::variant_name));
     const Dataset data = read_dataset(o_.data);
     check_dataset_robot(data, Model::robot_name);
     StudyResult out;
     out.robot = Model::robot_name;
     out.model = Model::variant_name;
+    out.consistency = to_string(o_.consistency);
     for (const auto& p : Model::parameters) {
       out.names.push_back(p.name);
       out.units.push_back(p.unit);
@@ -357,8 +439,21 @@ class Study {
     }
     out.stages.push_back(fmt::format("OLS{}, all-pose PD audit, conditional SDP projection: {} runs", o_.least_squares.weighted ? " (WLS)" : "",
                                      out.runs.size() - failures));
-    out.stages.push_back(fmt::format("SDP projection and rescue in the {} metric{}", to_string(o_.projection_metric),
-                                     o_.projection_metric == ProjectionMetric::information ? " (the run's W'W / sigma^2)" : ""));
+    if (o_.consistency == Consistency::physical)
+      out.stages.push_back(fmt::format(
+          "physical consistency (per-link pseudo-inertia LMIs, IA, FV, FS >= 0): every run's OLS and final vectors "
+          "checked; {}the rescue onto the base vectors with a consistent standard set in the metric of the torque "
+          "predicted on {} (clearance {:g} of each link's size); acceptance needs a consistent set and the final audit",
+          o_.physical_start ? fmt::format("CLIE's start projected onto that set (clearance {:g}) instead of the PD "
+                                          "projection; ", o_.physical_clearance)
+                            : "CLIE's start the paper's (conditional PD projection); ",
+          o_.rescue_metric_all_runs ? "every identification trajectory at the representative's interval"
+                                    : "the representative's run",
+          o_.physical_rescue_clearance));
+    if (o_.consistency == Consistency::pd || !o_.physical_start)
+      out.stages.push_back(fmt::format("SDP projection{} in the {} metric{}", o_.consistency == Consistency::pd ? " and rescue" : "",
+                                       to_string(o_.projection_metric),
+                                       o_.projection_metric == ProjectionMetric::information ? " (the run's W'W / sigma^2)" : ""));
     const std::string bounds =
         o_.clie.std_bound > 0 ? fmt::format(" (bounds: +-{:g} OLS standard deviations around the start)", o_.clie.std_bound) : "";
     if (skipped == 0)
@@ -407,10 +502,31 @@ class Study {
                        run.window_end, interval, o_.describe(), in.loop);
   }
 
-  // The information matrix of a run (the rescue's metric): its regression stacked again.
-  Eigen::MatrixXd information(const Dataset& data, const RunRecord& r) const {
+  // A run's least squares again (the rescue's metric: its information matrix).
+  LeastSquaresResult refit(const Dataset& data, const RunRecord& r) const {
     const preprocess::Samples s = preprocess::preprocess(load_log(data.find(r.trajectory, o_.trial)), r.interval, o_.preprocess);
-    return least_squares(stack_regression<Model>(s), o_.least_squares).information;
+    return least_squares(stack_regression<Model>(s), o_.least_squares);
+  }
+
+  // W'W / rows over every identification trajectory at one interval (ridge-regularized like the
+  // information metric): distances in it are RMS changes of the torque predicted on all the
+  // identification data. A log too short for the interval is left out.
+  Eigen::MatrixXd pooled_torque_metric(const Dataset& data, double interval) const {
+    Eigen::MatrixXd A = Eigen::MatrixXd::Zero(Model::np, Model::np);
+    double rows = 0;
+    for (const auto& name : identification_names(data)) {
+      try {
+        const preprocess::Samples s = preprocess::preprocess(load_log(data.find(name, o_.trial)), interval, o_.preprocess);
+        const Regression reg = stack_regression<Model>(s);
+        A.selfadjointView<Eigen::Lower>().rankUpdate(reg.W.transpose());
+        rows += static_cast<double>(reg.W.rows());
+      } catch (const std::exception&) {
+        continue;
+      }
+    }
+    if (rows == 0) throw std::runtime_error("the rescue's metric: no identification log could be read at this interval");
+    A = A.selfadjointView<Eigen::Lower>();
+    return information_metric(A / rows, o_.information_ridge);
   }
 
   void select_and_accept(const Dataset& data, StudyResult& out) const {
@@ -429,11 +545,26 @@ class Study {
     const RunRecord& sel = out.runs[out.selection.run];
     out.phi_rescue = sel.phi_clie;
     out.rescued = false;
-    if (!sel.clie_pd) {
+    if (o_.consistency == Consistency::physical) {
+      if (!sel.clie_consistent) {
+        // The rescue over standard parameters: the nearest base vector with a consistent set, in
+        // the selected run's predicted-torque metric.
+        const PhysicalProjection p = physical_projection<Model>(
+            sel.phi_clie, {},
+            o_.rescue_metric_all_runs ? pooled_torque_metric(data, sel.interval)
+                                      : detail::torque_metric(refit(data, sel), o_.information_ridge),
+            o_.physical_rescue_clearance);
+        out.phi_rescue = p.phi;
+        out.rescued = true;
+        out.rescue_eps = o_.physical_rescue_clearance;
+        out.rescue_feasible = p.feasible;
+        out.rescue_status = p.status;
+      }
+    } else if (!sel.clie_pd) {
       ProjectionOptions po = o_.projection;
       po.eps = 0;  // the paper's rescue: a minimal feasibility correction
       if (o_.projection_metric == ProjectionMetric::information)
-        po.metric = information_metric(information(data, sel), o_.information_ridge);
+        po.metric = information_metric(refit(data, sel).information, o_.information_ridge);
       const ProjectionResult p = project_pd(*inertia_, sel.phi_clie, domain_, po);
       out.phi_rescue = p.phi;
       out.rescued = true;
@@ -450,6 +581,12 @@ class Study {
     out.final_lambda_min = a.lambda_min;
     out.final_worst_pose = a.worst_pose;
     out.accepted = a.positive_definite();
+    // Physical consistency of the accepted vector, on both paths (the physical one requires it).
+    const ConsistencyResult k = physical_check<Model>(out.phi_rescue);
+    out.final_consistent = k.ok();
+    out.final_consistency = k.feasibility;
+    out.final_consistency_note = k.message;
+    if (o_.consistency == Consistency::physical) out.accepted = out.accepted && out.final_consistent;
   }
 
   void validate(const Dataset& data, const std::vector<std::string>& names, StudyResult& out) const {

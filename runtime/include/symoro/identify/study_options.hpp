@@ -24,6 +24,15 @@ const char* to_string(ProjectionMetric m);
 // "euclidean" or "information"; throws std::invalid_argument naming the choices otherwise.
 ProjectionMetric projection_metric_from_string(const std::string& s);
 
+// What makes a base vector admissible: the paper's all-pose PD of M(q) (sampled poses: the SDP
+// projection's exchange loop and the audit), or a physically consistent standard set mapping
+// onto it (per-link pseudo-inertia LMIs, IA, FV, FS >= 0: physical_projection.hpp), which implies
+// M(q) > 0 at every pose and makes the accepted vector exportable (dynid export --urdf).
+enum class Consistency { pd, physical };
+const char* to_string(Consistency c);
+// "pd" or "physical"; throws std::invalid_argument naming the choices otherwise.
+Consistency consistency_from_string(const std::string& s);
+
 struct StudyOptions {
   std::filesystem::path data;   // dataset folder (dataset.yaml and its logs)
   std::filesystem::path out;    // study folder: runs/ (one file per run) and the report
@@ -53,6 +62,22 @@ struct StudyOptions {
   // The information metric: measured on the twin's 160-run study (docs/identification.md).
   ProjectionMetric projection_metric = ProjectionMetric::information;
   double information_ridge = 1e-9;  // times the information matrix's mean diagonal
+  // Consistency::physical: the rescue is physical_projection (in the selected run's
+  // predicted-torque metric W'W / rows, each link's pseudo-inertia clearing
+  // physical_rescue_clearance of its size), acceptance needs a consistent set as well as the
+  // final audit, and every run's OLS and final vectors are checked for one. CLIE starts where the
+  // paper's does (the conditional PD projection) unless physical_start: then the OLS estimate is
+  // projected onto the consistent set instead (clearance physical_clearance). Measured on the
+  // twin's study (docs/identification.md): CLIE, unconstrained, walks back out of the consistent
+  // set from such a start, in many more iterations, and some starts diverge.
+  Consistency consistency = Consistency::pd;
+  // The physical rescue's metric: the predicted torque on every identification trajectory at the
+  // representative's interval (W'W / rows pooled), or on the representative's run alone (cheaper
+  // to form, but free along what that one run barely excites: measured, docs/identification.md).
+  bool rescue_metric_all_runs = true;
+  bool physical_start = false;
+  double physical_clearance = 1e-4;
+  double physical_rescue_clearance = 1e-7;
   // Its preprocess options are the study's. Stopping rule of MATLAB's lsqnonlin (the paper's):
   // relative cost change 1e-6; at most 25 steps. No bounds by OLS standard deviations
   // (clie.std_bound 0): they also block CLIE's correction of OLS's bias, which can be many

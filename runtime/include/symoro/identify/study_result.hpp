@@ -3,6 +3,7 @@
 // saved per run, and read by the report.
 #pragma once
 
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -47,6 +48,15 @@ struct RunRecord {
   Eigen::VectorXd clie_rms;       // per joint, N m, at the samples
   double clie_lambda_min = 0;     // all-pose audit of phi_clie
   bool clie_pd = false;
+  // Consistency::physical only (physical = true): whether the OLS and CLIE vectors have a
+  // physically consistent standard set, and phase 1's margin of each (relative to the links'
+  // size; < 0: none; NaN: not needed, the prior's projection was consistent). route, eps (the
+  // clearance) and sdp_feasible then describe the physical projection; the PD fields stay the
+  // all-pose audit's.
+  bool physical = false;
+  bool ols_consistent = false, clie_consistent = false;
+  double ols_consistency = std::numeric_limits<double>::quiet_NaN();
+  double clie_consistency = std::numeric_limits<double>::quiet_NaN();
   // Wall times, s
   double t_ols = 0, t_audit = 0, t_sdp = 0, t_clie = 0;
 
@@ -104,7 +114,14 @@ struct StudyResult {
   std::string rescue_status;
   double final_lambda_min = 0;
   Eigen::VectorXd final_worst_pose;
-  bool accepted = false;                  // final audit passed
+  bool accepted = false;                  // final audit passed (physical: and a consistent set exists)
+  std::string consistency = "pd";         // the path: pd (the paper's) or physical
+  // The accepted vector's physical consistency, checked on both paths where the model allows
+  // (physical_projection.hpp): a consistent standard set maps onto it, phase 1's margin (NaN: not
+  // needed), or why it was not checked.
+  bool final_consistent = false;
+  double final_consistency = std::numeric_limits<double>::quiet_NaN();
+  std::string final_consistency_note;
   std::vector<ValidationRecord> validation;
   Eigen::VectorXd truth;                  // the twin's true parameters (empty for real data)
   std::string data_source;                // e.g. "twin (robots/crane_x7/twin.yaml, config ...)"
