@@ -89,5 +89,19 @@ foreach(robot rx90 stanford_rrp)
     endif()
     expect("${out}" "Successfully Parsed XML")
   endif()
+
+  # The physical path: the accepted vector has a consistent set of link inertials, so the export
+  # reproduces it without --nearest and without a warning.
+  run(0 out identify --robot ${robot} --model ${after} --data ${w}/data -o ${w}/study-physical --interval 10
+      --consistency physical)
+  expect("${out}" "physical consistency of the accepted vector: consistent")
+  file(READ ${w}/study-physical/report/parameters.yaml params)
+  expect("${params}" "physically_consistent: true")
+  run(0 out export --robot ${robot} --study ${w}/study-physical --urdf ${w}/urdf/physical.urdf --prior zero)
+  expect("${out}" "consistent standard parameters: consistent")
+  file(READ ${w}/urdf/physical.urdf urdf)
+  if(urdf MATCHES "WARNING")
+    message(FATAL_ERROR "the physical study's export warns:\n${urdf}")
+  endif()
 endforeach()
 file(REMOVE_RECURSE ${WORK})
