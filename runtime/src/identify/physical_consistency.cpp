@@ -435,8 +435,9 @@ ConsistencyResult consistent_standard_parameters(const ConsistencyStructure& st,
     z1 = R * sol.y.head(nz);
   }
   // Constraints the base vector fixes count when they are violated; one met exactly (FS fixed
-  // at its bound 0 by a variant) would otherwise pin the margin at 0 whatever the links'.
-  r.feasibility = fixed.constant_min < 0 ? std::min(t_star, fixed.constant_min) : t_star;
+  // at its bound 0 by a variant, -1.6e-22 after the pseudo-inverse's rounding) would otherwise
+  // pin the margin at 0 whatever the links'.
+  r.feasibility = fixed.constant_min < -o.feasibility_tolerance ? std::min(t_star, fixed.constant_min) : t_star;
   if (r.feasibility < -o.feasibility_tolerance) {
     r.status = ConsistencyStatus::NoConsistentSet;
     if (fixed.constant_min < -o.feasibility_tolerance) r.feasibility = fixed.constant_min;
