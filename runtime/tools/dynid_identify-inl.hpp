@@ -107,7 +107,8 @@ void IdentifyCommand::run(const Common& common, const IdentifyOptions& o) {
     const auto& sel = r.runs[r.selection.run];
     fmt::print("representative: {} ({}); {}; final audit lambda_min {:.3e} -> {}\n", sel.id(), r.selection.rule,
                r.rescued ? (r.rescue_feasible ? (r.consistency == "physical" ? "rescued onto the consistent set" : "rescued (eps = 0)")
-                                                           : "rescue FAILED: " + r.rescue_status) : "PD without rescue",
+                                                           : "rescue FAILED: " + r.rescue_status)
+                         : (r.consistency == "physical" ? "consistent, no rescue" : "PD without rescue"),
                r.final_lambda_min, r.accepted ? "accepted" : "NOT accepted");
     fmt::print("physical consistency of the accepted vector: {}\n",
                r.final_consistency_note.empty() ? "not checked" : r.final_consistency_note);
