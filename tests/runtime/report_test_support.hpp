@@ -24,11 +24,14 @@
 #include "symoro/identify/report.hpp"
 #include "symoro/identify/reproduction.hpp"
 #include "symoro/identify/svg_plot.hpp"
+#include "svg_test_support.hpp"
 
 namespace symoro::test::report {
 
 using namespace symoro::identify;
 namespace fs = std::filesystem;
+using symoro::test::panels;
+using symoro::test::tick_values;
 
 inline constexpr int np = 8;
 inline const std::vector<std::string> kTrajectories{"PC07", "AG02", "PA01", "AP01", "PB03"};
@@ -127,25 +130,7 @@ inline bool balanced(const std::string& svg) {
 }
 
 // The text of every <text class="cls" ...>value</text>, as numbers.
-inline std::vector<double> tick_values(const std::string& svg, const std::string& cls) {
-  std::vector<double> v;
-  const std::regex re("<text class=\"" + cls + "\"[^>]*>([^<]*)</text>");
-  for (std::sregex_iterator it(svg.begin(), svg.end(), re), end; it != end; ++it) v.push_back(std::stod((*it)[1]));
-  return v;
-}
-
-inline std::vector<std::string> panels(const std::string& svg) {
-  std::vector<std::string> out;
-  const std::string open = "<g class=\"panel\">";
-  for (auto pos = svg.find(open); pos != std::string::npos;) {
-    const auto next = svg.find(open, pos + 1);
-    out.push_back(svg.substr(pos, next == std::string::npos ? std::string::npos : next - pos));
-    pos = next;
-  }
-  return out;
-}
-
-long ms(double interval) { return std::lround(interval * 1000); }
+inline long ms(double interval) { return std::lround(interval * 1000); }
 
 // --- The synthetic study --------------------------------------------------------------------
 

@@ -22,6 +22,7 @@
 
 #include "symoro/diagnose/localize.hpp"
 #include "symoro/diagnose/localize_report.hpp"
+#include "svg_test_support.hpp"
 
 namespace {
 
@@ -238,16 +239,7 @@ class XmlCheck {
   }
 };
 
-std::vector<std::string> panels(const std::string& svg) {
-  std::vector<std::string> out;
-  const std::string open = "<g class=\"panel\">";
-  for (auto pos = svg.find(open); pos != std::string::npos;) {
-    const auto next = svg.find(open, pos + 1);
-    out.push_back(svg.substr(pos, next == std::string::npos ? std::string::npos : next - pos));
-    pos = next;
-  }
-  return out;
-}
+using symoro::test::panels;
 
 // --- Welch ----------------------------------------------------------------------------------
 

@@ -134,14 +134,25 @@ TEST(PhysicalConsistency, CraneX7TwinTruth) {
   EXPECT_GT(alone, 20);
 }
 
+// A random consistent CRANE-X7 truth and its base vector with ZZ7 made negative: no consistent set
+// maps onto it (ZZ7, a base parameter on its own, is a link's inertia about its axis).
+struct InfeasibleCrane {
+  symoro::test::Random rng;  // continues after the truth's draws
+  VectorXd truth, phi;
+  explicit InfeasibleCrane(unsigned seed) : rng(seed) {
+    truth = symoro::test::random_standard_parameters<Crane>(rng).s;
+    phi = base_of<Crane>(truth);
+    phi(symoro::crane_x7::param::ZZ7) = -0.01;
+  }
+};
+
 // A base vector no consistent set maps onto: ZZ7 (the last link's inertia about its z axis,
 // a base parameter on its own) negative. Reported with the nearest base vector that has one,
 // which is itself solvable; phi is not forced.
 TEST(PhysicalConsistency, InfeasibleBaseVectorIsReported) {
-  symoro::test::Random rng(5);
-  const VectorXd truth = symoro::test::random_standard_parameters<Crane>(rng).s;
-  VectorXd phi = base_of<Crane>(truth);
-  phi(symoro::crane_x7::param::ZZ7) = -0.01;
+  const InfeasibleCrane c(5);
+  const VectorXd& truth = c.truth;
+  const VectorXd& phi = c.phi;
   const ConsistencyResult r = symoro::identify::consistent_standard_parameters<Crane>(phi, truth);
   ASSERT_EQ(r.status, ConsistencyStatus::NoConsistentSet) << r.message;
   std::printf("  %s\n  phase 1 t = %.3g, %d CSDP solves, %.3f s\n", r.message.c_str(), r.feasibility, r.solves, r.wall);
@@ -173,10 +184,10 @@ TEST(PhysicalConsistency, InfeasibleBaseVectorIsReported) {
 // R factor: the predicted torque): its distance is |R (phi_c - phi)|, and it is no farther in R's
 // metric than the default metric's answer (and that one no farther in the default metric).
 TEST(PhysicalConsistency, InfeasibleBaseVectorInAFullMetric) {
-  symoro::test::Random rng(7);
-  const VectorXd truth = symoro::test::random_standard_parameters<Crane>(rng).s;
-  VectorXd phi = base_of<Crane>(truth);
-  phi(symoro::crane_x7::param::ZZ7) = -0.01;
+  InfeasibleCrane c(7);
+  const VectorXd& truth = c.truth;
+  const VectorXd& phi = c.phi;
+  symoro::test::Random& rng = c.rng;
   const ConsistencyResult d = symoro::identify::consistent_standard_parameters<Crane>(phi, truth);
   ASSERT_EQ(d.status, ConsistencyStatus::NoConsistentSet) << d.message;
   // A random well-conditioned R, rows coupling every base parameter.
@@ -204,11 +215,10 @@ TEST(PhysicalConsistency, InfeasibleBaseVectorInAFullMetric) {
 // infeasible one, that the free answer moved most: it stays bit for bit, the answer is consistent
 // and no nearer than the free one.
 TEST(PhysicalConsistency, HeldRowsStayExactly) {
-  symoro::test::Random rng(9);
-  const VectorXd truth = symoro::test::random_standard_parameters<Crane>(rng).s;
-  VectorXd phi = base_of<Crane>(truth);
+  const InfeasibleCrane c(9);
+  const VectorXd& truth = c.truth;
+  const VectorXd& phi = c.phi;
   const int zz7 = symoro::crane_x7::param::ZZ7;
-  phi(zz7) = -0.01;
   const ConsistencyResult free = symoro::identify::consistent_standard_parameters<Crane>(phi, truth);
   ASSERT_EQ(free.status, ConsistencyStatus::NoConsistentSet) << free.message;
   VectorXd moved = (free.phi_consistent - phi).cwiseAbs();

@@ -138,22 +138,21 @@ RunRecord identify_run(const io::Log& log, const ClosedLoopSimulator<Model>* sim
   const bool physical = o.consistency == Consistency::physical;
   const ClieStart start = physical && o.physical_start ? physical_start<Model>(ls, o, inertia, domain, r)
                                                        : pd_start(ls, o, inertia, domain, r);
-  if (physical && !o.physical_start) {
-    const auto tc = std::chrono::steady_clock::now();
-    const ConsistencyResult k = physical_check<Model>(ls.phi);
-    r.physical = true;
-    r.ols_consistent = k.ok();
-    r.ols_consistency = k.feasibility;
-    r.t_sdp += seconds_since(tc);
-  }
-  // The run's final vector (CLIE's, or the start without CLIE) checked for a consistent set.
-  auto check_final = [&](const Eigen::VectorXd& phi) {
-    if (!physical) return;
+  // Whether a vector has a consistent set (the physical path; its time counts as the SDP's).
+  auto check = [&](const Eigen::VectorXd& phi, bool& consistent, double& margin) {
     const auto tc = std::chrono::steady_clock::now();
     const ConsistencyResult k = physical_check<Model>(phi);
-    r.clie_consistent = k.ok();
-    r.clie_consistency = k.feasibility;
+    consistent = k.ok();
+    margin = k.feasibility;
     r.t_sdp += seconds_since(tc);
+  };
+  if (physical && !o.physical_start) {  // physical_start has checked the OLS vector already
+    r.physical = true;
+    check(ls.phi, r.ols_consistent, r.ols_consistency);
+  }
+  // The run's final vector (CLIE's, or the start without CLIE).
+  auto check_final = [&](const Eigen::VectorXd& phi) {
+    if (physical) check(phi, r.clie_consistent, r.clie_consistency);
   };
   if (!r.sdp_feasible) return r;  // no admissible start: no SDP vector, no final one (r says why)
   r.phi_sdp = start.phi;
