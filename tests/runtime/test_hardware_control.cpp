@@ -205,13 +205,14 @@ TEST_F(HardwareControl, ANonFiniteCommandStopsAndIsNamed) {
   o.seconds = 2.0;
   // A feedforward model that returns NaN on joint 3 from its 1500th call on (the approach and
   // pre-roll call it too): never a silent zero or a saturated command.
-  auto calls = std::make_shared<int>(0);
-  o.feedforward = [calls](const Eigen::VectorXd& q, const Eigen::VectorXd&, const Eigen::VectorXd&, Eigen::VectorXd& tau) {
+  // (From trajectory time 0.5 s on: before torque on, the check of every reference must pass.)
+  auto broken = std::make_shared<std::atomic<bool>>(false);
+  o.feedforward = [broken](const Eigen::VectorXd& q, const Eigen::VectorXd&, const Eigen::VectorXd&, Eigen::VectorXd& tau) {
     tau = Eigen::VectorXd::Zero(q.size());
-    if (++*calls >= 1500) tau(2) = std::numeric_limits<double>::quiet_NaN();
+    if (broken->load()) tau(2) = std::numeric_limits<double>::quiet_NaN();
   };
   const std::string csv = (dir_ / "nan.csv").string();
-  const ControlResult r = run(rig, traj, csv, o);
+  const ControlResult r = run(rig, traj, csv, o, 0.5, [broken](Rig&) { broken->store(true); });
   EXPECT_EQ(r.reason, StopReason::invalid_command) << r.message;
   // Held on PD alone: the feedforward that failed is not asked for gravity.
   EXPECT_EQ(r.stop_action, StopAction::hold);
@@ -252,8 +253,11 @@ TEST_F(HardwareControl, ModelFeedforwardFromAStudysParameters) {
   ControlOptions o = options();
   o.seconds = 2.0;
   o.feedforward = model_feedforward<Identified>(read);
+  o.inertia = model_inertia<Identified>(read);
   const ControlResult r = run(rig, traj, (dir_ / "ff.csv").string(), o);
   ASSERT_EQ(r.reason, StopReason::completed) << r.message;
+  // The end of the run cannot be the feedforward's doing: the hold adds its gravity.
+  EXPECT_NE(r.at_stop.find("PD + the model's gravity"), std::string::npos) << r.at_stop;
   rig.expect_safe();
   // FF+PD alone (the twin's loop) leaves gravity to the PD; the model feedforward cancels it.
   const twin::ClosedLoopTwin<Model> sim(twin_);
@@ -265,6 +269,67 @@ TEST_F(HardwareControl, ModelFeedforwardFromAStudysParameters) {
   for (int j = 0; j < Model::nq; ++j) std::printf("  joint %d: %.3f vs %.3f\n", j + 1, r.max_error(j) * kDeg, st.max_error(j) * kDeg);
   EXPECT_LT(r.max_error(1), 0.5 * st.max_error(1));  // shoulder tilt
   EXPECT_LT(r.max_error(3), 0.5 * st.max_error(3));  // elbow
+}
+
+// Parameters with `accepted: true` but one value edited never reach the servos: MX2 = 50 asks
+// joint 2 for far more torque than its limit, ZZR2 = -100 makes M(q) indefinite. The run stops
+// in its setup, torque never on, and the refusal names the joint or the matrix.
+TEST_F(HardwareControl, AnEditedModelIsRefusedBeforeTorqueOn) {
+  using Identified = crane_x7::IdentifiedModel;
+  const trajectory::Trajectory traj = first_seconds("AG02", 2.0);
+  struct Case {
+    const char* name;
+    double value;
+    const char* says;
+  };
+  for (const Case& c : {Case{"MX2", 50.0, "joint 2 "}, Case{"ZZR2", -100.0, "is not positive definite"}}) {
+    Rig rig(twin_, hw_, traj);
+    Eigen::VectorXd phi = Identified::from_parent(rig.backend->truth().phi);
+    int i = 0;
+    while (std::string(Identified::parameters[i].name) != c.name) ++i;
+    phi(i) = c.value;
+    ControlOptions o = options();
+    o.seconds = 2.0;
+    o.feedforward = model_feedforward<Identified>(phi);
+    o.inertia = model_inertia<Identified>(phi);
+    const std::string csv = (dir_ / fmt::format("edited_{}.csv", c.name)).string();
+    const ControlResult r = run(rig, traj, csv, o);
+    EXPECT_EQ(r.reason, StopReason::setup_failed) << c.name << ": " << r.message;
+    EXPECT_NE(r.message.find("the model feedforward is refused before torque on"), std::string::npos) << r.message;
+    EXPECT_NE(r.message.find(c.says), std::string::npos) << r.message;
+    EXPECT_EQ(r.at_stop, "torque off (it had not been turned on)");
+    EXPECT_EQ(r.rows, 0);
+    rig.expect_safe();
+  }
+}
+
+// A limit stop may be the feedforward's doing: the hold then uses PD alone, never the model's
+// gravity (which, from a wrong model, held the arm 253 deg off the stop pose).
+TEST_F(HardwareControl, ALimitStopHoldsWithoutTheModelsGravity) {
+  using Identified = crane_x7::IdentifiedModel;
+  const trajectory::Trajectory traj = first_seconds("AG02", 2.0);
+  Rig rig(twin_, hw_, traj);
+  const Eigen::VectorXd phi = Identified::from_parent(rig.backend->truth().phi);
+  ControlOptions o = options();
+  o.seconds = 2.0;
+  o.feedforward = model_feedforward<Identified>(phi);
+  o.inertia = model_inertia<Identified>(phi);
+  // Joint j's velocity limit at half the reference's peak: the arm trips it mid-run.
+  Eigen::VectorXd q(Model::nq), v(Model::nq), a(Model::nq), peak = Eigen::VectorXd::Zero(Model::nq);
+  for (double t = 0; t < 2.0; t += 0.01) {
+    traj.evaluate(t, q, v, a);
+    peak = peak.cwiseMax(v.cwiseAbs());
+  }
+  int j = 0;
+  peak.maxCoeff(&j);
+  std::vector<JointInfo> js = joints();
+  js[j].velocity = 0.5 * peak(j) / hw_.safety.velocity_factor;
+  const ControlResult r = run(rig, traj, (dir_ / "limit_ff.csv").string(), o, -1, {}, js);
+  EXPECT_EQ(r.reason, StopReason::velocity_limit) << r.message;
+  EXPECT_EQ(r.stop_action, StopAction::hold);
+  EXPECT_NE(r.at_stop.find("(PD (a velocity_limit stop may come from the model feedforward)"), std::string::npos) << r.at_stop;
+  EXPECT_TRUE(r.torque_off_confirmed);
+  rig.expect_safe();
 }
 
 }  // namespace

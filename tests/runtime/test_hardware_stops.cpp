@@ -1,6 +1,9 @@
 // The controller's stops (hardware_rig.hpp): position, velocity and current limits (also while a
 // servo is silent), SIGINT, and what the arm does at a stop (hardware.yaml safety.at_stop: hold
 // the stop pose, then torque off; or torque off at once), each read back from the emulated servos.
+#include <signal.h>
+#include <unistd.h>
+
 #include "hardware_rig.hpp"
 
 namespace symoro::hardware {
@@ -228,7 +231,8 @@ TEST_F(HardwareControl, ASecondSigintEndsTheHold) {
   StopSignals signals;
   const ControlResult r = run(rig, traj, csv, o, 0.5, [](Rig&) {
     std::raise(SIGINT);
-    std::this_thread::sleep_for(std::chrono::milliseconds(300));
+    // A deliberate second request: past the escalation delay (a quicker one is the same request).
+    std::this_thread::sleep_for(std::chrono::milliseconds(static_cast<int>(kStopEscalationDelay * 1e3) + 200));
     std::raise(SIGINT);
   });
   EXPECT_EQ(r.reason, StopReason::signal) << r.message;
@@ -238,6 +242,56 @@ TEST_F(HardwareControl, ASecondSigintEndsTheHold) {
   EXPECT_TRUE(r.torque_off_confirmed);
   rig.expect_safe();
   expect_log(r, csv);
+}
+
+// GNU timeout and systemd send SIGTERM to the process and then to its group, microseconds
+// apart: one request. The hold runs its whole time (on the real arm the alternative is torque off
+// after 1 ms and a falling arm); the same pair of signals, sent the way a process-group kill
+// reaches the process (kill(pid) then again), and a SIGINT right behind a SIGTERM, alike.
+TEST_F(HardwareControl, SignalsMillisecondsApartAreOneStopRequest) {
+  const trajectory::Trajectory traj = first_seconds("AG02", 2.0);
+  hw_.safety.hold_time = 1.0;
+  for (const auto& [name, second] : {std::pair<const char*, int>{"sigterm_pair", SIGTERM}, {"sigterm_sigint", SIGINT}}) {
+    Rig rig(twin_, hw_, traj);
+    ControlOptions o = options();
+    o.seconds = 2.0;
+    const std::string csv = (dir_ / fmt::format("{}.csv", name)).string();
+    StopSignals signals;
+    const ControlResult r = run(rig, traj, csv, o, 0.5, [second = second](Rig&) {
+      ::kill(::getpid(), SIGTERM);
+      std::this_thread::sleep_for(std::chrono::milliseconds(2));
+      ::kill(::getpid(), second);
+    });
+    EXPECT_EQ(r.reason, StopReason::signal) << r.message;
+    EXPECT_EQ(r.stop_action, StopAction::hold);
+    EXPECT_NEAR(r.held, 1.0, 1e-9) << name << ": " << r.at_stop;
+    EXPECT_EQ(r.at_stop.find("ended early"), std::string::npos) << name << ": " << r.at_stop;
+    EXPECT_TRUE(r.torque_off_confirmed);
+    rig.expect_safe();
+    expect_log(r, csv);
+  }
+}
+
+// A SIGTERM that follows the first after the escalation delay is a new request: it ends the hold.
+TEST_F(HardwareControl, ASigtermAfterTheDelayEndsTheHold) {
+  const trajectory::Trajectory traj = first_seconds("AG02", 2.0);
+  hw_.safety.hold_time = 30;
+  Rig rig(twin_, hw_, traj);
+  ControlOptions o = options();
+  o.seconds = 2.0;
+  const std::string csv = (dir_ / "late_sigterm.csv").string();
+  StopSignals signals;
+  const ControlResult r = run(rig, traj, csv, o, 0.5, [](Rig&) {
+    ::kill(::getpid(), SIGTERM);
+    std::this_thread::sleep_for(std::chrono::milliseconds(static_cast<int>(kStopEscalationDelay * 1e3) + 200));
+    ::kill(::getpid(), SIGTERM);
+  });
+  EXPECT_EQ(r.reason, StopReason::signal) << r.message;
+  EXPECT_NE(r.at_stop.find("a further stop request"), std::string::npos) << r.at_stop;
+  EXPECT_GT(r.held, kStopEscalationDelay - 0.1) << r.at_stop;
+  EXPECT_LT(r.held, 20.0) << r.at_stop;
+  EXPECT_TRUE(r.torque_off_confirmed);
+  rig.expect_safe();
 }
 
 // A stop in the pre-roll, before the trajectory's first row: torque was on, so the pose is held;

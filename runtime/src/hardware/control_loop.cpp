@@ -199,6 +199,8 @@ void Loop::setup() {
   if (!fresh) throw StopNow{StopReason::setup_failed, "the first sync read of the servos' state failed 5 times"};
   q0_ = q_;
   std::fill(stale_.begin(), stale_.end(), 0);
+  plan();
+  if (o_.feedforward) check_feedforward();  // throws StopNow before any torque
   for (int j = 0; j < n_; ++j) {
     torque_on_ = true;  // from the first attempt on: a servo may have taken it without answering
     expect_ok(j, bus_.write(ids_[j], xs::kTorqueEnable, 1, wait()), "Torque Enable 1");
@@ -295,14 +297,20 @@ double Loop::reference(double s) {
   return t;
 }
 
-StopNow Loop::loop() {
+void Loop::plan() {
   Eigen::VectorXd tmp(n_);
   traj_.evaluate(0.0, qr0_, tmp, tmp);
   const double distance = (qr0_ - q0_).cwiseAbs().maxCoeff();
   approach_ = distance < 0.01 ? 0.0 : std::max(0.5, 1.875 * distance / hw_.safety.approach_speed);
   const double end = o_.seconds > 0 ? std::min(o_.seconds, traj_.duration()) : traj_.duration();
+  k_end_ = std::llround((approach_ + hw_.safety.pre_roll) / T_) + std::llround(end / T_);
+}
+
+StopNow Loop::loop() {
+  const double distance = (qr0_ - q0_).cwiseAbs().maxCoeff();
+  const double end = o_.seconds > 0 ? std::min(o_.seconds, traj_.duration()) : traj_.duration();
   const std::int64_t k_traj0 = std::llround((approach_ + hw_.safety.pre_roll) / T_);
-  const std::int64_t k_end = k_traj0 + std::llround(end / T_);
+  const std::int64_t k_end = k_end_;
   control::FfpdController& ctrl = ctrl_.emplace(gains_);
   ctrl.reset(q_);
   if (o_.verbose)

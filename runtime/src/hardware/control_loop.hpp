@@ -62,6 +62,10 @@ class Loop {
   void check_limits();
   void check_current();
   double reference(double s);
+  void plan();  // the approach from the measured start pose (q0_) to the trajectory's start
+  // feedforward_check.cpp: the model feedforward on every reference the run will command,
+  // before torque is enabled (ControlOptions::inertia says what is checked).
+  void check_feedforward();
   StopNow loop();
   void finish_timing();
   // stop_hold.cpp: what the arm does between the stop and torque off (result.at_stop says).
@@ -87,6 +91,8 @@ class Loop {
   int watchdog_ = 3;
   int alert_id_ = -1;
   bool torque_on_ = false;  // Torque Enable 1 was written to every servo
+  bool feedforward_checked_ = false;  // the model feedforward passed check_feedforward()
+  std::int64_t k_end_ = 0;            // the last cycle of the run (plan())
   std::optional<control::FfpdController> ctrl_;  // the run's controller: the hold continues it
   TimingStats timing_;
   std::array<double, 5> period_stats_{};

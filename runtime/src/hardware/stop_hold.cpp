@@ -45,18 +45,30 @@ void Loop::at_stop(const StopNow& stop, ControlResult& result) {
     result.at_stop = "torque off at once: the loop had not started";
     return;
   }
-  // Gravity at the stop pose from the model feedforward, unless the feedforward is what failed.
+  // Gravity at the stop pose from the model feedforward: only from a model that passed its checks
+  // before torque on, and only at a stop it cannot have caused. A limit stop may be the
+  // feedforward's doing (a wrong model drives the arm away), and its gravity would hold the arm
+  // with the same error: PD alone then.
   Eigen::VectorXd gravity = Eigen::VectorXd::Zero(n_);
   std::string with = "PD";
-  if (o_.feedforward && stop.reason != StopReason::invalid_command) {
+  const bool innocent = stop.reason == StopReason::signal || stop.reason == StopReason::completed || stop.reason == StopReason::error;
+  if (o_.feedforward && !feedforward_checked_) {
+    with = "PD (the model feedforward was not checked)";
+  } else if (o_.feedforward && stop.reason == StopReason::invalid_command) {
+    with = "PD";  // the feedforward is what failed
+  } else if (o_.feedforward && !innocent) {
+    with = fmt::format("PD (a {} stop may come from the model feedforward)", to_string(stop.reason));
+  } else if (o_.feedforward) {
     const Eigen::VectorXd zero = Eigen::VectorXd::Zero(n_);
     Eigen::VectorXd g(n_);
     o_.feedforward(q_, zero, zero, g);
-    if (g.size() == n_ && g.allFinite()) {
+    bool within = g.size() == n_ && g.allFinite();
+    for (int j = 0; within && j < n_; ++j) within = std::abs(g(j)) <= limit_(j) * kt_(j);
+    if (within) {
       gravity = g;
       with = "PD + the model's gravity";
     } else {
-      with = "PD (the model's gravity is not finite)";
+      with = "PD (the model's gravity is not finite or beyond a joint's torque limit)";
     }
   }
   result.stop_action = StopAction::hold;

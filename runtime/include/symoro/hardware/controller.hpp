@@ -86,6 +86,15 @@ struct ControlOptions {
   std::function<void(const Eigen::VectorXd& q_ref, const Eigen::VectorXd& qd_ref,
                      const Eigen::VectorXd& qdd_ref, Eigen::VectorXd& tau)>
       feedforward;
+  // The model behind `feedforward`: its mass matrix M(q) (nq x nq; model_inertia<Model>(phi)).
+  // A feedforward is checked before torque is enabled (else the run stops as setup_failed, torque
+  // never on): at every reference the loop will command (the approach from the measured pose,
+  // the pre-roll, the trajectory; every period) and at the measured start pose, the feedforward
+  // is finite and within each joint's torque limit, and M is positive definite (when given). A
+  // file's `accepted: true` is no evidence: an edited parameter would drive the arm. Only a
+  // feedforward that passed may add its gravity to the hold at a stop, and only at a stop it
+  // cannot have caused (a signal, the end, an exception).
+  std::function<void(const Eigen::VectorXd& q, Eigen::MatrixXd& M)> inertia;
   // Consecutive failed sync reads that stop the run (0: hardware.yaml's safety.watchdog_cycles).
   // An emulated bus on a loaded machine needs more than a real one: its servos are a thread
   // that may wait milliseconds for a core.
@@ -119,6 +128,11 @@ struct ControlResult {
 
 // The process-wide count of stop requests, raised by the SIGINT/SIGTERM handler of StopSignals.
 std::atomic<int>& stop_flag();
+// A further SIGINT/SIGTERM counts as a new request (it ends the hold at a stop) only when it
+// arrives this long after the last counted one, or when both are Ctrl-C typed at the terminal:
+// `timeout` and systemd send SIGTERM to the process and to its group within microseconds, and
+// that pair is one request (docs/safety.md).
+inline constexpr double kStopEscalationDelay = 0.5;  // s
 // Installs SIGINT and SIGTERM handlers that only count in stop_flag() (clearing it first), and
 // restores the previous handlers when destroyed.
 class StopSignals {
@@ -152,6 +166,20 @@ auto model_feedforward(const Eigen::VectorXd& phi) {
     Vec out;
     Model::inverse_dynamics(Vec(q), Vec(qd), Vec(qdd), p, out);
     tau = out;
+  };
+}
+
+// The identified model's mass matrix, for ControlOptions::inertia.
+template <class Model>
+auto model_inertia(const Eigen::VectorXd& phi) {
+  using Vec = Eigen::Matrix<double, Model::nq, 1>;
+  using Phi = Eigen::Matrix<double, Model::np, 1>;
+  using Mat = Eigen::Matrix<double, Model::nq, Model::nq>;
+  const Phi p = phi;
+  return [p](const Eigen::VectorXd& q, Eigen::MatrixXd& M) {
+    Mat out;
+    Model::inertia(Vec(q), p, out);
+    M = out;
   };
 }
 
