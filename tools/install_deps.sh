@@ -9,6 +9,7 @@ packages=(
   libgtest-dev libgmock-dev libbenchmark-dev
   libopenmpi-dev openmpi-bin  # optional: the MPI farm and its test (docs/scaling.md)
   procps  # pgrep/ps: the MPI test finds the rank it kills
+  libxxhash-dev  # content digests (io/digest.hpp): saved runs, parameters files, robot folders
   liburdfdom-dev liburdfdom-tools  # optional: dynid export --urdf's tests read the URDF back (urdfdom, check_urdf)
 )
 missing=()

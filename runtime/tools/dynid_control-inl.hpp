@@ -112,15 +112,24 @@ void ControlCommand::run(const Common& common, const ControlCliOptions& o) {
     const Eigen::VectorXd phi = io::read_parameters_yaml(o.params, names);
     // Parameters whose final audit failed may not be positive definite everywhere: their
     // inverse dynamics is no feed-forward for a real arm unless the user says so, and the log
-    // records it.
-    if (!io::parameters_accepted(o.params)) {
+    // records it. The flag counts only in a file as identify wrote it (its digest): an edited
+    // value or flag makes it a file of unknown origin. Whatever the file says, the loop checks
+    // the model on every reference before torque on (hardware::ControlOptions::inertia).
+    const io::ParametersIntegrity integrity = io::parameters_integrity(o.params, names);
+    const bool accepted = io::parameters_accepted(o.params);
+    if (!accepted || !integrity.intact) {
+      const std::string why = !integrity.intact ? "the file is not as identify wrote it: " + integrity.why
+                                                : "the identification was not accepted (its final all-pose audit failed, or "
+                                                  "the file has no 'accepted: true')";
       if (!o.unaccepted_params)
-        throw UsageError(fmt::format("{}: the identification was not accepted (its final all-pose audit failed, or the "
-                                     "file has no 'accepted: true'); --unaccepted-params drives with it anyway",
-                                     o.params));
-      co.notes += "; PARAMETERS NOT ACCEPTED (--unaccepted-params)";
+        throw UsageError(fmt::format("{}: {}; --unaccepted-params drives with it anyway (the model is still checked before "
+                                     "torque on)",
+                                     o.params, why));
+      co.notes += !integrity.intact ? "; PARAMETERS EDITED OR NOT FROM IDENTIFY (--unaccepted-params)"
+                                    : "; PARAMETERS NOT ACCEPTED (--unaccepted-params)";
     }
     co.feedforward = hardware::model_feedforward<Identified>(phi);
+    co.inertia = hardware::model_inertia<Identified>(phi);
     co.notes += "; model feedforward from " + o.params;
   }
 

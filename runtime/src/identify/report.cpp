@@ -13,6 +13,7 @@
 #include "symoro/identify/reproduction.hpp"
 #include "symoro/identify/svg_plot.hpp"
 #include "symoro/io/atomic_file.hpp"
+#include "symoro/io/parameters_yaml.hpp"
 #include "symoro/io/number_text.hpp"
 
 namespace symoro::identify {
@@ -369,6 +370,10 @@ void write_parameters_yaml(const StudyResult& study, const std::filesystem::path
   y += fmt::format("accepted: {}\n", study.accepted);
   y += "consistency: " + yaml_quoted(study.consistency) + "\n";
   y += fmt::format("physically_consistent: {}\n", study.final_consistent);
+  // What dynid control checks before it drives an arm with these values: an edit breaks it.
+  std::vector<std::string> names;
+  for (Eigen::Index i = 0; i < phi.size(); ++i) names.push_back(name_of(study, static_cast<int>(i)));
+  y += "digest: " + io::parameters_digest(study.robot, study.model, study.accepted, names, phi) + "\n";
   y += phi.size() == 0 ? "parameters: []\n" : "parameters:\n";
   for (Eigen::Index i = 0; i < phi.size(); ++i)
     y += fmt::format("  - {{name: {}, unit: {}, value: {}}}\n", yaml_quoted(name_of(study, static_cast<int>(i))),

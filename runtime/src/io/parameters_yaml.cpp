@@ -8,6 +8,8 @@
 #include <yaml-cpp/yaml.h>
 
 #include "symoro/error.hpp"
+#include "symoro/io/digest.hpp"
+#include "symoro/io/number_text.hpp"
 
 namespace symoro::io {
 
@@ -63,6 +65,32 @@ bool parameters_accepted(const std::string& path) {
   } catch (const YAML::Exception&) {
     throw DataError(path, flag.Mark().line + 1, "accepted: expected true or false");
   }
+}
+
+std::string parameters_digest(const std::string& robot, const std::string& model, bool accepted,
+                              const std::vector<std::string>& names, const Eigen::VectorXd& values) {
+  std::string text = fmt::format("symoro-parameters 1\n{}\n{}\n{}\n", robot, model, accepted);
+  for (std::size_t i = 0; i < names.size() && static_cast<Eigen::Index>(i) < values.size(); ++i)
+    text += names[i] + " " + number_text(values(static_cast<Eigen::Index>(i))) + "\n";
+  return digest_of(text);
+}
+
+ParametersIntegrity parameters_integrity(const std::string& path, const std::vector<std::string>& names) {
+  const Eigen::VectorXd phi = read_parameters_yaml(path, names);
+  const bool accepted = parameters_accepted(path);
+  const YAML::Node root = YAML::LoadFile(path);  // read and checked above
+  const auto text = [&](const char* key) {
+    const YAML::Node n = root[key];
+    return n && n.IsScalar() ? n.as<std::string>() : std::string();
+  };
+  const std::string saved = text("digest");
+  if (saved.empty()) return {false, "it has no 'digest:' (identify writes one; an edited or hand-made file has none)"};
+  const std::string actual = parameters_digest(text("robot"), text("model"), accepted, names, phi);
+  if (saved != actual)
+    return {false, fmt::format("its content does not match its digest (file {}, content {}): it was edited after identify "
+                               "wrote it",
+                               saved, actual)};
+  return {true, ""};
 }
 
 }  // namespace symoro::io

@@ -19,4 +19,18 @@ Eigen::VectorXd read_parameters_yaml(const std::string& path, const std::vector<
 // boolean.
 bool parameters_accepted(const std::string& path);
 
+// The digest identify writes under `digest:` (io/digest.hpp): of the robot, the model, the
+// `accepted:` flag and every parameter's exact value, in `names` order. An edited value or flag
+// no longer matches it.
+std::string parameters_digest(const std::string& robot, const std::string& model, bool accepted,
+                              const std::vector<std::string>& names, const Eigen::VectorXd& values);
+
+// Whether the file is as identify wrote it: its digest is there and matches its content. `why`
+// says what differs (no digest, or which digest against which).
+struct ParametersIntegrity {
+  bool intact = false;
+  std::string why;
+};
+ParametersIntegrity parameters_integrity(const std::string& path, const std::vector<std::string>& names);
+
 }  // namespace symoro::io
