@@ -57,6 +57,7 @@
 #include "symoro/io/log.hpp"
 #include "symoro/parallel/farm.hpp"
 #include "symoro/preprocess/preprocess.hpp"
+#include "symoro/io/digest.hpp"
 #include "symoro/trajectory/design.hpp"
 
 namespace symoro::identify {
@@ -112,9 +113,10 @@ class Study {
     for (const auto& name : ident) {
       const DatasetRun& run = data.find(name, o_.trial);
       const io::LogMetadata meta = io::read_log_metadata(run.file);
+      const std::string content = log_digest(run);  // once per log, whatever the intervals
       for (double h : o_.intervals) {
         Slot s{name, h, o_.out / "runs" / fmt::format("{}@{}ms.yaml", name, std::lround(h * 1e3)), {}, {}};
-        s.fingerprint = fingerprint_of(run_inputs(inputs, run, meta, h));
+        s.fingerprint = fingerprint_of(run_inputs(inputs, run, meta, content, h));
         if (!o_.fresh) s.record = load_run(s.file, s.fingerprint);
         slots.push_back(std::move(s));
       }
@@ -307,8 +309,8 @@ class Study {
     }
   }
 
-  // What a run's result depends on: the model, the log (its sidecar identifies the data and its
-  // size guards against a replaced file), the window, the interval, every option of every stage
+  // What a run's result depends on: the model, the log (the digest of every byte read: its CSV
+  // and its sidecar; one value edited in place is another log), the window, the interval, every option of every stage
   // and the closed loop (controller and the design's file, when given). The parts shared by
   // every run are made once per study.
   struct StudyInputs {
@@ -334,10 +336,16 @@ class Study {
     }
     return in;
   }
-  std::string run_inputs(const StudyInputs& in, const DatasetRun& run, const io::LogMetadata& meta, double interval) const {
-    return fmt::format("{}| {} {} {} {} {} [{}, {}] | {} | {} | {}", in.model, run.file.filename().string(),
-                       std::filesystem::file_size(run.file), meta.seed, meta.notes, meta.trial, run.window_start,
-                       run.window_end, interval, o_.describe(), in.loop);
+  static std::string log_digest(const DatasetRun& run) {
+    std::string d = io::file_digest(run.file);
+    const auto sidecar = io::metadata_path(run.file);
+    if (std::filesystem::exists(sidecar)) d += " " + io::file_digest(sidecar);
+    return d;
+  }
+  std::string run_inputs(const StudyInputs& in, const DatasetRun& run, const io::LogMetadata& meta, const std::string& content,
+                         double interval) const {
+    return fmt::format("{}| {} {} {} {} {} [{}, {}] | {} | {} | {}", in.model, run.file.filename().string(), content, meta.seed,
+                       meta.notes, meta.trial, run.window_start, run.window_end, interval, o_.describe(), in.loop);
   }
 
   // A run's least squares again (the rescue's metric: its information matrix).
