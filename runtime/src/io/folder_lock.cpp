@@ -1,0 +1,50 @@
+#include "symoro/io/folder_lock.hpp"
+
+#include <fcntl.h>
+#include <sys/file.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstring>
+
+#include <fmt/format.h>
+
+#include "symoro/error.hpp"
+
+namespace symoro::io {
+
+FolderLock::FolderLock(const std::filesystem::path& folder, const std::string& what) {
+  std::filesystem::create_directories(folder);
+  const std::filesystem::path file = folder / ".lock";
+  fd_ = ::open(file.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
+  if (fd_ < 0) throw DataError(file.string(), 0, fmt::format("cannot open the folder's lock file: {}", std::strerror(errno)));
+  if (::flock(fd_, LOCK_EX | LOCK_NB) != 0) {
+    const int err = errno;
+    char holder[256] = {};
+    const ssize_t n = ::pread(fd_, holder, sizeof holder - 1, 0);
+    std::string who = n > 0 ? std::string(holder, static_cast<std::size_t>(n)) : std::string("another process");
+    while (!who.empty() && (who.back() == '\n' || who.back() == '\r')) who.pop_back();
+    ::close(fd_);
+    fd_ = -1;
+    if (err == EWOULDBLOCK)
+      throw DataError(folder.string(), 0,
+                      fmt::format("in use by {} (lock {}): two runs would overwrite each other's results; wait for it or "
+                                  "choose another folder",
+                                  who, file.string()));
+    throw DataError(file.string(), 0, fmt::format("cannot lock the folder: {}", std::strerror(err)));
+  }
+  // Who holds it, for the next one's message (the lock, not this text, is what excludes).
+  const std::string me = fmt::format("pid {} ({})\n", ::getpid(), what);
+  if (::ftruncate(fd_, 0) == 0) {
+    [[maybe_unused]] const ssize_t w = ::pwrite(fd_, me.data(), me.size(), 0);
+  }
+}
+
+FolderLock::~FolderLock() {
+  if (fd_ >= 0) {
+    [[maybe_unused]] const int t = ::ftruncate(fd_, 0);
+    ::close(fd_);  // releases the lock
+  }
+}
+
+}  // namespace symoro::io

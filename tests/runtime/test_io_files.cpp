@@ -1,0 +1,106 @@
+// Files the runtime guards: the folder lock (two studies never write one folder at once) and
+// content digests (a log edited in place is a new log; a parameters file edited after identify
+// wrote it is known to be edited).
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <Eigen/Core>
+#include <filesystem>
+#include <fstream>
+#include <random>
+#include <string>
+
+#include <gtest/gtest.h>
+
+#include "symoro/error.hpp"
+#include "symoro/io/digest.hpp"
+#include "symoro/io/folder_lock.hpp"
+#include "symoro/io/parameters_yaml.hpp"
+
+namespace symoro::io {
+namespace {
+
+std::filesystem::path scratch(const std::string& name) {
+  const auto d = std::filesystem::temp_directory_path() / ("symoro_io_files_" + name + "_" + std::to_string(::getpid()));
+  std::filesystem::remove_all(d);
+  std::filesystem::create_directories(d);
+  return d;
+}
+
+TEST(FolderLock, ASecondHolderIsRefusedWithTheFirstsPid) {
+  const auto dir = scratch("lock");
+  {
+    FolderLock first(dir / "study", "dynid identify");
+    try {
+      FolderLock second(dir / "study", "dynid identify");
+      FAIL() << "two holders of one folder";
+    } catch (const DataError& e) {
+      const std::string what = e.what();
+      EXPECT_NE(what.find("in use by pid " + std::to_string(::getpid()) + " (dynid identify)"), std::string::npos) << what;
+      EXPECT_NE(what.find((dir / "study").string()), std::string::npos) << what;
+    }
+    // Another process is refused too (flock excludes open files, not only processes).
+    const pid_t child = ::fork();
+    if (child == 0) {
+      try {
+        FolderLock other(dir / "study", "child");
+        ::_exit(0);
+      } catch (const DataError&) {
+        ::_exit(3);
+      }
+    }
+    int status = 0;
+    ::waitpid(child, &status, 0);
+    EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 3);
+  }
+  // Released with its holder: the folder can be taken again.
+  EXPECT_NO_THROW(FolderLock again(dir / "study", "dynid identify"));
+  std::filesystem::remove_all(dir);
+}
+
+TEST(Digest, FileDigestIsTheBytesDigestAndSeesOneChangedByte) {
+  const auto dir = scratch("digest");
+  std::mt19937 rng(7);
+  std::string bytes(3 * (1 << 20) + 17, '\0');  // more than one read block
+  for (char& c : bytes) c = static_cast<char>(rng());
+  std::ofstream(dir / "a.bin", std::ios::binary) << bytes;
+  const std::string d = file_digest(dir / "a.bin");
+  EXPECT_EQ(d, digest_of(bytes));
+  EXPECT_EQ(d.size(), 32u);
+  bytes[2 * (1 << 20) + 5] ^= 1;  // same size, one bit
+  std::ofstream(dir / "a.bin", std::ios::binary | std::ios::trunc) << bytes;
+  EXPECT_NE(file_digest(dir / "a.bin"), d);
+  EXPECT_THROW(file_digest(dir / "missing.bin"), DataError);
+  std::filesystem::remove_all(dir);
+}
+
+// A parameters file as identify writes it is intact; one value or the accepted flag edited, or
+// the digest removed, is not, and says why.
+TEST(ParametersDigest, AnEditedValueOrFlagBreaksIt) {
+  const auto dir = scratch("params");
+  const std::vector<std::string> names = {"ZZR1", "MX2"};
+  const Eigen::Vector2d phi(0.0121, 0.0437);
+  const auto write = [&](const std::string& file, bool accepted, double mx2, bool with_digest) {
+    std::ofstream f(dir / file);
+    f << "robot: \"crane_x7\"\nmodel: \"reduced\"\naccepted: " << (accepted ? "true" : "false") << "\n";
+    if (with_digest) f << "digest: " << parameters_digest("crane_x7", "reduced", true, names, phi) << "\n";
+    f << "parameters:\n  - {name: \"ZZR1\", unit: \"kg m^2\", value: 0.0121}\n  - {name: \"MX2\", unit: \"kg m\", value: " << mx2
+      << "}\n";
+  };
+  write("ok.yaml", true, 0.0437, true);
+  EXPECT_TRUE(parameters_integrity((dir / "ok.yaml").string(), names).intact);
+  write("value.yaml", true, 50, true);
+  const ParametersIntegrity v = parameters_integrity((dir / "value.yaml").string(), names);
+  EXPECT_FALSE(v.intact);
+  EXPECT_NE(v.why.find("does not match its digest"), std::string::npos) << v.why;
+  write("flag.yaml", false, 0.0437, true);
+  EXPECT_FALSE(parameters_integrity((dir / "flag.yaml").string(), names).intact);
+  write("none.yaml", true, 0.0437, false);
+  const ParametersIntegrity n = parameters_integrity((dir / "none.yaml").string(), names);
+  EXPECT_FALSE(n.intact);
+  EXPECT_NE(n.why.find("no 'digest:'"), std::string::npos) << n.why;
+  std::filesystem::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace symoro::io
