@@ -1,4 +1,5 @@
 #include "symoro/codegen/generator.hpp"
+#include "symoro/codegen/source_digest.hpp"
 
 #include <algorithm>
 #include <set>
@@ -698,6 +699,7 @@ Generation generate_robot(RobotModel& r) {
   for (const auto& v : variants) u += ", " + v.model_type();
   u += ">;\n\n}  // namespace symoro::" + r.name + "\n";
   out.files.push_back({r.name + "/include/symoro/" + r.name + ".hpp", u});
+  out.files.push_back({r.name + "/include/symoro/" + r.name + "/source.hpp", source_digest_header(r)});
   return out;
 }
 

@@ -1,5 +1,8 @@
 #include "symoro/codegen/robot_model.hpp"
 
+#include "symoro/codegen/source_digest.hpp"
+
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <regex>
@@ -196,6 +199,11 @@ RobotModel load_robot(const std::string& dir_in) {
   if (par_path.empty()) throw InputError(m.dir, 0, 0, "no <robot>.par description");
   if (base_par_path.empty()) throw InputError(m.dir, 0, 0, "no <robot>_base.par description");
 
+  for (const std::string& f : {(dir / "robot.yaml").string(), par_path, base_par_path})
+    m.sources.emplace_back(fs::path(f).filename().string(), file_content_digest(f));
+  for (const char* f : {"dim.txt", "idm.txt", "ddm.txt", "inm.txt", "ccg.txt", "fgm.txt", "jac.txt", "regp.txt"})
+    if (fs::exists(dir / f)) m.sources.emplace_back(f, file_content_digest((dir / f).string()));
+  std::sort(m.sources.begin(), m.sources.end());
   const auto par = grammar::read_par_file(par_path);
   grammar::read_par_file(base_par_path);  // checked for syntax; the model files carry its content
   auto read = [&](const char* f) { return grammar::read_model_file((dir / f).string()); };

@@ -15,6 +15,18 @@ namespace symoro::dynid {
 // The robots of robots/ this dynid was built with, in folder order (generated).
 const std::vector<std::string>& robot_names();
 
+// The files a robot's code was generated from, with their digests (generated/<robot>/source.hpp,
+// gathered in the generated dynid_tables.cpp).
+struct SourceFile {
+  const char* name;
+  const char* digest;
+};
+std::vector<SourceFile> robot_sources(const std::string& robot);
+
+// Refuses (UsageError) a robot folder (--robots-dir/<robot>) whose robot.yaml or model files
+// differ from those this dynid was compiled from: the compiled copy would be used silently.
+void check_robot_folder(const Common& common);
+
 template <class Options>
 class CommandTable {
  public:
@@ -27,7 +39,10 @@ class CommandTable {
   // The command for common.robot (compiled for its full or identified model only).
   Run robot(const Common& common) const {
     for (const auto& e : entries_)
-      if (e.robot == common.robot && e.model.empty()) return e.run;
+      if (e.robot == common.robot && e.model.empty()) {
+        check_robot_folder(common);
+        return e.run;
+      }
     throw UsageError("unknown robot '" + common.robot + "'");
   }
 
@@ -37,7 +52,10 @@ class CommandTable {
     std::string list;
     for (const auto& e : entries_) {
       if (e.robot != common.robot) continue;
-      if (e.model == model) return e.run;
+      if (e.model == model) {
+        check_robot_folder(common);
+        return e.run;
+      }
       if (!e.model.empty()) list += (list.empty() ? "" : ", ") + e.model;
     }
     if (list.empty()) throw UsageError("unknown robot '" + common.robot + "'");

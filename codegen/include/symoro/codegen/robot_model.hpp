@@ -6,6 +6,7 @@
 
 #include <map>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "symoro/codegen/expr_graph.hpp"
@@ -54,6 +55,11 @@ struct RobotModel {
   int fgm_frame = 0;
   std::vector<std::vector<NodeId>> jac;  // 6 x n
   std::vector<NodeId> base_from_standard;  // per base parameter, over standard symbols
+
+  // The files of the folder the model was read from, with their content digests (file name,
+  // XXH3-128 hex): generated into source.hpp, so that the runtime can tell a robot folder edited
+  // after it was compiled (source_digest.hpp).
+  std::vector<std::pair<std::string, std::string>> sources;
 };
 
 // Reads robots/<name>/ (robot.yaml and the OpenSYMORO files). Errors name the file, line and
