@@ -39,7 +39,7 @@ $dynid twin bench --robot crane_x7 --seconds 3
 $dynid identify --robot crane_x7 --data build/twin-data -o build/study --consistency physical
 # The identified arm as a URDF (modified-DH link frames, consistent inertials nearest the CAD
 # prior) that reproduces the accepted base parameters exactly.
-$dynid export --robot crane_x7 --study build/study --urdf build/crane_x7_identified.urdf
+$dynid export --robot crane_x7 --study build/study --urdf build/crane_x7_identified.urdf --force
 
 # The model-gap workflow: a twin dataset with hidden Coulomb friction (joints 2 and 4) and a
 # torque offset (joint 5), which dynid diagnose is not told about; it names them, writes
@@ -89,4 +89,4 @@ for model in rigid full; do
 done
 $dynid diagnose --robot rx90 --model rigid --data build/rx90-data -o build/rx90-diagnosis
 $dynid compare --robot rx90 --before build/rx90-study-rigid --after build/rx90-study-full -o build/rx90-gap
-$dynid export --robot rx90 --model full --study build/rx90-study-full --urdf build/rx90_identified.urdf --prior zero
+$dynid export --robot rx90 --model full --study build/rx90-study-full --urdf build/rx90_identified.urdf --prior zero --force

@@ -7,6 +7,7 @@
 #include <fmt/format.h>
 
 #include "dynid_common.hpp"
+#include "dynid_numbers.hpp"
 #include "symoro/diagnose/gap_report.hpp"
 #include "symoro/identify/validation_io.hpp"
 
@@ -68,7 +69,8 @@ void add_compare_commands(CLI::App& app, Common& common) {
   cmd->add_option("-o,--out", o->out, "Report folder (gap.md, figures/)")->required();
   cmd->add_option("--trajectory", o->trajectory, "Held-out trajectory whose torques are plotted (default: the last)");
   cmd->add_option("--joints", o->joints, "Joints plotted, 1-based (default: the 3 whose error changed most)")
-      ->delimiter(',');
+      ->delimiter(',')
+      ->check(numbers::count(1, 64));
   cmd->callback([&common, o] { run(common, *o); });
 }
 

@@ -4,6 +4,7 @@
 #include <CLI/CLI.hpp>
 
 #include "dynid_control.hpp"
+#include "dynid_numbers.hpp"
 
 namespace symoro::dynid {
 
@@ -23,19 +24,20 @@ void add_control_commands(CLI::App& app, Common& common) {
                                                              "accepted (recorded in the log)");
   cmd->add_option("--if-exists", o->if_exists, "When -o exists: refuse (default) or new-name (<stem>-<k>.csv)")
       ->check(CLI::IsMember({"refuse", "new-name"}));
-  cmd->add_option("--seconds", o->seconds, "Run only this much of the trajectory")->check(CLI::PositiveNumber);
+  cmd->add_option("--seconds", o->seconds, "Run only this much of the trajectory")->check(numbers::positive(1e6, "> 0 and <= 1e6 s"));
   cmd->add_option("--hardware", o->hardware, "Hardware description (default robots/<robot>/hardware.yaml)")->check(CLI::ExistingFile);
   cmd->add_option("--config", o->twin_config, "--virtual: a YAML file overriding parts of twin.yaml")->check(CLI::ExistingFile);
   cmd->add_flag("--ideal", o->ideal, "--virtual: turn every twin effect off");
-  cmd->add_option("--trial", o->trial, "Trial number in the log")->check(CLI::PositiveNumber);
+  cmd->add_option("--trial", o->trial, "Trial number in the log")->check(numbers::count(1, 1e6));
   cmd->add_option("--watchdog", o->watchdog, "Consecutive failed reads that stop the arm (default: hardware.yaml's; "
-                                             "--virtual: at least 20)")->check(CLI::PositiveNumber);
+                                             "--virtual: at least 20)")->check(numbers::count(1, 1e6));
   cmd->add_option("--at-stop", o->at_stop, "At a stop with torque on: hold the stop pose for the hold time, then torque off; "
                                            "or torque-off at once (default: hardware.yaml's safety.at_stop; logged)")
       ->check(CLI::IsMember({"hold", "torque-off"}));
   cmd->add_option("--hold-time", o->hold_time, "Seconds of hold at a stop (default: hardware.yaml's safety.hold_time; logged)")
-      ->check(CLI::PositiveNumber);
-  cmd->add_option("--rt-priority", o->priority, "SCHED_FIFO priority of the loop (default 30; 0: normal scheduling; refused: normal, with a note)");
+      ->check(numbers::positive(600, "> 0 and <= 600 s"));
+  cmd->add_option("--rt-priority", o->priority, "SCHED_FIFO priority of the loop (default 30; 0: normal scheduling; refused: normal, with a note)")
+      ->check(numbers::count(0, 99));
   cmd->callback([&common, o] { control_units().robot(common)(common, *o); });
 }
 

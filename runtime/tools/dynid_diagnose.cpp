@@ -7,6 +7,7 @@
 #include <CLI/CLI.hpp>
 
 #include "dynid_diagnose.hpp"
+#include "dynid_numbers.hpp"
 #include "symoro/diagnose/effects.hpp"
 
 namespace symoro::dynid {
@@ -23,15 +24,15 @@ void add_diagnose_commands(CLI::App& app, Common& common) {
                                        "than V, e.g. the fitting part of a split run)")->delimiter(',');
   cmd->add_option("--heldout", o->heldout, "Held-out runs that judge them (default: the dataset's family V, e.g. the "
                                            "held-out part of a split run)")->delimiter(',');
-  cmd->add_option("--trial", o->trial, "Which trial of each trajectory");
-  cmd->add_option("--interval", o->interval_ms, "Diagnosis grid, ms")->check(CLI::PositiveNumber);
-  cmd->add_option("--cutoff", o->cutoff, "Low-pass on every column and the torque, Hz")->check(CLI::PositiveNumber);
+  cmd->add_option("--trial", o->trial, "Which trial of each trajectory")->check(numbers::count(1, 1e6));
+  cmd->add_option("--interval", o->interval_ms, "Diagnosis grid, ms")->check(numbers::interval_ms());
+  cmd->add_option("--cutoff", o->cutoff, "Low-pass on every column and the torque, Hz")->check(numbers::positive(1e5, "> 0 and <= 1e5 Hz"));
   cmd->add_option("--only", o->only, "Only these effects (coulomb, stribeck, offset, viscous_asymmetry, "
                                      "position_harmonics, inertia_products, torque_constant, actuation_delay, backlash, payload)")
       ->delimiter(',');
-  cmd->add_option("--alpha", o->alpha, "Family-wise level of each step");
-  cmd->add_option("--min-gain", o->min_gain, "Least relative fall of the held-out residual");
-  cmd->add_option("--min-torque", o->min_torque, "Least effect torque that matters, N m");
+  cmd->add_option("--alpha", o->alpha, "Family-wise level of each step")->check(numbers::checked(0, 0.5, true, false, "> 0 and <= 0.5"));
+  cmd->add_option("--min-gain", o->min_gain, "Least relative fall of the held-out residual")->check(numbers::non_negative(1, ">= 0 and <= 1"));
+  cmd->add_option("--min-torque", o->min_torque, "Least effect torque that matters, N m")->check(numbers::non_negative(1e6, ">= 0 and <= 1e6 N m"));
   cmd->add_flag("--no-backlash", o->no_backlash, "Skip the closed-loop high-band stage (backlash; simulates the twin)");
   cmd->add_option("--model", o->model, "Model whose gap is diagnosed: a robot.yaml variant, or full (default: "
                                        "robot.yaml's identified)");

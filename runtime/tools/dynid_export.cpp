@@ -8,6 +8,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include "dynid_export.hpp"
+#include "dynid_numbers.hpp"
 
 namespace symoro::dynid {
 
@@ -18,6 +19,13 @@ namespace {
 std::string study_model(const std::string& file) {
   try {
     const YAML::Node root = YAML::LoadFile(file);
+    // A study that produced no model says so here, before its (empty) parameter list is read
+    // against the model's names.
+    const YAML::Node list = root["parameters"];
+    if (!list || !list.IsSequence() || list.size() == 0)
+      throw UsageError(fmt::format("{}: the study has no model to export: no run produced a final vector, so there is "
+                                   "no representative and no accepted parameters (see the study's report.md)",
+                                   file));
     const std::string m = root["model"] ? root["model"].as<std::string>() : std::string();
     return m.empty() ? "full" : m;
   } catch (const YAML::BadFile&) {
@@ -51,7 +59,7 @@ void add_export_commands(CLI::App& app, Common& common) {
                   "without twin.yaml needs --prior");
   cmd->add_option("--margin", o->margin, "Strictness of the consistency: every link's pseudo-inertia >= margin I "
                                          "(kg m^2 / kg; 0 allows singular links)")
-      ->check(CLI::NonNegativeNumber)
+      ->check(numbers::non_negative(1, ">= 0 and <= 1"))
       ->capture_default_str();
   cmd->add_flag("--not-accepted", o->not_accepted, "Export even when the study's final audit did not accept its "
                                                    "parameters");
@@ -59,11 +67,24 @@ void add_export_commands(CLI::App& app, Common& common) {
                                      "the nearest consistent vector is the one that changes the predicted torque on "
                                      "the study's fitting run least, and that change is reported")
       ->check(CLI::ExistingDirectory);
-  cmd->add_option("--trial", o->trial, "Which trial of the fitting run (with --data)")->capture_default_str();
+  cmd->add_option("--trial", o->trial, "Which trial of the fitting run (with --data)")->check(numbers::count(1, 1e6))->capture_default_str();
   cmd->add_flag("--nearest", o->nearest, "When no consistent set reproduces the accepted base parameters, export the "
                                          "consistent set of the nearest base vector that has one (said in the files) "
                                          "instead of failing");
+  cmd->add_flag("--force", o->force, "Overwrite the URDF and its .standard.yaml/.csv when they exist");
   cmd->callback([&common, o] {
+    // Like import and control: an existing file is replaced only when the user says so, and
+    // before any work is done.
+    std::filesystem::path stem = o->urdf;
+    stem.replace_extension();
+    for (const std::filesystem::path& f : {std::filesystem::path(o->urdf), std::filesystem::path(stem.string() + ".standard.yaml"),
+                                           std::filesystem::path(stem.string() + ".standard.csv")}) {
+      if (std::filesystem::is_directory(f))
+        throw UsageError(fmt::format("{} is a directory: --urdf names the file to write", f.string()));
+      if (std::filesystem::exists(f) && !o->force)
+        throw UsageError(fmt::format("{} exists: dynid export does not overwrite it; choose another --urdf, or --force",
+                                     f.string()));
+    }
     const std::string file = (std::filesystem::path(o->study) / "report" / "parameters.yaml").string();
     const std::string label = study_model(file);
     if (!o->model.empty() && o->model != label)

@@ -15,6 +15,7 @@ struct ExportOptions {
   double margin = 1e-9;
   int trial = 1;
   bool not_accepted = false, nearest = false;
+  bool force = false;  // overwrite the URDF and its .standard files
 };
 
 struct ExportCommand {

@@ -5,6 +5,7 @@
 #include <fmt/format.h>
 
 #include "dynid_common.hpp"
+#include "dynid_numbers.hpp"
 #include "symoro/io/atomic_file.hpp"
 #include "symoro/io/log.hpp"
 #include "symoro/io/number_text.hpp"
@@ -68,12 +69,13 @@ void add_preprocess_commands(CLI::App& app, Common& common) {
   auto* cmd = app.add_subcommand("preprocess", "Preprocess logs: time axis, zero-phase filter, derivatives, resampling");
   cmd->add_option("logs", o->logs, "Log CSV files")->required()->check(CLI::ExistingFile);
   cmd->add_option("--robot", common.robot, "Check that the logs are of this robot");
-  cmd->add_option("--interval", o->intervals_ms, "Target intervals in ms (default: 10 20 40 80)");
+  cmd->add_option("--interval", o->intervals_ms, "Target intervals in ms (default: 10 20 40 80)")->check(numbers::interval_ms());
   cmd->add_option("-o,--output", o->out, "Write <log>_<interval>ms.csv samples here");
-  cmd->add_option("--cutoff", o->options.derivative_cutoff, "Low-pass cutoff for the derivatives, Hz");
-  cmd->add_option("--max-gap", o->options.max_gap, "Longest gap bridged by interpolation, s");
+  cmd->add_option("--cutoff", o->options.derivative_cutoff, "Low-pass cutoff for the derivatives, Hz")->check(numbers::positive(1e5, "> 0 and <= 1e5 Hz"));
+  cmd->add_option("--max-gap", o->options.max_gap, "Longest gap bridged by interpolation, s")->check(numbers::non_negative(3600, ">= 0 and <= 3600 s"));
   cmd->add_option("--base-period", o->options.base_period,
-                  "Grid period, s (default: each log's sample_time, else its median stamp interval)");
+                  "Grid period, s (default: each log's sample_time, else its median stamp interval)")
+      ->check(numbers::positive(10, "> 0 and <= 10 s"));
   cmd->add_flag("!--keep-stale", o->options.drop_stale, "Keep stale rows (a state logged twice) in the regression");
   cmd->add_flag("--logged-velocity", o->options.use_logged_velocity,
                 "qd from the log's qd (filtered), qdd from its differences, instead of both from q");

@@ -3,6 +3,7 @@
 #include <CLI/CLI.hpp>
 
 #include "dynid_trajectories.hpp"
+#include "dynid_numbers.hpp"
 
 namespace symoro::dynid {
 
@@ -13,7 +14,7 @@ void add_trajectory_commands(CLI::App& app, Common& common) {
   cmd->add_option("--robots-dir", common.robots_dir, "Where the robot folders are");
   cmd->add_option("-o,--output", o->out, "Write <name>.csv and <name>.meta.yaml here (default: list only)");
   cmd->add_option("--only", o->only, "Only these trajectories");
-  cmd->add_option("--period", o->period, "Sample period of the reference files, s")->check(CLI::PositiveNumber);
+  cmd->add_option("--period", o->period, "Sample period of the reference files, s")->check(numbers::positive(10, "> 0 and <= 10 s"));
   cmd->callback([&common, o] { trajectories_units().robot(common)(common, *o); });
 }
 

@@ -3,6 +3,7 @@
 #include <CLI/CLI.hpp>
 
 #include "dynid_twin.hpp"
+#include "dynid_numbers.hpp"
 
 namespace symoro::dynid {
 
@@ -30,7 +31,7 @@ void add_twin_commands(CLI::App& app, Common& common) {
   add_config_options(run, common, *o);
   run->add_option("--trajectory", o->trajectory, "Trajectory name (see dynid trajectories)")->required();
   run->add_option("-o,--output", o->out, "Output directory")->required();
-  run->add_option("--trial", o->trial, "Trial number")->check(CLI::PositiveNumber);
+  run->add_option("--trial", o->trial, "Trial number")->check(numbers::count(1, 1e6));
   run->add_option("--seed", o->seed, "Dataset seed (the run's seed derives from it, the trajectory and the trial)");
   run->callback([&common, o] {
     o->mode = TwinOptions::Mode::run;
@@ -40,9 +41,9 @@ void add_twin_commands(CLI::App& app, Common& common) {
   auto* data = twin->add_subcommand("dataset", "Run every trajectory for several trials (resumable, parallel)");
   add_config_options(data, common, *o);
   data->add_option("-o,--output", o->out, "Output directory")->required();
-  data->add_option("--trials", o->trials, "Repeated trials per trajectory")->check(CLI::PositiveNumber);
+  data->add_option("--trials", o->trials, "Repeated trials per trajectory")->check(numbers::count(1, 1e4));
   data->add_option("--seed", o->seed, "Dataset seed");
-  data->add_option("--jobs", o->jobs, "Worker threads per rank (default: the cores, shared among the MPI ranks on a machine)");
+  data->add_option("--jobs", o->jobs, "Worker threads per rank (default: the cores, shared among the MPI ranks on a machine)")->check(numbers::count(1, 1024));
   data->add_option("--only", o->only, "Only these trajectories");
   data->callback([&common, o] {
     o->mode = TwinOptions::Mode::dataset;
@@ -52,7 +53,7 @@ void add_twin_commands(CLI::App& app, Common& common) {
   auto* bench = twin->add_subcommand("bench", "Simulated seconds per wall second on one core");
   add_config_options(bench, common, *o);
   bench->add_option("--trajectory", o->trajectory, "Trajectory to simulate (default AG02)");
-  bench->add_option("--seconds", o->repeat_seconds, "Measure for at least this long");
+  bench->add_option("--seconds", o->repeat_seconds, "Measure for at least this long")->check(numbers::positive(3600, "> 0 and <= 3600 s"));
   bench->callback([&common, o] {
     o->mode = TwinOptions::Mode::bench;
     twin_units().robot(common)(common, *o);

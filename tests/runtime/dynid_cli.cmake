@@ -94,6 +94,47 @@ expect("${out}" "diag/validation.yaml: error: not found")
 file(WRITE ${WORK}/bad.csv "time,q1\n0,1\n")
 run(1 out preprocess ${WORK}/bad.csv)
 expect("${out}" "bad")
+# Every numeric option is a finite number in its range, refused when parsed (CLI11's exit code
+# for a failed check, 105) with a short message: --interval nan used to crash the study, inf named
+# a run @-9223372036854775808ms, --seconds nan ran the whole trajectory.
+foreach(case "identify|--interval|nan" "identify|--interval|inf" "identify|--interval|0" "identify|--interval|-10"
+             "identify|--interval|1e-300" "identify|--trial|0" "identify|--validation-interval|nan"
+             "control|--seconds|nan" "control|--seconds|1e400" "control|--trial|1.5" "diagnose|--alpha|nan"
+             "export|--margin|inf")
+  string(REPLACE "|" ";" case "${case}")
+  list(GET case 0 command)
+  list(GET case 1 option)
+  list(GET case 2 value)
+  if(command STREQUAL "identify" OR command STREQUAL "diagnose")
+    set(rest --robot crane_x7 --data ${ds} -o ${WORK}/numbers)
+  elseif(command STREQUAL "control")
+    set(rest --robot crane_x7 --virtual -o ${WORK}/numbers.csv)
+  else()
+    set(rest --robot crane_x7 --study ${WORK} --urdf ${WORK}/numbers.urdf)
+  endif()
+  run(105 out ${command} ${rest} ${option} ${value})
+  expect("${out}" "${option}: '?${value}'?:? (is out of range|a finite number is needed|a whole number is needed)")
+  string(LENGTH "${out}" length)
+  if(length GREATER 400)
+    message(FATAL_ERROR "${command} ${option} ${value}: a long message (${length} characters):\n${out}")
+  endif()
+  if(EXISTS ${WORK}/numbers OR EXISTS ${WORK}/numbers.csv)
+    message(FATAL_ERROR "${command} ${option} ${value} wrote something")
+  endif()
+endforeach()
+
+# A robot folder that differs from the one dynid was compiled from is refused, on two robots: a
+# copy as compiled goes on (here to the missing dataset), an edited robot.yaml is named.
+foreach(robot crane_x7 rx90)
+  file(REMOVE_RECURSE ${WORK}/robots/${robot})
+  file(COPY ${SOURCE_ROBOTS}/${robot} DESTINATION ${WORK}/robots)
+  file(MAKE_DIRECTORY ${WORK}/empty)
+  run(1 out identify --robot ${robot} --robots-dir ${WORK}/robots --data ${WORK}/empty -o ${WORK}/folder-study)
+  expect("${out}" "dataset.yaml")
+  file(APPEND ${WORK}/robots/${robot}/robot.yaml "# edited after the build\n")
+  run(2 out identify --robot ${robot} --robots-dir ${WORK}/robots --data ${WORK}/empty -o ${WORK}/folder-study)
+  expect("${out}" "robots/${robot}/robot.yaml differs from the robot.yaml robot '${robot}' was compiled from")
+endforeach()
 # control: one second of AG02 on the virtual bus (emulated servos driving the twin), then a
 # preprocessable log; a missing port is named.
 run(0 out control --robot crane_x7 --virtual --trajectory AG02 --seconds 1 -o ${WORK}/control/run.csv)
@@ -109,6 +150,60 @@ file(WRITE ${WORK}/control/dataset.yaml "format: symoro-dataset 1\nrobot: crane_
 run(0 out identify --robot crane_x7 --data ${WORK}/control -o ${WORK}/control/study --interval 20)
 expect("${out}" "CLIE: 1 runs\n")
 expect("${out}" "representative: V02@20ms")
+# A saved run is reused only for the same log contents: one digit changed in place (same size)
+# is a new log, where the name-and-size fingerprint kept the old parameters.
+file(MAKE_DIRECTORY ${WORK}/edited)
+file(COPY ${WORK}/control/V02.csv ${WORK}/control/V02.meta.yaml ${WORK}/control/dataset.yaml DESTINATION ${WORK}/edited)
+run(0 out identify --robot crane_x7 --data ${WORK}/edited -o ${WORK}/edited/study --interval 20 --no-report)
+run(0 out identify --robot crane_x7 --data ${WORK}/edited -o ${WORK}/edited/study --interval 20 --no-report)
+expect("${out}" "1 of 1 runs already finished \\(same inputs\\): skipped")
+file(READ ${WORK}/edited/V02.csv log)
+string(LENGTH "${log}" size)
+math(EXPR at "${size} / 2")
+while(at LESS size)
+  string(SUBSTRING "${log}" ${at} 1 c)
+  if(c MATCHES "[0-8]")
+    break()
+  endif()
+  math(EXPR at "${at} + 1")
+endwhile()
+math(EXPR next "${c} + 1")
+math(EXPR after "${at} + 1")
+string(SUBSTRING "${log}" 0 ${at} head)
+string(SUBSTRING "${log}" ${after} -1 tail)
+file(WRITE ${WORK}/edited/V02.csv "${head}${next}${tail}")
+file(SIZE ${WORK}/edited/V02.csv edited_size)
+if(NOT edited_size EQUAL size)
+  message(FATAL_ERROR "the edit changed the log's size")
+endif()
+run(0 out identify --robot crane_x7 --data ${WORK}/edited -o ${WORK}/edited/study --interval 20 --no-report)
+if(out MATCHES "already finished")
+  message(FATAL_ERROR "a log edited in place reused its saved run:\n${out}")
+endif()
+# Two studies into one folder at once: one runs, the other is refused with the holder's pid
+# (both started together by one execute_process; the last writer used to win silently).
+execute_process(COMMAND ${DYNID} identify --robot crane_x7 --data ${WORK}/control -o ${WORK}/locked --interval 20 --fresh
+                COMMAND ${DYNID} identify --robot crane_x7 --data ${WORK}/control -o ${WORK}/locked --interval 20 --fresh
+                RESULTS_VARIABLE codes OUTPUT_VARIABLE out ERROR_VARIABLE err)
+list(SORT codes)
+if(NOT codes STREQUAL "0;1")
+  message(FATAL_ERROR "two studies in one folder: exit codes ${codes}\n${out}\n${err}")
+endif()
+expect("${err}" "locked: error: in use by pid [0-9]+ \\(dynid identify\\)")
+# A study where no run succeeds (a log of two rows) exits non-zero with the reason, after
+# writing its report; export then names the real problem.
+file(STRINGS ${WORK}/control/V02.csv rows LIMIT_COUNT 3)
+list(JOIN rows "\n" rows)
+file(MAKE_DIRECTORY ${WORK}/tiny)
+file(WRITE ${WORK}/tiny/V02.csv "${rows}\n")
+file(COPY ${WORK}/control/V02.meta.yaml ${WORK}/control/dataset.yaml DESTINATION ${WORK}/tiny)
+run(1 out identify --robot crane_x7 --data ${WORK}/tiny -o ${WORK}/tiny/study --interval 20)
+expect("${out}" "no run of the study succeeded \\(1 of 1 failed; the first: V02@20ms: ")
+if(NOT EXISTS ${WORK}/tiny/study/report/report.md)
+  message(FATAL_ERROR "the failed study wrote no report")
+endif()
+run(2 out export --robot crane_x7 --study ${WORK}/tiny/study --urdf ${WORK}/tiny/crane.urdf --nearest)
+expect("${out}" "the study has no model to export: no run produced a final vector")
 # export: this one-run study's accepted vector has no physically consistent standard set (it
 # is PD over the audit box, which is necessary, not sufficient): no URDF, the nearest consistent
 # vector's distance and the torque it costs on the fitting run; --nearest writes that one, said
@@ -136,6 +231,15 @@ file(READ ${WORK}/control/study-physical/report/parameters.yaml params)
 expect("${params}" "consistency: \"physical\"\nphysically_consistent: true")
 run(0 out export --robot crane_x7 --study ${WORK}/control/study-physical --urdf ${WORK}/control/crane-physical.urdf)
 expect("${out}" "max \\|B s - phi\\| = [0-9.e-]+")
+# Exported files are not overwritten unless --force (as import and control refuse to); a folder
+# is no file.
+file(SHA256 ${WORK}/control/crane-physical.urdf before)
+run(2 out export --robot crane_x7 --study ${WORK}/control/study-physical --urdf ${WORK}/control/crane-physical.urdf)
+expect("${out}" "crane-physical.urdf exists: dynid export does not overwrite it; choose another --urdf, or --force")
+run(0 out export --robot crane_x7 --study ${WORK}/control/study-physical --urdf ${WORK}/control/crane-physical.urdf --force)
+file(MAKE_DIRECTORY ${WORK}/control/folder.urdf)
+run(2 out export --robot crane_x7 --study ${WORK}/control/study-physical --urdf ${WORK}/control/folder.urdf)
+expect("${out}" "folder.urdf is a directory")
 file(READ ${WORK}/control/crane-physical.urdf urdf)
 if(urdf MATCHES "WARNING")
   message(FATAL_ERROR "the physical study's export warns:\n${urdf}")
@@ -150,10 +254,55 @@ file(READ ${WORK}/control/study/report/parameters.yaml params)
 string(REPLACE "accepted: true" "accepted: false" params "${params}")
 file(WRITE ${WORK}/control/unaccepted.yaml "${params}")
 run(2 out control --robot crane_x7 --virtual --trajectory AG02 --seconds 1 -o ${WORK}/control/ff.csv --params ${WORK}/control/unaccepted.yaml)
-expect("${out}" "unaccepted.yaml: the identification was not accepted")
+# The flag was edited: the file's digest says so before its flag is believed.
+expect("${out}" "unaccepted.yaml: the file is not as identify wrote it: its content does not match its digest")
 run(0 out control --robot crane_x7 --virtual --trajectory AG02 --seconds 1 -o ${WORK}/control/ff.csv --params ${WORK}/control/unaccepted.yaml --unaccepted-params)
+expect("${out}" "model feedforward checked on [0-9]+ references")
 file(READ ${WORK}/control/ff.meta.yaml sidecar)
-expect("${sidecar}" "PARAMETERS NOT ACCEPTED")
+expect("${sidecar}" "PARAMETERS EDITED OR NOT FROM IDENTIFY")
+# An accepted file as identify wrote it drives without a flag, after the same checks.
+run(0 out control --robot crane_x7 --virtual --trajectory AG02 --seconds 1 -o ${WORK}/control/ff-accepted.csv
+    --params ${WORK}/control/study-physical/report/parameters.yaml)
+expect("${out}" "model feedforward checked on [0-9]+ references \(mass matrix positive definite")
+expect("${out}" "completed; torque off confirmed")
+# Tampered values with `accepted: true` left in place: the digest refuses them; driven anyway
+# (--unaccepted-params), the model's own content refuses them before torque is on: a first
+# moment of 50 kg m asks joint 2 for far more than its limit, ZZR2 = -100 is no physical arm.
+file(READ ${WORK}/control/study-physical/report/parameters.yaml params)
+foreach(case "MX2|50|joint 2 [^:]*: its torque [-0-9.e+]+ N m [^\n]* exceeds the joint's limit"
+             "ZZR2|-100|its mass matrix M\\(q\\) is not positive definite")
+  string(REPLACE "|" ";" case "${case}")
+  list(GET case 0 name)
+  list(GET case 1 value)
+  list(GET case 2 pattern)
+  string(REGEX REPLACE "(name: \"${name}\", unit: \"[^\"]*\", value: )[^}]*}" "\\1${value}}" tampered "${params}")
+  if(tampered STREQUAL params)
+    message(FATAL_ERROR "${name} not found in parameters.yaml")
+  endif()
+  file(WRITE ${WORK}/control/tampered-${name}.yaml "${tampered}")
+  run(2 out control --robot crane_x7 --virtual --trajectory AG02 --seconds 1 -o ${WORK}/control/t-${name}.csv
+      --params ${WORK}/control/tampered-${name}.yaml)
+  expect("${out}" "tampered-${name}.yaml: the file is not as identify wrote it")
+  run(1 out control --robot crane_x7 --virtual --trajectory AG02 --seconds 1 -o ${WORK}/control/t2-${name}.csv
+      --params ${WORK}/control/tampered-${name}.yaml --unaccepted-params)
+  expect("${out}" "setup_failed[^\n]*the model feedforward is refused before torque on: ${pattern}")
+  expect("${out}" "at stop: torque off \\(it had not been turned on\\)")
+endforeach()
+# GNU timeout sends SIGTERM to dynid and then to its process group, microseconds apart: one stop
+# request, so the hold at the stop runs its whole time (it used to end after 1 ms in 1 of 3 runs,
+# and the real arm falls). Three tries, each must hold.
+find_program(TIMEOUT timeout)
+if(TIMEOUT)
+  foreach(try 1 2 3)
+    run(124 out ${TIMEOUT} -s TERM 4 ${DYNID} control --robot crane_x7 --virtual --trajectory AG02 --hold-time 1
+        -o ${WORK}/control/timeout-${try}.csv)
+    expect("${out}" "stop: signal")
+    expect("${out}" "at stop: hold 1.000 s at the stop pose")
+    if(out MATCHES "ended early")
+      message(FATAL_ERROR "timeout's pair of SIGTERMs ended the hold:\n${out}")
+    endif()
+  endforeach()
+endif()
 run(2 out control --robot crane_x7 --port ${WORK}/no_such_tty --seconds 1 -o ${WORK}/control/real2.csv --watchdog 500)
 expect("${out}" "--watchdog 500: at most 50 cycles on a real port")
 run(2 out control --robot crane_x7 --port ${WORK}/no_such_tty --seconds 1 -o ${WORK}/control/real2.csv --ideal)
