@@ -8,6 +8,8 @@
 #include <regex>
 #include <set>
 
+#include "yaml_check.hpp"
+
 namespace symoro::codegen {
 
 InputError::InputError(const std::string& file, int line, int column, const std::string& message)
@@ -53,16 +55,9 @@ struct Reader {
     return n.Scalar();
   }
 
-  void only_keys(const YAML::Node& map, const std::set<std::string>& allowed,
+  void only_keys(const YAML::Node& map, const std::vector<std::string>& allowed,
                  const std::string& where) const {
-    for (const auto& kv : map) {
-      const std::string key = kv.first.Scalar();
-      if (!allowed.count(key)) {
-        std::string list;
-        for (const auto& a : allowed) list += (list.empty() ? "" : ", ") + a;
-        fail(kv.first, "unknown key '" + key + "' in " + where + " (expected one of: " + list + ")");
-      }
-    }
+    check_keys(map, allowed, path, where);
   }
 };
 
@@ -124,7 +119,7 @@ std::vector<EffectSpec> read_effects(const Reader& r, const YAML::Node& effects,
           *kind == EffectKind::Stribeck ? "the Stribeck velocity" : "the velocity scale of tanh(qd/v)";
       const std::string form = stribeck ? "{joints: [...], velocity: <rad/s>}" : "{joints: [...], orders: [...]}";
       if (!kv.second.IsMap()) r.fail(kv.second, effect + " takes " + form);
-      r.only_keys(kv.second, stribeck ? std::set<std::string>{"joints", "velocity"} : std::set<std::string>{"joints", "orders"},
+      r.only_keys(kv.second, stribeck ? std::vector<std::string>{"joints", "velocity"} : std::vector<std::string>{"joints", "orders"},
                   effect);
       list.reset(kv.second["joints"]);
       if (!list) r.fail(kv.second, effect + " needs 'joints': " + form);
@@ -234,14 +229,7 @@ bool glob_match(const std::string& pattern, const std::string& name) {
 }
 
 RobotSpec read_robot_spec(const std::string& path) {
-  YAML::Node root;
-  try {
-    root = YAML::LoadFile(path);
-  } catch (const YAML::BadFile&) {
-    throw InputError(path, 0, 0, "cannot open file");
-  } catch (const YAML::Exception& e) {
-    throw InputError(path, e.mark.line + 1, e.mark.column + 1, e.msg);
-  }
+  const YAML::Node root = load_yaml_file(path);
   Reader r{path};
   if (!root.IsMap()) throw InputError(path, 1, 1, "robot.yaml must be a mapping of keys");
   r.only_keys(root, {"name", "description", "constants", "joints", "parameter_units",
