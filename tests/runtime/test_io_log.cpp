@@ -606,6 +606,13 @@ TEST_F(LogFiles, RejectsSidecarWithUnknownKey) {
   expect_rejected(csv, metadata_path(csv), 3, "unknown key 'trajectroy' in the metadata sidecar; did you mean 'trajectory'?");
 }
 
+TEST_F(LogFiles, RejectsSidecarWithUnknownUnitsKey) {
+  std::string text = sidecar(1);
+  text.replace(text.find("  qd: rad/s"), 11, "  qdd: rad/s");
+  const fs::path csv = files(header2 + "0,1,2,3,4,5,6\n", text);
+  expect_rejected(csv, metadata_path(csv), 13, "unknown key 'qdd' in units; did you mean 'qd'?");
+}
+
 // yaml-cpp reads a value whose closing quote is missing as text to the end of the file: the
 // keys after it would vanish into the trajectory name.
 TEST_F(LogFiles, RejectsSidecarWithAnUnclosedQuote) {

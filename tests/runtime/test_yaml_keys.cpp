@@ -119,6 +119,7 @@ TEST(NearestName, MisspellingsFindTheirKeyAndStrangersNone) {
   EXPECT_EQ(symoro::io::nearest_name("colour", run), "");
   EXPECT_EQ(symoro::io::nearest_name("splti", {"split", "source", "runs"}), "split");
   EXPECT_EQ(symoro::io::nearest_name("x", {"q", "tau"}), "");
+  EXPECT_EQ(symoro::io::nearest_name("YM", {"M", "MX", "MY"}), "MY");  // of two at one edit, the one as long
 }
 
 // ---- dataset.yaml ------------------------------------------------------------------------------

@@ -157,6 +157,9 @@ Sidecar read_sidecar(const std::filesystem::path& yaml) {
   const YAML::Node units = value("units");
   sidecar.units_line = key_lines["units"];  // the map's own mark is its first entry
   if (!units.IsMap()) reader.fail(units, "units: expected a map from quantity (time, q, ...) to unit");
+  std::vector<std::string> quantities;
+  for (Group g : all_groups) quantities.emplace_back(group_name(g));
+  check_keys(units, quantities, file, "units");
   for (const auto& entry : units) {
     const std::string key = entry.first.IsScalar() ? entry.first.Scalar() : std::string();
     const auto group = group_named(key);
