@@ -104,7 +104,16 @@ std::vector<EffectSpec> read_effects(const Reader& r, const YAML::Node& effects,
   for (const auto& kv : effects) {
     const std::string name = kv.first.Scalar();
     const auto kind = effect_kind(name);
-    if (!kind) r.fail(kv.first, where + ": unknown effect '" + name + "' (known effects: " + effect_names() + ")");
+    if (!kind) {
+      std::vector<std::string> known;  // effect_names() is "a, b, ..."
+      for (std::size_t at = 0, comma; at < effect_names().size(); at = comma + 2) {
+        comma = std::min(effect_names().find(", ", at), effect_names().size());
+        known.push_back(effect_names().substr(at, comma - at));
+      }
+      const std::string near = nearest_name(name, known);
+      r.fail(kv.first, where + ": unknown effect '" + name + "'" + (near.empty() ? "" : "; did you mean '" + near + "'?") +
+                           " (known effects: " + effect_names() + ")");
+    }
     if (!seen.insert(name).second) r.fail(kv.first, where + ": effect " + name + " appears twice");
     const std::string what = effect_on_links(*kind) ? "link" : "joint";
     const std::string effect = where + ", effect " + name;
@@ -288,7 +297,12 @@ RobotSpec read_robot_spec(const std::string& path) {
       if (!m.IsMap()) r.fail(m, "units must map families (XX, MX, IA, FV, ...) to unit strings");
       for (const auto& kv : m) {
         const std::string fam = kv.first.Scalar();
-        if (!kDefaultUnits.count(fam)) r.fail(kv.first, "unknown parameter family '" + fam + "'");
+        if (!kDefaultUnits.count(fam)) {
+          std::vector<std::string> known;
+          for (const auto& [f, unit] : kDefaultUnits) known.push_back(f);
+          const std::string near = nearest_name(fam, known);
+          r.fail(kv.first, "unknown parameter family '" + fam + "'" + (near.empty() ? "" : "; did you mean '" + near + "'?"));
+        }
         into[fam] = r.string(kv.second, "unit");
       }
     };

@@ -5,6 +5,7 @@
 #include <fstream>
 #include <map>
 #include <sstream>
+#include <utility>
 
 #include "symoro/codegen/robot_spec.hpp"
 
@@ -89,12 +90,14 @@ YAML::Node load_yaml_file(const std::string& path) {
 
 std::string nearest_name(const std::string& name, const std::vector<std::string>& known) {
   std::string best;
-  std::size_t best_edits = 0;
+  std::pair<std::size_t, std::size_t> best_score;  // edits, then the difference in length
   for (const std::string& k : known) {
     const std::size_t e = edits(lower(name), lower(k));
     // At most 2 edits, and at most half the longer name: "qq" may be "q", "x" is not "q".
     if (e > 2 || 2 * e > std::max(name.size(), k.size())) continue;
-    if (best.empty() || e < best_edits) best = k, best_edits = e;
+    // Of equally near names, one as long ("YM": "MY" rather than "M").
+    const std::pair<std::size_t, std::size_t> score{e, std::max(name.size(), k.size()) - std::min(name.size(), k.size())};
+    if (best.empty() || score < best_score) best = k, best_score = score;
   }
   return best;
 }

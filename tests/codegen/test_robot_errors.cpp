@@ -114,6 +114,12 @@ TEST_F(BrokenRobot, MisspeltKeyNamesItsLineAndTheNearestKey) {
   start_from("rx90");
   replace("robot.yaml", "    fixed: {\"FS*\": 0}", "    fixde: {\"FS*\": 0}");
   expect_error(R"(robot\.yaml:26:5: error: unknown key 'fixde' in variant rigid; did you mean 'fixed'\?)");
+  start_from("rx90");
+  replace("robot.yaml", "MX: kg*m, MY", "MX: kg*m, YM");
+  expect_error(R"(robot\.yaml:19:24: error: unknown parameter family 'YM'; did you mean 'MY'\?)");
+  start_from("planar2r");
+  replace("robot.yaml", "      stribeck:", "      stribek:");
+  expect_error(R"(robot\.yaml:\d+:7: error: variant effects: unknown effect 'stribek'; did you mean 'stribeck'\? \(known effects: )");
 }
 
 // yaml-cpp reads a quoted value without its closing quote as text to the end of the file (here
