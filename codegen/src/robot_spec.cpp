@@ -8,6 +8,8 @@
 #include <regex>
 #include <set>
 
+#include "yaml_check.hpp"
+
 namespace symoro::codegen {
 
 InputError::InputError(const std::string& file, int line, int column, const std::string& message)
@@ -53,16 +55,9 @@ struct Reader {
     return n.Scalar();
   }
 
-  void only_keys(const YAML::Node& map, const std::set<std::string>& allowed,
+  void only_keys(const YAML::Node& map, const std::vector<std::string>& allowed,
                  const std::string& where) const {
-    for (const auto& kv : map) {
-      const std::string key = kv.first.Scalar();
-      if (!allowed.count(key)) {
-        std::string list;
-        for (const auto& a : allowed) list += (list.empty() ? "" : ", ") + a;
-        fail(kv.first, "unknown key '" + key + "' in " + where + " (expected one of: " + list + ")");
-      }
-    }
+    check_keys(map, allowed, path, where);
   }
 };
 
@@ -109,7 +104,16 @@ std::vector<EffectSpec> read_effects(const Reader& r, const YAML::Node& effects,
   for (const auto& kv : effects) {
     const std::string name = kv.first.Scalar();
     const auto kind = effect_kind(name);
-    if (!kind) r.fail(kv.first, where + ": unknown effect '" + name + "' (known effects: " + effect_names() + ")");
+    if (!kind) {
+      std::vector<std::string> known;  // effect_names() is "a, b, ..."
+      for (std::size_t at = 0, comma; at < effect_names().size(); at = comma + 2) {
+        comma = std::min(effect_names().find(", ", at), effect_names().size());
+        known.push_back(effect_names().substr(at, comma - at));
+      }
+      const std::string near = nearest_name(name, known);
+      r.fail(kv.first, where + ": unknown effect '" + name + "'" + (near.empty() ? "" : "; did you mean '" + near + "'?") +
+                           " (known effects: " + effect_names() + ")");
+    }
     if (!seen.insert(name).second) r.fail(kv.first, where + ": effect " + name + " appears twice");
     const std::string what = effect_on_links(*kind) ? "link" : "joint";
     const std::string effect = where + ", effect " + name;
@@ -124,7 +128,7 @@ std::vector<EffectSpec> read_effects(const Reader& r, const YAML::Node& effects,
           *kind == EffectKind::Stribeck ? "the Stribeck velocity" : "the velocity scale of tanh(qd/v)";
       const std::string form = stribeck ? "{joints: [...], velocity: <rad/s>}" : "{joints: [...], orders: [...]}";
       if (!kv.second.IsMap()) r.fail(kv.second, effect + " takes " + form);
-      r.only_keys(kv.second, stribeck ? std::set<std::string>{"joints", "velocity"} : std::set<std::string>{"joints", "orders"},
+      r.only_keys(kv.second, stribeck ? std::vector<std::string>{"joints", "velocity"} : std::vector<std::string>{"joints", "orders"},
                   effect);
       list.reset(kv.second["joints"]);
       if (!list) r.fail(kv.second, effect + " needs 'joints': " + form);
@@ -234,14 +238,7 @@ bool glob_match(const std::string& pattern, const std::string& name) {
 }
 
 RobotSpec read_robot_spec(const std::string& path) {
-  YAML::Node root;
-  try {
-    root = YAML::LoadFile(path);
-  } catch (const YAML::BadFile&) {
-    throw InputError(path, 0, 0, "cannot open file");
-  } catch (const YAML::Exception& e) {
-    throw InputError(path, e.mark.line + 1, e.mark.column + 1, e.msg);
-  }
+  const YAML::Node root = load_yaml_file(path);
   Reader r{path};
   if (!root.IsMap()) throw InputError(path, 1, 1, "robot.yaml must be a mapping of keys");
   r.only_keys(root, {"name", "description", "constants", "joints", "parameter_units",
@@ -300,7 +297,12 @@ RobotSpec read_robot_spec(const std::string& path) {
       if (!m.IsMap()) r.fail(m, "units must map families (XX, MX, IA, FV, ...) to unit strings");
       for (const auto& kv : m) {
         const std::string fam = kv.first.Scalar();
-        if (!kDefaultUnits.count(fam)) r.fail(kv.first, "unknown parameter family '" + fam + "'");
+        if (!kDefaultUnits.count(fam)) {
+          std::vector<std::string> known;
+          for (const auto& [f, unit] : kDefaultUnits) known.push_back(f);
+          const std::string near = nearest_name(fam, known);
+          r.fail(kv.first, "unknown parameter family '" + fam + "'" + (near.empty() ? "" : "; did you mean '" + near + "'?"));
+        }
         into[fam] = r.string(kv.second, "unit");
       }
     };

@@ -104,6 +104,37 @@ TEST_F(BrokenRobot, BadJointLimitsPointAtTheYamlLine) {
   expect_error(R"(robot\.yaml:10:\d+: error: joint elbow: upper must exceed lower)");
 }
 
+// A misspelt key is refused at its line with the key it resembles, not ignored, on two robots.
+TEST_F(BrokenRobot, MisspeltKeyNamesItsLineAndTheNearestKey) {
+  replace("robot.yaml", "{name: elbow,    lower: -150 deg", "{name: elbow,    lowr: -150 deg");
+  expect_error(R"(robot\.yaml:10:\d+: error: unknown key 'lowr' in a joint; did you mean 'lower'\? \(known keys: name, lower, )");
+  start_from("rx90");
+  replace("robot.yaml", "parameter_units:", "parameter_unts:");
+  expect_error(R"(robot\.yaml:17:1: error: unknown key 'parameter_unts' in robot\.yaml; did you mean 'parameter_units'\?)");
+  start_from("rx90");
+  replace("robot.yaml", "    fixed: {\"FS*\": 0}", "    fixde: {\"FS*\": 0}");
+  expect_error(R"(robot\.yaml:26:5: error: unknown key 'fixde' in variant rigid; did you mean 'fixed'\?)");
+  start_from("rx90");
+  replace("robot.yaml", "MX: kg*m, MY", "MX: kg*m, YM");
+  expect_error(R"(robot\.yaml:19:24: error: unknown parameter family 'YM'; did you mean 'MY'\?)");
+  start_from("planar2r");
+  replace("robot.yaml", "      stribeck:", "      stribek:");
+  expect_error(R"(robot\.yaml:\d+:7: error: variant effects: unknown effect 'stribek'; did you mean 'stribeck'\? \(known effects: )");
+}
+
+// yaml-cpp reads a quoted value without its closing quote as text to the end of the file (here
+// every key after the description): a syntax error at the opening quote instead. (A later quote
+// in the file would close it: the variant's "FS*" is written without quotes here.)
+TEST_F(BrokenRobot, UnclosedQuoteIsASyntaxError) {
+  start_from("stanford_rrp");
+  replace("robot.yaml", "fixed: {\"FS*\": 0}", "fixed: {FS*: 0}");
+  replace("robot.yaml", "description: ", "description: \"");
+  expect_error(R"(robot\.yaml:2:14: error: YAML syntax error: the quoted value opened here by " has no closing quote)");
+  start_from("rx90");
+  replace("robot.yaml", "  D3: 0.45 ", "  D3: [0.45 ");
+  expect_error(R"(robot\.yaml:\d+:\d+: error: YAML syntax error: )");
+}
+
 TEST_F(BrokenRobot, VariantPatternThatMatchesNothing) {
   add_variants("  light:\n    fixed: {\"XY*\": 0}\n");
   expect_error(R"(robot\.yaml:\d+:1: error: variant light: 'XY\*' matches no base parameter)");

@@ -581,7 +581,7 @@ TEST_F(LogFiles, RejectsSidecarWithBadYaml) {
     EXPECT_EQ(e.file(), metadata_path(csv).string());
     EXPECT_GE(e.line(), 9) << e.what();  // yaml-cpp notices at the list or just after it
     EXPECT_LE(e.line(), 10) << e.what();
-    EXPECT_NE(std::string(e.what()).find("invalid YAML in the metadata sidecar"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("YAML syntax error: end of sequence flow not found"), std::string::npos) << e.what();
   }
 }
 
@@ -603,7 +603,27 @@ TEST_F(LogFiles, RejectsSidecarWithoutAKey) {
 
 TEST_F(LogFiles, RejectsSidecarWithUnknownKey) {
   const fs::path csv = files(header2 + "0,1,2,3,4,5,6\n", sidecar_with_line(3, "trajectroy: AG02"));
-  expect_rejected(csv, metadata_path(csv), 3, "unknown key 'trajectroy'");
+  expect_rejected(csv, metadata_path(csv), 3, "unknown key 'trajectroy' in the metadata sidecar; did you mean 'trajectory'?");
+}
+
+TEST_F(LogFiles, RejectsSidecarWithUnknownUnitsKey) {
+  std::string text = sidecar(1);
+  text.replace(text.find("  qd: rad/s"), 11, "  qdd: rad/s");
+  const fs::path csv = files(header2 + "0,1,2,3,4,5,6\n", text);
+  expect_rejected(csv, metadata_path(csv), 13, "unknown key 'qdd' in units; did you mean 'qd'?");
+}
+
+// yaml-cpp reads a value whose closing quote is missing as text to the end of the file: the
+// keys after it would vanish into the trajectory name.
+TEST_F(LogFiles, RejectsSidecarWithAnUnclosedQuote) {
+  const fs::path csv = files(header2 + "0,1,2,3,4,5,6\n", sidecar_with_line(3, "trajectory: \"AG02"));
+  try {
+    read_log(csv);
+    FAIL() << "accepted a sidecar with an unclosed quote";
+  } catch (const DataError& e) {
+    EXPECT_EQ(e.line(), 3) << e.what();
+    EXPECT_EQ(std::string(e.what()).rfind(metadata_path(csv).string() + ":3:13: error: YAML syntax error: ", 0), 0u) << e.what();
+  }
 }
 
 TEST_F(LogFiles, RejectsSidecarWithRepeatedKey) {

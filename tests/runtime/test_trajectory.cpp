@@ -8,6 +8,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -588,8 +589,12 @@ class BrokenDesign : public ::testing::Test {
       EXPECT_EQ(e.file(), p.string());
       EXPECT_EQ(e.line(), line_of(text, marker)) << e.what();
       EXPECT_NE(std::string(e.what()).find(message), std::string::npos) << e.what();
-      const std::string prefix = p.string() + ":" + std::to_string(line_of(text, marker)) + ": error: ";
-      EXPECT_EQ(std::string(e.what()).rfind(prefix, 0), 0u) << e.what();
+      // "file:line: error: ", or "file:line:column: error: " for a YAML syntax error.
+      const std::string what = e.what(), at = p.string() + ":" + std::to_string(line_of(text, marker)) + ":";
+      EXPECT_EQ(what.rfind(at, 0), 0u) << what;
+      std::size_t k = at.size();
+      while (k < what.size() && std::isdigit(static_cast<unsigned char>(what[k]))) ++k;
+      EXPECT_EQ(what.substr(k).rfind(k == at.size() ? " error: " : ": error: ", 0), 0u) << what;
     }
   }
 
@@ -613,10 +618,10 @@ TEST_F(BrokenDesign, TheSmallDesignIsValid) {
 
 TEST_F(BrokenDesign, UnknownKeysNameTheirLine) {
   expect_read_error(edit("patterns:", "colour: red\npatterns:"), "colour", "unknown key 'colour' in the design");
-  expect_read_error(edit("    center: [0,", "    centre: [0,"), "centre", "unknown key 'centre' in primitives.A");
+  expect_read_error(edit("    center: [0,", "    centre: [0,"), "centre", "unknown key 'centre' in primitives.A; did you mean 'center'?");
   expect_read_error(edit("{single: [7], posture: A'}", "{single: [7], postur: A'}"), "postur:",
                     "unknown key 'postur'");
-  expect_read_error(edit("timing: {start_hold", "timing: {start_hld"), "timing", "unknown key 'start_hld' in timing");
+  expect_read_error(edit("timing: {start_hold", "timing: {start_hld"), "timing", "unknown key 'start_hld' in timing; did you mean 'start_hold'?");
 }
 
 TEST_F(BrokenDesign, WrongSizesNameTheirLine) {
@@ -663,7 +668,7 @@ TEST_F(BrokenDesign, StructuralMistakesNameTheirLine) {
                     "  - {name: PA01", "a trajectory lacks the key 'speed'");
   expect_read_error(edit("postures:\n  A:", "postures:\n  A':"), "  A':", "may not end in '");
   // The parser notices the unclosed list where a mapping key appears inside it.
-  expect_read_error(edit("limits:\n", "limits: [\n"), "  velocity:", "invalid YAML: end of sequence flow not found");
+  expect_read_error(edit("limits:\n", "limits: [\n"), "  velocity:", "YAML syntax error: end of sequence flow not found");
 }
 
 TEST_F(BrokenDesign, LimitViolationsAtBuildNameTrajectoryJointAndTime) {

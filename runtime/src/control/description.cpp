@@ -1,13 +1,14 @@
 #include "symoro/control/description.hpp"
 
 #include <cmath>
-#include <set>
+#include <vector>
 #include <string>
 
 #include <fmt/format.h>
 #include <yaml-cpp/yaml.h>
 
 #include "symoro/error.hpp"
+#include "symoro/io/yaml_keys.hpp"
 
 namespace symoro::control {
 
@@ -25,10 +26,9 @@ class Reader {
   [[noreturn]] void fail(const YAML::Node& node, const std::string& message) const {
     throw DataError(file_, node.IsDefined() ? static_cast<int>(node.Mark().line) + 1 : 0, message);
   }
-  void keys(const YAML::Node& map, const std::string& where, const std::set<std::string>& allowed) const {
+  void keys(const YAML::Node& map, const std::string& where, const std::vector<std::string>& allowed) const {
     if (!map.IsMap()) fail(map, where + " must be a map");
-    for (const auto& kv : map)
-      if (!allowed.count(kv.first.as<std::string>())) fail(kv.first, fmt::format("unknown key '{}' in {}", kv.first.as<std::string>(), where));
+    io::check_keys(map, allowed, file_, where);
     for (const auto& k : allowed)
       if (!map[k].IsDefined()) fail(map, fmt::format("{} lacks '{}'", where, k));
   }
@@ -64,12 +64,7 @@ class Reader {
 
 ControllerDescription read_controller_description(const std::filesystem::path& path, int joints) {
   if (!std::filesystem::exists(path)) throw DataError(path.string(), 0, "no such file (the controller description)");
-  YAML::Node root;
-  try {
-    root = YAML::LoadFile(path.string());
-  } catch (const YAML::Exception& e) {
-    throw DataError(path.string(), e.mark.line + 1, e.msg);
-  }
+  const YAML::Node root = io::load_yaml_file(path);
   const Reader r(path.string(), joints);
   ControllerDescription c;
   c.path = path.string();

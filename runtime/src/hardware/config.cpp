@@ -10,6 +10,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include "symoro/error.hpp"
+#include "symoro/io/yaml_keys.hpp"
 
 namespace symoro::hardware {
 
@@ -33,12 +34,7 @@ struct Reader {
   }
   void keys(const YAML::Node& map, std::initializer_list<const char*> allowed, const std::string& where) const {
     if (!map.IsMap()) fail(map, where + ": expected a map");
-    for (const auto& kv : map) {
-      const std::string k = kv.first.as<std::string>();
-      bool ok = false;
-      for (const char* a : allowed) ok = ok || k == a;
-      if (!ok) fail(kv.first, fmt::format("{}: unknown key '{}'", where, k));
-    }
+    io::check_keys(map, std::vector<std::string>(allowed.begin(), allowed.end()), file, where);
   }
   double number(const YAML::Node& n, const std::string& what) const {
     if (!n.IsScalar()) fail(n, what + ": expected a number");
@@ -78,12 +74,7 @@ HardwareConfig read_hardware_config(const std::filesystem::path& path, const std
   if (!in) throw DataError(c.path, 0, "not found (the robot's hardware description)");
   std::stringstream content;
   content << in.rdbuf();
-  YAML::Node root;
-  try {
-    root = YAML::Load(content.str());
-  } catch (const YAML::ParserException& e) {
-    throw DataError(c.path, e.mark.is_null() ? 0 : e.mark.line + 1, "invalid YAML: " + e.msg);
-  }
+  const YAML::Node root = io::load_yaml_text(content.str(), c.path);
   if (!root.IsMap()) throw DataError(c.path, 1, "expected a map of keys");
   r.keys(root, {"format", "bus", "models", "joints", "safety"}, "hardware.yaml");
   const std::string format = r.text(r.need(root, "format", "hardware.yaml"), "format");

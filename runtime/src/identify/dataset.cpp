@@ -7,10 +7,17 @@
 
 #include "symoro/error.hpp"
 #include "symoro/io/number_text.hpp"
+#include "symoro/io/yaml_keys.hpp"
 
 namespace symoro::identify {
 
 namespace {
+
+// The manifest's keys: those read, and the records the writers add (dynid twin dataset: seed,
+// trials, effects; dynid import: split, import, imported), which a typo must not pass for.
+const std::vector<std::string> kManifestKeys = {"format", "robot", "source", "twin", "twin_overrides", "seed", "trials",
+                                                "effects", "split", "import", "imported", "runs"};
+const std::vector<std::string> kRunKeys = {"trajectory", "family", "trial", "file", "window"};
 
 // The given rows of `m`, in order.
 Eigen::MatrixXd rows_of(const Eigen::MatrixXd& m, const std::vector<Eigen::Index>& rows) {
@@ -33,14 +40,10 @@ Dataset read_dataset(const std::filesystem::path& dir) {
     throw DataError(manifest.string(), 0, "not found: a dataset folder holds dataset.yaml (made by dynid twin dataset or dynid import)");
   Dataset d;
   d.dir = std::filesystem::absolute(dir);
-  YAML::Node root;
-  try {
-    root = YAML::LoadFile(manifest.string());
-  } catch (const YAML::Exception& e) {
-    throw DataError(manifest.string(), e.mark.line + 1, e.msg);
-  }
+  const YAML::Node root = io::load_yaml_file(manifest);
   auto line = [](const YAML::Node& n) { return n.Mark().line + 1; };
   try {
+    io::check_keys(root, kManifestKeys, manifest.string(), "dataset.yaml");
     if (!root["runs"] || !root["runs"].IsSequence()) throw DataError(manifest.string(), line(root), "'runs' list missing");
     d.robot = root["robot"] ? root["robot"].as<std::string>() : "";
     if (root["robot"]) d.robot_line = line(root["robot"]);
@@ -53,6 +56,7 @@ Dataset read_dataset(const std::filesystem::path& dir) {
                         fmt::format("twin_overrides file {} does not exist", d.twin_overrides));
     }
     for (const YAML::Node& r : root["runs"]) {
+      io::check_keys(r, kRunKeys, manifest.string(), "a run");
       for (const char* key : {"trajectory", "family", "trial", "file"})
         if (!r[key]) throw DataError(manifest.string(), line(r), fmt::format("run without '{}'", key));
       DatasetRun run{r["trajectory"].as<std::string>(), r["family"].as<std::string>(), r["trial"].as<int>(),

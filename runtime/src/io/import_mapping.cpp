@@ -9,6 +9,7 @@
 #include "symoro/error.hpp"
 #include "symoro/io/import.hpp"
 #include "symoro/io/number_text.hpp"
+#include "symoro/io/yaml_keys.hpp"
 
 namespace symoro::io {
 
@@ -74,6 +75,7 @@ class MappingReader {
   }
   void units(const YAML::Node& n) {
     if (!n.IsMap()) fail(n, "units: expected a map with time, angle and torque_scale");
+    check_keys(n, {"time", "angle", "torque_scale"}, file_, "units");
     for (const auto& e : n) {
       const std::string key = scalar(e.first, "units");
       const std::string value = scalar(e.second, "units." + key);
@@ -110,16 +112,13 @@ class MappingReader {
 ImportMapping read_import_mapping(const std::filesystem::path& yaml) {
   ImportMapping m;
   m.origin = yaml.string();
-  YAML::Node root;
-  try {
-    root = YAML::LoadFile(m.origin);
-  } catch (const YAML::BadFile&) {
-    throw DataError(m.origin, 0, "cannot read the mapping file");
-  } catch (const YAML::ParserException& e) {
-    throw DataError(m.origin, e.mark.is_null() ? 0 : e.mark.line + 1, "invalid YAML: " + e.msg);
-  }
+  if (!std::filesystem::is_regular_file(yaml)) throw DataError(m.origin, 0, "cannot read the mapping file");
+  const YAML::Node root = load_yaml_file(yaml);
   MappingReader reader(m.origin, m);
   if (!root.IsMap()) reader.fail(root, "the mapping is not a map of keys (time, q, qd, tau, ..., units)");
+  // "imported": import.yaml's record of what was imported.
+  check_keys(root, {"time", "q", "qd", "tau", "q_ref", "qd_ref", "qdd_ref", "units", "header", "delimiter", "imported"},
+             m.origin, "the mapping");
   for (const auto& e : root) {
     const std::string key = reader.scalar(e.first, "key");
     if (m.lines.count(key)) reader.fail(e.first, fmt::format("key '{}' appears twice", key));

@@ -14,6 +14,7 @@
 
 #include "symoro/error.hpp"
 #include "symoro/io/number_text.hpp"
+#include "symoro/io/yaml_keys.hpp"
 
 namespace symoro::io::detail {
 
@@ -85,13 +86,9 @@ Sidecar read_sidecar(const std::filesystem::path& yaml) {
   const std::string& file = sidecar.file;
   const std::string content = read_text(yaml, "missing or unreadable metadata sidecar (every log CSV needs one)");
 
-  YAML::Node root;
-  try {
-    root = YAML::Load(content);
-  } catch (const YAML::Exception& e) {
-    throw DataError(file, e.mark.is_null() ? 0 : e.mark.line + 1, "invalid YAML in the metadata sidecar: " + e.msg);
-  }
+  const YAML::Node root = load_yaml_text(content, file);
   if (!root.IsMap()) throw DataError(file, line_of(root), "the metadata sidecar is not a map of keys");
+  check_keys(root, std::vector<std::string>(sidecar_keys.begin(), sidecar_keys.end()), file, "the metadata sidecar");
 
   const SidecarReader reader(file);
   std::map<std::string, YAML::Node, std::less<>> values;
@@ -160,6 +157,9 @@ Sidecar read_sidecar(const std::filesystem::path& yaml) {
   const YAML::Node units = value("units");
   sidecar.units_line = key_lines["units"];  // the map's own mark is its first entry
   if (!units.IsMap()) reader.fail(units, "units: expected a map from quantity (time, q, ...) to unit");
+  std::vector<std::string> quantities;
+  for (Group g : all_groups) quantities.emplace_back(group_name(g));
+  check_keys(units, quantities, file, "units");
   for (const auto& entry : units) {
     const std::string key = entry.first.IsScalar() ? entry.first.Scalar() : std::string();
     const auto group = group_named(key);

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
 #include <map>
 
 #include <fmt/format.h>
@@ -10,18 +11,13 @@
 #include "symoro/error.hpp"
 #include "symoro/io/digest.hpp"
 #include "symoro/io/number_text.hpp"
+#include "symoro/io/yaml_keys.hpp"
 
 namespace symoro::io {
 
 Eigen::VectorXd read_parameters_yaml(const std::string& path, const std::vector<std::string>& names) {
-  YAML::Node root;
-  try {
-    root = YAML::LoadFile(path);
-  } catch (const YAML::BadFile&) {
-    throw DataError(path, 0, "not found");
-  } catch (const YAML::ParserException& e) {
-    throw DataError(path, e.mark.is_null() ? 0 : e.mark.line + 1, "invalid YAML: " + e.msg);
-  }
+  if (!std::filesystem::is_regular_file(path)) throw DataError(path, 0, "not found");
+  const YAML::Node root = load_yaml_file(path);
   const auto line = [](const YAML::Node& n) { return n.Mark().is_null() ? 0 : n.Mark().line + 1; };
   const YAML::Node list = root.IsMap() ? root["parameters"] : YAML::Node();
   if (!list || !list.IsSequence()) throw DataError(path, 0, "no 'parameters:' list (a study's report/parameters.yaml)");
@@ -50,14 +46,8 @@ Eigen::VectorXd read_parameters_yaml(const std::string& path, const std::vector<
 }
 
 bool parameters_accepted(const std::string& path) {
-  YAML::Node root;
-  try {
-    root = YAML::LoadFile(path);
-  } catch (const YAML::BadFile&) {
-    throw DataError(path, 0, "not found");
-  } catch (const YAML::Exception& e) {
-    throw DataError(path, e.mark.is_null() ? 0 : e.mark.line + 1, "invalid YAML: " + e.msg);
-  }
+  if (!std::filesystem::is_regular_file(path)) throw DataError(path, 0, "not found");
+  const YAML::Node root = load_yaml_file(path);
   const YAML::Node flag = root["accepted"];
   if (!flag) return false;
   try {

@@ -11,6 +11,7 @@
 
 #include "design_data.hpp"
 #include "symoro/error.hpp"
+#include "symoro/io/yaml_keys.hpp"
 
 namespace symoro::trajectory {
 
@@ -36,17 +37,12 @@ class Reader {
   }
 
   // A mapping whose keys are all in `allowed` (each at most once) and include `required`.
-  void keys(const YAML::Node& map, const std::string& where, const std::set<std::string>& allowed,
+  void keys(const YAML::Node& map, const std::string& where, const std::vector<std::string>& allowed,
             const std::set<std::string>& required) const {
     if (!map.IsMap()) fail(map, where + " must be a mapping");
-    std::set<std::string> seen;
-    for (const auto& entry : map) {
-      const std::string key = scalar(entry.first, "a key of " + where);
-      if (!allowed.count(key)) fail(entry.first, "unknown key '" + key + "' in " + where + " (expected " + list(allowed) + ")");
-      if (!seen.insert(key).second) fail(entry.first, "duplicate key '" + key + "' in " + where);
-    }
+    io::check_keys(map, allowed, file_, where);
     for (const auto& key : required)
-      if (!seen.count(key)) fail(map, where + " lacks the key '" + key + "'");
+      if (!map[key]) fail(map, where + " lacks the key '" + key + "'");
   }
 
   // The mapping's entries in file order, keys checked for duplicates.
@@ -123,12 +119,6 @@ class Reader {
   }
 
  private:
-  static std::string list(const std::set<std::string>& names) {
-    std::string out;
-    for (const auto& name : names) out += (out.empty() ? "" : ", ") + name;
-    return out;
-  }
-
   std::string file_;
   int n_;
 };
@@ -432,14 +422,7 @@ Design read_design(const std::filesystem::path& yaml, const std::vector<JointInf
       throw DataError(file, 0, "joint " + d.joint_names.back() + " is prismatic; trajectory designs cover revolute joints");
   }
   if (!std::filesystem::is_regular_file(yaml)) throw DataError(file, 0, "cannot read the trajectory design: no such file");
-  YAML::Node root;
-  try {
-    root = YAML::LoadFile(file);
-  } catch (const YAML::ParserException& e) {
-    throw DataError(file, e.mark.line + 1, "invalid YAML: " + e.msg);
-  } catch (const YAML::Exception& e) {
-    throw DataError(file, 0, std::string("cannot read the trajectory design: ") + e.what());
-  }
+  const YAML::Node root = io::load_yaml_file(yaml);
   const Reader reader(file, static_cast<int>(joints.size()));
   DesignReader(d, reader).read(root);
   return d;

@@ -12,6 +12,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include "symoro/error.hpp"
+#include "symoro/io/yaml_keys.hpp"
 
 namespace symoro::twin {
 
@@ -29,12 +30,9 @@ class Reader {
     throw DataError(file_, node.IsDefined() ? node.Mark().line + 1 : 0, message);
   }
 
-  void check_keys(const YAML::Node& map, const std::string& where, const std::set<std::string>& allowed) const {
+  void check_keys(const YAML::Node& map, const std::string& where, const std::vector<std::string>& allowed) const {
     if (!map.IsMap()) fail(map, where + " must be a map");
-    for (const auto& kv : map) {
-      const std::string key = kv.first.as<std::string>();
-      if (!allowed.count(key)) fail(kv.first, "unknown key '" + key + "' in " + where);
-    }
+    io::check_keys(map, allowed, file_, where);
   }
 
   // A number, optionally "x deg" (converted to rad).
@@ -214,14 +212,14 @@ class Reader {
     check_keys(node, "effects", {"coulomb", "stribeck", "torque_offset", "backlash", "payload",
                                  "torque_constant_error", "actuation_delay", "sensor_noise", "timestamp_jitter",
                                  "dropped_samples"});
-    auto section = [&](const char* name, const std::set<std::string>& keys, bool& enabled, auto&& body) {
+    auto section = [&](const char* name, const std::vector<std::string>& keys, bool& enabled, auto&& body) {
       const YAML::Node s = node[name];
       if (!s.IsDefined()) {
         if (partial_) return;
         fail(node, std::string("effects lacks '") + name + "'");
       }
-      std::set<std::string> allowed = keys;
-      allowed.insert("enabled");
+      std::vector<std::string> allowed{"enabled"};
+      allowed.insert(allowed.end(), keys.begin(), keys.end());
       check_keys(s, std::string("effect ") + name, allowed);
       field(s, "enabled", name, [&](const YAML::Node& v) { enabled = boolean(v, std::string(name) + " enabled"); });
       body(s);
@@ -306,11 +304,7 @@ class Reader {
 
 YAML::Node load(const std::filesystem::path& path) {
   if (!std::filesystem::exists(path)) throw DataError(path.string(), 0, "no such file");
-  try {
-    return YAML::LoadFile(path.string());
-  } catch (const YAML::Exception& e) {
-    throw DataError(path.string(), e.mark.line + 1, e.msg);
-  }
+  return io::load_yaml_file(path);
 }
 
 }  // namespace
