@@ -449,6 +449,39 @@ TEST_F(Import, ErrorsNameTheLine) {
   expect_error(import(csv, named), f.string(), 3, "'x' in 'pos_1' (column 2) is not a number");
 }
 
+// An export cut while it was written (the logger killed, the disk full) ends without a newline,
+// its last number perhaps cut to one that still parses ("-0" of "-0.737"): refused at that line.
+TEST_F(Import, RefusesALastLineWithoutNewline) {
+  const fs::path f = dir_ / "cut.txt";
+  const std::string good = "# c\n0 0 0 0 0\n0.001 1 1 1 1\n";
+  for (const std::string cut : {"0.002 2 2 2 -0", "0.002 2 2 2 -0.", "0.002 2 2 2 -", "0.002 2 2 2 1e", "0.002 2 2",
+                                "0.002 2 2 2 2", "0.002 2 2 2 2\r"}) {
+    SCOPED_TRACE(cut);
+    write_text(f, good + cut);
+    expect_error([&] { io::import_log(f, two_mapping(), two_joints()); }, f.string(), 4,
+                 "the last line has no newline at its end: the file may have been cut while it was written");
+  }
+  write_text(f, good + "# the end");
+  expect_error([&] { io::import_log(f, two_mapping(), two_joints()); }, f.string(), 4, "no newline at its end");
+  write_text(f, good + "0.002 2 2 2 2\n");
+  EXPECT_EQ(io::import_log(f, two_mapping(), two_joints()).rows, 3);
+}
+
+// A NUL byte in a field is shown escaped; the message does not stop at it.
+TEST_F(Import, QuotesControlBytesEscaped) {
+  const fs::path f = dir_ / "nul.txt";
+  write_text(f, "0 0 0 0 0\n0.001 1 -0." + std::string(1, '\0') + "73 1 1\n");
+  expect_error([&] { io::import_log(f, two_mapping(), two_joints()); }, f.string(), 2,
+               "'-0.\\073' in column 3 is not a number");
+  io::ImportMapping named;
+  named.time = "t";
+  named.q = "p1,p2";
+  named.tau = "e1,e2";
+  write_text(f, "t,p1,p\x01" "2,e1,e2\n0,0,0,0,0\n0.001,1,x,1,1\n");
+  named.q = "p1,p\x01" "2";
+  expect_error([&] { io::import_log(f, named, two_joints()); }, f.string(), 3, "'x' in 'p\\x012' (column 3)");
+}
+
 TEST_F(Import, MappingFileErrorsNameTheirLine) {
   const fs::path m = dir_ / "map.yaml";
   write_text(m, "time: t\nq: \"pos_*\"\ntau: [e1, e2]\nunits: {time: ms, angle: deg, torque_scale: 2}\nheader: yes\n");

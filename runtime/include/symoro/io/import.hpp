@@ -20,7 +20,8 @@
 // Errors (DataError naming the input file and its 1-based line, the column where one is at
 // fault): a stamp equal to the previous one with other values, time going backwards, a field
 // that is not a finite number, a row with another field count than the header (or the first
-// row), a pattern matching another number of columns than the robot has joints.
+// row), a pattern matching another number of columns than the robot has joints, a last line
+// without its newline (the file was cut while it was written).
 #pragma once
 
 #include <filesystem>
