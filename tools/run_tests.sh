@@ -2,7 +2,8 @@
 # Every test: install what is missing, build, run the GoogleTest suite through ctest, check
 # generated/ against a fresh compilation, drop an unseen robot folder in and run its generic
 # tests, and fuzz the grammar for a bounded time (FUZZ_SECONDS, default 60) and the DYNAMIXEL
-# decoder (FUZZ_DYNAMIXEL_SECONDS, default 20).
+# decoder (FUZZ_DYNAMIXEL_SECONDS, default 20) and the file readers (FUZZ_IO_SECONDS each,
+# default 20).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash tools/install_deps.sh
@@ -37,6 +38,17 @@ cp tests/fuzz/corpus_dynamixel/* build/fuzz/corpus_dynamixel/
 build/fuzz/tests/fuzz/fuzz_dynamixel -max_total_time="${FUZZ_DYNAMIXEL_SECONDS:-20}" -max_len=2048 -timeout=10 \
   build/fuzz/corpus_dynamixel 2>build/fuzz/fuzz_dynamixel.log || { tail -40 build/fuzz/fuzz_dynamixel.log; exit 1; }
 grep -E "^Done|#[0-9]+.*DONE" build/fuzz/fuzz_dynamixel.log | tail -1
+
+# The file readers' fuzzing, bounded in time (FUZZ_IO_SECONDS each, default 20): the log reader,
+# the importer's reader and dataset.yaml.
+cmake --build build/fuzz -j"$jobs" --target fuzz_log fuzz_import fuzz_dataset
+for t in log import dataset; do
+  mkdir -p build/fuzz/corpus_$t
+  cp tests/fuzz/corpus_$t/* build/fuzz/corpus_$t/
+  build/fuzz/tests/fuzz/fuzz_$t -max_total_time="${FUZZ_IO_SECONDS:-20}" -max_len=4096 -timeout=10 \
+    -artifact_prefix=build/fuzz/ build/fuzz/corpus_$t 2>build/fuzz/fuzz_$t.log || { tail -40 build/fuzz/fuzz_$t.log; exit 1; }
+  grep -E "^Done|#[0-9]+.*DONE" build/fuzz/fuzz_$t.log | tail -1
+done
 
 # The whole suite last, so its summary closes the output.
 ctest --test-dir build --output-on-failure -j"$jobs"

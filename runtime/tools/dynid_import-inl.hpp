@@ -48,9 +48,12 @@ void ImportCommand::run(const Common& common, const ImportOptions& o) {
   for (const JointInfo& j : Model::joints) {
     di.target.joints.emplace_back(j.name);
     di.target.prismatic.push_back(j.type == JointType::Prismatic);
+    di.target.lower.push_back(j.lower);
+    di.target.upper.push_back(j.upper);
   }
   di.mapping = import_detail::mapping_of(o);
   di.split = o.split;
+  di.allow_implausible = o.allow_implausible;
   if (!o.names.empty() && o.names.size() != o.inputs.size())
     throw UsageError(fmt::format("--name: {} names for {} input files", o.names.size(), o.inputs.size()));
   for (const std::string& h : o.heldout)

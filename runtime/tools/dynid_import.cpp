@@ -55,6 +55,9 @@ void add_import_commands(CLI::App& app, Common& common) {
                   "Fit on the first fraction of each run's time, hold out the rest as <name>_heldout (family V); "
                   "recorded in dataset.yaml")
       ->check(CLI::Range(0.0, 1.0));
+  cmd->add_flag("--allow-implausible", o->allow_implausible,
+               "Import positions far beyond the robot's joint limits, or a median time step outside "
+               "[0.1 ms, 0.5 s] (refused by default: a unit declared wrong)");
   cmd->add_option("--name", o->names, "Run names, one per input (default: the file names' stems)")->delimiter(',');
   cmd->add_option("--heldout", o->heldout, "Inputs held out whole (family V)")->delimiter(',');
   cmd->callback([&common, o] { import_units().robot(common)(common, *o); });

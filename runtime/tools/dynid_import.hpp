@@ -14,6 +14,7 @@ struct ImportOptions {
   std::string out, mapping, time, q, qd, tau, q_ref, qd_ref, qdd_ref;
   std::string time_unit, angle, header, delimiter;
   double torque_scale = 0, split = 0;
+  bool allow_implausible = false;
 };
 
 struct ImportCommand {

@@ -22,7 +22,7 @@ TEST_F(Report, WritesEveryFileAtomicallyAndReturnsThem) {
   // No temporary file left behind.
   for (const auto& dir : {*dir_, *dir_ / "figures"})
     for (const auto& e : fs::directory_iterator(dir))
-      EXPECT_EQ(e.path().string().find(".tmp."), std::string::npos) << e.path();
+      EXPECT_EQ(e.path().string().find(".symoro-tmp."), std::string::npos) << e.path();
   for (const char* fig : {"figures/routing.svg", "figures/pca_clouds.svg", "figures/validation_V03.svg"})
     EXPECT_NE(md_->find(std::string("](") + fig + ")"), std::string::npos) << fig;
   EXPECT_NE(md_->find("# Identification report: crane_x7 (reduced)"), std::string::npos);

@@ -9,6 +9,7 @@
 #include <filesystem>
 #include <fstream>
 #include <functional>
+#include <limits>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -405,6 +406,121 @@ TEST_F(Import, DatasetWindowsAreChecked) {
   expect_error([&] { symoro::identify::read_run_log(d.runs[0]); }, d.runs[0].file.string(), 0, "holds none of the log's samples");
 }
 
+// ---- Unit plausibility: a unit declared wrong is refused, with its evidence -------------------
+
+// Two revolute joints limited to +-2.8 rad; rows every `step` (in the file's unit), q2 taking
+// `peak` on line `peak_line` (1-based; no header).
+io::ImportTarget limited_joints() {
+  io::ImportTarget t = two_joints();
+  t.lower = {-2.8, -2.8};
+  t.upper = {2.8, 2.8};
+  return t;
+}
+
+std::string two_rows(int rows, double step, double peak = 1, int peak_line = 0) {
+  std::string text;
+  for (int k = 0; k < rows; ++k)
+    text += num(k * step) + " " + num(0.01 * k) + " " + num(k + 1 == peak_line ? peak : 0.5) + " 1 2\n";
+  return text;
+}
+
+io::DatasetImport limited_import(const fs::path& input, const io::ImportMapping& m) {
+  io::DatasetImport di;
+  di.target = limited_joints();
+  di.mapping = m;
+  di.inputs = {{input, "", false}};
+  return di;
+}
+
+// Degrees declared as radians: |q| up to 58.7 rad against limits of +-2.8 (the log).
+TEST_F(Import, RefusesAnglesFarBeyondTheJointLimits) {
+  const fs::path f = dir_ / "deg.txt";
+  write_text(f, two_rows(50, 0.001, 58.7, 17));
+  const io::DatasetImport di = limited_import(f, two_mapping());
+  expect_error([&] { io::import_dataset(dir_ / "data", di); }, f.string(), 17,
+               "joint 2 'elbow' is at 58.7 rad, far outside its limits [-2.8, 2.8] rad (by more than 2.8 rad, "
+               "max(0.5 rad, half its range)): are the angles in deg, not rad (--angle deg, units.angle: deg)? "
+               "if the values are right, import with --allow-implausible");
+  EXPECT_FALSE(fs::exists(dir_ / "data"));
+  // Read as degrees, 58.7 is 1.02 rad: within the limits.
+  io::ImportMapping deg = two_mapping();
+  deg.angle_unit = io::AngleUnit::deg;
+  EXPECT_NO_THROW(io::import_dataset(dir_ / "deg", limited_import(f, deg)));
+  // The values as written are shown when degrees were declared.
+  write_text(f, two_rows(50, 0.001, 3363.3, 9));
+  expect_error([&] { io::import_dataset(dir_ / "data", limited_import(f, deg)); }, f.string(), 9,
+               "joint 2 'elbow' is at 58.7007 rad (3363.3 as written, read as deg), far outside");
+  // Just past the margin is refused, just inside is not: limit 2.8 + margin 2.8.
+  write_text(f, two_rows(50, 0.001, 5.61, 3));
+  expect_error([&] { io::import_dataset(dir_ / "data", di); }, f.string(), 3, "is at 5.61 rad");
+  write_text(f, two_rows(50, 0.001, -5.59, 3));
+  EXPECT_NO_THROW(io::import_dataset(dir_ / "near", di));
+  // The override imports it as it is.
+  write_text(f, two_rows(50, 0.001, 58.7, 17));
+  io::DatasetImport allowed = di;
+  allowed.allow_implausible = true;
+  const io::DatasetImportResult r = io::import_dataset(dir_ / "allowed", allowed);
+  EXPECT_EQ(r.logs[0].log.q(16, 1), 58.7);
+}
+
+// A prismatic joint in mm read as m; a joint without finite limits is not judged.
+TEST_F(Import, PrismaticAndUnlimitedJoints) {
+  const fs::path f = dir_ / "mm.txt";
+  write_text(f, two_rows(50, 0.001, 450, 5));
+  io::DatasetImport di = limited_import(f, two_mapping());
+  di.target.prismatic = {false, true};
+  di.target.lower[1] = 0.2;
+  di.target.upper[1] = 0.9;
+  expect_error([&] { io::import_dataset(dir_ / "data", di); }, f.string(), 5,
+               "joint 2 'elbow' is at 450 m, far outside its limits [0.2, 0.9] m (by more than 0.35 m");
+  di.target.upper[1] = std::numeric_limits<double>::infinity();
+  EXPECT_NO_THROW(io::import_dataset(dir_ / "data", di));
+}
+
+// Time stamps in a unit other than the one declared: a median step of 1000.58 "ms", or 0.001 "ms".
+TEST_F(Import, RefusesAnImplausibleSampleTime) {
+  const fs::path f = dir_ / "slow.txt";
+  io::ImportMapping ms = two_mapping();
+  ms.time_unit = io::TimeUnit::ms;
+  write_text(f, two_rows(50, 1000.58));
+  expect_error([&] { io::import_dataset(dir_ / "data", limited_import(f, ms)); }, f.string(), 0,
+               "the median time step is 1000.58 ms as written (1.00058 s read as ms), outside the plausible "
+               "[0.0001 s, 0.5 s] of a robot's log: is the time unit right (--time-unit, units.time)? "
+               "if the values are right, import with --allow-implausible");
+  write_text(f, two_rows(50, 0.001));
+  expect_error([&] { io::import_dataset(dir_ / "data", limited_import(f, ms)); }, f.string(), 0,
+               "the median time step is 0.001 ms as written (1e-06 s read as ms)");
+  io::DatasetImport allowed = limited_import(f, ms);
+  allowed.allow_implausible = true;
+  EXPECT_EQ(io::import_dataset(dir_ / "allowed", allowed).logs[0].log.meta.sample_time, 1e-6);
+  // The bounds themselves pass: 0.1 ms and 500 ms.
+  write_text(f, two_rows(50, 0.1));
+  EXPECT_NO_THROW(io::import_dataset(dir_ / "fast", limited_import(f, ms)));
+  write_text(f, two_rows(50, 500));
+  EXPECT_NO_THROW(io::import_dataset(dir_ / "slowest", limited_import(f, ms)));
+}
+
+// A split that leaves a part too small to use (--split 1e-9: one sample) is refused.
+TEST_F(Import, RefusesASplitLeavingAPartOfTooFewSamples) {
+  write_six(dir_ / "a.csv", 300);
+  io::DatasetImport di;
+  di.target = six_joints();
+  di.mapping = six_mapping();
+  di.inputs = {{dir_ / "a.csv", "", false}};
+  di.split = 1e-9;
+  expect_error([&] { io::import_dataset(dir_ / "data", di); }, (dir_ / "a.csv").string(), 0,
+               "split 1e-09 at 2.99e-10 s leaves 1 of the 300 samples in the fitting part; each part needs at least 4");
+  di.split = 0.999;
+  expect_error([&] { io::import_dataset(dir_ / "data", di); }, (dir_ / "a.csv").string(), 0,
+               "leaves 1 of the 300 samples in the held-out part; each part needs at least 4");
+  EXPECT_FALSE(fs::exists(dir_ / "data"));
+  di.split = 0.01;  // at 2.99 ms: rows 0..2 of 1 ms, too few
+  expect_error([&] { io::import_dataset(dir_ / "data", di); }, (dir_ / "a.csv").string(), 0,
+               "leaves 3 of the 300 samples in the fitting part");
+  di.split = 0.011;  // at 3.289 ms: rows 0..3
+  EXPECT_NO_THROW(io::import_dataset(dir_ / "data", di));
+}
+
 // ---- Rejected inputs, each at its line ---------------------------------------------------------
 
 TEST_F(Import, ErrorsNameTheLine) {
@@ -447,6 +563,39 @@ TEST_F(Import, ErrorsNameTheLine) {
   // CSV with a header: the field count of a row against the header's, text in a named column.
   const std::string csv = "t;pos_1;pos_2;eff_1;eff_2\n0;0;0;0;0\n0.001;x;1;1;1\n";
   expect_error(import(csv, named), f.string(), 3, "'x' in 'pos_1' (column 2) is not a number");
+}
+
+// An export cut while it was written (the logger killed, the disk full) ends without a newline,
+// its last number perhaps cut to one that still parses ("-0" of "-0.737"): refused at that line.
+TEST_F(Import, RefusesALastLineWithoutNewline) {
+  const fs::path f = dir_ / "cut.txt";
+  const std::string good = "# c\n0 0 0 0 0\n0.001 1 1 1 1\n";
+  for (const std::string cut : {"0.002 2 2 2 -0", "0.002 2 2 2 -0.", "0.002 2 2 2 -", "0.002 2 2 2 1e", "0.002 2 2",
+                                "0.002 2 2 2 2", "0.002 2 2 2 2\r"}) {
+    SCOPED_TRACE(cut);
+    write_text(f, good + cut);
+    expect_error([&] { io::import_log(f, two_mapping(), two_joints()); }, f.string(), 4,
+                 "the last line has no newline at its end: the file may have been cut while it was written");
+  }
+  write_text(f, good + "# the end");
+  expect_error([&] { io::import_log(f, two_mapping(), two_joints()); }, f.string(), 4, "no newline at its end");
+  write_text(f, good + "0.002 2 2 2 2\n");
+  EXPECT_EQ(io::import_log(f, two_mapping(), two_joints()).rows, 3);
+}
+
+// A NUL byte in a field is shown escaped; the message does not stop at it.
+TEST_F(Import, QuotesControlBytesEscaped) {
+  const fs::path f = dir_ / "nul.txt";
+  write_text(f, "0 0 0 0 0\n0.001 1 -0." + std::string(1, '\0') + "73 1 1\n");
+  expect_error([&] { io::import_log(f, two_mapping(), two_joints()); }, f.string(), 2,
+               "'-0.\\073' in column 3 is not a number");
+  io::ImportMapping named;
+  named.time = "t";
+  named.q = "p1,p2";
+  named.tau = "e1,e2";
+  write_text(f, "t,p1,p\x01" "2,e1,e2\n0,0,0,0,0\n0.001,1,x,1,1\n");
+  named.q = "p1,p\x01" "2";
+  expect_error([&] { io::import_log(f, named, two_joints()); }, f.string(), 3, "'x' in 'p\\x012' (column 3)");
 }
 
 TEST_F(Import, MappingFileErrorsNameTheirLine) {

@@ -305,10 +305,10 @@ TEST_F(LogFiles, ColumnsAreMatchedByName) {
   EXPECT_EQ(log.meta.notes, "hand written");
 }
 
-TEST_F(LogFiles, AcceptsCrLfNoFinalNewlineSpacesAndByteOrderMark) {
+TEST_F(LogFiles, AcceptsCrLfSpacesAndByteOrderMark) {
   const fs::path csv = files("\xEF\xBB\xBFtime, q1,q2 ,qd1,qd2,tau1,tau2\r\n"
                              "0, 1 ,2,3,4,5,6\r\n"
-                             "1e-3,1,2,3,4,5,-6.5e-1",
+                             "1e-3,1,2,3,4,5,-6.5e-1\r\n",
                              sidecar(2));
   const Log log = read_log(csv);
   ASSERT_EQ(log.samples(), 2);
@@ -480,9 +480,27 @@ TEST_F(LogFiles, RejectsTrailingComma) {
   expect_rejected(csv, csv, 2, "row has 8 fields, the header has 7");
 }
 
-TEST_F(LogFiles, HintsAtTruncationWhenTheLastLineIsCut) {
-  const fs::path csv = files(header2 + "0,1,2,3,4,5,6\n1,1,2,3", sidecar(2));
-  expect_rejected(csv, csv, 3, "row has 4 fields, the header has 7 (the file ends in this line: truncated?)");
+// A writer killed mid-row leaves a last line without its newline. Cut inside a number, the rest
+// may still parse ("-0" of "-0.737", "1e" does not, "-0." does): every such file is refused at
+// its last line, whatever the cut left, even a row with all its fields.
+TEST_F(LogFiles, RejectsALastLineCutWithoutNewline) {
+  for (const std::string cut : {"1,1,2,3", "1,1,2,3,4,5,-0", "1,1,2,3,4,5,-0.", "1,1,2,3,4,5,-", "1,1,2,3,4,5,1e",
+                                "1,1,2,3,4,5,6", "1,1,2,3,4,5,6\r"}) {
+    SCOPED_TRACE(cut);
+    const fs::path csv = files(header2 + "0,1,2,3,4,5,6\n" + cut, sidecar(2));
+    expect_rejected(csv, csv, 3, "the last line has no newline at its end: the file was cut while it was written");
+  }
+  // The header alone, cut.
+  const fs::path csv = files("time,q1,q2,qd1,qd2,ta", sidecar(0));
+  expect_rejected(csv, csv, 1, "the last line has no newline at its end");
+}
+
+// A NUL byte in a field: the message shows it escaped and goes on past it.
+TEST_F(LogFiles, QuotesControlBytesEscaped) {
+  const fs::path csv = files(header2 + "0,1,2,3,4,5,6\n1,1,2,-0." + std::string(1, '\0') + "7x,4,5,6\n", sidecar(2));
+  expect_rejected(csv, csv, 3, "'-0.\\07x' in column 'qd1' is not a number");
+  const fs::path header = files("time,q1,q\x01" + std::string(1, '\0') + "2,qd1,qd2,tau1,tau2\n0,1,2,3,4,5,6\n", sidecar(1));
+  expect_rejected(header, header, 1, "unknown column 'q\\x01\\02'");
 }
 
 TEST_F(LogFiles, RejectsEmptyField) {

@@ -22,6 +22,7 @@ const std::vector<std::string> kRunKeys = {"trajectory", "family", "trial", "fil
 // The given rows of `m`, in order.
 Eigen::MatrixXd rows_of(const Eigen::MatrixXd& m, const std::vector<Eigen::Index>& rows) {
   Eigen::MatrixXd out(static_cast<Eigen::Index>(rows.size()), m.cols());
+  if (m.cols() == 0) return out;  // no data: a row of it would offset a null pointer (fuzz_dataset)
   for (std::size_t i = 0; i < rows.size(); ++i) out.row(static_cast<Eigen::Index>(i)) = m.row(rows[i]);
   return out;
 }

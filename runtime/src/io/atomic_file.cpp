@@ -2,10 +2,14 @@
 
 #include <atomic>
 #include <cerrno>
-#include <cstdio>
+#include <climits>
 #include <cstring>
+#include <streambuf>
+#include <string_view>
+#include <vector>
 
 #include <fcntl.h>
+#include <signal.h>
 #include <unistd.h>
 
 #include "symoro/error.hpp"
@@ -13,48 +17,156 @@
 namespace symoro::io {
 
 namespace {
-std::atomic<unsigned> temp_counter{0};
 
-// Flushes the file's data to disk so that the rename publishes complete content.
-void sync_file(const std::filesystem::path& p) {
-  const int fd = ::open(p.c_str(), O_RDONLY);
-  if (fd < 0) return;
-  ::fsync(fd);
-  ::close(fd);
+std::atomic<unsigned> temp_counter{0};
+constexpr std::string_view temp_tag = ".symoro-tmp.";
+
+std::string host_name() {
+  char name[HOST_NAME_MAX + 1] = {};
+  if (::gethostname(name, sizeof name - 1) != 0 || name[0] == '\0') return "localhost";
+  return name;
 }
+
+bool all_digits(std::string_view s) {
+  if (s.empty() || s.size() > 18) return false;
+  for (char c : s)
+    if (c < '0' || c > '9') return false;
+  return true;
+}
+
+// Removes ".<name>.symoro-tmp.<host>.<pid>.<n>" files of this host whose process is gone: a
+// writer killed (kill -9, a crash) before it could remove its own. ESRCH is the only proof; a
+// process we may not signal (EPERM) is alive.
+void remove_stale_temps(const std::filesystem::path& target) {
+  namespace fs = std::filesystem;
+  const fs::path dir = target.parent_path().empty() ? fs::path(".") : target.parent_path();
+  const std::string prefix = "." + target.filename().string() + std::string(temp_tag) + host_name() + ".";
+  std::error_code ec;
+  for (fs::directory_iterator it(dir, ec), end; !ec && it != end; it.increment(ec)) {
+    const std::string name = it->path().filename().string();
+    if (name.compare(0, prefix.size(), prefix) != 0) continue;
+    const std::string_view rest = std::string_view(name).substr(prefix.size());  // "<pid>.<n>"
+    const std::size_t dot = rest.find('.');
+    if (dot == std::string_view::npos || !all_digits(rest.substr(0, dot)) || !all_digits(rest.substr(dot + 1))) continue;
+    const long pid = std::stol(std::string(rest.substr(0, dot)));
+    if (pid <= 0 || pid == static_cast<long>(::getpid())) continue;
+    if (::kill(static_cast<pid_t>(pid), 0) == 0 || errno != ESRCH) continue;
+    std::error_code ignored;
+    fs::remove(it->path(), ignored);
+  }
+}
+
+// "No space left on device" as this project's messages say it; other reasons as the system does.
+std::string reason(int error) {
+  if (error == ENOSPC) return "no space left on device";
+  if (error == EDQUOT) return "disk quota exceeded";
+  return std::strerror(error);
+}
+
 }  // namespace
 
-AtomicFile::AtomicFile(std::filesystem::path target) : target_(std::move(target)) {
-  temp_ = target_;
-  temp_ += ".tmp." + std::to_string(::getpid()) + "." + std::to_string(temp_counter++);
-  out_.open(temp_, std::ios::binary | std::ios::trunc);
-  if (!out_)
-    throw DataError(target_.string(), 0,
-                    "cannot create a temporary file for writing (" + std::string(std::strerror(errno)) + ")");
+// Writes to the temporary file's descriptor and keeps the first error's errno (an ofstream
+// loses it, and a full disk then read as an unexplained failure).
+class AtomicFile::Buffer : public std::streambuf {
+ public:
+  explicit Buffer(int fd) : fd_(fd), data_(1 << 16) { setp(data_.data(), data_.data() + data_.size()); }
+  ~Buffer() override { close_fd(); }
+  int error() const { return error_; }
+  int fd() const { return fd_; }
+  void close_fd() {
+    if (fd_ >= 0 && ::close(fd_) != 0 && error_ == 0) error_ = errno;
+    fd_ = -1;
+  }
+  bool drain() {
+    const char* p = pbase();
+    const bool ok = write_all(p, static_cast<std::size_t>(pptr() - p));
+    setp(data_.data(), data_.data() + data_.size());
+    return ok;
+  }
+
+ protected:
+  int_type overflow(int_type c) override {
+    if (!drain()) return traits_type::eof();
+    if (!traits_type::eq_int_type(c, traits_type::eof())) {
+      *pptr() = traits_type::to_char_type(c);
+      pbump(1);
+    }
+    return traits_type::not_eof(c);
+  }
+  std::streamsize xsputn(const char* s, std::streamsize n) override {
+    if (n >= epptr() - pptr()) {  // a large block goes straight to the file
+      if (!drain() || !write_all(s, static_cast<std::size_t>(n))) return 0;
+      return n;
+    }
+    std::memcpy(pptr(), s, static_cast<std::size_t>(n));
+    pbump(static_cast<int>(n));
+    return n;
+  }
+  int sync() override { return drain() ? 0 : -1; }
+
+ private:
+  bool write_all(const char* p, std::size_t n) {
+    if (error_ != 0) return false;
+    while (n > 0) {
+      const ssize_t done = ::write(fd_, p, n);
+      if (done < 0 && errno == EINTR) continue;
+      if (done <= 0) {
+        error_ = done < 0 ? errno : EIO;
+        return false;
+      }
+      p += done;
+      n -= static_cast<std::size_t>(done);
+    }
+    return true;
+  }
+  int fd_;
+  std::vector<char> data_;
+  int error_ = 0;
+};
+
+std::filesystem::path AtomicFile::temp_path(const std::filesystem::path& target, long pid, unsigned n) {
+  return target.parent_path() / ("." + target.filename().string() + std::string(temp_tag) + host_name() + "." +
+                                 std::to_string(pid) + "." + std::to_string(n));
+}
+
+AtomicFile::AtomicFile(std::filesystem::path target) : target_(std::move(target)), out_(nullptr) {
+  remove_stale_temps(target_);
+  temp_ = temp_path(target_, static_cast<long>(::getpid()), temp_counter++);
+  const int fd = ::open(temp_.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0666);
+  if (fd < 0)
+    throw DataError(target_.string(), 0, "cannot create a temporary file for writing (" + reason(errno) + ")");
+  buffer_ = std::make_unique<Buffer>(fd);
+  out_.rdbuf(buffer_.get());
 }
 
 AtomicFile::~AtomicFile() {
   if (committed_) return;
-  out_.close();
+  buffer_->close_fd();
   std::error_code ec;
   std::filesystem::remove(temp_, ec);
 }
 
 void AtomicFile::commit() {
   out_.flush();
-  const bool ok = static_cast<bool>(out_);
-  out_.close();
-  if (!ok || out_.fail()) {
-    std::error_code ec;
-    std::filesystem::remove(temp_, ec);
-    throw DataError(target_.string(), 0, "writing failed; the previous file is left as it was");
-  }
-  sync_file(temp_);
+  int error = buffer_->error();
+  if (error == 0 && !out_) error = EIO;
+  // fsync: the rename must publish complete content (and a full disk may only show here).
+  if (error == 0 && ::fsync(buffer_->fd()) != 0) error = errno;
+  buffer_->close_fd();
+  if (error == 0) error = buffer_->error();
   std::error_code ec;
+  if (error != 0) {
+    std::filesystem::remove(temp_, ec);
+    const bool previous = std::filesystem::exists(target_, ec);
+    throw DataError(target_.string(), 0,
+                    "writing failed: " + reason(error) +
+                        (previous ? "; the previous file is left as it was" : "; nothing is written under this name"));
+  }
   std::filesystem::rename(temp_, target_, ec);
   if (ec) {
+    const std::string why = ec.value() == ENOSPC ? reason(ENOSPC) : ec.message();  // before remove() resets ec
     std::filesystem::remove(temp_, ec);
-    throw DataError(target_.string(), 0, "cannot rename the written file into place: " + ec.message());
+    throw DataError(target_.string(), 0, "cannot rename the written file into place: " + why);
   }
   committed_ = true;
 }

@@ -1,6 +1,7 @@
 // A dataset folder from imported files: one log per input, import.yaml (the mapping and what
 // each input gave), dataset.yaml last (docs/dataset.md). Every input is checked before the
 // first file is written, and no existing file is replaced.
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <set>
@@ -61,6 +62,7 @@ DatasetImportResult import_dataset(const std::filesystem::path& out, const Datas
   std::set<std::string> names;
   for (const ImportInput& in : import.inputs) {
     ImportedLog imported = import_log(in.file, import.mapping, import.target);
+    if (!import.allow_implausible) check_plausible(imported, import.mapping, import.target);
     const std::string name = in.name.empty() ? in.file.stem().string() : in.name;
     if (!valid_name(name)) throw DataError(in.file.string(), 0, fmt::format("'{}' cannot name a run (a file name)", name));
     imported.log.meta.trajectory = name;
@@ -77,11 +79,14 @@ DatasetImportResult import_dataset(const std::filesystem::path& out, const Datas
       // By time: the first `split` of the run's span fits, the rest is held out.
       const double t0 = log.time[0], t1 = log.time[log.samples() - 1];
       const double cut = t0 + import.split * (t1 - t0);
-      const Eigen::Index fitting = (log.time.array() < cut).count();
-      if (fitting == 0 || fitting == log.samples())
+      const Eigen::Index fitting = (log.time.array() < cut).count(), heldout = log.samples() - fitting;
+      // Fewer than 4 samples cannot even be differentiated (--split 1e-9 leaves the first one).
+      constexpr Eigen::Index min_part = 4;
+      if (fitting < min_part || heldout < min_part)
         throw DataError(in.file.string(), 0,
-                        fmt::format("split {} at {} s leaves an empty part of the {} samples", import.split,
-                                    number_text(cut), log.samples()));
+                        fmt::format("split {} at {} s leaves {} of the {} samples in the {} part; each part needs at "
+                                    "least {}", import.split, number_text(cut), std::min(fitting, heldout),
+                                    log.samples(), fitting < min_part ? "fitting" : "held-out", min_part));
       result.runs.push_back({name, "F", csv, t0, cut});
       result.runs.push_back({name + "_heldout", "V", csv, cut, std::numeric_limits<double>::infinity()});
     }

@@ -201,6 +201,7 @@ ImportedLog import_log(const std::filesystem::path& input, const ImportMapping& 
     }
   };
   for (Eigen::Index k = 0; k < rows; ++k) log.time[k] = values[kept[static_cast<std::size_t>(k)] * width] / divisor;
+  for (std::size_t r : kept) out.lines.push_back(lines[r]);
   fill(group("q"), log.q, false);
   fill(group("tau"), log.tau, true);
   fill(group("q_ref"), log.q_ref, false);

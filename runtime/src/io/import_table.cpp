@@ -1,5 +1,6 @@
 // Reading an exported text table: the delimiter and the header row are recognised on the
 // first line that is not a comment; the data rows are parsed only in the columns mapped.
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <fstream>
@@ -7,6 +8,7 @@
 
 #include <fmt/format.h>
 
+#include "cell_text.hpp"
 #include "import_detail.hpp"
 #include "symoro/error.hpp"
 #include "symoro/io/number_text.hpp"
@@ -76,6 +78,12 @@ TextTable::TextTable(const std::filesystem::path& file, Delimiter delimiter, Hea
   content << in.rdbuf();
   bytes_ = content.str();
   std::size_t start = bytes_.compare(0, 3, "\xEF\xBB\xBF") == 0 ? 3 : 0;  // UTF-8 byte order mark
+  // A writer killed mid-row leaves a last line without its newline, whose last number may be
+  // cut yet still parse ("-0" of "-0.737"): such a file is refused whole.
+  if (!bytes_.empty() && bytes_.back() != '\n')
+    throw DataError(file_, static_cast<int>(std::count(bytes_.begin(), bytes_.end(), '\n')) + 1,
+                    "the last line has no newline at its end: the file may have been cut while it was written "
+                    "(its last number may be incomplete); if the file is complete, end it with a newline");
 
   LineReader lines(bytes_, start, 1);
   std::string_view line;
@@ -131,7 +139,7 @@ void TextTable::split(std::string_view line, std::vector<std::string_view>& fiel
 
 std::string TextTable::column_label(int column) const {
   if (has_header() && column < static_cast<int>(header_.size()))
-    return fmt::format("'{}' (column {})", header_[column], column + 1);
+    return fmt::format("'{}' (column {})", shown_text(header_[column], 80), column + 1);
   return fmt::format("column {}", column + 1);
 }
 
@@ -156,10 +164,10 @@ void TextTable::read(const std::vector<int>& columns, std::vector<double>& value
       if (text.empty()) throw DataError(file_, line_number, fmt::format("empty field in {}", column_label(c)));
       if (parsed != NumberParse::ok)
         throw DataError(file_, line_number,
-                        fmt::format("'{}' in {} is not a number", std::string(text.substr(0, 40)), column_label(c)));
+                        fmt::format("'{}' in {} is not a number", shown_text(text), column_label(c)));
       if (!std::isfinite(v))
         throw DataError(file_, line_number, fmt::format("{} holds '{}', not a finite number", column_label(c),
-                                                        std::string(text.substr(0, 40))));
+                                                        shown_text(text)));
       values.push_back(v);
     }
     lines.push_back(line_number);

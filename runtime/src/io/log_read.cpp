@@ -13,6 +13,7 @@
 
 #include <fmt/format.h>
 
+#include "cell_text.hpp"
 #include "log_columns.hpp"
 #include "log_sidecar.hpp"
 #include "symoro/error.hpp"
@@ -65,7 +66,6 @@ class Lines {
     return true;
   }
   int number() const { return number_; }  // 1-based number of the last line returned
-  bool at_end() const { return p_ == end_; }
 
  private:
   const char* p_;
@@ -90,10 +90,11 @@ std::vector<Column> parse_header(std::string_view header, const detail::Sidecar&
   while (true) {
     const std::size_t comma = header.find(',', start);
     const std::string_view raw = header.substr(start, comma == std::string_view::npos ? std::string_view::npos : comma - start);
-    const std::string name(trim(raw));
+    const std::string_view raw_name = trim(raw);
+    const std::string name = detail::shown_text(raw_name, 80);  // as messages quote it
     const std::size_t position = columns.size() + 1;
     if (name.empty()) throw DataError(file, 1, fmt::format("column {} of the header has no name", position));
-    const auto column = detail::parse_column_name(name);
+    const auto column = detail::parse_column_name(raw_name);
     if (!column)
       throw DataError(file, 1, fmt::format("unknown column '{}' (a log has time, q<j>, qd<j>, tau<j>, q_ref<j>, "
                                            "qd_ref<j> and qdd_ref<j> for joints j = 1..{})", name, joints));
@@ -147,9 +148,8 @@ class RowParser {
       : file_(file), columns_(columns), destinations_(std::move(destinations)) {}
 
   // Parses row `row` (0-based) from `line`, which is line `line_number` of the file.
-  void parse(std::string_view line, Eigen::Index row, int line_number, bool last_line_unterminated) {
+  void parse(std::string_view line, Eigen::Index row, int line_number) {
     line_number_ = line_number;
-    truncated_hint_ = last_line_unterminated;
     if (trim(line).empty())
       throw DataError(file_, line_number, "blank line (every line after the header is a sample)");
     const char* p = line.data();
@@ -180,7 +180,7 @@ class RowParser {
     const std::string_view text = trim(std::string_view(p, field_end - p));
     const std::string column = detail::column_name(columns_[c]);
     if (text.empty()) throw DataError(file_, line_number_, fmt::format("empty field in column '{}'", column));
-    const std::string shown(text.substr(0, 40));
+    const std::string shown = detail::shown_text(text);
     switch (parse_number(text, value)) {
       case NumberParse::not_a_number:
         throw DataError(file_, line_number_, fmt::format("'{}' in column '{}' is not a number", shown, column));
@@ -195,15 +195,13 @@ class RowParser {
 
   [[noreturn]] void fail_field_count(std::size_t fields) const {
     throw DataError(file_, line_number_,
-                    fmt::format("row has {} field{}, the header has {}{}", fields, fields == 1 ? "" : "s", columns_.size(),
-                                truncated_hint_ ? " (the file ends in this line: truncated?)" : ""));
+                    fmt::format("row has {} field{}, the header has {}", fields, fields == 1 ? "" : "s", columns_.size()));
   }
 
   const std::string& file_;
   const std::vector<Column>& columns_;
   std::vector<double*> destinations_;
   int line_number_ = 0;
-  bool truncated_hint_ = false;
 };
 
 }  // namespace
@@ -223,6 +221,13 @@ Log read_log(const std::filesystem::path& csv) {
   Lines lines(text.data(), text.data() + text.size());
   std::string_view header;
   if (!lines.next(header) || trim(header).empty()) throw DataError(file, 1, "no header row");
+  // The writers end every line with a newline; a last line without one was cut while it was
+  // written (a killed process, a full disk), and its last number may still parse ("-0" of
+  // "-0.737"), so the file is refused rather than read short of a digit.
+  if (text.back() != '\n')
+    throw DataError(file, static_cast<int>(std::count(text.begin(), text.end(), '\n')) + 1,
+                    "the last line has no newline at its end: the file was cut while it was written "
+                    "(its last number may be incomplete)");
   const std::vector<Column> columns = parse_header(header, sidecar, file);
 
   Log log;
@@ -238,7 +243,7 @@ Log read_log(const std::filesystem::path& csv) {
 
   // Every line after the header is a sample (a blank one is an error), so the line count sizes
   // the matrices exactly.
-  const Eigen::Index rows = std::count(text.begin(), text.end(), '\n') + (text.back() != '\n' ? 1 : 0) - 1;
+  const Eigen::Index rows = std::count(text.begin(), text.end(), '\n') - 1;
   if (rows == 0)
     throw DataError(file, 2, sidecar.meta.notes.empty() ? std::string("no data rows after the header")
                                                         : "no data rows after the header; the sidecar's notes: " + sidecar.meta.notes);
@@ -256,7 +261,7 @@ Log read_log(const std::filesystem::path& csv) {
   RowParser parser(file, columns, std::move(destinations));
   std::string_view line;
   for (Eigen::Index row = 0; lines.next(line); ++row) {
-    parser.parse(line, row, lines.number(), lines.at_end() && text.back() != '\n');
+    parser.parse(line, row, lines.number());
     if (row > 0 && !(log.time[row] > log.time[row - 1]))
       throw DataError(file, lines.number(),
                       fmt::format("time does not increase strictly: {} s here, {} s on line {} before it",

@@ -20,7 +20,8 @@
 // Errors (DataError naming the input file and its 1-based line, the column where one is at
 // fault): a stamp equal to the previous one with other values, time going backwards, a field
 // that is not a finite number, a row with another field count than the header (or the first
-// row), a pattern matching another number of columns than the robot has joints.
+// row), a pattern matching another number of columns than the robot has joints, a last line
+// without its newline (the file was cut while it was written).
 #pragma once
 
 #include <filesystem>
@@ -64,6 +65,7 @@ struct ImportTarget {
   std::string robot;
   std::vector<std::string> joints;  // names, in the model's order
   std::vector<bool> prismatic;      // per joint (empty: all revolute)
+  std::vector<double> lower, upper;  // position limits per joint, rad or m (empty: not checked)
 };
 
 // One input file, converted.
@@ -72,6 +74,7 @@ struct ImportedLog {
   Log log;                           // meta: robot, trajectory (the file's stem), source "robot",
                                      // sample_time (median interval to the us), velocity
   int rows = 0;                      // data rows in the input
+  std::vector<int> lines;            // 1-based input line of each written row
   std::vector<int> stale_lines;      // 1-based input lines of stale rows (kept)
   std::vector<int> duplicate_lines;  // 1-based input lines of duplicates (dropped)
   std::map<std::string, std::string> columns;  // log column -> input column ("q1" -> "pos_1 (column 3)")
@@ -80,6 +83,14 @@ struct ImportedLog {
 // Reads and converts one input file. Throws DataError as described above; a mapping that does
 // not fit the target (another number of columns than joints) names the mapping's origin.
 ImportedLog import_log(const std::filesystem::path& input, const ImportMapping& mapping, const ImportTarget& target);
+
+// Unit plausibility (a unit declared wrong: deg read as rad, ms read as s): throws DataError
+// naming the file, the evidence and --allow-implausible, which skips the check, when
+//   a joint's position is beyond a limit by more than max(0.5 rad, half the joint's range)
+//     (revolute; prismatic: max(0.05 m, half the range)); joints without finite limits pass;
+//   the median time step is outside [0.1 ms, 0.5 s].
+// import_dataset calls it on every input unless DatasetImport::allow_implausible.
+void check_plausible(const ImportedLog& imported, const ImportMapping& mapping, const ImportTarget& target);
 
 // The velocity written when the input has none: per joint, the derivative of the parabola
 // through each row and its neighbours (second order on irregular stamps; the end rows use the
@@ -104,6 +115,8 @@ struct DatasetImport {
   // Fraction of each run (not held out as a whole) used for fitting, by time: the first
   // `split` of its duration; the rest is a second run <name>_heldout. 0: no split.
   double split = 0;
+  // Import values check_plausible refuses (--allow-implausible).
+  bool allow_implausible = false;
 };
 
 struct DatasetImportResult {
@@ -119,7 +132,8 @@ struct DatasetImportResult {
 
 // Imports every input into `out` (created): <name>.csv + .meta.yaml per input, import.yaml
 // (the mapping and what each input gave), dataset.yaml last. Every input is read and checked
-// before anything is written, and no existing file is ever replaced (DataError naming it).
+// (check_plausible; a split leaving a part with fewer than 4 samples is refused) before anything
+// is written, and no existing file is ever replaced (DataError naming it).
 DatasetImportResult import_dataset(const std::filesystem::path& out, const DatasetImport& import);
 
 }  // namespace symoro::io

@@ -15,10 +15,11 @@
 // partial reference group, a row with the wrong number of fields, a blank line, an empty
 // field, a field that is not a finite number (NaN, inf, text), time that does not increase
 // strictly, a log without rows, a row count that differs from the sidecar's (a truncated
-// CSV), and a missing or malformed sidecar (bad YAML, a missing, unknown or ill-typed key, an
-// unknown format version, source or unit, an empty or repeated joint name). It never drops or
-// repairs a sample: what the file holds is what the Log holds. "\r\n" line ends, a final
-// newline, spaces around fields and a UTF-8 byte order mark are accepted.
+// CSV), a last line without its newline (the writers always end one: the file was cut), and a
+// missing or malformed sidecar (bad YAML, a missing, unknown or ill-typed key, an unknown
+// format version, source or unit, an empty or repeated joint name). It never drops or repairs
+// a sample: what the file holds is what the Log holds. "\r\n" line ends, spaces around fields
+// and a UTF-8 byte order mark are accepted.
 //
 // A reference file (metadata source: "reference", written for each designed trajectory) holds
 // time and the three reference groups only; q, qd and tau then have 0 columns (and as many

@@ -1,0 +1,108 @@
+// Unit plausibility of an imported log: a unit declared wrong (degrees read as radians, ms read
+// as s) gives values that no robot logs; identification would accept them and fit nonsense.
+#include <algorithm>
+#include <cmath>
+
+#include <fmt/format.h>
+
+#include "symoro/error.hpp"
+#include "symoro/io/import.hpp"
+#include "symoro/io/number_text.hpp"
+
+namespace symoro::io {
+
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+// "Far" beyond a limit: a robot overshoots its soft limits, or is calibrated off, by far less
+// than half its range (and than 0.5 rad, for joints of a small range such as a gripper's);
+// degrees read as radians multiply positions by 57, so any motion of a few degrees lands far out.
+// Prismatic joints: 0.05 m instead of 0.5 rad (mm read as m multiplies by 1000).
+constexpr double kRevoluteMargin = 0.5, kPrismaticMargin = 0.05;
+// Robot controllers log their state at 10 kHz at most (servo buses: 1 to 8 kHz), and steps over
+// 0.5 s cannot resolve the accelerations identification needs. The unit mistakes land 1000
+// times off: 1 ms read as s is 1 s, 1 ms read as ms from a file in s is 1 us.
+constexpr double kMinStep = 1e-4, kMaxStep = 0.5;
+
+constexpr const char* kOverride = "if the values are right, import with --allow-implausible";
+
+const char* time_unit_name(TimeUnit u) {
+  switch (u) {
+    case TimeUnit::s: return "s";
+    case TimeUnit::ms: return "ms";
+    case TimeUnit::us: return "us";
+    case TimeUnit::ns: return "ns";
+  }
+  return "s";
+}
+
+double per_second(TimeUnit u) {
+  switch (u) {
+    case TimeUnit::s: return 1;
+    case TimeUnit::ms: return 1e3;
+    case TimeUnit::us: return 1e6;
+    case TimeUnit::ns: return 1e9;
+  }
+  return 1;
+}
+
+// 3 significant digits are enough evidence; number_text would print 58.70000000000001.
+std::string g(double v) { return fmt::format("{:.6g}", v); }
+
+}  // namespace
+
+void check_plausible(const ImportedLog& imported, const ImportMapping& mapping, const ImportTarget& target) {
+  const Log& log = imported.log;
+  const std::string file = imported.input.string();
+  const Eigen::Index n = log.q.cols();
+  const bool checked = target.lower.size() == static_cast<std::size_t>(n) && target.upper.size() == target.lower.size();
+
+  // The sample farthest beyond its joint's margin, over all joints.
+  double worst_excess = 0;
+  Eigen::Index worst_row = -1, worst_joint = -1;
+  for (Eigen::Index j = 0; checked && j < n; ++j) {
+    const double lo = target.lower[static_cast<std::size_t>(j)], hi = target.upper[static_cast<std::size_t>(j)];
+    if (!std::isfinite(lo) || !std::isfinite(hi) || !(hi > lo)) continue;  // no limits to judge by
+    const bool prismatic = !target.prismatic.empty() && target.prismatic[static_cast<std::size_t>(j)];
+    const double margin = std::max(prismatic ? kPrismaticMargin : kRevoluteMargin, 0.5 * (hi - lo));
+    for (Eigen::Index k = 0; k < log.samples(); ++k) {
+      const double q = log.q(k, j);
+      const double excess = std::max(lo - q, q - hi) - margin;
+      if (excess > worst_excess) {
+        worst_excess = excess;
+        worst_row = k;
+        worst_joint = j;
+      }
+    }
+  }
+  if (worst_row >= 0) {
+    const std::size_t j = static_cast<std::size_t>(worst_joint);
+    const bool prismatic = !target.prismatic.empty() && target.prismatic[j];
+    const double lo = target.lower[j], hi = target.upper[j], q = log.q(worst_row, worst_joint);
+    const double margin = std::max(prismatic ? kPrismaticMargin : kRevoluteMargin, 0.5 * (hi - lo));
+    const std::string unit = prismatic ? "m" : "rad";
+    const bool degrees = !prismatic && mapping.angle_unit == AngleUnit::deg;
+    const std::string as_written = degrees ? fmt::format(" ({} as written, read as deg)", g(q * 180 / kPi)) : "";
+    const std::string hint = prismatic ? "prismatic positions are read in m: is the file in mm?"
+                             : degrees ? "is the angle unit right (--angle, units.angle)?"
+                                       : "are the angles in deg, not rad (--angle deg, units.angle: deg)?";
+    throw DataError(file, imported.lines[static_cast<std::size_t>(worst_row)],
+                    fmt::format("joint {} '{}' is at {} {}{}, far outside its limits [{}, {}] {} (by more than {} {}, "
+                                "max({} {}, half its range)): {} {}",
+                                worst_joint + 1, target.joints[j], g(q), unit, as_written, g(lo), g(hi), unit, g(margin),
+                                unit, prismatic ? kPrismaticMargin : kRevoluteMargin, unit, hint, kOverride));
+  }
+
+  const double step = log.meta.sample_time;  // the median interval, to the us
+  if (step < kMinStep || step > kMaxStep) {
+    const TimeUnit u = mapping.time_unit;
+    throw DataError(file, 0,
+                    fmt::format("the median time step is {} {} as written ({} s read as {}), outside the plausible "
+                                "[{} s, {} s] of a robot's log: is the time unit right (--time-unit, units.time)? {}",
+                                g(step * per_second(u)), time_unit_name(u), g(step), time_unit_name(u),
+                                g(kMinStep), g(kMaxStep), kOverride));
+  }
+}
+
+}  // namespace symoro::io

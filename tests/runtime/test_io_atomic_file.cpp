@@ -1,0 +1,160 @@
+// Atomic writes: a temporary file left by a writer killed mid-write is removed by the next write
+// of the same target once its process is gone, never while it lives; failures name the system's
+// reason (a rename onto a directory, a full disk) and say whether a previous file is kept.
+#include <sys/mount.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+
+#include <gtest/gtest.h>
+
+#include "symoro/error.hpp"
+#include "symoro/io/atomic_file.hpp"
+
+namespace fs = std::filesystem;
+using symoro::DataError;
+using symoro::io::AtomicFile;
+using symoro::io::write_file_atomically;
+
+namespace {
+
+std::string read_text(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  std::ostringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+void touch(const fs::path& p) { std::ofstream(p) << "partial"; }
+
+class AtomicFiles : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() / ("symoro_atomic_" + std::to_string(::getpid()) + "_" +
+                                        ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+  }
+  void TearDown() override {
+    if (mounted_) ::umount(dir_.c_str());
+    fs::remove_all(dir_);
+  }
+  // The message of the DataError `f` throws ("" when it does not).
+  template <class F>
+  static std::string error_of(F f) {
+    try {
+      f();
+    } catch (const DataError& e) {
+      return e.what();
+    }
+    return "";
+  }
+  fs::path dir_;
+  bool mounted_ = false;
+};
+
+// A process that has exited and been reaped: its pid is no longer alive.
+pid_t dead_pid() {
+  const pid_t child = ::fork();
+  if (child == 0) ::_exit(0);
+  ::waitpid(child, nullptr, 0);
+  return child;
+}
+
+}  // namespace
+
+TEST_F(AtomicFiles, TheNextWriteRemovesOnlyStaleTemporaryFilesOfItsTarget) {
+  const fs::path target = dir_ / "big.csv";
+  const pid_t dead = dead_pid();
+  // A live process other than this one: a child waiting on a pipe until the test ends.
+  int pipe_fds[2];
+  ASSERT_EQ(::pipe(pipe_fds), 0);
+  const pid_t live = ::fork();
+  if (live == 0) {
+    char c;
+    ::close(pipe_fds[1]);
+    while (::read(pipe_fds[0], &c, 1) < 0) {
+    }
+    ::_exit(0);
+  }
+  ::close(pipe_fds[0]);
+
+  const fs::path stale = AtomicFile::temp_path(target, dead, 0);
+  const fs::path stale_later = AtomicFile::temp_path(target, dead, 12);
+  const fs::path mine = AtomicFile::temp_path(target, ::getpid(), 9999);
+  const fs::path living = AtomicFile::temp_path(target, live, 0);
+  const fs::path other_target = AtomicFile::temp_path(dir_ / "other.csv", dead, 0);
+  const fs::path other_host = dir_ / (".big.csv.symoro-tmp.another-host." + std::to_string(dead) + ".0");
+  const fs::path not_ours = dir_ / (".big.csv.symoro-tmp.x." + std::to_string(dead));
+  for (const fs::path& p : {stale, stale_later, mine, living, other_target, other_host, not_ours}) touch(p);
+  EXPECT_EQ(stale.filename().string().rfind(".big.csv.symoro-tmp.", 0), 0u) << stale;
+
+  write_file_atomically(target, "time\n");
+  EXPECT_EQ(read_text(target), "time\n");
+  EXPECT_FALSE(fs::exists(stale));
+  EXPECT_FALSE(fs::exists(stale_later));
+  for (const fs::path& p : {mine, living, other_target, other_host, not_ours}) EXPECT_TRUE(fs::exists(p)) << p;
+  ::close(pipe_fds[1]);
+  ::waitpid(live, nullptr, 0);
+  // The write's own temporary file is gone too: the folder holds the target and the kept files.
+  int entries = 0;
+  for (const auto& e : fs::directory_iterator(dir_)) {
+    (void)e;
+    ++entries;
+  }
+  EXPECT_EQ(entries, 6);
+}
+
+TEST_F(AtomicFiles, AnAbandonedWriteLeavesNothing) {
+  const fs::path target = dir_ / "a.yaml";
+  {
+    AtomicFile f(target);
+    f.stream() << "half";
+  }
+  EXPECT_TRUE(fs::is_empty(dir_));
+}
+
+// rename() onto a directory fails with EISDIR: the message says so (it said "Success": the
+// error code was overwritten by the clean-up before the message was built).
+TEST_F(AtomicFiles, ARenameFailureNamesItsReason) {
+  const fs::path target = dir_ / "taken";
+  fs::create_directories(target / "inside");
+  const std::string what = error_of([&] { write_file_atomically(target, "x\n"); });
+  EXPECT_NE(what.find(target.string() + ": error: cannot rename the written file into place: Is a directory"),
+            std::string::npos)
+      << what;
+  EXPECT_EQ(what.find("Success"), std::string::npos) << what;
+  EXPECT_EQ(std::distance(fs::directory_iterator(dir_), fs::directory_iterator()), 1);
+}
+
+// A full disk: a 64 KiB tmpfs (mounting needs root; skipped otherwise). Without a previous file
+// the message does not pretend one was kept; with one, it is kept as it was.
+TEST_F(AtomicFiles, AFullDiskSaysSoAndWhetherAPreviousFileIsKept) {
+  if (::geteuid() != 0) GTEST_SKIP() << "mounting a small tmpfs needs root";
+  if (::mount("tmpfs", dir_.c_str(), "tmpfs", 0, "size=64k") != 0)
+    GTEST_SKIP() << "cannot mount a tmpfs on " << dir_ << ": " << std::strerror(errno);
+  mounted_ = true;
+  const fs::path target = dir_ / "big.csv";
+  const std::string big(1 << 20, '1');
+  std::string what = error_of([&] { write_file_atomically(target, big); });
+  EXPECT_NE(what.find(target.string() + ": error: writing failed: no space left on device; nothing is written under "
+                                        "this name"),
+            std::string::npos)
+      << what;
+  EXPECT_EQ(what.find("previous file"), std::string::npos) << what;
+  EXPECT_TRUE(fs::is_empty(dir_));
+
+  write_file_atomically(target, "time\n0\n");
+  what = error_of([&] { write_file_atomically(target, big); });
+  EXPECT_NE(what.find("writing failed: no space left on device; the previous file is left as it was"),
+            std::string::npos)
+      << what;
+  EXPECT_EQ(read_text(target), "time\n0\n");
+  EXPECT_EQ(std::distance(fs::directory_iterator(dir_), fs::directory_iterator()), 1);
+}
