@@ -33,6 +33,17 @@ foreach(robot rx90 stanford_rrp)
   # Importing again never replaces what is there.
   run(1 out import --robot ${robot} -o ${w}/data ${w}/export.csv --name arm --time stamp_ms --time-unit ms
       --q "{name}_pos" --qd "{name}_vel" --tau "{name}_eff" --angle deg --split 0.7)
+  # Degrees declared as radians: positions far beyond the joint limits are refused with the
+  # evidence and the override, which imports them as they are; a split leaving one sample too.
+  set(deg_as_rad --robot ${robot} ${w}/export.csv --name arm --time stamp_ms --time-unit ms
+      --q "{name}_pos" --qd "{name}_vel" --tau "{name}_eff" --angle rad)
+  run(1 out import -o ${w}/deg-as-rad ${deg_as_rad})
+  expect("${out}" "export.csv:[0-9]+: error: joint [0-9]+ '[a-z0-9_]+' is at -?[0-9.e+-]+ rad, far outside its limits")
+  expect("${out}" "import with --allow-implausible")
+  run(0 out import -o ${w}/deg-as-rad ${deg_as_rad} --allow-implausible)
+  run(1 out import -o ${w}/split-1e-9 --robot ${robot} ${w}/export.csv --name arm --time stamp_ms --time-unit ms
+      --q "{name}_pos" --qd "{name}_vel" --tau "{name}_eff" --angle deg --split 1e-9)
+  expect("${out}" "split 1e-09 at [0-9.e+-]+ s leaves 1 of the [0-9]+ samples in the fitting part")
   # A dataset of another robot is refused, naming the manifest.
   if(robot STREQUAL "rx90")
     run(1 out identify --robot stanford_rrp --data ${w}/data -o ${w}/wrong)

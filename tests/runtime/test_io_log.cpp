@@ -584,6 +584,14 @@ std::string sidecar_with_line(int line, const std::string& text) {
   return out;
 }
 
+// A control byte in a sidecar's number is shown escaped, not sent raw to the terminal.
+TEST_F(LogFiles, SidecarNumbersAreQuotedEscaped) {
+  const fs::path csv = files(header2 + "0,1,2,3,4,5,6\n", sidecar_with_line(8, "samples: 1\x01x"));
+  expect_rejected(csv, metadata_path(csv), 8, "samples: expected a whole number, got '1\\x01x'");
+  const fs::path time = files(header2 + "0,1,2,3,4,5,6\n", sidecar_with_line(7, "sample_time: 0.001\x1b[2J"), "t");
+  expect_rejected(time, metadata_path(time), 7, "sample_time: expected a finite number, got '0.001\\x1b[2J'");
+}
+
 TEST_F(LogFiles, RejectsMissingSidecar) {
   const fs::path csv = path("alone.csv");
   write_text(csv, header2 + "0,1,2,3,4,5,6\n");

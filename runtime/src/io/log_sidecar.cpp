@@ -12,6 +12,7 @@
 #include <fmt/format.h>
 #include <yaml-cpp/yaml.h>
 
+#include "cell_text.hpp"
 #include "symoro/error.hpp"
 #include "symoro/io/number_text.hpp"
 #include "symoro/io/yaml_keys.hpp"
@@ -54,7 +55,7 @@ class SidecarReader {
     const auto [ptr, ec] = std::from_chars(s.data(), s.data() + s.size(), value);
     if (s.empty() || ec != std::errc() || ptr != s.data() + s.size())
       fail(node, fmt::format("{}: expected a whole number{}, got '{}'", key,
-                             std::is_signed_v<Integer> ? "" : " >= 0", s));
+                             std::is_signed_v<Integer> ? "" : " >= 0", shown_text(s)));
     return value;
   }
 
@@ -62,7 +63,7 @@ class SidecarReader {
     const std::string s = text(node, key);
     double value = 0;
     if (parse_number(s, value) != NumberParse::ok || !std::isfinite(value))
-      fail(node, fmt::format("{}: expected a finite number, got '{}'", key, s));
+      fail(node, fmt::format("{}: expected a finite number, got '{}'", key, shown_text(s)));
     return value;
   }
 
