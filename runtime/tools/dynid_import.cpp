@@ -6,6 +6,7 @@
 #include <CLI/CLI.hpp>
 
 #include "dynid_import.hpp"
+#include "dynid_numbers.hpp"
 
 namespace symoro::dynid {
 
@@ -46,7 +47,8 @@ void add_import_commands(CLI::App& app, Common& common) {
   cmd->add_option("--time-unit", o->time_unit, "Unit of the time column (default s)")->check(CLI::IsMember({"s", "ms", "us", "ns"}));
   cmd->add_option("--angle", o->angle, "Unit of angles (and angle/s, angle/s^2; prismatic joints stay in m)")
       ->check(CLI::IsMember({"rad", "deg"}));
-  cmd->add_option("--torque-scale", o->torque_scale, "Factor from the torque columns to N m (e.g. 0.001 for mN m)");
+  cmd->add_option("--torque-scale", o->torque_scale, "Factor from the torque columns to N m (e.g. 0.001 for mN m)")
+      ->check(numbers::positive(1e6, "> 0 and <= 1e6"));
   cmd->add_option("--header", o->header, "Header row (default auto: a first row with a non-number)")
       ->check(CLI::IsMember({"auto", "yes", "no"}));
   cmd->add_option("--delimiter", o->delimiter, "Field separator (default auto: ',' then ';' then blanks)")
@@ -54,7 +56,7 @@ void add_import_commands(CLI::App& app, Common& common) {
   cmd->add_option("--split,--fit", o->split,
                   "Fit on the first fraction of each run's time, hold out the rest as <name>_heldout (family V); "
                   "recorded in dataset.yaml")
-      ->check(CLI::Range(0.0, 1.0));
+      ->check(numbers::checked(0, 1, false, false, "a fraction from 0 (no split) to 1"));
   cmd->add_flag("--allow-implausible", o->allow_implausible,
                "Import positions far beyond the robot's joint limits, or a median time step outside "
                "[0.1 ms, 0.5 s] (refused by default: a unit declared wrong)");
