@@ -92,14 +92,15 @@ TEST_F(AtomicFiles, TheNextWriteRemovesOnlyStaleTemporaryFilesOfItsTarget) {
   const fs::path other_target = AtomicFile::temp_path(dir_ / "other.csv", dead, 0);
   const fs::path other_host = dir_ / (".big.csv.symoro-tmp.another-host." + std::to_string(dead) + ".0");
   const fs::path not_ours = dir_ / (".big.csv.symoro-tmp.x." + std::to_string(dead));
-  for (const fs::path& p : {stale, stale_later, mine, living, other_target, other_host, not_ours}) touch(p);
+  const fs::path no_pid = AtomicFile::temp_path(target, 4294967296L + dead, 0);  // wraps to `dead` as an int
+  for (const fs::path& p : {stale, stale_later, mine, living, other_target, other_host, not_ours, no_pid}) touch(p);
   EXPECT_EQ(stale.filename().string().rfind(".big.csv.symoro-tmp.", 0), 0u) << stale;
 
   write_file_atomically(target, "time\n");
   EXPECT_EQ(read_text(target), "time\n");
   EXPECT_FALSE(fs::exists(stale));
   EXPECT_FALSE(fs::exists(stale_later));
-  for (const fs::path& p : {mine, living, other_target, other_host, not_ours}) EXPECT_TRUE(fs::exists(p)) << p;
+  for (const fs::path& p : {mine, living, other_target, other_host, not_ours, no_pid}) EXPECT_TRUE(fs::exists(p)) << p;
   ::close(pipe_fds[1]);
   ::waitpid(live, nullptr, 0);
   // The write's own temporary file is gone too: the folder holds the target and the kept files.
@@ -108,7 +109,7 @@ TEST_F(AtomicFiles, TheNextWriteRemovesOnlyStaleTemporaryFilesOfItsTarget) {
     (void)e;
     ++entries;
   }
-  EXPECT_EQ(entries, 6);
+  EXPECT_EQ(entries, 7);
 }
 
 TEST_F(AtomicFiles, AnAbandonedWriteLeavesNothing) {

@@ -493,6 +493,10 @@ TEST_F(Import, RefusesAnImplausibleSampleTime) {
   io::DatasetImport allowed = limited_import(f, ms);
   allowed.allow_implausible = true;
   EXPECT_EQ(io::import_dataset(dir_ / "allowed", allowed).logs[0].log.meta.sample_time, 1e-6);
+  io::ImportMapping seconds = two_mapping();
+  write_text(f, two_rows(50, 2));
+  expect_error([&] { io::import_dataset(dir_ / "data", limited_import(f, seconds)); }, f.string(), 0,
+               "the median time step is 2 s as written, outside the plausible [0.0001 s, 0.5 s]");
   // The bounds themselves pass: 0.1 ms and 500 ms.
   write_text(f, two_rows(50, 0.1));
   EXPECT_NO_THROW(io::import_dataset(dir_ / "fast", limited_import(f, ms)));

@@ -28,7 +28,7 @@ std::string host_name() {
 }
 
 bool all_digits(std::string_view s) {
-  if (s.empty() || s.size() > 18) return false;
+  if (s.empty() || s.size() > 10) return false;  // a pid_t fits in 10 digits
   for (char c : s)
     if (c < '0' || c > '9') return false;
   return true;
@@ -49,7 +49,7 @@ void remove_stale_temps(const std::filesystem::path& target) {
     const std::size_t dot = rest.find('.');
     if (dot == std::string_view::npos || !all_digits(rest.substr(0, dot)) || !all_digits(rest.substr(dot + 1))) continue;
     const long pid = std::stol(std::string(rest.substr(0, dot)));
-    if (pid <= 0 || pid == static_cast<long>(::getpid())) continue;
+    if (pid <= 0 || pid > INT_MAX || pid == static_cast<long>(::getpid())) continue;  // not a pid, or ours
     if (::kill(static_cast<pid_t>(pid), 0) == 0 || errno != ESRCH) continue;
     std::error_code ignored;
     fs::remove(it->path(), ignored);

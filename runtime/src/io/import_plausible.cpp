@@ -97,11 +97,12 @@ void check_plausible(const ImportedLog& imported, const ImportMapping& mapping, 
   const double step = log.meta.sample_time;  // the median interval, to the us
   if (step < kMinStep || step > kMaxStep) {
     const TimeUnit u = mapping.time_unit;
+    const std::string in_seconds = u == TimeUnit::s ? "" : fmt::format(" ({} s read as {})", g(step), time_unit_name(u));
     throw DataError(file, 0,
-                    fmt::format("the median time step is {} {} as written ({} s read as {}), outside the plausible "
-                                "[{} s, {} s] of a robot's log: is the time unit right (--time-unit, units.time)? {}",
-                                g(step * per_second(u)), time_unit_name(u), g(step), time_unit_name(u),
-                                g(kMinStep), g(kMaxStep), kOverride));
+                    fmt::format("the median time step is {} {} as written{}, outside the plausible [{} s, {} s] of a "
+                                "robot's log: is the time unit right (--time-unit, units.time)? {}",
+                                g(step * per_second(u)), time_unit_name(u), in_seconds, g(kMinStep), g(kMaxStep),
+                                kOverride));
   }
 }
 
