@@ -50,4 +50,9 @@ std::vector<int> resolve_selector(const std::string& selector, const std::string
 // The line of `key` in the mapping (0 on the command line).
 int mapping_line(const ImportMapping& mapping, const std::string& key);
 
+// A time unit's name ("s", "ms", ...) and the exact factor a value in it is divided by to give
+// seconds (dividing by an exactly representable integer rounds once: "1500" ms is exactly 1.5 s).
+const char* time_unit_name(TimeUnit u);
+double time_divisor(TimeUnit u);
+
 }  // namespace symoro::io::detail

@@ -18,18 +18,6 @@ namespace {
 
 constexpr double kPi = 3.14159265358979323846;
 
-// The exact factor a time value is divided by (dividing by an exactly representable integer
-// rounds once, so "1500" ms is exactly 1.5 s).
-double time_divisor(TimeUnit u) {
-  switch (u) {
-    case TimeUnit::s: return 1;
-    case TimeUnit::ms: return 1e3;
-    case TimeUnit::us: return 1e6;
-    case TimeUnit::ns: return 1e9;
-  }
-  return 1;
-}
-
 bool same_bits(const double* a, const double* b, std::size_t count) {
   return std::memcmp(a, b, count * sizeof(double)) == 0;
 }
@@ -149,7 +137,7 @@ ImportedLog import_log(const std::filesystem::path& input, const ImportMapping& 
   ImportedLog out;
   out.input = input;
   out.rows = static_cast<int>(lines.size());
-  const double divisor = time_divisor(mapping.time_unit);
+  const double divisor = detail::time_divisor(mapping.time_unit);
   std::vector<std::size_t> kept;  // parsed rows written
   std::vector<bool> stale;
   for (std::size_t r = 0; r < lines.size(); ++r) {

@@ -8,6 +8,8 @@
 
 #include "symoro/error.hpp"
 #include "symoro/io/import.hpp"
+
+#include "import_detail.hpp"
 #include "symoro/io/number_text.hpp"
 #include "symoro/io/yaml_keys.hpp"
 
@@ -27,16 +29,6 @@ std::string& selector(ImportMapping& m, const std::string& key) {
   if (key == "q_ref") return m.q_ref;
   if (key == "qd_ref") return m.qd_ref;
   return m.qdd_ref;
-}
-
-const char* time_unit_name(TimeUnit u) {
-  switch (u) {
-    case TimeUnit::s: return "s";
-    case TimeUnit::ms: return "ms";
-    case TimeUnit::us: return "us";
-    case TimeUnit::ns: return "ns";
-  }
-  return "s";
 }
 
 const char* header_name(HeaderRow h) {
@@ -98,7 +90,7 @@ class MappingReader {
   }
   TimeUnit parse_time_unit(const std::string& value, const YAML::Node& n) const {
     for (TimeUnit u : {TimeUnit::s, TimeUnit::ms, TimeUnit::us, TimeUnit::ns})
-      if (value == time_unit_name(u)) return u;
+      if (value == detail::time_unit_name(u)) return u;
     fail(n, fmt::format("units.time: '{}' is not one of s, ms, us, ns", value));
   }
 
@@ -155,7 +147,7 @@ std::string import_mapping_yaml(const ImportMapping& m) {
     if (!value.empty()) out << YAML::Key << key << YAML::Value << YAML::DoubleQuoted << value;
   }
   out << YAML::Key << "units" << YAML::Value << YAML::Flow << YAML::BeginMap;
-  out << YAML::Key << "time" << YAML::Value << time_unit_name(m.time_unit);
+  out << YAML::Key << "time" << YAML::Value << detail::time_unit_name(m.time_unit);
   out << YAML::Key << "angle" << YAML::Value << (m.angle_unit == AngleUnit::deg ? "deg" : "rad");
   out << YAML::Key << "torque_scale" << YAML::Value << number_text(m.torque_scale) << YAML::EndMap;
   out << YAML::Key << "header" << YAML::Value << header_name(m.header);
@@ -163,5 +155,29 @@ std::string import_mapping_yaml(const ImportMapping& m) {
   out << YAML::EndMap;
   return std::string(out.c_str()) + "\n";
 }
+
+namespace detail {
+
+const char* time_unit_name(TimeUnit u) {
+  switch (u) {
+    case TimeUnit::s: return "s";
+    case TimeUnit::ms: return "ms";
+    case TimeUnit::us: return "us";
+    case TimeUnit::ns: return "ns";
+  }
+  return "s";
+}
+
+double time_divisor(TimeUnit u) {
+  switch (u) {
+    case TimeUnit::s: return 1;
+    case TimeUnit::ms: return 1e3;
+    case TimeUnit::us: return 1e6;
+    case TimeUnit::ns: return 1e9;
+  }
+  return 1;
+}
+
+}  // namespace detail
 
 }  // namespace symoro::io

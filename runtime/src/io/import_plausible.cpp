@@ -5,6 +5,7 @@
 
 #include <fmt/format.h>
 
+#include "import_detail.hpp"
 #include "symoro/error.hpp"
 #include "symoro/io/import.hpp"
 #include "symoro/io/number_text.hpp"
@@ -26,26 +27,6 @@ constexpr double kRevoluteMargin = 0.5, kPrismaticMargin = 0.05;
 constexpr double kMinStep = 1e-4, kMaxStep = 0.5;
 
 constexpr const char* kOverride = "if the values are right, import with --allow-implausible";
-
-const char* time_unit_name(TimeUnit u) {
-  switch (u) {
-    case TimeUnit::s: return "s";
-    case TimeUnit::ms: return "ms";
-    case TimeUnit::us: return "us";
-    case TimeUnit::ns: return "ns";
-  }
-  return "s";
-}
-
-double per_second(TimeUnit u) {
-  switch (u) {
-    case TimeUnit::s: return 1;
-    case TimeUnit::ms: return 1e3;
-    case TimeUnit::us: return 1e6;
-    case TimeUnit::ns: return 1e9;
-  }
-  return 1;
-}
 
 // 3 significant digits are enough evidence; number_text would print 58.70000000000001.
 std::string g(double v) { return fmt::format("{:.6g}", v); }
@@ -97,11 +78,11 @@ void check_plausible(const ImportedLog& imported, const ImportMapping& mapping, 
   const double step = log.meta.sample_time;  // the median interval, to the us
   if (step < kMinStep || step > kMaxStep) {
     const TimeUnit u = mapping.time_unit;
-    const std::string in_seconds = u == TimeUnit::s ? "" : fmt::format(" ({} s read as {})", g(step), time_unit_name(u));
+    const std::string in_seconds = u == TimeUnit::s ? "" : fmt::format(" ({} s read as {})", g(step), detail::time_unit_name(u));
     throw DataError(file, 0,
                     fmt::format("the median time step is {} {} as written{}, outside the plausible [{} s, {} s] of a "
                                 "robot's log: is the time unit right (--time-unit, units.time)? {}",
-                                g(step * per_second(u)), time_unit_name(u), in_seconds, g(kMinStep), g(kMaxStep),
+                                g(step * detail::time_divisor(u)), detail::time_unit_name(u), in_seconds, g(kMinStep), g(kMaxStep),
                                 kOverride));
   }
 }

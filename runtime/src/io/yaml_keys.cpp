@@ -11,71 +11,20 @@
 #include <fmt/ranges.h>
 #include <yaml-cpp/yaml.h>
 
+#include "symoro/detail/yaml_checks.hpp"
 #include "symoro/error.hpp"
 
 namespace symoro::io {
 
 namespace {
-
-int line_of(const YAML::Node& n) { return n.Mark().is_null() ? 0 : n.Mark().line + 1; }
-
-// Where the quoted scalar opening at text[at] ends (just past its closing quote), or npos when
-// the text ends first. Inside "...", a backslash escapes the next character; inside '...', ''
-// is a quote.
-std::size_t quoted_end(const std::string& text, std::size_t at) {
-  const char quote = text[at];
-  for (std::size_t k = at + 1; k < text.size(); ++k) {
-    if (quote == '"' && text[k] == '\\') {
-      ++k;
-    } else if (text[k] == quote) {
-      if (quote == '\'' && k + 1 < text.size() && text[k + 1] == '\'') {
-        ++k;
-      } else {
-        return k + 1;
-      }
-    }
+// A DataError at line (no column: the runtime's messages name file:line) for the shared checks.
+struct Fail {
+  const std::string& file;
+  [[noreturn]] void operator()(int line, int column, const std::string& message) const {
+    if (message.rfind("YAML syntax error", 0) == 0) throw DataError(file, line, column, message);
+    throw DataError(file, line, message);
   }
-  return std::string::npos;
-}
-
-// yaml-cpp takes a quoted scalar without its closing quote for text running to the end of the
-// file (the keys after it vanish into it): refused here at the opening quote.
-void check_quotes(const YAML::Node& n, const std::string& text, const std::string& file) {
-  if (n.IsScalar()) {
-    const YAML::Mark m = n.Mark();
-    if (m.is_null() || m.pos < 0 || static_cast<std::size_t>(m.pos) >= text.size()) return;
-    const char c = text[static_cast<std::size_t>(m.pos)];
-    if ((c == '"' || c == '\'') && quoted_end(text, static_cast<std::size_t>(m.pos)) == std::string::npos)
-      throw DataError(file, m.line + 1, m.column + 1,
-                      fmt::format("YAML syntax error: the quoted value opened here by {} has no closing quote", c));
-  } else if (n.IsMap()) {
-    for (const auto& e : n) {
-      check_quotes(e.first, text, file);
-      check_quotes(e.second, text, file);
-    }
-  } else if (n.IsSequence()) {
-    for (const auto& e : n) check_quotes(e, text, file);
-  }
-}
-
-std::string lower(std::string s) {
-  for (char& c : s) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  return s;
-}
-
-// Edits from a to b: insertions, deletions, substitutions and swaps of neighbours ("splti").
-std::size_t edits(const std::string& a, const std::string& b) {
-  std::vector<std::vector<std::size_t>> d(a.size() + 1, std::vector<std::size_t>(b.size() + 1));
-  for (std::size_t i = 0; i <= a.size(); ++i) d[i][0] = i;
-  for (std::size_t j = 0; j <= b.size(); ++j) d[0][j] = j;
-  for (std::size_t i = 1; i <= a.size(); ++i)
-    for (std::size_t j = 1; j <= b.size(); ++j) {
-      d[i][j] = std::min({d[i - 1][j] + 1, d[i][j - 1] + 1, d[i - 1][j - 1] + (a[i - 1] == b[j - 1] ? 0 : 1)});
-      if (i > 1 && j > 1 && a[i - 1] == b[j - 2] && a[i - 2] == b[j - 1]) d[i][j] = std::min(d[i][j], d[i - 2][j - 2] + 1);
-    }
-  return d[a.size()][b.size()];
-}
-
+};
 }  // namespace
 
 YAML::Node load_yaml_text(const std::string& text, const std::string& file) {
@@ -86,7 +35,7 @@ YAML::Node load_yaml_text(const std::string& text, const std::string& file) {
     if (e.mark.is_null()) throw DataError(file, 0, "YAML syntax error: " + e.msg);
     throw DataError(file, e.mark.line + 1, e.mark.column + 1, "YAML syntax error: " + e.msg);
   }
-  check_quotes(root, text, file);
+  ::symoro::detail::check_quotes(root, text, Fail{file});
   return root;
 }
 
@@ -99,35 +48,12 @@ YAML::Node load_yaml_file(const std::filesystem::path& path) {
 }
 
 std::string nearest_name(const std::string& name, const std::vector<std::string>& known) {
-  std::string best;
-  std::pair<std::size_t, std::size_t> best_score;  // edits, then the difference in length
-  for (const std::string& k : known) {
-    const std::size_t e = edits(lower(name), lower(k));
-    // At most 2 edits, and at most half the longer name: "qq" may be "q", "x" is not "q".
-    if (e > 2 || 2 * e > std::max(name.size(), k.size())) continue;
-    // Of equally near names, one as long ("YM": "MY" rather than "M").
-    const std::pair<std::size_t, std::size_t> score{e, std::max(name.size(), k.size()) - std::min(name.size(), k.size())};
-    if (best.empty() || score < best_score) best = k, best_score = score;
-  }
-  return best;
+  return ::symoro::detail::nearest_name(name, known);
 }
 
 void check_keys(const YAML::Node& map, const std::vector<std::string>& known, const std::string& file,
                 const std::string& where) {
-  if (!map.IsMap()) return;
-  std::map<std::string, int> seen;  // key -> its line
-  for (const auto& e : map) {
-    if (!e.first.IsScalar()) throw DataError(file, line_of(e.first), fmt::format("a key of {} must be a single word", where));
-    const std::string key = e.first.Scalar();
-    if (std::find(known.begin(), known.end(), key) == known.end()) {
-      const std::string near = nearest_name(key, known);
-      throw DataError(file, line_of(e.first),
-                      fmt::format("unknown key '{}' in {}{} (known keys: {})", key, where,
-                                  near.empty() ? "" : fmt::format("; did you mean '{}'?", near), fmt::join(known, ", ")));
-    }
-    const auto [at, fresh] = seen.emplace(key, line_of(e.first));
-    if (!fresh) throw DataError(file, line_of(e.first), fmt::format("key '{}' appears twice in {} (first on line {})", key, where, at->second));
-  }
+  ::symoro::detail::check_keys(map, known, where, Fail{file});
 }
 
 }  // namespace symoro::io
