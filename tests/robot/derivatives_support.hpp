@@ -1,0 +1,63 @@
+// What the derivative test units of one robot share (test_robot_derivatives_*.cpp, one unit per
+// generated function so that no unit instantiates every Jet at once: the crane_x7 unit took 14 min
+// and 4.8 GB as one): its models as gtest types, the tolerances and random states. Built into
+// test_robot_<robot> with test_robot.cpp.
+#pragma once
+
+#include SYMORO_ROBOT_HEADER
+
+#include <string>
+#include <tuple>
+
+#include <gtest/gtest.h>
+
+#include "jet_support.hpp"
+#include "test_support.hpp"
+
+namespace symoro::test {
+namespace {
+
+template <class Tuple>
+struct AsTypes;
+template <class... Model>
+struct AsTypes<std::tuple<Model...>> {
+  using type = ::testing::Types<Model...>;
+};
+using Models = AsTypes<SYMORO_ROBOT_NS::Models>::type;
+
+struct ModelName {
+  template <class Model>
+  static std::string GetName(int) {
+    const std::string variant = Model::variant_name;
+    return variant.empty() ? "full" : variant;
+  }
+};
+
+// Generated derivative vs Jet derivative of the generated value: the same exact derivative in a
+// different order of operations; 1e-10 of the object's magnitude (round-off, times the
+// conditioning of M for the forward dynamics).
+constexpr double kJetTol = 1e-10;
+// Central differences with h = 1e-6: truncation ~h^2, round-off ~1e-16/h.
+constexpr double kFdStep = 1e-6;
+constexpr double kFdTol = 1e-6;
+constexpr int kStates = 5;
+
+template <class Model>
+class RobotDerivatives : public ::testing::Test {
+ protected:
+  template <class Check>
+  void for_states(const Check& check) {
+    for (int k = 0; k < kStates; ++k) {
+      SCOPED_TRACE("random state " + std::to_string(k));
+      const State<Model> s = random_state<Model>(rng_);
+      check(s, random_phi<Model>(rng_));
+    }
+  }
+  // phi of physical standard parameters: M positive definite (see test_robot.cpp).
+  ParameterVector<Model> physical_phi() { return Model::base_from_standard(random_standard_parameters<Model>(rng_).s); }
+  JointVector<Model> random_torque() { return rng_.vector<JointVector<Model>>(Model::nq, -5, 5); }
+
+  Random rng_{20261124};
+};
+}  // namespace
+}  // namespace symoro::test

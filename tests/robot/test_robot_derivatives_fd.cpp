@@ -1,0 +1,60 @@
+// The generated forward dynamics derivatives of one robot and all its variants (issue 16), and their refusal of an indefinite inertia.
+// Against two independent references: forward-mode ceres::Jet through the generated value
+// functions, and central finite differences of their double versions (derivatives_support.hpp).
+#include <Eigen/Eigenvalues>
+#include <Eigen/LU>
+
+#include "derivatives_support.hpp"
+
+namespace symoro::test {
+namespace {
+
+template <class Model>
+class ForwardDynamicsDerivatives : public RobotDerivatives<Model> {};
+TYPED_TEST_SUITE(ForwardDynamicsDerivatives, Models, ModelName);
+
+TYPED_TEST(ForwardDynamicsDerivatives, ForwardDynamicsDerivativesAreTheJetAndFiniteDifferenceDerivatives) {
+  using M = TypeParam;
+  constexpr int nq = M::nq;
+  this->for_states([&](const State<M>& s, const ParameterVector<M>&) {
+    const ParameterVector<M> phi = this->physical_phi();
+    const JointVector<M> tau = this->random_torque();
+    typename M::template ForwardDynamicsDerivatives<double> d;
+    ASSERT_TRUE(M::forward_dynamics_derivatives(s.q, s.qd, tau, phi, d));
+    EXPECT_GT(d.min_pivot, 0);
+    // The value: ddm.txt's forward dynamics, which the generated code evaluates another way.
+    EXPECT_TRUE(close(d.qdd, M::forward_dynamics(s.q, s.qd, tau, phi), 1e-9)) << "qdd";
+    EXPECT_TRUE(close(d.dq, jet_jacobian(M::forward_dynamics(seeded<nq>(s.q), s.qd, tau, phi)), kJetTol)) << "d qdd / d q";
+    EXPECT_TRUE(close(d.dqd, jet_jacobian(M::forward_dynamics(s.q, seeded<nq>(s.qd), tau, phi)), kJetTol)) << "d qdd / d qd";
+    EXPECT_TRUE(close(d.dtau, jet_jacobian(M::forward_dynamics(s.q, s.qd, seeded<nq>(tau), phi)), kJetTol)) << "d qdd / d tau";
+    EXPECT_TRUE(close(d.dphi, jet_jacobian(M::forward_dynamics(s.q, s.qd, tau, seeded<M::np>(phi))), kJetTol)) << "d qdd / d phi";
+    // d qdd / d tau = M^-1 and d qdd / d phi = -M^-1 W(q, qd, qdd), from the other generated functions.
+    const Eigen::Matrix<double, nq, nq> Minv = M::inertia(s.q, phi).inverse();
+    EXPECT_TRUE(close(d.dtau, Minv, kJetTol)) << "M^-1";
+    EXPECT_TRUE(close(d.dphi, -Minv * M::regressor(s.q, s.qd, d.qdd), kJetTol)) << "-M^-1 W";
+    const auto fd = [&](const auto& f, const auto& x) { return finite_difference_jacobian(f, x, kFdStep); };
+    EXPECT_TRUE(close(d.dq, fd([&](const JointVector<M>& x) { return M::forward_dynamics(x, s.qd, tau, phi); }, s.q), kFdTol))
+        << "d qdd / d q, finite differences";
+    EXPECT_TRUE(close(d.dqd, fd([&](const JointVector<M>& x) { return M::forward_dynamics(s.q, x, tau, phi); }, s.qd), kFdTol))
+        << "d qdd / d qd, finite differences";
+    EXPECT_TRUE(close(d.dphi, fd([&](const ParameterVector<M>& x) { return M::forward_dynamics(s.q, s.qd, tau, x); }, phi), kFdTol))
+        << "d qdd / d phi, finite differences";
+  });
+}
+
+
+// An inertia matrix that is not positive definite is reported, not inverted.
+TYPED_TEST(ForwardDynamicsDerivatives, ForwardDynamicsDerivativesRefuseAnIndefiniteInertia) {
+  using M = TypeParam;
+  this->for_states([&](const State<M>& s, const ParameterVector<M>&) {
+    const ParameterVector<M> phi = -this->physical_phi();  // M(q; -phi) = -M(q; phi) + constant part
+    const Eigen::Matrix<double, M::nq, M::nq> A = M::inertia(s.q, phi);
+    const double smallest = Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, M::nq, M::nq>>(A).eigenvalues().minCoeff();
+    typename M::template ForwardDynamicsDerivatives<double> d;
+    const bool ok = M::forward_dynamics_derivatives(s.q, s.qd, this->random_torque(), phi, d);
+    EXPECT_EQ(ok, smallest > 0) << "smallest eigenvalue of M " << smallest << ", smallest pivot " << d.min_pivot;
+  });
+}
+
+}  // namespace
+}  // namespace symoro::test
