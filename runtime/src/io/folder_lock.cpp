@@ -20,8 +20,11 @@ FolderLock::FolderLock(const std::filesystem::path& folder, const std::string& w
   if (fd_ < 0) throw DataError(file.string(), 0, fmt::format("cannot open the folder's lock file: {}", std::strerror(errno)));
   if (::flock(fd_, LOCK_EX | LOCK_NB) != 0) {
     const int err = errno;
+    // The holder writes its pid just after it takes the lock: a refusal in between waits a little
+    // for it (at most 0.2 s) so that the message can name it.
     char holder[256] = {};
-    const ssize_t n = ::pread(fd_, holder, sizeof holder - 1, 0);
+    ssize_t n = 0;
+    for (int attempt = 0; attempt < 40 && (n = ::pread(fd_, holder, sizeof holder - 1, 0)) <= 0; ++attempt) ::usleep(5000);
     std::string who = n > 0 ? std::string(holder, static_cast<std::size_t>(n)) : std::string("another process");
     while (!who.empty() && (who.back() == '\n' || who.back() == '\r')) who.pop_back();
     ::close(fd_);
