@@ -12,26 +12,11 @@
 #include <gtest/gtest.h>
 
 #include "jet_support.hpp"
+#include "robot_models.hpp"
 #include "test_support.hpp"
 
 namespace symoro::test {
 namespace {
-
-template <class Tuple>
-struct AsTypes;
-template <class... Model>
-struct AsTypes<std::tuple<Model...>> {
-  using type = ::testing::Types<Model...>;
-};
-using Models = AsTypes<SYMORO_ROBOT_NS::Models>::type;
-
-struct ModelName {
-  template <class Model>
-  static std::string GetName(int) {
-    const std::string variant = Model::variant_name;
-    return variant.empty() ? "full" : variant;
-  }
-};
 
 // Generated derivative vs Jet derivative of the generated value: the same exact derivative in a
 // different order of operations; 1e-10 of the object's magnitude (round-off, times the

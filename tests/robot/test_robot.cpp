@@ -17,27 +17,11 @@
 
 #include "jet_support.hpp"
 #include "symoro/grammar/parser.hpp"
+#include "robot_models.hpp"
 #include "test_support.hpp"
 
 namespace symoro::test {
 namespace {
-
-template <class Tuple>
-struct AsTypes;
-template <class... Model>
-struct AsTypes<std::tuple<Model...>> {
-  using type = ::testing::Types<Model...>;
-};
-using Models = AsTypes<SYMORO_ROBOT_NS::Models>::type;
-
-// Test names: "full" for the robot's full model, else the variant's name.
-struct ModelName {
-  template <class Model>
-  static std::string GetName(int) {
-    const std::string variant = Model::variant_name;
-    return variant.empty() ? "full" : variant;
-  }
-};
 
 // The generated code and the references evaluate the same expressions in a different order;
 // 1e-9 of the object's magnitude leaves room for that round-off (about 1e-13 to 1e-15 in
