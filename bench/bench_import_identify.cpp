@@ -72,7 +72,7 @@ void BM_ImportAndIdentify(benchmark::State& state) {
     o.data = kDir / "data";
     o.out = kDir / "study";
     o.intervals = {0.010};
-    symoro::identify::Study<Model> study(o, symoro::identify::ClosedLoopSource{});
+    symoro::identify::Study study(symoro::identify::identification_model<Model>(), o, symoro::identify::ClosedLoopSource{});
     const auto r = study.run();
     state.counters["accepted"] = r.accepted;
   }

@@ -3,16 +3,147 @@
 // resumable: finished runs are kept in <out>/runs/ and skipped by a rerun. --only and
 // --interval narrow it to a few runs (e.g. --only AG02 --interval 40 to inspect one). Under
 // mpirun the runs spread over the ranks and rank 0 writes the study (docs/scaling.md).
+#include <sys/resource.h>
+
+#include <algorithm>
+#include <filesystem>
+#include <memory>
 #include <optional>
 
 #include <CLI/CLI.hpp>
+#include <fmt/format.h>
 
 #include "dynid_identify.hpp"
 #include "dynid_numbers.hpp"
+#include "symoro/control/description.hpp"
+#include "symoro/identify/dataset.hpp"
+#include "symoro/identify/report.hpp"
+#include "symoro/identify/study.hpp"
+#include "symoro/identify/validation_io.hpp"
 #include "symoro/io/folder_lock.hpp"
 #include "symoro/parallel/farm.hpp"
+#include "symoro/trajectory/design.hpp"
+#include "symoro/twin/config.hpp"
 
 namespace symoro::dynid {
+
+namespace identify_detail {
+
+identify::StudyResult study(const Common& common, const IdentifyOptions& o,
+                            const std::shared_ptr<const identify::IdentificationModel>& model, const TwinTruth& truth,
+                            bool quiet) {
+  const identify::ModelDescription& d = model->description();
+  identify::StudyOptions so;
+  so.data = o.data;
+  so.out = o.out;
+  so.trial = o.trial;
+  so.threads = o.threads;
+  so.fresh = o.fresh;
+  so.isolate = !o.in_process;
+  so.rank_timeout = o.rank_timeout;
+  so.trajectories = o.only;
+  so.validation = o.validation;
+  if (!o.intervals_ms.empty()) {
+    so.intervals.clear();
+    for (double ms : o.intervals_ms) so.intervals.push_back(ms / 1000);
+  }
+  so.least_squares.weighted = o.weighted;
+  so.preprocess.torque_delay = o.torque_delay_ms / 1000;
+  so.clie.max_iterations = o.clie_iterations;
+  so.clie.std_bound = o.clie_std_bound;
+  so.projection_metric = identify::projection_metric_from_string(o.projection_metric);
+  so.consistency = identify::consistency_from_string(o.consistency);
+  so.physical_start = o.physical_start;
+  so.rescue_metric_all_runs = o.rescue_metric == "all";
+  if (o.physical_start && so.consistency != identify::Consistency::physical)
+    throw UsageError("--physical-start needs --consistency physical");
+  so.validation_interval = o.validation_ms / 1000;
+  auto progress = std::make_shared<std::unique_ptr<Progress>>();
+  so.on_start = [progress, quiet](int total, int skipped) {
+    if (skipped > 0) fmt::print(stderr, "{} of {} runs already finished (same inputs): skipped\n", skipped, total);
+    if (!quiet) *progress = std::make_unique<Progress>(total - skipped, "run");
+  };
+  so.on_run = [progress](const identify::RunRecord& r) {
+    if (*progress)
+      (*progress)->done(r.id(), r.failed ? "FAILED: " + r.failure
+                                : r.clie_ran ? fmt::format("kappa {:.1f} {} lambda_min(CLIE) {:+.2e} CLIE {:.1f} s", r.kappa, r.route,
+                                                           r.clie_lambda_min, r.t_clie)
+                                             : fmt::format("kappa {:.1f} {} lambda_min(final, no CLIE) {:+.2e}", r.kappa, r.route,
+                                                           r.clie_lambda_min));
+  };
+  // What switches on the closed-loop stages: the robot's controller description (CLIE and
+  // closed-loop validation) and its trajectory design (references for logs without them).
+  const std::vector<JointInfo>& joints = d.joints;
+  identify::ClosedLoopSource loop;
+  const auto controller_path = common.robot_dir() / control::controller_file_name();
+  if (std::filesystem::exists(controller_path))
+    loop.setup = identify::closed_loop_setup(control::read_controller_description(controller_path, d.nq));
+  else
+    loop.why = fmt::format("no controller description ({} not found)", controller_path.string());
+  const auto design_path = common.robot_dir() / "trajectories.yaml";
+  if (std::filesystem::exists(design_path)) loop.design = trajectory::TrajectoryDesign::read(design_path, joints);
+  identify::Study s(model, so, std::move(loop));
+  identify::StudyResult result = s.run();
+  // On twin data the truth is known: the twin's standard parameters mapped to the identified
+  // model's base parameters (products of inertia dropped for a reduced variant), with the hidden
+  // Coulomb friction and offsets where the variant has parameters for them.
+  const identify::Dataset data = identify::read_dataset(o.data);
+  if (!data.twin.empty() && std::filesystem::exists(data.twin)) {
+    const twin::TwinConfig tc = twin::read_twin_config(data.twin, d.nq, data.twin_overrides);
+    result.truth = truth(tc);
+  }
+  return result;
+}
+
+}  // namespace identify_detail
+
+void IdentifyCommand::run_model(const Common& common, const IdentifyOptions& o,
+                                std::shared_ptr<const identify::IdentificationModel> model, const TwinTruth& truth) {
+  if (o.out.empty()) throw UsageError("--out is required");
+  const identify::StudyResult r = identify_detail::study(common, o, model, truth, false);
+  if (!parallel::place().coordinator()) return;  // rank 0 reports
+  rusage usage{};
+  getrusage(RUSAGE_SELF, &usage);
+  fmt::print("{} runs, {}{} threads: {:.1f} s wall ({:.1f} s of run stages summed), peak memory {:.0f} MB{}\n", r.runs.size(),
+             r.ranks > 1 ? fmt::format("{} ranks x ", r.ranks) : "", r.threads, r.wall, r.wall_runs, usage.ru_maxrss / 1024.0,
+             r.worker_peak_mb > 0 ? fmt::format(" (this process), {:.0f} MB (a trajectory's process, largest: {})", r.worker_peak_mb,
+                                                r.worker_peak_trajectory)
+                                  : "");
+  for (const auto& line : r.stages) fmt::print("{}\n", line);
+  if (r.selection.run < 0) fmt::print("no representative: {}\n", r.selection.rule.empty() ? "no run produced a final vector" : r.selection.rule);
+  if (r.selection.run >= 0) {
+    const auto& sel = r.runs[r.selection.run];
+    fmt::print("representative: {} ({}); {}; final audit lambda_min {:.3e} -> {}\n", sel.id(), r.selection.rule,
+               r.rescued ? (r.rescue_feasible ? (r.consistency == "physical" ? "rescued onto the consistent set" : "rescued (eps = 0)")
+                                                           : "rescue FAILED: " + r.rescue_status)
+                         : (r.consistency == "physical" ? "consistent, no rescue" : "PD without rescue"),
+               r.final_lambda_min, r.accepted ? "accepted" : "NOT accepted");
+    fmt::print("physical consistency of the accepted vector: {}\n",
+               r.final_consistency_note.empty() ? "not checked" : r.final_consistency_note);
+    for (const auto& v : r.validation)
+      fmt::print("validation {} at {:.0f} ms, {}: RMSE {:.4f} / {:.4f} N m, MNE {:.4f} / {:.4f} (final / accepted){}\n",
+                 v.trajectory, v.interval * 1e3, v.kind, v.rmse_clie, v.rmse_rescue, v.mne_clie, v.mne_rescue,
+                 v.note.empty() ? "" : "; " + v.note);
+  }
+  // The held-out series on disk: dynid compare reads them to set two model variants side by side.
+  if (!identify::write_validation(r, o.out).empty())
+    fmt::print("validation: {}\n", (std::filesystem::path(o.out) / "validation.yaml").string());
+  if (!o.no_report) {
+    const auto files = identify::write_report(r, std::filesystem::path(o.out) / "report");
+    fmt::print("report: {} ({} files)\n", (std::filesystem::path(o.out) / "report" / "report.md").string(), files.size());
+  }
+  // A study without a model fails, after its records and report are written: `identify &&
+  // export` must not carry on as if there were parameters.
+  const auto failed = std::count_if(r.runs.begin(), r.runs.end(), [](const identify::RunRecord& run) { return run.failed; });
+  if (r.runs.empty() || failed == static_cast<long>(r.runs.size()))
+    throw std::runtime_error(fmt::format("no run of the study succeeded ({} of {} failed{}): no model was identified",
+                                         failed, r.runs.size(),
+                                         r.runs.empty() ? "" : "; the first: " + r.runs.front().id() + ": " + r.runs.front().failure));
+  if (r.selection.run < 0)
+    throw std::runtime_error(fmt::format("no representative run: {}; no model was identified",
+                                         r.selection.rule.empty() ? "no run produced a final vector" : r.selection.rule));
+}
+
 
 void add_identify_commands(CLI::App& app, Common& common) {
   auto o = std::make_shared<IdentifyOptions>();

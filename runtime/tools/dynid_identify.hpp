@@ -1,11 +1,17 @@
-// dynid identify's options and its entry, compiled per model of each robot (any variant:
-// --model) in generated units; the body is in dynid_identify-inl.hpp.
+// dynid identify's options and its entry: a thin part per model of each robot (any variant:
+// --model) in generated units (dynid_identify-inl.hpp), the body once (dynid_identify.cpp).
 #pragma once
 
+#include <functional>
+#include <memory>
 #include <string>
 #include <vector>
 
+#include <Eigen/Core>
+
 #include "dynid_dispatch.hpp"
+#include "symoro/identify/identification_model.hpp"
+#include "symoro/twin/config.hpp"
 
 namespace symoro::dynid {
 
@@ -25,10 +31,17 @@ struct IdentifyOptions {
   double rank_timeout = 60;
 };
 
+// The twin's true parameters of the model being identified (twin data only).
+using TwinTruth = std::function<Eigen::VectorXd(const twin::TwinConfig&)>;
+
 struct IdentifyCommand {
   using Options = IdentifyOptions;
+  // Per model (dynid_identify-inl.hpp): hands the model to run_model.
   template <class Full, class Model>
   static void run(const Common& common, const Options& o);
+  // The study and its report, compiled once for every model (dynid_identify.cpp).
+  static void run_model(const Common& common, const Options& o, std::shared_ptr<const identify::IdentificationModel> model,
+                        const TwinTruth& truth);
 };
 
 const CommandTable<IdentifyOptions>& identify_units();  // generated: dynid_tables.cpp

@@ -150,7 +150,7 @@ TYPED_TEST(AnyRobotGap, AControllersCsvThroughImportIdentifyDiagnoseAndCompare) 
     o.data = this->dir_ / "data";
     o.out = this->dir_ / name;
     o.intervals = {0.010};
-    identify::Study<Model> s(o, identify::ClosedLoopSource{});
+    identify::Study s(identify::identification_model<Model>(), o, identify::ClosedLoopSource{});
     const identify::StudyResult r = s.run();
     identify::write_validation(r, o.out);
     return r;

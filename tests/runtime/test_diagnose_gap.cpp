@@ -73,7 +73,7 @@ identify::StudyResult study(const std::filesystem::path& out) {
   o.validation = kValid;
   o.intervals = {0.010};
   o.threads = 1;
-  identify::Study<Model> s(o,
+  identify::Study s(identify::identification_model<Model>(), o,
                            trajectory::TrajectoryDesign::read(kRobot + "/trajectories.yaml",
                                                               std::vector<JointInfo>(Model::joints.begin(), Model::joints.end())),
                            identify::closed_loop_setup(twin::read_twin_config(kRobot + "/twin.yaml", Model::nq)));

@@ -83,7 +83,7 @@ TYPED_TEST_SUITE(AnyRobotStudy, Robots);
 
 TYPED_TEST(AnyRobotStudy, RunsWithoutTwinDesignOrControllerAndValidatesOpenLoop) {
   using Model = TypeParam;
-  identify::Study<Model> study(this->options(), this->no_controller());
+  identify::Study study(identify::identification_model<Model>(), this->options(), this->no_controller());
   const identify::StudyResult r = study.run();
 
   ASSERT_EQ(r.runs.size(), 4u);  // R1 and R2 at 10 and 20 ms
@@ -142,7 +142,7 @@ TYPED_TEST(AnyRobotStudy, RunsWithoutTwinDesignOrControllerAndValidatesOpenLoop)
   }
 
   // A rerun skips every run and gives the same accepted vector.
-  identify::Study<Model> again(this->options(), this->no_controller());
+  identify::Study again(identify::identification_model<Model>(), this->options(), this->no_controller());
   const identify::StudyResult r2 = again.run();
   EXPECT_EQ(r2.phi_rescue, r.phi_rescue);
 }
@@ -159,7 +159,7 @@ TYPED_TEST(AnyRobotStudy, AFailingRunIsRecordedAndTheStudyGoesOn) {
   identify::StudyOptions o = this->options();
   o.trajectories = {"R1", "R3", "R3"};
   o.intervals = {0.010};
-  identify::Study<Model> study(o, identify::ClosedLoopSource{});
+  identify::Study study(identify::identification_model<Model>(), o, identify::ClosedLoopSource{});
   const identify::StudyResult r = study.run();
   ASSERT_EQ(r.runs.size(), 2u);  // R3 once
   EXPECT_FALSE(r.runs[0].failed);
@@ -214,7 +214,7 @@ TYPED_TEST(AnyRobotStudy, TheControllerDescriptionIsPartOfARunsFingerprint) {
     identify::StudyOptions o = this->options();
     o.intervals = {0.020};
     o.on_start = [&](int, int k) { skipped = k; };
-    identify::Study<Model>(o, std::move(source)).run();
+    identify::Study(identify::identification_model<Model>(), o, std::move(source)).run();
   };
   run(this->no_controller());
   run(this->no_controller());
@@ -240,7 +240,7 @@ TYPED_TEST(AnyRobotStudy, AOneRunStudyWhoseClieDivergedEndsWithAReport) {
   o.intervals = {0.020};
   identify::ClosedLoopSource source;
   source.setup = unstable_setup<Model>();
-  const identify::StudyResult r = identify::Study<Model>(o, std::move(source)).run();
+  const identify::StudyResult r = identify::Study(identify::identification_model<Model>(), o, std::move(source)).run();
   ASSERT_EQ(r.runs.size(), 1u);
   EXPECT_TRUE(r.runs[0].clie_ran);
   EXPECT_FALSE(r.runs[0].clie_success);
@@ -308,7 +308,7 @@ TYPED_TEST(AnyRobotStudy, ALogOfAnotherRobotOrJointCountIsNamed) {
   identify::StudyOptions o = this->options();
   o.trajectories = {"R1", "R5", "R6"};
   o.intervals = {0.020};
-  const identify::StudyResult r = identify::Study<Model>(o, this->no_controller()).run();
+  const identify::StudyResult r = identify::Study(identify::identification_model<Model>(), o, this->no_controller()).run();
   ASSERT_EQ(r.runs.size(), 3u);
   EXPECT_FALSE(r.runs[0].failed);
   EXPECT_TRUE(r.runs[1].failed && r.runs[2].failed);

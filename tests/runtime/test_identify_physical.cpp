@@ -106,7 +106,7 @@ TEST(PhysicalProjection, ModelsWithEffectsAreRefusedWithTheReason) {
   identify::StudyOptions o;
   o.data = "/nonexistent";
   o.consistency = identify::Consistency::physical;
-  identify::Study<Diagnosed> study(o, identify::ClosedLoopSource{});
+  identify::Study study(identify::identification_model<Diagnosed>(), o, identify::ClosedLoopSource{});
   try {
     study.run();
     ADD_FAILURE() << "a physical study of a model with effects ran";
@@ -148,7 +148,7 @@ class PhysicalStudy : public ::testing::Test {
     o.physical_start = physical_start;
     identify::ClosedLoopSource none;
     none.why = "no controller description (test)";
-    return identify::Study<Model>(o, std::move(none)).run();
+    return identify::Study(identify::identification_model<Model>(), o, std::move(none)).run();
   }
 
   static constexpr double kNoise = 0.3, kOffset = 0.1;

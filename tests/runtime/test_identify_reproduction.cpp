@@ -60,7 +60,7 @@ struct Studies {
     names.insert(names.end(), kValid.begin(), kValid.end());
     test::write_twin_dataset<Full>(data, twin::read_twin_config(kRobot + "/twin.yaml", Full::nq), design(), names, 1,
                                    kRobot + "/twin.yaml");
-    quiet = identify::Study<Model>(options(data, kTmp / ("symoro_repro_a_" + kPid)), design(), setup()).run();
+    quiet = identify::Study(identify::identification_model<Model>(), options(data, kTmp / ("symoro_repro_a_" + kPid)), design(), setup()).run();
     // The same study again while two threads compete for both cores.
     std::atomic<bool> stop{false};
     std::vector<std::thread> load;
@@ -69,7 +69,7 @@ struct Studies {
         volatile double x = 1;
         while (!stop.load(std::memory_order_relaxed)) x = std::sqrt(x + 1);
       });
-    loaded = identify::Study<Model>(options(data, kTmp / ("symoro_repro_b_" + kPid)), design(), setup()).run();
+    loaded = identify::Study(identify::identification_model<Model>(), options(data, kTmp / ("symoro_repro_b_" + kPid)), design(), setup()).run();
     stop = true;
     for (auto& t : load) t.join();
   }

@@ -78,7 +78,7 @@ struct Fixture {
     std::filesystem::remove_all(out);
     auto o = options(out);
     o.on_run = [this](const identify::RunRecord&) { ++ran_first; };
-    first = identify::Study<Model>(o, design(), setup()).run();
+    first = identify::Study(identify::identification_model<Model>(), o, design(), setup()).run();
   }
 };
 
@@ -110,7 +110,7 @@ void rerun_skips_finished_runs_and_redoes_stale_ones() {
   auto o = options(f.out);
   o.on_run = [&](const identify::RunRecord&) { ++ran; };
   o.on_start = [&](int, int s) { skipped = s; };
-  const auto again = identify::Study<Model>(o, design(), setup()).run();
+  const auto again = identify::Study(identify::identification_model<Model>(), o, design(), setup()).run();
   EXPECT_EQ(ran, 0);
   EXPECT_EQ(skipped, 6);
   ASSERT_EQ(again.runs.size(), f.first.runs.size());
@@ -127,7 +127,7 @@ void rerun_skips_finished_runs_and_redoes_stale_ones() {
   ran = 0;
   std::vector<std::string> redone;
   o.on_run = [&](const identify::RunRecord& r) { redone.push_back(r.id()); };
-  const auto third = identify::Study<Model>(o, design(), setup()).run();
+  const auto third = identify::Study(identify::identification_model<Model>(), o, design(), setup()).run();
   std::sort(redone.begin(), redone.end());
   EXPECT_EQ(redone, (std::vector<std::string>{"PA06@40ms", "PC09@80ms"}));
   for (size_t i = 0; i < third.runs.size(); ++i)

@@ -1,9 +1,14 @@
-// The non-template parts of CLIE (clie_model.hpp): the sample grid and filter, the bounds and
-// the Ceres solve.
+// CLIE (clie.hpp) for any model's closed loop: the sample grid and filter, the bounds, the cost
+// whose one block holds every residual, and the Ceres solve. Compiled once for every robot.
 #include <algorithm>
 #include <cmath>
+#include <array>
+#include <chrono>
 #include <stdexcept>
+#include <string>
+#include <vector>
 
+#include <ceres/cost_function.h>
 #include <ceres/problem.h>
 #include <ceres/solver.h>
 #include <fmt/format.h>
@@ -131,4 +136,161 @@ void solve_bounded(ceres::CostFunction& cost, const Bounds& bounds, const ClieOp
   result.residual_evaluations = summary.num_residual_evaluations;
 }
 
+// All residuals tau_m - tau_s at the samples (sample-major, joint fastest) in one block of
+// np parameters; its Jacobian, -(filtered d tau_s / d phi) at the sample rows, is one row of
+// the simulation's dtau per sample. A diverging simulation fails the evaluation, which Ceres
+// takes as a rejected step.
+class ClieCost final : public ceres::CostFunction {
+ public:
+  ClieCost(const ClosedLoop& sim, const preprocess::Samples& measured, const SampleGrid& grid)
+      : sim_(sim), measured_(measured), grid_(grid), n_(sim.joints()), np_(sim.parameters()) {
+    set_num_residuals(static_cast<int>(grid.rows.size()) * n_);
+    mutable_parameter_block_sizes()->push_back(np_);
+  }
+
+  // The residuals alone (no sensitivities); false on divergence.
+  bool residuals(const Eigen::VectorXd& phi, Eigen::VectorXd& r, Divergence* why) const {
+    r.resize(num_residuals());
+    return evaluate(phi.data(), r.data(), nullptr, why);
+  }
+
+  bool Evaluate(double const* const* parameters, double* residuals, double** jacobians) const override {
+    return evaluate(parameters[0], residuals, jacobians ? jacobians[0] : nullptr, nullptr);
+  }
+
+  // Distinct points whose simulation diverged.
+  int rejected() const { return rejected_; }
+
+ private:
+  // The last points evaluated, for residual-only requests that repeat them: Ceres' bounded
+  // line search evaluates the full step, then evaluates it again as the candidate, and the
+  // final point was evaluated with its Jacobian.
+  struct Evaluated {
+    Eigen::VectorXd phi;
+    bool ok = false;
+    Divergence why;
+    Eigen::VectorXd residuals;
+  };
+
+  bool evaluate(const double* phi_data, double* residuals, double* jacobian, Divergence* why) const {
+    const Eigen::Map<const Eigen::VectorXd> phi(phi_data, np_);
+    const Eigen::Index count = num_residuals();
+    if (!jacobian)
+      for (const Evaluated& e : evaluated_)
+        if (e.residuals.size() == count && e.phi.size() == phi.size() && e.phi == phi) {
+          if (e.ok) Eigen::Map<Eigen::VectorXd>(residuals, count) = e.residuals;
+          if (why) *why = e.why;
+          return e.ok;
+        }
+    Evaluated& slot = evaluated_[next_slot_];
+    next_slot_ = (next_slot_ + 1) % evaluated_.size();
+    slot.phi = phi;
+    slot.residuals.resize(count);
+    slot.ok = simulate_residuals(phi, slot.residuals.data(), jacobian, &slot.why);
+    if (!slot.ok) ++rejected_;
+    if (slot.ok) Eigen::Map<Eigen::VectorXd>(residuals, count) = slot.residuals;
+    if (why) *why = slot.why;
+    return slot.ok;
+  }
+
+  bool simulate_residuals(const Eigen::VectorXd& phi, double* residuals, double* jacobian,
+                          Divergence* why) const {
+    if (!sim_.simulate(phi, tau_, jacobian ? &dtau_ : nullptr, why)) return false;
+    lowpass(grid_, tau_);
+    const Eigen::Index samples = static_cast<Eigen::Index>(grid_.rows.size());
+    for (Eigen::Index s = 0; s < samples; ++s)
+      for (int j = 0; j < n_; ++j) residuals[s * n_ + j] = measured_.tau(s, j) - tau_(grid_.rows[s], j);
+    if (jacobian) {
+      lowpass(grid_, dtau_);
+      // A dtau row is d tau_j / d phi_i at j * np + i: the sample's n Jacobian rows, row-major.
+      for (Eigen::Index s = 0; s < samples; ++s)
+        Eigen::Map<Eigen::RowVectorXd>(jacobian + s * n_ * np_, n_ * np_) = -dtau_.row(grid_.rows[s]);
+    }
+    return true;
+  }
+
+  const ClosedLoop& sim_;
+  const preprocess::Samples& measured_;
+  const SampleGrid& grid_;
+  const int n_, np_;
+  // Reused between evaluations (dtau is the large one: cycles x n np).
+  mutable preprocess::Channels tau_, dtau_;
+  mutable int rejected_ = 0;
+  mutable std::array<Evaluated, 2> evaluated_;
+  mutable std::size_t next_slot_ = 0;
+};
+
 }  // namespace symoro::identify::detail
+
+namespace symoro::identify {
+namespace {
+
+void check_clie_inputs(const ClosedLoop& sim, const preprocess::Samples& measured, const Eigen::VectorXd& phi) {
+  if (phi.size() != sim.parameters())
+    throw std::invalid_argument("CLIE: phi has " + std::to_string(phi.size()) + " entries, the model " +
+                                std::to_string(sim.parameters()));
+  if (measured.tau.cols() != sim.joints() || measured.tau.rows() != measured.time.size())
+    throw std::invalid_argument("CLIE: the measured samples need time and an " + std::to_string(sim.joints()) +
+                                "-joint tau of as many rows");
+}
+
+}  // namespace
+
+bool simulated_samples(const ClosedLoop& sim, const preprocess::Samples& measured, const Eigen::VectorXd& phi,
+                       const ClieOptions& options, Eigen::MatrixXd& tau, Divergence* why) {
+  check_clie_inputs(sim, measured, phi);
+  const detail::SampleGrid grid = detail::sample_grid(measured, sim.period(), sim.cycles(), options);
+  preprocess::Channels simulated;
+  if (!sim.simulate(phi, simulated, nullptr, why)) return false;
+  detail::lowpass(grid, simulated);
+  tau.resize(static_cast<Eigen::Index>(grid.rows.size()), sim.joints());
+  for (Eigen::Index s = 0; s < tau.rows(); ++s) tau.row(s) = simulated.row(grid.rows[s]);
+  return true;
+}
+
+ClieResult clie(const ClosedLoop& sim, const preprocess::Samples& measured, const Eigen::VectorXd& phi0,
+                const ClieOptions& options) {
+  const auto wall0 = std::chrono::steady_clock::now();
+  const auto elapsed = [&] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count(); };
+  check_clie_inputs(sim, measured, phi0);
+  const int n = sim.joints(), np = sim.parameters();
+  const detail::SampleGrid grid = detail::sample_grid(measured, sim.period(), sim.cycles(), options);
+  std::vector<bool> rotor_inertia(static_cast<std::size_t>(np));
+  for (int i = 0; i < np; ++i) rotor_inertia[i] = std::string(sim.parameter_info()[i].family) == "IA";
+  const detail::Bounds bounds = detail::parameter_bounds(phi0, rotor_inertia, options);
+
+  ClieResult result;
+  result.phi = phi0.cwiseMax(bounds.lower).cwiseMin(bounds.upper);
+  detail::ClieCost cost(sim, measured, grid);
+  Eigen::VectorXd r;
+  if (!cost.residuals(result.phi, r, &result.start_divergence)) {
+    result.termination = "not started: the starting point's simulation diverges (" + result.start_divergence.describe() + ")";
+    result.wall = elapsed();
+    return result;
+  }
+  result.initial_cost = 0.5 * r.squaredNorm();
+  result.rms_initial = detail::rms_per_joint(r, n);
+
+  const Eigen::VectorXd start = result.phi;
+  detail::solve_bounded(cost, bounds, options, result);
+  result.rejected_divergent = cost.rejected();
+  // Ceres ends on a point it evaluated successfully, so this cannot diverge; if it did, the
+  // start is what remains valid.
+  Divergence why;
+  if (cost.residuals(result.phi, r, &why)) {
+    result.final_cost = 0.5 * r.squaredNorm();
+    result.rms_final = detail::rms_per_joint(r, n);
+  } else {
+    result.success = false;
+    result.termination += "; the end point diverges (" + why.describe() + "), the start is kept";
+    result.phi = start;
+    result.final_cost = result.initial_cost;
+    result.rms_final = result.rms_initial;
+  }
+  for (int i = 0; i < np; ++i)
+    if (result.phi(i) <= bounds.lower(i) || result.phi(i) >= bounds.upper(i)) result.at_bound.push_back(i);
+  result.wall = elapsed();
+  return result;
+}
+
+}  // namespace symoro::identify

@@ -50,17 +50,14 @@ struct ClieResult {
   double wall = 0;                  // s
 };
 
-// Defined in clie_model.hpp (templates over a generated Model):
-//
-// // The simulated torque at the samples' grid (filtered as the measurement when
-// // options.filter): rows match measured.time. Returns false on divergence (fills *why).
-// template <class Model>
-// bool simulated_samples(const ClosedLoopSimulator<Model>& sim, const preprocess::Samples& measured,
-//                        const Eigen::VectorXd& phi, const ClieOptions& options,
-//                        Eigen::MatrixXd& tau, Divergence* why);
-//
-// template <class Model>
-// ClieResult clie(const ClosedLoopSimulator<Model>& sim, const preprocess::Samples& measured,
-//                 const Eigen::VectorXd& phi0, const ClieOptions& options = {});
+// The simulated torque at the samples' grid (filtered as the measurement when options.filter):
+// rows match measured.time. Returns false on divergence (fills *why).
+bool simulated_samples(const ClosedLoop& sim, const preprocess::Samples& measured, const Eigen::VectorXd& phi,
+                       const ClieOptions& options, Eigen::MatrixXd& tau, Divergence* why);
+
+// CLIE from phi0 on one run's closed loop (any model: ClosedLoopSimulator<Model> for a generated
+// one, closed_loop_model.hpp).
+ClieResult clie(const ClosedLoop& sim, const preprocess::Samples& measured, const Eigen::VectorXd& phi0,
+                const ClieOptions& options = {});
 
 }  // namespace symoro::identify

@@ -11,11 +11,13 @@
 #pragma once
 
 #include <string>
+#include <vector>
 
 #include <Eigen/Core>
 
 #include "symoro/control/description.hpp"
 #include "symoro/control/ffpd.hpp"
+#include "symoro/model_info.hpp"
 #include "symoro/preprocess/channels.hpp"
 #include "symoro/trajectory/sampled_reference.hpp"
 #include "symoro/trajectory/trajectory.hpp"
@@ -53,20 +55,30 @@ struct Divergence {
   std::string describe() const;  // one line for reports
 };
 
-// Defined in closed_loop_model.hpp (templates over a generated Model):
-//
-// template <class Model> class ClosedLoopSimulator {
-//  public:
-//   ClosedLoopSimulator(ClosedLoopSetup setup, const trajectory::Trajectory& reference);
-//   int cycles() const;            // K + 1 with K = round(duration / T)
-//   double period() const;
-//   // tau: cycles() x nq, row k = the torque recorded at cycle k. With dtau (not null):
-//   // cycles() x (nq * np), column j * np + i = d tau_j / d phi_i. Returns false (and fills
-//   // *why when given) when the simulation diverges; tau is then unusable.
-//   bool simulate(const Eigen::VectorXd& phi, preprocess::Channels& tau, preprocess::Channels* dtau,
-//                 Divergence* why) const;
-//   // The same, also giving the sampled q (cycles() x nq) when q is not null.
-//   bool simulate(..., Divergence* why, preprocess::Channels* q) const;
-// };
+// A closed-loop simulation of one reference, seen through the model-independent interface that
+// CLIE, validation and the study are compiled against once for every robot. The implementation
+// for a generated Model is ClosedLoopSimulator<Model> (closed_loop_model.hpp), whose fixed-size
+// loop is the only part compiled per model.
+class ClosedLoop {
+ public:
+  virtual ~ClosedLoop() = default;
+  virtual int joints() const = 0;
+  // The model's parameters: the entries of phi, in order.
+  virtual const std::vector<ParameterInfo>& parameter_info() const = 0;
+  int parameters() const { return static_cast<int>(parameter_info().size()); }
+  virtual int cycles() const = 0;  // K + 1 with K = round(duration / T)
+  virtual const ClosedLoopSetup& setup() const = 0;
+  double period() const { return setup().gains.period; }
+  // tau: cycles() x nq, row k = the torque recorded at cycle k. With dtau (not null):
+  // cycles() x (nq * np), column j * np + i = d tau_j / d phi_i. Returns false (and fills *why
+  // when given) when the simulation diverges; tau is then unusable. With q (not null): the
+  // sampled q (cycles() x nq, row k = q(t_k), what the controller saw).
+  virtual bool simulate(const Eigen::VectorXd& phi, preprocess::Channels& tau, preprocess::Channels* dtau,
+                        Divergence* why, preprocess::Channels* q) const = 0;
+  bool simulate(const Eigen::VectorXd& phi, preprocess::Channels& tau, preprocess::Channels* dtau,
+                Divergence* why) const {
+    return simulate(phi, tau, dtau, why, nullptr);
+  }
+};
 
 }  // namespace symoro::identify

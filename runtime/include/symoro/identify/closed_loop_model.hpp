@@ -30,6 +30,7 @@
 #include <cmath>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 #include <Eigen/Cholesky>
 #include <Eigen/Core>
@@ -108,7 +109,7 @@ class FfpdSensitivity {
 }  // namespace detail
 
 template <class Model>
-class ClosedLoopSimulator {
+class ClosedLoopSimulator final : public ClosedLoop {
  public:
   static constexpr int n = Model::nq;
   static constexpr int np = Model::np;
@@ -137,9 +138,13 @@ class ClosedLoopSimulator {
     qdd_ref_ = reference.qdd;
   }
 
-  int cycles() const { return cycles_; }
-  double period() const { return setup_.gains.period; }
-  const ClosedLoopSetup& setup() const { return setup_; }
+  int joints() const override { return n; }
+  const std::vector<ParameterInfo>& parameter_info() const override {
+    static const std::vector<ParameterInfo> info(Model::parameters.begin(), Model::parameters.end());
+    return info;
+  }
+  int cycles() const override { return cycles_; }
+  const ClosedLoopSetup& setup() const override { return setup_; }
 
   // tau: cycles() x nq, row k = the torque recorded at cycle k. With dtau (not null):
   // cycles() x (nq * np), column j * np + i = d tau_j / d phi_i. Returns false (and fills *why
@@ -150,7 +155,7 @@ class ClosedLoopSimulator {
   }
   // The same, also giving the sampled q (cycles() x nq, row k = q(t_k), what the controller saw).
   bool simulate(const Eigen::VectorXd& phi, preprocess::Channels& tau, preprocess::Channels* dtau,
-                Divergence* why, preprocess::Channels* q) const {
+                Divergence* why, preprocess::Channels* q) const override {
     if (phi.size() != np)
       throw std::invalid_argument("closed-loop simulation: phi has " + std::to_string(phi.size()) + " entries, the model " +
                                   std::to_string(np));

@@ -1,0 +1,65 @@
+// IdentificationModel (identification_model.hpp) for a generated Model: the templates over the
+// model (stack_regression, open_loop_torque, ClosedLoopSimulator, ModelInertiaFunction and the
+// physical path) instantiated once, in the translation unit that asks for the model.
+#pragma once
+
+#include <memory>
+
+#include "symoro/identify/closed_loop_model.hpp"
+#include "symoro/identify/identification_model.hpp"
+#include "symoro/identify/inertia_function_model.hpp"
+#include "symoro/identify/physical_projection.hpp"
+#include "symoro/identify/regression.hpp"
+#include "symoro/identify/validation.hpp"
+
+namespace symoro::identify {
+namespace detail {
+
+template <class Model>
+class GeneratedIdentificationModel final : public IdentificationModel {
+ public:
+  GeneratedIdentificationModel() {
+    d_.robot = Model::robot_name;
+    d_.variant = Model::variant_name;
+    d_.nq = Model::nq;
+    d_.np = Model::np;
+    d_.parameters.assign(Model::parameters.begin(), Model::parameters.end());
+    d_.joints.assign(Model::joints.begin(), Model::joints.end());
+  }
+  const ModelDescription& description() const override { return d_; }
+
+  Regression stack_regression(const preprocess::Samples& samples) const override {
+    return identify::stack_regression<Model>(samples);
+  }
+  Eigen::MatrixXd open_loop_torque(const preprocess::Samples& samples, const Eigen::VectorXd& phi) const override {
+    return identify::open_loop_torque<Model>(samples, phi);
+  }
+  std::unique_ptr<InertiaFunction> inertia_function() const override { return make_inertia_function<Model>(); }
+  std::unique_ptr<ClosedLoop> closed_loop(const ClosedLoopSetup& setup,
+                                          const trajectory::SampledReference& reference) const override {
+    return std::make_unique<ClosedLoopSimulator<Model>>(setup, reference);
+  }
+
+  bool supports_physical_consistency() const override { return identify::supports_physical_consistency<Model>(); }
+  ConsistencyResult physical_check(const Eigen::VectorXd& phi) const override {
+    return identify::physical_check<Model>(phi);
+  }
+  PhysicalProjection physical_projection(const Eigen::VectorXd& phi0, const Eigen::MatrixXd& metric,
+                                         double clearance) const override {
+    return identify::physical_projection<Model>(phi0, {}, metric, clearance);
+  }
+
+ private:
+  ModelDescription d_;
+};
+
+}  // namespace detail
+
+template <class Model>
+std::shared_ptr<const IdentificationModel> identification_model() {
+  static const std::shared_ptr<const IdentificationModel> model =
+      std::make_shared<detail::GeneratedIdentificationModel<Model>>();
+  return model;
+}
+
+}  // namespace symoro::identify

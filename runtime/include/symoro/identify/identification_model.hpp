@@ -1,0 +1,60 @@
+// What identification needs of a robot model, behind one small virtual interface, so that the
+// study (OLS/WLS, audit, SDP, CLIE, selection, rescue, validation) is compiled once for every
+// robot. A generated Model fills it in identification_model-inl.hpp; only that adapter (the
+// model's fixed-size regression, closed loop and inertia function) is compiled per model.
+// The generated functions are far longer than a virtual call, and every call here covers a
+// whole run or a whole pose (bench/bench_clie.cpp: simulation through the interface).
+#pragma once
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "symoro/identify/closed_loop.hpp"
+#include "symoro/identify/inertia_function.hpp"
+#include "symoro/identify/physical_projection.hpp"
+#include "symoro/identify/regression.hpp"
+#include "symoro/model_info.hpp"
+#include "symoro/preprocess/preprocess.hpp"
+#include "symoro/trajectory/sampled_reference.hpp"
+
+namespace symoro::identify {
+
+// The model's description (the generated model.hpp's constants, at run time).
+struct ModelDescription {
+  std::string robot;    // e.g. "crane_x7"
+  std::string variant;  // "" for the robot's full model
+  int nq = 0, np = 0;
+  std::vector<ParameterInfo> parameters;  // phi's entries
+  std::vector<JointInfo> joints;
+};
+
+class IdentificationModel {
+ public:
+  virtual ~IdentificationModel() = default;
+  virtual const ModelDescription& description() const = 0;
+
+  // The stacked regression of one run's samples (regression.hpp).
+  virtual Regression stack_regression(const preprocess::Samples& samples) const = 0;
+  // ID(q, qd, qdd; phi) at every sample: samples x nq.
+  virtual Eigen::MatrixXd open_loop_torque(const preprocess::Samples& samples, const Eigen::VectorXd& phi) const = 0;
+  // M(q; phi) and its derivatives for the audit and the SDP projection.
+  virtual std::unique_ptr<InertiaFunction> inertia_function() const = 0;
+  // The closed loop of one reference under the experiment's controller.
+  virtual std::unique_ptr<ClosedLoop> closed_loop(const ClosedLoopSetup& setup,
+                                                  const trajectory::SampledReference& reference) const = 0;
+
+  // The physical path (physical_projection.hpp); a model with effect parameters has none.
+  virtual bool supports_physical_consistency() const = 0;
+  virtual ConsistencyResult physical_check(const Eigen::VectorXd& phi) const = 0;
+  virtual PhysicalProjection physical_projection(const Eigen::VectorXd& phi0, const Eigen::MatrixXd& metric,
+                                                 double clearance) const = 0;
+};
+
+// The interface of a generated Model, one shared instance per model (identification_model-inl.hpp).
+template <class Model>
+std::shared_ptr<const IdentificationModel> identification_model();
+
+}  // namespace symoro::identify

@@ -1,0 +1,450 @@
+// The identification study (study.hpp) for any model, through its IdentificationModel: compiled
+// once for every robot.
+#include "symoro/identify/study.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <iterator>
+#include <limits>
+#include <sstream>
+#include <vector>
+
+#include <fmt/format.h>
+#include <fmt/ranges.h>
+
+#include "symoro/error.hpp"
+#include "symoro/identify/clie.hpp"
+#include "symoro/identify/dataset.hpp"
+#include "symoro/identify/least_squares.hpp"
+#include "symoro/identify/pca.hpp"
+#include "symoro/identify/pd_audit.hpp"
+#include "symoro/identify/physical_projection.hpp"
+#include "symoro/identify/run_record_io.hpp"
+#include "symoro/identify/sdp_projection.hpp"
+#include "symoro/identify/study_run.hpp"
+#include "symoro/identify/validation.hpp"
+#include "symoro/io/digest.hpp"
+#include "symoro/io/log.hpp"
+#include "symoro/parallel/farm.hpp"
+#include "symoro/preprocess/preprocess.hpp"
+#include "symoro/trajectory/sampled_reference.hpp"
+
+namespace symoro::identify {
+namespace {
+
+// The all-pose audit's box (JointInfo::audit_lower/audit_upper, robot.yaml).
+AuditDomain audit_domain(const ModelDescription& d) {
+  AuditDomain a;
+  a.lower.resize(d.nq);
+  a.upper.resize(d.nq);
+  for (int j = 0; j < d.nq; ++j) {
+    a.lower(j) = d.joints[static_cast<std::size_t>(j)].audit_lower;
+    a.upper(j) = d.joints[static_cast<std::size_t>(j)].audit_upper;
+  }
+  return a;
+}
+
+// One study's run: the model, options and closed loop it works with, and what it builds once.
+class StudyRun {
+ public:
+  StudyRun(const IdentificationModel& model, const StudyOptions& options, const ClosedLoopSource& closed_loop)
+      : model_(model), d_(model.description()), o_(options), loop_(closed_loop), inertia_(model.inertia_function()),
+        domain_(audit_domain(d_)) {}
+
+  StudyResult run() {
+    const auto t0 = std::chrono::steady_clock::now();
+    if (o_.consistency == Consistency::physical && !model_.supports_physical_consistency())
+      throw std::invalid_argument(fmt::format("--consistency physical: the {} model has effect parameters (not standard "
+                                              "inertial parameters); identify it with the PD path", d_.variant));
+    const Dataset data = read_dataset(o_.data);
+    check_dataset_robot(data, d_.robot);
+    StudyResult out;
+    out.robot = d_.robot;
+    out.model = d_.variant;
+    out.consistency = to_string(o_.consistency);
+    for (const auto& p : d_.parameters) {
+      out.names.push_back(p.name);
+      out.units.push_back(p.unit);
+    }
+    out.data_source = data.twin.empty() ? "measured (" + data.dir.string() + ")"
+                                        : "digital twin (" + data.twin + "), " + data.dir.string();
+    const std::vector<std::string> ident = identification_names(data), valid = validation_names(data);
+
+    // Every run's fingerprint; finished runs are loaded, the others form the tasks.
+    std::filesystem::create_directories(o_.out / "runs");
+    struct Slot {
+      std::string trajectory;
+      double interval;
+      std::filesystem::path file;
+      std::string fingerprint;
+      std::optional<RunRecord> record;
+    };
+    std::vector<Slot> slots;
+    const StudyInputs inputs = study_inputs();  // once: the design file is read for its hash
+    for (const auto& name : ident) {
+      const DatasetRun& run = data.find(name, o_.trial);
+      const io::LogMetadata meta = io::read_log_metadata(run.file);
+      const std::string content = log_digest(run);  // once per log, whatever the intervals
+      for (double h : o_.intervals) {
+        Slot s{name, h, o_.out / "runs" / fmt::format("{}@{}ms.yaml", name, std::lround(h * 1e3)), {}, {}};
+        s.fingerprint = fingerprint_of(run_inputs(inputs, run, meta, content, h));
+        if (!o_.fresh) s.record = load_run(s.file, s.fingerprint);
+        slots.push_back(std::move(s));
+      }
+    }
+    std::vector<std::string> todo;
+    for (const auto& name : ident)
+      for (const Slot& s : slots)
+        if (s.trajectory == name && !s.record) {
+          todo.push_back(name);
+          break;
+        }
+    // Longest first (the log's size stands for its duration), so no thread ends on a long one.
+    std::stable_sort(todo.begin(), todo.end(), [&](const std::string& a, const std::string& b) {
+      return std::filesystem::file_size(data.find(a, o_.trial).file) > std::filesystem::file_size(data.find(b, o_.trial).file);
+    });
+    const int skipped = static_cast<int>(std::count_if(slots.begin(), slots.end(), [](const Slot& s) { return s.record.has_value(); }));
+    if (o_.on_start && parallel::place().coordinator()) o_.on_start(static_cast<int>(slots.size()), skipped);
+
+    // One task per trajectory (its log read once, its missing intervals in order), on the
+    // farm: this machine's threads, or MPI ranks when started by mpirun.
+    std::vector<std::string> tasks;
+    for (const auto& name : todo) {
+      std::string task = name;
+      for (const Slot& s : slots)
+        if (s.trajectory == name && !s.record) task += fmt::format("\n{:.17g}", s.interval);  // 17 digits: exact
+      tasks.push_back(std::move(task));
+    }
+    auto failed = [](const std::string& trajectory, double interval, const std::string& why) {
+      RunRecord r;
+      r.trajectory = trajectory;
+      r.interval = interval;
+      r.failed = true;
+      r.failure = why;
+      return r;
+    };
+    auto finish = [&](Slot& s, RunRecord r) {
+      if (!r.failed) save_run(r, s.fingerprint, s.file);  // a failed run is tried again by a rerun
+      s.record = std::move(r);
+      if (o_.on_run) o_.on_run(*s.record);
+    };
+    parallel::Farm farm;
+    farm.work = [&](const std::string& task, const std::function<void(const std::string&)>& emit) {
+      std::istringstream in(task);
+      std::string name, line;
+      std::getline(in, name);
+      const io::Log log = load_log(data.find(name, o_.trial));
+      std::string no_clie;
+      const auto sim = closed_loop(name, log, no_clie);
+      while (std::getline(in, line)) {
+        const double h = std::stod(line);
+        RunRecord r;
+        try {
+          r = detail::identify_run(model_, log, sim.get(), no_clie, h, o_, *inertia_, domain_);
+        } catch (const std::exception& e) {
+          r = failed(name, h, e.what());
+        }
+        emit(run_record_text(r, ""));
+      }
+    };
+    farm.on_result = [&](std::size_t, const std::string& text) {
+      RunRecord r = run_record_from_text(text);
+      for (Slot& s : slots)
+        if (!s.record && s.trajectory == r.trajectory && s.interval == r.interval) return finish(s, std::move(r));
+    };
+    farm.on_end = [&](const parallel::TaskEnd& e) {
+      const std::string& name = todo[e.task];
+      if (e.peak_memory_mb > out.worker_peak_mb) {
+        out.worker_peak_mb = e.peak_memory_mb;
+        out.worker_peak_trajectory = name;
+      }
+      if (!e.failed) return;
+      for (Slot& s : slots)  // the runs the task did not finish
+        if (s.trajectory == name && !s.record) finish(s, failed(s.trajectory, s.interval, e.failure));
+    };
+    parallel::FarmOptions fo;
+    fo.workers = o_.threads;
+    fo.isolate = o_.isolate;
+    fo.rank_timeout = o_.rank_timeout;
+    const parallel::FarmSummary farmed = parallel::run_farm(tasks, farm, fo);
+    out.threads = farmed.workers;
+    out.ranks = farmed.ranks;
+    if (!parallel::place().coordinator()) return out;  // rank 0 gathers the records and goes on
+
+    for (Slot& s : slots) out.runs.push_back(std::move(*s.record));
+    int failures = 0;
+    for (const RunRecord& r : out.runs) {
+      out.wall_runs += r.t_ols + r.t_audit + r.t_sdp + r.t_clie;
+      failures += r.failed;
+    }
+    describe_stages(out, failures);
+
+    select_and_accept(data, out);
+    if (out.selection.run >= 0) validate(data, valid, out);
+    out.wall = detail::seconds_since(t0);
+    return out;
+  }
+
+ private:
+  // Names in order, each once: a repeated name would give one run to two threads.
+  static std::vector<std::string> unique(const std::vector<std::string>& names) {
+    std::vector<std::string> v;
+    for (const auto& n : names)
+      if (std::find(v.begin(), v.end(), n) == v.end()) v.push_back(n);
+    return v;
+  }
+  std::vector<std::string> identification_names(const Dataset& d) const {
+    if (!o_.trajectories.empty()) return unique(o_.trajectories);
+    std::vector<std::string> v;
+    for (const DatasetRun& r : d.runs)
+      if (r.trial == o_.trial && r.family != o_.validation_family) v.push_back(r.trajectory);
+    return unique(v);
+  }
+  std::vector<std::string> validation_names(const Dataset& d) const {
+    if (!o_.validation.empty()) return unique(o_.validation);
+    std::vector<std::string> v;
+    for (const DatasetRun& r : d.runs)
+      if (r.trial == o_.trial && r.family == o_.validation_family) v.push_back(r.trajectory);
+    return unique(v);
+  }
+
+  // A run's log, its time counted from its first stamp (a controller's log may start at any t;
+  // the closed loop's cycle 0 is the first row).
+  io::Log load_log(const DatasetRun& run) const {
+    io::Log log = read_run_log(run, d_.robot, d_.nq);
+    if (log.samples() > 0) log.time.array() -= log.time(0);
+    return log;
+  }
+
+  // The closed loop of one run, or nullptr with the reason: the log's reference columns first,
+  // else the design's trajectory of that name.
+  std::unique_ptr<ClosedLoop> closed_loop(const std::string& name, const io::Log& log, std::string& why) const {
+    if (!loop_.setup) {
+      why = loop_.why.empty() ? "no controller description" : loop_.why;
+      return nullptr;
+    }
+    if (log.has_references())
+      return model_.closed_loop(*loop_.setup, trajectory::sampled_reference(log, loop_.setup->gains.period));
+    if (loop_.design) {
+      const auto names = loop_.design->names();
+      if (std::find(names.begin(), names.end(), name) != names.end())
+        return model_.closed_loop(*loop_.setup, trajectory::sample(loop_.design->build(name), loop_.setup->gains.period));
+    }
+    why = fmt::format("the log of {} has no reference columns{}", name,
+                      loop_.design ? " and the trajectory design has no trajectory of that name" : " and the robot has no trajectory design");
+    return nullptr;
+  }
+
+  void describe_stages(StudyResult& out, int failures) const {
+    int clie = 0, skipped = 0;
+    std::string why;
+    for (const RunRecord& r : out.runs) {
+      if (r.failed) continue;
+      if (r.clie_ran) {
+        ++clie;
+      } else {
+        ++skipped;
+        if (why.empty()) why = r.clie_termination;
+      }
+    }
+    out.stages.push_back(fmt::format("OLS{}, all-pose PD audit, conditional SDP projection: {} runs", o_.least_squares.weighted ? " (WLS)" : "",
+                                     out.runs.size() - failures));
+    if (o_.consistency == Consistency::physical)
+      out.stages.push_back(fmt::format(
+          "physical consistency (per-link pseudo-inertia LMIs, IA, FV, FS >= 0): every run's OLS and final vectors "
+          "checked; {}the rescue onto the base vectors with a consistent standard set in the metric of the torque "
+          "predicted on {} (clearance {:g} of each link's size); acceptance needs a consistent set and the final audit",
+          o_.physical_start ? fmt::format("CLIE's start projected onto that set (clearance {:g}) instead of the PD "
+                                          "projection; ", o_.physical_clearance)
+                            : "CLIE's start the paper's (conditional PD projection); ",
+          o_.rescue_metric_all_runs ? "every identification trajectory at the representative's interval"
+                                    : "the representative's run",
+          o_.physical_rescue_clearance));
+    if (o_.consistency == Consistency::pd || !o_.physical_start)
+      out.stages.push_back(fmt::format("SDP projection{} in the {} metric{}", o_.consistency == Consistency::pd ? " and rescue" : "",
+                                       to_string(o_.projection_metric),
+                                       o_.projection_metric == ProjectionMetric::information ? " (the run's W'W / sigma^2)" : ""));
+    const std::string bounds =
+        o_.clie.std_bound > 0 ? fmt::format(" (bounds: +-{:g} OLS standard deviations around the start)", o_.clie.std_bound) : "";
+    if (skipped == 0)
+      out.stages.push_back(fmt::format("CLIE: {} runs{}", clie, bounds));
+    else
+      out.stages.push_back(fmt::format("CLIE: {} runs; skipped in {} ({}){}", clie, skipped, why,
+                                       clie == 0 ? "; each run's final vector is its SDP (or PD OLS) estimate" : ""));
+    if (failures > 0) {
+      std::string list;
+      for (const RunRecord& r : out.runs)
+        if (r.failed) list += fmt::format("{}{}: {}", list.empty() ? "" : "; ", r.id(), r.failure);
+      out.stages.push_back(fmt::format("failed runs: {} ({})", failures, list));
+    }
+  }
+
+  // What a run's result depends on: the model, the log (the digest of every byte read: its CSV
+  // and its sidecar; one value edited in place is another log), the window, the interval, every option of every stage
+  // and the closed loop (controller and the design's file, when given). The parts shared by
+  // every run are made once per study.
+  struct StudyInputs {
+    std::string model, loop;
+  };
+  StudyInputs study_inputs() const {
+    StudyInputs in;
+    // The compiled model: its parameters and joints (a regenerated model with other names or
+    // limits is another model).
+    in.model = fmt::format("{}/{} ", d_.robot, d_.variant);
+    for (const auto& p : d_.parameters) in.model += std::string(p.name) + " ";
+    for (const auto& j : d_.joints) in.model += fmt::format("{} {} {} ", j.name, j.lower, j.upper);
+    in.loop = "open";
+    if (loop_.setup) {
+      const ClosedLoopSetup& c = *loop_.setup;
+      in.loop = fmt::format("{} {} {} {} {} | {} {} {} {}", c.gains.period, c.gains.pseudo_derivative_time, c.delay, c.pre_roll,
+                            c.substeps, fmt::join(c.gains.inertia, " "), fmt::join(c.gains.damping, " "),
+                            fmt::join(c.gains.kp, " "), fmt::join(c.gains.kv, " "));
+      if (loop_.design) {
+        std::ifstream file(loop_.design->path(), std::ios::binary);
+        in.loop += " | " + fingerprint_of(std::string(std::istreambuf_iterator<char>(file), std::istreambuf_iterator<char>()));
+      }
+    }
+    return in;
+  }
+  static std::string log_digest(const DatasetRun& run) {
+    std::string d = io::file_digest(run.file);
+    const auto sidecar = io::metadata_path(run.file);
+    if (std::filesystem::exists(sidecar)) d += " " + io::file_digest(sidecar);
+    return d;
+  }
+  std::string run_inputs(const StudyInputs& in, const DatasetRun& run, const io::LogMetadata& meta, const std::string& content,
+                         double interval) const {
+    return fmt::format("{}| {} {} {} {} {} [{}, {}] | {} | {} | {}", in.model, run.file.filename().string(), content, meta.seed,
+                       meta.notes, meta.trial, run.window_start, run.window_end, interval, o_.describe(), in.loop);
+  }
+
+  // A run's least squares again (the rescue's metric: its information matrix).
+  LeastSquaresResult refit(const Dataset& data, const RunRecord& r) const {
+    const preprocess::Samples s = preprocess::preprocess(load_log(data.find(r.trajectory, o_.trial)), r.interval, o_.preprocess);
+    return least_squares(model_.stack_regression(s), o_.least_squares);
+  }
+
+  // W'W / rows over every identification trajectory at one interval (ridge-regularized like the
+  // information metric): distances in it are RMS changes of the torque predicted on all the
+  // identification data. A log too short for the interval is left out.
+  Eigen::MatrixXd pooled_torque_metric(const Dataset& data, double interval) const {
+    Eigen::MatrixXd A = Eigen::MatrixXd::Zero(d_.np, d_.np);
+    double rows = 0;
+    for (const auto& name : identification_names(data)) {
+      try {
+        const preprocess::Samples s = preprocess::preprocess(load_log(data.find(name, o_.trial)), interval, o_.preprocess);
+        const Regression reg = model_.stack_regression(s);
+        A.selfadjointView<Eigen::Lower>().rankUpdate(reg.W.transpose());
+        rows += static_cast<double>(reg.W.rows());
+      } catch (const std::exception&) {
+        continue;
+      }
+    }
+    if (rows == 0) throw std::runtime_error("the rescue's metric: no identification log could be read at this interval");
+    A = A.selfadjointView<Eigen::Lower>();
+    return information_metric(A / rows, o_.information_ridge);
+  }
+
+  void select_and_accept(const Dataset& data, StudyResult& out) const {
+    int usable = 0;
+    for (const RunRecord& r : out.runs) usable += !r.failed && r.phi_clie.size() > 0;
+    if (usable == 0) return;
+    if (out.runs.size() == 1) {  // one run (--only X --interval h): it is the candidate, no cloud
+      out.selection.run = 0;
+      out.selection.centrality = {0.0};
+      out.selection.rule = "the only run (no PCA cloud)";
+    } else {
+      out.pca = pca_clouds(out.runs, o_.pca_components);
+      out.selection = select_central(out.runs, out.pca, o_.variance_fraction);
+    }
+    if (out.selection.run < 0) return;
+    const RunRecord& sel = out.runs[out.selection.run];
+    out.phi_rescue = sel.phi_clie;
+    out.rescued = false;
+    if (o_.consistency == Consistency::physical) {
+      if (!sel.clie_consistent) {
+        // The rescue over standard parameters: the nearest base vector with a consistent set, in
+        // the selected run's predicted-torque metric.
+        const PhysicalProjection p = model_.physical_projection(
+            sel.phi_clie,
+            o_.rescue_metric_all_runs ? pooled_torque_metric(data, sel.interval)
+                                      : detail::torque_metric(refit(data, sel), o_.information_ridge),
+            o_.physical_rescue_clearance);
+        out.phi_rescue = p.phi;
+        out.rescued = true;
+        out.rescue_eps = o_.physical_rescue_clearance;
+        out.rescue_feasible = p.feasible;
+        out.rescue_status = p.status;
+      }
+    } else if (!sel.clie_pd) {
+      ProjectionOptions po = o_.projection;
+      po.eps = 0;  // the paper's rescue: a minimal feasibility correction
+      if (o_.projection_metric == ProjectionMetric::information)
+        po.metric = information_metric(refit(data, sel).information, o_.information_ridge);
+      const ProjectionResult p = project_pd(*inertia_, sel.phi_clie, domain_, po);
+      out.phi_rescue = p.phi;
+      out.rescued = true;
+      out.rescue_eps = 0;
+      out.rescue_feasible = p.feasible;
+      out.rescue_status = p.status;
+    }
+    // The final audit: denser and with another seed than the ones the pipeline used.
+    AuditOptions fa = o_.audit;
+    fa.samples *= 4;
+    fa.starts *= 2;
+    fa.seed += 7919;
+    const AuditResult a = audit_pd(*inertia_, out.phi_rescue, domain_, fa);
+    out.final_lambda_min = a.lambda_min;
+    out.final_worst_pose = a.worst_pose;
+    out.accepted = a.positive_definite();
+    // Physical consistency of the accepted vector, on both paths (the physical one requires it).
+    const ConsistencyResult k = model_.physical_check(out.phi_rescue);
+    out.final_consistent = k.ok();
+    out.final_consistency = k.feasibility;
+    out.final_consistency_note = k.message;
+    if (o_.consistency == Consistency::physical) out.accepted = out.accepted && out.final_consistent;
+  }
+
+  void validate(const Dataset& data, const std::vector<std::string>& names, StudyResult& out) const {
+    const RunRecord& sel = out.runs[out.selection.run];
+    const double h = o_.validation_interval > 0 ? o_.validation_interval : sel.interval;
+    ClieOptions co = o_.clie;
+    co.preprocess = o_.preprocess;
+    for (const auto& name : names) {
+      try {
+        const io::Log log = load_log(data.find(name, o_.trial));
+        const preprocess::Samples s = preprocess::preprocess(log, h, o_.preprocess);
+        std::string why;
+        const auto sim = closed_loop(name, log, why);
+        out.validation.push_back(validate_trajectory(
+            sim.get(), [this](const preprocess::Samples& m, const Eigen::VectorXd& phi) { return model_.open_loop_torque(m, phi); },
+            s, sel.phi_clie, out.phi_rescue, co, why));
+        out.validation.back().trajectory = name;
+      } catch (const std::exception& e) {
+        out.stages.push_back(fmt::format("validation of {}: failed: {}", name, e.what()));
+      }
+    }
+  }
+
+  const IdentificationModel& model_;
+  const ModelDescription& d_;
+  const StudyOptions& o_;
+  const ClosedLoopSource& loop_;
+  std::unique_ptr<InertiaFunction> inertia_;
+  AuditDomain domain_;
+};
+
+
+}  // namespace
+
+Study::Study(std::shared_ptr<const IdentificationModel> model, StudyOptions options, ClosedLoopSource closed_loop)
+    : model_(std::move(model)), o_(std::move(options)), loop_(std::move(closed_loop)) {
+  if (!model_) throw std::invalid_argument("Study: no model");
+}
+
+StudyResult Study::run() { return StudyRun(*model_, o_, loop_).run(); }
+
+}  // namespace symoro::identify
