@@ -27,6 +27,36 @@ function(symoro_robot_model_count yaml out)
   set(${out} ${count} PARENT_SCOPE)
 endfunction()
 
+# symoro_add_robot_identification(<name> <model count>): the static library
+# symoro::<name>_identification with each model's IdentificationModel
+# (symoro/identify/identification_model.hpp), the only part of identification compiled per
+# model: one unit per model (cmake/identification_unit.cpp.in), the last one also taking any model
+# beyond the count. Whatever studies the robot's models (dynid, tests, applications) links it.
+function(symoro_add_robot_identification name count)
+  set(units "")
+  math(EXPR last "${count} - 1")
+  set(unit_robot ${name})
+  foreach(i RANGE 0 ${last})
+    set(unit_index ${i})
+    if(i EQUAL last)
+      set(unit_tail true)
+      set(unit_what "model ${i} of its Models, and any later one")
+    else()
+      set(unit_tail false)
+      set(unit_what "model ${i} of its Models")
+    endif()
+    set(file "${CMAKE_BINARY_DIR}/robot_units/${name}/identification_${i}.cpp")
+    configure_file("${PROJECT_SOURCE_DIR}/cmake/identification_unit.cpp.in" "${file}" @ONLY)
+    list(APPEND units "${file}")
+  endforeach()
+  set(target symoro_${name}_identification)
+  add_library(${target} STATIC ${units})
+  add_library(symoro::${name}_identification ALIAS ${target})
+  target_link_libraries(${target} PUBLIC symoro_robot_${name} symoro_identify)
+  set_target_properties(${target} PROPERTIES EXPORT_NAME ${name}_identification)
+  install(TARGETS ${target} EXPORT symoroTargets ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR})
+endfunction()
+
 # symoro_add_robot(<name> <robot dir>)
 function(symoro_add_robot name robot_dir)
   set(committed "${PROJECT_SOURCE_DIR}/generated/${name}/include")
@@ -60,6 +90,9 @@ function(symoro_add_robot name robot_dir)
   # A variant added to robot.yaml reconfigures, so it gets its own dynid units.
   symoro_robot_model_count("${robot_dir}/robot.yaml" models)
   set_property(GLOBAL PROPERTY SYMORO_ROBOT_MODELS_${name} ${models})
+  if(TARGET symoro_identify)
+    symoro_add_robot_identification(${name} ${models})
+  endif()
   set_property(DIRECTORY "${PROJECT_SOURCE_DIR}" APPEND PROPERTY CMAKE_CONFIGURE_DEPENDS "${robot_dir}/robot.yaml")
 endfunction()
 

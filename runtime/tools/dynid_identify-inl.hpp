@@ -1,11 +1,12 @@
 // dynid identify for one model (included by the generated units only): the model's
-// IdentificationModel and its twin truth, handed to the body compiled once (dynid_identify.cpp).
+// IdentificationModel (compiled once, in symoro::<robot>_identification) and its twin truth,
+// handed to the body compiled once (dynid_identify.cpp).
 #pragma once
 
 #include <Eigen/Core>
 
 #include "dynid_identify.hpp"
-#include "symoro/identify/identification_model-inl.hpp"
+#include "symoro/identify/identification_model.hpp"  // defined in symoro::<robot>_identification
 #include "symoro/twin/truth.hpp"
 
 namespace symoro::dynid {

@@ -1,9 +1,13 @@
 // IdentificationModel (identification_model.hpp) for a generated Model: the templates over the
 // model (stack_regression, open_loop_torque, ClosedLoopSimulator, ModelInertiaFunction and the
-// physical path) instantiated once, in the translation unit that asks for the model.
+// physical path). Compiled once per model into symoro::<robot>_identification
+// (cmake/SymoroRobots.cmake); include it only to instantiate a model that has no such library.
 #pragma once
 
+#include <cstddef>
 #include <memory>
+#include <tuple>
+#include <vector>
 
 #include "symoro/identify/closed_loop_model.hpp"
 #include "symoro/identify/identification_model.hpp"
@@ -61,5 +65,21 @@ std::shared_ptr<const IdentificationModel> identification_model() {
       std::make_shared<detail::GeneratedIdentificationModel<Model>>();
   return model;
 }
+
+namespace detail {
+
+// Instantiates identification_model<M>() for model I of a robot's Models, and with Tail for every
+// later one too (cmake/identification_unit.cpp.in: one unit per model of each robot). Each
+// function's address goes to `out`, so that the unit emits its definition for the linker.
+using IdentificationModelFactory = std::shared_ptr<const IdentificationModel> (*)();
+template <class Models, std::size_t I, bool Tail>
+void instantiate_identification_models(std::vector<IdentificationModelFactory>& out) {
+  if constexpr (I < std::tuple_size_v<Models>) {
+    out.push_back(&identification_model<std::tuple_element_t<I, Models>>);
+    if constexpr (Tail) instantiate_identification_models<Models, I + 1, true>(out);
+  }
+}
+
+}  // namespace detail
 
 }  // namespace symoro::identify

@@ -1,7 +1,8 @@
 // What identification needs of a robot model, behind one small virtual interface, so that the
 // study (OLS/WLS, audit, SDP, CLIE, selection, rescue, validation) is compiled once for every
 // robot. A generated Model fills it in identification_model-inl.hpp; only that adapter (the
-// model's fixed-size regression, closed loop and inertia function) is compiled per model.
+// model's fixed-size regression, closed loop and inertia function) is compiled per model, once,
+// into symoro::<robot>_identification.
 // The generated functions are far longer than a virtual call, and every call here covers a
 // whole run or a whole pose (bench/bench_clie.cpp: simulation through the interface).
 #pragma once
@@ -53,7 +54,9 @@ class IdentificationModel {
                                                  double clearance) const = 0;
 };
 
-// The interface of a generated Model, one shared instance per model (identification_model-inl.hpp).
+// The interface of a generated Model, one shared instance per model. Defined in
+// identification_model-inl.hpp and compiled for every model of a robot into the library
+// symoro::<robot>_identification: link it (or include the -inl header to compile it here).
 template <class Model>
 std::shared_ptr<const IdentificationModel> identification_model();
 

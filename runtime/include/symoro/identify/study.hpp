@@ -27,9 +27,8 @@
 #include <utility>
 
 #include "symoro/identify/closed_loop.hpp"
+// identification_model<Model>() of a generated model: link symoro::<robot>_identification.
 #include "symoro/identify/identification_model.hpp"
-// identification_model<Model>() for the callers that study a generated model.
-#include "symoro/identify/identification_model-inl.hpp"
 #include "symoro/identify/study_options.hpp"
 #include "symoro/identify/study_result.hpp"
 #include "symoro/trajectory/design.hpp"
