@@ -23,6 +23,10 @@
 
 #include "symoro/control/ffpd.hpp"
 #include "symoro/identify/report.hpp"
+#include "symoro/error.hpp"
+#include "symoro/identify/closed_loop_model.hpp"
+#include "symoro/identify/dataset.hpp"
+#include "symoro/identify/validation.hpp"
 #include "symoro/identify/study.hpp"
 #include "symoro/trajectory/sampled_reference.hpp"
 #include "symoro/io/atomic_file.hpp"

@@ -15,6 +15,9 @@
 
 #include <symoro/crane_x7.hpp>
 
+#include "symoro/identify/closed_loop_model.hpp"
+#include "symoro/identify/dataset.hpp"
+#include "symoro/identify/validation.hpp"
 #include "symoro/identify/study.hpp"
 #include "twin_dataset.hpp"
 #include "symoro/io/atomic_file.hpp"
