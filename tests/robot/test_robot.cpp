@@ -225,36 +225,19 @@ TYPED_TEST(RobotModel, ForwardDynamicsSolvesInertiaAndInvertsInverseDynamics) {
 
 // The generated functions run in Jets (jet_support.hpp: one Jet type, a derivative along a random
 // direction u of q, and every argument a Jet, so that each function has one Jet instantiation);
-// the derivative part is the central-difference Jacobian of the double version times u.
-TYPED_TEST(RobotModel, JetDerivativesInQMatchFiniteDifferences) {
+// the derivative part is the central-difference Jacobian of the double version times u. The
+// forward kinematics here; the regressor, inverse dynamics, forward dynamics and inertia in the
+// derivative units, which instantiate them in Jets anyway (test_robot_derivatives_*.cpp).
+TYPED_TEST(RobotModel, JetDerivativeOfForwardKinematicsMatchesFiniteDifferences) {
   using M = TypeParam;
-  this->for_states([&](const State<M>& s, const ParameterVector<M>& any_phi) {
-    const ParameterVector<M> phi = this->physical_phi();  // invertible M for forward dynamics
-    const JointVector<M> tau = this->random_torque();
+  this->for_states([&](const State<M>& s, const auto&) {
     const JointVector<M> u = this->random_direction();
-    const auto q = jet(s.q, u);
-    const auto qd = jet(s.qd), qdd = jet(s.qdd);
-    const auto fd = [&](const auto& f) -> Eigen::VectorXd { return finite_difference_jacobian(f, s.q, kFdStep) * u; };
-
-    EXPECT_TRUE(close(flat_derivative(M::regressor(q, qd, qdd)),
-                      fd([&](const JointVector<M>& x) { return M::regressor(x, s.qd, s.qdd); }), kFdTol))
-        << "regressor";
-    EXPECT_TRUE(close(flat_derivative(M::inverse_dynamics(q, qd, qdd, jet(any_phi))),
-                      fd([&](const JointVector<M>& x) { return M::inverse_dynamics(x, s.qd, s.qdd, any_phi); }),
-                      kFdTol))
-        << "inverse_dynamics";
-    const auto qdd_jet = M::forward_dynamics(q, qd, jet(tau), jet(phi));
-    EXPECT_TRUE(close(flat_derivative(qdd_jet),
-                      fd([&](const JointVector<M>& x) { return M::forward_dynamics(x, s.qd, tau, phi); }), kFdTol))
-        << "forward_dynamics";
-    EXPECT_TRUE(close(flat_derivative(M::inertia(q, jet(any_phi))),
-                      fd([&](const JointVector<M>& x) { return M::inertia(x, any_phi); }), kFdTol))
-        << "inertia";
-    EXPECT_TRUE(close(flat_derivative(M::forward_kinematics(q)),
-                      fd([&](const JointVector<M>& x) { return M::forward_kinematics(x); }), kFdTol))
-        << "forward_kinematics";
+    const auto T = M::forward_kinematics(jet(s.q, u));
+    const Eigen::MatrixXd fd =
+        finite_difference_jacobian([&](const JointVector<M>& x) { return M::forward_kinematics(x); }, s.q, kFdStep);
+    EXPECT_TRUE(close(flat_derivative(T), fd * u, kFdTol));
     // The value part of the Jet evaluation is the double evaluation.
-    EXPECT_TRUE(close(values(qdd_jet), M::forward_dynamics(s.q, s.qd, tau, phi), kRelTol));
+    EXPECT_TRUE(close(values(T), M::forward_kinematics(s.q), kRelTol));
   });
 }
 
@@ -271,17 +254,6 @@ TYPED_TEST(RobotModel, JacobianIsTheDerivativeOfForwardKinematics) {
     Eigen::Matrix<double, 6, 1> expected;
     expected << dT(0, 3), dT(1, 3), dT(2, 3), w(2, 1), w(0, 2), w(1, 0);
     EXPECT_TRUE(close(M::jacobian(s.q) * u, expected, kRelTol));
-  });
-}
-
-// tau is linear in phi, so its Jet derivative along a random direction p of phi is the regressor
-// times p, to round-off.
-TYPED_TEST(RobotModel, JetDerivativeOfInverseDynamicsInPhiIsRegressor) {
-  using M = TypeParam;
-  this->for_states([&](const State<M>& s, const ParameterVector<M>& phi) {
-    const ParameterVector<M> p = this->direction_rng_.template vector<ParameterVector<M>>(M::np, -1, 1);
-    const auto tau = M::inverse_dynamics(jet(s.q), jet(s.qd), jet(s.qdd), jet(phi, p));
-    EXPECT_TRUE(close(derivative(tau), M::regressor(s.q, s.qd, s.qdd) * p, 1e-12));
   });
 }
 

@@ -11,7 +11,7 @@ class InertiaDerivatives : public RobotDerivatives<Model> {};
 TYPED_TEST_SUITE(InertiaDerivatives, Models, ModelName);
 
 // d M / d q_k from the generated inertia_derivatives, against central differences of inertia() and,
-// along a random direction u, the Jet derivative of inertia(); in Jets along u it gives
+// along a random direction u, the Jet derivative of inertia() (itself against the differences); in Jets along u it gives
 // sum_l d2 M / d q_k d q_l u_l for every k, against central differences of itself.
 TYPED_TEST(InertiaDerivatives, InertiaDerivativesAreTheJetAndFiniteDifferenceDerivatives) {
   using M = TypeParam;
@@ -32,7 +32,10 @@ TYPED_TEST(InertiaDerivatives, InertiaDerivativesAreTheJetAndFiniteDifferenceDer
     const auto u = this->template random_direction<JointVector<M>>();
     Mat along_u = Mat::Zero();
     for (int k = 0; k < nq; ++k) along_u += u(k) * d.dq[k];
-    EXPECT_TRUE(close(along_u, derivative(M::inertia(jet(s.q, u), jet(phi))), kJetTol)) << "d M / d q along u";
+    const auto M_along_u = M::inertia(jet(s.q, u), jet(phi));
+    EXPECT_TRUE(close(along_u, derivative(M_along_u), kJetTol)) << "d M / d q along u";
+    // inertia() in Jets against the central differences too (formerly in test_robot.cpp).
+    EXPECT_TRUE(close(flat_derivative(M_along_u), fd * u, kFdTol)) << "d M / d q along u: Jet and finite differences";
 
     // inertia_derivatives in Jets along u: its value part is the double evaluation, the
     // derivative part of M is along_u, and that of d M / d q_k the second derivatives along u.
