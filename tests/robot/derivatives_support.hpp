@@ -20,7 +20,8 @@ namespace {
 
 // Generated derivative vs Jet derivative of the generated value: the same exact derivative in a
 // different order of operations; 1e-10 of the object's magnitude (round-off, times the
-// conditioning of M for the forward dynamics).
+// conditioning of M for the forward dynamics). The Jets are Duals along a random direction v
+// (jet_support.hpp), compared with the generated derivative times v.
 constexpr double kJetTol = 1e-10;
 // Central differences with h = 1e-6: truncation ~h^2, round-off ~1e-16/h.
 constexpr double kFdStep = 1e-6;
@@ -41,8 +42,13 @@ class RobotDerivatives : public ::testing::Test {
   // phi of physical standard parameters: M positive definite (see test_robot.cpp).
   ParameterVector<Model> physical_phi() { return Model::base_from_standard(random_standard_parameters<Model>(rng_).s); }
   JointVector<Model> random_torque() { return rng_.vector<JointVector<Model>>(Model::nq, -5, 5); }
+  // A random direction for the Jet references (jet_support.hpp), entries in [-1, 1], from a
+  // generator of its own: the states and parameters stay those drawn from rng_.
+  template <class Vector>
+  Vector random_direction() { return direction_rng_.vector<Vector>(Vector::RowsAtCompileTime, -1, 1); }
 
   Random rng_{20261124};
+  Random direction_rng_{20261125};
 };
 }  // namespace
 }  // namespace symoro::test

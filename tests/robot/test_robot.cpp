@@ -55,8 +55,12 @@ class RobotModel : public ::testing::Test {
     return Model::base_from_standard(random_standard_parameters<Model>(rng_).s);
   }
   JointVector<Model> random_torque() { return rng_.vector<JointVector<Model>>(Model::nq, -5, 5); }
+  // A random direction of q for the Jet checks, entries in [-1, 1], from a generator of its own:
+  // the states and parameters stay those drawn from rng_.
+  JointVector<Model> random_direction() { return direction_rng_.vector<JointVector<Model>>(Model::nq, -1, 1); }
 
   Random rng_{20240611};
+  Random direction_rng_{20240612};
 };
 TYPED_TEST_SUITE(RobotModel, Models, ModelName);
 
@@ -219,64 +223,37 @@ TYPED_TEST(RobotModel, ForwardDynamicsSolvesInertiaAndInvertsInverseDynamics) {
 
 // ---- e. Jet derivatives ------------------------------------------------------------------------
 
-TYPED_TEST(RobotModel, JetDerivativesInQMatchFiniteDifferences) {
+// The generated functions run in Jets (jet_support.hpp: one Jet type, a derivative along a random
+// direction u of q, and every argument a Jet, so that each function has one Jet instantiation);
+// the derivative part is the central-difference Jacobian of the double version times u. The
+// forward kinematics here; the regressor, inverse dynamics, forward dynamics and inertia in the
+// derivative units, which instantiate them in Jets anyway (test_robot_derivatives_*.cpp).
+TYPED_TEST(RobotModel, JetDerivativeOfForwardKinematicsMatchesFiniteDifferences) {
   using M = TypeParam;
-  constexpr int nq = M::nq;
-  this->for_states([&](const State<M>& s, const ParameterVector<M>& any_phi) {
-    const ParameterVector<M> phi = this->physical_phi();  // invertible M for forward dynamics
-    const JointVector<M> tau = this->random_torque();
-    const auto q = seeded<nq>(s.q);
-    const auto fd = [&](const auto& f) { return finite_difference_jacobian(f, s.q, kFdStep); };
-
-    EXPECT_TRUE(close(jet_jacobian(M::regressor(q, s.qd, s.qdd)),
-                      fd([&](const JointVector<M>& x) { return M::regressor(x, s.qd, s.qdd); }), kFdTol))
-        << "regressor";
-    EXPECT_TRUE(close(jet_jacobian(M::inverse_dynamics(q, s.qd, s.qdd, any_phi)),
-                      fd([&](const JointVector<M>& x) { return M::inverse_dynamics(x, s.qd, s.qdd, any_phi); }),
-                      kFdTol))
-        << "inverse_dynamics";
-    EXPECT_TRUE(close(jet_jacobian(M::forward_dynamics(q, s.qd, tau, phi)),
-                      fd([&](const JointVector<M>& x) { return M::forward_dynamics(x, s.qd, tau, phi); }),
-                      kFdTol))
-        << "forward_dynamics";
-    EXPECT_TRUE(close(jet_jacobian(M::inertia(q, any_phi)),
-                      fd([&](const JointVector<M>& x) { return M::inertia(x, any_phi); }), kFdTol))
-        << "inertia";
-    EXPECT_TRUE(close(jet_jacobian(M::forward_kinematics(q)),
-                      fd([&](const JointVector<M>& x) { return M::forward_kinematics(x); }), kFdTol))
-        << "forward_kinematics";
+  this->for_states([&](const State<M>& s, const auto&) {
+    const JointVector<M> u = this->random_direction();
+    const auto T = M::forward_kinematics(jet(s.q, u));
+    const Eigen::MatrixXd fd =
+        finite_difference_jacobian([&](const JointVector<M>& x) { return M::forward_kinematics(x); }, s.q, kFdStep);
+    EXPECT_TRUE(close(flat_derivative(T), fd * u, kFdTol));
     // The value part of the Jet evaluation is the double evaluation.
-    EXPECT_TRUE(close(values(M::forward_dynamics(q, s.qd, tau, phi)),
-                      M::forward_dynamics(s.q, s.qd, tau, phi), kRelTol));
+    EXPECT_TRUE(close(values(T), M::forward_kinematics(s.q), kRelTol));
   });
 }
 
-// The Jacobian is the derivative of the forward kinematics: linear rows d p / d q, angular rows
-// the axial vector of (d R / d q_k) R^T.
+// The Jacobian is the derivative of the forward kinematics: along a random direction u of q, its
+// linear rows give d p / d q u and its angular rows the axial vector of (d R / d q u) R^T.
 TYPED_TEST(RobotModel, JacobianIsTheDerivativeOfForwardKinematics) {
   using M = TypeParam;
   this->for_states([&](const State<M>& s, const auto&) {
-    const auto T = M::forward_kinematics(seeded<M::nq>(s.q));
+    const JointVector<M> u = this->random_direction();
+    const auto T = M::forward_kinematics(jet(s.q, u));
     const Eigen::Matrix3d R = values(T.template topLeftCorner<3, 3>());
-    Eigen::Matrix<double, 6, M::nq> expected;
-    for (int k = 0; k < M::nq; ++k) {
-      const auto d = [&](int r, int c) { return T(r, c).v(k); };
-      Eigen::Matrix3d dR;
-      for (int r = 0; r < 3; ++r)
-        for (int c = 0; c < 3; ++c) dR(r, c) = d(r, c);
-      const Eigen::Matrix3d w = dR * R.transpose();  // skew-symmetric
-      expected.col(k) << d(0, 3), d(1, 3), d(2, 3), w(2, 1), w(0, 2), w(1, 0);
-    }
-    EXPECT_TRUE(close(M::jacobian(s.q), expected, kRelTol));
-  });
-}
-
-// tau is linear in phi, so its Jet derivative in phi is the regressor, to round-off.
-TYPED_TEST(RobotModel, JetDerivativeOfInverseDynamicsInPhiIsRegressor) {
-  using M = TypeParam;
-  this->for_states([&](const State<M>& s, const ParameterVector<M>& phi) {
-    const auto tau = M::inverse_dynamics(s.q, s.qd, s.qdd, seeded<M::np>(phi));
-    EXPECT_TRUE(close(jet_jacobian(tau), M::regressor(s.q, s.qd, s.qdd), 1e-12));
+    const Eigen::MatrixXd dT = derivative(T);
+    const Eigen::Matrix3d w = dT.topLeftCorner<3, 3>() * R.transpose();  // skew-symmetric
+    Eigen::Matrix<double, 6, 1> expected;
+    expected << dT(0, 3), dT(1, 3), dT(2, 3), w(2, 1), w(0, 2), w(1, 0);
+    EXPECT_TRUE(close(M::jacobian(s.q) * u, expected, kRelTol));
   });
 }
 

@@ -10,8 +10,9 @@ template <class Model>
 class InertiaDerivatives : public RobotDerivatives<Model> {};
 TYPED_TEST_SUITE(InertiaDerivatives, Models, ModelName);
 
-// d M / d q_k from the generated inertia_derivatives, against the Jet derivative of inertia() and
-// central differences; in Jets it gives d2 M / d q_k d q_l, against differences of itself.
+// d M / d q_k from the generated inertia_derivatives, against central differences of inertia() and,
+// along a random direction u, the Jet derivative of inertia() (itself against the differences); in Jets along u it gives
+// sum_l d2 M / d q_k d q_l u_l for every k, against central differences of itself.
 TYPED_TEST(InertiaDerivatives, InertiaDerivativesAreTheJetAndFiniteDifferenceDerivatives) {
   using M = TypeParam;
   constexpr int nq = M::nq;
@@ -20,32 +21,43 @@ TYPED_TEST(InertiaDerivatives, InertiaDerivativesAreTheJetAndFiniteDifferenceDer
     typename M::template InertiaDerivatives<double> d;
     M::inertia_derivatives(s.q, phi, d);
     EXPECT_TRUE(close(d.M, M::inertia(s.q, phi), 1e-12)) << "M";
-    const auto jet = M::inertia(seeded<nq>(s.q), phi);
     const Eigen::MatrixXd fd =
         finite_difference_jacobian([&](const JointVector<M>& x) { return Mat(M::inertia(x, phi)); }, s.q, kFdStep);
     for (int k = 0; k < nq; ++k) {
       SCOPED_TRACE("d M / d q_" + std::to_string(k + 1));
-      Mat from_jet, from_fd;
-      for (int i = 0; i < nq; ++i)
-        for (int j = 0; j < nq; ++j) {
-          from_jet(i, j) = jet(i, j).v(k);
-          from_fd(i, j) = fd(j * nq + i, k);
-        }
-      EXPECT_TRUE(close(d.dq[k], from_jet, kJetTol));
+      const Mat from_fd = Eigen::Map<const Mat>(fd.col(k).data());
       EXPECT_TRUE(close(d.dq[k], from_fd, kFdTol));
     }
-    using Jet = ceres::Jet<double, nq>;
-    typename M::template InertiaDerivatives<Jet> dj;
-    M::inertia_derivatives(seeded<nq>(s.q), phi, dj);
-    const int k = nq - 1;  // d/dq of d M / d q_k for one k
+    // Along u: sum_k u_k d M / d q_k, the derivative part of inertia() in Jets along u.
+    const auto u = this->template random_direction<JointVector<M>>();
+    Mat along_u = Mat::Zero();
+    for (int k = 0; k < nq; ++k) along_u += u(k) * d.dq[k];
+    const auto M_along_u = M::inertia(jet(s.q, u), jet(phi));
+    EXPECT_TRUE(close(along_u, derivative(M_along_u), kJetTol)) << "d M / d q along u";
+    // inertia() in Jets against the central differences too (formerly in test_robot.cpp).
+    EXPECT_TRUE(close(flat_derivative(M_along_u), fd * u, kFdTol)) << "d M / d q along u: Jet and finite differences";
+
+    // inertia_derivatives in Jets along u: its value part is the double evaluation, the
+    // derivative part of M is along_u, and that of d M / d q_k the second derivatives along u.
+    typename M::template InertiaDerivatives<Dual> dj;
+    M::inertia_derivatives(jet(s.q, u), jet(phi), dj);
+    EXPECT_TRUE(close(values(dj.M), d.M, 1e-12)) << "M in Jets";
+    EXPECT_TRUE(close(derivative(dj.M), along_u, kJetTol)) << "d M / d q along u, from inertia_derivatives in Jets";
+    // Central differences of all of d M / d q_k at once: rows k nq^2 .. (k + 1) nq^2 - 1 are vec(d M / d q_k).
     const Eigen::MatrixXd second = finite_difference_jacobian(
         [&](const JointVector<M>& x) {
           typename M::template InertiaDerivatives<double> e;
           M::inertia_derivatives(x, phi, e);
-          return Mat(e.dq[k]);
+          Eigen::Matrix<double, nq * nq, nq> all;
+          for (int k = 0; k < nq; ++k) all.col(k) = Eigen::Map<const Eigen::Matrix<double, nq * nq, 1>>(e.dq[k].data());
+          return all;
         },
         s.q, kFdStep);
-    EXPECT_TRUE(close(jet_jacobian(dj.dq[k]), second, kFdTol)) << "d2 M / d q d q_" << k + 1;
+    const Eigen::VectorXd second_u = second * u;
+    for (int k = 0; k < nq; ++k) {
+      const Mat expected = Eigen::Map<const Mat>(second_u.data() + k * nq * nq);
+      EXPECT_TRUE(close(derivative(dj.dq[k]), expected, kFdTol)) << "d2 M / d q d q_" << k + 1 << " along u";
+    }
   });
 }
 
