@@ -3,7 +3,11 @@
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
+#include <string>
+#include <vector>
 
+#include <ceres/iteration_callback.h>
+#include <ceres/manifold.h>
 #include <ceres/problem.h>
 #include <ceres/solver.h>
 #include <fmt/format.h>
@@ -71,6 +75,8 @@ Bounds parameter_bounds(const Eigen::VectorXd& phi0, const std::vector<bool>& ro
     throw std::invalid_argument("CLIE: bound_factor >= 0, min_bound > 0 and min_rotor_inertia >= 0 needed");
   if (!phi0.allFinite()) throw std::invalid_argument("CLIE: the starting phi is not finite");
   if (!(options.std_bound >= 0)) throw std::invalid_argument("CLIE: std_bound must be >= 0");
+  if (!(options.noise_floor >= 0) || !std::isfinite(options.noise_floor))
+    throw std::invalid_argument("CLIE: noise_floor must be finite and >= 0");
   const bool by_std = options.std_bound > 0;
   if (by_std && (options.scale.size() != phi0.size() || !(options.scale.array() > 0).all() || !options.scale.allFinite()))
     throw std::invalid_argument(fmt::format("CLIE: std_bound needs {} positive standard deviations, got {}", phi0.size(),
@@ -92,43 +98,128 @@ Bounds parameter_bounds(const Eigen::VectorXd& phi0, const std::vector<bool>& ro
   return b;
 }
 
-void solve_bounded(ceres::CostFunction& cost, const Bounds& bounds, const ClieOptions& options, ClieResult& result) {
-  ceres::Problem::Options po;
-  po.cost_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
-  ceres::Problem problem(po);
-  double* phi = result.phi.data();
-  problem.AddResidualBlock(&cost, nullptr, phi);
-  for (int i = 0; i < static_cast<int>(result.phi.size()); ++i) {
-    problem.SetParameterLowerBound(phi, i, bounds.lower(i));
-    problem.SetParameterUpperBound(phi, i, bounds.upper(i));
-  }
-  ceres::Solver::Options so;
-  so.minimizer_type = ceres::TRUST_REGION;
-  so.trust_region_strategy_type = ceres::LEVENBERG_MARQUARDT;
-  // The step's linear solve is negligible next to the simulations (AG02 at 40 ms: 0.1 s of
-  // 16 s with QR, 0.03 s with the normal equations, same result), so the better-conditioned QR.
-  so.linear_solver_type = ceres::DENSE_QR;
-  so.max_num_iterations = options.max_iterations;
-  so.function_tolerance = options.function_tolerance;
-  so.parameter_tolerance = options.parameter_tolerance;
-  so.gradient_tolerance = options.gradient_tolerance;
-  // With bounds Ceres refines each step by a projected Armijo line search; its default cubic
-  // interpolation asks for the gradient at every trial point, i.e. a full sensitivity
-  // simulation. Quadratic interpolation needs costs only (measured: half the Jacobians).
-  so.line_search_interpolation_type = ceres::QUADRATIC;
-  so.num_threads = 1;  // the study runs trajectories in parallel
-  so.minimizer_progress_to_stdout = false;
-  so.logging_type = ceres::SILENT;
-  ceres::Solver::Summary summary;
-  ceres::Solve(so, &problem, &summary);
+namespace {
 
-  result.success = summary.termination_type == ceres::CONVERGENCE || summary.termination_type == ceres::NO_CONVERGENCE;
-  result.termination = fmt::format("{}: {}", ceres::TerminationTypeToString(summary.termination_type), summary.message);
-  // Ceres' count: the steps computed (one linear solve each), the one that ended the solve
-  // included.
-  result.iterations = summary.num_successful_steps + summary.num_unsuccessful_steps;
-  result.jacobian_evaluations = summary.num_jacobian_evaluations;
-  result.residual_evaluations = summary.num_residual_evaluations;
+// The noise-floor stop (ClieOptions::noise_floor), after each step taken: Ceres' own function
+// tolerance also ends the solve on a rejected step, whose small cost change says nothing about
+// the distance to the optimum.
+class NoiseFloorStop final : public ceres::IterationCallback {
+ public:
+  NoiseFloorStop(double noise_floor, double degrees_of_freedom) : floor_(noise_floor), dof_(degrees_of_freedom) {}
+
+  ceres::CallbackReturnType operator()(const ceres::IterationSummary& s) override {
+    if (s.iteration == 0 || !s.step_is_successful) return ceres::SOLVER_CONTINUE;
+    const double variance = 2 * s.cost / dof_;  // at the new point
+    if (!(s.cost_change < floor_ * variance)) return ceres::SOLVER_CONTINUE;
+    message_ = fmt::format("noise floor reached. cost_change: {:e} < {} sigma^2 = {:e} (sigma^2 = 2 cost / {})",
+                           s.cost_change, floor_, floor_ * variance, dof_);
+    return ceres::SOLVER_TERMINATE_SUCCESSFULLY;
+  }
+  const std::string& message() const { return message_; }
+
+ private:
+  double floor_, dof_;
+  std::string message_;
+};
+
+// Ends a round of the solve when a step taken puts a free parameter on its bound
+// (ClieOptions::hold_at_bounds). Reads the parameters Ceres writes back after every iteration.
+class BoundReached final : public ceres::IterationCallback {
+ public:
+  BoundReached(const double* phi, const Bounds& bounds, const std::vector<bool>& held)
+      : phi_(phi), bounds_(bounds), held_(held) {}
+
+  ceres::CallbackReturnType operator()(const ceres::IterationSummary& s) override {
+    if (s.iteration == 0 || !s.step_is_successful) return ceres::SOLVER_CONTINUE;
+    for (std::size_t i = 0; i < held_.size(); ++i) {
+      const auto k = static_cast<Eigen::Index>(i);
+      if (!held_[i] && (phi_[i] <= bounds_.lower(k) || phi_[i] >= bounds_.upper(k))) reached_.push_back(static_cast<int>(i));
+    }
+    return reached_.empty() ? ceres::SOLVER_CONTINUE : ceres::SOLVER_TERMINATE_SUCCESSFULLY;
+  }
+  const std::vector<int>& reached() const { return reached_; }
+
+ private:
+  const double* phi_;
+  const Bounds& bounds_;
+  const std::vector<bool>& held_;
+  std::vector<int> reached_;
+};
+
+}  // namespace
+
+void solve_bounded(ceres::CostFunction& cost, const Bounds& bounds, const ClieOptions& options, ClieResult& result) {
+  const int np = static_cast<int>(result.phi.size());
+  double* phi = result.phi.data();
+  const double dof = static_cast<double>(cost.num_residuals()) - np;
+  std::vector<bool> held(static_cast<std::size_t>(np), false);
+  result.iterations = result.jacobian_evaluations = result.residual_evaluations = 0;
+  // Rounds: each a Ceres solve from where the last ended, with the parameters that reached a bound
+  // held constant; a round ends when another reaches one. Every round restarts the trust region
+  // and evaluates the Jacobian at its start again (at most one round per parameter).
+  for (;;) {
+    ceres::Problem::Options po;
+    po.cost_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+    ceres::Problem problem(po);
+    problem.AddResidualBlock(&cost, nullptr, phi);
+    for (int i = 0; i < np; ++i) {
+      problem.SetParameterLowerBound(phi, i, bounds.lower(i));
+      problem.SetParameterUpperBound(phi, i, bounds.upper(i));
+    }
+    std::vector<int> constant;
+    for (int i = 0; i < np; ++i)
+      if (held[static_cast<std::size_t>(i)]) constant.push_back(i);
+    if (static_cast<int>(constant.size()) == np) break;  // nothing left to move
+    if (!constant.empty()) problem.SetManifold(phi, new ceres::SubsetManifold(np, constant));  // owned by problem
+
+    ceres::Solver::Options so;
+    so.minimizer_type = ceres::TRUST_REGION;
+    so.trust_region_strategy_type = ceres::LEVENBERG_MARQUARDT;
+    // The step's linear solve is negligible next to the simulations (AG02 at 40 ms: 0.1 s of
+    // 16 s with QR, 0.03 s with the normal equations, same result), so the better-conditioned QR.
+    so.linear_solver_type = ceres::DENSE_QR;
+    so.max_num_iterations = options.max_iterations - result.iterations;
+    so.function_tolerance = options.function_tolerance;
+    so.parameter_tolerance = options.parameter_tolerance;
+    so.gradient_tolerance = options.gradient_tolerance;
+    // With bounds Ceres refines each step by a projected Armijo line search; its default cubic
+    // interpolation asks for the gradient at every trial point, i.e. a full sensitivity
+    // simulation. Quadratic interpolation needs costs only (measured: half the Jacobians).
+    so.line_search_interpolation_type = ceres::QUADRATIC;
+    so.num_threads = 1;  // the study runs trajectories in parallel
+    so.minimizer_progress_to_stdout = false;
+    so.logging_type = ceres::SILENT;
+    so.update_state_every_iteration = options.hold_at_bounds;  // for BoundReached
+    NoiseFloorStop noise_floor(options.noise_floor, dof);
+    if (options.noise_floor > 0 && dof > 0) so.callbacks.push_back(&noise_floor);
+    BoundReached bound_reached(phi, bounds, held);
+    if (options.hold_at_bounds) so.callbacks.push_back(&bound_reached);
+    ceres::Solver::Summary summary;
+    ceres::Solve(so, &problem, &summary);
+
+    const bool user_stop = summary.termination_type == ceres::USER_SUCCESS;
+    const bool noise_stop = user_stop && !noise_floor.message().empty();
+    const bool new_bound = user_stop && !noise_stop;
+    // Ceres' count: the steps computed (one linear solve each), the one that ended the solve
+    // included. Iteration 0 counts as a successful step; a step that ends the solve by Ceres'
+    // tolerances does not, one that a callback ends does.
+    result.iterations += summary.num_successful_steps + summary.num_unsuccessful_steps - (user_stop ? 1 : 0);
+    result.jacobian_evaluations += summary.num_jacobian_evaluations;
+    result.residual_evaluations += summary.num_residual_evaluations;
+    result.success = summary.termination_type == ceres::CONVERGENCE || summary.termination_type == ceres::NO_CONVERGENCE || user_stop;
+    result.termination = noise_stop ? "CONVERGENCE: " + noise_floor.message()
+                                    : fmt::format("{}: {}", ceres::TerminationTypeToString(summary.termination_type), summary.message);
+    if (!new_bound) break;
+    for (int i : bound_reached.reached()) held[static_cast<std::size_t>(i)] = true;
+    if (result.iterations >= options.max_iterations) {
+      result.termination = fmt::format("NO_CONVERGENCE: Maximum number of iterations reached. Number of iterations: {}.",
+                                       result.iterations);
+      break;
+    }
+  }
+  result.held.clear();
+  for (int i = 0; i < np; ++i)
+    if (held[static_cast<std::size_t>(i)]) result.held.push_back(i);
 }
 
 }  // namespace symoro::identify::detail
