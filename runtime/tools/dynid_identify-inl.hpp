@@ -45,6 +45,7 @@ identify::StudyResult study(const Common& common, const IdentifyOptions& o, bool
   so.preprocess.torque_delay = o.torque_delay_ms / 1000;
   so.clie.max_iterations = o.clie_iterations;
   so.clie.std_bound = o.clie_std_bound;
+  so.clie.noise_floor = o.clie_noise_floor;
   so.projection_metric = identify::projection_metric_from_string(o.projection_metric);
   so.consistency = identify::consistency_from_string(o.consistency);
   so.physical_start = o.physical_start;
