@@ -146,6 +146,55 @@ class BoundReached final : public ceres::IterationCallback {
   std::vector<int> reached_;
 };
 
+// The cost with its last Jacobian kept: a round that a bound ends has evaluated the Jacobian
+// at its end point, where the next round starts and Ceres asks for it again (one sensitivity
+// simulation saved per held bound; the numbers served are the ones computed).
+class LastJacobian final : public ceres::CostFunction {
+ public:
+  explicit LastJacobian(ceres::CostFunction& cost) : cost_(cost) {
+    set_num_residuals(cost.num_residuals());
+    *mutable_parameter_block_sizes() = cost.parameter_block_sizes();
+  }
+
+  bool Evaluate(double const* const* parameters, double* residuals, double** jacobians) const override {
+    const Eigen::Index n = parameter_block_sizes()[0], m = num_residuals();
+    const Eigen::Map<const Eigen::VectorXd> phi(parameters[0], n);
+    const bool jacobian = jacobians && jacobians[0];
+    if (jacobian && kept_ && phi_ == phi) {
+      Eigen::Map<Eigen::VectorXd>(residuals, m) = residuals_;
+      Eigen::Map<Eigen::VectorXd>(jacobians[0], m * n) = jacobian_;
+      ++served_;
+      return true;
+    }
+    const bool ok = cost_.Evaluate(parameters, residuals, jacobians);
+    if (jacobian) {
+      kept_ = ok;
+      if (ok) {
+        phi_ = phi;
+        residuals_ = Eigen::Map<const Eigen::VectorXd>(residuals, m);
+        jacobian_ = Eigen::Map<const Eigen::VectorXd>(jacobians[0], m * n);
+      }
+    }
+    return ok;
+  }
+  int served() const { return served_; }  // Jacobians served from the kept one
+  // The cost's gradient J'r at phi when the kept Jacobian is phi's (Ceres evaluates it at every
+  // point it accepts, so at the end point of a solve).
+  bool gradient(const Eigen::VectorXd& phi, Eigen::VectorXd& g) const {
+    if (!kept_ || phi_ != phi) return false;
+    const Eigen::Index n = phi.size(), m = num_residuals();
+    const Eigen::Map<const Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>> j(jacobian_.data(), m, n);
+    g = j.transpose() * residuals_;
+    return true;
+  }
+
+ private:
+  ceres::CostFunction& cost_;
+  mutable bool kept_ = false;
+  mutable int served_ = 0;
+  mutable Eigen::VectorXd phi_, residuals_, jacobian_;
+};
+
 }  // namespace
 
 void solve_bounded(ceres::CostFunction& cost, const Bounds& bounds, const ClieOptions& options, ClieResult& result) {
@@ -154,14 +203,16 @@ void solve_bounded(ceres::CostFunction& cost, const Bounds& bounds, const ClieOp
   const double dof = static_cast<double>(cost.num_residuals()) - np;
   std::vector<bool> held(static_cast<std::size_t>(np), false);
   result.iterations = result.jacobian_evaluations = result.residual_evaluations = 0;
+  LastJacobian kept(cost);
   // Rounds: each a Ceres solve from where the last ended, with the parameters that reached a bound
-  // held constant; a round ends when another reaches one. Every round restarts the trust region
-  // and evaluates the Jacobian at its start again (at most one round per parameter).
+  // held constant; a round ends when another reaches one. After each round, a held parameter
+  // that the gradient pulls back into the box is released. Every round restarts the trust region
+  // (its starting Jacobian is the one kept from the last round's end).
   for (;;) {
     ceres::Problem::Options po;
     po.cost_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
     ceres::Problem problem(po);
-    problem.AddResidualBlock(&cost, nullptr, phi);
+    problem.AddResidualBlock(&kept, nullptr, phi);
     for (int i = 0; i < np; ++i) {
       problem.SetParameterLowerBound(phi, i, bounds.lower(i));
       problem.SetParameterUpperBound(phi, i, bounds.upper(i));
@@ -209,14 +260,27 @@ void solve_bounded(ceres::CostFunction& cost, const Bounds& bounds, const ClieOp
     result.success = summary.termination_type == ceres::CONVERGENCE || summary.termination_type == ceres::NO_CONVERGENCE || user_stop;
     result.termination = noise_stop ? "CONVERGENCE: " + noise_floor.message()
                                     : fmt::format("{}: {}", ceres::TerminationTypeToString(summary.termination_type), summary.message);
-    if (!new_bound) break;
     for (int i : bound_reached.reached()) held[static_cast<std::size_t>(i)] = true;
+    // Release a held parameter whose gradient points into the box (the cost falls moving it off
+    // its bound): another round then moves it.
+    bool released = false;
+    Eigen::VectorXd g;
+    if (std::find(held.begin(), held.end(), true) != held.end() && kept.gradient(result.phi, g))
+      for (int i = 0; i < np; ++i) {
+        const auto k = static_cast<std::size_t>(i);
+        if (held[k] && ((result.phi(i) <= bounds.lower(i) && g(i) < 0) || (result.phi(i) >= bounds.upper(i) && g(i) > 0))) {
+          held[k] = false;
+          released = true;
+        }
+      }
+    if (!new_bound && !released) break;
     if (result.iterations >= options.max_iterations) {
       result.termination = fmt::format("NO_CONVERGENCE: Maximum number of iterations reached. Number of iterations: {}.",
                                        result.iterations);
       break;
     }
   }
+  result.jacobian_evaluations -= kept.served();  // sensitivity simulations
   result.held.clear();
   for (int i = 0; i < np; ++i)
     if (held[static_cast<std::size_t>(i)]) result.held.push_back(i);
