@@ -38,12 +38,13 @@ struct ClieOptions {
   double bound_factor = 100;          // bounds phi0_i -+ bound_factor |phi0_i|
   double min_bound = 1e-4;            // bound half-width floor for phi0_i near 0 (in the parameter's unit)
   double min_rotor_inertia = 1e-6;    // kg m^2: lower bound of IA parameters
-  // A parameter that a step puts on its bound is held there for the rest of the solve (Ceres is
-  // restarted with it constant). Ceres' bounded Levenberg-Marquardt computes each step as if
-  // there were no bounds and then projects it, so while a parameter presses on its bound the
-  // step's predicted decrease counts a move that the projection cancels: steps are rejected or
-  // cut short and the solve creeps (docs/identification.md: PB01 at 20 ms, 22 steps for 0.02 %
-  // of cost after the first). false: Ceres' projection alone (as before).
+  // A parameter that a step puts on its bound is held there: Ceres is restarted with it
+  // constant, and released (another restart) when the gradient at the end of a round pulls it
+  // back into the box. Ceres' bounded Levenberg-Marquardt computes each step as if there were no
+  // bounds and then projects it, so while a parameter presses on its bound the step's predicted
+  // decrease counts a move that the projection cancels: steps are rejected or cut short and the
+  // solve creeps (docs/identification.md: PB01 at 20 ms, 21 steps for 0.02 % of cost after the
+  // first). false: Ceres' projection alone (as before).
   bool hold_at_bounds = true;
   // When std_bound > 0 and scale holds one value per parameter (the run's OLS standard
   // deviations): bounds phi0_i -+ std_bound scale_i as well, the tighter of the two applying.
