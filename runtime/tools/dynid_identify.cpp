@@ -68,9 +68,10 @@ void add_identify_commands(CLI::App& app, Common& common) {
       ->check(numbers::non_negative(1e6, ">= 0 and <= 1e6"))
       ->capture_default_str();
   cmd->add_option("--clie-noise-floor", o->clie_noise_floor,
-                  "CLIE also stops when a step changes its cost by less than this many residual variances "
-                  "(2 cost / (residuals - parameters)): 0.5, a step shorter than one standard deviation of the "
-                  "estimate; 0: the paper's relative tolerance 1e-6 alone")
+                  "CLIE also stops when a step lowers its cost by less than this many residual variances "
+                  "(2 cost / (residuals - parameters)); 0.5: a step shorter than one standard deviation of the "
+                  "estimate; 0 (default): the paper's relative tolerance 1e-6 alone (0.5 stopped some runs early: "
+                  "docs/identification.md)")
       ->check(numbers::non_negative(1e6, ">= 0 and <= 1e6"))
       ->capture_default_str();
   cmd->add_option("--validation-interval", o->validation_ms, "Validation interval in ms (default: the selected run's)")
