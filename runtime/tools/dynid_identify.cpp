@@ -51,6 +51,7 @@ identify::StudyResult study(const Common& common, const IdentifyOptions& o,
   so.preprocess.torque_delay = o.torque_delay_ms / 1000;
   so.clie.max_iterations = o.clie_iterations;
   so.clie.std_bound = o.clie_std_bound;
+  so.clie.noise_floor = o.clie_noise_floor;
   so.projection_metric = identify::projection_metric_from_string(o.projection_metric);
   so.consistency = identify::consistency_from_string(o.consistency);
   so.physical_start = o.physical_start;
@@ -196,6 +197,13 @@ void add_identify_commands(CLI::App& app, Common& common) {
                 "of the paper's PD projection (slower: CLIE walks back out of the set; docs/identification.md)");
   cmd->add_option("--clie-std-bound", o->clie_std_bound,
                   "CLIE bounds of +-K standard deviations of the run's OLS estimate around its start (0: off)")
+      ->check(numbers::non_negative(1e6, ">= 0 and <= 1e6"))
+      ->capture_default_str();
+  cmd->add_option("--clie-noise-floor", o->clie_noise_floor,
+                  "CLIE also stops when a step lowers its cost by less than this many residual variances "
+                  "(2 cost / (residuals - parameters)); 0.5: a step shorter than one standard deviation of the "
+                  "estimate; 0 (default): the paper's relative tolerance 1e-6 alone (0.5 stopped some runs early: "
+                  "docs/identification.md)")
       ->check(numbers::non_negative(1e6, ">= 0 and <= 1e6"))
       ->capture_default_str();
   cmd->add_option("--validation-interval", o->validation_ms, "Validation interval in ms (default: the selected run's)")

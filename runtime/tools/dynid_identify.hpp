@@ -28,6 +28,7 @@ struct IdentifyOptions {
   std::string consistency = "pd";
   std::string rescue_metric = "all";
   double clie_std_bound = 0;
+  double clie_noise_floor = 0;  // identify::ClieOptions::noise_floor
   double rank_timeout = 60;
 };
 

@@ -79,7 +79,10 @@ struct StudyOptions {
   double physical_clearance = 1e-4;
   double physical_rescue_clearance = 1e-7;
   // Its preprocess options are the study's. Stopping rule of MATLAB's lsqnonlin (the paper's):
-  // relative cost change 1e-6; at most 25 steps. No bounds by OLS standard deviations
+  // relative cost change 1e-6; at most 25 steps. Besides (ClieOptions' default): a parameter
+  // that reaches its bound is held there (clie.hold_at_bounds; docs/identification.md: PB01 took
+  // 22 steps for 0.02 % of cost); the noise-floor stop is off (clie.noise_floor 0, measured
+  // there). No bounds by OLS standard deviations
   // (clie.std_bound 0): they also block CLIE's correction of OLS's bias, which can be many
   // sigma (docs/identification.md: FC2 moved 70 sigma, to the truth).
   ClieOptions clie = [] {
