@@ -18,7 +18,7 @@
 #include <symoro/crane_x7.hpp>
 #include <symoro/planar2r.hpp>
 
-#include "symoro/identify/inertia_function_model.hpp"
+#include "symoro/identify/identification_model.hpp"  // inertia functions from symoro::<robot>_identification
 #include "symoro/identify/pd_audit.hpp"
 #include "symoro/twin/config.hpp"
 #include "symoro/twin/truth.hpp"
@@ -73,7 +73,7 @@ bool inside(const VectorXd& q, const AuditDomain& d) {
 // InertiaFunction
 
 TEST(InertiaFunction, DerivativesMatchCentralDifferences) {
-  const auto f = make_inertia_function<Crane>();
+  const auto f = identification_model<Crane>()->inertia_function();
   constexpr int n = Crane::nq;
   std::mt19937_64 rng(11);
   // CAD values plus noise, so that every term of M is active.
@@ -124,7 +124,7 @@ TEST(InertiaFunction, DerivativesMatchCentralDifferences) {
 }
 
 TEST(InertiaFunction, InertiaIsItsParameterLinearBasis) {
-  const auto f = make_inertia_function<Crane>();
+  const auto f = identification_model<Crane>()->inertia_function();
   EXPECT_EQ(f->joints(), Crane::nq);
   EXPECT_EQ(f->parameters(), Crane::np);
   std::mt19937_64 rng(12);
@@ -145,7 +145,7 @@ TEST(InertiaFunction, InertiaIsItsParameterLinearBasis) {
 }
 
 TEST(InertiaFunction, RejectsWrongSizes) {
-  const auto f = make_inertia_function<Crane>();
+  const auto f = identification_model<Crane>()->inertia_function();
   MatrixXd M, C;
   std::vector<MatrixXd> dM, d2M, L;
   const VectorXd q = VectorXd::Zero(Crane::nq), phi = crane_phi();
@@ -182,7 +182,7 @@ TEST(PdAudit, PlanarClosedFormMinimumBetweenTheBounds) {
   ASSERT_LT(at_zero, at_lower);  // the worst pose is strictly inside
   ASSERT_LT(at_zero, at_upper);
 
-  const auto f = make_inertia_function<Planar>();
+  const auto f = identification_model<Planar>()->inertia_function();
   const VectorXd phi = planar_phi(z, 0, m, ia);
   AuditDomain d;
   d.lower = Eigen::Vector2d(-M_PI, -2.0);
@@ -205,7 +205,7 @@ TEST(PdAudit, PlanarClosedFormMinimumBetweenTheBounds) {
 TEST(PdAudit, PlanarConstantDiagonalInertia) {
   // No first moments and ZZ2 = 0: M = diag(ZZR1, IA2) at every pose, a flat landscape with zero
   // derivatives everywhere; one joint of the box has zero width.
-  const auto f = make_inertia_function<Planar>();
+  const auto f = identification_model<Planar>()->inertia_function();
   const VectorXd phi = planar_phi(0.3, 0, 0, 0.2);
   AuditDomain d;
   d.lower = Eigen::Vector2d(-1.0, 0.5);
@@ -222,7 +222,7 @@ TEST(PdAudit, PlanarConstantDiagonalInertia) {
 // The audit on CRANE-X7 (reduced, 8 joints, 39 parameters) over the paper's domain.
 
 TEST(PdAudit, CraneFindsAtLeastTheBruteForceMinimum) {
-  const auto f = make_inertia_function<Crane>();
+  const auto f = identification_model<Crane>()->inertia_function();
   const VectorXd& phi = crane_phi();
   const AuditDomain d = audit_domain<Crane>();
   const AuditResult r = audit_pd(*f, phi, d);
@@ -280,7 +280,7 @@ double three_point_grid_lambda(const VectorXd& phi, const AuditDomain& d) {
 // (every joint at its bounds and centre: -90, 0, 90 deg for most joints) first turns non-PD at
 // MX3 = t_grid, but off the grid M is already indefinite at 0.9 t_grid, near q2 = -47 deg.
 TEST(PdAudit, CatchesNonPdBetweenTheGridPoints) {
-  const auto f = make_inertia_function<Crane>();
+  const auto f = identification_model<Crane>()->inertia_function();
   const AuditDomain d = audit_domain<Crane>();
   const VectorXd& phi0 = crane_phi();
   ASSERT_GT(three_point_grid_lambda(phi0, d), 0);
@@ -363,7 +363,7 @@ class FirstOrderOnly final : public InertiaFunction {
 };
 
 TEST(PdAudit, LimitedMemoryHessianFindsTheSameMinimum) {
-  const auto f = make_inertia_function<Crane>();
+  const auto f = identification_model<Crane>()->inertia_function();
   const FirstOrderOnly first(*f);
   const AuditDomain d = audit_domain<Crane>();
   const VectorXd& phi = crane_phi();
@@ -374,7 +374,7 @@ TEST(PdAudit, LimitedMemoryHessianFindsTheSameMinimum) {
 }
 
 TEST(PdAudit, ExtraStartsAndNoSearch) {
-  const auto f = make_inertia_function<Crane>();
+  const auto f = identification_model<Crane>()->inertia_function();
   const AuditDomain d = audit_domain<Crane>();
   const VectorXd& phi = crane_phi();
   const AuditResult full = audit_pd(*f, phi, d);
@@ -404,7 +404,7 @@ TEST(PdAudit, ExtraStartsAndNoSearch) {
 }
 
 TEST(PdAudit, SilentAndSafeFromSeveralThreads) {
-  const auto f = make_inertia_function<Crane>();
+  const auto f = identification_model<Crane>()->inertia_function();
   const AuditDomain d = audit_domain<Crane>();
   const VectorXd& phi = crane_phi();
   testing::internal::CaptureStdout();
@@ -425,7 +425,7 @@ TEST(PdAudit, SilentAndSafeFromSeveralThreads) {
 }
 
 TEST(PdAudit, RejectsBadInput) {
-  const auto f = make_inertia_function<Crane>();
+  const auto f = identification_model<Crane>()->inertia_function();
   const AuditDomain d = audit_domain<Crane>();
   const VectorXd& phi = crane_phi();
   EXPECT_THROW(audit_pd(*f, VectorXd::Zero(Crane::np - 1), d), std::invalid_argument);

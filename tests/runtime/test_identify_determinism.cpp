@@ -24,7 +24,7 @@
 #include <symoro/crane_x7.hpp>
 #include <symoro/rx90.hpp>
 
-#include "symoro/identify/inertia_function_model.hpp"
+#include "symoro/identify/identification_model.hpp"  // inertia functions from symoro::<robot>_identification
 #include "symoro/identify/least_squares.hpp"
 #include "symoro/identify/regression.hpp"
 #include "symoro/io/log.hpp"
@@ -71,7 +71,7 @@ std::vector<std::unique_ptr<char[]>> shift_heap(unsigned seed) {
 
 template <class Model>
 void same_bits_whatever_the_heap(const Eigen::VectorXd& truth, const Eigen::VectorXd& direction) {
-  const auto m = make_inertia_function<Model>();
+  const auto m = identification_model<Model>()->inertia_function();
   const AuditDomain domain = audit_domain<Model>();
   Eigen::VectorXd phi0 = truth;
   for (double t = 0.05; audit_pd(*m, phi0, domain).positive_definite(); t *= 1.5) phi0 = truth + t * direction;
@@ -172,7 +172,7 @@ TEST(Determinism, CraneX7StudyRunsAfterOtherRuns) {
   const auto pb05 = symoro::io::read_log(dir / "PB05_t1.csv");
   const auto pb07 = symoro::io::read_log(dir / "PB07_t1.csv");
   std::filesystem::remove_all(dir);
-  const auto m = make_inertia_function<Model>();
+  const auto m = identification_model<Model>()->inertia_function();
   const AuditDomain domain = audit_domain<Model>();
   auto project = [&](const symoro::io::Log& log, double interval, bool information) {
     const auto ls = least_squares(stack_regression<Model>(symoro::preprocess::preprocess(log, interval)));

@@ -21,7 +21,7 @@
 #include <symoro/crane_x7.hpp>
 #include <symoro/rx90.hpp>
 
-#include "symoro/identify/inertia_function_model.hpp"
+#include "symoro/identify/identification_model.hpp"  // inertia functions from symoro::<robot>_identification
 #include "symoro/identify/sdp_projection.hpp"
 #include "symoro/twin/config.hpp"
 #include "symoro/twin/truth.hpp"
@@ -283,7 +283,7 @@ Eigen::VectorXd barrier_projection(const InertiaFunction& m, const std::vector<E
 
 class CraneX7Projection : public testing::Test {
  protected:
-  std::unique_ptr<InertiaFunction> m = make_inertia_function<Reduced>();
+  std::unique_ptr<InertiaFunction> m = identification_model<Reduced>()->inertia_function();
   AuditDomain domain = audit_domain<Reduced>();
   Eigen::VectorXd truth = truth_phi();
   Eigen::VectorXd phi0 = non_pd_phi();
@@ -498,7 +498,7 @@ class BigModelProjection : public testing::Test {
       phi0 = short_log_ols<Model>(truth, 2.0, 0.1, 1);
     }
   }
-  std::unique_ptr<InertiaFunction> m = make_inertia_function<Model>();
+  std::unique_ptr<InertiaFunction> m = identification_model<Model>()->inertia_function();
   AuditDomain domain = audit_domain<Model>();
   Eigen::VectorXd truth, phi0;
 };

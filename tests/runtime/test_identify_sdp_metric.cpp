@@ -14,7 +14,7 @@
 #include <symoro/rx90.hpp>
 
 #include "affine_inertia.hpp"
-#include "symoro/identify/inertia_function_model.hpp"
+#include "symoro/identify/identification_model.hpp"  // inertia functions from symoro::<robot>_identification
 #include "symoro/identify/sdp_projection.hpp"
 #include "symoro/twin/config.hpp"
 #include "symoro/twin/truth.hpp"
@@ -95,7 +95,7 @@ TEST(SdpMetric, RejectsAMetricThatIsNotPositiveDefinite) {
 // its own metric (the exchange loop's working sets differ, so up to a small tolerance).
 template <class Model>
 void metric_and_euclidean_are_each_optimal(const Eigen::VectorXd& truth, std::uint64_t seed) {
-  const auto m = make_inertia_function<Model>();
+  const auto m = identification_model<Model>()->inertia_function();
   const AuditDomain domain = audit_domain<Model>();
   const int np = Model::np;
   std::mt19937_64 rng(seed);
