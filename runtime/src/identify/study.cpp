@@ -35,24 +35,12 @@
 namespace symoro::identify {
 namespace {
 
-// The all-pose audit's box (JointInfo::audit_lower/audit_upper, robot.yaml).
-AuditDomain audit_domain(const ModelDescription& d) {
-  AuditDomain a;
-  a.lower.resize(d.nq);
-  a.upper.resize(d.nq);
-  for (int j = 0; j < d.nq; ++j) {
-    a.lower(j) = d.joints[static_cast<std::size_t>(j)].audit_lower;
-    a.upper(j) = d.joints[static_cast<std::size_t>(j)].audit_upper;
-  }
-  return a;
-}
-
 // One study's run: the model, options and closed loop it works with, and what it builds once.
 class StudyRun {
  public:
   StudyRun(const IdentificationModel& model, const StudyOptions& options, const ClosedLoopSource& closed_loop)
       : model_(model), d_(model.description()), o_(options), loop_(closed_loop), inertia_(model.inertia_function()),
-        domain_(audit_domain(d_)) {}
+        domain_(audit_domain(d_.joints)) {}
 
   StudyResult run() {
     const auto t0 = std::chrono::steady_clock::now();

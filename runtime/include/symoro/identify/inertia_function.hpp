@@ -9,6 +9,8 @@
 
 #include <Eigen/Core>
 
+#include "symoro/model_info.hpp"
+
 namespace symoro::identify {
 
 // The box of joint angles the all-pose audit covers (rad), one interval per joint.
@@ -17,17 +19,23 @@ struct AuditDomain {
   int joints() const { return static_cast<int>(lower.size()); }
 };
 
-// The generated audit domain (JointInfo::audit_lower/audit_upper, robot.yaml).
-template <class Model>
-AuditDomain audit_domain() {
+// The audit domain of a model's joints (JointInfo::audit_lower/audit_upper, robot.yaml).
+inline AuditDomain audit_domain(const std::vector<JointInfo>& joints) {
   AuditDomain d;
-  d.lower.resize(Model::nq);
-  d.upper.resize(Model::nq);
-  for (int j = 0; j < Model::nq; ++j) {
-    d.lower(j) = Model::joints[j].audit_lower;
-    d.upper(j) = Model::joints[j].audit_upper;
+  const auto n = static_cast<Eigen::Index>(joints.size());
+  d.lower.resize(n);
+  d.upper.resize(n);
+  for (Eigen::Index j = 0; j < n; ++j) {
+    d.lower(j) = joints[static_cast<std::size_t>(j)].audit_lower;
+    d.upper(j) = joints[static_cast<std::size_t>(j)].audit_upper;
   }
   return d;
+}
+
+// The same for a generated Model.
+template <class Model>
+AuditDomain audit_domain() {
+  return audit_domain(std::vector<JointInfo>(Model::joints.begin(), Model::joints.end()));
 }
 
 class InertiaFunction {
