@@ -9,6 +9,7 @@
 #include <sstream>
 
 #include "symoro/codegen/generator.hpp"
+#include "symoro/codegen/modeling.hpp"
 #include "symoro/grammar/parser.hpp"
 
 namespace fs = std::filesystem;
@@ -171,6 +172,24 @@ int info(const std::string& dir) {
   return 0;
 }
 
+// Writes a robot folder's model files computed from its .par. Files that exist already are
+// replaced only after every file was computed, so a failure leaves the folder as it was.
+int model(const std::string& input, const std::string& out_dir, const ModelingOptions& options) {
+  const fs::path in(input);
+  if (in.extension() != ".par") throw std::runtime_error(input + ": symoroc model reads a .par (URDF input is to come)");
+  const Modeling m = model_from_par(input, options);
+  const fs::path dir(out_dir);
+  fs::create_directories(dir);
+  const fs::path par = dir / in.filename();
+  if (!fs::exists(par) || !fs::equivalent(par, in)) write_atomically(par, read_text(in));
+  for (const auto& f : m.files) write_atomically(dir / f.name, f.text);
+  fmt::print("{}: {} base parameters, {} files in {}\n", m.robot, m.base_parameters.size(), m.files.size() + 1, dir.string());
+  for (const auto& note : m.notes) fmt::print("  {}\n", note);
+  if (!fs::exists(dir / "robot.yaml"))
+    fmt::print("  {} has no robot.yaml yet: write one (joints, limits, constants) before symoroc generate\n", dir.string());
+  return 0;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -192,11 +211,19 @@ int main(int argc, char** argv) {
   auto* inf = app.add_subcommand("info", "Parameters, counts and operation counts of a robot");
   inf->add_option("robot_dir", info_dir, "robots/<name>")->required()->check(CLI::ExistingDirectory);
 
+  std::string model_input, model_out;
+  auto* mdl = app.add_subcommand("model", "Compute a robot's model files (base parameters, dynamics, geometry) from its .par");
+  mdl->add_option("description", model_input, "<robot>.par")->required()->check(CLI::ExistingFile);
+  mdl->add_option("-o,--output", model_out, "The robot folder to write (robots/<name>)")->required();
+  ModelingOptions model_options;
+  mdl->add_option("--frame", model_options.frame, "Frame of the geometric model and the Jacobian (default: the last)");
+
   CLI11_PARSE(app, argc, argv);
   try {
     if (*gen) return generate(gen_dirs, out_root);
     if (*chk) return check(robots, generated);
     if (*inf) return info(info_dir);
+    if (*mdl) return model(model_input, model_out, model_options);
   } catch (const symoro::grammar::ParseError& e) {
     std::cerr << e.what() << "\n";
     return 2;

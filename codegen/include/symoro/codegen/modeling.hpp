@@ -1,0 +1,36 @@
+// `symoroc model`: a robot's model files computed by the project itself from its description,
+// so that OpenSYMORO is no longer needed. From a .par (modified DH geometry, standard inertial
+// parameters): the base parameters (modeling/base_parameters.hpp says how), the inverse dynamics
+// by Newton-Euler, the identification model (its derivatives along the base parameters), the
+// Coriolis-gravity torques, the inertia matrix (derivatives along qdd), the direct dynamics
+// (an LDL^T solve of M qdd = tau - h), the geometric model and the Jacobian of the last frame.
+// The files are OpenSYMORO's format, so load_robot reads them like any other robot folder.
+#pragma once
+
+#include <string>
+#include <vector>
+
+namespace symoro::codegen {
+
+struct ModelFileText {
+  std::string name;  // file name inside the robot folder: idm.txt, <robot>_base.par, ...
+  std::string text;
+};
+
+struct Modeling {
+  std::string robot;
+  std::vector<ModelFileText> files;  // <robot>_base.par, regp, dim, idm, ccg, inm, ddm, fgm, jac
+  std::vector<std::string> base_parameters;
+  std::vector<std::string> notes;  // what the user should know (groupings found numerically)
+};
+
+struct ModelingOptions {
+  // The frame of the geometric model and the Jacobian (fgm.txt, jac.txt); 0: the last one.
+  // An arm with a gripper joint may want the wrist's (CRANE-X7: 7 of 8).
+  int frame = 0;
+};
+
+// Errors name the file, line and column (grammar::ParseError, InputError).
+Modeling model_from_par(const std::string& par_path, const ModelingOptions& options = {});
+
+}  // namespace symoro::codegen
