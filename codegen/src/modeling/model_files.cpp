@@ -207,15 +207,16 @@ Modeling model_from_par(const std::string& par_path, const ModelingOptions& opti
   // The direct dynamics: M qdd = tau - h by an LDL^T factorization of M.
   {
     std::vector<std::vector<NodeId>> L(n, std::vector<NodeId>(n, g.zero()));
-    std::vector<NodeId> D(n), x(n);
+    std::vector<NodeId> D(n), inv_D(n), x(n);  // one division per pivot
     for (int j = 0; j < n; ++j) {
       NodeId dj = A[j][j];
       for (int k = 0; k < j; ++k) dj = g.sub(dj, g.mul(g.pow(L[j][k], 2.0), D[k]));
       D[j] = dj;
+      inv_D[j] = g.div(g.one(), dj);
       for (int i = j + 1; i < n; ++i) {
         NodeId v = A[i][j];
         for (int k = 0; k < j; ++k) v = g.sub(v, g.mul(g.mul(L[i][k], L[j][k]), D[k]));
-        L[i][j] = g.div(v, D[j]);
+        L[i][j] = g.mul(v, inv_D[j]);
       }
     }
     for (int i = 0; i < n; ++i) {
@@ -223,7 +224,7 @@ Modeling model_from_par(const std::string& par_path, const ModelingOptions& opti
       for (int k = 0; k < i; ++k) y = g.sub(y, g.mul(L[i][k], x[k]));
       x[i] = y;
     }
-    for (int i = 0; i < n; ++i) x[i] = g.div(x[i], D[i]);
+    for (int i = 0; i < n; ++i) x[i] = g.mul(x[i], inv_D[i]);
     for (int i = n - 1; i >= 0; --i)
       for (int k = i + 1; k < n; ++k) x[i] = g.sub(x[i], g.mul(L[k][i], x[k]));
     std::vector<std::pair<std::string, NodeId>> o;
