@@ -10,7 +10,8 @@ packages=(
   libopenmpi-dev openmpi-bin  # optional: the MPI farm and its test (docs/scaling.md)
   procps  # pgrep/ps: the MPI test finds the rank it kills
   libxxhash-dev  # content digests (io/digest.hpp): saved runs, parameters files, robot folders
-  liburdfdom-dev liburdfdom-tools  # optional: dynid export --urdf's tests read the URDF back (urdfdom, check_urdf)
+  liburdfdom-dev liburdfdom-tools  # symoroc model reads URDFs (urdfdom); the export tests read them back (check_urdf)
+  liborocos-kdl-dev  # the tests compare URDF models against KDL, an independent rigid-body library
 )
 missing=()
 for p in "${packages[@]}"; do

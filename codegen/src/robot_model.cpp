@@ -309,6 +309,10 @@ RobotModel load_robot(const std::string& dir_in) {
     }
   }
 
+  for (const auto& [name, value] : m.spec.nominal)
+    if (!standard_names.count(name))
+      throw InputError(m.spec.path, 0, 0, "nominal: '" + name + "' is not a standard parameter of " + par_path);
+
   // ---- base parameters: the symbolic cells of the DIM's parameter tables
   const grammar::Table* inertia_table = find_table(dim, "Dynamic inertia parameters");
   const grammar::Table* joint_table = find_table(dim, "External forces and joint parameters");

@@ -242,7 +242,7 @@ RobotSpec read_robot_spec(const std::string& path) {
   Reader r{path};
   if (!root.IsMap()) throw InputError(path, 1, 1, "robot.yaml must be a mapping of keys");
   r.only_keys(root, {"name", "description", "constants", "joints", "parameter_units",
-                     "identified", "variants"},
+                     "identified", "variants", "nominal", "urdf"},
               "robot.yaml");
 
   RobotSpec spec;
@@ -343,6 +343,23 @@ RobotSpec read_robot_spec(const std::string& path) {
     }
     resolve_bases(r, raw);
     for (const auto& rv : raw) spec.variants.push_back(rv.spec);
+  }
+  if (const auto nom = root["nominal"]) {
+    if (!nom.IsMap()) r.fail(nom, "nominal must map standard parameter names to numbers");
+    for (const auto& kv : nom) spec.nominal[kv.first.Scalar()] = r.number(kv.second, "nominal " + kv.first.Scalar());
+  }
+  if (const auto u = root["urdf"]) {
+    if (!u.IsMap()) r.fail(u, "urdf must be a mapping (file, base_link, tip_link, ...)");
+    r.only_keys(u, {"file", "base_link", "tip_link", "frame0_in_base", "tip_in_last_frame", "joints", "links", "locked"}, "urdf");
+    for (const char* k : {"file", "base_link", "tip_link"})
+      if (!u[k]) r.fail(u, std::string("urdf needs '") + k + "'");
+    spec.urdf.file = r.string(u["file"], "urdf file");
+    spec.urdf.base_link = r.string(u["base_link"], "urdf base_link");
+    spec.urdf.tip_link = r.string(u["tip_link"], "urdf tip_link");
+    if (const auto j = u["joints"]) {
+      if (!j.IsSequence()) r.fail(j, "urdf joints must be a list of the URDF's joint names");
+      for (const auto& name : j) spec.urdf.joints.push_back(r.string(name, "urdf joint name"));
+    }
   }
   if (const auto id = root["identified"]) {
     spec.identified = r.string(id, "identified");

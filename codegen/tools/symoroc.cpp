@@ -172,18 +172,27 @@ int info(const std::string& dir) {
   return 0;
 }
 
-// Writes a robot folder's model files computed from its .par. Files that exist already are
-// replaced only after every file was computed, so a failure leaves the folder as it was.
-int model(const std::string& input, const std::string& out_dir, const ModelingOptions& options) {
+// Writes a robot folder's model files computed from its .par or URDF. Every file is computed
+// before any is written; a file that exists with other content (a robot.yaml the user edited)
+// is replaced only with --force.
+int model(const std::string& input, const std::string& out_dir, const ModelingOptions& options, bool force) {
   const fs::path in(input);
-  if (in.extension() != ".par") throw std::runtime_error(input + ": symoroc model reads a .par (URDF input is to come)");
-  const Modeling m = model_from_par(input, options);
+  const bool urdf = in.extension() == ".urdf" || in.extension() == ".xml";
+  if (!urdf && in.extension() != ".par") throw std::runtime_error(input + ": symoroc model reads a .par or a .urdf");
+  Modeling m = urdf ? model_from_urdf(input, options) : model_from_par(input, options);
   const fs::path dir(out_dir);
+  if (!urdf) m.files.insert(m.files.begin(), {in.filename().string(), read_text(in)});
+  std::vector<std::string> changed;
+  for (const auto& f : m.files)
+    if (fs::exists(dir / f.name) && read_text(dir / f.name) != f.text) changed.push_back(f.name);
+  if (!changed.empty() && !force) {
+    std::string list;
+    for (const auto& c : changed) list += " " + c;
+    throw std::runtime_error(dir.string() + " already has other versions of" + list + ": pass --force to replace them");
+  }
   fs::create_directories(dir);
-  const fs::path par = dir / in.filename();
-  if (!fs::exists(par) || !fs::equivalent(par, in)) write_atomically(par, read_text(in));
   for (const auto& f : m.files) write_atomically(dir / f.name, f.text);
-  fmt::print("{}: {} base parameters, {} files in {}\n", m.robot, m.base_parameters.size(), m.files.size() + 1, dir.string());
+  fmt::print("{}: {} base parameters, {} files in {}\n", m.robot, m.base_parameters.size(), m.files.size(), dir.string());
   for (const auto& note : m.notes) fmt::print("  {}\n", note);
   if (!fs::exists(dir / "robot.yaml"))
     fmt::print("  {} has no robot.yaml yet: write one (joints, limits, constants) before symoroc generate\n", dir.string());
@@ -213,17 +222,37 @@ int main(int argc, char** argv) {
 
   std::string model_input, model_out;
   auto* mdl = app.add_subcommand("model", "Compute a robot's model files (base parameters, dynamics, geometry) from its .par");
-  mdl->add_option("description", model_input, "<robot>.par")->required()->check(CLI::ExistingFile);
+  mdl->add_option("description", model_input, "<robot>.urdf or <robot>.par")->required()->check(CLI::ExistingFile);
   mdl->add_option("-o,--output", model_out, "The robot folder to write (robots/<name>)")->required();
   ModelingOptions model_options;
   mdl->add_option("--frame", model_options.frame, "Frame of the geometric model and the Jacobian (default: the last)");
+  mdl->add_option("--name", model_options.name, "The robot's name (URDF: default the URDF's)");
+  mdl->add_option("--base-link", model_options.base_link, "URDF: the chain's first link (default: the root)");
+  mdl->add_option("--tip-link", model_options.tip_link, "URDF: the chain's last link (default: where the moving joints end)");
+  std::vector<std::string> locks;
+  mdl->add_option("--lock", locks, "URDF: joint=position for a moving joint off the chain (default 0)");
+  bool no_ia = false, no_fv = false, no_fs = false, force = false;
+  mdl->add_flag("--no-rotor-inertia", no_ia, "URDF: no IA parameter per joint");
+  mdl->add_flag("--no-viscous", no_fv, "URDF: no FV (viscous friction) parameter per joint");
+  mdl->add_flag("--no-coulomb", no_fs, "URDF: no FS (Coulomb friction) parameter per joint");
+  mdl->add_flag("--force", force, "Replace files of the folder that differ");
 
   CLI11_PARSE(app, argc, argv);
   try {
     if (*gen) return generate(gen_dirs, out_root);
     if (*chk) return check(robots, generated);
     if (*inf) return info(info_dir);
-    if (*mdl) return model(model_input, model_out, model_options);
+    if (*mdl) {
+      for (const auto& l : locks) {
+        const auto eq = l.find('=');
+        if (eq == std::string::npos) throw std::runtime_error("--lock " + l + ": write joint=position");
+        model_options.locked[l.substr(0, eq)] = std::stod(l.substr(eq + 1));
+      }
+      model_options.rotor_inertia = !no_ia;
+      model_options.viscous = !no_fv;
+      model_options.coulomb = !no_fs;
+      return model(model_input, model_out, model_options, force);
+    }
   } catch (const symoro::grammar::ParseError& e) {
     std::cerr << e.what() << "\n";
     return 2;

@@ -6,6 +6,7 @@
 #include "description.hpp"
 #include "equation_text.hpp"
 #include "newton_euler.hpp"
+#include "urdf_chain.hpp"
 #include "symoro/codegen/passes.hpp"
 #include "symoro/codegen/robot_spec.hpp"
 #include "symoro/grammar/parser.hpp"
@@ -129,8 +130,30 @@ std::string base_par(const ExprGraph& g, const Description& d, const std::vector
 
 }  // namespace
 
+namespace {
+Modeling model_from_par_file(const grammar::ParFile& par, const ModelingOptions& options);
+}  // namespace
+
 Modeling model_from_par(const std::string& par_path, const ModelingOptions& options) {
-  const grammar::ParFile par = grammar::read_par_file(par_path);
+  return model_from_par_file(grammar::read_par_file(par_path), options);
+}
+
+Modeling model_from_par_text(const std::string& text, const std::string& path, const ModelingOptions& options) {
+  return model_from_par_file(grammar::parse_par_file(text, path), options);
+}
+
+Modeling model_from_urdf(const std::string& urdf_path, const ModelingOptions& options) {
+  const UrdfChain chain = read_urdf_chain(urdf_path, options);
+  Modeling m = model_from_par_text(chain.par_text, chain.name + ".par", options);
+  m.files.insert(m.files.begin(), {{chain.name + ".par", chain.par_text}, {"robot.yaml", chain.robot_yaml}});
+  m.notes.insert(m.notes.begin(), chain.notes.begin(), chain.notes.end());
+  return m;
+}
+
+namespace {
+
+Modeling model_from_par_file(const grammar::ParFile& par, const ModelingOptions& options) {
+  const std::string& par_path = par.path;
   ExprGraph g;
   const Description d = read_description(g, par);
   const BaseParameters base = base_parameters(g, d);
@@ -253,5 +276,7 @@ Modeling model_from_par(const std::string& par_path, const ModelingOptions& opti
   }
   return out;
 }
+
+}  // namespace
 
 }  // namespace symoro::codegen

@@ -53,6 +53,14 @@ struct RobotSpec {
   std::map<std::string, std::string> prismatic_units;
   std::string identified = "full";  // the model identification uses: "full" or a variant
   std::vector<VariantSpec> variants;
+  // Prior standard parameters by name (symoroc model writes the URDF's inertials here).
+  std::map<std::string, double> nominal;
+  // Where the robot came from when symoroc model read a URDF (robot.yaml `urdf`): the file, the
+  // chain's ends and its joints' names there.
+  struct Urdf {
+    std::string file, base_link, tip_link;
+    std::vector<std::string> joints;
+  } urdf;
 };
 
 // Reads and validates robot.yaml. Angles may be written as "90 deg"; plain numbers are SI.

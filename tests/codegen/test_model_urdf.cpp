@@ -1,0 +1,280 @@
+// symoroc model from a URDF against KDL (liborocos-kdl), an independent rigid-body library: the
+// test builds KDL's chain itself from urdfdom's parse, the way kdl_parser does (one segment per
+// joint on the way from base to tip, fixed ones included), and merges the links hanging off the
+// chain with KDL's own inertia algebra. The inverse dynamics and the inertia matrix of the model
+// symoroc wrote (loaded like any robot folder, its nominal standard parameters mapped through its
+// base_from_standard) must equal KDL's at random states. Three public arms (tests/urdf) and one
+// written here with a prismatic joint, rpy origins, a non-z axis, a negative axis, a fixed link
+// and a locked off-chain joint.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <random>
+#include <set>
+
+#include <kdl/chain.hpp>
+#include <kdl/chaindynparam.hpp>
+#include <kdl/chainidsolver_recursive_newton_euler.hpp>
+#include <urdf_parser/urdf_parser.h>
+
+#include "symoro/codegen/graph_evaluator.hpp"
+#include "symoro/codegen/modeling.hpp"
+#include "symoro/codegen/robot_model.hpp"
+
+namespace symoro::codegen {
+namespace {
+
+namespace fs = std::filesystem;
+const fs::path kUrdfs = SYMORO_TEST_URDF_DIR;
+
+KDL::Frame frame(const urdf::Pose& p) {
+  return KDL::Frame(KDL::Rotation::Quaternion(p.rotation.x, p.rotation.y, p.rotation.z, p.rotation.w),
+                    KDL::Vector(p.position.x, p.position.y, p.position.z));
+}
+
+// A link's own inertia, in its frame.
+KDL::RigidBodyInertia inertia(const urdf::Link& l) {
+  if (!l.inertial) return KDL::RigidBodyInertia::Zero();
+  const auto& i = *l.inertial;
+  return frame(i.origin) * KDL::RigidBodyInertia(i.mass, KDL::Vector::Zero(),
+                                                 KDL::RotationalInertia(i.ixx, i.iyy, i.izz, i.ixy, i.ixz, i.iyz));
+}
+
+// A joint's motion at position q.
+KDL::Frame motion(const urdf::Joint& j, double q) {
+  const KDL::Vector a(j.axis.x, j.axis.y, j.axis.z);
+  if (j.type == urdf::Joint::PRISMATIC) return KDL::Frame(q * a / a.Norm());
+  if (j.type == urdf::Joint::REVOLUTE || j.type == urdf::Joint::CONTINUOUS) return KDL::Frame(KDL::Rotation::Rot(a, q));
+  return KDL::Frame::Identity();
+}
+
+// KDL's chain from base to tip; links off the way are merged into the link they hang from,
+// their moving joints at `locked` positions (default 0).
+KDL::Chain kdl_chain(const urdf::ModelInterface& m, const std::string& base, const std::string& tip,
+                     const std::map<std::string, double>& locked) {
+  std::vector<urdf::JointConstSharedPtr> way;
+  for (auto l = m.getLink(tip); l->name != base; l = l->getParent()) way.insert(way.begin(), l->parent_joint);
+  std::set<std::string> on_way;
+  for (const auto& j : way) on_way.insert(j->child_link_name);
+  // The inertia of a link and everything hanging off it, in the link's frame.
+  std::function<KDL::RigidBodyInertia(const urdf::Link&)> lump = [&](const urdf::Link& l) {
+    KDL::RigidBodyInertia I = inertia(l);
+    for (const auto& c : l.child_links) {
+      if (on_way.count(c->name)) continue;
+      const auto it = locked.find(c->parent_joint->name);
+      const double q = it == locked.end() ? 0.0 : it->second;
+      I = I + (frame(c->parent_joint->parent_to_joint_origin_transform) * motion(*c->parent_joint, q)) * lump(*c);
+    }
+    return I;
+  };
+  KDL::Chain chain;
+  chain.addSegment(KDL::Segment("base", KDL::Joint(KDL::Joint::Fixed), KDL::Frame::Identity(), KDL::RigidBodyInertia::Zero()));
+  for (const auto& j : way) {
+    const KDL::Frame F = frame(j->parent_to_joint_origin_transform);
+    KDL::Joint joint(j->name, KDL::Joint::Fixed);
+    const KDL::Vector axis = F.M * KDL::Vector(j->axis.x, j->axis.y, j->axis.z);
+    if (j->type == urdf::Joint::REVOLUTE || j->type == urdf::Joint::CONTINUOUS)
+      joint = KDL::Joint(j->name, F.p, axis / axis.Norm(), KDL::Joint::RotAxis);
+    else if (j->type == urdf::Joint::PRISMATIC)
+      joint = KDL::Joint(j->name, F.p, axis / axis.Norm(), KDL::Joint::TransAxis);
+    chain.addSegment(KDL::Segment(j->child_link_name, joint, F, lump(*m.getLink(j->child_link_name))));
+  }
+  return chain;
+}
+
+struct Case {
+  std::string label;
+  fs::path urdf;
+  ModelingOptions options;
+  double tolerance = 1e-12;  // relative
+};
+
+// Largest |a - b| over the largest |a|.
+double relative_difference(const std::vector<double>& a, const std::vector<double>& b) {
+  double diff = 0, scale = 0;
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    diff = std::max(diff, std::abs(a[i] - b[i]));
+    scale = std::max(scale, std::abs(a[i]));
+  }
+  return diff / scale;
+}
+
+void expect_matches_kdl(const Case& c) {
+  SCOPED_TRACE(c.label);
+  const Modeling m = model_from_urdf(c.urdf.string(), c.options);
+  const fs::path dir = fs::temp_directory_path() / ("symoro_urdf_" + std::to_string(::getpid())) / m.robot;
+  fs::create_directories(dir);
+  for (const auto& f : m.files) std::ofstream(dir / f.name) << f.text;
+  RobotModel ours = load_robot(dir.string());
+
+  const auto model = urdf::parseURDFFile(c.urdf.string());
+  ASSERT_TRUE(model);
+  const std::string base = c.options.base_link.empty() ? model->getRoot()->name : c.options.base_link;
+  const KDL::Chain chain = kdl_chain(*model, base, ours.spec.urdf.tip_link, c.options.locked);
+  const int n = static_cast<int>(chain.getNrOfJoints());
+  ASSERT_EQ(n, ours.n);
+  ASSERT_EQ(ours.spec.urdf.base_link, base);
+
+  // The URDF's inertials (the nominal standard parameters), without friction or rotor inertia:
+  // KDL has neither.
+  std::map<std::string, double> standard = ours.spec.nominal;
+  for (auto& [name, v] : standard)
+    if (name.rfind("FV", 0) == 0 || name.rfind("FS", 0) == 0 || name.rfind("IA", 0) == 0) v = 0;
+  for (const auto& [k, v] : ours.spec.constants) standard[k] = v;
+  ASSERT_EQ(ours.spec.nominal.size(), ours.standard.size());
+  const std::vector<double> base_values = Evaluator(ours.graph, ours.base_from_standard)(standard);
+
+  std::vector<NodeId> roots = ours.idm;
+  for (const auto& row : ours.inm) roots.insert(roots.end(), row.begin(), row.end());
+  Evaluator eval(ours.graph, roots);
+  KDL::ChainIdSolver_RNE rne(chain, KDL::Vector(0, 0, -ours.spec.constants.at("G3")));
+  KDL::ChainDynParam dyn(chain, KDL::Vector(0, 0, -ours.spec.constants.at("G3")));
+  std::mt19937_64 rng(11);
+  std::uniform_real_distribution<double> u(-1, 1);
+  for (int trial = 0; trial < 25; ++trial) {
+    KDL::JntArray q(n), qd(n), qdd(n), tau(n);
+    std::map<std::string, double> at;
+    for (std::size_t p = 0; p < ours.base.size(); ++p) at[ours.base[p].name] = base_values[p];
+    for (int j = 0; j < n; ++j) {
+      q(j) = 1.5 * u(rng);
+      qd(j) = 2 * u(rng);
+      qdd(j) = 3 * u(rng);
+      at[ours.q[j]] = q(j);
+      at[ours.qd[j]] = qd(j);
+      at[ours.qdd[j]] = qdd(j);
+    }
+    ASSERT_GE(rne.CartToJnt(q, qd, qdd, KDL::Wrenches(chain.getNrOfSegments(), KDL::Wrench::Zero()), tau), 0);
+    KDL::JntSpaceInertiaMatrix H(n);
+    ASSERT_GE(dyn.JntToMass(q, H), 0);
+    const std::vector<double> v = eval(at);
+    std::vector<double> kdl_tau(n), our_tau(v.begin(), v.begin() + n), kdl_M, our_M(v.begin() + n, v.end());
+    for (int j = 0; j < n; ++j) kdl_tau[j] = tau(j);
+    for (int i = 0; i < n; ++i)
+      for (int j = 0; j < n; ++j) kdl_M.push_back(H(i, j));
+    EXPECT_LT(relative_difference(kdl_tau, our_tau), c.tolerance) << "inverse dynamics, trial " << trial;
+    EXPECT_LT(relative_difference(kdl_M, our_M), c.tolerance) << "inertia matrix, trial " << trial;
+  }
+}
+
+TEST(ModelFromUrdf, PandaMatchesKdl) {
+  Case c{"panda to its hand, fingers locked at 0", kUrdfs / "panda.urdf", {}};
+  c.options.tip_link = "panda_hand";
+  expect_matches_kdl(c);
+  c.label = "panda to link 7, fingers locked open";
+  c.options.tip_link = "panda_link7";
+  c.options.locked = {{"panda_finger_joint1", 0.03}, {"panda_finger_joint2", 0.01}};
+  expect_matches_kdl(c);
+}
+
+TEST(ModelFromUrdf, Ur5MatchesKdl) { expect_matches_kdl({"ur5", kUrdfs / "ur5_robot.urdf", {}}); }
+
+// The Kinova's rpy are quarter turns to 11 digits (1.57079632679: 5e-12 rad short). symoroc
+// model takes axes within 1e-9 rad of parallel as parallel (their common normal is not defined
+// in double), so its model is that much off the file's literal geometry: 1e-10, not 1e-12.
+TEST(ModelFromUrdf, KinovaMatchesKdl) { expect_matches_kdl({"kinova jaco2", kUrdfs / "kinova.urdf", {}, 1e-10}); }
+
+// Every case the conversion has to get right, in one small arm: rpy joint origins, an axis along
+// x, a negative axis, an oblique axis, a prismatic joint, a fixed link on the chain, a locked
+// off-chain revolute joint with its own link, and a base link that is not the root.
+const char* kTestArm = R"(<?xml version="1.0"?>
+<robot name="test_arm">
+  <link name="world"/>
+  <joint name="mount" type="fixed"><parent link="world"/><child link="base"/><origin xyz="0.1 0 0.2" rpy="0.1 0 0"/></joint>
+  <link name="base"><inertial><mass value="3"/><inertia ixx="1" ixy="0" ixz="0" iyy="1" iyz="0" izz="1"/></inertial></link>
+  <joint name="j1" type="revolute"><parent link="base"/><child link="l1"/><origin xyz="0 0 0.3" rpy="0 0 0.4"/>
+    <axis xyz="0 0 -1"/><limit lower="-3" upper="3" velocity="2" effort="50"/></joint>
+  <link name="l1"><inertial><origin xyz="0.02 0.01 -0.05" rpy="0.3 0.2 0.1"/><mass value="2.5"/>
+    <inertia ixx="0.02" ixy="0.001" ixz="-0.002" iyy="0.025" iyz="0.003" izz="0.01"/></inertial></link>
+  <joint name="j2" type="revolute"><parent link="l1"/><child link="l2"/><origin xyz="0.05 0.02 0.1" rpy="1.5707963267948966 0 0.2"/>
+    <axis xyz="1 0 0"/><limit lower="-2" upper="2" velocity="2" effort="40"/><dynamics damping="0.2" friction="0.1"/></joint>
+  <link name="l2"><inertial><origin xyz="0.1 -0.02 0.03" rpy="0 0.5 0"/><mass value="1.8"/>
+    <inertia ixx="0.01" ixy="-0.001" ixz="0.001" iyy="0.03" iyz="0.002" izz="0.028"/></inertial></link>
+  <joint name="j3" type="prismatic"><parent link="l2"/><child link="l3"/><origin xyz="0.3 0 0" rpy="0 -0.3 0.1"/>
+    <axis xyz="0 0.6 0.8"/><limit lower="-0.1" upper="0.2" velocity="0.5" effort="100"/></joint>
+  <link name="l3"><inertial><origin xyz="0 0.04 0.02"/><mass value="1.1"/>
+    <inertia ixx="0.004" ixy="0" ixz="0.0005" iyy="0.005" iyz="0" izz="0.003"/></inertial></link>
+  <joint name="l3_plate" type="fixed"><parent link="l3"/><child link="plate"/><origin xyz="0 0 0.15" rpy="0.2 0.1 0"/></joint>
+  <link name="plate"><inertial><origin xyz="0.01 0 0"/><mass value="0.4"/>
+    <inertia ixx="0.001" ixy="0" ixz="0" iyy="0.002" iyz="0" izz="0.002"/></inertial></link>
+  <joint name="j4" type="continuous"><parent link="plate"/><child link="l4"/><origin xyz="0.02 0.05 0.04" rpy="-0.5 0.7 1.1"/>
+    <axis xyz="0.3 -0.5 0.2"/><limit velocity="3" effort="10"/></joint>
+  <link name="l4"><inertial><origin xyz="0.03 0.02 0.06" rpy="0.1 0.2 0.3"/><mass value="0.9"/>
+    <inertia ixx="0.003" ixy="0.0002" ixz="0.0001" iyy="0.004" iyz="-0.0003" izz="0.002"/></inertial></link>
+  <joint name="side" type="revolute"><parent link="l4"/><child link="flap"/><origin xyz="0.05 0 0.02"/>
+    <axis xyz="0 1 0"/><limit lower="-1" upper="1" velocity="1" effort="1"/></joint>
+  <link name="flap"><inertial><origin xyz="0.04 0 0"/><mass value="0.3"/>
+    <inertia ixx="0.0002" ixy="0" ixz="0" iyy="0.0004" iyz="0" izz="0.0004"/></inertial></link>
+  <joint name="j5" type="revolute"><parent link="l4"/><child link="l5"/><origin xyz="0 0 0.12" rpy="0 1.5707963267948966 0"/>
+    <axis xyz="0 0 1"/><limit lower="-3" upper="3" velocity="3" effort="5"/></joint>
+  <link name="l5"><inertial><origin xyz="0.01 0.01 0.02"/><mass value="0.5"/>
+    <inertia ixx="0.001" ixy="0" ixz="0" iyy="0.001" iyz="0" izz="0.0008"/></inertial></link>
+</robot>
+)";
+
+TEST(ModelFromUrdf, EveryKindOfJointMatchesKdl) {
+  const fs::path p = fs::temp_directory_path() / ("symoro_test_arm_" + std::to_string(::getpid()) + ".urdf");
+  std::ofstream(p) << kTestArm;
+  Case c{"test arm", p, {}};
+  c.options.base_link = "base";
+  c.options.tip_link = "l5";
+  c.options.locked = {{"side", 0.6}};
+  expect_matches_kdl(c);
+}
+
+}  // namespace
+}  // namespace symoro::codegen
+
+namespace symoro::codegen {
+namespace {
+
+// The message of the error model_from_urdf raises on `text`.
+std::string error_of(const std::string& text, ModelingOptions o = {}) {
+  const fs::path p = fs::temp_directory_path() / ("symoro_bad_" + std::to_string(::getpid()) + ".urdf");
+  std::ofstream(p) << text;
+  try {
+    model_from_urdf(p.string(), o);
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "no error";
+}
+
+std::string arm(const std::string& joint2) {
+  return std::string(R"(<robot name="a"><link name="b"/><link name="l1"><inertial><mass value="1"/><inertia ixx="1" ixy="0" ixz="0" iyy="1" iyz="0" izz="1"/></inertial></link>
+<joint name="j1" type="revolute"><parent link="b"/><child link="l1"/><axis xyz="0 0 1"/><limit lower="-1" upper="1" velocity="1" effort="1"/></joint>
+<link name="l2"/>)") + (joint2.find("\"l3\"") != std::string::npos ? "<link name=\"l3\"/>" : "") + joint2 + "</robot>";
+}
+
+TEST(ModelFromUrdf, BadInputIsNamed) {
+  EXPECT_NE(error_of("<robot name=\"a\"><link name=\"b\"></robot>").find("not a valid URDF"), std::string::npos);
+  const std::string floating = error_of(arm(R"(<joint name="free" type="floating"><parent link="l1"/><child link="l2"/></joint>)"));
+  EXPECT_NE(floating.find("joint 'free' on the chain is floating"), std::string::npos) << floating;
+  EXPECT_NE(floating.find(".urdf:3:"), std::string::npos) << floating;  // the joint's line
+  const std::string branch = error_of(arm(R"(<joint name="x" type="revolute"><parent link="l1"/><child link="l2"/><axis xyz="0 0 1"/><limit lower="-1" upper="1" velocity="1" effort="1"/></joint>
+<joint name="y" type="revolute"><parent link="l1"/><child link="l3"/><axis xyz="0 0 1"/><limit lower="-1" upper="1" velocity="1" effort="1"/></joint>)"));
+  EXPECT_NE(branch.find("'l1' branches into moving joints ('x' and 'y')"), std::string::npos) << branch;
+  ModelingOptions tip;
+  tip.tip_link = "l2";
+  const std::string mimic = error_of(arm(R"(<joint name="m" type="revolute"><parent link="l1"/><child link="l2"/><axis xyz="0 0 1"/><mimic joint="j1"/><limit lower="-1" upper="1" velocity="1" effort="1"/></joint>)"), tip);
+  EXPECT_NE(mimic.find("joint 'm' on the chain mimics 'j1'"), std::string::npos) << mimic;
+  tip.tip_link = "nowhere";
+  const std::string fixed = R"(<joint name="f" type="fixed"><parent link="l1"/><child link="l2"/></joint>)";
+  EXPECT_NE(error_of(arm(fixed), tip).find("the tip link 'nowhere' is not a link"), std::string::npos);
+  ModelingOptions lock;
+  lock.locked = {{"j1", 0.1}};
+  EXPECT_NE(error_of(arm(fixed), lock).find("--lock j1: not a moving joint off the chain"), std::string::npos);
+  // An inconsistent inertial is a warning that names the link, not an error.
+  const fs::path p = fs::temp_directory_path() / ("symoro_warn_" + std::to_string(::getpid()) + ".urdf");
+  std::ofstream(p) << R"(<robot name="w"><link name="b"/><link name="l1"><inertial><mass value="1"/><inertia ixx="1" ixy="0" ixz="0" iyy="1" iyz="0" izz="3"/></inertial></link>
+<joint name="j1" type="revolute"><parent link="b"/><child link="l1"/><axis xyz="0 0 1"/><limit lower="-1" upper="1" velocity="1" effort="1"/></joint></robot>)";
+  const Modeling m = model_from_urdf(p.string());
+  bool warned = false;
+  for (const auto& note : m.notes) warned = warned || note.find("link 'l1' (line 1) is not physically consistent") != std::string::npos;
+  EXPECT_TRUE(warned);
+}
+
+}  // namespace
+}  // namespace symoro::codegen
