@@ -33,6 +33,7 @@ int main(int argc, char** argv) {
   add_compare_commands(app, common);
   add_control_commands(app, common);
   add_export_commands(app, common);
+  add_predict_commands(app, common);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

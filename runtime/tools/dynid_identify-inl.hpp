@@ -13,6 +13,7 @@ namespace symoro::dynid {
 
 template <class Full, class Model>
 void IdentifyCommand::run(const Common& common, const IdentifyOptions& o) {
+  if (o.take_model) return o.take_model(identify::identification_model<Model>());
   run_model(common, o, identify::identification_model<Model>(),
             [](const twin::TwinConfig& c) -> Eigen::VectorXd { return twin::identified_truth<Model>(c); });
 }

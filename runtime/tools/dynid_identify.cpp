@@ -146,6 +146,14 @@ void IdentifyCommand::run_model(const Common& common, const IdentifyOptions& o,
 }
 
 
+std::shared_ptr<const identify::IdentificationModel> identification_model_of(const Common& common, const std::string& model) {
+  std::shared_ptr<const identify::IdentificationModel> out;
+  IdentifyOptions o;
+  o.take_model = [&out](std::shared_ptr<const identify::IdentificationModel> m) { out = std::move(m); };
+  (model.empty() ? identify_units().robot(common) : identify_units().model(common, model))(common, o);
+  return out;
+}
+
 void add_identify_commands(CLI::App& app, Common& common) {
   auto o = std::make_shared<IdentifyOptions>();
   auto* cmd = app.add_subcommand("identify", "Identification study on a dataset: OLS, PD audit, SDP, CLIE, PCA "

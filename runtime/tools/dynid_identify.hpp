@@ -30,6 +30,9 @@ struct IdentifyOptions {
   double clie_std_bound = 0;
   double clie_noise_floor = 0;  // identify::ClieOptions::noise_floor
   double rank_timeout = 60;
+  // When set, the command hands its model here and runs nothing: the identify units double as
+  // the registry of every robot's identification models (identification_model_of).
+  std::function<void(std::shared_ptr<const identify::IdentificationModel>)> take_model;
 };
 
 // The twin's true parameters of the model being identified (twin data only).
@@ -46,5 +49,9 @@ struct IdentifyCommand {
 };
 
 const CommandTable<IdentifyOptions>& identify_units();  // generated: dynid_tables.cpp
+
+// The identification model of common.robot named `model` (a robot.yaml variant or "full"; ""
+// robot.yaml's `identified`), compiled once in symoro::<robot>_identification.
+std::shared_ptr<const identify::IdentificationModel> identification_model_of(const Common& common, const std::string& model);
 
 }  // namespace symoro::dynid

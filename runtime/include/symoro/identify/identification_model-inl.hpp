@@ -6,6 +6,8 @@
 
 #include <cstddef>
 #include <memory>
+#include <stdexcept>
+#include <string>
 #include <tuple>
 #include <vector>
 
@@ -29,11 +31,18 @@ class GeneratedIdentificationModel final : public IdentificationModel {
     d_.np = Model::np;
     d_.parameters.assign(Model::parameters.begin(), Model::parameters.end());
     d_.joints.assign(Model::joints.begin(), Model::joints.end());
+    d_.standard.assign(Model::standard_parameters.begin(), Model::standard_parameters.end());
   }
   const ModelDescription& description() const override { return d_; }
 
   Regression stack_regression(const preprocess::Samples& samples) const override {
     return identify::stack_regression<Model>(samples);
+  }
+  Eigen::VectorXd base_from_standard(const Eigen::VectorXd& s) const override {
+    if (s.size() != Model::ns)
+      throw std::invalid_argument("base_from_standard: " + std::to_string(s.size()) + " standard parameters for " +
+                                  std::to_string(Model::ns));
+    return Model::base_from_standard(Eigen::Matrix<double, Model::ns, 1>(s));
   }
   Eigen::MatrixXd open_loop_torque(const preprocess::Samples& samples, const Eigen::VectorXd& phi) const override {
     return identify::open_loop_torque<Model>(samples, phi);

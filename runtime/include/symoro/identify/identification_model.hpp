@@ -30,6 +30,7 @@ struct ModelDescription {
   int nq = 0, np = 0;
   std::vector<ParameterInfo> parameters;  // phi's entries
   std::vector<JointInfo> joints;
+  std::vector<StandardParameterInfo> standard;  // the argument of base_from_standard
 };
 
 class IdentificationModel {
@@ -39,6 +40,8 @@ class IdentificationModel {
 
   // The stacked regression of one run's samples (regression.hpp).
   virtual Regression stack_regression(const preprocess::Samples& samples) const = 0;
+  // phi of standard parameters s (description().standard's order; the effect parameters last).
+  virtual Eigen::VectorXd base_from_standard(const Eigen::VectorXd& s) const = 0;
   // ID(q, qd, qdd; phi) at every sample: samples x nq.
   virtual Eigen::MatrixXd open_loop_torque(const preprocess::Samples& samples, const Eigen::VectorXd& phi) const = 0;
   // M(q; phi) and its derivatives for the audit and the SDP projection.

@@ -1,0 +1,201 @@
+// dynid predict: a model's inverse-dynamics torque on a log's measured motion, beside the
+// measured torque, with the RMSE per joint: to check a model on one's own logs (an
+// identification's parameters, or the nominal ones symoroc model took from a URDF). q, qd and
+// qdd come from the identification's own preprocessing (time axis, zero-phase filter,
+// derivatives, the sampling interval), so the numbers compare with the study's. Compiled once:
+// the model is the robot's IdentificationModel (symoro::<robot>_identification).
+#include <cmath>
+#include <filesystem>
+#include <memory>
+
+#include <CLI/CLI.hpp>
+#include <fmt/format.h>
+#include <yaml-cpp/yaml.h>
+
+#include "dynid_common.hpp"
+#include "dynid_identify.hpp"
+#include "dynid_numbers.hpp"
+#include "symoro/identify/dataset.hpp"
+#include "symoro/identify/study_options.hpp"
+#include "symoro/io/atomic_file.hpp"
+#include "symoro/io/log.hpp"
+#include "symoro/io/number_text.hpp"
+#include "symoro/io/parameters_yaml.hpp"
+
+namespace symoro::dynid {
+
+namespace {
+
+namespace fs = std::filesystem;
+
+struct PredictOptions {
+  std::string params = "nominal", model, input, out;
+  double interval_ms = 10, torque_delay_ms = 0;
+  int trial = 1;
+  bool force = false;
+};
+
+// The model label a parameters file was identified with (its `model:`; "" the full model).
+std::string file_model(const std::string& file) {
+  try {
+    const YAML::Node root = YAML::LoadFile(file);
+    const std::string m = root["model"] ? root["model"].as<std::string>() : std::string();
+    return m.empty() ? "full" : m;
+  } catch (const YAML::BadFile&) {
+    throw UsageError(file + ": not found");
+  } catch (const YAML::Exception& e) {
+    throw UsageError(file + ": invalid YAML: " + e.what());
+  }
+}
+
+bool effect_family(const std::string& f) {
+  for (const char* rigid : {"XX", "XY", "XZ", "YY", "YZ", "ZZ", "MX", "MY", "MZ", "M", "IA", "FV", "FS"})
+    if (f == rigid) return false;
+  return true;
+}
+
+// phi from robot.yaml's `nominal:` standard parameters (effect parameters of a variant: 0).
+Eigen::VectorXd nominal_phi(const Common& common, const identify::IdentificationModel& model) {
+  const fs::path yaml = common.robot_dir() / "robot.yaml";
+  YAML::Node nominal;
+  try {
+    nominal = YAML::LoadFile(yaml.string())["nominal"];
+  } catch (const YAML::Exception& e) {
+    throw UsageError(yaml.string() + ": " + e.what());
+  }
+  if (!nominal || !nominal.IsMap())
+    throw UsageError(yaml.string() + " has no nominal parameters (symoroc model writes them from a URDF): give --params "
+                                     "<study>/report/parameters.yaml");
+  const auto& standard = model.description().standard;
+  Eigen::VectorXd s = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(standard.size()));
+  std::string missing;
+  for (std::size_t i = 0; i < standard.size(); ++i) {
+    const YAML::Node v = nominal[standard[i].name];
+    if (v) s(static_cast<Eigen::Index>(i)) = v.as<double>();
+    else if (!effect_family(standard[i].family)) missing += std::string(missing.empty() ? "" : ", ") + standard[i].name;
+  }
+  if (!missing.empty()) throw UsageError(yaml.string() + ": nominal lacks " + missing);
+  return model.base_from_standard(s);
+}
+
+struct Prediction {
+  std::string name;
+  int samples = 0;
+  Eigen::VectorXd rmse, rms;  // per joint: of tau - tau_model, and of tau
+};
+
+Prediction predict_log(const io::Log& log, const std::string& name, const identify::IdentificationModel& model,
+                       const Eigen::VectorXd& phi, const PredictOptions& o, const fs::path& csv) {
+  preprocess::Options po = identify::StudyOptions{}.preprocess;
+  po.torque_delay = o.torque_delay_ms / 1000;
+  const preprocess::Samples s = preprocess::preprocess(log, o.interval_ms / 1000, po);
+  const Eigen::MatrixXd tau_model = model.open_loop_torque(s, phi);
+  const int n = static_cast<int>(s.tau.cols());
+  Prediction p;
+  p.name = name;
+  p.samples = static_cast<int>(s.tau.rows());
+  p.rmse = ((s.tau - tau_model).colwise().squaredNorm() / p.samples).cwiseSqrt().transpose();
+  p.rms = (s.tau.colwise().squaredNorm() / p.samples).cwiseSqrt().transpose();
+  const auto& joints = model.description().joints;
+  std::string text = "time";
+  for (const char* what : {"q", "qd", "qdd", "tau", "tau_model"})
+    for (int j = 0; j < n; ++j) text += fmt::format(",{}_{}", what, joints[j].name);
+  text += "\n";
+  for (int k = 0; k < p.samples; ++k) {
+    text += io::number_text(s.time(k));
+    for (const Eigen::MatrixXd* m : {&s.q, &s.qd, &s.qdd, &s.tau, &tau_model})
+      for (int j = 0; j < n; ++j) text += "," + io::number_text((*m)(k, j));
+    text += "\n";
+  }
+  io::write_file_atomically(csv, text);
+  return p;
+}
+
+void run(const Common& common, const PredictOptions& o) {
+  std::string label = o.model;
+  if (o.params != "nominal") {
+    const std::string in_file = file_model(o.params);
+    if (!label.empty() && label != in_file)
+      throw UsageError(fmt::format("--model {}, but {} holds the parameters of model {}", label, o.params, in_file));
+    label = in_file;
+  }
+  const auto model = identification_model_of(common, label);
+  const identify::ModelDescription& d = model->description();
+  Eigen::VectorXd phi;
+  if (o.params == "nominal") {
+    phi = nominal_phi(common, *model);
+  } else {
+    std::vector<std::string> names;
+    for (const auto& p : d.parameters) names.push_back(p.name);
+    const io::ParametersIntegrity integrity = io::parameters_integrity(o.params, names);
+    if (!integrity.intact) fmt::print(stderr, "warning: {}: {}\n", o.params, integrity.why);
+    phi = io::read_parameters_yaml(o.params, names);
+  }
+
+  // What to predict: one log, or every run of a dataset's trial.
+  std::vector<std::pair<std::string, io::Log>> logs;
+  const fs::path input(o.input);
+  if (fs::is_directory(input)) {
+    const identify::Dataset data = identify::read_dataset(input);
+    identify::check_dataset_robot(data, common.robot);
+    for (const auto& r : data.runs)
+      if (r.trial == o.trial) logs.emplace_back(r.trajectory, identify::read_run_log(r, common.robot, d.nq));
+    if (logs.empty()) throw UsageError(fmt::format("{}: no run of trial {}", input.string(), o.trial));
+  } else {
+    io::Log log = io::read_log(input);
+    if (log.joints() != d.nq)
+      throw UsageError(fmt::format("{} has {} joints, the model of {} {}", input.string(), log.joints(), common.robot, d.nq));
+    logs.emplace_back(input.stem().string(), std::move(log));
+  }
+  const fs::path out(o.out);
+  const bool one = logs.size() == 1 && !fs::is_directory(input);
+  std::vector<fs::path> files;
+  for (const auto& [name, log] : logs) files.push_back(one ? out : out / (name + ".predicted.csv"));
+  for (const auto& f : files)
+    if (fs::exists(f) && !o.force) throw UsageError(f.string() + " exists: dynid predict does not overwrite it; choose another --out, or --force");
+  if (!one) fs::create_directories(out);
+
+  fmt::print("{} model {} with {} parameters, at {:.0f} ms: RMSE of tau - tau_model (RMS of tau) per joint, N m\n", common.robot,
+             d.variant.empty() ? "full" : d.variant, o.params == "nominal" ? "the nominal" : o.params, o.interval_ms);
+  Eigen::VectorXd sq = Eigen::VectorXd::Zero(d.nq);
+  int total = 0;
+  for (std::size_t i = 0; i < logs.size(); ++i) {
+    const Prediction p = predict_log(logs[i].second, logs[i].first, *model, phi, o, files[i]);
+    std::string line = fmt::format("  {:<10} {:>6} samples:", p.name, p.samples);
+    for (int j = 0; j < d.nq; ++j) line += fmt::format(" {:.4f} ({:.3f})", p.rmse(j), p.rms(j));
+    fmt::print("{}\n", line);
+    sq += p.rmse.cwiseAbs2() * p.samples;
+    total += p.samples;
+  }
+  if (logs.size() > 1) {
+    std::string line = fmt::format("  {:<10} {:>6} samples:", "all", total);
+    for (int j = 0; j < d.nq; ++j) line += fmt::format(" {:.4f}", std::sqrt(sq(j) / total));
+    fmt::print("{}\n", line);
+  }
+  fmt::print("predicted torque: {}\n", one ? out.string() : (out / "*.predicted.csv").string());
+}
+
+}  // namespace
+
+void add_predict_commands(CLI::App& app, Common& common) {
+  auto o = std::make_shared<PredictOptions>();
+  auto* cmd = app.add_subcommand("predict", "A model's inverse-dynamics torque on a log's measured motion (or every run of "
+                                            "a dataset), beside the measured torque, with the RMSE per joint");
+  cmd->add_option("--robot", common.robot, "Robot folder name under robots/")->required();
+  cmd->add_option("--robots-dir", common.robots_dir, "Where the robot folders are");
+  cmd->add_option("--params", o->params, "A study's report/parameters.yaml, or `nominal` (robot.yaml's nominal "
+                                         "standard parameters, e.g. a URDF's)")
+      ->capture_default_str();
+  cmd->add_option("--model", o->model, "Model: a robot.yaml variant or full (default: the parameters file's, or "
+                                       "robot.yaml's identified)");
+  cmd->add_option("input", o->input, "A log (CSV with its .meta.yaml) or a dataset folder")->required()->check(CLI::ExistingPath);
+  cmd->add_option("-o,--out", o->out, "The CSV to write (a folder of <run>.predicted.csv for a dataset)")->required();
+  cmd->add_option("--interval", o->interval_ms, "Sampling interval in ms, as in identification")->check(numbers::interval_ms())->capture_default_str();
+  cmd->add_option("--torque-delay", o->torque_delay_ms, "ms the logged torque lags the links' (as dynid identify)")
+      ->check(numbers::checked(-1000, 1000, false, false, "from -1000 to 1000 ms"));
+  cmd->add_option("--trial", o->trial, "Which trial of a dataset's runs")->check(numbers::count(1, 1e6))->capture_default_str();
+  cmd->add_flag("--force", o->force, "Overwrite existing output files");
+  cmd->callback([&common, o] { run(common, *o); });
+}
+
+}  // namespace symoro::dynid
