@@ -15,6 +15,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include "dynid_export.hpp"
+#include "dynid_urdf_into.hpp"
 #include "symoro/identify/dataset.hpp"
 #include "symoro/identify/physical_consistency_model.hpp"
 #include "symoro/identify/regression.hpp"
@@ -115,6 +116,16 @@ void ExportCommand::run(const Common& common, const ExportOptions& o) {
       const twin::TwinConfig tc = twin::read_twin_config(twin_path, Model::nq);
       prior = twin::make_truth<Parent>(tc).standard;
       prior_what = twin_path.string() + " (CAD truth)";
+    } else if (const YAML::Node nominal = YAML::LoadFile((common.robot_dir() / "robot.yaml").string())["nominal"]) {
+      // symoroc model's robot.yaml from a URDF: the URDF's own inertials.
+      prior = Eigen::VectorXd::Zero(Model::ns);
+      for (int i = 0; i < Model::ns; ++i) {
+        const YAML::Node v = nominal[Model::standard_parameters[i].name];
+        if (!v) throw UsageError(fmt::format("{}: nominal lacks {}", (common.robot_dir() / "robot.yaml").string(),
+                                             Model::standard_parameters[i].name));
+        prior(i) = v.as<double>();
+      }
+      prior_what = (common.robot_dir() / "robot.yaml").string() + " (nominal: the URDF's inertials)";
     } else {
       throw UsageError(fmt::format("robot '{}' has no twin.yaml to take a prior from: give --prior <standard-parameter "
                                    "YAML> or --prior zero (see dynid export --help)",
@@ -175,7 +186,13 @@ void ExportCommand::run(const Common& common, const ExportOptions& o) {
                           "lambda_min: {}\nbase_residual: {}\n",
                           Model::robot_name, model_label, o.study, prior_what, accepted, nearest, o.margin,
                           r.lambda_min, residual);
-    export_detail::write_text(urdf, identify::urdf_text(d));
+    if (o.into.empty()) {
+      export_detail::write_text(urdf, identify::urdf_text(d));
+    } else {
+      std::vector<std::string> notes;
+      export_detail::write_text(urdf, urdf_into(d, (common.robot_dir() / "robot.yaml").string(), o.into, notes));
+      for (const auto& note : notes) fmt::print("{}\n", note);
+    }
     export_detail::write_text(yaml, identify::standard_parameters_yaml(d, header));
     export_detail::write_text(csv, identify::standard_parameters_csv(d));
     if (nearest)

@@ -51,12 +51,15 @@ void add_export_commands(CLI::App& app, Common& common) {
   cmd->add_option("--urdf", o->urdf, "URDF file to write; <stem>.standard.yaml and <stem>.standard.csv go beside it")
       ->required();
   cmd->add_option("--model", o->model, "Model the study identified (checked; default: the study's own)");
+  cmd->add_option("--into", o->into, "The robot's own URDF (the one symoroc model read): --urdf is then that file with "
+                                     "the identified inertials and joint dynamics, everything else unchanged")
+      ->check(CLI::ExistingFile);
   cmd->add_option("--prior", o->prior,
                   "Standard parameters the consistent set is drawn towards where the base parameters leave it free: "
                   "a YAML with every standard parameter (e.g. an earlier export's .standard.yaml), or `zero` "
                   "(the consistent set nearest 0: smallest masses and inertias, a generic choice with no physical "
-                  "meaning for the unidentifiable part). Default: the CAD truth of robots/<robot>/twin.yaml; a robot "
-                  "without twin.yaml needs --prior");
+                  "meaning for the unidentifiable part). Default: the CAD truth of robots/<robot>/twin.yaml, else "
+                  "robot.yaml's nominal parameters (a URDF's); a robot with neither needs --prior");
   cmd->add_option("--margin", o->margin, "Strictness of the consistency: every link's pseudo-inertia >= margin I "
                                          "(kg m^2 / kg; 0 allows singular links)")
       ->check(numbers::non_negative(1, ">= 0 and <= 1"))
