@@ -67,6 +67,14 @@ struct Divergence {
 // loop is the only part compiled per model.
 class ClosedLoop {
  public:
+  // Takes d tau / d phi one cycle at a time, in order: row k's nq * np values, d tau_j / d phi_i
+  // at j * np + i (so that a caller can reduce them as they come instead of storing them all).
+  class SensitivityRows {
+   public:
+    virtual ~SensitivityRows() = default;
+    virtual void row(const double* dtau) = 0;
+  };
+
   virtual ~ClosedLoop() = default;
   virtual int joints() const = 0;
   // The model's parameters: the entries of phi, in order.
@@ -85,6 +93,9 @@ class ClosedLoop {
                 Divergence* why) const {
     return simulate(phi, tau, dtau, why, nullptr);
   }
+  // The same with d tau / d phi handed to `dtau` row by row (cycles() rows unless it diverges).
+  virtual bool simulate(const Eigen::VectorXd& phi, preprocess::Channels& tau, SensitivityRows& dtau,
+                        Divergence* why) const = 0;
 };
 
 }  // namespace symoro::identify

@@ -167,6 +167,25 @@ class ClosedLoopSimulator final : public ClosedLoop {
   // The same, also giving the sampled q (cycles() x nq, row k = q(t_k), what the controller saw).
   bool simulate(const Eigen::VectorXd& phi, preprocess::Channels& tau, preprocess::Channels* dtau,
                 Divergence* why, preprocess::Channels* q) const override {
+    if (!dtau) return simulate_into(phi, tau, nullptr, why, q);
+    // Rows into the matrix.
+    struct Store final : SensitivityRows {
+      preprocess::Channels& m;
+      Eigen::Index k = 0;
+      explicit Store(preprocess::Channels& out) : m(out) {}
+      void row(const double* d) override { m.row(k++) = Eigen::Map<const Eigen::RowVectorXd>(d, m.cols()); }
+    } store(*dtau);
+    dtau->resize(cycles_, n * np);
+    return simulate_into(phi, tau, &store, why, q);
+  }
+  bool simulate(const Eigen::VectorXd& phi, preprocess::Channels& tau, SensitivityRows& dtau,
+                Divergence* why) const override {
+    return simulate_into(phi, tau, &dtau, why, nullptr);
+  }
+
+ private:
+  bool simulate_into(const Eigen::VectorXd& phi, preprocess::Channels& tau, SensitivityRows* dtau, Divergence* why,
+                     preprocess::Channels* q) const {
     if (phi.size() != np)
       throw std::invalid_argument("closed-loop simulation: phi has " + std::to_string(phi.size()) + " entries, the model " +
                                   std::to_string(np));
@@ -177,7 +196,6 @@ class ClosedLoopSimulator final : public ClosedLoop {
     return ok;
   }
 
- private:
   using Mat = Eigen::Matrix<double, n, n>;
   using Jet = ceres::Jet<double, 2 * n>;
 
@@ -344,13 +362,13 @@ class ClosedLoopSimulator final : public ClosedLoop {
   }
 
   template <bool Sens>
-  bool run(const Phi& phi, preprocess::Channels& tau, preprocess::Channels* dtau, preprocess::Channels* q_out,
+  bool run(const Phi& phi, preprocess::Channels& tau, SensitivityRows* dtau, preprocess::Channels* q_out,
            Divergence& why) const {
     const double T = period(), d = setup_.delay;
     const int total = pre_cycles_ + cycles_;  // pre-roll cycles, then the recorded ones
     const bool split = setup_.split_at_sampling;
     tau.resize(cycles_, n);
-    if constexpr (Sens) dtau->resize(cycles_, n * np);
+    Eigen::Matrix<double, n, np, Eigen::RowMajor> dtau_row;
     if (q_out) q_out->resize(cycles_, n);
 
     detail::FfpdSensitivity<n, np> controller(setup_.gains);
@@ -390,7 +408,10 @@ class ClosedLoopSimulator final : public ClosedLoop {
       }
       if (c >= pre_cycles_) {
         tau.row(k) = u_prev.transpose();
-        if constexpr (Sens) Eigen::Map<Eigen::Matrix<double, n, np, Eigen::RowMajor>>(dtau->row(k).data()) = du_prev;
+        if constexpr (Sens) {
+          dtau_row = du_prev;
+          dtau->row(dtau_row.data());
+        }
         if (q_out) q_out->row(k) = qs.transpose();
       }
       controller.template update<Sens>(qs, dqs, q_ref_.col(k), qd_ref_.col(k), qdd_ref_.col(k), u, du);
