@@ -1,6 +1,8 @@
 // CLIE's cost: the closed-loop simulation in simulated seconds per wall second, with and
 // without forward sensitivities (the paper's 39-parameter model on AG02; the sensitivities'
-// derivatives generated, or from Jets as before: the *Jet benchmarks), and one complete
+// derivatives generated, from the first Heun stage only by default, from both stages (the exact
+// derivative of the discrete map) in the *Exact benchmarks, or from Jets as before: the *Jet
+// benchmarks), and one complete
 // CLIE refinement of AG02 at 40 ms on data from the default twin, from the truth perturbed by
 // 20 % (alternating signs).
 //
@@ -36,10 +38,17 @@ struct Fixture {
   identify::ClosedLoopSimulator<Reduced> sim{identify::closed_loop_setup(config), trajectory};
   // The same with the sensitivities' derivatives from Jets (ClosedLoopSetup::jet_derivatives).
   identify::ClosedLoopSimulator<Reduced> sim_jet{jet_setup(config), trajectory};
+  // The exact derivatives of the discrete map (ClosedLoopSetup::exact_sensitivities).
+  identify::ClosedLoopSimulator<Reduced> sim_exact{exact_setup(config), trajectory};
 
   static identify::ClosedLoopSetup jet_setup(const symoro::twin::TwinConfig& c) {
     identify::ClosedLoopSetup s = identify::closed_loop_setup(c);
     s.jet_derivatives = true;
+    return s;
+  }
+  static identify::ClosedLoopSetup exact_setup(const symoro::twin::TwinConfig& c) {
+    identify::ClosedLoopSetup s = identify::closed_loop_setup(c);
+    s.exact_sensitivities = true;
     return s;
   }
 };
@@ -49,13 +58,18 @@ const Fixture& fixture() {
   return f;
 }
 
-void simulate(benchmark::State& state, bool sensitivities, bool jet = false, bool interface = false) {
+enum class Path { fast, jet, exact };
+
+const identify::ClosedLoopSimulator<Reduced>& simulator(const Fixture& f, Path p) {
+  return p == Path::jet ? f.sim_jet : p == Path::exact ? f.sim_exact : f.sim;
+}
+
+void simulate(benchmark::State& state, bool sensitivities, Path path = Path::fast, bool interface = false) {
   const Fixture& f = fixture();
   // Through the model-independent interface (a virtual call, as CLIE and the study make it) or
   // on the concrete ClosedLoopSimulator<Reduced> (resolved at compile time).
-  const identify::ClosedLoop& through = jet ? f.sim_jet : f.sim;
-  const auto& concrete = jet ? f.sim_jet : f.sim;
-  const auto& sim = concrete;
+  const identify::ClosedLoop& through = simulator(f, path);
+  const auto& sim = simulator(f, path);
   symoro::preprocess::Channels tau, dtau;
   double simulated = 0;
   for (auto _ : state) {
@@ -71,15 +85,17 @@ void BM_Simulate(benchmark::State& s) { simulate(s, false); }
 void BM_SimulateWithSensitivities(benchmark::State& s) { simulate(s, true); }
 BENCHMARK(BM_Simulate)->Unit(benchmark::kMillisecond)->UseRealTime();
 // The same through identify::ClosedLoop (issue 27: the interface must cost no measurable time).
-void BM_SimulateThroughInterface(benchmark::State& s) { simulate(s, false, false, true); }
-void BM_SimulateWithSensitivitiesThroughInterface(benchmark::State& s) { simulate(s, true, false, true); }
+void BM_SimulateThroughInterface(benchmark::State& s) { simulate(s, false, Path::fast, true); }
+void BM_SimulateWithSensitivitiesThroughInterface(benchmark::State& s) { simulate(s, true, Path::fast, true); }
 BENCHMARK(BM_SimulateThroughInterface)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_SimulateWithSensitivitiesThroughInterface)->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(3);
-void BM_SimulateWithSensitivitiesJet(benchmark::State& s) { simulate(s, true, true); }
+void BM_SimulateWithSensitivitiesJet(benchmark::State& s) { simulate(s, true, Path::jet); }
+void BM_SimulateWithSensitivitiesExact(benchmark::State& s) { simulate(s, true, Path::exact); }
 BENCHMARK(BM_SimulateWithSensitivities)->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(3);
+BENCHMARK(BM_SimulateWithSensitivitiesExact)->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(3);
 BENCHMARK(BM_SimulateWithSensitivitiesJet)->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(3);
 
-void clie_ag02(benchmark::State& state, bool jet) {
+void clie_ag02(benchmark::State& state, Path path) {
   const Fixture& f = fixture();
   symoro::twin::RunOptions run;
   run.robot = "crane_x7";
@@ -90,7 +106,7 @@ void clie_ag02(benchmark::State& state, bool jet) {
   for (int i = 0; i < phi0.size(); ++i) phi0(i) *= i % 2 ? 1.2 : 0.8;
   identify::ClieResult r;
   for (auto _ : state) {
-    r = identify::clie<Reduced>(jet ? f.sim_jet : f.sim, samples, phi0, options);
+    r = identify::clie<Reduced>(simulator(f, path), samples, phi0, options);
     if (!r.success) state.SkipWithError(r.termination.c_str());
   }
   state.counters["iterations"] = r.iterations;
@@ -103,9 +119,11 @@ void clie_ag02(benchmark::State& state, bool jet) {
   state.counters["wall_s"] = r.wall;
   state.SetLabel(r.termination.substr(0, 60));
 }
-void BM_ClieAG02At40ms(benchmark::State& s) { clie_ag02(s, false); }
-void BM_ClieAG02At40msJet(benchmark::State& s) { clie_ag02(s, true); }
+void BM_ClieAG02At40ms(benchmark::State& s) { clie_ag02(s, Path::fast); }
+void BM_ClieAG02At40msJet(benchmark::State& s) { clie_ag02(s, Path::jet); }
+void BM_ClieAG02At40msExact(benchmark::State& s) { clie_ag02(s, Path::exact); }
 BENCHMARK(BM_ClieAG02At40ms)->Unit(benchmark::kSecond)->UseRealTime()->Iterations(1);
+BENCHMARK(BM_ClieAG02At40msExact)->Unit(benchmark::kSecond)->UseRealTime()->Iterations(1);
 BENCHMARK(BM_ClieAG02At40msJet)->Unit(benchmark::kSecond)->UseRealTime()->Iterations(1);
 
 }  // namespace

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <array>
 #include <chrono>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -289,6 +290,45 @@ void solve_bounded(ceres::CostFunction& cost, const Bounds& bounds, const ClieOp
     if (held[static_cast<std::size_t>(i)]) result.held.push_back(i);
 }
 
+// d tau / d phi at the sample rows, low-passed as the measurement when the grid filters, taken
+// from the simulation row by row (preprocess::SampledZeroPhase): never stored for every cycle
+// (cycles x n np doubles, 290 MB for AG02 on the reduced model).
+class SampledSensitivities final : public ClosedLoop::SensitivityRows {
+ public:
+  SampledSensitivities(const SampleGrid& grid, Eigen::Index cycles, Eigen::Index width) : grid_(grid), width_(width) {
+    if (grid.filter) {
+      filter_.emplace(grid.sections, grid.padding, cycles, width, grid.rows);
+    } else {
+      order_.resize(grid.rows.size());
+      for (std::size_t s = 0; s < order_.size(); ++s) order_[s] = s;
+      std::stable_sort(order_.begin(), order_.end(), [&](std::size_t a, std::size_t b) { return grid.rows[a] < grid.rows[b]; });
+      rows_.resize(static_cast<Eigen::Index>(grid.rows.size()), width);
+    }
+  }
+  void row(const double* d) override {
+    if (filter_) {
+      filter_->push(d);
+    } else {
+      for (; next_ < order_.size() && grid_.rows[order_[next_]] == k_; ++next_)
+        rows_.row(static_cast<Eigen::Index>(order_[next_])) = Eigen::Map<const Eigen::RowVectorXd>(d, width_);
+    }
+    ++k_;
+  }
+  // Row s: the sample's d tau / d phi (after a complete simulation).
+  const preprocess::Channels& finish() {
+    if (filter_) filter_->finish(rows_);
+    return rows_;
+  }
+
+ private:
+  const SampleGrid& grid_;
+  Eigen::Index width_, k_ = 0;
+  std::optional<preprocess::SampledZeroPhase> filter_;
+  std::vector<std::size_t> order_;
+  std::size_t next_ = 0;
+  preprocess::Channels rows_;
+};
+
 // All residuals tau_m - tau_s at the samples (sample-major, joint fastest) in one block of
 // np parameters; its Jacobian, -(filtered d tau_s / d phi) at the sample rows, is one row of
 // the simulation's dtau per sample. A diverging simulation fails the evaluation, which Ceres
@@ -348,16 +388,21 @@ class ClieCost final : public ceres::CostFunction {
 
   bool simulate_residuals(const Eigen::VectorXd& phi, double* residuals, double* jacobian,
                           Divergence* why) const {
-    if (!sim_.simulate(phi, tau_, jacobian ? &dtau_ : nullptr, why)) return false;
+    std::optional<SampledSensitivities> dtau;
+    if (jacobian) {
+      dtau.emplace(grid_, sim_.cycles(), static_cast<Eigen::Index>(n_) * np_);
+      if (!sim_.simulate(phi, tau_, *dtau, why)) return false;
+    } else if (!sim_.simulate(phi, tau_, nullptr, why)) {
+      return false;
+    }
     lowpass(grid_, tau_);
     const Eigen::Index samples = static_cast<Eigen::Index>(grid_.rows.size());
     for (Eigen::Index s = 0; s < samples; ++s)
       for (int j = 0; j < n_; ++j) residuals[s * n_ + j] = measured_.tau(s, j) - tau_(grid_.rows[s], j);
     if (jacobian) {
-      lowpass(grid_, dtau_);
-      // A dtau row is d tau_j / d phi_i at j * np + i: the sample's n Jacobian rows, row-major.
-      for (Eigen::Index s = 0; s < samples; ++s)
-        Eigen::Map<Eigen::RowVectorXd>(jacobian + s * n_ * np_, n_ * np_) = -dtau_.row(grid_.rows[s]);
+      const preprocess::Channels& d = dtau->finish();
+      // A row is d tau_j / d phi_i at j * np + i: the sample's n Jacobian rows, row-major.
+      Eigen::Map<preprocess::Channels>(jacobian, samples, static_cast<Eigen::Index>(n_) * np_) = -d;
     }
     return true;
   }
@@ -366,8 +411,7 @@ class ClieCost final : public ceres::CostFunction {
   const preprocess::Samples& measured_;
   const SampleGrid& grid_;
   const int n_, np_;
-  // Reused between evaluations (dtau is the large one: cycles x n np).
-  mutable preprocess::Channels tau_, dtau_;
+  mutable preprocess::Channels tau_;  // reused between evaluations
   mutable int rejected_ = 0;
   mutable std::array<Evaluated, 2> evaluated_;
   mutable std::size_t next_slot_ = 0;

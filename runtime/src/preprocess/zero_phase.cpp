@@ -1,5 +1,6 @@
 #include "symoro/preprocess/zero_phase.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 #include <string>
@@ -51,6 +52,22 @@ class Cascade {
     }
   }
 
+  // The state of channel 0 as one vector (z1, z2 of each section in turn), and back.
+  Eigen::VectorXd state() const {
+    Eigen::VectorXd z(2 * z1_.cols());
+    for (Eigen::Index i = 0; i < z1_.cols(); ++i) {
+      z(2 * i) = z1_(0, i);
+      z(2 * i + 1) = z2_(0, i);
+    }
+    return z;
+  }
+  void set_state(const Eigen::VectorXd& z) {
+    for (Eigen::Index i = 0; i < z1_.cols(); ++i) {
+      z1_(0, i) = z(2 * i);
+      z2_(0, i) = z(2 * i + 1);
+    }
+  }
+
  private:
   const std::vector<Biquad>& sections_;
   Eigen::ArrayXXd z1_, z2_;  // channels x sections
@@ -85,6 +102,153 @@ void filtfilt(const std::vector<Biquad>& sections, int padding, Channels& signal
   cascade.start_at_rest(last);
   cascade.run(last, padding, -1);
   cascade.run(signals.data() + (n - 1) * channels, n, -1);
+}
+
+struct SampledZeroPhase::State {
+  State(const std::vector<Biquad>& s, int p, Eigen::Index n, Eigen::Index c)
+      : sections(s), padding(p), rows(n), channels(c), forward(sections, c) {}
+  std::vector<Biquad> sections;
+  int padding;
+  Eigen::Index rows, channels, pushed = 0;
+  Cascade forward;
+  Channels head, ring;          // the first padding + 1 rows; the last padding + 1 rows (raw)
+  Eigen::ArrayXd tmp;           // one row through the forward pass
+  std::vector<Eigen::Index> wanted, unique;  // as asked; sorted without repeats
+  // The backward cascade as z <- A z + B u, y = c z + d u; at rest on u: z = rest u.
+  Eigen::MatrixXd A;
+  Eigen::VectorXd B, c, rest;
+  double d = 0;
+  std::vector<Eigen::VectorXd> power;  // power[p] = A^p B
+  // Block i: sum over forward outputs u_e, unique[i] < e <= unique[i + 1] (the last block: to the
+  // end of the padding) of A^(e - unique[i] - 1) B u_e (dim rows of channels each); and the forward
+  // output at unique[i] itself.
+  Channels blocks, at_row;
+  Eigen::ArrayXd last;  // the forward output at the very end
+  Eigen::Index block = -1;
+
+  // Forward output u at index e of the padded signal (e = row, or rows + i in the end padding).
+  void consume(const double* u, Eigen::Index e) {
+    const Eigen::Index m = static_cast<Eigen::Index>(unique.size()), dim = B.size();
+    while (block + 1 < m && unique[static_cast<std::size_t>(block + 1)] < e) ++block;
+    if (block >= 0) {
+      const Eigen::VectorXd& g = power[static_cast<std::size_t>(e - unique[static_cast<std::size_t>(block)] - 1)];
+      for (Eigen::Index k = 0; k < dim; ++k) {
+        double* __restrict acc = blocks.row(block * dim + k).data();
+        const double w = g(k);
+        for (Eigen::Index ch = 0; ch < channels; ++ch) acc[ch] += w * u[ch];
+      }
+    }
+    if (block + 1 < m && unique[static_cast<std::size_t>(block + 1)] == e)
+      at_row.row(block + 1) = Eigen::Map<const Eigen::RowVectorXd>(u, channels);
+    if (e == rows + padding - 1) last = Eigen::Map<const Eigen::ArrayXd>(u, channels);
+  }
+  void step(const double* x, Eigen::Index e) {
+    tmp = Eigen::Map<const Eigen::ArrayXd>(x, channels);
+    forward.run(tmp.data(), 1, 1);
+    consume(tmp.data(), e);
+  }
+};
+
+SampledZeroPhase::SampledZeroPhase(const std::vector<Biquad>& sections, int padding, Eigen::Index rows,
+                                   Eigen::Index channels, const std::vector<Eigen::Index>& wanted)
+    : s_(std::make_unique<State>(sections, padding, rows, channels)) {
+  if (padding < 0 || padding >= rows)
+    throw std::invalid_argument("SampledZeroPhase: padding " + std::to_string(padding) +
+                                " needs more than that many samples, got " + std::to_string(rows));
+  State& s = *s_;
+  s.wanted = wanted;
+  s.unique = wanted;
+  std::sort(s.unique.begin(), s.unique.end());
+  s.unique.erase(std::unique(s.unique.begin(), s.unique.end()), s.unique.end());
+  if (!s.unique.empty() && (s.unique.front() < 0 || s.unique.back() >= rows))
+    throw std::invalid_argument("SampledZeroPhase: a wanted row lies outside the signal");
+  s.head.resize(padding + 1, channels);
+  s.ring.resize(padding + 1, channels);
+  // The backward cascade's matrices, by running one channel on unit states and inputs.
+  Cascade one(s.sections, 1);
+  const Eigen::Index dim = 2 * static_cast<Eigen::Index>(sections.size());
+  s.A.resize(dim, dim);
+  s.c.resize(dim);
+  for (Eigen::Index j = 0; j < dim; ++j) {
+    one.set_state(Eigen::VectorXd::Unit(dim, j));
+    double u = 0;
+    one.run(&u, 1, 1);
+    s.c(j) = u;
+    s.A.col(j) = one.state();
+  }
+  one.set_state(Eigen::VectorXd::Zero(dim));
+  double u = 1;
+  one.run(&u, 1, 1);
+  s.d = u;
+  s.B = one.state();
+  u = 1;
+  one.start_at_rest(&u);
+  s.rest = one.state();
+  Eigen::Index longest = 1;
+  for (std::size_t i = 0; i + 1 < s.unique.size(); ++i) longest = std::max(longest, s.unique[i + 1] - s.unique[i]);
+  if (!s.unique.empty()) longest = std::max(longest, rows + padding - 1 - s.unique.back());
+  s.power.resize(static_cast<std::size_t>(longest) + 1);
+  s.power[0] = s.B;
+  for (std::size_t p = 1; p < s.power.size(); ++p) s.power[p] = s.A * s.power[p - 1];
+  const Eigen::Index m = static_cast<Eigen::Index>(s.unique.size());
+  s.blocks = Channels::Zero(m * dim, channels);
+  s.at_row.resize(m, channels);
+}
+
+SampledZeroPhase::~SampledZeroPhase() = default;
+
+void SampledZeroPhase::push(const double* row) {
+  State& s = *s_;
+  const Eigen::Index k = s.pushed++, P = s.padding, C = s.channels;
+  if (k >= s.rows) throw std::logic_error("SampledZeroPhase: more rows than announced");
+  const auto x = Eigen::Map<const Eigen::RowVectorXd>(row, C);
+  s.ring.row(k % (P + 1)) = x;
+  if (k <= P) s.head.row(k) = x;
+  if (k == P) {
+    // The start padding (filtfilt's `before`), then the rows held so far.
+    Channels before(P, C);
+    for (Eigen::Index i = 0; i < P; ++i) before.row(i) = 2 * s.head.row(0) - s.head.row(P - i);
+    s.forward.start_at_rest(P > 0 ? before.data() : s.head.data());
+    s.forward.run(before.data(), P, 1);
+    for (Eigen::Index i = 0; i <= P; ++i) s.step(s.head.row(i).data(), i);
+  } else if (k > P) {
+    s.step(row, k);
+  }
+  if (k == s.rows - 1) {
+    // The end padding: after(i) = 2 x(n - 1) - x(n - 2 - i), from the ring.
+    Eigen::RowVectorXd a(C);
+    for (Eigen::Index i = 0; i < P; ++i) {
+      a = 2 * s.ring.row((s.rows - 1) % (P + 1)) - s.ring.row((s.rows - 2 - i) % (P + 1));
+      s.step(a.data(), s.rows + i);
+    }
+  }
+}
+
+void SampledZeroPhase::finish(Channels& out) {
+  State& s = *s_;
+  if (s.pushed != s.rows) throw std::logic_error("SampledZeroPhase: finished before the last row");
+  const Eigen::Index m = static_cast<Eigen::Index>(s.unique.size()), dim = s.B.size(), C = s.channels;
+  Channels y(m, C);
+  if (m > 0) {
+    // Backward from the end: at rest on the last output, A^(steps to the last wanted row) of it.
+    const Eigen::Index end = s.rows + s.padding - 1;
+    Eigen::VectorXd start = s.rest;
+    for (Eigen::Index p = 0; p < end - s.unique.back(); ++p) start = s.A * start;
+    Eigen::MatrixXd z = s.blocks.middleRows((m - 1) * dim, dim) + start * s.last.matrix().transpose();
+    for (Eigen::Index i = m - 1;; --i) {
+      y.row(i) = s.c.transpose() * z + s.d * s.at_row.row(i);
+      if (i == 0) break;
+      Eigen::MatrixXd a = Eigen::MatrixXd::Identity(dim, dim);
+      for (Eigen::Index p = 0; p < s.unique[static_cast<std::size_t>(i)] - s.unique[static_cast<std::size_t>(i - 1)]; ++p)
+        a = s.A * a;
+      z = a * z + s.blocks.middleRows((i - 1) * dim, dim);
+    }
+  }
+  out.resize(static_cast<Eigen::Index>(s.wanted.size()), C);
+  for (std::size_t w = 0; w < s.wanted.size(); ++w) {
+    const auto i = std::lower_bound(s.unique.begin(), s.unique.end(), s.wanted[w]) - s.unique.begin();
+    out.row(static_cast<Eigen::Index>(w)) = y.row(i);
+  }
 }
 
 }  // namespace symoro::preprocess

@@ -3,7 +3,7 @@
 // over the target-grid samples of one sampling interval. tau_s comes from the closed-loop
 // simulation (closed_loop.hpp) passed through the same zero-phase low-pass the measurement
 // went through in preprocessing, so both sides see the same filter; the Jacobian is the
-// simulation's forward sensitivities through that (linear) filter: exact, no finite
+// simulation's forward sensitivities through that (linear) filter (closed_loop.hpp), no finite
 // differences. Bounds: about +-bound_factor times each initial value, rotor inertias positive,
 // a parameter that reaches its bound held there (ClieOptions::hold_at_bounds);
 // optionally also +-std_bound standard deviations of the run's OLS estimate (`scale`), so that

@@ -1,7 +1,8 @@
 // The closed-loop simulation CLIE fits through (paper Fig. clie_block): the identified model's
 // forward dynamics driven by the same fixed FF+PD controller, sample-and-hold and bus delay as
-// the experiment, with forward sensitivities d tau / d phi that are the exact derivatives of
-// the discrete simulation (no finite differences).
+// the experiment, with forward sensitivities d tau / d phi (no finite differences): by default
+// O(h^2) from the exact derivatives of the discrete simulation, or those exactly
+// (ClosedLoopSetup::exact_sensitivities).
 //
 // Timing of cycle k (period T, sampling instant t_k = k T, no jitter): q is sampled, the
 // controller computes a command that takes effect at t_k + delay and is held until the next
@@ -39,6 +40,11 @@ struct ClosedLoopSetup {
   // (default), or the older way, a ceres::Jet over (q, qd) through the generated inverse dynamics
   // (kept to compare the two; the results agree to round-off).
   bool jet_derivatives = false;
+  // The sensitivities' d qdd / d(q, qd, tau, phi) at each Heun stage (the exact derivative of the
+  // discrete map, twice the derivative work), or, by default, once per step at its midpoint
+  // (closed_loop_model.hpp: d tau ~6e-5 relative from the exact one). Only with the generated
+  // derivatives (jet_derivatives takes each stage's).
+  bool exact_sensitivities = false;
 };
 
 // The experiment's controller and timing, from the robot's controller description.
@@ -61,6 +67,14 @@ struct Divergence {
 // loop is the only part compiled per model.
 class ClosedLoop {
  public:
+  // Takes d tau / d phi one cycle at a time, in order: row k's nq * np values, d tau_j / d phi_i
+  // at j * np + i (so that a caller can reduce them as they come instead of storing them all).
+  class SensitivityRows {
+   public:
+    virtual ~SensitivityRows() = default;
+    virtual void row(const double* dtau) = 0;
+  };
+
   virtual ~ClosedLoop() = default;
   virtual int joints() const = 0;
   // The model's parameters: the entries of phi, in order.
@@ -79,6 +93,9 @@ class ClosedLoop {
                 Divergence* why) const {
     return simulate(phi, tau, dtau, why, nullptr);
   }
+  // The same with d tau / d phi handed to `dtau` row by row (cycles() rows unless it diverges).
+  virtual bool simulate(const Eigen::VectorXd& phi, preprocess::Channels& tau, SensitivityRows& dtau,
+                        Divergence* why) const = 0;
 };
 
 }  // namespace symoro::identify

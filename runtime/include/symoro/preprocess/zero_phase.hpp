@@ -10,7 +10,10 @@
 // are unaffected; pieces split at a long gap in mid-motion are.
 #pragma once
 
+#include <memory>
 #include <vector>
+
+#include <Eigen/Core>
 
 #include "symoro/preprocess/butterworth.hpp"
 #include "symoro/preprocess/channels.hpp"
@@ -27,5 +30,26 @@ int zero_phase_padding(const std::vector<Biquad>& sections);
 // a padded copy). Needs padding < rows (std::invalid_argument otherwise; callers check the
 // length first and report it).
 void filtfilt(const std::vector<Biquad>& sections, int padding, Channels& signals);
+
+// filtfilt's output at a few rows of a signal fed one row at a time, without storing the signal:
+// the forward pass runs as rows arrive; the backward pass, linear in its state (z <- A z + B u,
+// y = C z + D u), is summed block by block between the wanted rows as the forward output comes,
+// and swept back over the blocks at the end. Memory: (2 sections + 1) values per channel and
+// wanted row, plus padding + 1 rows. Equal to filtfilt at those rows up to rounding.
+class SampledZeroPhase {
+ public:
+  // `wanted`: rows of the signal (0 <= row < rows, any order, repeats allowed); padding < rows.
+  SampledZeroPhase(const std::vector<Biquad>& sections, int padding, Eigen::Index rows, Eigen::Index channels,
+                   const std::vector<Eigen::Index>& wanted);
+  ~SampledZeroPhase();
+  // The next row (rows in order 0, 1, ..., rows - 1; `channels` values).
+  void push(const double* row);
+  // After the last row: out(s, c) = filtfilt(signal)(wanted[s], c).
+  void finish(Channels& out);
+
+ private:
+  struct State;
+  std::unique_ptr<State> s_;
+};
 
 }  // namespace symoro::preprocess
