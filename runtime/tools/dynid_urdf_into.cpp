@@ -280,8 +280,11 @@ std::string urdf_into(const identify::UrdfDescription& d, const std::string& rob
     if (whole)
       for (const auto& name : merged) {
         const Span s = find_element(x, "link", name);
-        const auto [b, e] = find_child(x, "inertial", s.open_end, s.end);
-        if (b != std::string::npos) x.erase(b, e - b);
+        auto [b, e] = find_child(x, "inertial", s.open_end, s.end);
+        if (b == std::string::npos) continue;
+        while (b > 0 && (x[b - 1] == ' ' || x[b - 1] == '\t')) --b;  // the element's whole line
+        if (e < x.size() && x[e] == '\n') ++e;
+        x.erase(b, e - b);
       }
     // The joint's friction.
     bool has_fv = false, has_fs = false;

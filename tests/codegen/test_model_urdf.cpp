@@ -20,6 +20,7 @@
 #include <kdl/chainidsolver_recursive_newton_euler.hpp>
 #include <urdf_parser/urdf_parser.h>
 
+#include "dynid_urdf_into.hpp"
 #include "symoro/codegen/graph_evaluator.hpp"
 #include "symoro/codegen/modeling.hpp"
 #include "symoro/codegen/robot_model.hpp"
@@ -274,6 +275,114 @@ TEST(ModelFromUrdf, BadInputIsNamed) {
   bool warned = false;
   for (const auto& note : m.notes) warned = warned || note.find("link 'l1' (line 1) is not physically consistent") != std::string::npos;
   EXPECT_TRUE(warned);
+}
+
+}  // namespace
+}  // namespace symoro::codegen
+
+// dynid export --into: identified standard parameters written into the user's own URDF. Read
+// back through symoroc model, the file gives every model link's standard parameters again
+// (so the base parameters too); with the <inertial> and <dynamics> elements taken out, the file
+// is the user's, byte for byte.
+
+namespace symoro::codegen {
+namespace {
+
+std::string without_dynamic_elements(std::string x) {
+  for (const std::string tag : {"inertial", "dynamics"}) {
+    std::size_t at;
+    while ((at = x.find("<" + tag)) != std::string::npos) {
+      const std::size_t gt = x.find('>', at);
+      const std::size_t end = x[gt - 1] == '/' ? gt + 1 : x.find("</" + tag + ">", gt) + tag.size() + 3;
+      std::size_t from = at;
+      while (from > 0 && (x[from - 1] == ' ' || x[from - 1] == '\t')) --from;  // its indentation
+      std::size_t to = end;
+      if (to < x.size() && x[to] == '\n') ++to;
+      x.erase(from, to - from);
+    }
+  }
+  return x;
+}
+
+void expect_written_into(double extra_mass, bool expect_whole) {
+  ModelingOptions o;
+  o.tip_link = "panda_hand";
+  o.locked = {{"panda_finger_joint1", 0.02}, {"panda_finger_joint2", 0.02}};
+  const fs::path user = kUrdfs / "panda.urdf";
+  const Modeling m = model_from_urdf(user.string(), o);
+  const fs::path dir = fs::temp_directory_path() / ("symoro_into_" + std::to_string(::getpid())) / m.robot;
+  fs::create_directories(dir);
+  for (const auto& f : m.files) std::ofstream(dir / f.name) << f.text;
+  const RobotModel r = load_robot(dir.string());
+
+  // "Identified": each model link's nominal body plus a random consistent one (or, for the last
+  // link, minus mass when extra_mass < 0: less than the merged hand and fingers weigh).
+  identify::UrdfDescription d;
+  d.robot = r.name;
+  for (const auto& f : r.frames) d.frames.push_back({f.ant, f.sigma, f.mu, f.gamma, f.b, f.alpha, f.d, f.theta, f.r});
+  for (int j = 0; j < r.n; ++j) {
+    const auto& js = r.spec.joints[j];
+    d.joints.push_back({js.name.c_str(), JointType::Revolute, js.lower, js.upper, js.velocity, js.effort, js.audit_lower, js.audit_upper});
+  }
+  for (const auto& p : r.standard) d.names.push_back({p.name.c_str(), p.family.c_str(), p.joint});
+  d.s.resize(static_cast<Eigen::Index>(r.standard.size()));
+  std::mt19937_64 rng(5);
+  std::uniform_real_distribution<double> u(0, 1);
+  std::map<std::string, double> extra;
+  for (int j = 1; j <= r.n; ++j) {
+    const double mass = j == r.n ? extra_mass : 0.1 + 0.2 * u(rng);
+    const double c[3] = {0.05 * u(rng), 0.05 * u(rng), 0.05 * u(rng)}, I = 1e-3 * (1 + u(rng));
+    const double cc = c[0] * c[0] + c[1] * c[1] + c[2] * c[2];
+    const std::string s = std::to_string(j);
+    // A point-like body with a small isotropic inertia (negative mass: a lighter link).
+    extra["XX" + s] = std::abs(mass) / mass * I + mass * (cc - c[0] * c[0]);
+    extra["YY" + s] = std::abs(mass) / mass * I + mass * (cc - c[1] * c[1]);
+    extra["ZZ" + s] = std::abs(mass) / mass * I + mass * (cc - c[2] * c[2]);
+    extra["XY" + s] = -mass * c[0] * c[1];
+    extra["XZ" + s] = -mass * c[0] * c[2];
+    extra["YZ" + s] = -mass * c[1] * c[2];
+    extra["MX" + s] = mass * c[0];
+    extra["MY" + s] = mass * c[1];
+    extra["MZ" + s] = mass * c[2];
+    extra["M" + s] = mass;
+    extra["FV" + s] = 0.01 + u(rng);
+    extra["FS" + s] = 0.01 + u(rng);
+  }
+  for (std::size_t i = 0; i < r.standard.size(); ++i) {
+    const std::string& name = r.standard[i].name;
+    d.s(static_cast<Eigen::Index>(i)) = r.spec.nominal.at(name) + (extra.count(name) ? extra.at(name) : 0.0);
+  }
+  std::vector<std::string> notes;
+  const std::string text = dynid::urdf_into(d, (dir / "robot.yaml").string(), user.string(), notes);
+  bool whole = false;
+  for (const auto& n : notes) whole = whole || n.find("takes the whole body") != std::string::npos;
+  EXPECT_EQ(whole, expect_whole);
+
+  std::ifstream in(user);
+  const std::string original((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  EXPECT_EQ(without_dynamic_elements(text), without_dynamic_elements(original));
+
+  const fs::path written = dir / "written.urdf";
+  std::ofstream(written) << text;
+  const Modeling back = model_from_urdf(written.string(), o);
+  const fs::path dir2 = dir.parent_path() / "back";
+  fs::create_directories(dir2);
+  for (const auto& f : back.files) std::ofstream(dir2 / f.name) << f.text;
+  const RobotModel rb = load_robot(dir2.string());
+  double scale = 0;
+  for (Eigen::Index i = 0; i < d.s.size(); ++i) scale = std::max(scale, std::abs(d.s(i)));
+  for (std::size_t i = 0; i < r.standard.size(); ++i) {
+    const std::string& name = r.standard[i].name;
+    if (name.rfind("IA", 0) == 0) continue;  // no URDF field
+    EXPECT_NEAR(rb.spec.nominal.at(name), d.s(static_cast<Eigen::Index>(i)), 1e-12 * scale) << name;
+  }
+}
+
+TEST(ModelFromUrdf, IdentifiedInertialsGoIntoTheUsersUrdf) {
+  expect_written_into(0.2, false);
+  // The identified last link weighs less than the hand and fingers merged into it: the chain
+  // link takes the whole body and their inertials go.
+  expect_written_into(-0.9, true);
 }
 
 }  // namespace
