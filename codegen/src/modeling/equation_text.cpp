@@ -11,6 +11,13 @@ namespace symoro::codegen::modeling {
 
 std::string number_text(double v) {
   char t[40];
+  // Plain decimals where they are short (150, 0.0825), else the shortest %g (1e-05).
+  if (v == 0) return "0";
+  if (std::abs(v) >= 1e-4 && std::abs(v) < 1e15)
+    for (int k = 0; k <= 17; ++k) {
+      std::snprintf(t, sizeof t, "%.*f", k, v);
+      if (std::strtod(t, nullptr) == v) return t;
+    }
   for (int p = 1; p <= 17; ++p) {
     std::snprintf(t, sizeof t, "%.*g", p, v);
     if (std::strtod(t, nullptr) == v) break;

@@ -25,7 +25,9 @@ using Eigen::Isometry3d;
 using Eigen::Matrix3d;
 using Eigen::Vector3d;
 
-constexpr double kAngleSnap = 1e-12;   // rad: an angle this close to k pi/2 is k pi/2
+// rad: an angle this close to k pi/2 is k pi/2. URDFs write quarter turns to 9 or 11 digits
+// (1.570796325, 1.57079632679): they mean pi/2, and exact zeros keep the model's code short.
+constexpr double kAngleSnap = 1e-8;
 constexpr double kLengthSnap = 1e-12;  // m
 
 // urdfdom reports through console_bridge: the messages go into the error instead of stderr.
@@ -39,12 +41,7 @@ class Capture : public console_bridge::OutputHandler {
   std::string messages;
 };
 
-Isometry3d pose(const urdf::Pose& p) {
-  Isometry3d T = Isometry3d::Identity();
-  T.linear() = Eigen::Quaterniond(p.rotation.w, p.rotation.x, p.rotation.y, p.rotation.z).normalized().toRotationMatrix();
-  T.translation() = Vector3d(p.position.x, p.position.y, p.position.z);
-  return T;
-}
+
 
 Vector3d vec(const urdf::Vector3& v) { return {v.x, v.y, v.z}; }
 
@@ -69,14 +66,14 @@ double snapped_angle(double a) {
   const double k = std::round(a / (M_PI / 2));
   return std::abs(a - k * M_PI / 2) <= kAngleSnap ? k * M_PI / 2 : a;
 }
-// A length: 0 below kLengthSnap, else the 15-digit decimal it is within rounding of (the URDF's
+// A length: 0 below kLengthSnap, else the 12-digit decimal it is within rounding of (the URDF's
 // decimals come back as 0.0825 rather than 0.08250000000000005).
 double snapped_length(double x) {
   if (std::abs(x) <= kLengthSnap) return 0.0;
   char t[40];
-  std::snprintf(t, sizeof t, "%.15g", x);
+  std::snprintf(t, sizeof t, "%.12g", x);
   const double r = std::strtod(t, nullptr);
-  return std::abs(r - x) <= 1e-14 * std::abs(x) ? r : x;
+  return std::abs(r - x) <= 1e-13 * std::abs(x) ? r : x;
 }
 
 std::string identifier(const std::string& s) {
@@ -105,6 +102,21 @@ Isometry3d dh_transform(const Dh& p) {
 
 // Exact trig at quarter turns, so that the frames agree with the exact model's.
 double exact(double v) { return std::abs(v) < 1e-15 ? 0.0 : std::abs(std::abs(v) - 1) < 1e-15 ? std::copysign(1.0, v) : v; }
+
+// A URDF origin; its roll, pitch and yaw near quarter turns are taken as exact (kAngleSnap), so
+// that the geometry computed from them is exact too (0.09465, not 0.0946499999959983).
+Isometry3d pose(const urdf::Pose& p) {
+  double roll, pitch, yaw;
+  p.rotation.getRPY(roll, pitch, yaw);
+  Isometry3d T = Isometry3d::Identity();
+  T.linear() = (Eigen::AngleAxisd(snapped_angle(yaw), Vector3d::UnitZ()) * Eigen::AngleAxisd(snapped_angle(pitch), Vector3d::UnitY()) *
+                Eigen::AngleAxisd(snapped_angle(roll), Vector3d::UnitX()))
+                   .toRotationMatrix();
+  for (int a = 0; a < 3; ++a)
+    for (int b = 0; b < 3; ++b) T.linear()(a, b) = exact(T.linear()(a, b));
+  T.translation() = Vector3d(p.position.x, p.position.y, p.position.z);
+  return T;
+}
 
 std::string xyz_rpy(const Isometry3d& T) {
   const Vector3d p = T.translation();
@@ -292,7 +304,7 @@ UrdfChain read_urdf_chain(const std::string& path, const ModelingOptions& option
     Vector3d A, B, xp;
     double d = 0;
     const Vector3d c = zi.cross(zk);
-    if (c.norm() > 1e-9) {
+    if (c.norm() > 1e-7) {  // axes closer to parallel than that are parallel (see kAngleSnap)
       A = closest_on(O_prev, zi, P[k], zk);
       B = closest_on(P[k], zk, O_prev, zi);
       const Vector3d w = B - A;
@@ -331,7 +343,7 @@ UrdfChain read_urdf_chain(const std::string& path, const ModelingOptions& option
     Isometry3d Tk = prev * dh_transform(p);
     for (int a = 0; a < 3; ++a)
       for (int bb = 0; bb < 3; ++bb) Tk.linear()(a, bb) = exact(Tk.linear()(a, bb));
-    if ((Tk.linear().col(2) - zk).norm() > 1e-9 || (Tk.translation() - Ok).norm() > 1e-9)
+    if ((Tk.linear().col(2) - zk).norm() > 1e-6 || (Tk.translation() - Ok).norm() > 1e-6)
       throw std::logic_error("symoroc model: the DH frame of joint '" + chain[k]->name + "' does not reproduce its axis (an internal error)");
     R_prev = Tk.linear();
     O_prev = Tk.translation();
