@@ -6,7 +6,8 @@
 # one (CLIE skipped and said, open-loop validation on the held-out part), diagnosed (names the
 # friction and the offset) and compared; the full model's study is exported as a URDF (dynid export
 # --urdf; no twin.yaml, so --prior is required) and, when -DCHECK_URDF names urdfdom's check_urdf,
-# read back with it. Run with -DDYNID, -DWRITE_EXPORT, -DWORK [-DCHECK_URDF].
+# read back with it. Then a robot from its URDF alone (robots/ur5), below. Run with -DDYNID,
+# -DWRITE_EXPORT, -DWORK, -DURDF_DIR [-DCHECK_URDF].
 file(REMOVE_RECURSE ${WORK})
 file(MAKE_DIRECTORY ${WORK})
 
@@ -115,4 +116,52 @@ foreach(robot rx90 stanford_rrp)
     message(FATAL_ERROR "the physical study's export warns:\n${urdf}")
   endif()
 endforeach()
+
+# A robot from its URDF alone: robots/ur5 is what `symoroc model tests/urdf/ur5_robot.urdf` wrote
+# (plus a `rigid` variant). Its controller's export is synthesized from the URDF's own inertials
+# with what the URDF lacks: Coulomb friction and an offset on the last joint. The nominal model's
+# torque on it (dynid predict), the identification, the diagnosis (names what the URDF lacked),
+# and the identified inertials written into the user's own URDF (dynid export --into): only its
+# <inertial> and <dynamics> change.
+set(w ${WORK}/ur5)
+file(MAKE_DIRECTORY ${w})
+execute_process(COMMAND ${WRITE_EXPORT} ur5 ${w}/export.csv 60 5 RESULT_VARIABLE code)
+if(NOT code EQUAL 0)
+  message(FATAL_ERROR "write_export ur5 failed")
+endif()
+run(0 out import --robot ur5 -o ${w}/data ${w}/export.csv --name arm --time stamp_ms --time-unit ms
+    --q "{name}_pos" --qd "{name}_vel" --tau "{name}_eff" --angle deg --split 0.7)
+run(0 out predict --robot ur5 --params nominal ${w}/data -o ${w}/nominal)
+expect("${out}" "ur5 model full with the nominal parameters, at 10 ms")
+expect("${out}" "arm_heldout")
+foreach(f arm arm_heldout)
+  if(NOT EXISTS ${w}/nominal/${f}.predicted.csv)
+    message(FATAL_ERROR "dynid predict wrote no ${f}.predicted.csv")
+  endif()
+endforeach()
+file(STRINGS ${w}/nominal/arm.predicted.csv header LIMIT_COUNT 1)
+expect("${header}" "tau_model_wrist_3_joint")
+run(2 out predict --robot ur5 --params nominal ${w}/data -o ${w}/nominal)
+expect("${out}" "exists: dynid predict does not overwrite it")
+run(0 out identify --robot ur5 --model rigid --data ${w}/data -o ${w}/study-rigid --interval 10)
+expect("${out}" "accepted")
+run(0 out diagnose --robot ur5 --model rigid --data ${w}/data -o ${w}/diagnosis)
+expect("${out}" "effect: Coulomb friction \\(tanh width [0-9.]+ rad/s\\), joint [12]")
+expect("${out}" "effect: constant torque offset, joint 6")
+run(0 out identify --robot ur5 --data ${w}/data -o ${w}/study-physical --interval 10 --consistency physical)
+expect("${out}" "physical consistency of the accepted vector: consistent")
+run(0 out predict --robot ur5 --params ${w}/study-physical/report/parameters.yaml ${w}/data -o ${w}/identified)
+expect("${out}" "ur5 model full with .*parameters.yaml")
+run(0 out export --robot ur5 --study ${w}/study-physical --urdf ${w}/ur5_identified.urdf --into ${URDF_DIR}/ur5_robot.urdf)
+expect("${out}" "nominal: the URDF's inertials")
+expect("${out}" "6 chain links' <inertial> and their joints' <dynamics> written into")
+file(READ ${w}/ur5_identified.urdf written)
+expect("${written}" "package://example-robot-data/robots/ur_description/meshes/ur5/visual/base.dae")
+expect("${written}" "<dynamics damping=")
+if(CHECK_URDF)
+  execute_process(COMMAND ${CHECK_URDF} ${w}/ur5_identified.urdf RESULT_VARIABLE code OUTPUT_VARIABLE out ERROR_VARIABLE err)
+  if(NOT code EQUAL 0)
+    message(FATAL_ERROR "check_urdf ${w}/ur5_identified.urdf: exit ${code}\n${out}\n${err}")
+  endif()
+endif()
 file(REMOVE_RECURSE ${WORK})

@@ -1,5 +1,6 @@
 // Writes a CSV as a robot's own controller could export it, for the command-line tests of the
-// any-robot workflow: `write_export <robot> <file> <seconds> <seed>` for rx90 or planar2r. The
+// any-robot workflow: `write_export <robot> <file> <seconds> <seed>` for rx90, stanford_rrp or
+// ur5 (from its URDF's inertials). The
 // motion and torque come from the robot's generated model (synthetic_log.hpp) with Coulomb
 // friction (in the truth; a `rigid` model lacks it), an offset of -0.06 N m on the last joint,
 // noise and 5 % stale rows; columns stamp_ms, mode (text), <joint>_pos, _vel (deg, deg/s; m,
@@ -7,11 +8,14 @@
 #include <cstdio>
 #include <fstream>
 #include <string>
+#include <vector>
 
 #include <fmt/format.h>
 
 #include <symoro/rx90.hpp>
 #include <symoro/stanford_rrp.hpp>
+#include <symoro/ur5.hpp>
+#include <yaml-cpp/yaml.h>
 
 #include "synthetic_log.hpp"
 #include "test_support.hpp"
@@ -28,11 +32,27 @@ int write(const std::string& file, double seconds, unsigned seed) {
   return 0;
 }
 
+// A robot symoroc model made from its URDF: the truth is the URDF's own inertials (robot.yaml's
+// nominal parameters), with Coulomb friction the URDF does not have (and the offset).
+template <class Model>
+int write_from_nominal(const std::string& file, double seconds, unsigned seed, const std::vector<double>& coulomb) {
+  const YAML::Node nominal = YAML::LoadFile(std::string(SYMORO_ROBOTS_DIR) + "/" + Model::robot_name + "/robot.yaml")["nominal"];
+  Eigen::Matrix<double, Model::ns, 1> s;
+  for (int i = 0; i < Model::ns; ++i) {
+    const auto& p = Model::standard_parameters[i];
+    s(i) = std::string(p.family) == "FS" ? coulomb.at(p.joint - 1) : nominal[p.name].template as<double>();
+  }
+  const symoro::io::Log log = symoro::test::synthesize<Model>("export", Model::base_from_standard(s), seconds, seed, 0.05,
+                                                              symoro::test::offset_on<Model>(Model::nq, -0.06));
+  symoro::test::write_export_csv<Model>(log, file);
+  return 0;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
   if (argc != 5) {
-    std::fprintf(stderr, "usage: write_export rx90|stanford_rrp <file.csv> <seconds> <seed>\n");
+    std::fprintf(stderr, "usage: write_export rx90|stanford_rrp|ur5 <file.csv> <seconds> <seed>\n");
     return 2;
   }
   const std::string robot = argv[1];
@@ -40,6 +60,7 @@ int main(int argc, char** argv) {
   const unsigned seed = static_cast<unsigned>(std::stoul(argv[4]));
   if (robot == "rx90") return write<symoro::rx90::Model>(argv[2], seconds, seed);
   if (robot == "stanford_rrp") return write<symoro::stanford_rrp::Model>(argv[2], seconds, seed);
+  if (robot == "ur5") return write_from_nominal<symoro::ur5::Model>(argv[2], seconds, seed, {1.5, 1.5, 1.0, 0.3, 0.3, 0.3});
   std::fprintf(stderr, "unknown robot %s\n", robot.c_str());
   return 2;
 }
