@@ -13,11 +13,12 @@ cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release >/dev/null
 cmake --build build -j"$jobs"
 build/codegen/symoroc check
 
-# A robot folder the suite has never seen: a copy under a new name, in a scratch tree.
+# A robot folder the suite has never seen, in a scratch tree: written by symoroc model from a
+# URDF that is not a robot of robots/ (the Kinova Jaco2, continuous joints, rpy offsets).
 scratch=build/unseen
 rm -rf "$scratch" && mkdir -p "$scratch/robots"
 cp -r CMakeLists.txt cmake grammar codegen runtime tests bench "$scratch/"
-cp -r robots/stanford_rrp "$scratch/robots/unseen_arm"
+build/codegen/symoroc model tests/urdf/kinova.urdf -o "$scratch/robots/unseen_arm" --name unseen_arm
 cmake -S "$scratch" -B "$scratch/build" -G Ninja -DCMAKE_BUILD_TYPE=Release -DSYMORO_BUILD_BENCHMARKS=OFF >/dev/null
 cmake --build "$scratch/build" -j"$jobs" --target test_robot_unseen_arm
 ctest --test-dir "$scratch/build" -R '^unseen_arm\.' --output-on-failure -j"$jobs"

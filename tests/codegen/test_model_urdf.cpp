@@ -9,6 +9,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <functional>
@@ -176,6 +177,17 @@ TEST(ModelFromUrdf, Ur5MatchesKdl) { expect_matches_kdl({"ur5", kUrdfs / "ur5_ro
 // short), and symoroc model takes them as quarter turns (within 1e-8 rad: exact zeros in the
 // model), so its model is that much off the files' literal geometry: 1e-9, not 1e-12.
 TEST(ModelFromUrdf, KinovaMatchesKdl) { expect_matches_kdl({"kinova jaco2", kUrdfs / "kinova.urdf", {}, 1e-9}); }
+
+// Any URDF, named by the environment (SYMORO_URDF, and SYMORO_URDF_TIP / SYMORO_URDF_BASE when
+// the chain's ends must be named): a user's arm checked against KDL. Skipped when unset.
+TEST(ModelFromUrdf, TheUrdfNamedByTheEnvironmentMatchesKdl) {
+  const char* path = std::getenv("SYMORO_URDF");
+  if (!path) GTEST_SKIP() << "SYMORO_URDF names no URDF";
+  Case c{path, path, {}, 1e-9};
+  if (const char* tip = std::getenv("SYMORO_URDF_TIP")) c.options.tip_link = tip;
+  if (const char* base = std::getenv("SYMORO_URDF_BASE")) c.options.base_link = base;
+  expect_matches_kdl(c);
+}
 
 // Every case the conversion has to get right, in one small arm: rpy joint origins, an axis along
 // x, a negative axis, an oblique axis, a prismatic joint, a fixed link on the chain, a locked
