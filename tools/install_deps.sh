@@ -11,6 +11,7 @@ packages=(
   procps  # pgrep/ps: the MPI test finds the rank it kills
   libxxhash-dev  # content digests (io/digest.hpp): saved runs, parameters files, robot folders
   liburdfdom-dev liburdfdom-tools  # symoroc model reads URDFs (urdfdom); the export tests read them back (check_urdf)
+  libtinyxml-dev  # symoroc model names the line of a malformed URDF (urdfdom's own XML parser)
   liborocos-kdl-dev  # the tests compare URDF models against KDL, an independent rigid-body library
 )
 missing=()

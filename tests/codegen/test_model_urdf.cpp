@@ -262,7 +262,10 @@ std::string arm(const std::string& joint2) {
 }
 
 TEST(ModelFromUrdf, BadInputIsNamed) {
-  EXPECT_NE(error_of("<robot name=\"a\"><link name=\"b\"></robot>").find("not a valid URDF"), std::string::npos);
+  const std::string malformed = error_of("<robot name=\"a\">\n<link name=\"b\">\n</robot>");
+  EXPECT_NE(malformed.find(".urdf:3:"), std::string::npos) << malformed;  // where the mismatch is
+  EXPECT_NE(malformed.find("malformed XML"), std::string::npos) << malformed;
+  EXPECT_NE(error_of("<robot name=\"a\"><link name=\"b\"/><link name=\"c\"/></robot>").find("not a valid URDF"), std::string::npos);
   const std::string floating = error_of(arm(R"(<joint name="free" type="floating"><parent link="l1"/><child link="l2"/></joint>)"));
   EXPECT_NE(floating.find("joint 'free' on the chain is floating"), std::string::npos) << floating;
   EXPECT_NE(floating.find(".urdf:3:"), std::string::npos) << floating;  // the joint's line

@@ -12,6 +12,7 @@
 #include <Eigen/Eigenvalues>
 #include <Eigen/Geometry>
 #include <console_bridge/console.h>
+#include <tinyxml.h>
 #include <urdf_parser/urdf_parser.h>
 
 #include "equation_text.hpp"
@@ -154,6 +155,12 @@ UrdfChain read_urdf_chain(const std::string& path, const ModelingOptions& option
     }
     return 0;
   };
+  // Malformed XML is reported where it is (urdfdom says only that parsing failed).
+  {
+    TiXmlDocument doc;
+    doc.Parse(text.c_str());
+    if (doc.Error()) throw InputError(path, doc.ErrorRow(), doc.ErrorCol(), std::string("malformed XML: ") + doc.ErrorDesc());
+  }
   urdf::ModelInterfaceSharedPtr model;
   {
     Capture capture;
