@@ -1,8 +1,7 @@
 // CLIE's cost: the closed-loop simulation in simulated seconds per wall second, with and
 // without forward sensitivities (the paper's 39-parameter model on AG02; the sensitivities'
-// derivatives generated, from the first Heun stage only by default, from both stages (the exact
-// derivative of the discrete map) in the *Exact benchmarks, or from Jets as before: the *Jet
-// benchmarks), and one complete
+// derivatives generated, once per Heun step at its midpoint by default, at both stages (the exact
+// derivative of the discrete map) in the *Exact benchmarks), and one complete
 // CLIE refinement of AG02 at 40 ms on data from the default twin, from the truth perturbed by
 // 20 % (alternating signs).
 //
@@ -36,16 +35,9 @@ struct Fixture {
           .build("AG02");
   Eigen::VectorXd truth = Reduced::from_parent(symoro::twin::make_truth<Full>(config).phi);
   identify::ClosedLoopSimulator<Reduced> sim{identify::closed_loop_setup(config), trajectory};
-  // The same with the sensitivities' derivatives from Jets (ClosedLoopSetup::jet_derivatives).
-  identify::ClosedLoopSimulator<Reduced> sim_jet{jet_setup(config), trajectory};
   // The exact derivatives of the discrete map (ClosedLoopSetup::exact_sensitivities).
   identify::ClosedLoopSimulator<Reduced> sim_exact{exact_setup(config), trajectory};
 
-  static identify::ClosedLoopSetup jet_setup(const symoro::twin::TwinConfig& c) {
-    identify::ClosedLoopSetup s = identify::closed_loop_setup(c);
-    s.jet_derivatives = true;
-    return s;
-  }
   static identify::ClosedLoopSetup exact_setup(const symoro::twin::TwinConfig& c) {
     identify::ClosedLoopSetup s = identify::closed_loop_setup(c);
     s.exact_sensitivities = true;
@@ -58,10 +50,10 @@ const Fixture& fixture() {
   return f;
 }
 
-enum class Path { fast, jet, exact };
+enum class Path { fast, exact };
 
 const identify::ClosedLoopSimulator<Reduced>& simulator(const Fixture& f, Path p) {
-  return p == Path::jet ? f.sim_jet : p == Path::exact ? f.sim_exact : f.sim;
+  return p == Path::exact ? f.sim_exact : f.sim;
 }
 
 void simulate(benchmark::State& state, bool sensitivities, Path path = Path::fast, bool interface = false) {
@@ -89,11 +81,9 @@ void BM_SimulateThroughInterface(benchmark::State& s) { simulate(s, false, Path:
 void BM_SimulateWithSensitivitiesThroughInterface(benchmark::State& s) { simulate(s, true, Path::fast, true); }
 BENCHMARK(BM_SimulateThroughInterface)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_SimulateWithSensitivitiesThroughInterface)->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(3);
-void BM_SimulateWithSensitivitiesJet(benchmark::State& s) { simulate(s, true, Path::jet); }
 void BM_SimulateWithSensitivitiesExact(benchmark::State& s) { simulate(s, true, Path::exact); }
 BENCHMARK(BM_SimulateWithSensitivities)->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(3);
 BENCHMARK(BM_SimulateWithSensitivitiesExact)->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(3);
-BENCHMARK(BM_SimulateWithSensitivitiesJet)->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(3);
 
 void clie_ag02(benchmark::State& state, Path path) {
   const Fixture& f = fixture();
@@ -120,10 +110,8 @@ void clie_ag02(benchmark::State& state, Path path) {
   state.SetLabel(r.termination.substr(0, 60));
 }
 void BM_ClieAG02At40ms(benchmark::State& s) { clie_ag02(s, Path::fast); }
-void BM_ClieAG02At40msJet(benchmark::State& s) { clie_ag02(s, Path::jet); }
 void BM_ClieAG02At40msExact(benchmark::State& s) { clie_ag02(s, Path::exact); }
 BENCHMARK(BM_ClieAG02At40ms)->Unit(benchmark::kSecond)->UseRealTime()->Iterations(1);
 BENCHMARK(BM_ClieAG02At40msExact)->Unit(benchmark::kSecond)->UseRealTime()->Iterations(1);
-BENCHMARK(BM_ClieAG02At40msJet)->Unit(benchmark::kSecond)->UseRealTime()->Iterations(1);
 
 }  // namespace

@@ -233,60 +233,6 @@ TEST(ClosedLoopSimulator, MidpointSensitivitiesAreCloseToTheExactOnes) {
   EXPECT_GT(column_worst, 1e-9);  // not the exact path by mistake
 }
 
-// The generated forward_dynamics_derivatives (exact_sensitivities) and the Jet path (jet_derivatives)
-// compute the same sensitivities in a different order of operations: they agree to round-off,
-// on the reduced and the full model (Coulomb friction included), and CLIE takes the same steps.
-TEST(ClosedLoopSimulator, GeneratedDerivativesAndJetsGiveTheSameSensitivitiesAndClie) {
-  identify::ClosedLoopSetup generated = exact_setup();
-  identify::ClosedLoopSetup jet = identify::closed_loop_setup(ideal_config());
-  jet.jet_derivatives = true;
-  const auto compare = [&](const auto& model_tag, const Eigen::VectorXd& phi) {
-    using M = std::decay_t<decltype(model_tag)>;
-    Channels tau_g, dtau_g, tau_j, dtau_j;
-    ASSERT_TRUE(closed_loop<M>(generated)->simulate(phi, tau_g, &dtau_g, nullptr));
-    ASSERT_TRUE(closed_loop<M>(jet)->simulate(phi, tau_j, &dtau_j, nullptr));
-    const double tau_error = (tau_g - tau_j).cwiseAbs().maxCoeff() / tau_j.cwiseAbs().maxCoeff();
-    const double dtau_error = (dtau_g - dtau_j).cwiseAbs().maxCoeff() / dtau_j.cwiseAbs().maxCoeff();
-    std::cout << "  " << M::np << " parameters: tau differs by " << tau_error << ", d tau / d phi by " << dtau_error
-              << " of its largest entry\n";
-    EXPECT_LT(tau_error, 1e-10);
-    EXPECT_LT(dtau_error, 1e-9);
-  };
-  compare(Reduced{}, reduced_truth());
-  compare(Full{}, twin::make_truth<Full>(ideal_config()).phi);
-
-  // CLIE both ways from the same start on the same data: the same solution.
-  const auto sim_g_ptr = closed_loop<Reduced>(generated), sim_j_ptr = closed_loop<Reduced>(jet);
-  const identify::ClosedLoop &sim_g = *sim_g_ptr, &sim_j = *sim_j_ptr;
-  Channels tau, q;
-  ASSERT_TRUE(sim_g.simulate(reduced_truth(), tau, nullptr, nullptr, &q));
-  io::Log log;
-  log.meta.robot = "crane_x7";
-  log.meta.trajectory = short_trajectory().name;
-  log.meta.source = "twin";
-  log.meta.sample_time = sim_g.period();
-  for (const auto& j : Full::joints) log.meta.joints.push_back(j.name);
-  log.time = Eigen::VectorXd::LinSpaced(sim_g.cycles(), 0, (sim_g.cycles() - 1) * sim_g.period());
-  log.q = q;
-  log.qd = Eigen::MatrixXd::Zero(sim_g.cycles(), n);
-  log.tau = tau;
-  twin::Random rng(5);
-  for (Eigen::Index k = 0; k < log.tau.size(); ++k) log.tau.data()[k] += 1e-3 * rng.normal();
-  identify::ClieOptions options;
-  options.max_iterations = 8;
-  const preprocess::Samples samples = preprocess::preprocess(log, 0.04, options.preprocess);
-  Eigen::VectorXd phi0 = reduced_truth();
-  for (int i = 0; i < Reduced::np; ++i) phi0(i) *= (i % 2 ? 1.2 : 0.8);
-  const identify::ClieResult rg = identify::clie(sim_g, samples, phi0, options);
-  const identify::ClieResult rj = identify::clie(sim_j, samples, phi0, options);
-  std::cout << "  CLIE generated: " << rg.iterations << " iterations, cost " << rg.final_cost << ", " << rg.wall
-            << " s; Jet: " << rj.iterations << " iterations, cost " << rj.final_cost << ", " << rj.wall << " s\n";
-  ASSERT_TRUE(rg.success && rj.success);
-  EXPECT_EQ(rg.iterations, rj.iterations);
-  EXPECT_NEAR(rg.final_cost, rj.final_cost, 1e-8 * rj.final_cost);
-  EXPECT_LT((rg.phi - rj.phi).norm(), 1e-7 * rj.phi.norm());
-}
-
 // The full model at the twin's truth reproduces the ideal twin's log: exactly up to the
 // integrators when the twin's quantization is made negligible, and within the quantization's
 // own effect when it is not. No delay, or rows recording the new command instead of the one

@@ -36,14 +36,10 @@ struct ClosedLoopSetup {
   // holds) instead of spanning each hold with q(t_k) read inside the step
   // (closed_loop_model.hpp): twice the work for no accuracy that matters.
   bool split_at_sampling = false;
-  // The sensitivities' d qdd / d(q, qd, tau, phi) from the generated forward_dynamics_derivatives
-  // (default), or the older way, a ceres::Jet over (q, qd) through the generated inverse dynamics
-  // (kept to compare the two; the results agree to round-off).
-  bool jet_derivatives = false;
-  // The sensitivities' d qdd / d(q, qd, tau, phi) at each Heun stage (the exact derivative of the
-  // discrete map, twice the derivative work), or, by default, once per step at its midpoint
-  // (closed_loop_model.hpp: d tau ~6e-5 relative from the exact one). Only with the generated
-  // derivatives (jet_derivatives takes each stage's).
+  // The sensitivities' d qdd / d(q, qd, tau, phi) (the generated forward_dynamics_derivatives)
+  // at each Heun stage (the exact derivative of the discrete map, twice the derivative work), or,
+  // by default, once per step at its midpoint (closed_loop_model.hpp: d tau ~6e-5 relative from
+  // the exact one).
   bool exact_sensitivities = false;
 };
 

@@ -9,8 +9,8 @@
 // M(q) qdd + h(q, qd) = u:  d qdd = M^-1 (d u - J_q d q - J_qd d qd - W(q, qd, qdd)), taken from
 // the generated forward_dynamics_derivatives (d qdd / d q = -M^-1 J_q, d qdd / d qd = -M^-1 J_qd,
 // d qdd / d tau = M^-1, d qdd / d phi = -M^-1 W, in one call that shares M's factorization and
-// every subexpression). ClosedLoopSetup::jet_derivatives takes J_q, J_qd from a Jet over q and
-// qd through the inverse dynamics instead (five times slower; kept to compare).
+// every subexpression). (A Jet over (q, qd) through the inverse dynamics gave the same to
+// round-off at five times the cost; it was dropped with the compile time it cost every model.)
 //
 // Exact sensitivities need those derivatives at both stages. By default they are taken once per
 // step, at its midpoint x0 + h/2 f(x0), and serve both stages (x itself goes through the plain
@@ -45,7 +45,6 @@
 
 #include <Eigen/Cholesky>
 #include <Eigen/Core>
-#include <ceres/jet.h>
 
 #include "symoro/control/ffpd.hpp"
 #include "symoro/identify/closed_loop.hpp"
@@ -197,7 +196,6 @@ class ClosedLoopSimulator final : public ClosedLoop {
   }
 
   using Mat = Eigen::Matrix<double, n, n>;
-  using Jet = ceres::Jet<double, 2 * n>;
 
   struct State {
     Vec q, qd;
@@ -213,60 +211,40 @@ class ClosedLoopSimulator final : public ClosedLoop {
       return false;
     }
     if constexpr (Sens) {
-      if (!setup_.jet_derivatives) {
-        typename Model::template ForwardDynamicsDerivatives<double> d;
-        if (!Model::forward_dynamics_derivatives(x.q, x.qd, u, phi, d)) {
-          why = detail::indefinite_inertia(t, d.min_pivot);
-          return false;
-        }
-        qdd = d.qdd;
-        if (!qdd.allFinite()) {
-          why = detail::not_finite(t);
-          return false;
-        }
-        // Coefficient-wise products: at these fixed sizes they beat Eigen's blocked GEMM.
-        dqdd = d.dphi;
-        dqdd.noalias() += d.dq.lazyProduct(x.S.template topRows<n>());
-        dqdd.noalias() += d.dqd.lazyProduct(x.S.template bottomRows<n>());
-        dqdd.noalias() += d.dtau.lazyProduct(du);
-        return true;
+      typename Model::template ForwardDynamicsDerivatives<double> d;
+      if (!Model::forward_dynamics_derivatives(x.q, x.qd, u, phi, d)) {
+        why = detail::indefinite_inertia(t, d.min_pivot);
+        return false;
       }
-    }
-    Mat M;
-    Model::inertia(x.q, phi, M);
-    Vec h;
-    Model::nonlinear_effects(x.q, x.qd, phi, h);
-    const Eigen::LDLT<Mat> ldlt(M);
-    const double pivot = ldlt.vectorD().minCoeff();
-    if (ldlt.info() != Eigen::Success || !(pivot > 0)) {
-      why = detail::indefinite_inertia(t, pivot);
-      return false;
-    }
-    qdd = ldlt.solve(u - h);
-    if (!qdd.allFinite()) {
-      why = detail::not_finite(t);
-      return false;
-    }
-    if constexpr (Sens) {
-      // d ID / d(q, qd) at this stage's (q, qd, qdd): a Jet seeded on the 2n state entries.
-      Eigen::Matrix<Jet, n, 1> q_jet, qd_jet, id_jet;
-      for (int i = 0; i < n; ++i) {
-        q_jet(i) = Jet(x.q(i), i);
-        qd_jet(i) = Jet(x.qd(i), n + i);
+      qdd = d.qdd;
+      if (!qdd.allFinite()) {
+        why = detail::not_finite(t);
+        return false;
       }
-      Model::inverse_dynamics(q_jet, qd_jet, qdd, phi, id_jet);
-      Eigen::Matrix<double, n, 2 * n> J;
-      for (int j = 0; j < n; ++j) J.row(j) = id_jet(j).v.transpose();
-      Eigen::Matrix<double, n, np> W;
-      Model::regressor(x.q, x.qd, qdd, W);
-      SensQ rhs = du - W;
-      // Coefficient-wise products: at these fixed sizes they beat Eigen's blocked GEMM and
-      // its triangular solves several times over; M^-1 costs n solves instead of np.
-      rhs.noalias() -= J.lazyProduct(x.S);
-      const Mat M_inv = ldlt.solve(Mat::Identity());
-      dqdd.noalias() = M_inv.lazyProduct(rhs);
+      // Coefficient-wise products: at these fixed sizes they beat Eigen's blocked GEMM.
+      dqdd = d.dphi;
+      dqdd.noalias() += d.dq.lazyProduct(x.S.template topRows<n>());
+      dqdd.noalias() += d.dqd.lazyProduct(x.S.template bottomRows<n>());
+      dqdd.noalias() += d.dtau.lazyProduct(du);
+      return true;
+    } else {
+      Mat M;
+      Model::inertia(x.q, phi, M);
+      Vec h;
+      Model::nonlinear_effects(x.q, x.qd, phi, h);
+      const Eigen::LDLT<Mat> ldlt(M);
+      const double pivot = ldlt.vectorD().minCoeff();
+      if (ldlt.info() != Eigen::Success || !(pivot > 0)) {
+        why = detail::indefinite_inertia(t, pivot);
+        return false;
+      }
+      qdd = ldlt.solve(u - h);
+      if (!qdd.allFinite()) {
+        why = detail::not_finite(t);
+        return false;
+      }
+      return true;
     }
-    return true;
   }
 
   // Holds the command u for `length` seconds from x (starting at time t0) in `substeps` Heun
@@ -276,7 +254,7 @@ class ClosedLoopSimulator final : public ClosedLoop {
             Vec& qs, SensQ& dqs, Divergence& why) const {
     if (!(length > 0)) return true;
     if constexpr (Sens)
-      if (!setup_.exact_sensitivities && !setup_.jet_derivatives)
+      if (!setup_.exact_sensitivities)
         return hold_frozen(phi, x, u, du, length, t0, sample_at, qs, dqs, why);
     const int m = setup_.substeps;
     const double h = length / m;
