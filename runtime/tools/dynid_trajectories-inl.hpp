@@ -20,6 +20,12 @@ void TrajectoriesCommand::run(const Common& common, const TrajectoryOptions& o) 
   const std::vector<std::string> names = o.only.empty() ? design.names() : o.only;
   std::vector<std::string> joint_names;
   for (const auto& j : Full::joints) joint_names.push_back(j.name);
+  if (o.out.empty() && o.quality) {
+    std::vector<trajectory::Trajectory> all;
+    for (const auto& name : names) all.push_back(design.build(name));
+    print_trajectory_quality(common, all, o);
+    return;
+  }
   if (o.out.empty()) {
     fmt::print("{:<6} {:<4} {:>9}  {}\n", "name", "fam", "duration", "description");
     double total = 0;

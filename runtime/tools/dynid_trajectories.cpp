@@ -3,9 +3,49 @@
 #include <CLI/CLI.hpp>
 
 #include "dynid_trajectories.hpp"
+#include "dynid_identify.hpp"
 #include "dynid_numbers.hpp"
+#include "symoro/identify/excitation_quality.hpp"
+
+#include <fmt/format.h>
 
 namespace symoro::dynid {
+
+void print_trajectory_quality(const Common& common, const std::vector<trajectory::Trajectory>& trajectories,
+                              const TrajectoryOptions& o) {
+  const auto model = identification_model_of(common, "");
+  const identify::ModelDescription& d = model->description();
+  const double interval = o.interval_ms / 1000;
+  fmt::print("excitation of {} model {} ({} base parameters) at {:.0f} ms: kappa of W, kappa and log det (per row) of "
+             "W with unit columns, the weakest direction's largest components\n",
+             common.robot, d.variant.empty() ? "full" : d.variant, d.np, o.interval_ms);
+  fmt::print("{:<6} {:<4} {:>8} {:>11} {:>11} {:>10}  {}\n", "name", "fam", "duration", "kappa", "kappa_scl", "logdet_scl",
+             "weakest");
+  auto row = [&](const std::string& name, const std::string& family, double duration, const identify::ExcitationQuality& q) {
+    std::string weakest;
+    if (!q.unexcited.empty()) weakest = fmt::format("{} parameters not excited (e.g. {})", q.unexcited.size(), q.unexcited.front());
+    for (const auto& [p, v] : q.weakest) weakest += fmt::format("{}{} {:+.2f}", weakest.empty() ? "" : ", ", p, v);
+    fmt::print("{:<6} {:<4} {:>7.1f}s {:>11.4g} {:>11.4g} {:>10.3f}  {}\n", name, family, duration, q.kappa, q.kappa_scaled,
+               q.log_det_scaled, weakest);
+  };
+  std::vector<Eigen::MatrixXd> Ws;
+  Eigen::Index rows = 0;
+  double total = 0;
+  for (const auto& t : trajectories) {
+    Ws.push_back(model->stack_regression(identify::reference_samples(trajectory::sample(t, o.period), interval)).W);
+    row(t.name, t.family, t.duration(), identify::excitation_quality(Ws.back(), d.parameters));
+    rows += Ws.back().rows();
+    total += t.duration();
+  }
+  // All of them stacked: the design as a whole.
+  Eigen::MatrixXd all(rows, d.np);
+  Eigen::Index at = 0;
+  for (const auto& W : Ws) {
+    all.middleRows(at, W.rows()) = W;
+    at += W.rows();
+  }
+  if (trajectories.size() > 1) row("all", "", total, identify::excitation_quality(all, d.parameters));
+}
 
 void add_trajectory_commands(CLI::App& app, Common& common) {
   auto o = std::make_shared<TrajectoryOptions>();
@@ -15,6 +55,11 @@ void add_trajectory_commands(CLI::App& app, Common& common) {
   cmd->add_option("-o,--output", o->out, "Write <name>.csv and <name>.meta.yaml here (default: list only)");
   cmd->add_option("--only", o->only, "Only these trajectories");
   cmd->add_option("--period", o->period, "Sample period of the reference files, s")->check(numbers::positive(10, "> 0 and <= 10 s"));
+  cmd->add_flag("--quality", o->quality, "Print each trajectory's excitation of the robot's identified model: kappa, "
+                                         "kappa and log det with unit columns, the weakest direction");
+  cmd->add_option("--interval", o->interval_ms, "Sampling interval of --quality, ms (as in identification)")
+      ->check(numbers::interval_ms())
+      ->capture_default_str();
   cmd->callback([&common, o] { trajectories_units().robot(common)(common, *o); });
 }
 

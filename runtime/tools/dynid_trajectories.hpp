@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "dynid_dispatch.hpp"
+#include "symoro/trajectory/trajectory.hpp"
 
 namespace symoro::dynid {
 
@@ -13,7 +14,14 @@ struct TrajectoryOptions {
   std::string out;
   std::vector<std::string> only;
   double period = 0.001;
+  bool quality = false;      // print each trajectory's excitation quality (identify/excitation_quality.hpp)
+  double interval_ms = 10;   // ... at this sampling interval
 };
+
+// The excitation quality of each trajectory and of all of them together, for the robot's
+// identified model (compiled once: dynid_trajectories.cpp).
+void print_trajectory_quality(const Common& common, const std::vector<trajectory::Trajectory>& trajectories,
+                              const TrajectoryOptions& o);
 
 struct TrajectoriesCommand {
   using Options = TrajectoryOptions;

@@ -3,13 +3,17 @@
 // twin's truth for the well-excited parameters of the full model.
 #include <cmath>
 #include <random>
+#include <set>
+#include <string>
 
 #include <Eigen/Cholesky>
 #include <Eigen/SVD>
 #include <gtest/gtest.h>
 
 #include <symoro/crane_x7.hpp>
+#include <symoro/rx90.hpp>
 
+#include "symoro/identify/excitation_quality.hpp"
 #include "symoro/identify/least_squares.hpp"
 #include "symoro/identify/regression.hpp"
 #include "symoro/preprocess/preprocess.hpp"
@@ -134,6 +138,101 @@ TEST(LeastSquares, RecoversTheTwinsWellExcitedParameters) {
   EXPECT_GE(checked, 15);
   std::printf("AG02 at 10 ms, full model: kappa %.1f, %d well-excited parameters checked, residual rms %.4f N m\n",
               ls.kappa, checked, ls.residual_rms);
+}
+
+}  // namespace
+
+// Excitation quality (identify/excitation_quality.hpp): hand-derived values on a regressor whose
+// singular values are known, and on two robots against the generated regressor stacked here.
+
+namespace {
+
+std::vector<symoro::ParameterInfo> names(int p) {
+  static std::vector<std::string> storage;
+  storage.clear();
+  for (int c = 0; c < p; ++c) storage.push_back("P" + std::to_string(c));
+  std::vector<symoro::ParameterInfo> out;
+  for (const auto& s : storage) out.push_back({s.c_str(), "XX", 1, "kg*m^2"});
+  return out;
+}
+
+TEST(ExcitationQuality, HandDerivedValues) {
+  // Orthogonal columns of norms 1, 10, 100: kappa 100; unit columns are orthonormal, so kappa
+  // scaled 1 and log det (per row) -3 log(rows).
+  const int rows = 50;
+  std::mt19937_64 rng(3);
+  const Eigen::MatrixXd Q = Eigen::HouseholderQR<Eigen::MatrixXd>(Eigen::MatrixXd::Random(rows, 3)).householderQ() *
+                            Eigen::MatrixXd::Identity(rows, 3);
+  Eigen::MatrixXd W = Q * Eigen::Vector3d(1, 10, 100).asDiagonal();
+  const auto p = names(3);
+  ExcitationQuality q = excitation_quality(W, p);
+  EXPECT_NEAR(q.kappa, 100, 1e-9);
+  EXPECT_NEAR(q.kappa_scaled, 1, 1e-12);
+  EXPECT_NEAR(q.log_det_scaled, -3 * std::log(double(rows)), 1e-10);
+  // Two unit columns at angle theta: the scaled singular values are sqrt(1 +- cos theta), the
+  // weakest direction (1, -1) / sqrt(2) over them.
+  const double theta = 0.01;
+  W.col(1) = 7 * (std::cos(theta) * Q.col(0) + std::sin(theta) * Q.col(1));
+  q = excitation_quality(W, p, 2);
+  EXPECT_NEAR(q.kappa_scaled, std::sqrt((1 + std::cos(theta)) / (1 - std::cos(theta))), 1e-6);
+  EXPECT_NEAR(q.log_det_scaled, std::log((1 + std::cos(theta)) * (1 - std::cos(theta))) - 3 * std::log(double(rows)), 1e-8);
+  ASSERT_EQ(q.weakest.size(), 2u);
+  EXPECT_NEAR(std::abs(q.weakest[0].second), std::sqrt(0.5), 1e-9);
+  EXPECT_NEAR(q.weakest[0].second, -q.weakest[1].second, 1e-9);
+  std::set<std::string> weak{q.weakest[0].first, q.weakest[1].first};
+  EXPECT_EQ(weak, (std::set<std::string>{"P0", "P1"}));
+  // A zero column is named, not hidden in a kappa.
+  W.col(2).setZero();
+  q = excitation_quality(W, p);
+  EXPECT_EQ(q.unexcited, std::vector<std::string>{"P2"});
+  EXPECT_TRUE(std::isinf(q.kappa_scaled));
+}
+
+// On a designed or random motion: the interface's regression gives the numbers an SVD of the
+// generated regressor stacked here gives.
+template <class Model>
+void expect_quality_of_random_motion() {
+  constexpr int n = Model::nq;
+  symoro::trajectory::SampledReference ref;
+  ref.name = "random";
+  ref.period = 0.001;
+  const int cycles = 8000;
+  ref.q.resize(n, cycles);
+  ref.qd.resize(n, cycles);
+  ref.qdd.resize(n, cycles);
+  for (int k = 0; k < cycles; ++k)
+    for (int j = 0; j < n; ++j) {
+      const double w = 1.1 + 0.37 * j, t = k * ref.period, a = 0.8;
+      ref.q(j, k) = a * std::sin(w * t + j);
+      ref.qd(j, k) = a * w * std::cos(w * t + j);
+      ref.qdd(j, k) = -a * w * w * std::sin(w * t + j);
+    }
+  const ExcitationQuality q =
+      excitation_quality(*identification_model<Model>(), ref, 0.01, static_cast<int>(Model::np));
+  // Independently: W from the generated regressor every 10 cycles.
+  Eigen::MatrixXd W(cycles / 10 * n, Model::np);
+  for (int k = 0; k < cycles / 10; ++k) {
+    Eigen::Matrix<double, n, Model::np> w;
+    Model::regressor(Eigen::Matrix<double, n, 1>(ref.q.col(10 * k)), Eigen::Matrix<double, n, 1>(ref.qd.col(10 * k)),
+                     Eigen::Matrix<double, n, 1>(ref.qdd.col(10 * k)), w);
+    W.middleRows(k * n, n) = w;
+  }
+  const Eigen::VectorXd norms = W.colwise().norm().transpose();
+  const Eigen::VectorXd s = Eigen::JacobiSVD<Eigen::MatrixXd>(W * norms.cwiseInverse().asDiagonal()).singularValues();
+  const Eigen::VectorXd raw = Eigen::JacobiSVD<Eigen::MatrixXd>(W).singularValues();
+  EXPECT_EQ(q.rows, W.rows());
+  EXPECT_NEAR(q.kappa / (raw(0) / raw(raw.size() - 1)), 1, 1e-9);
+  EXPECT_NEAR(q.kappa_scaled / (s(0) / s(s.size() - 1)), 1, 1e-9);
+  EXPECT_NEAR(q.log_det_scaled, 2 * s.array().log().sum() - s.size() * std::log(double(W.rows())), 1e-8);
+  // The weakest direction is a unit vector over every parameter.
+  double norm2 = 0;
+  for (const auto& [name, v] : q.weakest) norm2 += v * v;
+  EXPECT_NEAR(norm2, 1, 1e-9);
+}
+
+TEST(ExcitationQuality, MatchesTheGeneratedRegressorOnTwoRobots) {
+  expect_quality_of_random_motion<symoro::crane_x7::Model>();
+  expect_quality_of_random_motion<symoro::rx90::Model>();
 }
 
 }  // namespace
