@@ -3,6 +3,7 @@
 // reference files, and the design file's error reporting.
 #include <symoro/crane_x7.hpp>
 #include <symoro/trajectory/design.hpp>
+#include <symoro/trajectory/fourier.hpp>
 #include <symoro/trajectory/move.hpp>
 #include <symoro/trajectory/trajectory.hpp>
 #include <yaml-cpp/yaml.h>
@@ -13,6 +14,7 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <random>
 #include <string>
 #include <vector>
 
@@ -710,6 +712,72 @@ TEST_F(BrokenDesign, MissingFileIsAnError) {
   } catch (const DataError& e) {
     EXPECT_EQ(e.line(), 0);
     EXPECT_NE(std::string(e.what()).find("no such file"), std::string::npos);
+  }
+}
+
+}  // namespace
+}  // namespace symoro::trajectory
+
+// The Fourier excitation trajectory (trajectory/fourier.hpp): derivatives against central
+// differences of q, at rest at the start and after each period once come_to_rest_at moved its
+// coefficients, and the closed-form bounds above the maxima of a dense grid (equal for a single
+// harmonic).
+
+namespace symoro::trajectory {
+namespace {
+
+FourierTrajectory random_fourier(int n, int L, unsigned seed) {
+  std::mt19937 gen(seed);
+  std::uniform_real_distribution<double> u(-1, 1);
+  FourierTrajectory f;
+  f.name = "F";
+  f.w = 2 * 3.14159265358979323846 / 10;  // 10 s period
+  f.q0 = Eigen::VectorXd::Zero(n);
+  f.a.resize(n, L);
+  f.b.resize(n, L);
+  for (int j = 0; j < n; ++j)
+    for (int l = 0; l < L; ++l) {
+      f.a(j, l) = 0.3 * u(gen);
+      f.b(j, l) = 0.3 * u(gen);
+    }
+  return f;
+}
+
+TEST(FourierTrajectory, DerivativesRestAndBounds) {
+  FourierTrajectory f = random_fourier(7, 5, 11);
+  Eigen::VectorXd start(7);
+  start << 0.1, -0.2, 0.3, -1.0, 0.5, 0.2, -0.3;
+  f.come_to_rest_at(start);
+  Eigen::VectorXd q, qd, qdd, qp, qdp, qddp, qm, qdm, qddm;
+  for (const double t : {0.0, f.period()}) {
+    f.evaluate(t, q, qd, qdd);
+    EXPECT_LT((q - start).cwiseAbs().maxCoeff(), 1e-12) << t;
+    EXPECT_LT(qd.cwiseAbs().maxCoeff(), 1e-12) << t;
+    EXPECT_LT(qdd.cwiseAbs().maxCoeff(), 1e-12) << t;
+  }
+  const double h = 1e-5;
+  for (const double t : {0.7, 3.1, 8.9}) {
+    f.evaluate(t, q, qd, qdd);
+    f.evaluate(t + h, qp, qdp, qddp);
+    f.evaluate(t - h, qm, qdm, qddm);
+    EXPECT_LT(((qp - qm) / (2 * h) - qd).cwiseAbs().maxCoeff(), 1e-8);
+    EXPECT_LT(((qdp - qdm) / (2 * h) - qdd).cwiseAbs().maxCoeff(), 1e-8);
+  }
+  // A dense grid (1 ms over the period) never exceeds the bounds.
+  const SampledReference r = f.sample(0.001);
+  EXPECT_EQ(r.cycles(), 10001);
+  const Eigen::VectorXd pb = f.position_bound(), vb = f.velocity_bound(), ab = f.acceleration_bound();
+  for (int j = 0; j < 7; ++j) {
+    EXPECT_LE((r.q.row(j).array() - f.q0(j)).abs().maxCoeff(), pb(j) + 1e-12);
+    EXPECT_LE(r.qd.row(j).cwiseAbs().maxCoeff(), vb(j) + 1e-12);
+    EXPECT_LE(r.qdd.row(j).cwiseAbs().maxCoeff(), ab(j) + 1e-12);
+  }
+  // One harmonic: each bound is reached (a rotating vector).
+  FourierTrajectory one = random_fourier(2, 1, 3);
+  const SampledReference s = one.sample(0.0005);
+  for (int j = 0; j < 2; ++j) {
+    EXPECT_NEAR(s.qd.row(j).cwiseAbs().maxCoeff(), one.velocity_bound()(j), 1e-6);
+    EXPECT_NEAR(s.qdd.row(j).cwiseAbs().maxCoeff(), one.acceleration_bound()(j), 1e-6);
   }
 }
 
