@@ -61,6 +61,12 @@ class Progress {
   static bool isatty_stderr();
 };
 
+// robot.yaml's `nominal:` standard parameters (symoroc model writes a URDF's there) in the
+// order of `standard`, a variant's effect parameters 0; false when robot.yaml has none. A
+// UsageError names the parameters it lacks. (dynid_robot_folder.cpp)
+bool nominal_standard_parameters(const Common& common, const std::vector<StandardParameterInfo>& standard,
+                                 std::vector<double>& values);
+
 void add_compare_commands(CLI::App& app, Common& common);
 void add_twin_commands(CLI::App& app, Common& common);
 void add_trajectory_commands(CLI::App& app, Common& common);

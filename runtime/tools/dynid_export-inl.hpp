@@ -116,15 +116,11 @@ void ExportCommand::run(const Common& common, const ExportOptions& o) {
       const twin::TwinConfig tc = twin::read_twin_config(twin_path, Model::nq);
       prior = twin::make_truth<Parent>(tc).standard;
       prior_what = twin_path.string() + " (CAD truth)";
-    } else if (const YAML::Node nominal = YAML::LoadFile((common.robot_dir() / "robot.yaml").string())["nominal"]) {
+    } else if (std::vector<double> nominal;
+               nominal_standard_parameters(common, {Model::standard_parameters.begin(), Model::standard_parameters.end()},
+                                           nominal)) {
       // symoroc model's robot.yaml from a URDF: the URDF's own inertials.
-      prior = Eigen::VectorXd::Zero(Model::ns);
-      for (int i = 0; i < Model::ns; ++i) {
-        const YAML::Node v = nominal[Model::standard_parameters[i].name];
-        if (!v) throw UsageError(fmt::format("{}: nominal lacks {}", (common.robot_dir() / "robot.yaml").string(),
-                                             Model::standard_parameters[i].name));
-        prior(i) = v.as<double>();
-      }
+      prior = Eigen::Map<const Eigen::VectorXd>(nominal.data(), Model::ns);
       prior_what = (common.robot_dir() / "robot.yaml").string() + " (nominal: the URDF's inertials)";
     } else {
       throw UsageError(fmt::format("robot '{}' has no twin.yaml to take a prior from: give --prior <standard-parameter "

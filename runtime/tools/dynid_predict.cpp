@@ -48,34 +48,14 @@ std::string file_model(const std::string& file) {
   }
 }
 
-bool effect_family(const std::string& f) {
-  for (const char* rigid : {"XX", "XY", "XZ", "YY", "YZ", "ZZ", "MX", "MY", "MZ", "M", "IA", "FV", "FS"})
-    if (f == rigid) return false;
-  return true;
-}
-
-// phi from robot.yaml's `nominal:` standard parameters (effect parameters of a variant: 0).
+// phi from robot.yaml's nominal standard parameters.
 Eigen::VectorXd nominal_phi(const Common& common, const identify::IdentificationModel& model) {
-  const fs::path yaml = common.robot_dir() / "robot.yaml";
-  YAML::Node nominal;
-  try {
-    nominal = YAML::LoadFile(yaml.string())["nominal"];
-  } catch (const YAML::Exception& e) {
-    throw UsageError(yaml.string() + ": " + e.what());
-  }
-  if (!nominal || !nominal.IsMap())
-    throw UsageError(yaml.string() + " has no nominal parameters (symoroc model writes them from a URDF): give --params "
-                                     "<study>/report/parameters.yaml");
-  const auto& standard = model.description().standard;
-  Eigen::VectorXd s = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(standard.size()));
-  std::string missing;
-  for (std::size_t i = 0; i < standard.size(); ++i) {
-    const YAML::Node v = nominal[standard[i].name];
-    if (v) s(static_cast<Eigen::Index>(i)) = v.as<double>();
-    else if (!effect_family(standard[i].family)) missing += std::string(missing.empty() ? "" : ", ") + standard[i].name;
-  }
-  if (!missing.empty()) throw UsageError(yaml.string() + ": nominal lacks " + missing);
-  return model.base_from_standard(s);
+  std::vector<double> s;
+  if (!nominal_standard_parameters(common, model.description().standard, s))
+    throw UsageError((common.robot_dir() / "robot.yaml").string() +
+                     " has no nominal parameters (symoroc model writes them from a URDF): give --params "
+                     "<study>/report/parameters.yaml");
+  return model.base_from_standard(Eigen::Map<const Eigen::VectorXd>(s.data(), static_cast<Eigen::Index>(s.size())));
 }
 
 struct Prediction {

@@ -4,6 +4,7 @@
 #include <filesystem>
 
 #include <fmt/format.h>
+#include <yaml-cpp/yaml.h>
 
 #include "dynid_dispatch.hpp"
 #include "symoro/error.hpp"
@@ -27,6 +28,31 @@ void check_robot_folder(const Common& common) {
                                    "rebuild, or point --robots-dir at the folder it was compiled from",
                                    file.string(), f.name, common.robot, now, f.digest, dir.string()));
   }
+}
+
+bool nominal_standard_parameters(const Common& common, const std::vector<StandardParameterInfo>& standard,
+                                 std::vector<double>& values) {
+  const std::filesystem::path yaml = common.robot_dir() / "robot.yaml";
+  YAML::Node nominal;
+  try {
+    nominal = YAML::LoadFile(yaml.string())["nominal"];
+  } catch (const YAML::Exception& e) {
+    throw UsageError(yaml.string() + ": " + e.what());
+  }
+  if (!nominal || !nominal.IsMap()) return false;
+  auto rigid = [](const std::string& f) {
+    for (const char* r : {"XX", "XY", "XZ", "YY", "YZ", "ZZ", "MX", "MY", "MZ", "M", "IA", "FV", "FS"})
+      if (f == r) return true;
+    return false;
+  };
+  values.assign(standard.size(), 0.0);
+  std::string missing;
+  for (std::size_t i = 0; i < standard.size(); ++i) {
+    if (const YAML::Node v = nominal[standard[i].name]) values[i] = v.as<double>();
+    else if (rigid(standard[i].family)) missing += std::string(missing.empty() ? "" : ", ") + standard[i].name;
+  }
+  if (!missing.empty()) throw UsageError(yaml.string() + ": nominal lacks " + missing);
+  return true;
 }
 
 }  // namespace symoro::dynid

@@ -16,11 +16,13 @@
 #include "dynid_common.hpp"
 #include "symoro/io/number_text.hpp"
 #include "symoro/mdh.hpp"
+#include "symoro/urdf_geometry.hpp"
 
 namespace symoro::dynid {
 
 namespace {
 
+using urdf_geometry::pose;
 using Eigen::Isometry3d;
 using Eigen::Matrix3d;
 using Eigen::Vector3d;
@@ -60,12 +62,6 @@ Origin read_origin(const std::string& robot_yaml) {
   return o;
 }
 
-Isometry3d pose(const urdf::Pose& p) {
-  Isometry3d T = Isometry3d::Identity();
-  T.linear() = Eigen::Quaterniond(p.rotation.w, p.rotation.x, p.rotation.y, p.rotation.z).normalized().toRotationMatrix();
-  T.translation() = Vector3d(p.position.x, p.position.y, p.position.z);
-  return T;
-}
 
 // A body's parameters about a frame's origin: inertia J, first moment h, mass m.
 struct Body {
@@ -202,13 +198,8 @@ std::string urdf_into(const identify::UrdfDescription& d, const std::string& rob
   std::function<void(const urdf::Link&)> walk = [&](const urdf::Link& l) {
     for (const auto& c : l.child_links) {
       const urdf::Joint& j = *c->parent_joint;
-      Isometry3d motion = Isometry3d::Identity();
       const auto lock = origin.locked.find(j.name);
-      if (lock != origin.locked.end()) {
-        const Vector3d axis = Vector3d(j.axis.x, j.axis.y, j.axis.z).normalized();
-        if (j.type == urdf::Joint::PRISMATIC) motion.translation() = lock->second * axis;
-        else motion.linear() = Eigen::AngleAxisd(lock->second, axis).toRotationMatrix();
-      }
+      const Isometry3d motion = urdf_geometry::motion(j, lock == origin.locked.end() ? 0.0 : lock->second);
       T[c->name] = T[l.name] * pose(j.parent_to_joint_origin_transform) * motion;
       walk(*c);
     }

@@ -17,18 +17,20 @@
 
 #include "equation_text.hpp"
 #include "symoro/codegen/robot_spec.hpp"
+#include "symoro/urdf_geometry.hpp"
 
 namespace symoro::codegen::modeling {
 
 namespace {
 
+using urdf_geometry::exact;
+using urdf_geometry::kAngleSnap;
+using urdf_geometry::pose;
+using urdf_geometry::snapped_angle;
 using Eigen::Isometry3d;
 using Eigen::Matrix3d;
 using Eigen::Vector3d;
 
-// rad: an angle this close to k pi/2 is k pi/2. URDFs write quarter turns to 9 or 11 digits
-// (1.570796325, 1.57079632679): they mean pi/2, and exact zeros keep the model's code short.
-constexpr double kAngleSnap = 1e-8;
 constexpr double kLengthSnap = 1e-12;  // m
 
 // urdfdom reports through console_bridge: the messages go into the error instead of stderr.
@@ -62,10 +64,6 @@ std::string angle_text(double a) {
     }
   }
   return number_text(a);
-}
-double snapped_angle(double a) {
-  const double k = std::round(a / (M_PI / 2));
-  return std::abs(a - k * M_PI / 2) <= kAngleSnap ? k * M_PI / 2 : a;
 }
 // A length: 0 below kLengthSnap, else the 12-digit decimal it is within rounding of (the URDF's
 // decimals come back as 0.0825 rather than 0.08250000000000005).
@@ -101,23 +99,7 @@ Isometry3d dh_transform(const Dh& p) {
   return T;
 }
 
-// Exact trig at quarter turns, so that the frames agree with the exact model's.
-double exact(double v) { return std::abs(v) < 1e-15 ? 0.0 : std::abs(std::abs(v) - 1) < 1e-15 ? std::copysign(1.0, v) : v; }
 
-// A URDF origin; its roll, pitch and yaw near quarter turns are taken as exact (kAngleSnap), so
-// that the geometry computed from them is exact too (0.09465, not 0.0946499999959983).
-Isometry3d pose(const urdf::Pose& p) {
-  double roll, pitch, yaw;
-  p.rotation.getRPY(roll, pitch, yaw);
-  Isometry3d T = Isometry3d::Identity();
-  T.linear() = (Eigen::AngleAxisd(snapped_angle(yaw), Vector3d::UnitZ()) * Eigen::AngleAxisd(snapped_angle(pitch), Vector3d::UnitY()) *
-                Eigen::AngleAxisd(snapped_angle(roll), Vector3d::UnitX()))
-                   .toRotationMatrix();
-  for (int a = 0; a < 3; ++a)
-    for (int b = 0; b < 3; ++b) T.linear()(a, b) = exact(T.linear()(a, b));
-  T.translation() = Vector3d(p.position.x, p.position.y, p.position.z);
-  return T;
-}
 
 std::string xyz_rpy(const Isometry3d& T) {
   const Vector3d p = T.translation();
@@ -250,12 +232,11 @@ UrdfChain read_urdf_chain(const std::string& path, const ModelingOptions& option
         for (int k = 0; k < n; ++k)
           if (chain[k]->name == j.name) b = k + 1;
       } else if (moving(j)) {
+        if (j.type != urdf::Joint::PRISMATIC && j.type != urdf::Joint::REVOLUTE && j.type != urdf::Joint::CONTINUOUS)
+          throw InputError(path, line_of("joint", j.name), 0, "joint '" + j.name + "' off the chain is floating or planar: it cannot be locked");
         const auto it = options.locked.find(j.name);
         const double q = it == options.locked.end() ? 0.0 : it->second;
-        const Vector3d axis = vec(j.axis).normalized();
-        if (j.type == urdf::Joint::PRISMATIC) motion.translation() = q * axis;
-        else if (j.type == urdf::Joint::REVOLUTE || j.type == urdf::Joint::CONTINUOUS) motion.linear() = Eigen::AngleAxisd(q, axis).toRotationMatrix();
-        else throw InputError(path, line_of("joint", j.name), 0, "joint '" + j.name + "' off the chain is floating or planar: it cannot be locked");
+        motion = urdf_geometry::motion(j, q);
         locked_notes.push_back(j.name + " = " + number_text(q));
       }
       T[c->name] = T[l.name] * pose(j.parent_to_joint_origin_transform) * motion;
