@@ -22,6 +22,7 @@
 #include <urdf_parser/urdf_parser.h>
 
 #include "dynid_urdf_into.hpp"
+#include "relative_difference.hpp"
 #include "symoro/codegen/graph_evaluator.hpp"
 #include "symoro/codegen/modeling.hpp"
 #include "symoro/codegen/robot_model.hpp"
@@ -94,15 +95,7 @@ struct Case {
   double tolerance = 1e-12;  // relative
 };
 
-// Largest |a - b| over the largest |a|.
-double relative_difference(const std::vector<double>& a, const std::vector<double>& b) {
-  double diff = 0, scale = 0;
-  for (std::size_t i = 0; i < a.size(); ++i) {
-    diff = std::max(diff, std::abs(a[i] - b[i]));
-    scale = std::max(scale, std::abs(a[i]));
-  }
-  return diff / scale;
-}
+using test::relative_difference;
 
 void expect_matches_kdl(const Case& c) {
   SCOPED_TRACE(c.label);

@@ -11,6 +11,7 @@
 #include <fstream>
 #include <random>
 
+#include "relative_difference.hpp"
 #include "symoro/codegen/graph_evaluator.hpp"
 #include "symoro/codegen/modeling.hpp"
 #include "symoro/codegen/robot_model.hpp"
@@ -50,15 +51,7 @@ std::vector<NodeId> flat(const std::vector<std::vector<NodeId>>& m) {
   return out;
 }
 
-// Largest |a - b| over the scale of a.
-double relative_difference(const std::vector<double>& a, const std::vector<double>& b) {
-  double diff = 0, scale = 0;
-  for (std::size_t i = 0; i < a.size(); ++i) {
-    diff = std::max(diff, std::abs(a[i] - b[i]));
-    scale = std::max(scale, std::abs(a[i]));
-  }
-  return diff / std::max(scale, 1e-300);
-}
+using test::relative_difference;
 
 class ModelFromPar : public ::testing::TestWithParam<std::string> {};
 
