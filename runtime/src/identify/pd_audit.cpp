@@ -19,6 +19,8 @@
 
 #include <Eigen/Eigenvalues>
 
+#include "ipopt_lock.hpp"
+
 namespace symoro::identify {
 namespace {
 
@@ -315,19 +317,12 @@ class RayleighProblem : public Ipopt::TNLP {
   std::vector<MatrixXd> dM_, d2M_;
 };
 
-// Ipopt's linear solver here (MUMPS, Ipopt 3.11) keeps global state and is not thread-safe:
-// concurrent audits run their local searches one at a time.
-std::mutex& ipopt_mutex() {
-  static std::mutex mutex;
-  return mutex;
-}
-
 // The pose Ipopt reaches from (q0, v0); empty when it returned none.
 VectorXd minimize_locally(const InertiaFunction& m, const VectorXd& phi, const AuditDomain& d, const VectorXd& q0,
                           const VectorXd& v0, bool exact_hessian, const AuditOptions& options) {
   auto* problem = new RayleighProblem(m, phi, d, q0, v0, exact_hessian);
   const Ipopt::SmartPtr<Ipopt::TNLP> owner = problem;
-  std::lock_guard<std::mutex> lock(ipopt_mutex());
+  std::lock_guard<std::mutex> lock(detail::ipopt_mutex());  // concurrent audits: one at a time
   // No console journal: Ipopt prints nothing, banner included.
   Ipopt::SmartPtr<Ipopt::IpoptApplication> app = new Ipopt::IpoptApplication(false);
   auto& o = *app->Options();

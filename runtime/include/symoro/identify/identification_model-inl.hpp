@@ -32,6 +32,8 @@ class GeneratedIdentificationModel final : public IdentificationModel {
     d_.parameters.assign(Model::parameters.begin(), Model::parameters.end());
     d_.joints.assign(Model::joints.begin(), Model::joints.end());
     d_.standard.assign(Model::standard_parameters.begin(), Model::standard_parameters.end());
+    d_.frames.assign(Model::frames.begin(), Model::frames.end());
+    for (const auto& f : Model::fixed_parameters) has_fixed_ = has_fixed_ || f.value != 0;
   }
   const ModelDescription& description() const override { return d_; }
 
@@ -46,6 +48,29 @@ class GeneratedIdentificationModel final : public IdentificationModel {
   }
   Eigen::MatrixXd open_loop_torque(const preprocess::Samples& samples, const Eigen::VectorXd& phi) const override {
     return identify::open_loop_torque<Model>(samples, phi);
+  }
+  void state_derivatives(const Eigen::VectorXd& q, const Eigen::VectorXd& qd, const Eigen::VectorXd& qdd,
+                         const Eigen::VectorXd& phi, bool with_fixed, StateDerivatives& out) const override {
+    using V = Eigen::Matrix<double, Model::nq, 1>;
+    const V Q = q, QD = qd, QDD = qdd;
+    const Eigen::Matrix<double, Model::np, 1> P = phi;
+    typename Model::template InverseDynamicsDerivatives<double> d;
+    Model::inverse_dynamics_derivatives(Q, QD, QDD, P, d);
+    Eigen::Matrix<double, Model::nq, Model::nq> M;
+    Model::inertia(Q, P, M);
+    out.tau = d.tau;
+    out.dq = d.dq;
+    out.dqd = d.dqd;
+    out.dqdd = M;
+    if (has_fixed_ && !with_fixed) {  // the fixed parameters' part, affine: subtract it at phi = 0
+      const Eigen::Matrix<double, Model::np, 1> zero = Eigen::Matrix<double, Model::np, 1>::Zero();
+      Model::inverse_dynamics_derivatives(Q, QD, QDD, zero, d);
+      Model::inertia(Q, zero, M);
+      out.tau -= d.tau;
+      out.dq -= d.dq;
+      out.dqd -= d.dqd;
+      out.dqdd -= M;
+    }
   }
   std::unique_ptr<InertiaFunction> inertia_function() const override { return make_inertia_function<Model>(); }
   std::unique_ptr<ClosedLoop> closed_loop(const ClosedLoopSetup& setup,
@@ -64,6 +89,7 @@ class GeneratedIdentificationModel final : public IdentificationModel {
 
  private:
   ModelDescription d_;
+  bool has_fixed_ = false;
 };
 
 }  // namespace detail

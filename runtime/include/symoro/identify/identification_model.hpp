@@ -31,6 +31,13 @@ struct ModelDescription {
   std::vector<ParameterInfo> parameters;  // phi's entries
   std::vector<JointInfo> joints;
   std::vector<StandardParameterInfo> standard;  // the argument of base_from_standard
+  std::vector<FrameInfo> frames;                // the modified-DH frames (symoro/mdh.hpp)
+};
+
+// The inverse dynamics at one state and its derivatives along the state (nq x nq each).
+struct StateDerivatives {
+  Eigen::VectorXd tau;
+  Eigen::MatrixXd dq, dqd, dqdd;  // d tau / d q, d qd, d qdd (the last is M(q; phi))
 };
 
 class IdentificationModel {
@@ -44,6 +51,12 @@ class IdentificationModel {
   virtual Eigen::VectorXd base_from_standard(const Eigen::VectorXd& s) const = 0;
   // ID(q, qd, qdd; phi) at every sample: samples x nq.
   virtual Eigen::MatrixXd open_loop_torque(const preprocess::Samples& samples, const Eigen::VectorXd& phi) const = 0;
+  // At one state (q, qd, qdd): tau = W phi, with the fixed parameters' torque when
+  // `with_fixed` (then it is ID(q, qd, qdd; phi)), and its derivatives from the generated
+  // inverse_dynamics_derivatives and inertia. Without the fixed torque it is linear in phi: for
+  // phi = g it gives d (W g) / d state, what the gradient of an excitation criterion needs.
+  virtual void state_derivatives(const Eigen::VectorXd& q, const Eigen::VectorXd& qd, const Eigen::VectorXd& qdd,
+                                 const Eigen::VectorXd& phi, bool with_fixed, StateDerivatives& out) const = 0;
   // M(q; phi) and its derivatives for the audit and the SDP projection.
   virtual std::unique_ptr<InertiaFunction> inertia_function() const = 0;
   // The closed loop of one reference under the experiment's controller.

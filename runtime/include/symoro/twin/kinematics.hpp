@@ -14,9 +14,8 @@
 
 namespace symoro::twin {
 
-// ^0T_j for every frame j = 1..n (index j - 1), following `ant`. q has one entry per movable
-// frame, in frame order.
-std::vector<Eigen::Isometry3d> mdh_poses(const std::vector<FrameInfo>& frames, const Eigen::VectorXd& q);
+// The model's frames: symoro/mdh.hpp.
+using symoro::mdh_poses;
 
 // The pose in the URDF base of the child link of every URDF joint (index as chain.joints), with
 // the model joint variables q (fixed joints take none).

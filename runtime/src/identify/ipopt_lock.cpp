@@ -1,0 +1,10 @@
+#include "ipopt_lock.hpp"
+
+namespace symoro::identify::detail {
+
+std::mutex& ipopt_mutex() {
+  static std::mutex mutex;
+  return mutex;
+}
+
+}  // namespace symoro::identify::detail
