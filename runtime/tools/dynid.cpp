@@ -25,6 +25,7 @@ int main(int argc, char** argv) {
   for (const auto& r : robot_names()) known += (known.empty() ? "" : ", ") + r;
   app.footer("Robots: " + known);
   add_trajectory_commands(app, common);
+  add_excite_commands(app, common);
   add_twin_commands(app, common);
   add_import_commands(app, common);
   add_preprocess_commands(app, common);

@@ -22,7 +22,12 @@ namespace symoro::dynid {
 struct Common {
   std::string robot;
   std::string robots_dir = SYMORO_DEFAULT_ROBOTS_DIR;
+  std::string design;  // --design: a trajectory design file instead of the robot's own
   std::filesystem::path robot_dir() const { return std::filesystem::path(robots_dir) / robot; }
+  // The trajectory design commands read: --design, else robots/<robot>/trajectories.yaml.
+  std::filesystem::path design_path() const {
+    return design.empty() ? robot_dir() / "trajectories.yaml" : std::filesystem::path(design);
+  }
 };
 
 // An error in the command's use (unknown robot, missing file): printed without a stack.
@@ -70,6 +75,7 @@ bool nominal_standard_parameters(const Common& common, const std::vector<Standar
 void add_compare_commands(CLI::App& app, Common& common);
 void add_twin_commands(CLI::App& app, Common& common);
 void add_trajectory_commands(CLI::App& app, Common& common);
+void add_excite_commands(CLI::App& app, Common& common);
 void add_preprocess_commands(CLI::App& app, Common& common);
 void add_identify_commands(CLI::App& app, Common& common);
 void add_diagnose_commands(CLI::App& app, Common& common);

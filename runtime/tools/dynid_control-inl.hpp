@@ -88,7 +88,7 @@ void ControlCommand::run(const Common& common, const ControlCliOptions& o) {
     if (o.ideal) tc->effects.disable_all();
   }
   const trajectory::Trajectory traj =
-      trajectory::TrajectoryDesign::read(common.robot_dir() / "trajectories.yaml", joints).build(o.trajectory);
+      trajectory::TrajectoryDesign::read(common.design_path(), joints).build(o.trajectory);
 
   hardware::ControlOptions co;
   co.robot = common.robot;

@@ -14,6 +14,8 @@ void add_control_commands(CLI::App& app, Common& common) {
                                             "--virtual: on the emulated bus driving the digital twin");
   cmd->add_option("--robot", common.robot, "Robot folder name under robots/")->required();
   cmd->add_option("--robots-dir", common.robots_dir, "Where the robot folders are");
+  cmd->add_option("--design", common.design, "A trajectory design file (e.g. dynid excite's) instead of robots/<robot>/trajectories.yaml")
+      ->check(CLI::ExistingFile);
   cmd->add_option("--port", o->port, "Serial device of the DYNAMIXEL bus (default /dev/ttyUSB0)");
   cmd->add_flag("--virtual", o->virtual_bus, "Emulated servos on a pseudo-terminal, driving the digital twin");
   cmd->add_option("--trajectory", o->trajectory, "Trajectory name (default AG02)");

@@ -81,7 +81,7 @@ identify::StudyResult study(const Common& common, const IdentifyOptions& o,
     loop.setup = identify::closed_loop_setup(control::read_controller_description(controller_path, d.nq));
   else
     loop.why = fmt::format("no controller description ({} not found)", controller_path.string());
-  const auto design_path = common.robot_dir() / "trajectories.yaml";
+  const auto design_path = common.design_path();
   if (std::filesystem::exists(design_path)) loop.design = trajectory::TrajectoryDesign::read(design_path, joints);
   identify::Study s(model, so, std::move(loop));
   identify::StudyResult result = s.run();
@@ -160,6 +160,8 @@ void add_identify_commands(CLI::App& app, Common& common) {
                                              "selection, rescue, validation, report");
   cmd->add_option("--robot", common.robot, "Robot folder name under robots/")->required();
   cmd->add_option("--robots-dir", common.robots_dir, "Where the robot folders are");
+  cmd->add_option("--design", common.design, "A trajectory design file (e.g. dynid excite's) instead of robots/<robot>/trajectories.yaml")
+      ->check(CLI::ExistingFile);
   cmd->add_option("--data", o->data, "Dataset folder (dataset.yaml and logs)")->required()->check(CLI::ExistingDirectory);
   cmd->add_option("-o,--out", o->out, "Study folder (runs/ and report/)")->required();
   cmd->add_option("--model", o->model, "Model to identify: a robot.yaml variant, or full (default: robot.yaml's "

@@ -16,14 +16,14 @@ namespace symoro::dynid {
 
 template <class Full, class Model>
 void TrajectoriesCommand::run(const Common& common, const TrajectoryOptions& o) {
-  const auto design = trajectory::TrajectoryDesign::read(common.robot_dir() / "trajectories.yaml", joint_list<Full>());
+  const auto design = trajectory::TrajectoryDesign::read(common.design_path(), joint_list<Full>());
   const std::vector<std::string> names = o.only.empty() ? design.names() : o.only;
   std::vector<std::string> joint_names;
   for (const auto& j : Full::joints) joint_names.push_back(j.name);
   if (o.out.empty() && o.quality) {
     std::vector<trajectory::Trajectory> all;
     for (const auto& name : names) all.push_back(design.build(name));
-    print_trajectory_quality(common, all, o);
+    fmt::print("{}", trajectory_quality_table(common, all, o));
     return;
   }
   if (o.out.empty()) {

@@ -11,21 +11,22 @@
 
 namespace symoro::dynid {
 
-void print_trajectory_quality(const Common& common, const std::vector<trajectory::Trajectory>& trajectories,
-                              const TrajectoryOptions& o) {
-  const auto model = identification_model_of(common, "");
+std::string trajectory_quality_table(const Common& common, const std::vector<trajectory::Trajectory>& trajectories,
+                                     const TrajectoryOptions& o, const std::string& model_name) {
+  const auto model = identification_model_of(common, model_name);
+  std::string out;
   const identify::ModelDescription& d = model->description();
   const double interval = o.interval_ms / 1000;
-  fmt::print("excitation of {} model {} ({} base parameters) at {:.0f} ms: kappa of W, kappa and log det (per row) of "
-             "W with unit columns, the weakest direction's largest components\n",
+  out += fmt::format("excitation of {} model {} ({} base parameters) at {:.0f} ms: kappa of W, kappa of W and log det of W'W with "
+                     "unit columns (<= 0, 0 when the columns are orthogonal), the weakest direction's largest components\n",
              common.robot, d.variant.empty() ? "full" : d.variant, d.np, o.interval_ms);
-  fmt::print("{:<6} {:<4} {:>8} {:>11} {:>11} {:>10}  {}\n", "name", "fam", "duration", "kappa", "kappa_scl", "logdet_scl",
+  out += fmt::format("{:<6} {:<4} {:>8} {:>11} {:>11} {:>10}  {}\n", "name", "fam", "duration", "kappa", "kappa_scl", "logdet_scl",
              "weakest");
   auto row = [&](const std::string& name, const std::string& family, double duration, const identify::ExcitationQuality& q) {
     std::string weakest;
     if (!q.unexcited.empty()) weakest = fmt::format("{} parameters not excited (e.g. {})", q.unexcited.size(), q.unexcited.front());
     for (const auto& [p, v] : q.weakest) weakest += fmt::format("{}{} {:+.2f}", weakest.empty() ? "" : ", ", p, v);
-    fmt::print("{:<6} {:<4} {:>7.1f}s {:>11.4g} {:>11.4g} {:>10.3f}  {}\n", name, family, duration, q.kappa, q.kappa_scaled,
+    out += fmt::format("{:<6} {:<4} {:>7.1f}s {:>11.4g} {:>11.4g} {:>10.3f}  {}\n", name, family, duration, q.kappa, q.kappa_scaled,
                q.log_det_scaled, weakest);
   };
   std::vector<Eigen::MatrixXd> Ws;
@@ -45,6 +46,7 @@ void print_trajectory_quality(const Common& common, const std::vector<trajectory
     at += W.rows();
   }
   if (trajectories.size() > 1) row("all", "", total, identify::excitation_quality(all, d.parameters));
+  return out;
 }
 
 void add_trajectory_commands(CLI::App& app, Common& common) {
@@ -52,6 +54,8 @@ void add_trajectory_commands(CLI::App& app, Common& common) {
   auto* cmd = app.add_subcommand("trajectories", "List the identification trajectories, or write them as reference files");
   cmd->add_option("--robot", common.robot, "Robot folder name under robots/")->required();
   cmd->add_option("--robots-dir", common.robots_dir, "Where the robot folders are");
+  cmd->add_option("--design", common.design, "A trajectory design file (e.g. dynid excite's) instead of robots/<robot>/trajectories.yaml")
+      ->check(CLI::ExistingFile);
   cmd->add_option("-o,--output", o->out, "Write <name>.csv and <name>.meta.yaml here (default: list only)");
   cmd->add_option("--only", o->only, "Only these trajectories");
   cmd->add_option("--period", o->period, "Sample period of the reference files, s")->check(numbers::positive(10, "> 0 and <= 10 s"));

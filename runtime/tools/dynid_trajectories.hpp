@@ -18,10 +18,10 @@ struct TrajectoryOptions {
   double interval_ms = 10;   // ... at this sampling interval
 };
 
-// The excitation quality of each trajectory and of all of them together, for the robot's
-// identified model (compiled once: dynid_trajectories.cpp).
-void print_trajectory_quality(const Common& common, const std::vector<trajectory::Trajectory>& trajectories,
-                              const TrajectoryOptions& o);
+// The excitation quality of each trajectory and of all of them together, for the robot's model
+// `model` ("" robot.yaml's identified), as a table (compiled once: dynid_trajectories.cpp).
+std::string trajectory_quality_table(const Common& common, const std::vector<trajectory::Trajectory>& trajectories,
+                                     const TrajectoryOptions& o, const std::string& model = "");
 
 struct TrajectoriesCommand {
   using Options = TrajectoryOptions;

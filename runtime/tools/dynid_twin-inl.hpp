@@ -47,7 +47,7 @@ inline std::string describe(const twin::RunStats& s) {
 }
 
 inline trajectory::TrajectoryDesign read_design(const Common& common, const std::vector<JointInfo>& joints) {
-  return trajectory::TrajectoryDesign::read(common.robot_dir() / "trajectories.yaml", joints);
+  return trajectory::TrajectoryDesign::read(common.design_path(), joints);
 }
 
 template <class Model>

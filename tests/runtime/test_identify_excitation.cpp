@@ -218,7 +218,7 @@ TEST(ExcitationDesign, CraneDesignMeetsEveryLimitAndBeatsAStructuredTrajectory) 
   expect_limits_hold<Crane>(d, o, o.nominal);
   const auto structured = excitation_quality(*m, symoro::trajectory::sample(pa01, 0.001), 0.01);
   const auto optimized = excitation_quality(*m, d.trajectory.sample(0.001), 0.01);
-  // Per row, so the comparison does not depend on the number of samples.
+  // Unit columns: both measure how well the motion tells the parameters apart.
   EXPECT_GT(optimized.log_det_scaled, structured.log_det_scaled + 10) << structured.log_det_scaled;
   EXPECT_LT(optimized.kappa_scaled, structured.kappa_scaled / 2) << structured.kappa_scaled;
   EXPECT_LT(optimized.kappa, structured.kappa) << structured.kappa;

@@ -29,7 +29,7 @@ ExcitationQuality excitation_quality(const Eigen::MatrixXd& W, const std::vector
   q.sigma_min_scaled = s(s.size() - 1);
   if (q.sigma_min_scaled > 0) {
     q.kappa_scaled = s(0) / q.sigma_min_scaled;
-    q.log_det_scaled = 2 * s.array().log().sum() - static_cast<double>(s.size()) * std::log(static_cast<double>(q.rows));
+    q.log_det_scaled = 2 * s.array().log().sum();
   }
   const Eigen::VectorXd v = svd.matrixV().col(svd.matrixV().cols() - 1);
   std::vector<int> order(static_cast<std::size_t>(v.size()));

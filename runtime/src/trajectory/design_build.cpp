@@ -34,13 +34,16 @@ class Assembler {
     for (const ItemSpec& item : spec_.items) {
       if (item.kind == ItemSpec::Kind::Waypoints)
         waypoints(item);
+      else if (item.kind == ItemSpec::Kind::Fourier)
+        periodic(item);
       else
         for (const PrimitiveSpec& p : item.primitives) primitive(item, p);
     }
     // Back to the trajectory's posture, and at rest for the end hold instead of the last dwell.
     transition(d_.postures.at(spec_.posture), spec_.speed, "");
     auto& segments = trajectory_.segments;
-    while (!segments.empty() && !segments.back().profile.moves() && segments.size() > 1) segments.pop_back();
+    while (!segments.empty() && !segments.back().profile.moves() && !segments.back().periodic && segments.size() > 1)
+      segments.pop_back();
     dwell(d_.end_hold, "hold");
     return std::move(trajectory_);
   }
@@ -116,6 +119,18 @@ class Assembler {
       move(to, factor(joints, item.speed, item.speed_class), label);
       dwell(k + 1 < item.waypoints.size() ? d_.waypoint_dwell : d_.primitive_dwell, label);
     }
+  }
+
+  // Whole periods of a Fourier series from rest where the arm is, back to rest there.
+  void periodic(const ItemSpec& item) {
+    auto series = std::make_shared<FourierTrajectory>(*item.fourier);
+    series->q0 = at_;
+    for (int l = 1; l <= series->harmonics(); ++l) series->q0 += series->b.col(l - 1) / (series->w * l);
+    Segment s = plan_hold(now(), at_, item.periods * series->period());
+    s.label = "fourier";
+    s.periodic = std::move(series);
+    trajectory_.segments.push_back(std::move(s));
+    dwell(d_.primitive_dwell, "dwell");
   }
 
   double now() const { return trajectory_.duration(); }

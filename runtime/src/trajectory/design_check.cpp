@@ -1,12 +1,14 @@
 // The limits check of a built trajectory. It is exact, not sampled: along a segment every joint
 // moves monotonically from one waypoint to the next (ds/dt >= 0), so its position extremes are
 // the waypoints, and its speed peaks at |to - from| times the profile's peak velocity, reached
-// at the end of the first ramp.
+// at the end of the first ramp. A periodic segment (a Fourier series) is checked over one period
+// every millisecond, the control period its references are stepped through.
 #include <cmath>
 #include <sstream>
 
 #include "design_data.hpp"
 #include "symoro/error.hpp"
+#include "symoro/trajectory/fourier.hpp"
 
 namespace symoro::trajectory {
 
@@ -44,6 +46,19 @@ void check_limits(const Design& design, const TrajectorySpec& spec, const Trajec
   check_position(trajectory.segments.front().from, 0.0);
   for (const Segment& s : trajectory.segments) {
     check_position(s.to, s.end());
+    if (s.periodic) {
+      Eigen::VectorXd q, qd, qdd;
+      const double period = s.periodic->period();
+      for (int k = 0; k * 1e-3 <= period; ++k) {
+        s.periodic->evaluate(k * 1e-3, q, qd, qdd);
+        check_position(q, s.start + k * 1e-3);
+        for (std::size_t j = 0; j < design.joints.size(); ++j)
+          if (std::abs(qd[j]) > design.joints[j].velocity)
+            fail(j, s.start + k * 1e-3,
+                 "moves at " + text(std::abs(qd[j])) + " rad/s, over its velocity limit " + text(design.joints[j].velocity) + " rad/s");
+      }
+      continue;
+    }
     if (!s.profile.moves()) continue;
     const double peak = s.profile.peak_velocity();
     for (std::size_t j = 0; j < design.joints.size(); ++j) {

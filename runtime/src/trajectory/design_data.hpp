@@ -4,12 +4,14 @@
 
 #include <filesystem>
 #include <map>
+#include <memory>
 #include <string>
 #include <vector>
 
 #include <Eigen/Core>
 
 #include "symoro/model_info.hpp"
+#include "symoro/trajectory/fourier.hpp"
 #include "symoro/trajectory/trajectory.hpp"
 
 namespace symoro::trajectory {
@@ -22,10 +24,12 @@ struct PrimitiveSpec {
 
 // One step of a trajectory's sequence, with patterns and sweeps expanded.
 struct ItemSpec {
-  enum class Kind { Primitives, Waypoints };
+  enum class Kind { Primitives, Waypoints, Fourier };
   Kind kind = Kind::Primitives;
   std::vector<PrimitiveSpec> primitives;   // Kind::Primitives, in order
   std::vector<Eigen::VectorXd> waypoints;  // Kind::Waypoints, rad
+  std::shared_ptr<const FourierTrajectory> fourier;  // Kind::Fourier: w, a, b (q0 from where it starts)
+  int periods = 1;                         // Kind::Fourier
   std::string posture;                     // e.g. "A" or "C'"
   int speed = 1;                           // level, 1-based
   std::string speed_class;                 // empty: the slowest class of the moving joints

@@ -337,15 +337,20 @@ class DesignReader {
   }
 
   ItemSpec item(const YAML::Node& node, const TrajectorySpec& t) const {
-    r_.keys(node, "an item of " + t.name, {"pattern", "single", "pair", "signs", "waypoints", "posture", "speed", "class"}, {});
-    const int kinds = !!node["pattern"] + !!node["single"] + !!node["pair"] + !!node["waypoints"];
-    if (kinds != 1) r_.fail(node, "an item of " + t.name + " needs exactly one of pattern, single, pair and waypoints");
+    r_.keys(node, "an item of " + t.name, {"pattern", "single", "pair", "signs", "waypoints", "fourier", "posture", "speed", "class"}, {});
+    const int kinds = !!node["pattern"] + !!node["single"] + !!node["pair"] + !!node["waypoints"] + !!node["fourier"];
+    if (kinds != 1) r_.fail(node, "an item of " + t.name + " needs exactly one of pattern, single, pair, waypoints and fourier");
     ItemSpec item;
     item.line = static_cast<int>(node.Mark().line) + 1;
     item.posture = node["posture"] ? posture_name(node["posture"]) : t.posture;
     item.speed = node["speed"] ? r_.integer(node["speed"], "speed (a level)", 1, d_.levels()) : t.speed;
     if (node["class"]) item.speed_class = speed_class(node["class"]);
-    if (node["waypoints"]) {
+    if (node["fourier"]) {
+      for (const char* key : {"signs", "posture", "speed", "class"})
+        if (node[key]) r_.fail(node[key], std::string("a fourier item starts where the arm is and keeps its own timing: it takes no ") + key);
+      item.kind = ItemSpec::Kind::Fourier;
+      fourier(node["fourier"], t.name, item);
+    } else if (node["waypoints"]) {
       if (node["signs"]) r_.fail(node["signs"], "signs apply to pair primitives only");
       if (node["posture"]) r_.fail(node["posture"], "waypoints are absolute: they take no posture");
       item.kind = ItemSpec::Kind::Waypoints;
@@ -369,8 +374,45 @@ class DesignReader {
         r_.fail(node, "posture " + d_.base_posture.at(item.posture) + " has no entry in primitives (amplitudes)");
       item.summary += " at " + item.posture;
     }
-    item.summary += ", speed " + std::to_string(item.speed);
+    if (item.kind != ItemSpec::Kind::Fourier) item.summary += ", speed " + std::to_string(item.speed);
     return item;
+  }
+
+  // fourier: {period: T s, periods: P, a: [[a_j1 .. a_jL] per joint], b: [...]} in rad/s, at
+  // rest at t = 0 (sum_l a_jl = 0, sum_l l b_jl = 0; trajectory/fourier.hpp).
+  void fourier(const YAML::Node& node, const std::string& name, ItemSpec& item) const {
+    r_.keys(node, "fourier of " + name, {"period", "periods", "a", "b"}, {"period", "a", "b"});
+    auto series = std::make_shared<FourierTrajectory>();
+    series->name = name;
+    series->w = 2 * 3.14159265358979323846 / r_.positive(node["period"], "fourier.period");
+    item.periods = node["periods"] ? r_.integer(node["periods"], "fourier.periods", 1, 1000) : 1;
+    auto matrix = [&](const YAML::Node& m, const char* key, Eigen::MatrixXd& out) {
+      r_.sequence(m, std::string("fourier.") + key + " (one list of harmonics per joint)", static_cast<std::size_t>(n_));
+      const std::size_t L = r_.sequence(m[0], std::string("fourier.") + key + " of joint 1").size();
+      if (L < 2) r_.fail(m[0], "fourier needs at least 2 harmonics");
+      out.resize(n_, static_cast<Eigen::Index>(L));
+      for (int j = 0; j < n_; ++j) {
+        const YAML::Node row = r_.sequence(m[j], std::string("fourier.") + key + " of joint " + std::to_string(j + 1), L);
+        for (std::size_t l = 0; l < L; ++l) out(j, static_cast<Eigen::Index>(l)) = r_.number(row[l], std::string("fourier.") + key);
+      }
+    };
+    matrix(node["a"], "a", series->a);
+    matrix(node["b"], "b", series->b);
+    if (series->a.cols() != series->b.cols()) r_.fail(node["b"], "fourier.a and fourier.b need the same number of harmonics");
+    for (int j = 0; j < n_; ++j) {
+      double sa = 0, sb = 0, scale = 1e-300;
+      for (Eigen::Index l = 0; l < series->a.cols(); ++l) {
+        sa += series->a(j, l);
+        sb += (l + 1.0) * series->b(j, l);
+        scale = std::max({scale, std::abs(series->a(j, l)), (l + 1.0) * std::abs(series->b(j, l))});
+      }
+      if (std::abs(sa) > 1e-9 * scale || std::abs(sb) > 1e-9 * scale)
+        r_.fail(node, "fourier of " + name + ": joint " + std::to_string(j + 1) + " (" + d_.joint_names[j] +
+                          ") is not at rest at t = 0 (sum a = " + Reader::format(sa) + ", sum l b = " + Reader::format(sb) + ", both must be 0)");
+    }
+    item.fourier = std::move(series);
+    item.summary = "fourier " + std::to_string(item.fourier->harmonics()) + " harmonics, " + Reader::format(item.fourier->period()) +
+                   " s x " + std::to_string(item.periods);
   }
 
   void trajectories(const YAML::Node& node) {

@@ -4,6 +4,8 @@
 #include <algorithm>
 #include <stdexcept>
 
+#include "symoro/trajectory/fourier.hpp"
+
 namespace symoro::trajectory {
 
 void Trajectory::evaluate(double t, Eigen::Ref<Eigen::VectorXd> q, Eigen::Ref<Eigen::VectorXd> qd,
@@ -15,6 +17,14 @@ void Trajectory::evaluate(double t, Eigen::Ref<Eigen::VectorXd> q, Eigen::Ref<Ei
   auto after = std::upper_bound(segments.begin(), segments.end(), t,
                                 [](double time, const Segment& s) { return time < s.start; });
   const Segment& segment = after == segments.begin() ? segments.front() : *std::prev(after);
+  if (segment.periodic) {
+    Eigen::VectorXd pq, pqd, pqdd;
+    segment.periodic->evaluate(std::clamp(t - segment.start, 0.0, segment.profile.duration), pq, pqd, pqdd);
+    q = pq;
+    qd = pqd;
+    qdd = pqdd;
+    return;
+  }
   double s = 0, sd = 0, sdd = 0;
   segment.profile.evaluate(t - segment.start, s, sd, sdd);
   if (!segment.profile.moves()) {

@@ -3,9 +3,12 @@
 //   - kappa: sigma_max / sigma_min of W, the paper's condition number (unit dependent);
 //   - kappa_scaled: the same with W's columns scaled to unit norm, so that a parameter's unit
 //     (kg against kg m^2) does not count as poor excitation;
-//   - log_det_scaled: log det of the column-scaled W'W = 2 sum log sigma_i, the D-optimality
-//     criterion of an excitation design (larger is better; per row, so that designs of
-//     different lengths compare);
+//   - log_det_scaled: log det of W_s'W_s with W_s's columns of unit norm = 2 sum log sigma_i of
+//     W_s: at most 0 (orthogonal columns), the more negative the more the parameters' columns
+//     are alike. Unit columns make it independent of the units and of the motion's length and
+//     amplitude: it measures how well the motion tells the parameters apart, not how strongly
+//     it moves (the D-optimal design, excitation_design.hpp, maximizes log det with fixed
+//     scales, which rewards both);
 //   - the weakest direction: the right singular vector of the smallest scaled singular value,
 //     its largest components named (what the motion excites least).
 #pragma once
@@ -27,7 +30,7 @@ struct ExcitationQuality {
   int rows = 0;
   double kappa = std::numeric_limits<double>::infinity();
   double kappa_scaled = std::numeric_limits<double>::infinity();
-  double log_det_scaled = -std::numeric_limits<double>::infinity();  // of W_s'W_s / rows
+  double log_det_scaled = -std::numeric_limits<double>::infinity();  // of W_s'W_s, unit columns
   double sigma_min_scaled = 0;
   std::vector<std::pair<std::string, double>> weakest;  // name, component of the weakest direction
   std::vector<std::string> unexcited;                  // parameters whose column is zero

@@ -4,12 +4,15 @@
 // enough), or holds a waypoint. A Trajectory is exact: evaluate(t) gives q, qd, qdd at any t.
 #pragma once
 
+#include <memory>
 #include <string>
 #include <vector>
 
 #include <Eigen/Core>
 
 namespace symoro::trajectory {
+
+struct FourierTrajectory;  // fourier.hpp
 
 // The normalized point-to-point profile, planned for one segment.
 struct Profile {
@@ -36,7 +39,11 @@ struct Segment {
   Eigen::VectorXd from, to;  // waypoints (rad or m), one entry per joint; equal for a hold
   Profile profile;
   std::string label;       // what the segment belongs to: "hold", "dwell", "transition",
-                           // a primitive such as "P4@B'" or "P2,3(+,-)@C", or "waypoint 3"
+                           // a primitive such as "P4@B'" or "P2,3(+,-)@C", "waypoint 3", "fourier"
+  // A periodic excitation (its whole periods, from rest at `from` back to rest there): set, the
+  // segment follows this series from its start instead of the profile (which only holds the
+  // duration).
+  std::shared_ptr<const FourierTrajectory> periodic;
   double end() const { return start + profile.duration; }
 };
 

@@ -1,0 +1,253 @@
+// dynid excite: identification trajectories for any robot from its robots/ folder alone: the
+// paper's structured families (trajectory/structured_design.hpp) or a given design file, and
+// optimized Fourier series (identify/excitation_design.hpp) under the same speed limits, in one
+// design file that dynid twin, control, trajectories and identify read (--design), with the
+// excitation quality of every trajectory side by side.
+#include <CLI/CLI.hpp>
+
+#include <algorithm>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include <fmt/format.h>
+#include <yaml-cpp/yaml.h>
+
+#include "dynid_identify.hpp"
+#include "dynid_numbers.hpp"
+#include "dynid_trajectories.hpp"
+#include "symoro/identify/excitation_design.hpp"
+#include "symoro/io/atomic_file.hpp"
+#include "symoro/io/parameters_yaml.hpp"
+#include "symoro/trajectory/design.hpp"
+#include "symoro/trajectory/structured_design.hpp"
+
+namespace symoro::dynid {
+
+namespace {
+
+namespace fs = std::filesystem;
+constexpr double kDeg = 3.14159265358979323846 / 180.0;
+
+struct ExciteOptions {
+  std::string out;
+  std::string model;        // "" robot.yaml's identified
+  std::string from_design;  // structured families from this file instead of the generator
+  std::string params;       // nominal phi; "" robot.yaml's nominal
+  int optimized = 3;
+  int harmonics = 5;
+  double period = 10;
+  int periods = 1;
+  int starts = 4;
+  std::uint64_t seed = 1;
+  double torque_fraction = 0.8;
+  double table = -1;                    // m below frame 0; < 0: none
+  std::vector<std::string> half_spaces;  // "frame:nx,ny,nz:offset"
+  double interval_ms = 10;
+};
+
+std::vector<double> numbers_of(const std::string& text, char sep, const std::string& what) {
+  std::vector<double> out;
+  std::stringstream in(text);
+  std::string item;
+  while (std::getline(in, item, sep)) {
+    try {
+      std::size_t used = 0;
+      out.push_back(std::stod(item, &used));
+      if (used != item.size()) throw std::invalid_argument(item);
+    } catch (const std::exception&) {
+      throw UsageError(fmt::format("{}: '{}' is not a number", what, item));
+    }
+  }
+  return out;
+}
+
+std::vector<identify::HalfSpace> half_spaces(const ExciteOptions& o, int frames) {
+  std::vector<identify::HalfSpace> out;
+  if (o.table >= 0)  // every frame origin past the first two above the table
+    for (int f = 3; f <= frames; ++f) out.push_back({fmt::format("table@{}", f), f, Eigen::Vector3d(0, 0, -1), o.table});
+  for (const auto& spec : o.half_spaces) {
+    const auto colon = spec.find(':'), last = spec.rfind(':');
+    if (colon == std::string::npos || last == colon) throw UsageError("--half-space takes frame:nx,ny,nz:offset, not " + spec);
+    const auto frame = numbers_of(spec.substr(0, colon), ',', "--half-space frame");
+    const auto normal = numbers_of(spec.substr(colon + 1, last - colon - 1), ',', "--half-space normal");
+    const auto offset = numbers_of(spec.substr(last + 1), ',', "--half-space offset");
+    if (frame.size() != 1 || normal.size() != 3 || offset.size() != 1 || frame[0] < 1 || frame[0] > frames)
+      throw UsageError(fmt::format("--half-space {}: a frame 1..{}, a normal of 3 numbers and an offset", spec, frames));
+    Eigen::Vector3d nv(normal[0], normal[1], normal[2]);
+    if (!(nv.norm() > 0)) throw UsageError("--half-space " + spec + ": the normal is zero");
+    out.push_back({spec, static_cast<int>(frame[0]), nv.normalized(), offset[0] / nv.norm()});
+  }
+  return out;
+}
+
+// The speed limits of a design file's fastest level per joint (velocity f v, acceleration f^2 a):
+// the optimized series move no faster than the structured families.
+void fastest_level(const YAML::Node& design, int n, Eigen::VectorXd& velocity, Eigen::VectorXd& acceleration) {
+  velocity.resize(n);
+  acceleration.resize(n);
+  for (int j = 0; j < n; ++j) {
+    const std::string c = design["joint_class"][j].as<std::string>();
+    double f = 0;
+    for (const auto& level : design["speed_factors"][c]) f = std::max(f, level.as<double>());
+    velocity(j) = f * design["limits"]["velocity"][j].as<double>();
+    acceleration(j) = f * f * design["limits"]["acceleration"][j].as<double>();
+  }
+}
+
+void run(const Common& common, const ExciteOptions& o) {
+  const auto model = identification_model_of(common, o.model);
+  const identify::ModelDescription& d = model->description();
+  const int n = d.nq;
+  fs::create_directories(o.out);
+  const fs::path design_file = fs::path(o.out) / "trajectories.yaml";
+
+  // 1. The structured families.
+  std::string text;
+  trajectory::StructuredDesignOptions so;
+  so.robot = common.robot;
+  so.joints = d.joints;
+  so.seed = o.seed;
+  if (!o.from_design.empty()) {
+    std::ifstream in(o.from_design);
+    std::stringstream all;
+    all << in.rdbuf();
+    text = all.str();
+  } else {
+    try {
+      text = trajectory::structured_design_yaml(so);
+    } catch (const std::invalid_argument& e) {
+      throw UsageError(e.what());
+    }
+  }
+  const YAML::Node design = YAML::Load(text);
+  Eigen::VectorXd velocity, acceleration;
+  fastest_level(design, n, velocity, acceleration);
+  const double margin = design["limits"]["position_margin"].as<double>() * kDeg;
+  so.position_margin = margin;
+  Eigen::VectorXd lower, upper;
+  trajectory::structured_box(so, lower, upper);
+
+  // 2. The nominal model for the torque limits.
+  Eigen::VectorXd nominal;
+  std::string nominal_from;
+  std::vector<std::string> names;
+  for (const auto& p : d.parameters) names.push_back(p.name);
+  if (!o.params.empty()) {
+    nominal = io::read_parameters_yaml(o.params, names);
+    nominal_from = o.params;
+  } else if (std::vector<double> s; nominal_standard_parameters(common, d.standard, s)) {
+    nominal = model->base_from_standard(Eigen::Map<const Eigen::VectorXd>(s.data(), static_cast<Eigen::Index>(s.size())));
+    nominal_from = "robot.yaml nominal";
+  } else {
+    fmt::print(stderr, "excite: {} has no nominal parameters and no --params was given: torque limits are NOT enforced\n",
+               (common.robot_dir() / "robot.yaml").string());
+  }
+
+  // 3. The optimized series, one per posture in turn, each from rest at its posture.
+  std::vector<std::string> postures;
+  for (const auto& p : design["postures"]) postures.push_back(p.first.as<std::string>());
+  std::string optimized_text;
+  if (o.optimized > 0)
+    fmt::print("optimized excitation of {} model {} ({} base parameters): {} harmonics, period {:.3g} s, {} starts each; "
+               "limits: the box, the structured families' fastest level, torque {:.0f} % of effort{}\n",
+               common.robot, d.variant.empty() ? "full" : d.variant, d.np, o.harmonics, o.period, o.starts, 100 * o.torque_fraction,
+               nominal_from.empty() ? " (not enforced)" : " (" + nominal_from + ")");
+  for (int k = 0; k < o.optimized; ++k) {
+    const std::string posture = postures[static_cast<std::size_t>(k) % postures.size()];
+    identify::ExcitationDesignOptions eo;
+    eo.name = fmt::format("OF{:02d}", k + 1);
+    eo.period = o.period;
+    eo.harmonics = o.harmonics;
+    eo.start.resize(n);
+    for (int j = 0; j < n; ++j) eo.start(j) = design["postures"][posture][j].as<double>() * kDeg;
+    eo.limits.lower = lower.cwiseMin(eo.start - Eigen::VectorXd::Constant(n, 1e-3));
+    eo.limits.upper = upper.cwiseMax(eo.start + Eigen::VectorXd::Constant(n, 1e-3));
+    eo.limits.velocity = velocity;
+    eo.limits.acceleration = acceleration;
+    if (nominal.size() > 0) {
+      eo.nominal = nominal;
+      eo.limits.torque.resize(n);
+      for (int j = 0; j < n; ++j) eo.limits.torque(j) = o.torque_fraction * d.joints[static_cast<std::size_t>(j)].effort;
+    }
+    eo.workspace = half_spaces(o, static_cast<int>(d.frames.size()));
+    eo.starts = o.starts;
+    eo.seed = o.seed + static_cast<std::uint64_t>(k);
+    identify::ExcitationDesign r;
+    try {
+      r = identify::design_excitation(*model, eo);
+    } catch (const identify::ExcitationInfeasible& e) {
+      throw UsageError(fmt::format("excite {} at posture {}: {}", eo.name, posture, e.what()));
+    }
+    std::string starts;
+    for (std::size_t s = 0; s < r.starts.size(); ++s)
+      starts += fmt::format("{}{}{:.2f} ({}, {} it, {:.1f} s{})", s ? "; " : "", static_cast<int>(s) == r.chosen ? "*" : "",
+                            r.starts[s].criterion, r.starts[s].status, r.starts[s].iterations, r.starts[s].seconds,
+                            r.starts[s].passed ? "" : ", fails " + r.starts[s].worst.constraint);
+    fmt::print("{} from {}: log det {:.2f} in {:.1f} s; starts: {}\n", eo.name, posture, r.criterion, r.seconds, starts);
+    std::string tight;
+    for (const auto& s : r.slack) tight += fmt::format("{}{} {:.3g} ({}, t = {:.2f} s)", tight.empty() ? "" : ", ", s.constraint, s.slack, s.where, s.time);
+    fmt::print("  tightest limits (dense check every 1 ms): {}\n", tight);
+    optimized_text += "\n" + trajectory::fourier_trajectory_yaml(
+                                 eo.name, posture, r.trajectory, o.periods,
+                                 fmt::format("Optimized (D-optimal) from rest at {}: log det {:.4g}, {} harmonics", posture, r.criterion,
+                                             o.harmonics));
+  }
+  if (o.optimized > 0 && text.find("\ntrajectories:") == std::string::npos) throw UsageError("the design has no trajectories list");
+  const std::string full = text + (text.empty() || text.back() == '\n' ? "" : "\n") + optimized_text;
+  // Read back before it is kept: the file must build, every trajectory inside its limits.
+  const fs::path tmp = fs::path(o.out) / "trajectories.yaml.new";
+  io::write_file_atomically(tmp, full);
+  std::vector<trajectory::Trajectory> all;
+  try {
+    const auto check = trajectory::TrajectoryDesign::read(tmp, d.joints);
+    for (const auto& name : check.names()) all.push_back(check.build(name));
+  } catch (...) {
+    fs::remove(tmp);
+    throw;
+  }
+  fs::rename(tmp, design_file);
+  fmt::print("{}: {} trajectories\n", design_file.string(), all.size());
+
+  // 4. The excitation quality of each, side by side.
+  TrajectoryOptions to;
+  to.interval_ms = o.interval_ms;
+  const std::string table = trajectory_quality_table(common, all, to, o.model);
+  fmt::print("{}", table);
+  io::write_file_atomically(fs::path(o.out) / "quality.txt", table);
+}
+
+}  // namespace
+
+void add_excite_commands(CLI::App& app, Common& common) {
+  auto o = std::make_shared<ExciteOptions>();
+  auto* cmd = app.add_subcommand("excite", "Identification trajectories for any robot: the structured families and optimized "
+                                           "Fourier series, in one design file, with their excitation quality");
+  cmd->add_option("--robot", common.robot, "Robot folder name under robots/")->required();
+  cmd->add_option("--robots-dir", common.robots_dir, "Where the robot folders are");
+  cmd->add_option("-o,--output", o->out, "Write trajectories.yaml and quality.txt here")->required();
+  cmd->add_option("--model", o->model, "The model whose base parameters are excited (default: robot.yaml's identified)");
+  cmd->add_option("--from-design", o->from_design, "Take the structured families from this design file (e.g. the robot's "
+                                                   "trajectories.yaml) instead of generating them")
+      ->check(CLI::ExistingFile);
+  cmd->add_option("--params", o->params, "Nominal parameters of --model for the torque limits (default: robot.yaml's nominal)")
+      ->check(CLI::ExistingFile);
+  cmd->add_option("--optimized", o->optimized, "Optimized trajectories (OF01...), from the postures in turn")
+      ->check(numbers::count(0, 99))
+      ->capture_default_str();
+  cmd->add_option("--harmonics", o->harmonics, "Harmonics of each series")->check(numbers::count(2, 20))->capture_default_str();
+  cmd->add_option("--period", o->period, "Period of each series, s")->check(numbers::positive(3600, "> 0 and <= 3600 s"))->capture_default_str();
+  cmd->add_option("--periods", o->periods, "Periods each optimized trajectory runs")->check(numbers::count(1, 100))->capture_default_str();
+  cmd->add_option("--starts", o->starts, "Random starts of each optimization")->check(numbers::count(1, 100))->capture_default_str();
+  cmd->add_option("--seed", o->seed, "Seed of the starts and of the validation waypoints")->capture_default_str();
+  cmd->add_option("--torque-fraction", o->torque_fraction, "Torque limit as a fraction of each joint's effort limit")
+      ->check(CLI::Range(0.01, 1.0))
+      ->capture_default_str();
+  cmd->add_option("--table", o->table, "A table this far below frame 0 (m): every frame origin from 3 on stays above it "
+                                       "(1 cm clearance)");
+  cmd->add_option("--half-space", o->half_spaces, "frame:nx,ny,nz:offset: that frame's origin p keeps n.p <= offset (m, frame 0)");
+  cmd->add_option("--interval", o->interval_ms, "Sampling interval of the quality table, ms")->check(numbers::interval_ms())->capture_default_str();
+  cmd->callback([&common, o] { run(common, *o); });
+}
+
+}  // namespace symoro::dynid
