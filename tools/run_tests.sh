@@ -20,7 +20,7 @@ rm -rf "$scratch" && mkdir -p "$scratch/robots"
 cp -r CMakeLists.txt cmake grammar codegen runtime tests bench "$scratch/"
 build/codegen/symoroc model tests/urdf/kinova.urdf -o "$scratch/robots/unseen_arm" --name unseen_arm
 cmake -S "$scratch" -B "$scratch/build" -G Ninja -DCMAKE_BUILD_TYPE=Release -DSYMORO_BUILD_BENCHMARKS=OFF >/dev/null
-cmake --build "$scratch/build" -j"$jobs" --target test_robot_unseen_arm
+cmake --build "$scratch/build" -j"$jobs" --target test_robot_unseen_arm test_excite_unseen_arm
 ctest --test-dir "$scratch/build" -R '^unseen_arm\.' --output-on-failure -j"$jobs"
 
 # Grammar fuzzing with clang's libFuzzer, bounded in time.
