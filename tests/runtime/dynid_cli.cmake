@@ -141,6 +141,32 @@ run(0 out control --robot crane_x7 --virtual --trajectory AG02 --seconds 1 -o ${
 expect("${out}" "completed; torque off confirmed")
 expect("${out}" "overruns")
 run(0 out preprocess --robot crane_x7 ${WORK}/control/run.csv --interval 40 -o ${WORK}/control/samples)
+# excite: CRANE-X7's own design plus one optimized series (a short one: 3 harmonics, 6 s), which
+# the twin and the controller on the virtual bus then run from the written design file; limits
+# that cannot be met are refused with the constraint and the joint.
+run(0 out excite --robot crane_x7 -o ${WORK}/excite --from-design ${SOURCE_ROBOTS}/crane_x7/trajectories.yaml --optimized 1
+    --harmonics 3 --period 6 --starts 1)
+expect("${out}" "OF01 from A: log det")
+expect("${out}" "tightest limits \\(dense check every 1 ms\\): position [0-9]")
+expect("${out}" "OF01 +OF +9.0s")
+expect("${out}" "AG02 +AG")
+expect("${out}" "torque limits are NOT enforced")  # CRANE-X7's robot.yaml has no nominal parameters
+if(NOT EXISTS ${WORK}/excite/quality.txt)
+  message(FATAL_ERROR "dynid excite wrote no quality.txt")
+endif()
+run(0 out twin run --robot crane_x7 --design ${WORK}/excite/trajectories.yaml --trajectory OF01 -o ${WORK}/excite/twin)
+expect("${out}" "OF01_t1.csv: 900[0-9] rows")
+run(0 out control --robot crane_x7 --virtual --design ${WORK}/excite/trajectories.yaml --trajectory OF01 --seconds 3
+    -o ${WORK}/excite/control.csv)
+expect("${out}" "completed; torque off confirmed")
+run(0 out trajectories --robot crane_x7 --design ${WORK}/excite/trajectories.yaml --only OF01 V01 --quality)
+expect("${out}" "OF01 +OF")
+# The UR5's robot.yaml has (its URDF's): a torque limit below the gravity load at the start.
+run(2 out excite --robot ur5 -o ${WORK}/excite-bad --optimized 1 --harmonics 3 --period 6 --starts 1 --torque-fraction 0.01)
+expect("${out}" "excite OF01 at posture A: torque limit of joint 2 \\(shoulder_lift_joint\\): holding the start pose takes")
+if(EXISTS ${WORK}/excite-bad/trajectories.yaml)
+  message(FATAL_ERROR "a refused design wrote trajectories.yaml")
+endif()
 # A log the controller wrote (its time starts after the approach and pre-roll, at t > 0; its
 # reference columns are the controller's) through identify with CLIE: the closed loop replays
 # the log's own references, from its first stamp.
