@@ -663,7 +663,7 @@ TEST_F(BrokenDesign, StructuralMistakesNameTheirLine) {
                          "  - {name: PA02, posture: A, speed: 1, sequence: [{pattern: singles}]}"),
                     "  - name: PA02", "duplicate trajectory name 'PA02'");
   expect_read_error(edit("{pattern: singles}]}", "{pattern: singles, single: [1]}]}"), "{pattern: singles, single",
-                    "needs exactly one of pattern, single, pair and waypoints");
+                    "needs exactly one of pattern, single, pair, waypoints and fourier");
   expect_read_error(edit("name: PA01", "name: pa-1"), "pa-1", "a trajectory name is its family's capital letters");
   expect_read_error(edit("  - {name: PA01, posture: A, speed: 1, sequence: [{pattern: singles}]}",
                          "  - {name: PA01, posture: A, sequence: [{pattern: singles}]}"),

@@ -427,6 +427,7 @@ std::vector<std::filesystem::path> write_report(const StudyResult& study, const 
   if (!study.data_source.empty()) md += "Data source: " + study.data_source + "\n\n";
   md += summary(study);
   md += reproduction_section(study);
+  md += excitation_section(study);
   md += routing_table(study);
   if (routing) md += "![Routing per sampling interval](figures/routing.svg)\n\n";
   md += route_examples_table(study, options);

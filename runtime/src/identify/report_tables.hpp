@@ -56,6 +56,7 @@ std::string route_examples_table(const StudyResult& study, const ReportOptions& 
 std::string transition_table(const StudyResult& study);                               // Table V
 std::string rescue_delta_table(const StudyResult& study, int count = 5);              // Table VI
 std::string validation_table(const StudyResult& study);                               // Table VII
+std::string excitation_section(const StudyResult& study);  // report_excitation.cpp
 std::string dispersion_table(const StudyResult& study);
 std::string central_runs_table(const StudyResult& study, int count = 5);
 std::string appendix_record(const StudyResult& study);

@@ -56,6 +56,8 @@ std::string run_record_text(const RunRecord& r, const std::string& fingerprint) 
   y << YAML::Key << "samples" << YAML::Value << r.samples;
   y << YAML::Key << "kappa" << YAML::Value << r.kappa;
   y << YAML::Key << "kappa_scaled" << YAML::Value << r.kappa_scaled;
+  y << YAML::Key << "log_det_scaled" << YAML::Value << r.log_det_scaled;
+  y << YAML::Key << "weakest" << YAML::Value << r.weakest;
   detail::put_vector(y, "phi_ols", r.phi_ols);
   detail::put_vector(y, "std_ols", r.std_ols);
   y << YAML::Key << "residual_rms" << YAML::Value << r.residual_rms;
@@ -107,6 +109,8 @@ RunRecord parse(const YAML::Node& n) {
   r.samples = n["samples"].as<int>();
   r.kappa = n["kappa"].as<double>();
   r.kappa_scaled = n["kappa_scaled"].as<double>();
+  r.log_det_scaled = n["log_det_scaled"].as<double>();
+  r.weakest = n["weakest"].as<std::string>();
   r.phi_ols = vec(n["phi_ols"]);
   r.std_ols = vec(n["std_ols"]);
   r.residual_rms = n["residual_rms"].as<double>();
@@ -156,6 +160,7 @@ std::optional<RunRecord> load_run(const std::filesystem::path& file, const std::
   try {
     const YAML::Node n = YAML::LoadFile(file.string());
     if (n["fingerprint"].as<std::string>() != fingerprint) return std::nullopt;
+    if (!n["failed"].as<bool>(false) && !n["log_det_scaled"]) return std::nullopt;  // a record before issue 29: done again
     return parse(n);
   } catch (const YAML::Exception&) {
     return std::nullopt;  // unreadable: the run is done again

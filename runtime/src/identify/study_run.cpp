@@ -7,6 +7,7 @@
 #include <fmt/format.h>
 
 #include "symoro/error.hpp"
+#include "symoro/identify/excitation_quality.hpp"
 #include "symoro/identify/physical_projection.hpp"
 #include "symoro/identify/sdp_projection.hpp"
 #include "symoro/preprocess/preprocess.hpp"
@@ -94,6 +95,9 @@ RunRecord identify_run(const IdentificationModel& model, const io::Log& log, con
   }
   r.kappa = ls.kappa;
   r.kappa_scaled = ls.kappa_scaled;
+  const ExcitationQuality q = excitation_quality(reg.W, model.description().parameters);
+  r.log_det_scaled = q.log_det_scaled;
+  for (const auto& [name, v] : q.weakest) r.weakest += fmt::format("{}{} {:+.2f}", r.weakest.empty() ? "" : ", ", name, v);
   r.phi_ols = ls.phi;
   r.std_ols = ls.std_dev;
   r.residual_rms = ls.residual_rms;

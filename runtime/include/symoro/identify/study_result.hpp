@@ -23,6 +23,10 @@ struct RunRecord {
   // OLS
   double kappa = 0;          // sigma_max / sigma_min of the stacked W (paper's kappa)
   double kappa_scaled = 0;   // the same with unit-norm columns (conditioning, not units)
+  // excitation_quality.hpp of W: log det of W'W with unit columns (<= 0) and the weakest
+  // direction's largest components ("MX3 +0.71, MX2 -0.70, XXR4 -0.05")
+  double log_det_scaled = 0;
+  std::string weakest;
   Eigen::VectorXd phi_ols, std_ols;  // estimate and standard deviations
   double residual_rms = 0;   // N m, of tau - W phi_ols
   bool weighted = false;     // WLS (per-joint weights) instead of OLS
