@@ -95,6 +95,54 @@ void fastest_level(const YAML::Node& design, int n, Eigen::VectorXd& velocity, E
   }
 }
 
+// The design options of one series from rest at `posture`.
+identify::ExcitationDesignOptions design_options(const ExciteOptions& o, const YAML::Node& design, const std::string& posture,
+                                                 const Eigen::VectorXd& lower, const Eigen::VectorXd& upper,
+                                                 const Eigen::VectorXd& velocity, const Eigen::VectorXd& acceleration,
+                                                 const Eigen::VectorXd& nominal, const identify::ModelDescription& d) {
+  const int n = d.nq;
+  identify::ExcitationDesignOptions eo;
+  eo.period = o.period;
+  eo.harmonics = o.harmonics;
+  eo.start.resize(n);
+  for (int j = 0; j < n; ++j) eo.start(j) = design["postures"][posture][j].as<double>() * kDeg;
+  eo.limits.lower = lower.cwiseMin(eo.start - Eigen::VectorXd::Constant(n, 1e-3));
+  eo.limits.upper = upper.cwiseMax(eo.start + Eigen::VectorXd::Constant(n, 1e-3));
+  eo.limits.velocity = velocity;
+  eo.limits.acceleration = acceleration;
+  if (nominal.size() > 0) {
+    eo.nominal = nominal;
+    eo.limits.torque.resize(n);
+    for (int j = 0; j < n; ++j) eo.limits.torque(j) = o.torque_fraction * d.joints[static_cast<std::size_t>(j)].effort;
+  }
+  eo.workspace = half_spaces(o, static_cast<int>(d.frames.size()));
+  eo.starts = o.starts;
+  return eo;
+}
+
+// Where the structured families cross a half-space (they know the joint limits only), every
+// 10 ms: one line per trajectory, its worst crossing.
+void warn_crossings(const std::vector<trajectory::Trajectory>& all, const std::vector<identify::HalfSpace>& spaces,
+                    const identify::ModelDescription& d) {
+  if (spaces.empty()) return;
+  for (const auto& t : all) {
+    if (t.family == "OF") continue;  // designed inside them
+    Eigen::VectorXd q(d.nq), qd(d.nq), qdd(d.nq);
+    double worst = 0, when = 0;
+    std::string where;
+    for (double time = 0; time <= t.duration(); time += 0.01) {
+      t.evaluate(time, q, qd, qdd);
+      const Eigen::VectorXd v = identify::half_space_values(d.frames, q, spaces);
+      Eigen::Index h = 0;
+      if (v.maxCoeff(&h) > worst) worst = v(h), when = time, where = spaces[static_cast<std::size_t>(h)].name;
+    }
+    if (worst > 0)
+      fmt::print("warning: {} takes a frame {:.3f} m beyond {} at t = {:.2f} s: the structured families know the joint "
+                 "limits, not the surroundings; edit their postures or amplitudes\n",
+                 t.name, worst, where, when);
+  }
+}
+
 void run(const Common& common, const ExciteOptions& o) {
   const auto model = identification_model_of(common, o.model);
   const identify::ModelDescription& d = model->description();
@@ -153,31 +201,32 @@ void run(const Common& common, const ExciteOptions& o) {
                "limits: the box, the structured families' fastest level, torque {:.0f} % of effort{}\n",
                common.robot, d.variant.empty() ? "full" : d.variant, d.np, o.harmonics, o.period, o.starts, 100 * o.torque_fraction,
                nominal_from.empty() ? " (not enforced)" : " (" + nominal_from + ")");
+  // A posture whose rest already breaks a limit (a table above the arm there, gravity beyond a
+  // drive) is skipped for the next one: the series designed so far are kept.
+  std::size_t next = 0;
+  std::string failure;
   for (int k = 0; k < o.optimized; ++k) {
-    const std::string posture = postures[static_cast<std::size_t>(k) % postures.size()];
-    identify::ExcitationDesignOptions eo;
-    eo.name = fmt::format("OF{:02d}", k + 1);
-    eo.period = o.period;
-    eo.harmonics = o.harmonics;
-    eo.start.resize(n);
-    for (int j = 0; j < n; ++j) eo.start(j) = design["postures"][posture][j].as<double>() * kDeg;
-    eo.limits.lower = lower.cwiseMin(eo.start - Eigen::VectorXd::Constant(n, 1e-3));
-    eo.limits.upper = upper.cwiseMax(eo.start + Eigen::VectorXd::Constant(n, 1e-3));
-    eo.limits.velocity = velocity;
-    eo.limits.acceleration = acceleration;
-    if (nominal.size() > 0) {
-      eo.nominal = nominal;
-      eo.limits.torque.resize(n);
-      for (int j = 0; j < n; ++j) eo.limits.torque(j) = o.torque_fraction * d.joints[static_cast<std::size_t>(j)].effort;
-    }
-    eo.workspace = half_spaces(o, static_cast<int>(d.frames.size()));
-    eo.starts = o.starts;
-    eo.seed = o.seed + static_cast<std::uint64_t>(k);
     identify::ExcitationDesign r;
-    try {
-      r = identify::design_excitation(*model, eo);
-    } catch (const identify::ExcitationInfeasible& e) {
-      throw UsageError(fmt::format("excite {} at posture {}: {}", eo.name, posture, e.what()));
+    identify::ExcitationDesignOptions eo;
+    std::string posture, refused;
+    for (std::size_t tries = 0; tries < postures.size() && posture.empty(); ++tries, ++next) {
+      const std::string candidate = postures[next % postures.size()];
+      eo = design_options(o, design, candidate, lower, upper, velocity, acceleration, nominal, d);
+      eo.name = fmt::format("OF{:02d}", k + 1);
+      eo.seed = o.seed + static_cast<std::uint64_t>(k);
+      try {
+        r = identify::design_excitation(*model, eo);
+        posture = candidate;
+      } catch (const identify::ExcitationInfeasible& e) {
+        fmt::print("{} from {}: refused: {}\n", eo.name, candidate, e.what());
+        refused += fmt::format("{}{}: {}", refused.empty() ? "" : "; ", candidate, e.what());
+      }
+    }
+    if (posture.empty()) {
+      // Nothing designed yet: nothing to keep. Else the series so far are written first.
+      failure = fmt::format("excite {}: no posture can start it: {}", eo.name, refused);
+      if (k == 0) throw UsageError(failure);
+      break;
     }
     std::string starts;
     for (std::size_t s = 0; s < r.starts.size(); ++s)
@@ -208,6 +257,7 @@ void run(const Common& common, const ExciteOptions& o) {
   }
   fs::rename(tmp, design_file);
   fmt::print("{}: {} trajectories\n", design_file.string(), all.size());
+  warn_crossings(all, half_spaces(o, static_cast<int>(d.frames.size())), d);
 
   // 4. The excitation quality of each, side by side.
   TrajectoryOptions to;
@@ -215,6 +265,7 @@ void run(const Common& common, const ExciteOptions& o) {
   const std::string table = trajectory_quality_table(common, all, to, o.model);
   fmt::print("{}", table);
   io::write_file_atomically(fs::path(o.out) / "quality.txt", table);
+  if (!failure.empty()) throw UsageError(failure + fmt::format(" ({} keeps the series designed before it)", design_file.string()));
 }
 
 }  // namespace

@@ -163,7 +163,7 @@ run(0 out trajectories --robot crane_x7 --design ${WORK}/excite/trajectories.yam
 expect("${out}" "OF01 +OF")
 # The UR5's robot.yaml has (its URDF's): a torque limit below the gravity load at the start.
 run(2 out excite --robot ur5 -o ${WORK}/excite-bad --optimized 1 --harmonics 3 --period 6 --starts 1 --torque-fraction 0.01)
-expect("${out}" "excite OF01 at posture A: torque limit of joint 2 \\(shoulder_lift_joint\\): holding the start pose takes")
+expect("${out}" "excite OF01: no posture can start it: A: torque limit of joint 2 \\(shoulder_lift_joint\\): holding the start pose takes")
 if(EXISTS ${WORK}/excite-bad/trajectories.yaml)
   message(FATAL_ERROR "a refused design wrote trajectories.yaml")
 endif()
