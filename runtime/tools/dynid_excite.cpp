@@ -36,7 +36,7 @@ struct ExciteOptions {
   std::string params;       // nominal phi; "" robot.yaml's nominal
   int optimized = 3;
   int harmonics = 5;
-  double period = 10;
+  double period = 0;  // s; 0: from the limits (auto_period)
   int periods = 1;
   int starts = 4;
   std::uint64_t seed = 1;
@@ -62,10 +62,13 @@ std::vector<double> numbers_of(const std::string& text, char sep, const std::str
   return out;
 }
 
-std::vector<identify::HalfSpace> half_spaces(const ExciteOptions& o, int frames) {
+std::vector<identify::HalfSpace> half_spaces(const ExciteOptions& o, const identify::ModelDescription& d) {
+  const int frames = static_cast<int>(d.frames.size());
   std::vector<identify::HalfSpace> out;
-  if (o.table >= 0)  // every frame origin past the first two above the table
-    for (int f = 3; f <= frames; ++f) out.push_back({fmt::format("table@{}", f), f, Eigen::Vector3d(0, 0, -1), o.table});
+  if (o.table >= 0) {  // every frame origin past the first two above the table, "down" along gravity
+    if (!(d.gravity.norm() > 0)) throw UsageError("--table: the model has no gravity to tell down from up; use --half-space");
+    for (int f = 3; f <= frames; ++f) out.push_back({fmt::format("table@{}", f), f, d.gravity.normalized(), o.table});
+  }
   for (const auto& spec : o.half_spaces) {
     const auto colon = spec.find(':'), last = spec.rfind(':');
     if (colon == std::string::npos || last == colon) throw UsageError("--half-space takes frame:nx,ny,nz:offset, not " + spec);
@@ -95,14 +98,24 @@ void fastest_level(const YAML::Node& design, int n, Eigen::VectorXd& velocity, E
   }
 }
 
+// The period at which the fundamental, at a joint's velocity limit, sweeps half of its box:
+// 2 pi (half width / velocity), the median over the joints, in [5, 60] s to 0.1 s. A slow arm
+// (the Kinova's 0.28 rad/s) needs tens of seconds to use its range; a fast one a few.
+double auto_period(const Eigen::VectorXd& lower, const Eigen::VectorXd& upper, const Eigen::VectorXd& velocity) {
+  std::vector<double> t;
+  for (Eigen::Index j = 0; j < velocity.size(); ++j) t.push_back(2 * 3.14159265358979323846 * (upper(j) - lower(j)) / 4 / velocity(j));
+  std::nth_element(t.begin(), t.begin() + static_cast<std::ptrdiff_t>(t.size() / 2), t.end());
+  return std::round(std::clamp(t[t.size() / 2], 5.0, 60.0) * 10) / 10;
+}
+
 // The design options of one series from rest at `posture`.
-identify::ExcitationDesignOptions design_options(const ExciteOptions& o, const YAML::Node& design, const std::string& posture,
+identify::ExcitationDesignOptions design_options(const ExciteOptions& o, double period, const YAML::Node& design, const std::string& posture,
                                                  const Eigen::VectorXd& lower, const Eigen::VectorXd& upper,
                                                  const Eigen::VectorXd& velocity, const Eigen::VectorXd& acceleration,
                                                  const Eigen::VectorXd& nominal, const identify::ModelDescription& d) {
   const int n = d.nq;
   identify::ExcitationDesignOptions eo;
-  eo.period = o.period;
+  eo.period = period;
   eo.harmonics = o.harmonics;
   eo.start.resize(n);
   for (int j = 0; j < n; ++j) eo.start(j) = design["postures"][posture][j].as<double>() * kDeg;
@@ -115,7 +128,7 @@ identify::ExcitationDesignOptions design_options(const ExciteOptions& o, const Y
     eo.limits.torque.resize(n);
     for (int j = 0; j < n; ++j) eo.limits.torque(j) = o.torque_fraction * d.joints[static_cast<std::size_t>(j)].effort;
   }
-  eo.workspace = half_spaces(o, static_cast<int>(d.frames.size()));
+  eo.workspace = half_spaces(o, d);
   eo.starts = o.starts;
   return eo;
 }
@@ -176,6 +189,8 @@ void run(const Common& common, const ExciteOptions& o) {
   Eigen::VectorXd lower, upper;
   trajectory::structured_box(so, lower, upper);
 
+  const double period = o.period > 0 ? o.period : auto_period(lower, upper, velocity);
+
   // 2. The nominal model for the torque limits.
   Eigen::VectorXd nominal;
   std::string nominal_from;
@@ -199,7 +214,7 @@ void run(const Common& common, const ExciteOptions& o) {
   if (o.optimized > 0)
     fmt::print("optimized excitation of {} model {} ({} base parameters): {} harmonics, period {:.3g} s, {} starts each; "
                "limits: the box, the structured families' fastest level, torque {:.0f} % of effort{}\n",
-               common.robot, d.variant.empty() ? "full" : d.variant, d.np, o.harmonics, o.period, o.starts, 100 * o.torque_fraction,
+               common.robot, d.variant.empty() ? "full" : d.variant, d.np, o.harmonics, period, o.starts, 100 * o.torque_fraction,
                nominal_from.empty() ? " (not enforced)" : " (" + nominal_from + ")");
   // A posture whose rest already breaks a limit (a table above the arm there, gravity beyond a
   // drive) is skipped for the next one: the series designed so far are kept.
@@ -211,7 +226,7 @@ void run(const Common& common, const ExciteOptions& o) {
     std::string posture, refused;
     for (std::size_t tries = 0; tries < postures.size() && posture.empty(); ++tries, ++next) {
       const std::string candidate = postures[next % postures.size()];
-      eo = design_options(o, design, candidate, lower, upper, velocity, acceleration, nominal, d);
+      eo = design_options(o, period, design, candidate, lower, upper, velocity, acceleration, nominal, d);
       eo.name = fmt::format("OF{:02d}", k + 1);
       eo.seed = o.seed + static_cast<std::uint64_t>(k);
       try {
@@ -257,7 +272,7 @@ void run(const Common& common, const ExciteOptions& o) {
   }
   fs::rename(tmp, design_file);
   fmt::print("{}: {} trajectories\n", design_file.string(), all.size());
-  warn_crossings(all, half_spaces(o, static_cast<int>(d.frames.size())), d);
+  warn_crossings(all, half_spaces(o, d), d);
 
   // 4. The excitation quality of each, side by side.
   TrajectoryOptions to;
@@ -287,15 +302,16 @@ void add_excite_commands(CLI::App& app, Common& common) {
       ->check(numbers::count(0, 99))
       ->capture_default_str();
   cmd->add_option("--harmonics", o->harmonics, "Harmonics of each series")->check(numbers::count(2, 20))->capture_default_str();
-  cmd->add_option("--period", o->period, "Period of each series, s")->check(numbers::positive(3600, "> 0 and <= 3600 s"))->capture_default_str();
+  cmd->add_option("--period", o->period, "Period of each series, s (default: from the joints' box and speed, 5-60 s)")
+      ->check(numbers::positive(3600, "> 0 and <= 3600 s"));
   cmd->add_option("--periods", o->periods, "Periods each optimized trajectory runs")->check(numbers::count(1, 100))->capture_default_str();
   cmd->add_option("--starts", o->starts, "Random starts of each optimization")->check(numbers::count(1, 100))->capture_default_str();
   cmd->add_option("--seed", o->seed, "Seed of the starts and of the validation waypoints")->capture_default_str();
   cmd->add_option("--torque-fraction", o->torque_fraction, "Torque limit as a fraction of each joint's effort limit")
       ->check(CLI::Range(0.01, 1.0))
       ->capture_default_str();
-  cmd->add_option("--table", o->table, "A table this far below frame 0 (m): every frame origin from 3 on stays above it "
-                                       "(1 cm clearance)");
+  cmd->add_option("--table", o->table, "A table this far below frame 0's origin (m, along gravity): every frame origin "
+                                       "from 3 on stays above it (1 cm clearance)");
   cmd->add_option("--half-space", o->half_spaces, "frame:nx,ny,nz:offset: that frame's origin p keeps n.p <= offset (m, frame 0)");
   cmd->add_option("--interval", o->interval_ms, "Sampling interval of the quality table, ms")->check(numbers::interval_ms())->capture_default_str();
   cmd->callback([&common, o] { run(common, *o); });

@@ -5,11 +5,13 @@
 #include <numeric>
 #include <stdexcept>
 
+#include <Eigen/Eigenvalues>
 #include <Eigen/SVD>
 
 namespace symoro::identify {
 
-ExcitationQuality excitation_quality(const Eigen::MatrixXd& W, const std::vector<ParameterInfo>& parameters, int top) {
+ExcitationQuality excitation_quality(const Eigen::MatrixXd& W, const std::vector<ParameterInfo>& parameters, int top,
+                                     bool raw_kappa) {
   if (static_cast<std::size_t>(W.cols()) != parameters.size())
     throw std::invalid_argument("excitation_quality: " + std::to_string(W.cols()) + " columns for " +
                                 std::to_string(parameters.size()) + " parameters");
@@ -20,18 +22,25 @@ ExcitationQuality excitation_quality(const Eigen::MatrixXd& W, const std::vector
   const double largest = norms.maxCoeff();
   for (Eigen::Index c = 0; c < W.cols(); ++c)
     if (!(norms(c) > 1e-14 * largest)) q.unexcited.push_back(parameters[static_cast<std::size_t>(c)].name);
-  const Eigen::VectorXd sigma = Eigen::JacobiSVD<Eigen::MatrixXd>(W).singularValues();
-  if (sigma(sigma.size() - 1) > 0) q.kappa = sigma(0) / sigma(sigma.size() - 1);
-  if (!q.unexcited.empty()) return q;
-  const Eigen::MatrixXd Ws = W * norms.cwiseInverse().asDiagonal();
-  const Eigen::JacobiSVD<Eigen::MatrixXd> svd(Ws, Eigen::ComputeThinV);
-  const Eigen::VectorXd s = svd.singularValues();
-  q.sigma_min_scaled = s(s.size() - 1);
-  if (q.sigma_min_scaled > 0) {
-    q.kappa_scaled = s(0) / q.sigma_min_scaled;
-    q.log_det_scaled = 2 * s.array().log().sum();
+  if (raw_kappa) {
+    const Eigen::VectorXd sigma = Eigen::JacobiSVD<Eigen::MatrixXd>(W).singularValues();
+    if (sigma(sigma.size() - 1) > 0) q.kappa = sigma(0) / sigma(sigma.size() - 1);
   }
-  const Eigen::VectorXd v = svd.matrixV().col(svd.matrixV().cols() - 1);
+  if (!q.unexcited.empty()) return q;
+  // The scaled quantities from the Gram matrix of the unit columns (parameters x parameters:
+  // cheap for a study's 10^5-row W): its eigenvalues are the scaled sigma^2, exact to ~1e-16 of
+  // the largest, so kappa_scaled keeps ~kappa_scaled^2 1e-16 of relative error.
+  const Eigen::VectorXd inverse = norms.cwiseInverse();
+  Eigen::MatrixXd G = Eigen::MatrixXd::Zero(W.cols(), W.cols());
+  G.selfadjointView<Eigen::Lower>().rankUpdate((W * inverse.asDiagonal()).transpose());
+  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eigen(G.selfadjointView<Eigen::Lower>());
+  const Eigen::VectorXd lambda = eigen.eigenvalues();  // ascending
+  q.sigma_min_scaled = std::sqrt(std::max(lambda(0), 0.0));
+  if (lambda(0) > 0) {
+    q.kappa_scaled = std::sqrt(lambda(lambda.size() - 1) / lambda(0));
+    q.log_det_scaled = lambda.array().log().sum();
+  }
+  const Eigen::VectorXd v = eigen.eigenvectors().col(0);
   std::vector<int> order(static_cast<std::size_t>(v.size()));
   std::iota(order.begin(), order.end(), 0);
   std::sort(order.begin(), order.end(), [&](int a, int b) { return std::abs(v(a)) > std::abs(v(b)); });

@@ -95,7 +95,7 @@ RunRecord identify_run(const IdentificationModel& model, const io::Log& log, con
   }
   r.kappa = ls.kappa;
   r.kappa_scaled = ls.kappa_scaled;
-  const ExcitationQuality q = excitation_quality(reg.W, model.description().parameters);
+  const ExcitationQuality q = excitation_quality(reg.W, model.description().parameters, 3, false);
   r.log_det_scaled = q.log_det_scaled;
   for (const auto& [name, v] : q.weakest) r.weakest += fmt::format("{}{} {:+.2f}", r.weakest.empty() ? "" : ", ", name, v);
   r.phi_ols = ls.phi;

@@ -38,7 +38,9 @@ struct ExcitationQuality {
 
 // From a stacked regressor (rows x parameters). `top`: how many components of the weakest
 // direction to name. Throws std::invalid_argument when the names do not match W's columns.
-ExcitationQuality excitation_quality(const Eigen::MatrixXd& W, const std::vector<ParameterInfo>& parameters, int top = 3);
+// raw_kappa false: kappa is left infinite (a caller that has it already saves an SVD of W).
+ExcitationQuality excitation_quality(const Eigen::MatrixXd& W, const std::vector<ParameterInfo>& parameters, int top = 3,
+                                     bool raw_kappa = true);
 
 // A reference motion as identification samples every `interval` s: its own q, qd, qdd (no
 // preprocessing: they are exact), torque 0.

@@ -33,6 +33,7 @@ class GeneratedIdentificationModel final : public IdentificationModel {
     d_.joints.assign(Model::joints.begin(), Model::joints.end());
     d_.standard.assign(Model::standard_parameters.begin(), Model::standard_parameters.end());
     d_.frames.assign(Model::frames.begin(), Model::frames.end());
+    d_.gravity = Eigen::Vector3d(Model::gravity[0], Model::gravity[1], Model::gravity[2]);
     for (const auto& f : Model::fixed_parameters) has_fixed_ = has_fixed_ || f.value != 0;
   }
   const ModelDescription& description() const override { return d_; }

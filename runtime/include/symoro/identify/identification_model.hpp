@@ -32,6 +32,7 @@ struct ModelDescription {
   std::vector<JointInfo> joints;
   std::vector<StandardParameterInfo> standard;  // the argument of base_from_standard
   std::vector<FrameInfo> frames;                // the modified-DH frames (symoro/mdh.hpp)
+  Eigen::Vector3d gravity = Eigen::Vector3d::Zero();  // in frame 0 (m/s^2): which way is down
 };
 
 // The inverse dynamics at one state and its derivatives along the state (nq x nq each).
