@@ -113,6 +113,51 @@ TEST_F(Report, TableVIListsTheFiveLargestChangesInOrder) {
   EXPECT_EQ(t[1][0], "ZZR2");  // delta 2.5e-4, by construction the largest
 }
 
+// The moves table against the vectors themselves: every stage's move in units of the OLS
+// standard deviation, ordered by the rescue's; a well-determined parameter the rescue pushed by
+// 10 sigma is flagged and named, one pushed by 2 sigma is not; the relative errors against the
+// truth.
+TEST(ReportMoves, StagesMovesInOlsStandardDeviations) {
+  Synthetic s = make_study();
+  StudyResult& st = s.study;
+  const RunRecord& r = st.runs[s.selected];
+  const Eigen::VectorXd& ols = r.phi_ols;
+  // MYR2 (-0.238, sigma 0.002: 0.8 %) pushed 10 sigma; ZZR2 (0.09) 2 sigma: only MYR2 is flagged.
+  const int myr2 = 4, zzr2 = 2;
+  ASSERT_EQ(st.names[myr2], "MYR2");
+  ASSERT_EQ(st.names[zzr2], "ZZR2");
+  st.phi_rescue = r.phi_clie;
+  st.phi_rescue(myr2) += 10 * r.std_ols(myr2);
+  st.phi_rescue(zzr2) -= 2 * r.std_ols(zzr2);
+  st.rescued = true;
+  const fs::path dir = fresh_dir("moves");
+  write_report(st, dir);
+  const std::string md = read_text(dir / "report.md");
+  EXPECT_NE(md.find("moved 1 well-determined parameter by more than 3 σ (largest: MYR2, +10.0 σ)"), std::string::npos);
+  const double e_ols = (ols - st.truth).norm() / st.truth.norm(), e_acc = (st.phi_rescue - st.truth).norm() / st.truth.norm();
+  char text[64];
+  std::snprintf(text, sizeof text, "OLS %.2f %%", 100 * e_ols);
+  EXPECT_NE(md.find(text), std::string::npos) << text;
+  std::snprintf(text, sizeof text, "accepted %.2f %%", 100 * e_acc);
+  EXPECT_NE(md.find(text), std::string::npos) << text;
+  const auto t = md_table(md, "## Parameter moves");
+  ASSERT_GE(t.size(), 3u);
+  EXPECT_EQ(t[1][0], "MYR2");
+  EXPECT_EQ(t[1][9], "yes");
+  EXPECT_EQ(t[2][0], "ZZR2");
+  EXPECT_EQ(t[2][9], "");
+  for (std::size_t k = 1; k < t.size(); ++k) {
+    const int i = static_cast<int>(std::find(st.names.begin(), st.names.end(), t[k][0]) - st.names.begin());
+    ASSERT_LT(i, static_cast<int>(st.names.size()));
+    const double sd = r.std_ols(i);
+    EXPECT_NEAR(std::stod(t[k][5]), (r.phi_sdp(i) - ols(i)) / sd, 0.006) << t[k][0];
+    EXPECT_NEAR(std::stod(t[k][6]), (r.phi_clie(i) - ols(i)) / sd, 0.006) << t[k][0];
+    EXPECT_NEAR(std::stod(t[k][7]), (st.phi_rescue(i) - r.phi_clie(i)) / sd, 0.006) << t[k][0];
+    EXPECT_NEAR(std::stod(t[k][8]), (st.phi_rescue(i) - ols(i)) / sd, 0.006) << t[k][0];
+  }
+  fs::remove_all(dir);
+}
+
 TEST_F(Report, TableVIIMeanIsTheMeanOfTheRecords) {
   const auto t = md_table(*md_, "## Table VII");
   ASSERT_EQ(t.size(), 5u);

@@ -434,6 +434,7 @@ std::vector<std::filesystem::path> write_report(const StudyResult& study, const 
   md += clouds_section(study, clouds);
   md += transition_table(study);
   md += rescue_delta_table(study);
+  md += moves_table(study);
   md += validation_table(study);
   if (!torque_file.empty())
     md += fmt::format("![{} torques: measured, CLIE and PD-rescue](figures/{})\n\n", options.validation_figure,

@@ -57,6 +57,9 @@ std::string transition_table(const StudyResult& study);                         
 std::string rescue_delta_table(const StudyResult& study, int count = 5);              // Table VI
 std::string validation_table(const StudyResult& study);                               // Table VII
 std::string excitation_section(const StudyResult& study);  // report_excitation.cpp
+// Every parameter the accepted vector moved from CLIE by more than 3 OLS std while its OLS
+// relative std is under 5 %, and the `count` largest such moves (report_moves.cpp).
+std::string moves_table(const StudyResult& study, int count = 10);
 std::string dispersion_table(const StudyResult& study);
 std::string central_runs_table(const StudyResult& study, int count = 5);
 std::string appendix_record(const StudyResult& study);
