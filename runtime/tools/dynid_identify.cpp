@@ -21,6 +21,7 @@
 #include "symoro/identify/study.hpp"
 #include "symoro/identify/validation_io.hpp"
 #include "symoro/io/folder_lock.hpp"
+#include "symoro/io/parameters_yaml.hpp"
 #include "symoro/parallel/farm.hpp"
 #include "symoro/trajectory/design.hpp"
 #include "symoro/twin/config.hpp"
@@ -56,6 +57,22 @@ identify::StudyResult study(const Common& common, const IdentifyOptions& o,
   so.consistency = identify::consistency_from_string(o.consistency);
   so.physical_start = o.physical_start;
   so.rescue_metric_all_runs = o.rescue_metric == "all";
+  so.rescue_prior_weight = o.rescue_prior_weight;
+  // The rescue's prior: as given, else robot.yaml's nominal parameters when it has them.
+  if (o.rescue_prior.empty() || o.rescue_prior == "nominal") {
+    std::vector<double> s;
+    if (nominal_standard_parameters(common, d.standard, s)) {
+      so.rescue_prior = Eigen::Map<const Eigen::VectorXd>(s.data(), static_cast<Eigen::Index>(s.size()));
+      so.rescue_prior_source = "robot.yaml's nominal parameters";
+    } else if (o.rescue_prior == "nominal") {
+      throw UsageError((common.robot_dir() / "robot.yaml").string() + " has no nominal parameters for --rescue-prior nominal");
+    }
+  } else if (o.rescue_prior != "zero") {
+    std::vector<std::string> names;
+    for (const auto& p : d.standard) names.push_back(p.name);
+    so.rescue_prior = io::read_parameters_yaml(o.rescue_prior, names);
+    so.rescue_prior_source = o.rescue_prior;
+  }
   if (o.physical_start && so.consistency != identify::Consistency::physical)
     throw UsageError("--physical-start needs --consistency physical");
   so.validation_interval = o.validation_ms / 1000;
@@ -201,6 +218,13 @@ void add_identify_commands(CLI::App& app, Common& common) {
                   "With --consistency physical: the rescue moves the representative onto the consistent set changing "
                   "least the torque predicted on all the identification trajectories (all) or on its own run (run)")
       ->check(CLI::IsMember({"all", "run"}))
+      ->capture_default_str();
+  cmd->add_option("--rescue-prior", o->rescue_prior,
+                  "With --consistency physical: the standard parameters the rescue leans towards along what the data "
+                  "barely tell apart: nominal (robot.yaml's), zero, or a standard-parameter YAML (default: robot.yaml's "
+                  "nominal when it has them, else zero)");
+  cmd->add_option("--rescue-prior-weight", o->rescue_prior_weight, "The prior's weight relative to the torque metric")
+      ->check(numbers::positive(1e6, "> 0 and <= 1e6"))
       ->capture_default_str();
   cmd->add_flag("--physical-start", o->physical_start,
                 "With --consistency physical: project each OLS estimate onto the consistent set before CLIE instead "

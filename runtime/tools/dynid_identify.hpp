@@ -27,6 +27,8 @@ struct IdentifyOptions {
   std::string projection_metric = "information";
   std::string consistency = "pd";
   std::string rescue_metric = "all";
+  std::string rescue_prior;          // "" zero, "nominal" robot.yaml's, or a standard-parameter YAML
+  double rescue_prior_weight = 1e-6;
   double clie_std_bound = 0;
   double clie_noise_floor = 0;  // identify::ClieOptions::noise_floor
   double rank_timeout = 60;

@@ -244,13 +244,17 @@ class StudyRun {
       out.stages.push_back(fmt::format(
           "physical consistency (per-link pseudo-inertia LMIs, IA, FV, FS >= 0): every run's OLS and final vectors "
           "checked; {}the rescue onto the base vectors with a consistent standard set in the metric of the torque "
-          "predicted on {} (clearance {:g} of each link's size); acceptance needs a consistent set and the final audit",
+          "predicted on {} (clearance {:g} of each link's size), leaning along what that metric barely sees towards "
+          "{} (weight {:g}); acceptance needs a consistent set and the final audit",
           o_.physical_start ? fmt::format("CLIE's start projected onto that set (clearance {:g}) instead of the PD "
                                           "projection; ", o_.physical_clearance)
                             : "CLIE's start the paper's (conditional PD projection); ",
           o_.rescue_metric_all_runs ? "every identification trajectory at the representative's interval"
                                     : "the representative's run",
-          o_.physical_rescue_clearance));
+          o_.physical_rescue_clearance,
+          o_.rescue_prior.size() > 0 ? o_.rescue_prior_source : std::string("zero inertia (no prior: the links shrink towards line-like "
+                                                                         "mass distributions; give --rescue-prior)"),
+          o_.rescue_prior_weight));
     if (o_.consistency == Consistency::pd || !o_.physical_start)
       out.stages.push_back(fmt::format("SDP projection{} in the {} metric{}", o_.consistency == Consistency::pd ? " and rescue" : "",
                                        to_string(o_.projection_metric),
@@ -360,7 +364,7 @@ class StudyRun {
             sel.phi_clie,
             o_.rescue_metric_all_runs ? pooled_torque_metric(data, sel.interval)
                                       : detail::torque_metric(refit(data, sel), o_.information_ridge),
-            o_.physical_rescue_clearance);
+            o_.physical_rescue_clearance, o_.rescue_prior, o_.rescue_prior_weight);
         out.phi_rescue = p.phi;
         out.rescued = true;
         out.rescue_eps = o_.physical_rescue_clearance;

@@ -83,9 +83,11 @@ class GeneratedIdentificationModel final : public IdentificationModel {
   ConsistencyResult physical_check(const Eigen::VectorXd& phi) const override {
     return identify::physical_check<Model>(phi);
   }
-  PhysicalProjection physical_projection(const Eigen::VectorXd& phi0, const Eigen::MatrixXd& metric,
-                                         double clearance) const override {
-    return identify::physical_projection<Model>(phi0, {}, metric, clearance);
+  PhysicalProjection physical_projection(const Eigen::VectorXd& phi0, const Eigen::MatrixXd& metric, double clearance,
+                                         const Eigen::VectorXd& prior, double prior_weight) const override {
+    ConsistencyOptions options;
+    options.prior_regularization = prior_weight;
+    return identify::physical_projection<Model>(phi0, prior, metric, clearance, options);
   }
 
  private:

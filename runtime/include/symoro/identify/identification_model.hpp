@@ -67,8 +67,12 @@ class IdentificationModel {
   // The physical path (physical_projection.hpp); a model with effect parameters has none.
   virtual bool supports_physical_consistency() const = 0;
   virtual ConsistencyResult physical_check(const Eigen::VectorXd& phi) const = 0;
+  // prior: standard parameters (description().standard's order) the projection leans towards
+  // among the base vectors it cannot tell apart, with relative weight prior_weight (empty: zero,
+  // the physical_consistency.hpp default).
   virtual PhysicalProjection physical_projection(const Eigen::VectorXd& phi0, const Eigen::MatrixXd& metric,
-                                                 double clearance) const = 0;
+                                                 double clearance, const Eigen::VectorXd& prior = {},
+                                                 double prior_weight = 1e-6) const = 0;
 };
 
 // The interface of a generated Model, one shared instance per model. Defined in

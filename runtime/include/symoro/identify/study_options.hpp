@@ -6,6 +6,8 @@
 #include <string>
 #include <vector>
 
+#include <Eigen/Core>
+
 #include "symoro/identify/clie.hpp"
 #include "symoro/identify/least_squares.hpp"
 #include "symoro/identify/pd_audit.hpp"
@@ -78,6 +80,12 @@ struct StudyOptions {
   bool physical_start = false;
   double physical_clearance = 1e-4;
   double physical_rescue_clearance = 1e-7;
+  // The physical rescue's prior (standard parameters, e.g. the URDF's or CAD values; empty: zero)
+  // and its relative weight: among the base vectors the torque metric barely tells apart, the
+  // rescue takes the one whose standard set is nearest the prior (issue 30).
+  Eigen::VectorXd rescue_prior;
+  std::string rescue_prior_source;  // what it is, for the report
+  double rescue_prior_weight = 1e-6;
   // Its preprocess options are the study's. Stopping rule of MATLAB's lsqnonlin (the paper's):
   // relative cost change 1e-6; at most 25 steps. Besides (ClieOptions' default): a parameter
   // that reaches its bound is held there (clie.hold_at_bounds; docs/identification.md: PB01 took
