@@ -150,7 +150,7 @@ expect("${out}" "OF01 from A: log det")
 expect("${out}" "tightest limits \\(dense check every 1 ms\\): position [0-9]")
 expect("${out}" "OF01 +OF +9.0s")
 expect("${out}" "AG02 +AG")
-expect("${out}" "torque limits are NOT enforced")  # CRANE-X7's robot.yaml has no nominal parameters
+expect("${out}" "torque 80 % of effort \\(robot.yaml nominal\\)")  # CRANE-X7's CAD values
 if(NOT EXISTS ${WORK}/excite/quality.txt)
   message(FATAL_ERROR "dynid excite wrote no quality.txt")
 endif()

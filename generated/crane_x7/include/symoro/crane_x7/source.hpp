@@ -22,7 +22,7 @@ inline constexpr File files[] = {
     {"inm.txt", "03f80e67da7ea2a9f7ade109985c9b4a"},
     {"jac.txt", "0d3d6e9f234dc0fbc312b1aa201434a8"},
     {"regp.txt", "ffd687fda6e739fda9d7d1d9acddd863"},
-    {"robot.yaml", "0c46388c3dce0afcdea1e11756bc2af7"},
+    {"robot.yaml", "adb1ee0f4b38e6a7f9303c3f3be4a08f"},
 };
 
 }  // namespace symoro::crane_x7::source
