@@ -344,8 +344,9 @@ std::vector<ExcitationSlack> check_excitation(const IdentificationModel& model, 
                                      {"acceleration", "", kInfinity, 0}};
   if (torque) worst.push_back({"torque", "", kInfinity, 0});
   if (!o.workspace.empty()) worst.push_back({"workspace", "", kInfinity, 0});
-  auto note = [](ExcitationSlack& w, double slack, std::string where, double time) {
-    if (slack < w.slack) w = {w.constraint, std::move(where), slack, time};
+  // The name is looked up only when a new tightest slack is found (not per joint per millisecond).
+  auto note = [](ExcitationSlack& w, double slack, const auto& where, double time) {
+    if (slack < w.slack) w = {w.constraint, where(), slack, time};
   };
   const int cycles = static_cast<int>(std::lround(t.period() / o.check_period));
   Eigen::VectorXd q, qd, qdd;
@@ -354,18 +355,19 @@ std::vector<ExcitationSlack> check_excitation(const IdentificationModel& model, 
     const double time = k * o.check_period;
     t.evaluate(time, q, qd, qdd);
     for (int j = 0; j < n; ++j) {
-      const std::string name = joint_name(model, j);
+      const auto name = [&] { return joint_name(model, j); };
       note(worst[0], std::min(o.limits.upper(j) - q(j), q(j) - o.limits.lower(j)), name, time);
       note(worst[1], o.limits.velocity(j) - std::abs(qd(j)), name, time);
       note(worst[2], o.limits.acceleration(j) - std::abs(qdd(j)), name, time);
     }
     if (torque) {
       model.state_derivatives(q, qd, qdd, o.nominal, true, d);
-      for (int j = 0; j < n; ++j) note(worst[3], o.limits.torque(j) - std::abs(d.tau(j)), joint_name(model, j), time);
+      for (int j = 0; j < n; ++j) note(worst[3], o.limits.torque(j) - std::abs(d.tau(j)), [&] { return joint_name(model, j); }, time);
     }
     if (!o.workspace.empty()) {
       const Eigen::VectorXd v = half_space_values(model.description().frames, q, o.workspace);
-      for (std::size_t h = 0; h < o.workspace.size(); ++h) note(worst.back(), -v(static_cast<Eigen::Index>(h)), o.workspace[h].name, time);
+      for (std::size_t h = 0; h < o.workspace.size(); ++h)
+        note(worst.back(), -v(static_cast<Eigen::Index>(h)), [&] { return o.workspace[h].name; }, time);
     }
   }
   return worst;

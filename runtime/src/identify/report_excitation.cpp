@@ -9,14 +9,6 @@
 
 namespace symoro::identify::report_detail {
 
-namespace {
-double median(std::vector<double> v) {
-  std::sort(v.begin(), v.end());
-  const std::size_t n = v.size();
-  return n == 0 ? 0.0 : n % 2 ? v[n / 2] : (v[n / 2 - 1] + v[n / 2]) / 2;
-}
-}  // namespace
-
 std::string excitation_section(const StudyResult& study) {
   std::string out = "## Excitation of the identification trajectories\n\n";
   if (study.runs.empty()) return out + "No runs.\n\n";

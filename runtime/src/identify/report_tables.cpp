@@ -13,6 +13,14 @@
 
 namespace symoro::identify::report_detail {
 
+double median(std::vector<double> v) {
+  if (v.empty()) return std::numeric_limits<double>::quiet_NaN();
+  std::sort(v.begin(), v.end());
+  const std::size_t m = v.size() / 2;
+  return v.size() % 2 ? v[m] : 0.5 * (v[m - 1] + v[m]);
+}
+
+
 namespace {
 
 constexpr double nan = std::numeric_limits<double>::quiet_NaN();

@@ -16,6 +16,7 @@ std::string fixed(double value, int decimals);  // "n/a" when not finite
 std::string sig(double value, int digits);      // significant digits, "n/a" when not finite
 std::string yes_no(bool value);
 long interval_ms(double interval);               // s -> whole ms
+double median(std::vector<double> v);            // NaN when empty
 std::string md_cell(std::string text);           // '|' and newlines made table-safe
 
 class MarkdownTable {

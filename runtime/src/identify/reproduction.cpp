@@ -20,12 +20,7 @@ constexpr int kPaperPdOls[] = {6, 14, 22, 25};
 constexpr double kPaperRmseClie = 0.16820, kPaperRmseRescue = 0.16797;  // N m
 constexpr double kPaperKappaMin = 33.2, kPaperKappaMax = 173;
 
-double median(std::vector<double> v) {
-  if (v.empty()) return nan;
-  std::sort(v.begin(), v.end());
-  const std::size_t m = v.size() / 2;
-  return v.size() % 2 ? v[m] : 0.5 * (v[m - 1] + v[m]);
-}
+using report_detail::median;
 
 std::string num(double v, int digits = 4) { return report_detail::sig(v, digits); }
 
