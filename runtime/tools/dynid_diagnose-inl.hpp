@@ -125,6 +125,8 @@ void DiagnoseCommand::run(const Common& common, const DiagnoseOptions& o) {
   d.model = std::string(Model::robot_name) + (std::string(Model::variant_name).empty() ? "" : "::" + std::string(Model::variant_name));
   d.cutoff = o.cutoff;
   d.held_parameters = o.params;
+  for (const auto& e : d.selection.dropped)
+    fmt::print("dropped: {}: {} ({})\n", e.candidate.label(), e.magnitude, e.reason);
   for (const auto& e : d.selection.effects)
     fmt::print("effect: {}: {} (F {:.1f}, held-out gain {:.1f} %)\n", e.candidate.label(), e.magnitude.text, e.f,
                100 * e.heldout_gain);

@@ -119,6 +119,14 @@ std::vector<std::filesystem::path> write_diagnosis_report(const Diagnosis& d, co
                          "controller description's communication_delay for the closed loop.\n\n",
                          e.magnitude.values[0] * 1e3);
   }
+  if (!s.dropped.empty()) {
+    m += "Named by a forward step, then dropped by the backward check (each named effect refitted with all the others "
+         "must have a 95 % region that excludes half its size, agree with its physics, and still lower its joints' "
+         "held-out residual):\n\n";
+    for (const auto& e : s.dropped)
+      m += fmt::format("- {}: {}; {}.\n", e.candidate.label(), e.magnitude, e.reason);
+    m += "\n";
+  }
   if (d.backlash_judged) {
     const BacklashFit& b = d.backlash;
     m += "## Backlash: the closed loop's high band\n\n";

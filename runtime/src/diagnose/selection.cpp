@@ -7,6 +7,7 @@
 #include <Eigen/Cholesky>
 #include <Eigen/Eigenvalues>
 #include <Eigen/QR>
+#include <boost/math/distributions/chi_squared.hpp>
 #include <boost/math/distributions/fisher_f.hpp>
 #include <fmt/format.h>
 
@@ -58,7 +59,8 @@ Eigen::MatrixXd design(const DesignStack& d, const std::vector<Candidate>& effec
 // Weighted LS with unit-norm columns: beta and, optionally, its covariance factor.
 struct Solve {
   Eigen::VectorXd beta;
-  Eigen::VectorXd sd;  // sqrt(diag(sigma^2 (A'WA)^-1)), times sqrt(autocorrelation time)
+  Eigen::VectorXd sd;   // sqrt(diag(sigma^2 (A'WA)^-1)), times sqrt(autocorrelation time)
+  Eigen::MatrixXd cov;  // sigma^2 tau_int (A'WA)^-1, in beta's units
 };
 
 // Scales the columns of As to unit norm (zero columns stay) and returns the scales: the
@@ -87,6 +89,8 @@ Solve weighted_ls(const Eigen::MatrixXd& A, const Eigen::VectorXd& y, const Eige
   const Eigen::MatrixXd G = As.transpose() * As;
   const Eigen::MatrixXd Ginv = G.ldlt().solve(Eigen::MatrixXd::Identity(G.rows(), G.cols()));
   s.sd = (sigma2 * tau_int * Ginv.diagonal()).cwiseMax(0).cwiseSqrt().cwiseQuotient(scale);
+  const Eigen::VectorXd inv = scale.cwiseInverse();
+  s.cov = sigma2 * tau_int * (inv.asDiagonal() * Ginv * inv.asDiagonal());
   return s;
 }
 
@@ -167,6 +171,73 @@ bool matters(const Candidate& c, const CandidateTest& t, const DesignStack& d, c
   return t.effect_rms >= o.min_effect_torque;
 }
 
+// Held-out weighted SSE of a fit on the joints in `on` (all when empty).
+double heldout_sse(const Fit& f, const Eigen::VectorXd& weights, const std::vector<int>& on, int samples) {
+  double sse = 0;
+  for (Eigen::Index j = 0; j < f.heldout_rmse.size(); ++j)
+    if (on.empty() || std::find(on.begin(), on.end(), static_cast<int>(j) + 1) != on.end())
+      sse += std::pow(weights(j) * f.heldout_rmse(j), 2) * samples;
+  return sse;
+}
+
+// The backward check (selection.hpp): every chosen effect refitted with all the others; the
+// weakest of those that no longer stand is dropped, and the rest refitted, until all stand.
+void backward_check(const DesignStack& train, const DesignStack& heldout, const SelectionOptions& o,
+                    const Eigen::VectorXd& weights, std::vector<Candidate>& chosen, Selection& sel) {
+  while (!chosen.empty()) {
+    std::vector<Eigen::VectorXd> sds;
+    std::vector<Eigen::MatrixXd> covs;
+    const Fit full = fit_with_effects(train, heldout, chosen, weights, &sds, &covs);
+    int worst = -1;
+    DroppedEffect drop;
+    for (std::size_t i = 0; i < chosen.size(); ++i) {
+      const Candidate& c = chosen[i];
+      const Eigen::VectorXd& theta = full.theta[i];
+      const Eigen::Index m = theta.size();
+      // The region {x : (x - theta)' C^-1 (x - theta) <= chi2_m(0.95)} holds f theta when
+      // (1 - f)^2 theta' C^-1 theta <= chi2_m: the effect is determined when its Wald statistic
+      // exceeds chi2_m / (1 - f)^2.
+      const Eigen::LDLT<Eigen::MatrixXd> cf(covs[i]);
+      const double wald = cf.info() == Eigen::Success ? theta.dot(cf.solve(theta)) : 0.0;
+      const boost::math::chi_squared_distribution<double> chi2(static_cast<double>(m));
+      const double bound = boost::math::quantile(chi2, 0.95) / std::pow(1 - o.smallest_fraction, 2);
+      const double size = wald / bound;
+      std::vector<int> on;
+      if (effect_info(c.kind).per_joint) on.push_back(c.joint);
+      std::vector<Candidate> others = chosen;
+      others.erase(others.begin() + static_cast<std::ptrdiff_t>(i));
+      const Fit without = fit_with_effects(train, heldout, others, weights);
+      const double s0 = heldout_sse(without, weights, on, heldout.samples()), s1 = heldout_sse(full, weights, on, heldout.samples());
+      const double gain = s0 > 0 ? 1 - s1 / s0 : 0;
+      std::string reason;
+      if (!physical(c, theta))
+        reason = "refitted with the others, its parameters contradict its physics";
+      else if (size < 1)
+        reason = fmt::format("refitted with the others, its 95 % region reaches {:.0f} % of its size or less",
+                             100 * o.smallest_fraction);
+      else if (gain < o.min_heldout_gain)
+        reason = fmt::format("refitted with the others, it lowers its joints' held-out residual by {:.1f} % (under {:.0f} %)",
+                             100 * gain, 100 * o.min_heldout_gain);
+      if (reason.empty()) continue;
+      // The weakest: the smallest size, held-out gain breaking ties among determined ones.
+      const double weakness = size < 1 ? size : 1 + std::max(0.0, gain);
+      const double worst_weakness = worst < 0 ? 1e300 : (drop.size < 1 ? drop.size : 1 + std::max(0.0, drop.heldout_gain));
+      if (weakness < worst_weakness) {
+        worst = static_cast<int>(i);
+        drop.candidate = c;
+        drop.magnitude = magnitude(c, theta, sds[i]).text;
+        drop.size = size;
+        drop.heldout_gain = gain;
+        drop.reason = reason;
+      }
+    }
+    if (worst < 0) return;
+    sel.dropped.push_back(drop);
+    chosen.erase(chosen.begin() + worst);
+    sel.effects.erase(sel.effects.begin() + worst);
+  }
+}
+
 }  // namespace
 
 Eigen::VectorXd autocorrelation_time(const DesignStack& d, const Eigen::MatrixXd& r, int max_lag) {
@@ -190,7 +261,8 @@ Eigen::VectorXd autocorrelation_time(const DesignStack& d, const Eigen::MatrixXd
 }
 
 Fit fit_with_effects(const DesignStack& train, const DesignStack& heldout, const std::vector<Candidate>& effects,
-                     const Eigen::VectorXd& weights, std::vector<Eigen::VectorXd>* theta_sd) {
+                     const Eigen::VectorXd& weights, std::vector<Eigen::VectorXd>* theta_sd,
+                     std::vector<Eigen::MatrixXd>* theta_cov) {
   if (heldout.held() != train.held()) throw std::invalid_argument("fit_with_effects: parameters held in one stack only");
   const Eigen::Index np = free_parameters(train);
   const Eigen::VectorXd rw = row_weights(train, weights);
@@ -220,6 +292,7 @@ Fit fit_with_effects(const DesignStack& train, const DesignStack& heldout, const
     const Eigen::Index m = static_cast<Eigen::Index>(e.parameters.size());
     f.theta.push_back(s.beta.segment(c, m));
     if (theta_sd) theta_sd->push_back(sd.sd.segment(c, m));
+    if (theta_cov) theta_cov->push_back(sd.cov.block(c, c, m, m));
     c += m;
   }
   f.train_tau = st.tau_model;
@@ -425,6 +498,7 @@ Selection select_effects(const DesignStack& train, const DesignStack& heldout, c
     current = fit_with_effects(train, heldout, chosen, sel.weights);
   }
   if (sel.stop_reason.empty()) sel.stop_reason = "the maximum number of effects was reached";
+  backward_check(train, heldout, o, sel.weights, chosen, sel);
   std::vector<Eigen::VectorXd> sds;
   sel.after = fit_with_effects(train, heldout, chosen, sel.weights, &sds);
   for (std::size_t i = 0; i < sel.effects.size(); ++i) {

@@ -14,8 +14,15 @@
 //     `min_heldout_gain`, and it must matter in its own units (a delay of at least one log
 //     period; any other effect at least `min_effect_torque` rms on a joint);
 //   * of those, the one that removes the largest share of the whole held-out weighted
-//     residual is taken; the selection stops when no candidate passes. On clean data it
-//     reports nothing.
+//     residual is taken; the selection stops when no candidate passes;
+//   * then every named effect is refitted with all the others and must still stand on its own:
+//     its 95 % confidence region (the residual's autocorrelation counted) must exclude half
+//     its own size, it must still agree with its physics, and dropping it from the full model
+//     must cost its joints `min_heldout_gain` held out. A term named early can be made
+//     redundant by a later one, and a small term fitted beside a large one (a Stribeck term
+//     after Coulomb, a delay or an offset after a payload) can win a step on the large one's
+//     leftovers with an interval that reaches down to nothing. The weakest failing effect is
+//     dropped and the rest refitted, until all stand. On clean data it reports nothing.
 #pragma once
 
 #include <string>
@@ -42,6 +49,9 @@ struct SelectionOptions {
   double min_delay_periods = 1.0;
   int max_effects = 10;
   int max_lag = 400;               // samples, for the autocorrelation time
+  // The backward check: a named effect whose 95 % region reaches this fraction of its own
+  // size (or less) is not determined by the data.
+  double smallest_fraction = 0.5;
   CandidateOptions candidates;
 };
 
@@ -82,10 +92,20 @@ struct Fit {
   Eigen::VectorXd train_tau, heldout_tau;  // stacked model torques (with the effects)
 };
 
+// An effect the forward steps named and the backward check dropped, with why.
+struct DroppedEffect {
+  Candidate candidate;
+  std::string magnitude;  // as refitted with the others, e.g. "-0.0126 +- 0.0238 N m"
+  double size = 0;        // its Wald statistic over the region's bound (< 1: undetermined)
+  double heldout_gain = 0;  // what dropping it from the full model costs its joints, held out
+  std::string reason;
+};
+
 struct Selection {
   Eigen::VectorXd weights;          // per joint, 1 / residual std of the base fit
   std::vector<SelectionStep> steps;
   std::vector<SelectedEffect> effects;
+  std::vector<DroppedEffect> dropped;  // by the backward check, in the order dropped
   Fit before, after;                // base model alone, and with the selected effects
   std::string stop_reason;
 };
@@ -94,8 +114,10 @@ Selection select_effects(const DesignStack& train, const DesignStack& heldout, c
 
 // Weighted least squares of y on [W | effect columns] (no selection): what `Selection::after`
 // holds, exposed for reports and tests that fix the effects.
+// theta_cov: each effect's parameter covariance (the residual's autocorrelation counted).
 Fit fit_with_effects(const DesignStack& train, const DesignStack& heldout, const std::vector<Candidate>& effects,
-                     const Eigen::VectorXd& weights, std::vector<Eigen::VectorXd>* theta_sd = nullptr);
+                     const Eigen::VectorXd& weights, std::vector<Eigen::VectorXd>* theta_sd = nullptr,
+                     std::vector<Eigen::MatrixXd>* theta_cov = nullptr);
 
 // Integrated autocorrelation time of the columns of a samples x joints residual along the
 // segments (1 + 2 sum of rho_k up to the first non-positive one), per joint.
