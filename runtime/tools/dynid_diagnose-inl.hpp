@@ -13,6 +13,7 @@
 #include <fmt/format.h>
 
 #include "dynid_diagnose.hpp"
+#include "symoro/control/description.hpp"
 #include "symoro/diagnose/diagnosis.hpp"
 #include "symoro/diagnose/stack_builder.hpp"
 #include "symoro/identify/dataset.hpp"
@@ -96,6 +97,10 @@ void DiagnoseCommand::run(const Common& common, const DiagnoseOptions& o) {
   dopt.selection.min_heldout_gain = o.min_gain;
   dopt.selection.min_effect_torque = o.min_torque;
   dopt.selection.candidates = so.candidates;
+  // A delay the controller description already models is not a missing effect.
+  const auto controller_path = common.robot_dir() / control::controller_file_name();
+  if (std::filesystem::exists(controller_path))
+    dopt.selection.modeled_delay = control::read_controller_description(controller_path, Full::nq).communication_delay;
   diagnose::Diagnosis d = diagnose::diagnose(train, heldout, dopt);
   // Backlash from the closed loop's high band: the robot's digital twin replays the fitting
   // run's own references. A stage that cannot run, or fails, is said in the report; what the

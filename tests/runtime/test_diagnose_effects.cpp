@@ -84,6 +84,10 @@ BacklashFit high_band(const Data& d, const Selection& s) {
     for (const auto& f : b.findings)
       std::cout << fmt::format("  -> backlash joint {}: {:.3f} deg ({:.4f} measured, {:.4f} +- {:.4f} before, {:.4f} after)\n",
                                f.joint, f.width * 180 / M_PI, f.measured, f.simulated_before, f.spread, f.simulated_after);
+    for (Eigen::Index j = 0; j < b.measured.size(); ++j)
+      std::cout << fmt::format("  joint {}: measured {:.4f} null {:.4f} (floor {:.4f}) spread {:.4f}\n", j + 1, b.measured(j),
+                               b.simulated(j), b.floor.rms(j), b.spread(j));
+    std::cout << fmt::format("  encoder noise {:.3f} counts, lag {}\n", b.floor.encoder_noise, b.floor.lag);
     std::cout << fmt::format("  high band: {} simulations, delay {:.3f} ms\n", b.simulations, b.delay * 1e3);
   }
   return b;
@@ -176,6 +180,16 @@ TEST(DiagnoseTwin, ActuationDelay) {
   const Selection s = select_effects(d.train, d.heldout);
   print(s);
   expect_effects(s, {{EffectKind::ActuationDelay, 0, 0.004}});
+  // A delay the controller description models already is not missing: told that the loop's
+  // description holds 4 ms, the backward check drops it; told 0.9 ms (robots/crane_x7's), not.
+  SelectionOptions told;
+  told.modeled_delay = 0.004;
+  const Selection known = select_effects(d.train, d.heldout, told);
+  EXPECT_TRUE(known.effects.empty()) << known.effects.front().candidate.label();
+  ASSERT_EQ(known.dropped.size(), 1u);
+  EXPECT_EQ(known.dropped[0].candidate.kind, EffectKind::ActuationDelay);
+  told.modeled_delay = 0.0009;
+  expect_effects(select_effects(d.train, d.heldout, told), {{EffectKind::ActuationDelay, 0, 0.004}});
   // The loop's ringing with the delay is not taken for play, and the high band pins the delay.
   const BacklashFit b = high_band(d, s);
   EXPECT_TRUE(b.findings.empty()) << "backlash named with a delay only";

@@ -1,5 +1,6 @@
 #include "symoro/diagnose/diagnosis.hpp"
 
+#include <cmath>
 #include <algorithm>
 #include <map>
 #include <set>
@@ -116,8 +117,11 @@ std::vector<std::filesystem::path> write_diagnosis_report(const Diagnosis& d, co
       if (e.candidate.kind == EffectKind::ActuationDelay && !e.magnitude.values.empty())
         m += fmt::format("The actuation delay is not a model term: identify with the logged torque read {0:.2f} ms later "
                          "(`dynid identify --torque-delay {0:.2f}`, preprocess::Options::torque_delay) and add it to the "
-                         "controller description's communication_delay for the closed loop.\n\n",
-                         e.magnitude.values[0] * 1e3);
+                         "controller description's communication_delay for the closed loop{1}.\n\n",
+                         e.magnitude.values[0] * 1e3,
+                         d.options.modeled_delay >= 0
+                             ? fmt::format(" (which models {:.2f} ms; the delay named is beyond it)", d.options.modeled_delay * 1e3)
+                             : std::string());
   }
   if (!s.dropped.empty()) {
     m += "Named by a forward step, then dropped by the backward check (each named effect refitted with all the others "
@@ -130,18 +134,24 @@ std::vector<std::filesystem::path> write_diagnosis_report(const Diagnosis& d, co
   if (d.backlash_judged) {
     const BacklashFit& b = d.backlash;
     m += "## Backlash: the closed loop's high band\n\n";
-    m += "The fitting run's torque above 40 Hz against the robot's digital twin running the same trajectory in closed "
-         "loop with the effects above (mean and spread over noise seeds); a joint whose excess exceeds 6 spreads and "
-         "50 % gets the play whose simulation reproduces it, then the others are judged again.";
+    m += fmt::format(
+        "The fitting run's torque above 40 Hz against a null: the robot's digital twin running the same references in "
+        "closed loop with the effects above (mean and spread over noise seeds), with the log's own floor, which the twin "
+        "does not model: the encoders' noise estimated from the log ({:.2f} counts) in the loop, and the torque the "
+        "controller's law does not explain (the logged torque less the description's FF+PD command of {} row(s) before, "
+        "from the logged position and velocity) added. A joint whose excess over the null exceeds 6 spreads and 50 % gets "
+        "the play whose simulation reproduces it, then the others are judged again.",
+        b.floor.encoder_noise, b.floor.lag);
     if (b.delay > 0) m += fmt::format(" The selected delay, refined on the high band: {:.2f} ms.", b.delay * 1e3);
-    m += "\n\n| joint | measured (N m) | simulated (N m) | spread (N m) | play |\n|---|---|---|---|---|\n";
+    m += "\n\n| joint | measured (N m) | null (N m) | of which the log's floor (N m) | spread (N m) | play |\n|---|---|---|---|---|---|\n";
     for (Eigen::Index j = 0; j < b.measured.size(); ++j) {
       std::string play;
       for (const auto& f : b.findings)
         if (f.joint == j + 1) play = fmt::format("{:.3f} deg", f.width * 180 / 3.14159265358979323846);
-      m += fmt::format("| {} | {:.4f} | {:.4f} | {:.4f} | {} |\n",
+      m += fmt::format("| {} | {:.4f} | {:.4f} | {:.4f} | {:.4f} | {} |\n",
                        j < static_cast<Eigen::Index>(d.before.joints.size()) ? d.before.joints[j].name : std::to_string(j + 1),
-                       b.measured(j), b.simulated(j), b.spread(j), play.empty() ? "—" : play);
+                       b.measured(j), b.simulated(j), j < b.floor.rms.size() ? b.floor.rms(j) : 0.0, b.spread(j),
+                       play.empty() ? "—" : play);
     }
     m += b.findings.empty() ? "\nNo backlash found.\n\n" : "\n";
     for (const auto& note : b.notes) m += "- " + note + "\n";

@@ -160,13 +160,14 @@ Eigen::MatrixXd score_covariance(const DesignStack& d, const Eigen::MatrixXd& Z,
   return V;
 }
 
+double log_period(const DesignStack& d) { return d.base_interval > 0 ? d.base_interval : d.interval; }
+
 // Whether an effect is large enough to act on, in its own terms: a delay against the logs'
 // period (a shift below one sample is not a remedy one can apply, and the logs' own sample and
 // hold sits there), every other effect against the torque resolution on its largest joint.
 bool matters(const Candidate& c, const CandidateTest& t, const DesignStack& d, const SelectionOptions& o) {
   if (c.kind == EffectKind::ActuationDelay) {
-    const double period = d.base_interval > 0 ? d.base_interval : d.interval;
-    return !t.magnitude.empty() && std::abs(t.magnitude[0]) >= o.min_delay_periods * period;
+    return !t.magnitude.empty() && std::abs(t.magnitude[0]) >= o.min_delay_periods * log_period(d);
   }
   return t.effect_rms >= o.min_effect_torque;
 }
@@ -212,6 +213,11 @@ void backward_check(const DesignStack& train, const DesignStack& heldout, const 
       std::string reason;
       if (!physical(c, theta))
         reason = "refitted with the others, its parameters contradict its physics";
+      else if (c.kind == EffectKind::ActuationDelay && o.modeled_delay >= 0 &&
+               std::abs(theta(0) - o.modeled_delay) <=
+                   std::max(1.96 * std::sqrt(std::max(0.0, covs[i](0, 0))), o.min_delay_periods * log_period(train)))
+        reason = fmt::format("refitted with the others, it is the {:.2f} ms the controller description already models",
+                             1e3 * o.modeled_delay);
       else if (size < 1)
         reason = fmt::format("refitted with the others, its 95 % region reaches {:.0f} % of its size or less",
                              100 * o.smallest_fraction);

@@ -3,15 +3,20 @@
 // torque (current) gains power far above the diagnosis's 5 Hz band, where the stack's columns
 // cannot see it (a linear column of the low band explains < 2 % of it). So backlash is judged
 // by simulating the experiment: the robot's digital twin (its nominal description, plus the
-// effects the diagnosis already selected) runs the fitting trajectory in closed loop, and
-//   1. a joint whose measured high-band torque rms exceeds the simulated one by more than the
+// effects the diagnosis already selected) runs the fitting run's references in closed loop.
+// A real arm's high band also holds what the twin does not model (current noise, the current
+// loop, its encoders' noise): judged against the twin alone, any real arm has play. So the null
+// is the twin with the log's own floor (high_band.hpp: the encoder noise estimated from the log
+// put into the twin, and the torque the controller's law does not explain added to it):
+//   1. a joint whose measured high-band torque rms exceeds the null's by more than the
 //      simulation's own spread across noise seeds (and by a relative margin) has a candidate;
-//   2. the joint with the largest excess gets the play width whose simulation reproduces its
-//      measured high-band rms (bisection: the chatter grows with the width), and the others are
+//   2. the joint with the largest excess gets the play width whose null reproduces its measured
+//      high-band rms (bisection: the chatter grows with the width), and the others are
 //      re-judged with it in the simulation (a neighbour's chatter couples into them);
 //   3. until no joint exceeds.
 // A joint whose mesh torque never reverses (a gravity-loaded elbow) never crosses its play: its
-// backlash leaves no trace in either band and is not named.
+// backlash leaves no trace in either band and is not named. The width is the twin's mesh's: an
+// arm whose gears are stiffer or better damped chatters less for the same play.
 #pragma once
 
 #include <algorithm>
@@ -23,35 +28,14 @@
 
 #include <fmt/format.h>
 
+#include "symoro/diagnose/high_band.hpp"
 #include "symoro/diagnose/selection.hpp"
 #include "symoro/error.hpp"
-#include "symoro/preprocess/butterworth.hpp"
-#include "symoro/preprocess/preprocess.hpp"
-#include "symoro/preprocess/zero_phase.hpp"
 #include "symoro/trajectory/sampled_reference.hpp"
 #include "symoro/twin/config.hpp"
 #include "symoro/twin/simulator.hpp"
 
 namespace symoro::diagnose {
-
-struct BacklashFitOptions {
-  double band_hz = 40;        // the high band starts here (the low band ends at the stack's 5 Hz)
-  double light_hz = 150;      // the 1 kHz preprocessing's low-pass (the band's top)
-  int seeds = 3;              // simulations of the nominal loop: the spread of the high-band rms
-  double sigmas = 6;          // an excess must exceed this many spreads ...
-  // ... and this fraction of the simulated rms: the loop's chatter is heavy-tailed from run to
-  // run (clean twin runs of V01: joint 2 at 0.76-0.79 N m for five seeds, 0.98 for another),
-  // which the spread of a few seeds does not show.
-  double relative = 0.5;
-  double max_width = 0.1;     // rad (5.7 deg): the bisection's upper end
-  int bisection_steps = 10;   // width resolution max_width / 2^steps
-  std::uint64_t seed = 7919;  // of the simulations (any: they are not the data's)
-  // A selected actuation delay shapes the loop's ringing in the high band far more finely than
-  // the low band resolves it: it is refined first (golden section over +-delay_range of it,
-  // matching the log of the high-band rms on every joint), so its ringing is not taken for play.
-  double delay_range = 0.3;
-  int delay_steps = 10;
-};
 
 struct BacklashFinding {
   int joint = 0;                  // 1-based
@@ -63,7 +47,8 @@ struct BacklashFinding {
 };
 
 struct BacklashFit {
-  Eigen::VectorXd measured, simulated, spread;  // per joint, the final judgement (N m)
+  Eigen::VectorXd measured, simulated, spread;  // per joint, the final judgement (N m); simulated: the null
+  LoopFloor floor;                // the log's own floor, in the null
   std::vector<BacklashFinding> findings;
   double delay = 0;               // s, the refined actuation delay (0: none was selected)
   int simulations = 0;
@@ -105,32 +90,6 @@ inline twin::TwinConfig with_selected_effects(twin::TwinConfig c, const Selectio
   return c;
 }
 
-// High-band rms of the torque per joint: the log preprocessed at its own rate (light low-pass),
-// minus its zero-phase low-pass at band_hz, over every piece.
-inline Eigen::VectorXd high_band_rms(const io::Log& log, const BacklashFitOptions& o = {}) {
-  preprocess::Options po;
-  po.derivative_cutoff = o.light_hz;
-  const double base = log.meta.sample_time > 0 ? log.meta.sample_time : 0.001;
-  const preprocess::Samples s = preprocess::preprocess(log, base, po);
-  const auto sections = preprocess::butterworth_lowpass(4, o.band_hz, 1.0 / base);
-  const int padding = preprocess::zero_phase_padding(sections);
-  const Eigen::Index n = s.tau.cols();
-  Eigen::VectorXd sum = Eigen::VectorXd::Zero(n);
-  long count = 0;
-  for (Eigen::Index a = 0; a < s.tau.rows();) {
-    Eigen::Index b = a + 1;
-    while (b < s.tau.rows() && (s.piece.empty() || s.piece[b] == s.piece[a])) ++b;
-    if (b - a > padding + 1) {
-      preprocess::Channels low = s.tau.middleRows(a, b - a);
-      preprocess::filtfilt(sections, padding, low);
-      sum += (s.tau.middleRows(a, b - a) - low).colwise().squaredNorm().transpose();
-      count += static_cast<long>(b - a);
-    }
-    a = b;
-  }
-  return (sum / static_cast<double>(std::max(1L, count))).cwiseSqrt();
-}
-
 // `nominal`: the robot's twin configuration with the effects already diagnosed switched on and
 // every unknown one off (backlash off); `measured` the fitting run and `reference` its
 // reference at every cycle (the log's own references: the motion that was logged).
@@ -143,12 +102,20 @@ BacklashFit fit_backlash(const io::Log& measured, const trajectory::SampledRefer
   // No play anywhere to start with (a description may carry widths with backlash switched off).
   nominal.effects.backlash = false;
   nominal.effects.backlash_width = Eigen::VectorXd::Zero(n);
+  // The null: the log's encoder noise in the loop, its unexplained torque added to the result
+  // (the twin's own current noise off: the log's is that).
+  fit.floor = loop_floor(measured, nominal, o);
+  nominal.effects.sensor_noise = true;
+  nominal.effects.encoder_noise = fit.floor.encoder_noise;
+  nominal.effects.encoder_noise_per_joint = fit.floor.encoder_noise_per_joint;
+  nominal.effects.current_noise = 0;
   auto simulate = [&](const twin::TwinConfig& c, std::uint64_t seed) {
     twin::RunOptions ro;
     ro.robot = Full::robot_name;
     ro.seed = seed;
     ++fit.simulations;
-    return high_band_rms(twin::ClosedLoopTwin<Full>(c).run(reference, ro), o);
+    const Eigen::VectorXd loop = high_band_rms(twin::ClosedLoopTwin<Full>(c).run(reference, ro), o);
+    return Eigen::VectorXd((loop.cwiseAbs2() + fit.floor.rms.cwiseAbs2()).cwiseSqrt());
   };
   auto judge = [&](const twin::TwinConfig& c) {
     Eigen::MatrixXd runs(n, o.seeds);

@@ -52,6 +52,11 @@ struct SelectionOptions {
   // The backward check: a named effect whose 95 % region reaches this fraction of its own
   // size (or less) is not determined by the data.
   double smallest_fraction = 0.5;
+  // s, the sampling-to-command delay the controller description already models (negative: no
+  // description). A named actuation delay within its 95 % interval of it, or within
+  // min_delay_periods log periods (what a delay must reach to matter), is that delay, not a
+  // missing effect, and is dropped.
+  double modeled_delay = -1;
   CandidateOptions candidates;
 };
 

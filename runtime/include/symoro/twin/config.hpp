@@ -75,6 +75,8 @@ struct Effects {
   double actuation_delay_time = 0;  // s
   bool sensor_noise = false;
   double encoder_noise = 0;   // counts
+  // Per joint (counts), when given: replaces encoder_noise (the diagnosis estimates it per joint).
+  Eigen::VectorXd encoder_noise_per_joint;
   double current_noise = 0;   // A
   bool timestamp_jitter = false;
   double jitter_std = 0, jitter_max = 0;

@@ -110,7 +110,8 @@ class ClosedLoopTwin {
     auto encoder = [&](const Vec& q) {
       Vec m;
       for (int j = 0; j < n; ++j) {
-        const double noise = e.sensor_noise ? e.encoder_noise * rng.normal() : 0.0;
+        const double sd = e.encoder_noise_per_joint.size() == n ? e.encoder_noise_per_joint(j) : e.encoder_noise;
+        const double noise = e.sensor_noise ? sd * rng.normal() : 0.0;
         m(j) = std::round(q(j) / lsb(j) + noise) * lsb(j);
       }
       return m;
