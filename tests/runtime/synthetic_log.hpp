@@ -90,6 +90,31 @@ io::Log synthesize(const std::string& name, const Eigen::Matrix<double, Model::n
   return log;
 }
 
+// The log a real controller writes of that motion: q from a quantized encoder (counts per
+// revolution, plus noise in counts), qd the controller's own estimate (the backward difference of
+// the encoder over the nominal period, through a first-order low-pass at `velocity_cutoff` Hz),
+// the torque as synthesized (noise included). A stale row stays a copy of the row before.
+inline io::Log with_real_sensors(io::Log log, double counts, double encoder_noise, double velocity_cutoff, unsigned seed) {
+  constexpr double kPi = 3.14159265358979323846;
+  std::mt19937 gen(seed);
+  std::normal_distribution<double> gauss(0, 1);
+  const double lsb = 2 * kPi / counts, T = log.meta.sample_time > 0 ? log.meta.sample_time : 0.001;
+  const double a = std::exp(-2 * kPi * velocity_cutoff * T);
+  const Eigen::MatrixXd q_true = log.q;
+  Eigen::RowVectorXd v = Eigen::RowVectorXd::Zero(log.q.cols());
+  for (int i = 0; i < log.samples(); ++i) {
+    if (i > 0 && q_true.row(i) == q_true.row(i - 1) && log.tau.row(i) == log.tau.row(i - 1)) {  // stale
+      log.q.row(i) = log.q.row(i - 1);
+      log.qd.row(i) = log.qd.row(i - 1);
+      continue;
+    }
+    for (Eigen::Index j = 0; j < log.q.cols(); ++j) log.q(i, j) = std::round(q_true(i, j) / lsb + encoder_noise * gauss(gen)) * lsb;
+    if (i > 0) v = a * v + (1 - a) * (log.q.row(i) - log.q.row(i - 1)) / T;
+    log.qd.row(i) = v;
+  }
+  return log;
+}
+
 // The log as a robot's controller could export it: a comment line, then stamp_ms, mode (a text
 // column), <joint>_pos and _vel (deg, deg/s; m, m/s for a prismatic joint), <joint>_eff (N m; N),
 // every number in its shortest round-trip form.

@@ -177,7 +177,7 @@ Samples preprocess(const io::Log& raw, double interval, const Options& options) 
     Channels q = interpolation.apply(log.q);
     Channels tau = interpolation.apply(log.tau);
     filtfilt(sections, padding, q);
-    filtfilt(sections, padding, tau);
+    if (options.filter_torque) filtfilt(sections, padding, tau);
     if (options.torque_delay != 0) shift_later(tau, options.torque_delay / period);
 
     const std::vector<int> rows = target_rows(piece.first_index, piece.grid_samples(), stride);

@@ -39,6 +39,9 @@ struct Options {
   // The torque channel is read this much later (tau(t) := tau_logged(t + delay), on the
   // filtered grid, linear between grid points) so that it lines up with the motion. 0: none.
   double torque_delay = 0;
+  // false: the torque is only brought onto the grid (interpolated between its stamps), not
+  // low-passed: the raw measured torque, against which a model is scored (identify/raw_torque.hpp).
+  bool filter_torque = true;
 };
 
 // The base period preprocess() uses for `log`: options.base_period when positive, else the
