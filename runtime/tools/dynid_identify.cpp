@@ -139,9 +139,14 @@ void IdentifyCommand::run_model(const Common& common, const IdentifyOptions& o,
     fmt::print("physical consistency of the accepted vector: {}\n",
                r.final_consistency_note.empty() ? "not checked" : r.final_consistency_note);
     for (const auto& v : r.validation)
+    {
       fmt::print("validation {} at {:.0f} ms, {}: RMSE {:.4f} / {:.4f} N m, MNE {:.4f} / {:.4f} (final / accepted){}\n",
                  v.trajectory, v.interval * 1e3, v.kind, v.rmse_clie, v.rmse_rescue, v.mne_clie, v.mne_rescue,
                  v.note.empty() ? "" : "; " + v.note);
+      if (std::isfinite(v.raw_rmse_rescue))
+        fmt::print("validation {} against the raw torque, open loop: RMSE {:.4f} / {:.4f} N m (final / accepted)\n", v.trajectory,
+                   v.raw_rmse_clie, v.raw_rmse_rescue);
+    }
   }
   // The held-out series on disk: dynid compare reads them to set two model variants side by side.
   if (!identify::write_validation(r, o.out).empty())

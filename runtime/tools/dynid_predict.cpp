@@ -16,6 +16,7 @@
 #include "dynid_identify.hpp"
 #include "dynid_numbers.hpp"
 #include "symoro/identify/dataset.hpp"
+#include "symoro/identify/raw_torque.hpp"
 #include "symoro/identify/study_options.hpp"
 #include "symoro/io/atomic_file.hpp"
 #include "symoro/io/log.hpp"
@@ -62,6 +63,7 @@ struct Prediction {
   std::string name;
   int samples = 0;
   Eigen::VectorXd rmse, rms;  // per joint: of tau - tau_model, and of tau
+  identify::RawTorqueScore raw;  // against the raw torque at the log's own rate
 };
 
 Prediction predict_log(const io::Log& log, const std::string& name, const identify::IdentificationModel& model,
@@ -88,6 +90,8 @@ Prediction predict_log(const io::Log& log, const std::string& name, const identi
     text += "\n";
   }
   io::write_file_atomically(csv, text);
+  p.raw = identify::raw_torque_error(
+      log, [&](const preprocess::Samples& m, const Eigen::VectorXd& x) { return model.open_loop_torque(m, x); }, phi);
   return p;
 }
 
@@ -139,11 +143,16 @@ void run(const Common& common, const PredictOptions& o) {
              d.variant.empty() ? "full" : d.variant, o.params == "nominal" ? "the nominal" : o.params, o.interval_ms);
   Eigen::VectorXd sq = Eigen::VectorXd::Zero(d.nq);
   int total = 0;
+  std::string raw_filter;
   for (std::size_t i = 0; i < logs.size(); ++i) {
     const Prediction p = predict_log(logs[i].second, logs[i].first, *model, phi, o, files[i]);
     std::string line = fmt::format("  {:<10} {:>6} samples:", p.name, p.samples);
     for (int j = 0; j < d.nq; ++j) line += fmt::format(" {:.4f} ({:.3f})", p.rmse(j), p.rms(j));
     fmt::print("{}\n", line);
+    line = fmt::format("  {:<10} {:>6} raw:    ", "", p.raw.samples);
+    for (int j = 0; j < d.nq; ++j) line += fmt::format(" {:.4f}        ", p.raw.error.rmse_joint(j));
+    fmt::print("{}\n", line);
+    if (i + 1 == logs.size()) raw_filter = p.raw.filter;
     sq += p.rmse.cwiseAbs2() * p.samples;
     total += p.samples;
   }
@@ -152,6 +161,7 @@ void run(const Common& common, const PredictOptions& o) {
     for (int j = 0; j < d.nq; ++j) line += fmt::format(" {:.4f}", std::sqrt(sq(j) / total));
     fmt::print("{}\n", line);
   }
+  fmt::print("raw: RMSE against the {}\n", raw_filter);
   fmt::print("predicted torque: {}\n", one ? out.string() : (out / "*.predicted.csv").string());
 }
 

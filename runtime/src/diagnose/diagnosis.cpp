@@ -167,6 +167,18 @@ std::vector<std::filesystem::path> write_diagnosis_report(const Diagnosis& d, co
   }
   m += fmt::format("| all | {:.4f} | {:.4f} | {:+.1f} % |\n\n", s.before.heldout_total, s.after.heldout_total,
                    s.before.heldout_total > 0 ? 100 * (s.after.heldout_total / s.before.heldout_total - 1) : 0.0);
+  if (!d.raw_filter.empty()) {
+    m += "Against the raw measured torque at the logs' own rate (the same fits; " + d.raw_filter + "):\n\n";
+    m += "| joint | rms before (N m) | rms after (N m) | change |\n|---|---|---|---|\n";
+    for (Eigen::Index j = 0; j < d.raw_before.size(); ++j) {
+      const double b = d.raw_before(j), a = d.raw_after(j);
+      m += fmt::format("| {} | {:.4f} | {:.4f} | {:+.1f} % |\n", j + 1, b, a, b > 0 ? 100 * (a / b - 1) : 0.0);
+    }
+    m += fmt::format("| all | {:.4f} | {:.4f} | {:+.1f} % |\n\n", d.raw_total_before, d.raw_total_after,
+                     d.raw_total_before > 0 ? 100 * (d.raw_total_after / d.raw_total_before - 1) : 0.0);
+  } else if (!d.raw_note.empty()) {
+    m += "Against the raw measured torque: not scored (" + d.raw_note + ").\n\n";
+  }
   io::write_file_atomically(dir / "figures" / "heldout_rmse.svg", rmse_figure(d, {}));
   written.push_back(dir / "figures" / "heldout_rmse.svg");
   m += "![held-out rms per joint](figures/heldout_rmse.svg)\n\n";

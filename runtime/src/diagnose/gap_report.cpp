@@ -253,6 +253,20 @@ std::vector<std::filesystem::path> write_gap_report(const StudyValidation& befor
                       for (const auto& t : c.trajectories) v.push_back(t.trajectory);
                       return v;
                     }(), ", "));
+  {
+    // Against the raw measured torque, open loop, where both studies scored it.
+    std::string rows;
+    for (const auto& b : before.records)
+      for (const auto& a : after.records)
+        if (a.trajectory == b.trajectory && std::isfinite(a.raw_rmse_rescue) && std::isfinite(b.raw_rmse_rescue))
+          rows += fmt::format("| {} | {:.4f} | {:.4f} | {} |\n", a.trajectory, b.raw_rmse_rescue, a.raw_rmse_rescue,
+                              pct(b.raw_rmse_rescue, a.raw_rmse_rescue));
+    if (!rows.empty())
+      md += "Against the raw measured torque, open loop at the logs' own rate (" + after.records.front().raw_filter +
+            "):\n\n| trajectory | rms before [N m] | rms after [N m] | change |\n|---|---|---|---|\n" + rows + "\n";
+    else
+      md += "Against the raw measured torque: not scored (a study written before raw-torque validation).\n\n";
+  }
   if (!c.only_before.empty() || !c.only_after.empty())
     md += fmt::format("Left out (validated by one study only): {}.\n\n",
                       fmt::join([&] {

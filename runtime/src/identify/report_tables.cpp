@@ -328,6 +328,22 @@ std::string rescue_delta_table(const StudyResult& study, int count) {
                      sig(delta.norm() / r->phi_clie.norm(), 4));
 }
 
+// Against the raw measured torque (raw_torque.hpp), when the records carry it.
+std::string raw_validation_table(const StudyResult& study) {
+  std::string filter;
+  for (const auto& v : study.validation)
+    if (std::isfinite(v.raw_rmse_rescue)) filter = v.raw_filter;
+  if (filter.empty()) return "";
+  MarkdownTable table({"Trajectory", "Final RMSE [N m]", "Accepted RMSE [N m]", "Accepted, per joint [N m]"});
+  for (const auto& v : study.validation) {
+    if (!std::isfinite(v.raw_rmse_rescue)) continue;
+    std::string joints;
+    for (Eigen::Index j = 0; j < v.raw_rmse_joint_rescue.size(); ++j) joints += (j ? ", " : "") + sig(v.raw_rmse_joint_rescue(j), 3);
+    table.row({v.trajectory, sig(v.raw_rmse_clie, 6), sig(v.raw_rmse_rescue, 6), joints});
+  }
+  return "\nAgainst the raw measured torque, open loop at the log's own rate: " + filter + ".\n\n" + table.str() + "\n";
+}
+
 std::string validation_table(const StudyResult& study) {
   std::string out = "## Table VII: validation on held-out trajectories\n\n";
   if (study.validation.empty()) return out + "No validation records.\n\n";
@@ -350,6 +366,7 @@ std::string validation_table(const StudyResult& study) {
          "motion. RMSE over all joints and samples; MNE: mean over joints of ‖e_j‖ / ‖τ_m,j‖.\n\n";
   for (const auto& v : study.validation)
     if (!v.note.empty()) out += fmt::format("- {}: {}\n", v.trajectory, v.note);
+  out += raw_validation_table(study);
 
   // Per joint, when the records carry it.
   int joints = 0;

@@ -2,6 +2,8 @@
 // once for every robot.
 #include "symoro/identify/study.hpp"
 
+#include "symoro/identify/raw_torque.hpp"
+
 #include <algorithm>
 #include <chrono>
 #include <filesystem>
@@ -415,6 +417,16 @@ class StudyRun {
             sim.get(), [this](const preprocess::Samples& m, const Eigen::VectorXd& phi) { return model_.open_loop_torque(m, phi); },
             s, sel.phi_clie, out.phi_rescue, co, why));
         out.validation.back().trajectory = name;
+        // The same vectors against the raw torque, at the log's own rate.
+        const OpenLoopTorque open = [this](const preprocess::Samples& m, const Eigen::VectorXd& phi) {
+          return model_.open_loop_torque(m, phi);
+        };
+        const RawTorqueScore raw_clie = raw_torque_error(log, open, sel.phi_clie), raw = raw_torque_error(log, open, out.phi_rescue);
+        ValidationRecord& v = out.validation.back();
+        v.raw_rmse_clie = raw_clie.error.rmse;
+        v.raw_rmse_rescue = raw.error.rmse;
+        v.raw_rmse_joint_rescue = raw.error.rmse_joint;
+        v.raw_filter = raw.filter;
       } catch (const std::exception& e) {
         out.stages.push_back(fmt::format("validation of {}: failed: {}", name, e.what()));
       }

@@ -159,6 +159,12 @@ std::vector<std::filesystem::path> write_validation(const StudyResult& study, co
     detail::put_vector(y, "rmse_joint_clie", v.rmse_joint_clie);
     detail::put_vector(y, "rmse_joint_accepted", v.rmse_joint_rescue);
     detail::put_vector(y, "nrmse_joint_accepted", v.nrmse_joint_rescue);
+    if (std::isfinite(v.raw_rmse_rescue)) {
+      y << YAML::Key << "raw_rmse_clie" << YAML::Value << v.raw_rmse_clie;
+      y << YAML::Key << "raw_rmse_accepted" << YAML::Value << v.raw_rmse_rescue;
+      detail::put_vector(y, "raw_rmse_joint_accepted", v.raw_rmse_joint_rescue);
+      y << YAML::Key << "raw_filter" << YAML::Value << v.raw_filter;
+    }
     y << YAML::Key << "series" << YAML::Value << "validation/" + csv_name(v.trajectory);
     y << YAML::EndMap;
   }
@@ -216,6 +222,12 @@ StudyValidation read_validation(const std::filesystem::path& study_dir) {
     v.rmse_joint_clie = vec(t, "rmse_joint_clie", file);
     v.rmse_joint_rescue = vec(t, "rmse_joint_accepted", file);
     v.nrmse_joint_rescue = vec(t, "nrmse_joint_accepted", file, true);
+    if (t["raw_rmse_accepted"]) {  // studies before raw-torque validation have none
+      v.raw_rmse_clie = as<double>(t, "raw_rmse_clie", file);
+      v.raw_rmse_rescue = as<double>(t, "raw_rmse_accepted", file);
+      v.raw_rmse_joint_rescue = vec(t, "raw_rmse_joint_accepted", file, true);
+      v.raw_filter = t["raw_filter"] ? as<std::string>(t, "raw_filter", file) : "";
+    }
     read_series(study_dir / as<std::string>(t, "series", file), joints, v);
     s.records.push_back(std::move(v));
   }

@@ -97,6 +97,11 @@ struct ValidationRecord {
   double rmse_clie = 0, rmse_rescue = 0;   // N m, over all joints and samples
   double mne_clie = 0, mne_rescue = 0;     // mean over joints of |e_j| / |tau_m,j| (2-norms)
   Eigen::VectorXd rmse_joint_clie, rmse_joint_rescue;
+  // Open loop against the raw measured torque at the log's own rate (raw_torque.hpp), beside the
+  // filtered numbers above: what a plain least-squares fit would be compared with. NaN: not scored.
+  double raw_rmse_clie = std::numeric_limits<double>::quiet_NaN(), raw_rmse_rescue = std::numeric_limits<double>::quiet_NaN();
+  Eigen::VectorXd raw_rmse_joint_rescue;
+  std::string raw_filter;  // the evaluation's own filter, one sentence
   // The series (for the torque figure and the closed-loop localization): samples x joints; the
   // motion is the measured one, preprocessed like the torque.
   Eigen::VectorXd time;
