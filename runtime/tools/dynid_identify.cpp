@@ -58,6 +58,7 @@ identify::StudyResult study(const Common& common, const IdentifyOptions& o,
   so.physical_start = o.physical_start;
   so.rescue_metric_all_runs = o.rescue_metric == "all";
   so.rescue_prior_weight = o.rescue_prior_weight;
+  so.rescue_prior_weights = o.rescue_prior_weights;
   // The rescue's prior: as given, else robot.yaml's nominal parameters when it has them.
   if (o.rescue_prior.empty() || o.rescue_prior == "nominal") {
     std::vector<double> s;
@@ -231,6 +232,11 @@ void add_identify_commands(CLI::App& app, Common& common) {
   cmd->add_option("--rescue-prior-weight", o->rescue_prior_weight, "The prior's weight relative to the torque metric")
       ->check(numbers::positive(1e6, "> 0 and <= 1e6"))
       ->capture_default_str();
+  cmd->add_option("--rescue-prior-weights", o->rescue_prior_weights,
+                  "Weights to choose the prior's among by held-out error (comma-separated, e.g. 1e-6,1e-4,1e-2): each "
+                  "rescue is scored open loop on the identification runs other than the representative's")
+      ->delimiter(',')
+      ->check(numbers::positive(1e6, "> 0 and <= 1e6"));
   cmd->add_flag("--physical-start", o->physical_start,
                 "With --consistency physical: project each OLS estimate onto the consistent set before CLIE instead "
                 "of the paper's PD projection (slower: CLIE walks back out of the set; docs/identification.md)");

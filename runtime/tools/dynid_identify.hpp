@@ -29,6 +29,7 @@ struct IdentifyOptions {
   std::string rescue_metric = "all";
   std::string rescue_prior;          // "" zero, "nominal" robot.yaml's, or a standard-parameter YAML
   double rescue_prior_weight = 1e-6;
+  std::vector<double> rescue_prior_weights;  // chosen among by held-out error when given
   double clie_std_bound = 0;
   double clie_noise_floor = 0;  // identify::ClieOptions::noise_floor
   double rank_timeout = 60;

@@ -362,11 +362,48 @@ class StudyRun {
       if (!sel.clie_consistent) {
         // The rescue over standard parameters: the nearest base vector with a consistent set, in
         // the selected run's predicted-torque metric.
-        const PhysicalProjection p = model_.physical_projection(
-            sel.phi_clie,
-            o_.rescue_metric_all_runs ? pooled_torque_metric(data, sel.interval)
-                                      : detail::torque_metric(refit(data, sel), o_.information_ridge),
-            o_.physical_rescue_clearance, o_.rescue_prior, o_.rescue_prior_weight);
+        const Eigen::MatrixXd metric = o_.rescue_metric_all_runs ? pooled_torque_metric(data, sel.interval)
+                                                                 : detail::torque_metric(refit(data, sel), o_.information_ridge);
+        auto rescue = [&](double weight) {
+          return model_.physical_projection(sel.phi_clie, metric, o_.physical_rescue_clearance, o_.rescue_prior, weight);
+        };
+        out.rescue_prior_weight = o_.rescue_prior_weight;
+        PhysicalProjection p;
+        if (o_.rescue_prior_weights.empty()) {
+          p = rescue(o_.rescue_prior_weight);
+        } else {
+          // Held out: the other identification runs at the representative's interval.
+          std::vector<preprocess::Samples> others;
+          for (const RunRecord& r : out.runs)
+            if (&r != &sel && !r.failed && std::abs(r.interval - sel.interval) < 1e-12) {
+              try {
+                others.push_back(preprocess::preprocess(load_log(data.find(r.trajectory, o_.trial)), r.interval, o_.preprocess));
+              } catch (const std::exception&) {
+              }
+            }
+          double best = std::numeric_limits<double>::infinity();
+          for (double w : o_.rescue_prior_weights) {
+            PhysicalProjection q = rescue(w);
+            double sq = 0, count = 0;
+            for (const auto& s : others) {
+              const Eigen::MatrixXd e = s.tau - model_.open_loop_torque(s, q.phi);
+              sq += e.squaredNorm();
+              count += static_cast<double>(e.size());
+            }
+            const double rmse = count > 0 ? std::sqrt(sq / count) : 0.0;
+            out.rescue_prior_scores.emplace_back(w, rmse);
+            if (q.feasible && (p.phi.size() == 0 || rmse < best * (1 - 1e-3))) {
+              best = rmse;
+              p = std::move(q);
+              out.rescue_prior_weight = w;
+            }
+          }
+          if (p.phi.size() == 0) p = rescue(o_.rescue_prior_weight);
+          std::string scores;
+          for (const auto& [w, e] : out.rescue_prior_scores) scores += fmt::format("{}{:g}: {:.6g}", scores.empty() ? "" : ", ", w, e);
+          out.stages.push_back(fmt::format("rescue prior weight: {:g}, by held-out open-loop RMSE on {} other runs (N m; {})",
+                                           out.rescue_prior_weight, others.size(), scores));
+        }
         out.phi_rescue = p.phi;
         out.rescued = true;
         out.rescue_eps = o_.physical_rescue_clearance;

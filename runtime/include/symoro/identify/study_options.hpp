@@ -86,6 +86,10 @@ struct StudyOptions {
   Eigen::VectorXd rescue_prior;
   std::string rescue_prior_source;  // what it is, for the report
   double rescue_prior_weight = 1e-6;
+  // When not empty, the weight is chosen among these by held-out error: each gives a rescued
+  // vector, scored open loop on the identification runs other than the representative's (same
+  // interval); the smallest error wins (the smaller weight on a tie within 0.1 %).
+  std::vector<double> rescue_prior_weights;
   // Its preprocess options are the study's. Stopping rule of MATLAB's lsqnonlin (the paper's):
   // relative cost change 1e-6; at most 25 steps. Besides (ClieOptions' default): a parameter
   // that reaches its bound is held there (clie.hold_at_bounds; docs/identification.md: PB01 took

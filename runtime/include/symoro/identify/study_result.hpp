@@ -121,6 +121,10 @@ struct StudyResult {
   double rescue_eps = 0;
   bool rescue_feasible = true;            // false: the rescue's projection failed (rescue_status says why)
   std::string rescue_status;
+  // The physical rescue's prior weight, and when it was chosen by held-out error, each
+  // candidate's open-loop RMSE on the other identification runs (N m).
+  double rescue_prior_weight = 0;
+  std::vector<std::pair<double, double>> rescue_prior_scores;
   double final_lambda_min = 0;
   Eigen::VectorXd final_worst_pose;
   bool accepted = false;                  // final audit passed (physical: and a consistent set exists)
