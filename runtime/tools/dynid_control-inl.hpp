@@ -22,7 +22,7 @@
 #include "symoro/hardware/controller.hpp"
 #include "symoro/io/log.hpp"
 #include "symoro/io/parameters_yaml.hpp"
-#include "symoro/hardware/twin_servo_backend.hpp"
+#include "symoro/twin_bus/twin_servo_backend.hpp"
 #include "symoro/trajectory/design.hpp"
 #include "symoro/twin/simulator.hpp"
 
@@ -150,8 +150,8 @@ void ControlCommand::run(const Common& common, const ControlCliOptions& o) {
       raised = pthread_setschedparam(pthread_self(), SCHED_FIFO, &p) == 0;
     }
     virt = std::make_unique<dynamixel::VirtualBus>(
-        hardware::virtual_servos(hw),
-        std::make_unique<hardware::TwinServoBackend<Full>>(*tc, hw, Eigen::Matrix<double, Full::nq, 1>(q)));
+        twin_bus::virtual_servos(hw),
+        std::make_unique<twin_bus::TwinServoBackend<Full>>(*tc, hw, Eigen::Matrix<double, Full::nq, 1>(q)));
     if (raised) pthread_setschedparam(pthread_self(), policy, &saved);
     device = virt->device();
   }

@@ -12,7 +12,7 @@
 #include <symoro/hardware/config.hpp>
 #include <symoro/hardware/controller.hpp>
 #include <symoro/io/parameters_yaml.hpp>
-#include <symoro/hardware/twin_servo_backend.hpp>
+#include <symoro/twin_bus/twin_servo_backend.hpp>
 #include <symoro/io/log.hpp>
 #include <symoro/io/log_stream.hpp>
 #include <symoro/io/number_text.hpp>
@@ -44,6 +44,9 @@
 
 namespace symoro::hardware {
 namespace {
+
+using twin_bus::TwinServoBackend;
+using twin_bus::virtual_servos;
 
 using Model = crane_x7::Model;
 namespace xs = dynamixel::xseries;

@@ -23,7 +23,7 @@
 
 #include "symoro/identify/report.hpp"
 #include "symoro/identify/reproduction.hpp"
-#include "symoro/identify/svg_plot.hpp"
+#include "symoro/report/svg_plot.hpp"
 #include "svg_test_support.hpp"
 
 namespace symoro::test::report {

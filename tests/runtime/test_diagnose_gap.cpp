@@ -76,7 +76,7 @@ identify::StudyResult study(const std::filesystem::path& out) {
   identify::Study s(identify::identification_model<Model>(), o,
                            trajectory::TrajectoryDesign::read(kRobot + "/trajectories.yaml",
                                                               std::vector<JointInfo>(Model::joints.begin(), Model::joints.end())),
-                           identify::closed_loop_setup(twin::read_twin_config(kRobot + "/twin.yaml", Model::nq)));
+                           identify::closed_loop_setup(twin::read_twin_config(kRobot + "/twin.yaml", Model::nq).controller));
   identify::StudyResult r = s.run();
   r.truth = twin::identified_truth<Model>(hidden_effects());
   identify::write_validation(r, out);

@@ -91,7 +91,7 @@ Channels lowpassed(Channels x, double interval) {
 }
 
 TEST(ClosedLoopController, SensitivityFormMatchesFfpdControllerAndIsItsDerivative) {
-  const identify::ClosedLoopSetup setup = identify::closed_loop_setup(ideal_config());
+  const identify::ClosedLoopSetup setup = identify::closed_loop_setup(ideal_config().controller);
   control::FfpdController reference(setup.gains);
   identify::detail::FfpdSensitivity<n, 3> loop(setup.gains);
   identify::detail::FfpdSensitivity<n, 3> moved(setup.gains);

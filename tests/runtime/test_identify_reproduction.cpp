@@ -42,7 +42,7 @@ trajectory::TrajectoryDesign design() {
                                             std::vector<JointInfo>(Model::joints.begin(), Model::joints.end()));
 }
 identify::ClosedLoopSetup setup() {
-  return identify::closed_loop_setup(twin::read_twin_config(kRobot + "/twin.yaml", Model::nq));
+  return identify::closed_loop_setup(twin::read_twin_config(kRobot + "/twin.yaml", Model::nq).controller);
 }
 
 identify::StudyOptions options(const std::filesystem::path& data, const std::filesystem::path& out) {

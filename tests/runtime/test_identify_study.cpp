@@ -65,7 +65,7 @@ identify::StudyOptions options(const std::filesystem::path& out) {
 }
 
 identify::ClosedLoopSetup setup() {
-  return identify::closed_loop_setup(twin::read_twin_config(kRobot + "/twin.yaml", Model::nq));
+  return identify::closed_loop_setup(twin::read_twin_config(kRobot + "/twin.yaml", Model::nq).controller);
 }
 
 struct Fixture {

@@ -8,7 +8,7 @@
 #include <fmt/format.h>
 
 #include "symoro/diagnose/localize_report.hpp"
-#include "symoro/identify/svg_plot.hpp"
+#include "symoro/report/svg_plot.hpp"
 #include "symoro/io/atomic_file.hpp"
 
 namespace symoro::diagnose {

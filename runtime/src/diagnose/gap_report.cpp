@@ -10,7 +10,7 @@
 
 #include "symoro/diagnose/localize.hpp"
 #include "symoro/diagnose/localize_report.hpp"
-#include "symoro/identify/svg_plot.hpp"
+#include "symoro/report/svg_plot.hpp"
 #include "symoro/io/atomic_file.hpp"
 
 namespace symoro::diagnose {

@@ -6,7 +6,8 @@
 
 #include <fmt/format.h>
 
-#include "symoro/identify/svg_plot.hpp"
+#include "symoro/report/markdown_table.hpp"
+#include "symoro/report/svg_plot.hpp"
 #include "symoro/io/atomic_file.hpp"
 
 namespace symoro::diagnose {
@@ -29,41 +30,6 @@ std::string sig3(double v) {
 }
 
 std::string percent(double fraction) { return std::isfinite(fraction) ? fixed(100 * fraction, 0) + " %" : "n/a"; }
-
-// A Markdown table; cells are made table-safe ('|' escaped, no line breaks).
-class Table {
- public:
-  explicit Table(std::vector<std::string> header) : header_(std::move(header)) {}
-  void row(std::vector<std::string> cells) {
-    cells.resize(header_.size());
-    rows_.push_back(std::move(cells));
-  }
-  std::string str() const {
-    auto line = [](const std::vector<std::string>& cells) {
-      std::string s = "|";
-      for (const auto& c : cells) s += " " + cell(c) + " |";
-      return s + "\n";
-    };
-    std::string out = line(header_) + "|";
-    for (std::size_t i = 0; i < header_.size(); ++i) out += i == 0 ? ":---|" : "---:|";
-    out += "\n";
-    for (const auto& r : rows_) out += line(r);
-    return out + "\n";
-  }
-
- private:
-  static std::string cell(const std::string& text) {
-    std::string out;
-    for (char c : text) {
-      if (c == '|') out += "\\|";
-      else if (c == '\n' || c == '\r') out += ' ';
-      else out += c;
-    }
-    return out;
-  }
-  std::vector<std::string> header_;
-  std::vector<std::vector<std::string>> rows_;
-};
 
 std::string heading(int level, const std::string& text) {
   return std::string(static_cast<std::size_t>(std::clamp(level, 1, 6)), '#') + " " + text + "\n\n";
@@ -273,9 +239,9 @@ std::string localization_markdown(const Localization& loc, const std::vector<std
       "and its lag (+: r lags qd).\n\n",
       loc.samples, loc.series, fixed(loc.interval * 1000, 1));
 
-  Table main({"joint", "residual rms [N m]", "of torque rms", "SSE at reversals", "samples at reversals",
+  markdown::Table main({"joint", "residual rms [N m]", "of torque rms", "SSE at reversals", "samples at reversals",
               "direction step [N m]", "torque lag [ms]", "lag, friction removed [ms]", "peak [Hz]", "dominant band", "corr(r, qd)",
-              "r lag [ms]"});
+              "r lag [ms]"}, markdown::Align::first_left);
   for (const auto& jl : loc.joints) {
     const RegimeStat* rev = jl.regimes.empty() ? nullptr : &jl.regimes.front();
     std::string band = "n/a";
@@ -292,18 +258,18 @@ std::string localization_markdown(const Localization& loc, const std::vector<std
               fixed(jl.torque_lag * 1000, 2), fixed(jl.torque_lag_adjusted * 1000, 2), sig3(jl.peak_frequency), band, fixed(jl.velocity_correlation, 2),
               fixed(jl.velocity_lag * 1000, 1)});
   }
-  md += main.str();
+  md += main.str() + "\n";
   for (const auto& jl : loc.joints) md += "- " + jl.summary + "\n";
   md += "\n";
   for (const auto& link : figures) md += fmt::format("![{}]({})\n\n", caption(link), link);
 
   md += heading(heading_level + 1, "Residual by motion regime");
-  Table regimes({"joint", "regime", "samples", "mean [N m]", "rms [N m]", "rms / overall", "SSE share"});
+  markdown::Table regimes({"joint", "regime", "samples", "mean [N m]", "rms [N m]", "rms / overall", "SSE share"}, markdown::Align::first_left);
   for (const auto& jl : loc.joints)
     for (const auto& r : jl.regimes)
       regimes.row({jl.name, r.regime, fmt::format("{} ({})", r.samples, percent(r.fraction)), sig3(r.mean),
                    sig3(r.rms), fixed(r.rms_ratio, 2), percent(r.sse_share)});
-  md += regimes.str();
+  md += regimes.str() + "\n";
 
   md += heading(heading_level + 1, "Residual power by frequency band");
   if (loc.spectrum.frequency.size() == 0) {
@@ -316,7 +282,7 @@ std::string localization_markdown(const Localization& loc, const std::vector<std
   std::vector<std::string> header{"joint"};
   header.insert(header.end(), loc.bands.begin(), loc.bands.end());
   header.push_back("peak [Hz]");
-  Table bands(header);
+  markdown::Table bands(header, markdown::Align::first_left);
   for (const auto& jl : loc.joints) {
     std::vector<std::string> cells{jl.name};
     for (Index b = 0; b < jl.band_power_fraction.size(); ++b) cells.push_back(percent(jl.band_power_fraction(b)));
@@ -324,7 +290,7 @@ std::string localization_markdown(const Localization& loc, const std::vector<std
     cells.push_back(sig3(jl.peak_frequency));
     bands.row(cells);
   }
-  md += bands.str();
+  md += bands.str() + "\n";
   return md;
 }
 

@@ -6,7 +6,6 @@
 #include <fmt/format.h>
 
 #include "symoro/identify/closed_loop_model.hpp"
-#include "symoro/twin/simulator.hpp"
 
 namespace symoro::identify {
 
@@ -16,10 +15,6 @@ ClosedLoopSetup closed_loop_setup(const control::ControllerDescription& controll
   s.delay = controller.communication_delay;
   s.pre_roll = pre_roll;
   return s;
-}
-
-ClosedLoopSetup closed_loop_setup(const twin::TwinConfig& config, double pre_roll) {
-  return closed_loop_setup(config.controller, pre_roll);
 }
 
 std::string Divergence::describe() const {

@@ -11,7 +11,7 @@
 
 #include "report_tables.hpp"
 #include "symoro/identify/reproduction.hpp"
-#include "symoro/identify/svg_plot.hpp"
+#include "symoro/report/svg_plot.hpp"
 #include "symoro/io/atomic_file.hpp"
 #include "symoro/io/parameters_yaml.hpp"
 #include "symoro/io/number_text.hpp"

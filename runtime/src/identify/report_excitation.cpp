@@ -36,7 +36,7 @@ std::string excitation_section(const StudyResult& study) {
       if (r->kappa_scaled < best->kappa_scaled) best = r;
     }
     table.row({fam, std::to_string(runs.size()), sig(median(kappa), 4), sig(median(scaled), 4), fixed(median(log_det), 2),
-               best->trajectory, sig(best->kappa_scaled, 4), md_cell(best->weakest)});
+               best->trajectory, sig(best->kappa_scaled, 4), cell(best->weakest)});
   }
   return out + table.str() + "\n";
 }

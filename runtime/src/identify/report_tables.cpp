@@ -77,51 +77,6 @@ std::string yes_no(bool value) { return value ? "yes" : "no"; }
 
 long interval_ms(double interval) { return std::lround(interval * 1000); }
 
-std::string md_cell(std::string text) {
-  std::string out;
-  for (char c : text) {
-    if (c == '|') out += "\\|";
-    else if (c == '\n' || c == '\r') out += ' ';
-    else out += c;
-  }
-  return out;
-}
-
-MarkdownTable::MarkdownTable(std::vector<std::string> header) : header_(std::move(header)) {}
-
-void MarkdownTable::row(std::vector<std::string> cells) {
-  cells.resize(header_.size());
-  rows_.push_back(std::move(cells));
-}
-
-namespace {
-
-// A cell that reads as a number (or stands for a missing one): such columns align right.
-bool numeric_cell(const std::string& c) {
-  if (c.empty() || c == "--" || c == "n/a") return true;
-  std::size_t i = c[0] == '-' || c[0] == '+' ? 1 : 0;
-  return i < c.size() && (std::isdigit(static_cast<unsigned char>(c[i])) || c[i] == '.');
-}
-
-}  // namespace
-
-std::string MarkdownTable::str() const {
-  auto line = [](const std::vector<std::string>& cells) {
-    std::string s = "|";
-    for (const auto& c : cells) s += " " + md_cell(c) + " |";
-    return s + "\n";
-  };
-  std::string out = line(header_) + "|";
-  for (std::size_t i = 0; i < header_.size(); ++i) {
-    const bool numbers = i > 0 && std::all_of(rows_.begin(), rows_.end(),
-                                              [&](const auto& r) { return numeric_cell(r[i]); });
-    out += numbers ? "---:|" : ":---|";
-  }
-  out += "\n";
-  for (const auto& r : rows_) out += line(r);
-  return out;
-}
-
 // --- Views --------------------------------------------------------------------------------
 
 std::vector<double> intervals(const StudyResult& study) {

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "symoro/identify/report.hpp"
+#include "symoro/report/markdown_table.hpp"
 #include "symoro/identify/study_result.hpp"
 
 namespace symoro::identify::report_detail {
@@ -17,19 +18,9 @@ std::string sig(double value, int digits);      // significant digits, "n/a" whe
 std::string yes_no(bool value);
 long interval_ms(double interval);               // s -> whole ms
 double median(std::vector<double> v);            // NaN when empty
-std::string md_cell(std::string text);           // '|' and newlines made table-safe
+using markdown::cell;                            // '|' and newlines made table-safe (md_cell before)
 
-class MarkdownTable {
- public:
-  // Columns of numbers align right, the first column and text columns left.
-  explicit MarkdownTable(std::vector<std::string> header);
-  void row(std::vector<std::string> cells);
-  std::string str() const;
-
- private:
-  std::vector<std::string> header_;
-  std::vector<std::vector<std::string>> rows_;
-};
+using MarkdownTable = markdown::Table;  // numbers right, the first column and text left
 
 // --- Views of the study -------------------------------------------------------------------
 std::vector<double> intervals(const StudyResult& study);  // distinct, ascending

@@ -22,7 +22,6 @@
 #include "symoro/preprocess/channels.hpp"
 #include "symoro/trajectory/sampled_reference.hpp"
 #include "symoro/trajectory/trajectory.hpp"
-#include "symoro/twin/config.hpp"
 
 namespace symoro::identify {
 
@@ -45,8 +44,6 @@ struct ClosedLoopSetup {
 
 // The experiment's controller and timing, from the robot's controller description.
 ClosedLoopSetup closed_loop_setup(const control::ControllerDescription& controller, double pre_roll = 0.5);
-// The same from a twin configuration (whose controller is that description).
-ClosedLoopSetup closed_loop_setup(const twin::TwinConfig& config, double pre_roll = 0.5);
 
 // Why a simulation stopped early.
 struct Divergence {

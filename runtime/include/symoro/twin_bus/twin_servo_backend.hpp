@@ -31,13 +31,13 @@
 #include "symoro/twin/plant.hpp"
 #include "symoro/twin/truth.hpp"
 
-namespace symoro::hardware {
+namespace symoro::twin_bus {
 
 // The virtual servos of a hardware description (IDs, models), in joint order, with Return Delay
 // Time as configured and Operating Mode left at the factory value (the controller sets it).
-inline std::vector<dynamixel::VirtualServo> virtual_servos(const HardwareConfig& hw) {
+inline std::vector<dynamixel::VirtualServo> virtual_servos(const hardware::HardwareConfig& hw) {
   std::vector<dynamixel::VirtualServo> out;
-  for (const JointHardware& j : hw.joints) {
+  for (const hardware::JointHardware& j : hw.joints) {
     dynamixel::VirtualServo s;
     s.id = j.id;
     const dynamixel::xseries::Model* m = dynamixel::xseries::find_model(j.model.model_number);
@@ -56,7 +56,7 @@ class TwinServoBackend : public dynamixel::ServoBackend {
   using Vec = Eigen::Matrix<double, n, 1>;
 
   // q0: the arm's initial joint angles (at rest).
-  TwinServoBackend(const twin::TwinConfig& config, const HardwareConfig& hw, const Vec& q0)
+  TwinServoBackend(const twin::TwinConfig& config, const hardware::HardwareConfig& hw, const Vec& q0)
       : truth_(twin::make_truth<Model>(config)), plant_(truth_, config, q0) {
     if (static_cast<int>(hw.joints.size()) != n || static_cast<int>(config.servos.size()) != n)
       throw std::invalid_argument("TwinServoBackend: hardware.yaml and twin.yaml need one servo per joint");
@@ -109,4 +109,4 @@ class TwinServoBackend : public dynamixel::ServoBackend {
   std::uint64_t steps_ = 0;
 };
 
-}  // namespace symoro::hardware
+}  // namespace symoro::twin_bus

@@ -8,7 +8,7 @@
 #include <string>
 #include <vector>
 
-namespace symoro::identify::svg {
+namespace symoro::svg {
 
 // Axis ticks: a round step (1, 2 or 5 times a power of ten) and every multiple of it from the
 // largest one <= lo to the smallest one >= hi, so the ticks always cover [lo, hi].
@@ -84,4 +84,4 @@ std::string render(const Figure& figure);
 // Text safe inside an SVG/XML element or attribute.
 std::string xml_escape(const std::string& text);
 
-}  // namespace symoro::identify::svg
+}  // namespace symoro::svg

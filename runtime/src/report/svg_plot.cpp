@@ -1,4 +1,4 @@
-#include "symoro/identify/svg_plot.hpp"
+#include "symoro/report/svg_plot.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -7,7 +7,7 @@
 
 #include <fmt/format.h>
 
-namespace symoro::identify::svg {
+namespace symoro::svg {
 
 namespace {
 
@@ -416,4 +416,4 @@ std::string render(const Figure& figure) {
   return out;
 }
 
-}  // namespace symoro::identify::svg
+}  // namespace symoro::svg
