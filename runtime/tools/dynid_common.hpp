@@ -30,6 +30,13 @@ struct Common {
   }
 };
 
+// --robot (required) and --robots-dir, declared once for every command that reads a robot folder.
+template <class App>
+void add_robot_options(App* cmd, Common& common, const std::string& robot_help = "Robot folder name under robots/") {
+  cmd->add_option("--robot", common.robot, robot_help)->required();
+  cmd->add_option("--robots-dir", common.robots_dir, "Where the robot folders are");
+}
+
 // An error in the command's use (unknown robot, missing file): printed without a stack.
 struct UsageError : std::runtime_error {
   using std::runtime_error::runtime_error;

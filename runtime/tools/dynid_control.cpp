@@ -12,8 +12,7 @@ void add_control_commands(CLI::App& app, Common& common) {
   auto o = std::make_shared<ControlCliOptions>();
   auto* cmd = app.add_subcommand("control", "Run a trajectory on the arm (DYNAMIXEL bus, FF+PD at 1 kHz) and log it; "
                                             "--virtual: on the emulated bus driving the digital twin");
-  cmd->add_option("--robot", common.robot, "Robot folder name under robots/")->required();
-  cmd->add_option("--robots-dir", common.robots_dir, "Where the robot folders are");
+  add_robot_options(cmd, common);
   cmd->add_option("--design", common.design, "A trajectory design file (e.g. dynid excite's) instead of robots/<robot>/trajectories.yaml")
       ->check(CLI::ExistingFile);
   cmd->add_option("--port", o->port, "Serial device of the DYNAMIXEL bus (default /dev/ttyUSB0)");

@@ -16,8 +16,7 @@ void add_diagnose_commands(CLI::App& app, Common& common) {
   auto o = std::make_shared<DiagnoseOptions>();
   auto* cmd = app.add_subcommand("diagnose", "Model-gap diagnosis: which effects the identified model misses, how large, "
                                              "where the residual is; before/after report");
-  cmd->add_option("--robot", common.robot, "Robot folder name under robots/")->required();
-  cmd->add_option("--robots-dir", common.robots_dir, "Where the robot folders are");
+  add_robot_options(cmd, common);
   cmd->add_option("--data", o->data, "Dataset folder (dataset.yaml and logs)")->required()->check(CLI::ExistingDirectory);
   cmd->add_option("-o,--out", o->out, "Report folder")->required();
   cmd->add_option("--train", o->train, "Runs the effects are fitted on (default: the dataset's runs of families other "

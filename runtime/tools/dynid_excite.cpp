@@ -289,8 +289,7 @@ void add_excite_commands(CLI::App& app, Common& common) {
   auto o = std::make_shared<ExciteOptions>();
   auto* cmd = app.add_subcommand("excite", "Identification trajectories for any robot: the structured families and optimized "
                                            "Fourier series, in one design file, with their excitation quality");
-  cmd->add_option("--robot", common.robot, "Robot folder name under robots/")->required();
-  cmd->add_option("--robots-dir", common.robots_dir, "Where the robot folders are");
+  add_robot_options(cmd, common);
   cmd->add_option("-o,--output", o->out, "Write trajectories.yaml and quality.txt here")->required();
   cmd->add_option("--model", o->model, "The model whose base parameters are excited (default: robot.yaml's identified)");
   cmd->add_option("--from-design", o->from_design, "Take the structured families from this design file (e.g. the robot's "

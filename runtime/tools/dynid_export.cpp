@@ -43,8 +43,7 @@ void add_export_commands(CLI::App& app, Common& common) {
       "export",
       "A study's accepted base parameters as a URDF with physically consistent inertials (one link per modified-DH "
       "frame of the model), joint damping/friction from FV/FS, and the standard parameters as YAML and CSV");
-  cmd->add_option("--robot", common.robot, "Robot folder name under robots/")->required();
-  cmd->add_option("--robots-dir", common.robots_dir, "Where the robot folders are");
+  add_robot_options(cmd, common);
   cmd->add_option("--study", o->study, "Study folder of dynid identify (reads report/parameters.yaml)")
       ->required()
       ->check(CLI::ExistingDirectory);

@@ -181,8 +181,7 @@ void add_identify_commands(CLI::App& app, Common& common) {
   auto o = std::make_shared<IdentifyOptions>();
   auto* cmd = app.add_subcommand("identify", "Identification study on a dataset: OLS, PD audit, SDP, CLIE, PCA "
                                              "selection, rescue, validation, report");
-  cmd->add_option("--robot", common.robot, "Robot folder name under robots/")->required();
-  cmd->add_option("--robots-dir", common.robots_dir, "Where the robot folders are");
+  add_robot_options(cmd, common);
   cmd->add_option("--design", common.design, "A trajectory design file (e.g. dynid excite's) instead of robots/<robot>/trajectories.yaml")
       ->check(CLI::ExistingFile);
   cmd->add_option("--data", o->data, "Dataset folder (dataset.yaml and logs)")->required()->check(CLI::ExistingDirectory);

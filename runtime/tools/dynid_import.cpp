@@ -33,8 +33,7 @@ void add_import_commands(CLI::App& app, Common& common) {
       "kept and counted; a repeated stamp with the same values is dropped; without --qd the velocity is\n"
       "differentiated from q and the log says so.");
   cmd->add_option("inputs", o->inputs, "Exported files, one run each")->required()->check(CLI::ExistingFile);
-  cmd->add_option("--robot", common.robot, "Robot folder name under robots/ (its joints set n)")->required();
-  cmd->add_option("--robots-dir", common.robots_dir, "Where the robot folders are");
+  add_robot_options(cmd, common, "Robot folder name under robots/ (its joints set n)");
   cmd->add_option("-o,--out", o->out, "Dataset folder to create (existing files are never replaced)")->required();
   cmd->add_option("--mapping", o->mapping, "Mapping file (YAML); the options below override it")->check(CLI::ExistingFile);
   cmd->add_option("--time", o->time, std::string("Time column: ") + selector_help);

@@ -171,8 +171,7 @@ void add_predict_commands(CLI::App& app, Common& common) {
   auto o = std::make_shared<PredictOptions>();
   auto* cmd = app.add_subcommand("predict", "A model's inverse-dynamics torque on a log's measured motion (or every run of "
                                             "a dataset), beside the measured torque, with the RMSE per joint");
-  cmd->add_option("--robot", common.robot, "Robot folder name under robots/")->required();
-  cmd->add_option("--robots-dir", common.robots_dir, "Where the robot folders are");
+  add_robot_options(cmd, common);
   cmd->add_option("--params", o->params, "A study's report/parameters.yaml, or `nominal` (robot.yaml's nominal "
                                          "standard parameters, e.g. a URDF's)")
       ->capture_default_str();

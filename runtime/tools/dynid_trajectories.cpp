@@ -52,8 +52,7 @@ std::string trajectory_quality_table(const Common& common, const std::vector<tra
 void add_trajectory_commands(CLI::App& app, Common& common) {
   auto o = std::make_shared<TrajectoryOptions>();
   auto* cmd = app.add_subcommand("trajectories", "List the identification trajectories, or write them as reference files");
-  cmd->add_option("--robot", common.robot, "Robot folder name under robots/")->required();
-  cmd->add_option("--robots-dir", common.robots_dir, "Where the robot folders are");
+  add_robot_options(cmd, common);
   cmd->add_option("--design", common.design, "A trajectory design file (e.g. dynid excite's) instead of robots/<robot>/trajectories.yaml")
       ->check(CLI::ExistingFile);
   cmd->add_option("-o,--output", o->out, "Write <name>.csv and <name>.meta.yaml here (default: list only)");

@@ -10,8 +10,7 @@ namespace symoro::dynid {
 namespace {
 
 void add_config_options(CLI::App* cmd, Common& common, TwinOptions& o) {
-  cmd->add_option("--robot", common.robot, "Robot folder name under robots/")->required();
-  cmd->add_option("--robots-dir", common.robots_dir, "Where the robot folders are");
+  add_robot_options(cmd, common);
   cmd->add_option("--design", common.design, "A trajectory design file (e.g. dynid excite's) instead of robots/<robot>/trajectories.yaml")
       ->check(CLI::ExistingFile);
   cmd->add_option("--config", o.config, "A YAML file overriding parts of robots/<robot>/twin.yaml")->check(CLI::ExistingFile);
