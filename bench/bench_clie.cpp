@@ -14,8 +14,8 @@
 #include <symoro/crane_x7.hpp>
 
 #include "symoro/identify/clie.hpp"
-#include "symoro/identify/clie_model.hpp"
-#include "symoro/identify/closed_loop_model.hpp"
+#include "symoro/identify/detail/clie_model.hpp"
+#include "symoro/identify/detail/closed_loop_model.hpp"
 #include "symoro/preprocess/preprocess.hpp"
 #include "symoro/trajectory/design.hpp"
 #include "symoro/twin/simulator.hpp"

@@ -17,7 +17,7 @@
 #include "dynid_export.hpp"
 #include "dynid_urdf_into.hpp"
 #include "symoro/identify/dataset.hpp"
-#include "symoro/identify/physical_consistency_model.hpp"
+#include "symoro/identify/detail/physical_consistency_model.hpp"
 #include "symoro/identify/regression.hpp"
 #include "symoro/io/atomic_file.hpp"
 #include "symoro/preprocess/preprocess.hpp"

@@ -12,7 +12,7 @@
 #include <gtest/gtest.h>
 
 #include "symoro/identify/physical_consistency.hpp"
-#include "symoro/identify/physical_consistency_model.hpp"
+#include "symoro/identify/detail/physical_consistency_model.hpp"
 #include "test_support.hpp"
 
 namespace symoro::test {

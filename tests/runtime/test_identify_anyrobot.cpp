@@ -24,7 +24,7 @@
 #include "symoro/control/ffpd.hpp"
 #include "symoro/identify/report.hpp"
 #include "symoro/error.hpp"
-#include "symoro/identify/closed_loop_model.hpp"
+#include "symoro/identify/detail/closed_loop_model.hpp"
 #include "symoro/identify/dataset.hpp"
 #include "symoro/identify/validation.hpp"
 #include "symoro/identify/least_squares.hpp"

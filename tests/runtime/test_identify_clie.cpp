@@ -19,9 +19,9 @@
 
 #include "symoro/control/ffpd.hpp"
 #include "symoro/identify/clie.hpp"
-#include "symoro/identify/clie_model.hpp"
+#include "symoro/identify/detail/clie_model.hpp"
 #include "symoro/identify/closed_loop.hpp"
-#include "symoro/identify/closed_loop_model.hpp"  // detail::FfpdSensitivity only
+#include "symoro/identify/detail/closed_loop_model.hpp"  // detail::FfpdSensitivity only
 #include "symoro/identify/identification_model.hpp"
 #include "symoro/preprocess/butterworth.hpp"
 #include "symoro/preprocess/preprocess.hpp"

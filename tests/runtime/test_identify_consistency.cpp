@@ -13,7 +13,7 @@
 #include <symoro/stanford_rrp.hpp>
 
 #include "symoro/identify/physical_consistency.hpp"
-#include "symoro/identify/physical_consistency_model.hpp"
+#include "symoro/identify/detail/physical_consistency_model.hpp"
 #include "symoro/twin/config.hpp"
 #include "symoro/twin/truth.hpp"
 #include "consistency_test_support.hpp"

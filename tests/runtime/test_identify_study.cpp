@@ -15,7 +15,7 @@
 
 #include <symoro/crane_x7.hpp>
 
-#include "symoro/identify/closed_loop_model.hpp"
+#include "symoro/identify/detail/closed_loop_model.hpp"
 #include "symoro/identify/dataset.hpp"
 #include "symoro/identify/validation.hpp"
 #include "symoro/identify/study.hpp"

@@ -18,7 +18,7 @@
 #include <symoro/rx90.hpp>
 #include <symoro/stanford_rrp.hpp>
 
-#include "symoro/identify/physical_consistency_model.hpp"
+#include "symoro/identify/detail/physical_consistency_model.hpp"
 #include "symoro/identify/urdf_export.hpp"
 #include "symoro/io/parameters_yaml.hpp"
 #include "symoro/mdh.hpp"

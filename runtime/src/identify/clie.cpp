@@ -16,7 +16,7 @@
 #include <ceres/solver.h>
 #include <fmt/format.h>
 
-#include "symoro/identify/clie_model.hpp"
+#include "symoro/identify/detail/clie_model.hpp"
 #include "symoro/preprocess/zero_phase.hpp"
 
 namespace symoro::identify::detail {

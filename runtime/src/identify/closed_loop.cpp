@@ -5,7 +5,7 @@
 
 #include <fmt/format.h>
 
-#include "symoro/identify/closed_loop_model.hpp"
+#include "symoro/identify/detail/closed_loop_model.hpp"
 
 namespace symoro::identify {
 

@@ -26,7 +26,7 @@
 #include "symoro/identify/physical_projection.hpp"
 #include "symoro/identify/run_record_io.hpp"
 #include "symoro/identify/sdp_projection.hpp"
-#include "symoro/identify/study_run.hpp"
+#include "symoro/identify/detail/study_run.hpp"
 #include "symoro/identify/validation.hpp"
 #include "symoro/io/digest.hpp"
 #include "symoro/io/log.hpp"

@@ -1,5 +1,5 @@
 // One run of the study (study_run.hpp), for any model through its IdentificationModel.
-#include "symoro/identify/study_run.hpp"
+#include "symoro/identify/detail/study_run.hpp"
 
 #include <algorithm>
 #include <limits>

@@ -11,9 +11,9 @@
 #include <tuple>
 #include <vector>
 
-#include "symoro/identify/closed_loop_model.hpp"
+#include "symoro/identify/detail/closed_loop_model.hpp"
 #include "symoro/identify/identification_model.hpp"
-#include "symoro/identify/inertia_function_model.hpp"
+#include "symoro/identify/detail/inertia_function_model.hpp"
 #include "symoro/identify/physical_projection.hpp"
 #include "symoro/identify/regression.hpp"
 #include "symoro/identify/validation.hpp"

@@ -21,7 +21,7 @@
 #include <Eigen/Core>
 #include <fmt/format.h>
 
-#include "symoro/identify/physical_consistency_model.hpp"
+#include "symoro/identify/detail/physical_consistency_model.hpp"
 
 namespace symoro::identify {
 

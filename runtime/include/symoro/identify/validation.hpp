@@ -15,7 +15,7 @@
 #include <Eigen/Core>
 
 #include "symoro/identify/clie.hpp"
-#include "symoro/identify/closed_loop_model.hpp"
+#include "symoro/identify/detail/closed_loop_model.hpp"
 #include "symoro/identify/study_result.hpp"
 
 namespace symoro::identify {

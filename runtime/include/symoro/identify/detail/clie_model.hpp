@@ -13,7 +13,7 @@
 #include <ceres/cost_function.h>
 
 #include "symoro/identify/clie.hpp"
-#include "symoro/identify/closed_loop_model.hpp"
+#include "symoro/identify/detail/closed_loop_model.hpp"
 #include "symoro/preprocess/butterworth.hpp"
 #include "symoro/preprocess/channels.hpp"
 
