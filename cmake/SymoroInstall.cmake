@@ -1,8 +1,10 @@
 # Installs symoro as a CMake package: find_package(symoro) gives symoro::core and one
 # symoro::<robot> target per generated robot (header-only over Eigen), and the runtime's stages
 # as static libraries: symoro::io (logs, import), symoro::trajectory, symoro::preprocess,
-# symoro::control, symoro::parallel (the task farm, MPI or threads), symoro::twin, symoro::identify (OLS, audit, SDP, CLIE, the study),
-# symoro::diagnose, symoro::dynamixel, symoro::hardware, and symoro::runtime (all of them).
+# symoro::control, symoro::parallel (the task farm, MPI or threads), symoro::twin, symoro::report
+# (SVG figures, Markdown tables), symoro::identify (OLS, audit, SDP, CLIE, the study),
+# symoro::diagnose, symoro::dynamixel, symoro::hardware, symoro::twin_bus (the twin behind the
+# virtual bus), and symoro::runtime (all of them). docs/architecture.md draws them.
 include(CMakePackageConfigHelpers)
 
 install(TARGETS symoro_core EXPORT symoroTargets)
