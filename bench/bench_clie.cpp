@@ -34,12 +34,12 @@ struct Fixture {
                                                  std::vector<symoro::JointInfo>(Full::joints.begin(), Full::joints.end()))
           .build("AG02");
   Eigen::VectorXd truth = Reduced::from_parent(symoro::twin::make_truth<Full>(config).phi);
-  identify::ClosedLoopSimulator<Reduced> sim{identify::closed_loop_setup(config), trajectory};
+  identify::ClosedLoopSimulator<Reduced> sim{identify::closed_loop_setup(config.controller), trajectory};
   // The exact derivatives of the discrete map (ClosedLoopSetup::exact_sensitivities).
   identify::ClosedLoopSimulator<Reduced> sim_exact{exact_setup(config), trajectory};
 
   static identify::ClosedLoopSetup exact_setup(const symoro::twin::TwinConfig& c) {
-    identify::ClosedLoopSetup s = identify::closed_loop_setup(c);
+    identify::ClosedLoopSetup s = identify::closed_loop_setup(c.controller);
     s.exact_sensitivities = true;
     return s;
   }

@@ -129,7 +129,7 @@ TEST(ClosedLoopController, SensitivityFormMatchesFfpdControllerAndIsItsDerivativ
 
 // The recorded torque is FfpdController's output one cycle earlier, fed the simulated q.
 TEST(ClosedLoopSimulator, RecordedTorqueIsFfpdControllerOnTheSampledQ) {
-  identify::ClosedLoopSetup setup = identify::closed_loop_setup(ideal_config(), 0.0);
+  identify::ClosedLoopSetup setup = identify::closed_loop_setup(ideal_config().controller, 0.0);
   const auto sim = closed_loop<Reduced>(setup);
   Channels tau, q;
   ASSERT_TRUE(sim->simulate(reduced_truth(), tau, nullptr, nullptr, &q));
@@ -182,7 +182,7 @@ double check_sensitivities(const identify::ClosedLoopSetup& setup, double tolera
 }
 
 identify::ClosedLoopSetup exact_setup() {
-  identify::ClosedLoopSetup setup = identify::closed_loop_setup(ideal_config());
+  identify::ClosedLoopSetup setup = identify::closed_loop_setup(ideal_config().controller);
   setup.exact_sensitivities = true;
   return setup;
 }
@@ -201,7 +201,7 @@ TEST(ClosedLoopSimulator, ExactSensitivitiesMatchCentralDifferencesWithStepsSpli
 // simulation's bit for bit. Measured: d tau 6e-5 of each parameter's largest entry off the exact
 // path, 1.5e-5 off central differences (the exact path 6e-7).
 TEST(ClosedLoopSimulator, MidpointSensitivitiesAreCloseToTheExactOnes) {
-  const identify::ClosedLoopSetup fast = identify::closed_loop_setup(ideal_config());
+  const identify::ClosedLoopSetup fast = identify::closed_loop_setup(ideal_config().controller);
   ASSERT_FALSE(fast.exact_sensitivities);
   const double worst = check_sensitivities(fast, 1e-4);
   const auto sim = closed_loop<Reduced>(fast);
@@ -249,7 +249,7 @@ TEST(ClosedLoopSimulator, ReproducesTheIdealTwin) {
   const io::Log unquantized = twin::ClosedLoopTwin<Full>(fine).run(traj, {});
   const Eigen::VectorXd phi = twin::make_truth<Full>(config).phi;
 
-  const identify::ClosedLoopSetup setup = identify::closed_loop_setup(config);
+  const identify::ClosedLoopSetup setup = identify::closed_loop_setup(config.controller);
   const auto sim_ptr = closed_loop<Full>(setup, traj);
   const identify::ClosedLoop& sim = *sim_ptr;
   Channels tau;
@@ -283,7 +283,7 @@ TEST(ClosedLoopSimulator, ReproducesTheIdealTwin) {
 }
 
 TEST(ClosedLoopSimulator, DivergenceIsReportedNotThrown) {
-  const identify::ClosedLoopSetup setup = identify::closed_loop_setup(ideal_config());
+  const identify::ClosedLoopSetup setup = identify::closed_loop_setup(ideal_config().controller);
   const auto sim_ptr = closed_loop<Reduced>(setup, short_trajectory());
   const identify::ClosedLoop& sim = *sim_ptr;
   Eigen::VectorXd phi = reduced_truth();
@@ -310,7 +310,7 @@ TEST(ClosedLoopSimulator, DivergenceIsReportedNotThrown) {
 // Data CLIE's own simulation made at a known phi (plus noise), preprocessed as a log would be:
 // from phi perturbed by 25 %, CLIE returns to phi wherever the data determine it.
 TEST(Clie, RecoversKnownParametersFromSimulatedData) {
-  const identify::ClosedLoopSetup setup = identify::closed_loop_setup(ideal_config());
+  const identify::ClosedLoopSetup setup = identify::closed_loop_setup(ideal_config().controller);
   const trajectory::Trajectory& traj = short_trajectory();
   const auto sim_ptr = closed_loop<Reduced>(setup, traj);
   const identify::ClosedLoop& sim = *sim_ptr;
@@ -383,7 +383,7 @@ TEST(Clie, RecoversKnownParametersFromSimulatedData) {
 
 // A start whose M is indefinite: no solve, a clear report, no exception.
 TEST(Clie, DivergentStartIsReportedWithoutSolving) {
-  const identify::ClosedLoopSetup setup = identify::closed_loop_setup(ideal_config());
+  const identify::ClosedLoopSetup setup = identify::closed_loop_setup(ideal_config().controller);
   const auto sim_ptr = closed_loop<Reduced>(setup, short_trajectory());
   const identify::ClosedLoop& sim = *sim_ptr;
   Eigen::VectorXd truth = reduced_truth();

@@ -5,6 +5,7 @@
 namespace {
 
 using namespace symoro::identify;
+namespace svg = symoro::svg;
 using namespace symoro::test::report;
 namespace fs = std::filesystem;
 

@@ -55,7 +55,6 @@ Diagnosis diagnose(const DesignStack& train, const DesignStack& heldout, const D
 namespace {
 
 std::string rmse_figure(const Diagnosis& d, const std::vector<std::string>& joints) {
-  namespace svg = identify::svg;
   svg::Figure f;
   f.title = "Held-out torque residual per joint (rms), before and after the selected effects";
   svg::Panel p;

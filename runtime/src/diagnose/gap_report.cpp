@@ -17,7 +17,6 @@ namespace symoro::diagnose {
 
 namespace {
 
-namespace svg = identify::svg;
 using identify::StudyValidation;
 using identify::ValidationRecord;
 

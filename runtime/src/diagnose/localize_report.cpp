@@ -14,7 +14,6 @@ namespace symoro::diagnose {
 
 namespace {
 
-namespace svg = identify::svg;
 using Index = Eigen::Index;
 constexpr double nan = std::numeric_limits<double>::quiet_NaN();
 
