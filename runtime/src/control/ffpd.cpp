@@ -40,9 +40,14 @@ const Eigen::VectorXd& FfpdController::update(const Eigen::VectorXd& q, const Ei
                                               const Eigen::VectorXd& qd_ref, const Eigen::VectorXd& qdd_ref) {
   qd_hat_ = a_ * qd_hat_ + b_ * (q - q_prev_);
   q_prev_ = q;
-  u_ = g_.inertia.cwiseProduct(g_.kv.cwiseProduct(qd_ref - qd_hat_) + g_.kp.cwiseProduct(q_ref - q) + qdd_ref) +
-       g_.damping.cwiseProduct(qd_ref);
+  u_ = ffpd_command(g_, q, qd_hat_, q_ref, qd_ref, qdd_ref);
   return u_;
+}
+
+Eigen::VectorXd ffpd_command(const FfpdGains& g, const Eigen::VectorXd& q, const Eigen::VectorXd& qd_hat,
+                             const Eigen::VectorXd& q_ref, const Eigen::VectorXd& qd_ref, const Eigen::VectorXd& qdd_ref) {
+  return g.inertia.cwiseProduct(g.kv.cwiseProduct(qd_ref - qd_hat) + g.kp.cwiseProduct(q_ref - q) + qdd_ref) +
+         g.damping.cwiseProduct(qd_ref);
 }
 
 }  // namespace symoro::control

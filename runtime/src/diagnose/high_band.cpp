@@ -5,6 +5,7 @@
 #include <random>
 #include <vector>
 
+#include "symoro/control/ffpd.hpp"
 #include "symoro/error.hpp"
 #include "symoro/preprocess/butterworth.hpp"
 #include "symoro/preprocess/preprocess.hpp"
@@ -55,29 +56,30 @@ LoopFloor loop_floor(const io::Log& log, const twin::TwinConfig& c, const Backla
   const double T = c.controller.period;
   // The law's torque at every row, as the servo realizes it (quantized current, its limit).
   Eigen::MatrixXd command(rows, n);
-  for (Eigen::Index k = 0; k < rows; ++k)
+  for (Eigen::Index k = 0; k < rows; ++k) {
+    const Eigen::VectorXd u = control::ffpd_command(g, log.q.row(k).transpose(), log.qd.row(k).transpose(), log.q_ref.row(k).transpose(),
+                                                    log.qd_ref.row(k).transpose(), log.qdd_ref.row(k).transpose());
     for (Eigen::Index j = 0; j < n; ++j) {
       const auto& s = c.servos[static_cast<std::size_t>(j)];
-      const double u = g.inertia(j) * (g.kv(j) * (log.qd_ref(k, j) - log.qd(k, j)) + g.kp(j) * (log.q_ref(k, j) - log.q(k, j)) +
-                                       log.qdd_ref(k, j)) +
-                       g.damping(j) * log.qd_ref(k, j);
       const double limit = std::floor(s.current_limit / s.current_unit) * s.current_unit;
-      command(k, j) = s.torque_constant * std::clamp(std::round(u / s.torque_constant / s.current_unit) * s.current_unit, -limit, limit);
+      command(k, j) = s.torque_constant * std::clamp(std::round(u(j) / s.torque_constant / s.current_unit) * s.current_unit, -limit, limit);
     }
+  }
+  // The residual at one lag (rows without a command that lag before: 0).
+  auto residual_at = [&](int lag) {
+    Eigen::MatrixXd r = Eigen::MatrixXd::Zero(rows, n);
+    for (Eigen::Index k = 0; k + lag < rows; ++k)
+      if (consecutive(log, k, lag, T)) r.row(k + lag) = log.tau.row(k + lag) - command.row(k);
+    return r;
+  };
   LoopFloor f;
   double best = -1;
-  io::Log residual;
   for (int lag = 0; lag <= 2; ++lag) {
-    io::Log r = log;
-    r.tau.setZero();
-    double sum = 0;
-    for (Eigen::Index k = 0; k + lag < rows; ++k) {
-      if (!consecutive(log, k, lag, T)) continue;
-      r.tau.row(k + lag) = log.tau.row(k + lag) - command.row(k);
-      sum += r.tau.row(k + lag).squaredNorm();
-    }
-    if (best < 0 || sum < best) best = sum, f.lag = lag, residual = std::move(r);
+    const double sum = residual_at(lag).squaredNorm();
+    if (best < 0 || sum < best) best = sum, f.lag = lag;
   }
+  io::Log residual = log;
+  residual.tau = residual_at(f.lag);
   f.law_rms = (residual.tau.colwise().squaredNorm() / std::max<double>(1.0, static_cast<double>(rows))).cwiseSqrt().transpose();
   f.rms = high_band_rms(residual, o);
   // Encoder noise: the position's second difference in counts on 50 ms blocks, its median over

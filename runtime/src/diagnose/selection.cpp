@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <set>
 
 #include <Eigen/Cholesky>
@@ -190,6 +191,7 @@ void backward_check(const DesignStack& train, const DesignStack& heldout, const 
     std::vector<Eigen::MatrixXd> covs;
     const Fit full = fit_with_effects(train, heldout, chosen, weights, &sds, &covs);
     int worst = -1;
+    double worst_weakness = 0;
     DroppedEffect drop;
     for (std::size_t i = 0; i < chosen.size(); ++i) {
       const Candidate& c = chosen[i];
@@ -203,13 +205,18 @@ void backward_check(const DesignStack& train, const DesignStack& heldout, const 
       const boost::math::chi_squared_distribution<double> chi2(static_cast<double>(m));
       const double bound = boost::math::quantile(chi2, 0.95) / std::pow(1 - o.smallest_fraction, 2);
       const double size = wald / bound;
-      std::vector<int> on;
-      if (effect_info(c.kind).per_joint) on.push_back(c.joint);
-      std::vector<Candidate> others = chosen;
-      others.erase(others.begin() + static_cast<std::ptrdiff_t>(i));
-      const Fit without = fit_with_effects(train, heldout, others, weights);
-      const double s0 = heldout_sse(without, weights, on, heldout.samples()), s1 = heldout_sse(full, weights, on, heldout.samples());
-      const double gain = s0 > 0 ? 1 - s1 / s0 : 0;
+      // What dropping it costs its joints held out (a refit without it): not needed for an effect
+      // its own region already fails (the weakest by size).
+      auto heldout_gain = [&] {
+        std::vector<int> on;
+        if (effect_info(c.kind).per_joint) on.push_back(c.joint);
+        std::vector<Candidate> others = chosen;
+        others.erase(others.begin() + static_cast<std::ptrdiff_t>(i));
+        const Fit without = fit_with_effects(train, heldout, others, weights);
+        const double s0 = heldout_sse(without, weights, on, heldout.samples()), s1 = heldout_sse(full, weights, on, heldout.samples());
+        return s0 > 0 ? 1 - s1 / s0 : 0.0;
+      };
+      const double gain = size < 1 ? std::numeric_limits<double>::quiet_NaN() : heldout_gain();
       std::string reason;
       if (!physical(c, theta))
         reason = "refitted with the others, its parameters contradict its physics";
@@ -227,9 +234,9 @@ void backward_check(const DesignStack& train, const DesignStack& heldout, const 
       if (reason.empty()) continue;
       // The weakest: the smallest size, held-out gain breaking ties among determined ones.
       const double weakness = size < 1 ? size : 1 + std::max(0.0, gain);
-      const double worst_weakness = worst < 0 ? 1e300 : (drop.size < 1 ? drop.size : 1 + std::max(0.0, drop.heldout_gain));
-      if (weakness < worst_weakness) {
+      if (worst < 0 || weakness < worst_weakness) {
         worst = static_cast<int>(i);
+        worst_weakness = weakness;
         drop.candidate = c;
         drop.magnitude = magnitude(c, theta, sds[i]).text;
         drop.size = size;

@@ -25,7 +25,11 @@ std::string raw_torque_filter_text(const RawTorqueOptions& options) {
 
 RawTorqueScore raw_torque_error(const io::Log& log, const OpenLoopTorque& model, const Eigen::VectorXd& phi,
                                 const RawTorqueOptions& options) {
-  const preprocess::Samples s = raw_torque_samples(log, options);
+  return raw_torque_error(raw_torque_samples(log, options), model, phi, options);
+}
+
+RawTorqueScore raw_torque_error(const preprocess::Samples& s, const OpenLoopTorque& model, const Eigen::VectorXd& phi,
+                                const RawTorqueOptions& options) {
   RawTorqueScore r;
   r.error = torque_error(s.tau, model(s, phi));
   r.samples = static_cast<int>(s.tau.rows());

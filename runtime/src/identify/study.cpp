@@ -247,7 +247,7 @@ class StudyRun {
           "physical consistency (per-link pseudo-inertia LMIs, IA, FV, FS >= 0): every run's OLS and final vectors "
           "checked; {}the rescue onto the base vectors with a consistent standard set in the metric of the torque "
           "predicted on {} (clearance {:g} of each link's size), leaning along what that metric barely sees towards "
-          "{} (weight {:g}); acceptance needs a consistent set and the final audit",
+          "{} (weight {}); acceptance needs a consistent set and the final audit",
           o_.physical_start ? fmt::format("CLIE's start projected onto that set (clearance {:g}) instead of the PD "
                                           "projection; ", o_.physical_clearance)
                             : "CLIE's start the paper's (conditional PD projection); ",
@@ -256,7 +256,8 @@ class StudyRun {
           o_.physical_rescue_clearance,
           o_.rescue_prior.size() > 0 ? o_.rescue_prior_source : std::string("zero inertia (no prior: the links shrink towards line-like "
                                                                          "mass distributions; give --rescue-prior)"),
-          o_.rescue_prior_weight));
+          o_.rescue_prior_weights.empty() ? fmt::format("{:g}", o_.rescue_prior_weight)
+                                        : "chosen by held-out error, below"));
     if (o_.consistency == Consistency::pd || !o_.physical_start)
       out.stages.push_back(fmt::format("SDP projection{} in the {} metric{}", o_.consistency == Consistency::pd ? " and rescue" : "",
                                        to_string(o_.projection_metric),
@@ -450,15 +451,15 @@ class StudyRun {
         const preprocess::Samples s = preprocess::preprocess(log, h, o_.preprocess);
         std::string why;
         const auto sim = closed_loop(name, log, why);
-        out.validation.push_back(validate_trajectory(
-            sim.get(), [this](const preprocess::Samples& m, const Eigen::VectorXd& phi) { return model_.open_loop_torque(m, phi); },
-            s, sel.phi_clie, out.phi_rescue, co, why));
-        out.validation.back().trajectory = name;
-        // The same vectors against the raw torque, at the log's own rate.
         const OpenLoopTorque open = [this](const preprocess::Samples& m, const Eigen::VectorXd& phi) {
           return model_.open_loop_torque(m, phi);
         };
-        const RawTorqueScore raw_clie = raw_torque_error(log, open, sel.phi_clie), raw = raw_torque_error(log, open, out.phi_rescue);
+        out.validation.push_back(validate_trajectory(sim.get(), open, s, sel.phi_clie, out.phi_rescue, co, why));
+        out.validation.back().trajectory = name;
+        // The same vectors against the raw torque, at the log's own rate (the log preprocessed once).
+        const preprocess::Samples raw_samples = raw_torque_samples(log);
+        const RawTorqueScore raw_clie = raw_torque_error(raw_samples, open, sel.phi_clie),
+                             raw = raw_torque_error(raw_samples, open, out.phi_rescue);
         ValidationRecord& v = out.validation.back();
         v.raw_rmse_clie = raw_clie.error.rmse;
         v.raw_rmse_rescue = raw.error.rmse;

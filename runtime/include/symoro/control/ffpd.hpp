@@ -22,6 +22,11 @@ struct FfpdGains {
                                   const Eigen::VectorXd& damping_ratio);
 };
 
+// The law for one cycle given the velocity estimate qd_hat (FfpdController's own, or a log's):
+// u = M_hat [K_V (qd_ref - qd_hat) + K_P (q_ref - q) + qdd_ref] + D_hat qd_ref.
+Eigen::VectorXd ffpd_command(const FfpdGains& g, const Eigen::VectorXd& q, const Eigen::VectorXd& qd_hat,
+                             const Eigen::VectorXd& q_ref, const Eigen::VectorXd& qd_ref, const Eigen::VectorXd& qdd_ref);
+
 class FfpdController {
  public:
   explicit FfpdController(const FfpdGains& gains);

@@ -102,7 +102,8 @@ struct DroppedEffect {
   Candidate candidate;
   std::string magnitude;  // as refitted with the others, e.g. "-0.0126 +- 0.0238 N m"
   double size = 0;        // its Wald statistic over the region's bound (< 1: undetermined)
-  double heldout_gain = 0;  // what dropping it from the full model costs its joints, held out
+  double heldout_gain = 0;  // what dropping it from the full model costs its joints, held out (NaN: not
+                            // asked, its region already failed)
   std::string reason;
 };
 
