@@ -16,7 +16,7 @@
 #include "symoro/control/description.hpp"
 #include "symoro/diagnose/diagnosis.hpp"
 #include "symoro/diagnose/stack_builder.hpp"
-#include "symoro/identify/dataset.hpp"
+#include "symoro/io/dataset.hpp"
 #include "symoro/identify/raw_torque.hpp"
 #include "symoro/io/parameters_yaml.hpp"
 #include "symoro/io/atomic_file.hpp"
@@ -30,7 +30,7 @@ namespace diagnose_detail {
 
 // The fitting and held-out runs: as named, else the dataset's (held out: family V, as a split
 // at import records it; fitting: every other run of the trial).
-inline std::pair<std::vector<std::string>, std::vector<std::string>> run_names(const identify::Dataset& data, const DiagnoseOptions& o) {
+inline std::pair<std::vector<std::string>, std::vector<std::string>> run_names(const io::Dataset& data, const DiagnoseOptions& o) {
   auto pick = [&](bool heldout) {
     std::vector<std::string> v;
     for (const auto& r : data.runs)
@@ -62,8 +62,8 @@ inline std::pair<std::vector<std::string>, std::vector<std::string>> run_names(c
 
 template <class Full, class Model>
 void DiagnoseCommand::run(const Common& common, const DiagnoseOptions& o) {
-  const identify::Dataset data = identify::read_dataset(o.data);
-  identify::check_dataset_robot(data, Model::robot_name);
+  const io::Dataset data = io::read_dataset(o.data);
+  io::check_dataset_robot(data, Model::robot_name);
   const auto [train_names, heldout_names] = diagnose_detail::run_names(data, o);
   diagnose::StackOptions so;
   so.interval = o.interval_ms / 1000;
@@ -74,7 +74,7 @@ void DiagnoseCommand::run(const Common& common, const DiagnoseOptions& o) {
   auto stack = [&](const std::vector<std::string>& names, bool fitting) {
     std::vector<diagnose::NamedSamples> runs;
     for (const auto& name : names) {
-      io::Log log = identify::read_run_log(data.find(name, o.trial), Model::robot_name, Model::nq);
+      io::Log log = io::read_run_log(data.find(name, o.trial), Model::robot_name, Model::nq);
       if (fitting && name == names.front()) first_train = log;
       if (!fitting) heldout_logs.emplace_back(name, log);
       runs.push_back({name, preprocess::preprocess(log, log.meta.sample_time > 0 ? log.meta.sample_time : 0.001,

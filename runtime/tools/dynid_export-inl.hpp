@@ -16,7 +16,7 @@
 
 #include "dynid_export.hpp"
 #include "dynid_urdf_into.hpp"
-#include "symoro/identify/dataset.hpp"
+#include "symoro/io/dataset.hpp"
 #include "symoro/identify/detail/physical_consistency_model.hpp"
 #include "symoro/identify/regression.hpp"
 #include "symoro/io/atomic_file.hpp"
@@ -52,8 +52,8 @@ FittingRun fitting_run(const std::filesystem::path& params, const std::string& d
   const auto at = f.id.find('@');
   if (at == std::string::npos || f.id.size() < at + 4)
     throw UsageError(fmt::format("{}: no source_run like PA11@10ms to measure the torque on", params.string()));
-  const identify::Dataset data = identify::read_dataset(data_dir);
-  io::Log log = identify::read_run_log(data.find(f.id.substr(0, at), trial), Full::robot_name, Full::nq);
+  const io::Dataset data = io::read_dataset(data_dir);
+  io::Log log = io::read_run_log(data.find(f.id.substr(0, at), trial), Full::robot_name, Full::nq);
   if (log.samples() > 0) log.time.array() -= log.time(0);
   f.reg = identify::stack_regression<Full>(preprocess::preprocess(log, std::stod(f.id.substr(at + 1)) / 1000, {}));
   return f;

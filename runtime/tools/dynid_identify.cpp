@@ -16,7 +16,6 @@
 #include "dynid_identify.hpp"
 #include "dynid_numbers.hpp"
 #include "symoro/control/description.hpp"
-#include "symoro/identify/dataset.hpp"
 #include "symoro/identify/report.hpp"
 #include "symoro/identify/study.hpp"
 #include "symoro/identify/validation_io.hpp"
@@ -106,9 +105,8 @@ identify::StudyResult study(const Common& common, const IdentifyOptions& o,
   // On twin data the truth is known: the twin's standard parameters mapped to the identified
   // model's base parameters (products of inertia dropped for a reduced variant), with the hidden
   // Coulomb friction and offsets where the variant has parameters for them.
-  const identify::Dataset data = identify::read_dataset(o.data);
-  if (!data.twin.empty() && std::filesystem::exists(data.twin)) {
-    const twin::TwinConfig tc = twin::read_twin_config(data.twin, d.nq, data.twin_overrides);
+  if (!result.data_twin.empty() && std::filesystem::exists(result.data_twin)) {
+    const twin::TwinConfig tc = twin::read_twin_config(result.data_twin, d.nq, result.data_twin_overrides);
     result.truth = truth(tc);
   }
   return result;

@@ -15,7 +15,7 @@
 #include "dynid_common.hpp"
 #include "dynid_identify.hpp"
 #include "dynid_numbers.hpp"
-#include "symoro/identify/dataset.hpp"
+#include "symoro/io/dataset.hpp"
 #include "symoro/identify/raw_torque.hpp"
 #include "symoro/identify/study_options.hpp"
 #include "symoro/io/atomic_file.hpp"
@@ -120,10 +120,10 @@ void run(const Common& common, const PredictOptions& o) {
   std::vector<std::pair<std::string, io::Log>> logs;
   const fs::path input(o.input);
   if (fs::is_directory(input)) {
-    const identify::Dataset data = identify::read_dataset(input);
-    identify::check_dataset_robot(data, common.robot);
+    const io::Dataset data = io::read_dataset(input);
+    io::check_dataset_robot(data, common.robot);
     for (const auto& r : data.runs)
-      if (r.trial == o.trial) logs.emplace_back(r.trajectory, identify::read_run_log(r, common.robot, d.nq));
+      if (r.trial == o.trial) logs.emplace_back(r.trajectory, io::read_run_log(r, common.robot, d.nq));
     if (logs.empty()) throw UsageError(fmt::format("{}: no run of trial {}", input.string(), o.trial));
   } else {
     io::Log log = io::read_log(input);

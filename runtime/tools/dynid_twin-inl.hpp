@@ -1,21 +1,16 @@
 // dynid twin's bodies for one robot (included by the generated units only): one run, a whole
-// dataset (resumable, parallel), and the speed measurement.
+// dataset (twin/dataset.hpp makes it), and the speed measurement.
 #pragma once
 
 #include <algorithm>
-#include <chrono>
-#include <fstream>
 #include <optional>
-#include <sstream>
 
 #include <fmt/format.h>
-#include <yaml-cpp/yaml.h>
 
 #include "dynid_twin.hpp"
-#include "symoro/io/atomic_file.hpp"
 #include "symoro/io/log.hpp"
-#include "symoro/parallel/farm.hpp"
 #include "symoro/trajectory/design.hpp"
+#include "symoro/twin/dataset.hpp"
 #include "symoro/twin/simulator.hpp"
 
 namespace symoro::dynid {
@@ -38,14 +33,6 @@ twin::TwinConfig load_config(const Common& common, const TwinOptions& o) {
   return c;
 }
 
-inline std::string run_file(const std::string& trajectory, int trial) { return fmt::format("{}_t{}.csv", trajectory, trial); }
-
-inline std::string describe(const twin::RunStats& s) {
-  return fmt::format("{:.1f} s simulated in {:.2f} s ({:.0f}x), max |error| {:.2f} deg, {} dropped, {} saturated",
-                     s.simulated, s.wall, s.simulated / std::max(s.wall, 1e-9),
-                     s.max_error.maxCoeff() * 180 / 3.14159265358979323846, s.dropped, s.saturated);
-}
-
 inline trajectory::TrajectoryDesign read_design(const Common& common, const std::vector<JointInfo>& joints) {
   return trajectory::TrajectoryDesign::read(common.design_path(), joints);
 }
@@ -61,9 +48,9 @@ void twin_run(const Common& common, const TwinOptions& o) {
   twin::RunStats stats;
   const io::Log log = sim.run(traj, ro, &stats);
   std::filesystem::create_directories(o.out);
-  const auto file = std::filesystem::path(o.out) / run_file(o.trajectory, o.trial);
+  const auto file = std::filesystem::path(o.out) / twin::run_file_name(o.trajectory, o.trial);
   io::write_log(file, log);
-  fmt::print("{}: {} rows; {}\n", file.string(), log.samples(), describe(stats));
+  fmt::print("{}: {} rows; {}\n", file.string(), log.samples(), twin::describe_run(stats));
   fmt::print("max |q_ref - q| per joint (deg):");
   for (int j = 0; j < Model::nq; ++j) fmt::print(" {:.3f}", stats.max_error(j) * 180 / 3.14159265358979323846);
   fmt::print("\nmax |torque| per joint (N m):");
@@ -71,112 +58,29 @@ void twin_run(const Common& common, const TwinOptions& o) {
   fmt::print("\n");
 }
 
-// A finished run is one whose sidecar (written last) names the same seed, trial and twin
-// (configuration fingerprint and effects).
-inline bool finished(const std::filesystem::path& csv, std::uint64_t seed, int trial, const std::string& notes) {
-  const auto meta = io::metadata_path(csv);
-  if (!std::filesystem::exists(meta) || !std::filesystem::exists(csv)) return false;
-  try {
-    const YAML::Node m = YAML::LoadFile(meta.string());
-    return m["seed"].as<std::uint64_t>() == seed && m["trial"].as<int>() == trial &&
-           m["notes"].as<std::string>() == notes;
-  } catch (const YAML::Exception&) {
-    return false;
-  }
-}
-
 template <class Model>
 void twin_dataset(const Common& common, const TwinOptions& o) {
   const twin::ClosedLoopTwin<Model> sim(load_config<Model>(common, o));
   const auto design = read_design(common, joint_list<Model>());
-  const std::vector<std::string> names = o.only.empty() ? design.names() : o.only;
   std::vector<trajectory::Trajectory> trajs;
-  for (const auto& n : names) trajs.push_back(design.build(n));
-  std::filesystem::create_directories(o.out);
-
-  struct Job { int traj, trial; };
-  std::vector<Job> jobs;
-  int skipped = 0;
-  for (int t = 0; t < static_cast<int>(trajs.size()); ++t)
-    for (int k = 1; k <= o.trials; ++k) {
-      const auto file = std::filesystem::path(o.out) / run_file(names[t], k);
-      if (finished(file, twin::run_seed(o.seed, names[t], k), k, sim.notes())) ++skipped;
-      else jobs.push_back({t, k});
-    }
-  // Longest runs first: better load balance across workers.
-  std::stable_sort(jobs.begin(), jobs.end(), [&](const Job& a, const Job& b) { return trajs[a.traj].duration() > trajs[b.traj].duration(); });
-  if (skipped > 0 && parallel::place().coordinator()) fmt::print(stderr, "{} runs already finished in {} (same seed and twin): skipped\n", skipped, o.out);
-
-  // The runs on the farm (threads here, or MPI ranks under mpirun): each worker writes its run's
-  // log (atomically, a file of its own) and sends rank 0 what it simulated.
-  std::vector<std::string> tasks;
-  for (const Job& j : jobs) tasks.push_back(fmt::format("{} {}", j.traj, j.trial));
-  const bool coordinator = parallel::place().coordinator();
+  for (const auto& n : o.only.empty() ? design.names() : o.only) trajs.push_back(design.build(n));
+  twin::TwinDatasetOptions d;
+  d.out = o.out;
+  d.robot = common.robot;
+  d.seed = o.seed;
+  d.trials = o.trials;
+  d.workers = o.jobs;
+  d.overrides = o.config;
   std::optional<Progress> progress;
-  if (coordinator) progress.emplace(static_cast<int>(jobs.size()), "twin");
-  std::string errors;
-  double simulated = 0;
-  parallel::Farm farm;
-  farm.work = [&](const std::string& task, const std::function<void(const std::string&)>& emit) {
-    std::istringstream in(task);
-    Job j{};
-    in >> j.traj >> j.trial;
-    twin::RunOptions ro;
-    ro.robot = common.robot;
-    ro.trial = j.trial;
-    ro.seed = twin::run_seed(o.seed, names[j.traj], j.trial);
-    twin::RunStats st;
-    const io::Log log = sim.run(trajs[j.traj], ro, &st);
-    io::write_log(std::filesystem::path(o.out) / run_file(names[j.traj], j.trial), log);
-    emit(fmt::format("{:.17g} {}", st.simulated, describe(st)));
+  d.on_start = [&](int to_run, int skipped) {
+    if (skipped > 0) fmt::print(stderr, "{} runs already finished in {} (same seed and twin): skipped\n", skipped, o.out);
+    progress.emplace(to_run, "twin");
   };
-  farm.on_result = [&](std::size_t i, const std::string& text) {
-    std::istringstream in(text);
-    double s = 0;
-    in >> s;
-    simulated += s;
-    std::string rest;
-    std::getline(in, rest);
-    progress->done(fmt::format("{} t{}", names[jobs[i].traj], jobs[i].trial), rest.empty() ? rest : rest.substr(1));
-  };
-  farm.on_end = [&](const parallel::TaskEnd& e) {
-    if (e.failed) errors += fmt::format("{}{} t{}: {}", errors.empty() ? "" : "; ", names[jobs[e.task].traj], jobs[e.task].trial, e.failure);
-  };
-  parallel::FarmOptions fo;
-  fo.workers = o.jobs;
-  const auto t0 = std::chrono::steady_clock::now();
-  const parallel::FarmSummary farmed = parallel::run_farm(tasks, farm, fo);
-  if (!coordinator) return;
-  // The finished runs stay on disk: a rerun does only the failed ones.
-  if (!errors.empty()) throw std::runtime_error("twin dataset: failed runs (the others are written): " + errors);
-  const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-
-  // The manifest: what the dataset holds and how it was made (written last, atomically).
-  YAML::Emitter y;
-  y << YAML::BeginMap << YAML::Key << "format" << YAML::Value << "symoro-dataset 1";
-  y << YAML::Key << "robot" << YAML::Value << common.robot << YAML::Key << "seed" << YAML::Value << o.seed;
-  y << YAML::Key << "trials" << YAML::Value << o.trials;
-  y << YAML::Key << "twin" << YAML::Value << sim.config().path;
-  if (!o.config.empty()) {
-    // The overrides travel with the dataset: its truth (hidden effects) stays known.
-    std::ifstream in(o.config);
-    std::stringstream text;
-    text << in.rdbuf();
-    io::write_file_atomically(std::filesystem::path(o.out) / "twin_overrides.yaml", text.str());
-    y << YAML::Key << "twin_overrides" << YAML::Value << "twin_overrides.yaml";
-  }
-  y << YAML::Key << "effects" << YAML::Value << YAML::Flow << sim.config().effects.enabled();
-  y << YAML::Key << "runs" << YAML::Value << YAML::BeginSeq;
-  for (int t = 0; t < static_cast<int>(trajs.size()); ++t)
-    for (int k = 1; k <= o.trials; ++k)
-      y << YAML::Flow << YAML::BeginMap << YAML::Key << "trajectory" << YAML::Value << names[t] << YAML::Key << "family"
-        << YAML::Value << trajs[t].family << YAML::Key << "trial" << YAML::Value << k << YAML::Key << "file"
-        << YAML::Value << run_file(names[t], k) << YAML::EndMap;
-  y << YAML::EndSeq << YAML::EndMap;
-  io::write_file_atomically(std::filesystem::path(o.out) / "dataset.yaml", std::string(y.c_str()) + "\n");
-  fmt::print("{} runs ({} new, {} skipped) in {}: {:.0f} s simulated in {:.1f} s wall on {}{} workers\n",
-             trajs.size() * o.trials, jobs.size(), skipped, o.out, simulated, wall,
-             farmed.ranks > 1 ? fmt::format("{} ranks x ", farmed.ranks) : "", farmed.workers);
+  d.on_run = [&](const std::string& run, const std::string& what) { progress->done(run, what); };
+  const twin::TwinDatasetSummary s = twin::make_twin_dataset(sim, trajs, d);
+  if (!s.coordinator) return;
+  fmt::print("{} runs ({} new, {} skipped) in {}: {:.0f} s simulated in {:.1f} s wall on {}{} workers\n", s.runs, s.made,
+             s.skipped, o.out, s.simulated, s.wall, s.ranks > 1 ? fmt::format("{} ranks x ", s.ranks) : "", s.workers);
 }
 
 template <class Model>

@@ -1,6 +1,6 @@
-// libFuzzer entry point for a dataset folder's manifest (identify::read_dataset on the input as
+// libFuzzer entry point for a dataset folder's manifest (io::read_dataset on the input as
 // dataset.yaml, in a folder holding a valid log a.csv), then each run's window of that log
-// (identify::read_run_log). Any input must either read or throw DataError; a run read has its
+// (io::read_run_log). Any input must either read or throw DataError; a run read has its
 // window's samples only. Another exception, a crash, a sanitizer report or a hang is a bug.
 #include <cstddef>
 #include <cstdint>
@@ -8,7 +8,7 @@
 
 #include "fuzz_files.hpp"
 #include "symoro/error.hpp"
-#include "symoro/identify/dataset.hpp"
+#include "symoro/io/dataset.hpp"
 #include "symoro/io/log.hpp"
 
 using symoro::fuzz::check;
@@ -42,13 +42,13 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   const fs::path& dir = folder();
   symoro::fuzz::write_bytes(dir / "dataset.yaml", std::string_view(reinterpret_cast<const char*>(data), size));
   try {
-    const symoro::identify::Dataset d = symoro::identify::read_dataset(dir);
+    const symoro::io::Dataset d = symoro::io::read_dataset(dir);
     int read = 0;
-    for (const symoro::identify::DatasetRun& run : d.runs) {
+    for (const symoro::io::DatasetRun& run : d.runs) {
       // Only the folder's own log: a manifest may name any path (/dev/zero would never end).
       if (run.file != fs::absolute(dir / "a.csv") || ++read > 8) continue;
       try {
-        const symoro::io::Log log = symoro::identify::read_run_log(run);
+        const symoro::io::Log log = symoro::io::read_run_log(run);
         check(log.samples() >= 1 && log.samples() <= 5);
         for (Eigen::Index k = 0; k < log.samples(); ++k)
           check(run.window_start <= log.time[k] && log.time[k] < run.window_end);

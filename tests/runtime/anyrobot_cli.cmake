@@ -30,7 +30,7 @@ foreach(robot rx90 stanford_rrp)
       --q "{name}_pos" --qd "{name}_vel" --tau "{name}_eff" --angle deg --split 0.7)
   expect("${out}" "stale")
   file(READ ${w}/data/dataset.yaml manifest)
-  expect("${manifest}" "trajectory: \"?arm_heldout\"?, family: V")
+  expect("${manifest}" "trajectory: \"?arm_heldout\"?, family: \"?V\"?")
   # Importing again never replaces what is there.
   run(1 out import --robot ${robot} -o ${w}/data ${w}/export.csv --name arm --time stamp_ms --time-unit ms
       --q "{name}_pos" --qd "{name}_vel" --tau "{name}_eff" --angle deg --split 0.7)

@@ -80,7 +80,7 @@ endif()
 file(WRITE ${WORK}/hidden.yaml "effects:\n  torque_offset: {enabled: true, torque: [0, 0, 0, 0, 0.02, 0, 0, 0]}\n")
 run(0 out twin dataset --robot crane_x7 -o ${WORK}/hidden --seed 4 --only V01 --config ${WORK}/hidden.yaml)
 file(READ ${WORK}/hidden/dataset.yaml manifest)
-expect("${manifest}" "twin_overrides: twin_overrides.yaml")
+expect("${manifest}" "twin_overrides: \"?twin_overrides.yaml\"?")
 file(READ ${WORK}/hidden/twin_overrides.yaml kept)
 expect("${kept}" "torque: \\[0, 0, 0, 0, 0.02")
 # Models by name: an unknown one is named with the robot's compiled models.

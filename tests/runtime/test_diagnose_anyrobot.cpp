@@ -25,7 +25,7 @@
 #include "symoro/diagnose/diagnosis.hpp"
 #include "symoro/diagnose/gap_report.hpp"
 #include "symoro/diagnose/stack_builder.hpp"
-#include "symoro/identify/dataset.hpp"
+#include "symoro/io/dataset.hpp"
 #include "symoro/identify/study.hpp"
 #include "symoro/identify/validation_io.hpp"
 #include "symoro/io/import.hpp"
@@ -166,8 +166,8 @@ TYPED_TEST(AnyRobotGap, AControllersCsvThroughImportIdentifyDiagnoseAndCompare) 
     EXPECT_EQ(r->validation[0].kind, "open-loop");
   }
   // The held-out part is the last 30 % of the log, by time.
-  const identify::Dataset data = identify::read_dataset(this->dir_ / "data");
-  const io::Log held = identify::read_run_log(data.find("arm_heldout", 1), Full::robot_name, n);
+  const io::Dataset data = io::read_dataset(this->dir_ / "data");
+  const io::Log held = io::read_run_log(data.find("arm_heldout", 1), Full::robot_name, n);
   EXPECT_NEAR(held.time(0) - log.time(0), 0.7 * (log.time(log.samples() - 1) - log.time(0)), 0.002);
 
   // Diagnosis of the model before on the dataset's split: Coulomb friction on every joint where
@@ -181,7 +181,7 @@ TYPED_TEST(AnyRobotGap, AControllersCsvThroughImportIdentifyDiagnoseAndCompare) 
     for (int j = 0; j < n; ++j) EXPECT_NEAR(held.q(i, j), log.q(k, j), 1e-12 * (1 + std::abs(log.q(k, j))));
   }
   const diagnose::Diagnosis d = diagnose::diagnose(
-      TestFixture::template stack<Before>({identify::read_run_log(data.find("arm", 1), Full::robot_name, n)}),
+      TestFixture::template stack<Before>({io::read_run_log(data.find("arm", 1), Full::robot_name, n)}),
       TestFixture::template stack<Before>({held}));
   auto has = [](auto model, const std::string& name) {
     for (const auto& p : decltype(model)::parameters)

@@ -25,7 +25,7 @@
 #include "symoro/identify/report.hpp"
 #include "symoro/error.hpp"
 #include "symoro/identify/detail/closed_loop_model.hpp"
-#include "symoro/identify/dataset.hpp"
+#include "symoro/io/dataset.hpp"
 #include "symoro/identify/validation.hpp"
 #include "symoro/identify/least_squares.hpp"
 #include "symoro/identify/raw_torque.hpp"
@@ -34,7 +34,6 @@
 #include "symoro/preprocess/zero_phase.hpp"
 #include "symoro/identify/study.hpp"
 #include "symoro/trajectory/sampled_reference.hpp"
-#include "symoro/io/atomic_file.hpp"
 #include "symoro/io/log.hpp"
 #include "synthetic_log.hpp"
 #include "test_support.hpp"
@@ -55,15 +54,16 @@ class AnyRobotStudy : public ::testing::Test {
     std::filesystem::create_directories(dir_ / "data");
     test::Random rng(17);
     truth_ = Model::base_from_standard(test::random_standard_parameters<Model>(rng).s);
-    std::string manifest = "format: symoro-dataset 1\nrobot: " + std::string(Model::robot_name) + "\nruns:\n";
+    io::Dataset manifest;
+    manifest.dir = dir_ / "data";
+    manifest.robot = Model::robot_name;
     const char* names[] = {"R1", "R2", "H1"};
     for (int r = 0; r < 3; ++r) {
       const io::Log log = test::synthesize<Model>(names[r], truth_, 30.0, 100 + r, kNoise, test::offset_on<Model>(1, kOffset));
       io::write_log(dir_ / "data" / (std::string(names[r]) + ".csv"), log);
-      manifest += fmt::format("  - {{trajectory: {}, family: {}, trial: 1, file: {}.csv}}\n", names[r], r < 2 ? "F" : "V",
-                              names[r]);
+      manifest.runs.push_back({names[r], r < 2 ? "F" : "V", 1, std::string(names[r]) + ".csv"});
     }
-    io::write_file_atomically(dir_ / "data" / "dataset.yaml", manifest);
+    io::write_dataset(manifest);
   }
   void TearDown() override { std::filesystem::remove_all(dir_); }
 
@@ -132,8 +132,8 @@ TYPED_TEST(AnyRobotStudy, RunsWithoutTwinDesignOrControllerAndValidatesOpenLoop)
   EXPECT_LT(v.rmse_rescue, 1.1 * floor) << "floor " << floor;
   // The 5 % stale rows, were they kept, would cost the truth itself (a repeated state under a
   // later stamp is a step back in q and a spike in qdd).
-  const identify::Dataset data = identify::read_dataset(this->dir_ / "data");
-  const io::Log held = identify::read_run_log(data.find("H1", 1));
+  const io::Dataset data = io::read_dataset(this->dir_ / "data");
+  const io::Log held = io::read_run_log(data.find("H1", 1));
   auto truth_error = [&](bool drop) {
     preprocess::Options po;
     po.drop_stale = drop;
@@ -297,16 +297,16 @@ TYPED_TEST(AnyRobotStudy, ALogOfAnotherRobotOrJointCountIsNamed) {
   io::write_log(this->dir_ / "data" / "R6.csv", fewer);
   std::ofstream(this->dir_ / "data" / "dataset.yaml", std::ios::app)
       << "  - {trajectory: R5, family: F, trial: 1, file: R5.csv}\n  - {trajectory: R6, family: F, trial: 1, file: R6.csv}\n";
-  const identify::Dataset data = identify::read_dataset(this->dir_ / "data");
+  const io::Dataset data = io::read_dataset(this->dir_ / "data");
   try {
-    identify::read_run_log(data.find("R5", 1), Model::robot_name, Model::nq);
+    io::read_run_log(data.find("R5", 1), Model::robot_name, Model::nq);
     FAIL() << "another robot's log was accepted";
   } catch (const DataError& e) {
     EXPECT_NE(std::string(e.what()).find("R5.meta.yaml: error: run R5: the log is of robot 'some_other_arm'"), std::string::npos)
         << e.what();
   }
   try {
-    identify::read_run_log(data.find("R6", 1), Model::robot_name, Model::nq);
+    io::read_run_log(data.find("R6", 1), Model::robot_name, Model::nq);
     FAIL() << "a log with another joint count was accepted";
   } catch (const DataError& e) {
     EXPECT_NE(std::string(e.what()).find(fmt::format("R6.csv: error: run R6: the log has {} joints, the model {}", n, Model::nq)),
@@ -407,13 +407,15 @@ TYPED_TEST(AnyRobotStudy, ThePriorsWeightIsChosenByHeldOutError) {
   // rescue runs.
   const auto noisy = this->dir_ / "noisy";
   std::filesystem::create_directories(noisy);
-  std::string manifest = "format: symoro-dataset 1\nrobot: " + std::string(Model::robot_name) + "\nruns:\n";
+  io::Dataset manifest;
+  manifest.dir = noisy;
+  manifest.robot = Model::robot_name;
   for (int r = 0; r < 3; ++r) {
     const std::string name = r < 2 ? fmt::format("N{}", r + 1) : "NH";
     io::write_log(noisy / (name + ".csv"), test::synthesize<Model>(name, this->truth_, 6.0, 500 + r, 1.0));
-    manifest += fmt::format("  - {{trajectory: {}, family: {}, trial: 1, file: {}.csv}}\n", name, r < 2 ? "F" : "V", name);
+    manifest.runs.push_back({name, r < 2 ? "F" : "V", 1, name + ".csv"});
   }
-  io::write_file_atomically(noisy / "dataset.yaml", manifest);
+  io::write_dataset(manifest);
   identify::StudyOptions o = this->options();
   o.data = noisy;
   o.out = this->dir_ / "noisy-study";

@@ -21,7 +21,7 @@
 #include "consistency_test_support.hpp"
 #include "symoro/identify/physical_projection.hpp"
 #include "symoro/identify/study.hpp"
-#include "symoro/io/atomic_file.hpp"
+#include "symoro/io/dataset.hpp"
 #include "symoro/io/log.hpp"
 #include "synthetic_log.hpp"
 #include "test_support.hpp"
@@ -170,15 +170,16 @@ class PhysicalStudy : public ::testing::Test {
     std::filesystem::remove_all(dir_);
     std::filesystem::create_directories(dir_ / "data");
     truth_ = test::base_of<Model>(consistent_truth<Model>(17));
-    std::string manifest = "format: symoro-dataset 1\nrobot: " + std::string(Model::robot_name) + "\nruns:\n";
+    io::Dataset manifest;
+    manifest.dir = dir_ / "data";
+    manifest.robot = Model::robot_name;
     const char* names[] = {"R1", "R2", "R3", "H1"};
     for (int r = 0; r < 4; ++r) {
       const io::Log log = test::synthesize<Model>(names[r], truth_, 12.0, 200 + r, kNoise, test::offset_on<Model>(2, kOffset));
       io::write_log(dir_ / "data" / (std::string(names[r]) + ".csv"), log);
-      manifest += fmt::format("  - {{trajectory: {}, family: {}, trial: 1, file: {}.csv}}\n", names[r], r < 3 ? "F" : "V",
-                              names[r]);
+      manifest.runs.push_back({names[r], r < 3 ? "F" : "V", 1, std::string(names[r]) + ".csv"});
     }
-    io::write_file_atomically(dir_ / "data" / "dataset.yaml", manifest);
+    io::write_dataset(manifest);
   }
   void TearDown() override { std::filesystem::remove_all(dir_); }
 

@@ -19,7 +19,7 @@
 #include "symoro/identify/reproduction.hpp"
 #include "symoro/identify/run_record_io.hpp"
 #include "symoro/identify/detail/closed_loop_model.hpp"
-#include "symoro/identify/dataset.hpp"
+#include "symoro/io/dataset.hpp"
 #include "symoro/identify/detail/inertia_function_model.hpp"
 #include "symoro/identify/validation.hpp"
 #include "symoro/identify/study.hpp"

@@ -16,7 +16,7 @@
 #include <symoro/crane_x7.hpp>
 
 #include "symoro/identify/detail/closed_loop_model.hpp"
-#include "symoro/identify/dataset.hpp"
+#include "symoro/io/dataset.hpp"
 #include "symoro/identify/validation.hpp"
 #include "symoro/identify/study.hpp"
 #include "twin_dataset.hpp"

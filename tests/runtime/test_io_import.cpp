@@ -18,7 +18,7 @@
 #include <unistd.h>
 
 #include "symoro/error.hpp"
-#include "symoro/identify/dataset.hpp"
+#include "symoro/io/dataset.hpp"
 #include "symoro/io/import.hpp"
 #include "symoro/io/log.hpp"
 #include "symoro/io/number_text.hpp"
@@ -243,7 +243,7 @@ TEST_F(Import, SixJointsInDegreesAndMillisecondsReadBackExactly) {
   EXPECT_NEAR(log.qd(k, 2), 30 * kPi / 180 * 2 * kPi * 0.5 * std::cos(2 * kPi * 0.5 * log.time[k] + 0.8), 1e-13);
 
   // The dataset manifest and the record of the import.
-  const symoro::identify::Dataset d = symoro::identify::read_dataset(dir_ / "data");
+  const symoro::io::Dataset d = symoro::io::read_dataset(dir_ / "data");
   EXPECT_EQ(d.robot, "arm6");
   EXPECT_EQ(d.source, "imported");
   ASSERT_EQ(d.runs.size(), 1u);
@@ -346,7 +346,7 @@ TEST_F(Import, SplitRecordsWindowsThatPartitionEachRun) {
   di.inputs = {{dir_ / "a.csv", "", false}, {dir_ / "b.csv", "second", false}};
   di.split = 0.7;
   io::import_dataset(dir_ / "data", di);
-  const symoro::identify::Dataset d = symoro::identify::read_dataset(dir_ / "data");
+  const symoro::io::Dataset d = symoro::io::read_dataset(dir_ / "data");
   ASSERT_EQ(d.runs.size(), 4u);
   const std::vector<std::pair<std::string, std::string>> expected{
       {"a", "F"}, {"a_heldout", "V"}, {"second", "F"}, {"second_heldout", "V"}};
@@ -365,7 +365,7 @@ TEST_F(Import, SplitRecordsWindowsThatPartitionEachRun) {
     EXPECT_EQ(fit.window_end, cut);
     EXPECT_EQ(held.window_start, cut);
     EXPECT_TRUE(std::isinf(held.window_end));
-    const io::Log a = symoro::identify::read_run_log(fit), b = symoro::identify::read_run_log(held);
+    const io::Log a = symoro::io::read_run_log(fit), b = symoro::io::read_run_log(held);
     EXPECT_EQ(a.meta.trajectory, fit.trajectory);
     EXPECT_EQ(b.meta.trajectory, held.trajectory);
     ASSERT_EQ(a.samples() + b.samples(), whole.samples());
@@ -378,12 +378,12 @@ TEST_F(Import, SplitRecordsWindowsThatPartitionEachRun) {
     EXPECT_EQ(b.tau.row(b.samples() - 1), whole.tau.row(whole.samples() - 1));
   }
   // 1500 rows of ~1 ms: the cut is at 0.7 * 1499 ms, so the fitting part has 1050 rows (0..1049 ms).
-  EXPECT_EQ(symoro::identify::read_run_log(d.runs[0]).samples(), 1050);
+  EXPECT_EQ(symoro::io::read_run_log(d.runs[0]).samples(), 1050);
   EXPECT_NE(read_text(dir_ / "data" / "dataset.yaml").find("split: 0.7\n"), std::string::npos);
 
   // The dataset belongs to arm6; another robot is refused at the line of robot:.
-  EXPECT_NO_THROW(symoro::identify::check_dataset_robot(d, "arm6"));
-  expect_error([&] { symoro::identify::check_dataset_robot(d, "crane_x7"); }, (d.dir / "dataset.yaml").string(), 2,
+  EXPECT_NO_THROW(symoro::io::check_dataset_robot(d, "arm6"));
+  expect_error([&] { symoro::io::check_dataset_robot(d, "crane_x7"); }, (d.dir / "dataset.yaml").string(), 2,
                "made for robot 'arm6', not 'crane_x7'");
 }
 
@@ -400,10 +400,82 @@ TEST_F(Import, DatasetWindowsAreChecked) {
   write_text(manifest, text.substr(0, runs) + "runs:\n  - {trajectory: a, family: F, trial: 1, file: a.csv,\n"
                                               "     window: [2, 1]}\n");
   const int window_line = static_cast<int>(std::count(text.begin(), text.begin() + runs, '\n')) + 3;
-  expect_error([&] { symoro::identify::read_dataset(dir_ / "data"); }, manifest.string(), window_line, "not an interval");
+  expect_error([&] { symoro::io::read_dataset(dir_ / "data"); }, manifest.string(), window_line, "not an interval");
   write_text(manifest, text.substr(0, runs) + "runs:\n  - {trajectory: a, family: F, trial: 1, file: a.csv, window: [5, 6]}\n");
-  const symoro::identify::Dataset d = symoro::identify::read_dataset(dir_ / "data");
-  expect_error([&] { symoro::identify::read_run_log(d.runs[0]); }, d.runs[0].file.string(), 0, "holds none of the log's samples");
+  const symoro::io::Dataset d = symoro::io::read_dataset(dir_ / "data");
+  expect_error([&] { symoro::io::read_run_log(d.runs[0]); }, d.runs[0].file.string(), 0, "holds none of the log's samples");
+}
+
+// The manifest's one writer against its one reader: every field, awkward names (quotes, a
+// colon, a '#', a backslash, a control byte), numbers that need all 17 digits, open windows,
+// and files given absolute or relative to the folder.
+TEST_F(Import, DatasetManifestReadsBackWhatWasWritten) {
+  const fs::path data = dir_ / "data";
+  fs::create_directories(data);
+  const std::vector<std::string> files = {"a b.csv", "q\"uote: #x.csv", "back\\slash.csv"};
+  for (const auto& f : files) write_text(data / f, "");
+  write_text(data / "over.yaml", "effects: {}\n");
+  symoro::io::Dataset w;
+  w.dir = data;
+  w.robot = "arm: \"six\"";
+  w.source = "imported";
+  w.twin = "/robots/arm6/twin.yaml";
+  w.twin_overrides = "over.yaml";
+  w.twin_record = symoro::io::TwinDatasetRecord{18446744073709551615ull, 3, {"coulomb", "sensor_noise"}};
+  w.split = 0.1 + 0.2;  // 0.30000000000000004
+  w.import = symoro::io::ImportCounts{2, 1001, 1000, 7, 1};
+  w.imported = {{"a b.csv", 600, 4, 1, 0.001, "measured"}, {"q\"uote: #x.csv", 401, 3, 0, 1.0 / 3, "differentiated"}};
+  const double cut = 84.21370000000001;
+  w.runs = {{"long", "F", 1, "a b.csv", 0.000512, cut},
+            {"long_heldout", "V", 1, data / "a b.csv", cut, std::numeric_limits<double>::infinity()},
+            {"tab\there", "AG", 2, "q\"uote: #x.csv"},
+            {"early", "F", 1, data / "back\\slash.csv", -std::numeric_limits<double>::infinity(), -2.5}};
+  symoro::io::write_dataset(w);
+
+  const symoro::io::Dataset r = symoro::io::read_dataset(data);
+  EXPECT_EQ(r.robot, w.robot);
+  EXPECT_EQ(r.robot_line, 2);
+  EXPECT_EQ(r.source, w.source);
+  EXPECT_EQ(r.twin, w.twin);
+  EXPECT_EQ(r.twin_overrides, (fs::absolute(data) / "over.yaml").string());
+  ASSERT_TRUE(r.twin_record.has_value());
+  EXPECT_EQ(r.twin_record->seed, w.twin_record->seed);
+  EXPECT_EQ(r.twin_record->trials, 3);
+  EXPECT_EQ(r.twin_record->effects, w.twin_record->effects);
+  EXPECT_EQ(r.split, w.split);
+  ASSERT_TRUE(r.import.has_value());
+  EXPECT_EQ(r.import->inputs, 2);
+  EXPECT_EQ(r.import->rows, 1001);
+  EXPECT_EQ(r.import->written, 1000);
+  EXPECT_EQ(r.import->stale_rows, 7);
+  EXPECT_EQ(r.import->duplicate_rows, 1);
+  ASSERT_EQ(r.imported.size(), 2u);
+  for (std::size_t i = 0; i < 2; ++i) {
+    EXPECT_EQ(r.imported[i].file, w.imported[i].file);
+    EXPECT_EQ(r.imported[i].rows, w.imported[i].rows);
+    EXPECT_EQ(r.imported[i].stale_rows, w.imported[i].stale_rows);
+    EXPECT_EQ(r.imported[i].duplicate_rows, w.imported[i].duplicate_rows);
+    EXPECT_EQ(r.imported[i].sample_time, w.imported[i].sample_time);  // exact: shortest round-trip text
+    EXPECT_EQ(r.imported[i].velocity, w.imported[i].velocity);
+  }
+  ASSERT_EQ(r.runs.size(), w.runs.size());
+  const std::vector<std::string> run_files = {files[0], files[0], files[1], files[2]};
+  for (std::size_t i = 0; i < w.runs.size(); ++i) {
+    EXPECT_EQ(r.runs[i].trajectory, w.runs[i].trajectory);
+    EXPECT_EQ(r.runs[i].family, w.runs[i].family);
+    EXPECT_EQ(r.runs[i].trial, w.runs[i].trial);
+    EXPECT_EQ(r.runs[i].file, fs::absolute(data) / run_files[i]);
+    EXPECT_EQ(r.runs[i].window_start, w.runs[i].window_start);
+    EXPECT_EQ(r.runs[i].window_end, w.runs[i].window_end);
+  }
+  // Files inside the folder are listed relative to it, so the folder can move.
+  EXPECT_EQ(read_text(data / "dataset.yaml").find(fs::absolute(data).string()), std::string::npos);
+  // A record of the wrong type is an error at its line.
+  std::string text = read_text(data / "dataset.yaml");
+  const std::size_t seed = text.find("seed: ");
+  write_text(data / "dataset.yaml", text.substr(0, seed) + "seed: many" + text.substr(text.find('\n', seed)));
+  expect_error([&] { symoro::io::read_dataset(data); }, (data / "dataset.yaml").string(),
+               static_cast<int>(std::count(text.begin(), text.begin() + seed, '\n')) + 1, "");
 }
 
 // ---- Unit plausibility: a unit declared wrong is refused, with its evidence -------------------

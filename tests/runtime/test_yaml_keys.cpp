@@ -18,7 +18,7 @@
 #include "symoro/control/description.hpp"
 #include "symoro/error.hpp"
 #include "symoro/hardware/config.hpp"
-#include "symoro/identify/dataset.hpp"
+#include "symoro/io/dataset.hpp"
 #include "symoro/io/import.hpp"
 #include "symoro/io/yaml_keys.hpp"
 #include "symoro/trajectory/design.hpp"
@@ -141,11 +141,11 @@ TEST_F(YamlKeys, DatasetRefusesTyposOfWindowSplitAndTrial) {
       "    window: [7, .inf]\n";
   const fs::path manifest = dir_ / "data" / "dataset.yaml";
   write(manifest, good);
-  const symoro::identify::Dataset d = symoro::identify::read_dataset(dir_ / "data");
+  const symoro::io::Dataset d = symoro::io::read_dataset(dir_ / "data");
   ASSERT_EQ(d.runs.size(), 2u);
   EXPECT_EQ(d.runs[0].window_end, 7);
   EXPECT_EQ(d.runs[1].window_start, 7);
-  const auto read_it = [&] { symoro::identify::read_dataset(dir_ / "data"); };
+  const auto read_it = [&] { symoro::io::read_dataset(dir_ / "data"); };
 
   write(manifest, edited(good, "a.csv, window:", "a.csv, windw:"));
   expect_unknown(read_it, manifest, 6, "windw", "window");

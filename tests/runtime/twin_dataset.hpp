@@ -6,7 +6,7 @@
 #include <string>
 #include <vector>
 
-#include "symoro/io/atomic_file.hpp"
+#include "symoro/io/dataset.hpp"
 #include "symoro/io/log.hpp"
 #include "symoro/trajectory/design.hpp"
 #include "symoro/twin/simulator.hpp"
@@ -22,18 +22,19 @@ void write_twin_dataset(const std::filesystem::path& dir, const twin::TwinConfig
   std::filesystem::remove_all(dir);
   std::filesystem::create_directories(dir);
   const twin::ClosedLoopTwin<Full> tw(config);
-  std::string manifest = "format: symoro-dataset 1\nrobot: " + std::string(Full::robot_name) + "\n";
-  if (!twin_file.empty()) manifest += "twin: " + twin_file + "\n";
-  manifest += "runs:\n";
+  io::Dataset d;
+  d.dir = dir;
+  d.robot = Full::robot_name;
+  d.twin = twin_file;
   for (const auto& name : names) {
     twin::RunOptions ro;
     ro.robot = Full::robot_name;
     ro.seed = twin::run_seed(seed, name, 1);
     const auto traj = design.build(name);
     io::write_log(dir / (name + "_t1.csv"), tw.run(traj, ro));
-    manifest += "  - {trajectory: " + name + ", family: " + traj.family + ", trial: 1, file: " + name + "_t1.csv}\n";
+    d.runs.push_back({name, traj.family, 1, name + "_t1.csv"});
   }
-  io::write_file_atomically(dir / "dataset.yaml", manifest);
+  io::write_dataset(d);
 }
 
 }  // namespace symoro::test

@@ -15,6 +15,7 @@
 #include "symoro/io/atomic_file.hpp"
 #include "symoro/io/parameters_yaml.hpp"
 #include "symoro/io/number_text.hpp"
+#include "symoro/io/yaml_text.hpp"
 
 namespace symoro::identify {
 
@@ -323,25 +324,8 @@ const Eigen::VectorXd& accepted_vector(const StudyResult& study) {
   return study.phi_rescue;
 }
 
-std::string yaml_quoted(const std::string& text) {
-  std::string out = "\"";
-  for (char c : text) {
-    if (c == '"' || c == '\\') out += '\\';
-    if (static_cast<unsigned char>(c) < 0x20) {
-      out += fmt::format("\\x{:02x}", static_cast<unsigned char>(c));
-      continue;
-    }
-    out += c;
-  }
-  return out + "\"";
-}
-
-// Shortest text that reads back to the same double; YAML's spelling of the non-finite ones.
-std::string yaml_number(double v) {
-  if (std::isnan(v)) return ".nan";
-  if (std::isinf(v)) return v > 0 ? ".inf" : "-.inf";
-  return io::number_text(v);
-}
+using io::yaml_number;
+using io::yaml_quoted;
 
 std::string csv_field(const std::string& text) {
   if (text.find_first_of(",\"\n\r") == std::string::npos) return text;

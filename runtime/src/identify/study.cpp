@@ -19,7 +19,7 @@
 
 #include "symoro/error.hpp"
 #include "symoro/identify/clie.hpp"
-#include "symoro/identify/dataset.hpp"
+#include "symoro/io/dataset.hpp"
 #include "symoro/identify/least_squares.hpp"
 #include "symoro/identify/pca.hpp"
 #include "symoro/identify/pd_audit.hpp"
@@ -37,6 +37,9 @@
 namespace symoro::identify {
 namespace {
 
+using io::Dataset;
+using io::DatasetRun;
+
 // One study's run: the model, options and closed loop it works with, and what it builds once.
 class StudyRun {
  public:
@@ -49,8 +52,8 @@ class StudyRun {
     if (o_.consistency == Consistency::physical && !model_.supports_physical_consistency())
       throw std::invalid_argument(fmt::format("--consistency physical: the {} model has effect parameters (not standard "
                                               "inertial parameters); identify it with the PD path", d_.variant));
-    const Dataset data = read_dataset(o_.data);
-    check_dataset_robot(data, d_.robot);
+    const Dataset data = io::read_dataset(o_.data);
+    io::check_dataset_robot(data, d_.robot);
     StudyResult out;
     out.robot = d_.robot;
     out.model = d_.variant;
@@ -59,6 +62,8 @@ class StudyRun {
       out.names.push_back(p.name);
       out.units.push_back(p.unit);
     }
+    out.data_twin = data.twin;
+    out.data_twin_overrides = data.twin_overrides;
     out.data_source = data.twin.empty() ? "measured (" + data.dir.string() + ")"
                                         : "digital twin (" + data.twin + "), " + data.dir.string();
     const std::vector<std::string> ident = identification_names(data), valid = validation_names(data);
@@ -204,7 +209,7 @@ class StudyRun {
   // A run's log, its time counted from its first stamp (a controller's log may start at any t;
   // the closed loop's cycle 0 is the first row).
   io::Log load_log(const DatasetRun& run) const {
-    io::Log log = read_run_log(run, d_.robot, d_.nq);
+    io::Log log = io::read_run_log(run, d_.robot, d_.nq);
     if (log.samples() > 0) log.time.array() -= log.time(0);
     return log;
   }

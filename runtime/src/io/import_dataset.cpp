@@ -11,31 +11,13 @@
 #include "symoro/error.hpp"
 #include "symoro/io/atomic_file.hpp"
 #include "symoro/io/import.hpp"
+#include "symoro/io/dataset.hpp"
 #include "symoro/io/number_text.hpp"
+#include "symoro/io/yaml_text.hpp"
 
 namespace symoro::io {
 
 namespace {
-
-// A YAML double-quoted string.
-std::string quoted(const std::string& s) {
-  std::string out = "\"";
-  for (char c : s) {
-    if (c == '"' || c == '\\') out += '\\';
-    if (c == '\n') {
-      out += "\\n";
-      continue;
-    }
-    out += c;
-  }
-  return out + "\"";
-}
-
-// Shortest round-trip text; infinities as YAML writes them.
-std::string yaml_number(double v) {
-  if (std::isinf(v)) return v > 0 ? ".inf" : "-.inf";
-  return number_text(v);
-}
 
 std::string line_list(const std::vector<int>& lines) {
   std::string out = "[";
@@ -111,47 +93,40 @@ DatasetImportResult import_dataset(const std::filesystem::path& out, const Datas
 
   // import.yaml: the mapping (reusable as --mapping) and what each input gave.
   std::string text = import_mapping_yaml(import.mapping);
-  text += fmt::format("imported:\n  robot: {}\n  split: {}\n  inputs:\n", quoted(import.target.robot),
+  text += fmt::format("imported:\n  robot: {}\n  split: {}\n  inputs:\n", yaml_quoted(import.target.robot),
                       number_text(import.split));
   for (const ImportedLog& l : result.logs) {
-    text += fmt::format("    - input: {}\n      log: {}\n      rows: {}\n      written: {}\n", quoted(fs::absolute(l.input).string()),
-                        quoted(l.log.meta.trajectory + ".csv"), l.rows, l.log.samples());
+    text += fmt::format("    - input: {}\n      log: {}\n      rows: {}\n      written: {}\n", yaml_quoted(fs::absolute(l.input).string()),
+                        yaml_quoted(l.log.meta.trajectory + ".csv"), l.rows, l.log.samples());
     text += fmt::format("      stale_rows: {}\n      stale_lines: {}\n", l.stale_lines.size(), line_list(l.stale_lines));
     text += fmt::format("      duplicate_rows: {}\n      duplicate_lines: {}\n", l.duplicate_lines.size(),
                         line_list(l.duplicate_lines));
     text += fmt::format("      sample_time: {}\n      velocity: {}\n      columns:\n", number_text(l.log.meta.sample_time),
                         l.log.meta.velocity == Velocity::measured ? "measured" : "differentiated");
-    for (const auto& [column, source] : l.columns) text += fmt::format("        {}: {}\n", column, quoted(source));
+    for (const auto& [column, source] : l.columns) text += fmt::format("        {}: {}\n", column, yaml_quoted(source));
   }
   write_file_atomically(record, text);
 
   // dataset.yaml last: it lists only files already in place.
-  int rows = 0, written = 0, stale = 0, duplicates = 0;
+  Dataset d;
+  d.dir = out;
+  d.robot = import.target.robot;
+  d.source = "imported";
+  d.split = import.split;
+  d.import.emplace();
+  d.import->inputs = static_cast<int>(result.logs.size());
   for (const ImportedLog& l : result.logs) {
-    rows += l.rows;
-    written += l.log.samples();
-    stale += static_cast<int>(l.stale_lines.size());
-    duplicates += static_cast<int>(l.duplicate_lines.size());
+    d.import->rows += l.rows;
+    d.import->written += l.log.samples();
+    d.import->stale_rows += static_cast<int>(l.stale_lines.size());
+    d.import->duplicate_rows += static_cast<int>(l.duplicate_lines.size());
+    d.imported.push_back({l.log.meta.trajectory + ".csv", l.rows, static_cast<int>(l.stale_lines.size()),
+                          static_cast<int>(l.duplicate_lines.size()), l.log.meta.sample_time,
+                          l.log.meta.velocity == Velocity::measured ? "measured" : "differentiated"});
   }
-  text = fmt::format("format: symoro-dataset 1\nrobot: {}\nsource: imported\n", quoted(import.target.robot));
-  if (import.split > 0) text += fmt::format("split: {}\n", number_text(import.split));
-  text += fmt::format("import: {{inputs: {}, rows: {}, written: {}, stale_rows: {}, duplicate_rows: {}}}\n",
-                      result.logs.size(), rows, written, stale, duplicates);
-  text += "imported:\n";
-  for (const ImportedLog& l : result.logs)
-    text += fmt::format("  - {{file: {}, rows: {}, stale_rows: {}, duplicate_rows: {}, sample_time: {}, velocity: {}}}\n",
-                        quoted(l.log.meta.trajectory + ".csv"), l.rows, l.stale_lines.size(), l.duplicate_lines.size(),
-                        number_text(l.log.meta.sample_time),
-                        l.log.meta.velocity == Velocity::measured ? "measured" : "differentiated");
-  text += "runs:\n";
-  for (const DatasetImportResult::Run& r : result.runs) {
-    text += fmt::format("  - {{trajectory: {}, family: {}, trial: 1, file: {}", quoted(r.trajectory), r.family,
-                        quoted(r.file.filename().string()));
-    if (std::isfinite(r.window_start) || std::isfinite(r.window_end))
-      text += fmt::format(", window: [{}, {}]", yaml_number(r.window_start), yaml_number(r.window_end));
-    text += "}\n";
-  }
-  write_file_atomically(manifest, text);
+  for (const DatasetImportResult::Run& r : result.runs)
+    d.runs.push_back({r.trajectory, r.family, 1, r.file.filename(), r.window_start, r.window_end});
+  write_dataset(d);
   result.dataset = manifest;
   return result;
 }

@@ -138,6 +138,7 @@ struct StudyResult {
   std::vector<ValidationRecord> validation;
   Eigen::VectorXd truth;                  // the twin's true parameters (empty for real data)
   std::string data_source;                // e.g. "twin (robots/crane_x7/twin.yaml, config ...)"
+  std::string data_twin, data_twin_overrides;  // the dataset's twin and overrides ("" for real data)
   // What the chain did and skipped, one line each (e.g. "CLIE: not run: no controller
   // description (robots/x/controller.yaml)"), for the report.
   std::vector<std::string> stages;

@@ -2,7 +2,7 @@
 // whitespace-separated text, with or without a header row, '#' comment lines, any sample
 // rate, irregular stamps. A mapping says which columns hold time, q, qd (optional), tau and
 // the optional references, and in which units; the importer converts to the project's log
-// (log.hpp, SI units) and writes a dataset folder (identify/dataset.hpp) of one log per input.
+// (log.hpp, SI units) and writes a dataset folder (dataset.hpp) of one log per input.
 //
 // Column selectors (the mapping's values):
 //   by header name:  "t" (one column), "pos_*" ('*' = joint number 1..n), "pos_%" ('%' = 0..n-1),
