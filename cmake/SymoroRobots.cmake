@@ -53,7 +53,7 @@ function(symoro_add_robot_identification name count)
   add_library(${target} STATIC ${units})
   add_library(symoro::${name}_identification ALIAS ${target})
   target_link_libraries(${target} PUBLIC symoro_robot_${name} symoro_identify)
-  set_target_properties(${target} PROPERTIES EXPORT_NAME ${name}_identification)
+  set_target_properties(${target} PROPERTIES EXPORT_NAME ${name}_identification POSITION_INDEPENDENT_CODE ON)
   install(TARGETS ${target} EXPORT symoroTargets ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR})
 endfunction()
 

@@ -15,14 +15,13 @@
 
 #include "dynid_identify.hpp"
 #include "dynid_numbers.hpp"
-#include "symoro/control/description.hpp"
 #include "symoro/identify/report.hpp"
+#include "symoro/identify/robot_folder.hpp"
 #include "symoro/identify/study.hpp"
 #include "symoro/identify/validation_io.hpp"
 #include "symoro/io/folder_lock.hpp"
 #include "symoro/io/parameters_yaml.hpp"
 #include "symoro/parallel/farm.hpp"
-#include "symoro/trajectory/design.hpp"
 #include "symoro/twin/config.hpp"
 
 namespace symoro::dynid {
@@ -91,15 +90,7 @@ identify::StudyResult study(const Common& common, const IdentifyOptions& o,
   };
   // What switches on the closed-loop stages: the robot's controller description (CLIE and
   // closed-loop validation) and its trajectory design (references for logs without them).
-  const std::vector<JointInfo>& joints = d.joints;
-  identify::ClosedLoopSource loop;
-  const auto controller_path = common.robot_dir() / control::controller_file_name();
-  if (std::filesystem::exists(controller_path))
-    loop.setup = identify::closed_loop_setup(control::read_controller_description(controller_path, d.nq));
-  else
-    loop.why = fmt::format("no controller description ({} not found)", controller_path.string());
-  const auto design_path = common.design_path();
-  if (std::filesystem::exists(design_path)) loop.design = trajectory::TrajectoryDesign::read(design_path, joints);
+  identify::ClosedLoopSource loop = identify::closed_loop_source(common.robot_dir(), d, common.design_path());
   identify::Study s(model, so, std::move(loop));
   identify::StudyResult result = s.run();
   // On twin data the truth is known: the twin's standard parameters mapped to the identified

@@ -4,10 +4,10 @@
 #include <filesystem>
 
 #include <fmt/format.h>
-#include <yaml-cpp/yaml.h>
 
 #include "dynid_dispatch.hpp"
 #include "symoro/error.hpp"
+#include "symoro/identify/robot_folder.hpp"
 #include "symoro/io/digest.hpp"
 
 namespace symoro::dynid {
@@ -32,27 +32,7 @@ void check_robot_folder(const Common& common) {
 
 bool nominal_standard_parameters(const Common& common, const std::vector<StandardParameterInfo>& standard,
                                  std::vector<double>& values) {
-  const std::filesystem::path yaml = common.robot_dir() / "robot.yaml";
-  YAML::Node nominal;
-  try {
-    nominal = YAML::LoadFile(yaml.string())["nominal"];
-  } catch (const YAML::Exception& e) {
-    throw UsageError(yaml.string() + ": " + e.what());
-  }
-  if (!nominal || !nominal.IsMap()) return false;
-  auto rigid = [](const std::string& f) {
-    for (const char* r : {"XX", "XY", "XZ", "YY", "YZ", "ZZ", "MX", "MY", "MZ", "M", "IA", "FV", "FS"})
-      if (f == r) return true;
-    return false;
-  };
-  values.assign(standard.size(), 0.0);
-  std::string missing;
-  for (std::size_t i = 0; i < standard.size(); ++i) {
-    if (const YAML::Node v = nominal[standard[i].name]) values[i] = v.as<double>();
-    else if (rigid(standard[i].family)) missing += std::string(missing.empty() ? "" : ", ") + standard[i].name;
-  }
-  if (!missing.empty()) throw UsageError(yaml.string() + ": nominal lacks " + missing);
-  return true;
+  return identify::nominal_standard_parameters(common.robot_dir(), standard, values);
 }
 
 }  // namespace symoro::dynid

@@ -160,11 +160,17 @@ class StudyRun {
       for (Slot& s : slots)  // the runs the task did not finish
         if (s.trajectory == name && !s.record) finish(s, failed(s.trajectory, s.interval, e.failure));
     };
+    farm.stop = o_.stop;
     parallel::FarmOptions fo;
     fo.workers = o_.threads;
     fo.isolate = o_.isolate;
     fo.rank_timeout = o_.rank_timeout;
     const parallel::FarmSummary farmed = parallel::run_farm(tasks, farm, fo);
+    if (farmed.stopped) {
+      const auto saved = std::count_if(slots.begin(), slots.end(), [](const Slot& s) { return s.record && !s.record->failed; });
+      throw StudyStopped(fmt::format("the study was stopped: {} of {} runs are saved in {}; run it again to resume", saved,
+                                     slots.size(), (o_.out / "runs").string()));
+    }
     out.threads = farmed.workers;
     out.ranks = farmed.ranks;
     if (!parallel::place().coordinator()) return out;  // rank 0 gathers the records and goes on

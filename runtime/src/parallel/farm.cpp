@@ -190,9 +190,16 @@ FarmSummary run_local(const std::vector<std::string>& tasks, const Farm& farm, c
   summary.workers = std::min(detail::worker_count(o, 1), std::max(1, static_cast<int>(tasks.size())));
   summary.tasks.resize(tasks.size());
   std::mutex m;  // one callback at a time
-  std::atomic<std::size_t> next{0};
+  std::size_t next = 0;  // under m
   auto worker = [&] {
-    for (std::size_t i; (i = next++) < tasks.size();) {
+    for (;;) {
+      std::size_t i = 0;
+      {
+        std::lock_guard<std::mutex> lock(m);
+        if (!summary.stopped && next < tasks.size() && farm.stop && farm.stop()) summary.stopped = true;
+        if (summary.stopped || next >= tasks.size()) return;
+        i = next++;
+      }
       TaskEnd e = detail::run_task(farm, tasks[i], o.isolate, [&](const std::string& r) {
         std::lock_guard<std::mutex> lock(m);
         if (farm.on_result) farm.on_result(i, r);
@@ -206,6 +213,7 @@ FarmSummary run_local(const std::vector<std::string>& tasks, const Farm& farm, c
   std::vector<std::thread> pool;
   for (int w = 0; w < summary.workers; ++w) pool.emplace_back(worker);
   for (auto& t : pool) t.join();
+  for (std::size_t i = next; i < tasks.size(); ++i) summary.tasks[i] = TaskEnd{i, 0, true, "stopped"};
   return summary;
 }
 

@@ -22,6 +22,7 @@
 #pragma once
 
 #include <memory>
+#include <stdexcept>
 #include <optional>
 #include <string>
 #include <utility>
@@ -42,6 +43,11 @@ struct ClosedLoopSource {
   std::optional<ClosedLoopSetup> setup;
   std::optional<trajectory::TrajectoryDesign> design;
   std::string why;  // e.g. "no controller description (robots/x/controller.yaml not found)"
+};
+
+// Study::run when StudyOptions::stop said so: the finished runs are saved; a rerun resumes.
+struct StudyStopped : std::runtime_error {
+  using std::runtime_error::runtime_error;
 };
 
 // The study of one model (any robot: its IdentificationModel; identification_model<Model>() for

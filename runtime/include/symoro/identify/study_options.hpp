@@ -110,6 +110,10 @@ struct StudyOptions {
   // Progress: the number of runs and of those already finished, then each new run as it ends.
   std::function<void(int total, int skipped)> on_start;
   std::function<void(const RunRecord&)> on_run;
+  // Asked (on the coordinator, from any thread) before each trajectory's runs start: true stops
+  // the study. The runs in progress finish and are saved, no other starts, and Study::run throws
+  // StudyStopped; a rerun resumes. Not asked under MPI.
+  std::function<bool()> stop;
 
   // The options a run's result depends on, as text for its fingerprint.
   std::string describe() const;

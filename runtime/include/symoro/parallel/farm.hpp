@@ -70,12 +70,18 @@ struct Farm {
   std::function<void(std::size_t task, const std::string& result)> on_result;
   // Rank 0 only, one call at a time, after the task's last result.
   std::function<void(const TaskEnd&)> on_end;
+  // Rank 0 only, one call at a time with the others, before each task is handed out: true
+  // stops the farm. No further task starts (those not started end failed, "stopped"); the tasks
+  // in flight finish and their results arrive. Honoured by the local farm (threads or isolated
+  // processes); under MPI it is not asked.
+  std::function<bool()> stop;
 };
 
 struct FarmSummary {
   int ranks = 1;
   int workers = 1;  // worker threads per rank (on rank 0)
   std::vector<TaskEnd> tasks;  // rank 0: one per task, in list order
+  bool stopped = false;        // Farm::stop said so: some tasks did not run
 };
 
 // Runs every task of rank 0's list; the other ranks' lists are not read (they receive their
