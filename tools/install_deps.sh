@@ -13,6 +13,7 @@ packages=(
   liburdfdom-dev liburdfdom-tools  # symoroc model reads URDFs (urdfdom); the export tests read them back (check_urdf)
   libtinyxml-dev  # symoroc model names the line of a malformed URDF (urdfdom's own XML parser)
   liborocos-kdl-dev  # the tests compare URDF models against KDL, an independent rigid-body library
+  python3-dev pybind11-dev python3-numpy python3-pytest  # the Python package (python/) and its tests
 )
 missing=()
 for p in "${packages[@]}"; do

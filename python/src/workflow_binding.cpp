@@ -1,0 +1,373 @@
+// The workflow from Python (docs/python.md): import a controller's export into a dataset, and
+// run the identification study with dynid identify's options, its results as Python objects.
+// A study runs in a thread of its own while the calling thread waits with the GIL released and
+// checks for Ctrl-C: KeyboardInterrupt stops it cleanly (StudyOptions::stop: the runs in
+// progress finish and are saved, a rerun resumes).
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <condition_variable>
+#include <mutex>
+#include <optional>
+#include <thread>
+
+#include <fmt/format.h>
+#include <pybind11/eigen.h>
+#include <pybind11/stl.h>
+#include <pybind11/stl/filesystem.h>
+
+#include "arrays.hpp"
+#include "symoro/identify/report.hpp"
+#include "symoro/identify/robot_folder.hpp"
+#include "symoro/identify/study.hpp"
+#include "symoro/identify/validation_io.hpp"
+#include "symoro/io/folder_lock.hpp"
+#include "symoro/io/import.hpp"
+#include "symoro/io/parameters_yaml.hpp"
+
+namespace symoro::python {
+
+std::shared_ptr<const identify::IdentificationModel> identification_of(py::handle model);
+
+namespace {
+
+template <class E>
+E choice(const std::string& value, const char* name, std::initializer_list<std::pair<const char*, E>> choices) {
+  std::string list;
+  for (const auto& [text, e] : choices) {
+    if (value == text) return e;
+    list += (list.empty() ? "" : ", ") + std::string(text);
+  }
+  throw py::value_error(fmt::format("{}: '{}' is not one of {}", name, value, list));
+}
+
+py::dict run_record(const identify::RunRecord& r) {
+  py::dict d;
+  d["id"] = r.id();
+  d["trajectory"] = r.trajectory;
+  d["interval"] = r.interval;
+  d["failed"] = r.failed;
+  d["failure"] = r.failure;
+  d["samples"] = r.samples;
+  d["kappa"] = r.kappa;
+  d["route"] = r.route;
+  d["residual_rms"] = r.residual_rms;
+  d["phi_ols"] = r.phi_ols;
+  d["std_ols"] = r.std_ols;
+  d["ols_lambda_min"] = r.ols_lambda_min;
+  d["eps"] = r.eps;
+  d["phi_sdp"] = r.phi_sdp;
+  d["clie_ran"] = r.clie_ran;
+  d["phi_clie"] = r.phi_clie;
+  d["clie_termination"] = r.clie_termination;
+  d["clie_iterations"] = r.clie_iterations;
+  d["clie_lambda_min"] = r.clie_lambda_min;
+  d["clie_pd"] = r.clie_pd;
+  return d;
+}
+
+py::dict validation_record(const identify::ValidationRecord& v) {
+  py::dict d;
+  d["trajectory"] = v.trajectory;
+  d["kind"] = v.kind;
+  d["note"] = v.note;
+  d["interval"] = v.interval;
+  d["rmse_clie"] = v.rmse_clie;
+  d["rmse_rescue"] = v.rmse_rescue;
+  d["mne_clie"] = v.mne_clie;
+  d["mne_rescue"] = v.mne_rescue;
+  d["rmse_joint_rescue"] = v.rmse_joint_rescue;
+  d["nrmse_joint_rescue"] = v.nrmse_joint_rescue;
+  d["raw_rmse_rescue"] = v.raw_rmse_rescue;
+  d["raw_rmse_joint_rescue"] = v.raw_rmse_joint_rescue;
+  d["time"] = v.time;
+  d["tau_measured"] = v.tau_measured;
+  d["tau_rescue"] = v.tau_rescue;
+  return d;
+}
+
+// Runs `work` in a thread of its own; this thread waits with the GIL released, checking every
+// 50 ms for a signal. On KeyboardInterrupt (or another signal handler's exception) it sets
+// `stop`, waits for `work` to end, and raises that exception.
+template <class Work>
+void run_interruptible(std::atomic<bool>& stop, Work&& work) {
+  std::mutex m;
+  std::condition_variable cv;
+  bool done = false;
+  std::exception_ptr error;
+  std::thread t([&] {
+    try {
+      work();
+    } catch (...) {
+      error = std::current_exception();
+    }
+    std::lock_guard<std::mutex> lock(m);
+    done = true;
+    cv.notify_all();
+  });
+  bool interrupted = false;
+  for (;;) {
+    {
+      py::gil_scoped_release release;
+      std::unique_lock<std::mutex> lock(m);
+      if (cv.wait_for(lock, std::chrono::milliseconds(50), [&] { return done; })) break;
+    }
+    if (!interrupted && PyErr_CheckSignals() != 0) {
+      interrupted = true;  // the exception stays set until the study has stopped
+      stop = true;
+    }
+  }
+  {
+    py::gil_scoped_release release;
+    t.join();
+  }
+  if (interrupted) throw py::error_already_set();
+  if (error) std::rethrow_exception(error);
+}
+
+}  // namespace
+
+void bind_workflow(py::module_& m) {
+  m.def("import_logs", [](py::handle model, const std::filesystem::path& out, const std::vector<std::filesystem::path>& files,
+                          const std::string& time, const std::string& q, const std::string& tau, const std::string& qd,
+                          const std::string& q_ref, const std::string& qd_ref, const std::string& qdd_ref,
+                          const std::string& time_unit, const std::string& angle, double torque_scale, const std::string& header,
+                          const std::string& delimiter, const std::optional<std::filesystem::path>& mapping, const std::vector<std::string>& names,
+                          const std::vector<std::filesystem::path>& heldout, double split, bool allow_implausible) {
+    const identify::ModelDescription& d = identification_of(model)->description();
+    io::DatasetImport di;
+    di.target.robot = d.robot;
+    for (const JointInfo& j : d.joints) {
+      di.target.joints.emplace_back(j.name);
+      di.target.prismatic.push_back(j.type == JointType::Prismatic);
+      di.target.lower.push_back(j.lower);
+      di.target.upper.push_back(j.upper);
+    }
+    // As dynid import: the arguments over the mapping file's settings (or the defaults).
+    io::ImportMapping& mp = di.mapping;
+    if (mapping) mp = io::read_import_mapping(*mapping);
+    for (const auto& [text, target] : std::vector<std::pair<const std::string*, std::string*>>{
+             {&time, &mp.time}, {&q, &mp.q}, {&qd, &mp.qd}, {&tau, &mp.tau}, {&q_ref, &mp.q_ref}, {&qd_ref, &mp.qd_ref},
+             {&qdd_ref, &mp.qdd_ref}})
+      if (!text->empty()) *target = *text;
+    if (!time_unit.empty())
+      mp.time_unit = choice<io::TimeUnit>(time_unit, "time_unit", {{"s", io::TimeUnit::s}, {"ms", io::TimeUnit::ms},
+                                                                    {"us", io::TimeUnit::us}, {"ns", io::TimeUnit::ns}});
+    if (!angle.empty()) mp.angle_unit = choice<io::AngleUnit>(angle, "angle", {{"rad", io::AngleUnit::rad}, {"deg", io::AngleUnit::deg}});
+    if (torque_scale != 0) mp.torque_scale = torque_scale;
+    if (!header.empty())
+      mp.header = choice<io::HeaderRow>(header, "header", {{"auto", io::HeaderRow::automatic}, {"yes", io::HeaderRow::present},
+                                                           {"no", io::HeaderRow::absent}});
+    if (!delimiter.empty())
+      mp.delimiter = choice<io::Delimiter>(delimiter, "delimiter", {{"auto", io::Delimiter::automatic}, {"comma", io::Delimiter::comma},
+                                                                     {"semicolon", io::Delimiter::semicolon},
+                                                                     {"whitespace", io::Delimiter::whitespace}});
+    if (mp.time.empty() || mp.q.empty() || mp.tau.empty())
+      throw py::value_error("say which columns hold time, q and tau: time=, q=, tau=, or mapping='map.yaml'");
+    if (!names.empty() && names.size() != files.size())
+      throw py::value_error(fmt::format("names: {} names for {} input files", names.size(), files.size()));
+    for (const auto& h : heldout)
+      if (std::find(files.begin(), files.end(), h) == files.end())
+        throw py::value_error(fmt::format("heldout: {} is not one of the input files", h.string()));
+    di.split = split;
+    di.allow_implausible = allow_implausible;
+    for (std::size_t i = 0; i < files.size(); ++i)
+      di.inputs.push_back({files[i], names.empty() ? "" : names[i], std::find(heldout.begin(), heldout.end(), files[i]) != heldout.end()});
+    io::DatasetImportResult r;
+    {
+      py::gil_scoped_release release;
+      r = io::import_dataset(out, di);
+    }
+    py::list logs;
+    for (const io::ImportedLog& l : r.logs) {
+      py::dict x;
+      x["input"] = l.input;
+      x["name"] = l.log.meta.trajectory;
+      x["rows"] = l.rows;
+      x["samples"] = l.log.samples();
+      x["stale_rows"] = l.stale_lines.size();
+      x["duplicate_rows"] = l.duplicate_lines.size();
+      x["sample_time"] = l.log.meta.sample_time;
+      x["velocity"] = l.log.meta.velocity == io::Velocity::measured ? "measured" : "differentiated";
+      logs.append(x);
+    }
+    py::list runs;
+    for (const auto& run : r.runs) {
+      py::dict x;
+      x["trajectory"] = run.trajectory;
+      x["family"] = run.family;
+      x["file"] = run.file;
+      x["window"] = py::make_tuple(run.window_start, run.window_end);
+      runs.append(x);
+    }
+    py::dict result;
+    result["dataset"] = r.dataset;
+    result["logs"] = logs;
+    result["runs"] = runs;
+    return result;
+  }, py::arg("model"), py::arg("out"), py::arg("files"), py::kw_only(), py::arg("time") = "", py::arg("q") = "",
+     py::arg("tau") = "", py::arg("qd") = "", py::arg("q_ref") = "", py::arg("qd_ref") = "", py::arg("qdd_ref") = "",
+     py::arg("time_unit") = "", py::arg("angle") = "", py::arg("torque_scale") = 0.0, py::arg("header") = "",
+     py::arg("delimiter") = "", py::arg("mapping") = py::none(), py::arg("names") = std::vector<std::string>{},
+     py::arg("heldout") = std::vector<std::filesystem::path>{}, py::arg("split") = 0.0, py::arg("allow_implausible") = false);
+
+  m.def("identify", [](py::handle model, const std::filesystem::path& data, const std::filesystem::path& out,
+                       const std::optional<std::filesystem::path>& robot_dir_arg,
+                       const std::optional<std::filesystem::path>& design_arg,
+                       const std::vector<std::string>& only, const std::vector<std::string>& validation,
+                       const std::vector<double>& intervals_ms, int jobs, int trial, bool weighted, bool fresh,
+                       bool in_process, double torque_delay_ms, int clie_iterations, double clie_std_bound,
+                       double clie_noise_floor, const std::string& projection_metric, const std::string& consistency,
+                       bool physical_start, const std::string& rescue_metric, py::object rescue_prior,
+                       double rescue_prior_weight, const std::vector<double>& rescue_prior_weights, double validation_ms,
+                       bool report, py::object progress) {
+    const std::shared_ptr<const identify::IdentificationModel> id = identification_of(model);
+    const identify::ModelDescription& d = id->description();
+    const std::filesystem::path robot_dir = robot_dir_arg.value_or(""), design = design_arg.value_or("");
+    // As dynid identify (runtime/tools/dynid_identify.cpp): the same options, the same defaults.
+    identify::StudyOptions so;
+    so.data = data;
+    so.out = out;
+    so.trial = trial;
+    so.threads = jobs;
+    so.fresh = fresh;
+    so.isolate = !in_process;
+    so.trajectories = only;
+    so.validation = validation;
+    if (!intervals_ms.empty()) {
+      so.intervals.clear();
+      for (double ms : intervals_ms) so.intervals.push_back(ms / 1000);
+    }
+    so.least_squares.weighted = weighted;
+    so.preprocess.torque_delay = torque_delay_ms / 1000;
+    so.clie.max_iterations = clie_iterations;
+    so.clie.std_bound = clie_std_bound;
+    so.clie.noise_floor = clie_noise_floor;
+    so.projection_metric = identify::projection_metric_from_string(projection_metric);
+    so.consistency = identify::consistency_from_string(consistency);
+    so.physical_start = physical_start;
+    if (physical_start && so.consistency != identify::Consistency::physical)
+      throw py::value_error("physical_start needs consistency='physical'");
+    so.rescue_metric_all_runs = choice<bool>(rescue_metric, "rescue_metric", {{"all", true}, {"run", false}});
+    so.rescue_prior_weight = rescue_prior_weight;
+    so.rescue_prior_weights = rescue_prior_weights;
+    so.validation_interval = validation_ms / 1000;
+    // The rescue's prior: an array of standard parameters, a parameters file, "zero", or
+    // robot.yaml's nominal parameters ("nominal"; by default when robot.yaml has them).
+    const bool named = py::isinstance<py::str>(rescue_prior);
+    const std::string prior_name = named ? rescue_prior.cast<std::string>() : "";
+    if (!rescue_prior.is_none() && !named) {
+      const StateArg s = state_arg(rescue_prior, "rescue_prior", static_cast<int>(d.standard.size()));
+      so.rescue_prior = Eigen::Map<const Eigen::VectorXd>(s.data(), static_cast<Eigen::Index>(d.standard.size()));
+      so.rescue_prior_source = "an array given from Python";
+    } else if (rescue_prior.is_none() || prior_name == "nominal") {
+      std::vector<double> s;
+      if (!robot_dir.empty() && identify::nominal_standard_parameters(robot_dir, d.standard, s)) {
+        so.rescue_prior = Eigen::Map<const Eigen::VectorXd>(s.data(), static_cast<Eigen::Index>(s.size()));
+        so.rescue_prior_source = "robot.yaml's nominal parameters";
+      } else if (prior_name == "nominal") {
+        throw py::value_error("rescue_prior='nominal': " + (robot_dir.empty() ? std::string("no robot_dir given")
+                                                                              : (robot_dir / "robot.yaml").string() + " has no nominal parameters"));
+      }
+    } else if (prior_name != "zero") {
+      std::vector<std::string> standard;
+      for (const auto& p : d.standard) standard.push_back(p.name);
+      so.rescue_prior = io::read_parameters_yaml(prior_name, standard);
+      so.rescue_prior_source = prior_name;
+    }
+    identify::ClosedLoopSource loop;
+    if (!robot_dir.empty()) loop = identify::closed_loop_source(robot_dir, d, design);
+    else loop.why = "no robot folder given (robot_dir): no controller description";
+
+    std::atomic<bool> stop{false};
+    so.stop = [&stop] { return stop.load(); };
+    std::exception_ptr callback_error;
+    std::mutex callback_mutex;
+    if (!progress.is_none()) {
+      auto total = std::make_shared<int>(0), count = std::make_shared<int>(0);
+      so.on_start = [total, count](int t, int skipped) {
+        *total = t;
+        *count = skipped;
+      };
+      so.on_run = [&, total, count](const identify::RunRecord& r) {
+        py::gil_scoped_acquire gil;
+        try {
+          progress(++*count, *total, run_record(r));
+        } catch (py::error_already_set&) {  // the callback raised: stop, and raise it afterwards
+          std::lock_guard<std::mutex> lock(callback_mutex);
+          if (!callback_error) callback_error = std::current_exception();
+          stop = true;
+        }
+      };
+    }
+    identify::StudyResult r;
+    std::optional<io::FolderLock> lock;
+    lock.emplace(out, "symoro.identify");  // one study per folder at a time
+    try {
+      run_interruptible(stop, [&] {
+        r = identify::Study(id, so, std::move(loop)).run();
+        identify::write_validation(r, out);
+        if (report) identify::write_report(r, out / "report");
+      });
+    } catch (const identify::StudyStopped&) {
+      if (callback_error) std::rethrow_exception(callback_error);  // the callback's own exception stopped it
+      throw;
+    }
+    if (callback_error) std::rethrow_exception(callback_error);
+    // As dynid identify: a study without a model fails, after its records and report are written.
+    const auto failed = std::count_if(r.runs.begin(), r.runs.end(), [](const identify::RunRecord& run) { return run.failed; });
+    if (r.runs.empty() || failed == static_cast<long>(r.runs.size()))
+      throw std::runtime_error(fmt::format("no run of the study succeeded ({} of {} failed{}): no model was identified",
+                                           failed, r.runs.size(),
+                                           r.runs.empty() ? "" : "; the first: " + r.runs.front().id() + ": " + r.runs.front().failure));
+    if (r.selection.run < 0)
+      throw std::runtime_error(fmt::format("no representative run: {}; no model was identified",
+                                           r.selection.rule.empty() ? "no run produced a final vector" : r.selection.rule));
+
+    py::dict result;
+    result["robot"] = r.robot;
+    result["model"] = r.model.empty() ? std::string("full") : r.model;
+    result["names"] = r.names;
+    result["units"] = r.units;
+    py::list runs;
+    for (const auto& run : r.runs) runs.append(run_record(run));
+    result["runs"] = runs;
+    py::dict selection;
+    selection["run"] = r.selection.run;
+    selection["id"] = r.selection.run >= 0 ? r.runs[r.selection.run].id() : std::string();
+    selection["rule"] = r.selection.rule;
+    selection["centrality"] = r.selection.centrality;
+    result["selection"] = selection;
+    result["phi"] = r.phi_rescue;
+    py::dict parameters;
+    for (std::size_t i = 0; i < r.names.size() && static_cast<Eigen::Index>(i) < r.phi_rescue.size(); ++i)
+      parameters[py::str(r.names[i])] = r.phi_rescue[static_cast<Eigen::Index>(i)];
+    result["parameters"] = parameters;
+    result["accepted"] = r.accepted;
+    result["rescued"] = r.rescued;
+    result["consistency"] = r.consistency;
+    result["final_lambda_min"] = r.final_lambda_min;
+    result["final_consistent"] = r.final_consistent;
+    py::list valid;
+    for (const auto& v : r.validation) valid.append(validation_record(v));
+    result["validation"] = valid;
+    result["truth"] = r.truth;
+    result["stages"] = r.stages;
+    result["data_source"] = r.data_source;
+    result["out"] = out;
+    result["validation_file"] = out / "validation.yaml";
+    result["report"] = report ? py::object(py::cast(out / "report" / "report.md")) : py::none();
+    return result;
+  }, py::arg("model"), py::arg("data"), py::arg("out"), py::kw_only(), py::arg("robot_dir") = py::none(),
+     py::arg("design") = py::none(), py::arg("only") = std::vector<std::string>{},
+     py::arg("validation") = std::vector<std::string>{}, py::arg("intervals_ms") = std::vector<double>{},
+     py::arg("jobs") = 0, py::arg("trial") = 1, py::arg("weighted") = false, py::arg("fresh") = false,
+     py::arg("in_process") = false, py::arg("torque_delay_ms") = 0.0, py::arg("clie_iterations") = 25,
+     py::arg("clie_std_bound") = 0.0, py::arg("clie_noise_floor") = 0.0, py::arg("projection_metric") = "information",
+     py::arg("consistency") = "pd", py::arg("physical_start") = false, py::arg("rescue_metric") = "all",
+     py::arg("rescue_prior") = py::none(), py::arg("rescue_prior_weight") = 1e-6,
+     py::arg("rescue_prior_weights") = std::vector<double>{}, py::arg("validation_ms") = 0.0, py::arg("report") = true,
+     py::arg("progress") = py::none());
+}
+
+}  // namespace symoro::python

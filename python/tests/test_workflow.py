@@ -1,0 +1,177 @@
+"""The workflow from Python on logs synthesized here from a generated model (the RX-90, which
+has no twin), with an effect the study is not told about (a torque offset) and noise:
+import_logs as dynid import, identify as dynid identify (the same files, bit for bit), the
+project's errors with dynid's text, and a study stopped by Ctrl-C that a rerun resumes."""
+
+import os
+import pathlib
+import signal
+import subprocess
+import time
+
+import numpy as np
+import pytest
+
+import symoro
+
+ARM = symoro.models.rx90.full
+RATE = 1000.0  # Hz
+
+
+def true_phi():
+    rng = np.random.default_rng(11)
+    s = []
+    for name in ARM.standard_names:
+        f = name.rstrip("0123456789")
+        r = rng.uniform(-1, 1)
+        s.append(0.6 + 0.3 * r if f in ("XX", "YY", "ZZ") else 1.5 + 0.5 * r if f == "M"
+                 else 0.05 + 0.04 * r if f in ("IA", "FV", "FS") else 0.1 * r if f in ("MX", "MY", "MZ") else 0.01 * r)
+    return ARM.base_from_standard(np.array(s))
+
+
+def ramp(t, seconds, rise=1.0):
+    """A smooth window 0 -> 1 -> 0 (quintic rise and fall over `rise` s) and its two derivatives:
+    the logs start and end at rest, as a recording does (the study's zero-phase filter has end
+    transients on a log cut in mid-motion)."""
+    def up(x):
+        x = np.clip(x, 0, 1)
+        inside = (x > 0) & (x < 1)
+        return (10 * x**3 - 15 * x**4 + 6 * x**5, inside * (30 * x**2 - 60 * x**3 + 30 * x**4) / rise,
+                inside * (60 * x - 180 * x**2 + 120 * x**3) / rise**2)
+    a, da, dda = up(t / rise)
+    b, db, ddb = up((seconds - t) / rise)
+    return a * b, da * b - a * db, dda * b - 2 * da * db + a * ddb
+
+
+def write_export(path, seed, seconds=8.0):
+    """A controller's CSV export: time in ms, angles in degrees, with a 0.05 N m offset on joint 2
+    (not modelled) and 0.02 N m of noise."""
+    rng = np.random.default_rng(seed)
+    t = np.arange(0, seconds, 1 / RATE)
+    w, dw, ddw = ramp(t, seconds - 1 / RATE)
+    mid, half = (ARM.lower + ARM.upper) / 2, (ARM.upper - ARM.lower) / 2
+    q, qd, qdd = (np.zeros((t.size, ARM.nq)) for _ in range(3))
+    for j in range(ARM.nq):
+        for _ in range(3):
+            a, f, p = 0.12 * half[j] * rng.uniform(0.5, 1), 2 * np.pi * rng.uniform(0.1, 0.6), rng.uniform(0, 2 * np.pi)
+            s, ds, dds = a * np.sin(f * t + p), a * f * np.cos(f * t + p), -a * f * f * np.sin(f * t + p)
+            q[:, j] += w * s
+            qd[:, j] += dw * s + w * ds
+            qdd[:, j] += ddw * s + 2 * dw * ds + w * dds
+        q[:, j] += mid[j] * 0.2
+    tau = ARM.inverse_dynamics(q, qd, qdd, true_phi())
+    tau[:, 1] += 0.05
+    tau += rng.normal(0, 0.02, tau.shape)
+    cols = ["t_ms"] + [f"pos{j + 1}" for j in range(ARM.nq)] + [f"vel{j + 1}" for j in range(ARM.nq)] + \
+           [f"eff{j + 1}" for j in range(ARM.nq)]
+    data = np.column_stack([t * 1000, np.degrees(q), np.degrees(qd), tau])
+    np.savetxt(path, data, delimiter=",", header=",".join(cols), comments="", fmt="%.17g")
+
+
+MAPPING = dict(time="t_ms", q="pos*", qd="vel*", tau="eff*", time_unit="ms", angle="deg")
+CLI_MAPPING = ["--time", "t_ms", "--q", "pos*", "--qd", "vel*", "--tau", "eff*", "--time-unit", "ms", "--angle", "deg"]
+
+
+@pytest.fixture(scope="module")
+def exports(tmp_path_factory):
+    d = tmp_path_factory.mktemp("exports")
+    files = []
+    for k, name in enumerate(["r1", "r2", "r3", "check"]):
+        f = d / f"{name}.csv"
+        write_export(f, 100 + k)
+        files.append(f)
+    return files
+
+
+def run(cmd):
+    return subprocess.run([str(c) for c in cmd], capture_output=True, text=True)
+
+
+def records(study):
+    """A study's records without their wall times."""
+    out = {}
+    for f in sorted((study / "runs").glob("*.yaml")):
+        out[f.name] = [l for l in f.read_text().splitlines() if not l.lstrip().startswith("t_")]
+    return out
+
+
+def test_import_and_identify_equal_the_command_line(tmp_path, exports, dynid, source_dir):
+    robot_dir = source_dir / "robots" / "rx90"
+    r = symoro.import_logs(ARM, tmp_path / "py-data", exports, heldout=[exports[-1]], **MAPPING)
+    assert [l["name"] for l in r["logs"]] == ["r1", "r2", "r3", "check"]
+    assert [x["family"] for x in r["runs"]] == ["F", "F", "F", "V"]
+    assert r["logs"][0]["samples"] == 8000 and r["logs"][0]["velocity"] == "measured"
+    cli = run([dynid, "import", "--robot", "rx90", "--robots-dir", source_dir / "robots", "-o", tmp_path / "cli-data",
+               *exports, "--heldout", exports[-1], *CLI_MAPPING])
+    assert cli.returncode == 0, cli.stderr
+    for f in ["r1.csv", "check.csv", "r1.meta.yaml", "dataset.yaml", "import.yaml"]:
+        assert (tmp_path / "py-data" / f).read_bytes() == (tmp_path / "cli-data" / f).read_bytes(), f
+
+    seen = []
+    study = symoro.identify(ARM, tmp_path / "py-data", tmp_path / "py-study", robot_dir=robot_dir, intervals_ms=[10],
+                            jobs=1, progress=lambda done, total, run: seen.append((done, total, run["id"])))
+    assert [s[:2] for s in seen] == [(1, 3), (2, 3), (3, 3)]
+    cli = run([dynid, "identify", "--robot", "rx90", "--robots-dir", source_dir / "robots", "--data", tmp_path / "py-data",
+               "-o", tmp_path / "cli-study", "--interval", "10", "--jobs", "1"])
+    assert cli.returncode == 0, cli.stderr
+    assert records(tmp_path / "py-study") == records(tmp_path / "cli-study")
+    assert (tmp_path / "py-study" / "validation.yaml").read_bytes() == (tmp_path / "cli-study" / "validation.yaml").read_bytes()
+    assert pathlib.Path(study["report"]).exists()
+
+    # The results as Python objects, and the physics: the identified model predicts the
+    # held-out torque to near its noise, and tau = W phi holds with the accepted parameters.
+    assert study["robot"] == "rx90" and study["model"] == "full"
+    assert len(study["runs"]) == 3 and study["selection"]["id"] in [r["id"] for r in study["runs"]]
+    assert list(study["parameters"]) == ARM.parameter_names
+    np.testing.assert_array_equal(study["phi"], [study["parameters"][n] for n in ARM.parameter_names])
+    [v] = study["validation"]
+    # 0.02 N m of noise on every joint, and the unmodelled 0.05 N m offset on one
+    assert v["trajectory"] == "check" and 0.02 < v["rmse_rescue"] < 0.04
+    assert study["validation"][0]["tau_rescue"].shape[1] == ARM.nq
+
+
+def test_errors_carry_the_project_text(tmp_path, exports, dynid, source_dir):
+    bad = tmp_path / "bad.csv"
+    text = exports[0].read_text().splitlines()
+    text[5] = text[5].replace(",", ",x", 1)
+    bad.write_text("\n".join(text) + "\n")
+    with pytest.raises(symoro.DataError) as e:
+        symoro.import_logs(ARM, tmp_path / "data", [bad], **MAPPING)
+    assert e.value.file == str(bad) and e.value.line == 6
+    assert isinstance(e.value, ValueError)
+    cli = run([dynid, "import", "--robot", "rx90", "--robots-dir", source_dir / "robots", "-o", tmp_path / "cli", bad,
+               *CLI_MAPPING])
+    assert cli.returncode == 1 and cli.stderr.strip() == str(e.value)
+    assert not (tmp_path / "data").exists()  # nothing written: every input is checked first
+    with pytest.raises(ValueError, match="time_unit: 'min' is not one of s, ms, us, ns"):
+        symoro.import_logs(ARM, tmp_path / "data", exports[:1], **{**MAPPING, "time_unit": "min"})
+    with pytest.raises(symoro.DataError, match="dataset.yaml: error: not found"):
+        symoro.identify(ARM, tmp_path, tmp_path / "study")
+
+
+def test_ctrl_c_stops_a_study_and_a_rerun_resumes(tmp_path, exports, source_dir):
+    symoro.import_logs(ARM, tmp_path / "data", exports, heldout=[exports[-1]], **MAPPING)
+    calls = []
+
+    def interrupt_after_first(done, total, run):
+        calls.append(run["id"])
+        if len(calls) == 1:
+            os.kill(os.getpid(), signal.SIGINT)  # as Ctrl-C would
+            time.sleep(0.5)  # the waiting thread sees it before the next run is handed out
+
+    with pytest.raises(KeyboardInterrupt):
+        symoro.identify(ARM, tmp_path / "data", tmp_path / "study", intervals_ms=[10], jobs=1,
+                        progress=interrupt_after_first)
+    assert len(calls) == 1
+    assert len(list((tmp_path / "study" / "runs").glob("*.yaml"))) == 1  # the finished run is kept
+    seen = []
+    symoro.identify(ARM, tmp_path / "data", tmp_path / "study", intervals_ms=[10], jobs=1,
+                    progress=lambda done, total, run: seen.append((done, total)))
+    assert seen == [(2, 3), (3, 3)]  # the saved run is not done again
+    symoro.identify(ARM, tmp_path / "data", tmp_path / "fresh", intervals_ms=[10], jobs=1)
+    assert records(tmp_path / "study") == records(tmp_path / "fresh")
+    # A callback's own exception stops the study the same way, and arrives as itself.
+    with pytest.raises(ZeroDivisionError):
+        symoro.identify(ARM, tmp_path / "data", tmp_path / "other", intervals_ms=[10], jobs=1,
+                        progress=lambda done, total, run: 1 / 0)
+    assert len(list((tmp_path / "other" / "runs").glob("*.yaml"))) == 1
