@@ -116,9 +116,12 @@ void lower_robot(const RobotFiles& files, const ParameterNames& names, RobotMode
       tau(m.tau.begin(), m.tau.end());
   const Names& params = names.base;
   lower_identification_model(lower, files.dim, unite({&q, &qd, &qdd}), m);
-  m.idm = outputs(files.idm, lower.run(files.idm, unite({&q, &qd, &qdd, &params}), "inverse dynamic model (idm.txt)"), m.tau);
-  m.ccg = outputs(files.ccg, lower.run(files.ccg, unite({&q, &qd, &params}), "Coriolis and gravity model (ccg.txt)"), m.tau);
-  m.ddm = outputs(files.ddm, lower.run(files.ddm, unite({&q, &qd, &tau, &params}), "direct dynamic model (ddm.txt)"), m.qdd);
+  m.idm = outputs(files.idm, lower.run(files.idm, unite({&q, &qd, &qdd, &params}), "inverse dynamic model (idm.txt)"),
+                  m.tau);
+  m.ccg = outputs(files.ccg, lower.run(files.ccg, unite({&q, &qd, &params}), "Coriolis and gravity model (ccg.txt)"),
+                  m.tau);
+  m.ddm = outputs(files.ddm, lower.run(files.ddm, unite({&q, &qd, &tau, &params}), "direct dynamic model (ddm.txt)"),
+                  m.qdd);
   lower_inertia_matrix(lower, files.inm, unite({&q, &params}), m);
   lower_geometric_model(lower, files.fgm, q, m);
   lower_jacobian(lower, files.jac, q, m);
