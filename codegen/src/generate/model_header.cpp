@@ -19,12 +19,8 @@ std::string escape(const std::string& in) {
   return out;
 }
 
-}  // namespace
-
-std::string model_header(ModelContext& c) {
-  std::ostringstream s;
-  s << c.banner("Model description: sizes, parameters, joints, geometry.");
-  s << "#include <array>\n\n#include \"symoro/model_info.hpp\"\n\n" << c.open();
+// The model's names and sizes: nq, np, ns, nf (and ne with effects).
+void write_names_and_sizes(const ModelContext& c, std::ostringstream& s) {
   s << "inline constexpr const char* robot_name = " << quoted(c.r.name) << ";\n";
   s << "// The variant's name; empty for the robot's full model.\n";
   s << "inline constexpr const char* variant_name = " << quoted(c.variant) << ";\n";
@@ -41,6 +37,11 @@ std::string model_header(ModelContext& c) {
     s << "inline constexpr int ne = " << c.ne()
       << ";  // effect parameters (robot.yaml effects): the last ne entries of phi and of s\n";
   s << "\n";
+}
+
+// The parameter tables: identified, fixed, their parent indices, standard and effect parameters,
+// and the param:: indices into phi.
+void write_parameter_tables(const ModelContext& c, std::ostringstream& s) {
   s << "// Identified base parameters: the columns of the regressor and the entries of phi.\n";
   s << "inline constexpr std::array<ParameterInfo, np> parameters = {{\n";
   for (int p : c.identified) {
@@ -85,6 +86,10 @@ std::string model_header(ModelContext& c) {
         << cpp_literal(e.velocity) << "},\n";
     s << "}};\n\n";
   }
+}
+
+// The robot's joints, modified DH frames and gravity.
+void write_geometry(const ModelContext& c, std::ostringstream& s) {
   s << "// name, type, position limits, velocity limit, effort limit, PD-audit domain.\n";
   s << "inline constexpr std::array<JointInfo, nq> joints = {{\n";
   for (int j = 0; j < c.r.n; ++j) {
@@ -104,6 +109,17 @@ std::string model_header(ModelContext& c) {
   s << "// Gravity acceleration in frame 0 (m/s^2).\n";
   s << "inline constexpr std::array<double, 3> gravity = {{" << cpp_literal(c.r.gravity[0]) << ", "
     << cpp_literal(c.r.gravity[1]) << ", " << cpp_literal(c.r.gravity[2]) << "}};\n\n";
+}
+
+}  // namespace
+
+std::string model_header(ModelContext& c) {
+  std::ostringstream s;
+  s << c.banner("Model description: sizes, parameters, joints, geometry.");
+  s << "#include <array>\n\n#include \"symoro/model_info.hpp\"\n\n" << c.open();
+  write_names_and_sizes(c, s);
+  write_parameter_tables(c, s);
+  write_geometry(c, s);
   s << c.close();
   return s.str();
 }
