@@ -1,7 +1,8 @@
-// The generated derivative functions of a model (generator.cpp writes the headers around them):
-// inverse_dynamics_derivatives and forward_dynamics_derivatives, differentiated on the expression
-// graph (passes.hpp differentiate) and emitted with the value in one body, so that every
-// subexpression (the kinematics, the trigonometry) is computed once for all outputs.
+// The generated derivative functions of a model (generate/derivative_headers.cpp writes the
+// headers around them): inverse_dynamics_derivatives and forward_dynamics_derivatives,
+// differentiated on the expression graph (passes.hpp differentiate) and emitted with the value in
+// one body, so that every subexpression (the kinematics, the trigonometry) is computed once for
+// all outputs.
 #pragma once
 
 #include <string>
