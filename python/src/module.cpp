@@ -11,6 +11,8 @@ namespace py = pybind11;
 
 void bind_models(py::module_& m);
 void bind_workflow(py::module_& m);
+void bind_results(py::module_& m);
+void bind_export(py::module_& m);
 
 }  // namespace symoro::python
 
@@ -34,4 +36,6 @@ PYBIND11_MODULE(_symoro, m) {
   });
   symoro::python::bind_models(m);
   symoro::python::bind_workflow(m);
+  symoro::python::bind_results(m);
+  symoro::python::bind_export(m);
 }

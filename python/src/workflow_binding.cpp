@@ -315,14 +315,7 @@ void bind_workflow(py::module_& m) {
     }
     if (callback_error) std::rethrow_exception(callback_error);
     // As dynid identify: a study without a model fails, after its records and report are written.
-    const auto failed = std::count_if(r.runs.begin(), r.runs.end(), [](const identify::RunRecord& run) { return run.failed; });
-    if (r.runs.empty() || failed == static_cast<long>(r.runs.size()))
-      throw std::runtime_error(fmt::format("no run of the study succeeded ({} of {} failed{}): no model was identified",
-                                           failed, r.runs.size(),
-                                           r.runs.empty() ? "" : "; the first: " + r.runs.front().id() + ": " + r.runs.front().failure));
-    if (r.selection.run < 0)
-      throw std::runtime_error(fmt::format("no representative run: {}; no model was identified",
-                                           r.selection.rule.empty() ? "no run produced a final vector" : r.selection.rule));
+    identify::require_identified(r);
 
     py::dict result;
     result["robot"] = r.robot;

@@ -17,7 +17,8 @@
 #include "dynid_export.hpp"
 #include "dynid_urdf_into.hpp"
 #include "symoro/io/dataset.hpp"
-#include "symoro/identify/detail/physical_consistency_model.hpp"
+#include "symoro/identify/identification_model.hpp"
+#include "symoro/identify/model_export.hpp"
 #include "symoro/identify/regression.hpp"
 #include "symoro/io/atomic_file.hpp"
 #include "symoro/preprocess/preprocess.hpp"
@@ -128,76 +129,44 @@ void ExportCommand::run(const Common& common, const ExportOptions& o) {
                                    common.robot));
     }
 
-    identify::ConsistencyOptions co;
-    co.margin = o.margin;
+    identify::ModelExportOptions eo;
+    eo.prior = prior;
+    eo.prior_what = prior_what;
+    eo.study = o.study;
+    eo.accepted = accepted;
+    eo.margin = o.margin;
+    eo.nearest = o.nearest;
     std::optional<export_detail::FittingRun> fitting;
     if (!o.data.empty()) {
       fitting = export_detail::fitting_run<Parent>(params, o.data, o.trial);
-      co.base_metric_root = export_detail::torque_metric_root(fitting->reg);
+      eo.base_metric_root = export_detail::torque_metric_root(fitting->reg);
     }
-    const identify::ConsistencyResult r = identify::consistent_standard_parameters<Model>(phi, prior, co);
-    const bool nearest = r.status == identify::ConsistencyStatus::NoConsistentSet && o.nearest;
-    // Checked here, independently of the solver's own report.
-    const Eigen::VectorXd target = identify::consistency_target<Model>(phi);
-    std::string cost;
-    if (r.status == identify::ConsistencyStatus::NoConsistentSet)
-      cost = fitting ? export_detail::torque_cost(*fitting, target, r.phi_consistent)
-                     : "--data <the study's dataset> measures the torque it costs on the fitting data (and takes the "
-                       "nearest vector in that metric)";
-    if (!r.ok() && !nearest) {
-      std::string why = fmt::format("no URDF written: {} ({})", r.message, identify::to_string(r.status));
-      if (r.status == identify::ConsistencyStatus::NoConsistentSet)
-        why += fmt::format("; the nearest base vector with a consistent set is {:.4g} away (weighted): --nearest "
-                           "exports that one; {}",
-                           r.base_distance, cost);
-      throw std::runtime_error(why);
-    }
-    const Eigen::VectorXd back = Parent::base_from_standard(Eigen::Matrix<double, Parent::ns, 1>(r.s));
-    const double residual = (back - target).cwiseAbs().maxCoeff();
-
-    identify::UrdfDescription d = identify::urdf_description<Model>(r.s);
-    const std::string model_label = std::string(Model::variant_name).empty() ? "full" : Model::variant_name;
-    d.notes.push_back(fmt::format("Model: {} ({}), {} base parameters. Study: {}{}.", Model::robot_name, model_label,
-                                  Model::np, std::filesystem::absolute(o.study).lexically_normal().string(),
-                                  accepted ? "" : " (NOT accepted by its final audit)"));
-    if (nearest)
-      d.notes.push_back(fmt::format("WARNING: no consistent set reproduces the accepted base parameters ({}); these "
-                                    "inertials reproduce the nearest base vector that has one, {:.4g} away (weighted): "
-                                    "max |B s - phi| below is against the accepted vector. {}.",
-                                    r.message, r.base_distance, cost));
-    d.notes.push_back(fmt::format("Inertials: the physically consistent standard parameters (pseudo-inertia >= {} I per "
-                                  "link) nearest the prior {} that reproduce {}: max |B s - phi| = {:.3g} (phi the "
-                                  "accepted vector), smallest pseudo-inertia eigenvalue {:.6g}.",
-                                  o.margin, prior_what,
-                                  nearest ? "the nearest consistent base vector" : "the accepted base parameters",
-                                  residual, r.lambda_min));
-    const std::filesystem::path urdf = o.urdf;
-    std::filesystem::path stem = urdf;
-    stem.replace_extension();
-    const std::filesystem::path yaml = stem.string() + ".standard.yaml", csv = stem.string() + ".standard.csv";
-
-    std::string header = "# Physically consistent standard parameters (dynid export) reproducing a study's accepted base\n"
-                         "# parameters; the URDF " + urdf.filename().string() + " holds them but for IA.\n";
-    header += fmt::format("robot: \"{}\"\nmodel: \"{}\"\nstudy: \"{}\"\nprior: \"{}\"\naccepted: {}\nnearest_consistent_base: {}\nmargin: {}\n"
-                          "lambda_min: {}\nbase_residual: {}\n",
-                          Model::robot_name, model_label, o.study, prior_what, accepted, nearest, o.margin,
-                          r.lambda_min, residual);
+    eo.cost = [&](const Eigen::VectorXd& target, const Eigen::VectorXd& phi_consistent) {
+      return fitting ? export_detail::torque_cost(*fitting, target, phi_consistent)
+                     : std::string("--data <the study's dataset> measures the torque it costs on the fitting data (and takes "
+                                   "the nearest vector in that metric)");
+    };
+    const identify::ModelExport e = identify::export_model(*identify::identification_model<Model>(), phi, eo);
+    const identify::ConsistencyResult& r = e.consistency;
+    const bool nearest = e.nearest;
+    const std::string& cost = e.cost;
+    const double residual = e.residual;
+    std::string urdf_text;
     if (o.into.empty()) {
-      export_detail::write_text(urdf, identify::urdf_text(d));
+      urdf_text = identify::urdf_text(e.description);
     } else {
       std::vector<std::string> notes;
-      export_detail::write_text(urdf, urdf_into(d, (common.robot_dir() / "robot.yaml").string(), o.into, notes));
+      urdf_text = urdf_into(e.description, (common.robot_dir() / "robot.yaml").string(), o.into, notes);
       for (const auto& note : notes) fmt::print("{}\n", note);
     }
-    export_detail::write_text(yaml, identify::standard_parameters_yaml(d, header));
-    export_detail::write_text(csv, identify::standard_parameters_csv(d));
+    const identify::ModelExportFiles files = identify::write_model_export(e, o.urdf, urdf_text);
     if (nearest)
       fmt::print("WARNING: {}; exported the nearest base vector with a consistent set ({:.4g} away); {}\n", r.message,
                  r.base_distance, cost);
     fmt::print("{}: {}; max |B s - phi| = {:.3g}, lambda_min = {:.4g}, prior {}\n",
                nearest ? "standard parameters of the nearest consistent base vector" : "consistent standard parameters",
                r.message, residual, r.lambda_min, prior_what);
-    fmt::print("urdf: {}\nstandard parameters: {}, {}\n", urdf.string(), yaml.string(), csv.string());
+    fmt::print("urdf: {}\nstandard parameters: {}, {}\n", files.urdf.string(), files.yaml.string(), files.csv.string());
   }
 }
 

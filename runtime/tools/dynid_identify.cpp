@@ -147,14 +147,7 @@ void IdentifyCommand::run_model(const Common& common, const IdentifyOptions& o,
   }
   // A study without a model fails, after its records and report are written: `identify &&
   // export` must not carry on as if there were parameters.
-  const auto failed = std::count_if(r.runs.begin(), r.runs.end(), [](const identify::RunRecord& run) { return run.failed; });
-  if (r.runs.empty() || failed == static_cast<long>(r.runs.size()))
-    throw std::runtime_error(fmt::format("no run of the study succeeded ({} of {} failed{}): no model was identified",
-                                         failed, r.runs.size(),
-                                         r.runs.empty() ? "" : "; the first: " + r.runs.front().id() + ": " + r.runs.front().failure));
-  if (r.selection.run < 0)
-    throw std::runtime_error(fmt::format("no representative run: {}; no model was identified",
-                                         r.selection.rule.empty() ? "no run produced a final vector" : r.selection.rule));
+  identify::require_identified(r);
 }
 
 

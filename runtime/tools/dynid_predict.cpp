@@ -16,7 +16,7 @@
 #include "dynid_identify.hpp"
 #include "dynid_numbers.hpp"
 #include "symoro/io/dataset.hpp"
-#include "symoro/identify/raw_torque.hpp"
+#include "symoro/identify/prediction.hpp"
 #include "symoro/identify/study_options.hpp"
 #include "symoro/io/atomic_file.hpp"
 #include "symoro/io/log.hpp"
@@ -59,39 +59,24 @@ Eigen::VectorXd nominal_phi(const Common& common, const identify::Identification
   return model.base_from_standard(Eigen::Map<const Eigen::VectorXd>(s.data(), static_cast<Eigen::Index>(s.size())));
 }
 
-struct Prediction {
-  std::string name;
-  int samples = 0;
-  Eigen::VectorXd rmse, rms;  // per joint: of tau - tau_model, and of tau
-  identify::RawTorqueScore raw;  // against the raw torque at the log's own rate
-};
-
-Prediction predict_log(const io::Log& log, const std::string& name, const identify::IdentificationModel& model,
-                       const Eigen::VectorXd& phi, const PredictOptions& o, const fs::path& csv) {
-  preprocess::Options po = identify::StudyOptions{}.preprocess;
-  po.torque_delay = o.torque_delay_ms / 1000;
-  const preprocess::Samples s = preprocess::preprocess(log, o.interval_ms / 1000, po);
-  const Eigen::MatrixXd tau_model = model.open_loop_torque(s, phi);
+// The prediction of one log, its samples written to `csv`.
+identify::Prediction predict_log(const io::Log& log, const identify::IdentificationModel& model, const Eigen::VectorXd& phi,
+                                 const PredictOptions& o, const fs::path& csv) {
+  identify::Prediction p = identify::predict(log, model, phi, o.interval_ms / 1000, o.torque_delay_ms / 1000);
+  const preprocess::Samples& s = p.samples;
   const int n = static_cast<int>(s.tau.cols());
-  Prediction p;
-  p.name = name;
-  p.samples = static_cast<int>(s.tau.rows());
-  p.rmse = ((s.tau - tau_model).colwise().squaredNorm() / p.samples).cwiseSqrt().transpose();
-  p.rms = (s.tau.colwise().squaredNorm() / p.samples).cwiseSqrt().transpose();
   const auto& joints = model.description().joints;
   std::string text = "time";
   for (const char* what : {"q", "qd", "qdd", "tau", "tau_model"})
     for (int j = 0; j < n; ++j) text += fmt::format(",{}_{}", what, joints[j].name);
   text += "\n";
-  for (int k = 0; k < p.samples; ++k) {
+  for (Eigen::Index k = 0; k < s.tau.rows(); ++k) {
     text += io::number_text(s.time(k));
-    for (const Eigen::MatrixXd* m : {&s.q, &s.qd, &s.qdd, &s.tau, &tau_model})
+    for (const Eigen::MatrixXd* m : {&s.q, &s.qd, &s.qdd, &s.tau, &p.tau_model})
       for (int j = 0; j < n; ++j) text += "," + io::number_text((*m)(k, j));
     text += "\n";
   }
   io::write_file_atomically(csv, text);
-  p.raw = identify::raw_torque_error(
-      log, [&](const preprocess::Samples& m, const Eigen::VectorXd& x) { return model.open_loop_torque(m, x); }, phi);
   return p;
 }
 
@@ -145,16 +130,17 @@ void run(const Common& common, const PredictOptions& o) {
   int total = 0;
   std::string raw_filter;
   for (std::size_t i = 0; i < logs.size(); ++i) {
-    const Prediction p = predict_log(logs[i].second, logs[i].first, *model, phi, o, files[i]);
-    std::string line = fmt::format("  {:<10} {:>6} samples:", p.name, p.samples);
+    const identify::Prediction p = predict_log(logs[i].second, *model, phi, o, files[i]);
+    const int samples = static_cast<int>(p.samples.tau.rows());
+    std::string line = fmt::format("  {:<10} {:>6} samples:", logs[i].first, samples);
     for (int j = 0; j < d.nq; ++j) line += fmt::format(" {:.4f} ({:.3f})", p.rmse(j), p.rms(j));
     fmt::print("{}\n", line);
     line = fmt::format("  {:<10} {:>6} raw:    ", "", p.raw.samples);
     for (int j = 0; j < d.nq; ++j) line += fmt::format(" {:.4f}        ", p.raw.error.rmse_joint(j));
     fmt::print("{}\n", line);
     if (i + 1 == logs.size()) raw_filter = p.raw.filter;
-    sq += p.rmse.cwiseAbs2() * p.samples;
-    total += p.samples;
+    sq += p.rmse.cwiseAbs2() * samples;
+    total += samples;
   }
   if (logs.size() > 1) {
     std::string line = fmt::format("  {:<10} {:>6} samples:", "all", total);

@@ -500,4 +500,15 @@ Study::Study(std::shared_ptr<const IdentificationModel> model, StudyOptions opti
 
 StudyResult Study::run() { return StudyRun(*model_, o_, loop_).run(); }
 
+void require_identified(const StudyResult& r) {
+  const auto failed = std::count_if(r.runs.begin(), r.runs.end(), [](const RunRecord& run) { return run.failed; });
+  if (r.runs.empty() || failed == static_cast<long>(r.runs.size()))
+    throw std::runtime_error(fmt::format("no run of the study succeeded ({} of {} failed{}): no model was identified",
+                                         failed, r.runs.size(),
+                                         r.runs.empty() ? "" : "; the first: " + r.runs.front().id() + ": " + r.runs.front().failure));
+  if (r.selection.run < 0)
+    throw std::runtime_error(fmt::format("no representative run: {}; no model was identified",
+                                         r.selection.rule.empty() ? "no run produced a final vector" : r.selection.rule));
+}
+
 }  // namespace symoro::identify

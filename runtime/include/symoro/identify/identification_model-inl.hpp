@@ -89,8 +89,32 @@ class GeneratedIdentificationModel final : public IdentificationModel {
     options.prior_regularization = prior_weight;
     return identify::physical_projection<Model>(phi0, prior, metric, clearance, options);
   }
+  ConsistencyResult consistent_standard_parameters(const Eigen::VectorXd& phi, const Eigen::VectorXd& prior,
+                                                   const ConsistencyOptions& options) const override {
+    if constexpr (supports_physical_consistency<Model>())
+      return identify::consistent_standard_parameters<Model>(phi, prior, options);
+    else
+      throw std::logic_error(unsupported());
+  }
+  Eigen::VectorXd consistency_target(const Eigen::VectorXd& phi) const override {
+    if constexpr (supports_physical_consistency<Model>())
+      return identify::consistency_target<Model>(phi);
+    else
+      throw std::logic_error(unsupported());
+  }
+  Eigen::VectorXd parent_base_from_standard(const Eigen::VectorXd& s) const override {
+    if constexpr (supports_physical_consistency<Model>()) {
+      using Parent = typename Model::Parent;
+      return Parent::base_from_standard(Eigen::Matrix<double, Parent::ns, 1>(s));
+    } else {
+      throw std::logic_error(unsupported());
+    }
+  }
 
  private:
+  static std::string unsupported() {
+    return std::string("the ") + Model::variant_name + " model has effect parameters, which have no standard-parameter form";
+  }
   ModelDescription d_;
   bool has_fixed_ = false;
 };

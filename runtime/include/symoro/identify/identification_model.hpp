@@ -73,6 +73,14 @@ class IdentificationModel {
   virtual PhysicalProjection physical_projection(const Eigen::VectorXd& phi0, const Eigen::MatrixXd& metric,
                                                  double clearance, const Eigen::VectorXd& prior = {},
                                                  double prior_weight = 1e-6) const = 0;
+  // The export's solve (model_export.hpp): the consistent standard parameters nearest `prior`
+  // that reproduce phi in the full model's base (consistency_target: a variant's fixed
+  // parameters included), and the full model's base_from_standard. A model without physical
+  // consistency throws std::logic_error.
+  virtual ConsistencyResult consistent_standard_parameters(const Eigen::VectorXd& phi, const Eigen::VectorXd& prior,
+                                                           const ConsistencyOptions& options) const = 0;
+  virtual Eigen::VectorXd consistency_target(const Eigen::VectorXd& phi) const = 0;
+  virtual Eigen::VectorXd parent_base_from_standard(const Eigen::VectorXd& s) const = 0;
 };
 
 // The interface of a generated Model, one shared instance per model. Defined in

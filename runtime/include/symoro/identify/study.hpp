@@ -50,6 +50,11 @@ struct StudyStopped : std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
+// A study without a model is a failure (after its records and report are written: `identify &&
+// export` must not carry on as if there were parameters): std::runtime_error when no run
+// succeeded or none was selected.
+void require_identified(const StudyResult& result);
+
 // The study of one model (any robot: its IdentificationModel; identification_model<Model>() for
 // a generated one). Compiled once for every robot (study.cpp).
 class Study {
