@@ -72,7 +72,7 @@ identify::Prediction predict_log(const io::Log& log, const identify::Identificat
   text += "\n";
   for (Eigen::Index k = 0; k < s.tau.rows(); ++k) {
     text += io::number_text(s.time(k));
-    for (const Eigen::MatrixXd* m : {&s.q, &s.qd, &s.qdd, &s.tau, &p.tau_model})
+    for (const Eigen::MatrixXd* m : std::initializer_list<const Eigen::MatrixXd*>{&s.q, &s.qd, &s.qdd, &s.tau, &p.tau_model})
       for (int j = 0; j < n; ++j) text += "," + io::number_text((*m)(k, j));
     text += "\n";
   }

@@ -91,19 +91,19 @@ class GeneratedIdentificationModel final : public IdentificationModel {
   }
   ConsistencyResult consistent_standard_parameters(const Eigen::VectorXd& phi, const Eigen::VectorXd& prior,
                                                    const ConsistencyOptions& options) const override {
-    if constexpr (supports_physical_consistency<Model>())
+    if constexpr (identify::supports_physical_consistency<Model>())
       return identify::consistent_standard_parameters<Model>(phi, prior, options);
     else
       throw std::logic_error(unsupported());
   }
   Eigen::VectorXd consistency_target(const Eigen::VectorXd& phi) const override {
-    if constexpr (supports_physical_consistency<Model>())
+    if constexpr (identify::supports_physical_consistency<Model>())
       return identify::consistency_target<Model>(phi);
     else
       throw std::logic_error(unsupported());
   }
   Eigen::VectorXd parent_base_from_standard(const Eigen::VectorXd& s) const override {
-    if constexpr (supports_physical_consistency<Model>()) {
+    if constexpr (identify::supports_physical_consistency<Model>()) {
       using Parent = typename Model::Parent;
       return Parent::base_from_standard(Eigen::Matrix<double, Parent::ns, 1>(s));
     } else {
