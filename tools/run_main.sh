@@ -90,3 +90,10 @@ done
 $dynid diagnose --robot rx90 --model rigid --data build/rx90-data -o build/rx90-diagnosis
 $dynid compare --robot rx90 --before build/rx90-study-rigid --after build/rx90-study-full -o build/rx90-gap
 $dynid export --robot rx90 --model full --study build/rx90-study-full --urdf build/rx90_identified.urdf --prior zero --force
+
+# The same from Python (docs/python.md), when the build made the package: the example goes from
+# a CSV export of the RX-90 to an identified model, a plot and a URDF (build/python-example/).
+if [ -f build/python/symoro/__init__.py ]; then
+  rm -rf build/python-example
+  PYTHONPATH=build/python /usr/bin/python3 examples/python/identify_from_csv.py --robots-dir robots -o build/python-example
+fi
