@@ -19,15 +19,15 @@ ARM = symoro.models.rx90.full
 RATE = 1000.0  # Hz
 
 
-def true_phi():
+def true_phi(arm=ARM):
     rng = np.random.default_rng(11)
     s = []
-    for name in ARM.standard_names:
+    for name in arm.standard_names:
         f = name.rstrip("0123456789")
         r = rng.uniform(-1, 1)
         s.append(0.6 + 0.3 * r if f in ("XX", "YY", "ZZ") else 1.5 + 0.5 * r if f == "M"
                  else 0.05 + 0.04 * r if f in ("IA", "FV", "FS") else 0.1 * r if f in ("MX", "MY", "MZ") else 0.01 * r)
-    return ARM.base_from_standard(np.array(s))
+    return arm.base_from_standard(np.array(s))
 
 
 def ramp(t, seconds, rise=1.0):
@@ -44,28 +44,29 @@ def ramp(t, seconds, rise=1.0):
     return a * b, da * b - a * db, dda * b - 2 * da * db + a * ddb
 
 
-def write_export(path, seed, seconds=8.0):
-    """A controller's CSV export: time in ms, angles in degrees, with a 0.05 N m offset on joint 2
-    (not modelled) and 0.02 N m of noise."""
+def write_export(path, seed, seconds=8.0, arm=ARM):
+    """A controller's CSV export: time in ms, angles in degrees (prismatic joints in m), with a
+    0.05 N m offset on joint 2 (not modelled) and 0.02 N m of noise."""
     rng = np.random.default_rng(seed)
     t = np.arange(0, seconds, 1 / RATE)
     w, dw, ddw = ramp(t, seconds - 1 / RATE)
-    mid, half = (ARM.lower + ARM.upper) / 2, (ARM.upper - ARM.lower) / 2
-    q, qd, qdd = (np.zeros((t.size, ARM.nq)) for _ in range(3))
-    for j in range(ARM.nq):
+    mid, half = (arm.lower + arm.upper) / 2, (arm.upper - arm.lower) / 2
+    q, qd, qdd = (np.zeros((t.size, arm.nq)) for _ in range(3))
+    for j in range(arm.nq):
         for _ in range(3):
             a, f, p = 0.12 * half[j] * rng.uniform(0.5, 1), 2 * np.pi * rng.uniform(0.1, 0.6), rng.uniform(0, 2 * np.pi)
             s, ds, dds = a * np.sin(f * t + p), a * f * np.cos(f * t + p), -a * f * f * np.sin(f * t + p)
             q[:, j] += w * s
             qd[:, j] += dw * s + w * ds
             qdd[:, j] += ddw * s + 2 * dw * ds + w * dds
-        q[:, j] += mid[j] * 0.2
-    tau = ARM.inverse_dynamics(q, qd, qdd, true_phi())
+        q[:, j] += mid[j] if arm.joint_types[j] == "prismatic" else 0.2 * mid[j]
+    tau = arm.inverse_dynamics(q, qd, qdd, true_phi(arm))
     tau[:, 1] += 0.05
     tau += rng.normal(0, 0.02, tau.shape)
-    cols = ["t_ms"] + [f"pos{j + 1}" for j in range(ARM.nq)] + [f"vel{j + 1}" for j in range(ARM.nq)] + \
-           [f"eff{j + 1}" for j in range(ARM.nq)]
-    data = np.column_stack([t * 1000, np.degrees(q), np.degrees(qd), tau])
+    cols = ["t_ms"] + [f"pos{j + 1}" for j in range(arm.nq)] + [f"vel{j + 1}" for j in range(arm.nq)] + \
+           [f"eff{j + 1}" for j in range(arm.nq)]
+    unit = np.array([1.0 if kind == "prismatic" else 180 / np.pi for kind in arm.joint_types])
+    data = np.column_stack([t * 1000, q * unit, qd * unit, tau])
     np.savetxt(path, data, delimiter=",", header=",".join(cols), comments="", fmt="%.17g")
 
 
@@ -73,15 +74,18 @@ MAPPING = dict(time="t_ms", q="pos*", qd="vel*", tau="eff*", time_unit="ms", ang
 CLI_MAPPING = ["--time", "t_ms", "--q", "pos*", "--qd", "vel*", "--tau", "eff*", "--time-unit", "ms", "--angle", "deg"]
 
 
-@pytest.fixture(scope="module")
-def exports(tmp_path_factory):
-    d = tmp_path_factory.mktemp("exports")
+def make_exports(d, arm=ARM):
     files = []
     for k, name in enumerate(["r1", "r2", "r3", "check"]):
         f = d / f"{name}.csv"
-        write_export(f, 100 + k)
+        write_export(f, 100 + k, arm=arm)
         files.append(f)
     return files
+
+
+@pytest.fixture(scope="module")
+def exports(tmp_path_factory):
+    return make_exports(tmp_path_factory.mktemp("exports"))
 
 
 def run(cmd):
@@ -96,23 +100,26 @@ def records(study):
     return out
 
 
-def test_import_and_identify_equal_the_command_line(tmp_path, exports, dynid, source_dir):
-    robot_dir = source_dir / "robots" / "rx90"
-    r = symoro.import_logs(ARM, tmp_path / "py-data", exports, heldout=[exports[-1]], **MAPPING)
+@pytest.mark.parametrize("robot", ["rx90", "stanford_rrp"])  # six revolute joints; two and a prismatic one
+def test_import_and_identify_equal_the_command_line(tmp_path, robot, dynid, source_dir):
+    arm = getattr(symoro.models, robot).full
+    exports = make_exports(tmp_path, arm)
+    robot_dir = source_dir / "robots" / robot
+    r = symoro.import_logs(arm, tmp_path / "py-data", exports, heldout=[exports[-1]], **MAPPING)
     assert [l["name"] for l in r["logs"]] == ["r1", "r2", "r3", "check"]
     assert [x["family"] for x in r["runs"]] == ["F", "F", "F", "V"]
     assert r["logs"][0]["samples"] == 8000 and r["logs"][0]["velocity"] == "measured"
-    cli = run([dynid, "import", "--robot", "rx90", "--robots-dir", source_dir / "robots", "-o", tmp_path / "cli-data",
+    cli = run([dynid, "import", "--robot", robot, "--robots-dir", source_dir / "robots", "-o", tmp_path / "cli-data",
                *exports, "--heldout", exports[-1], *CLI_MAPPING])
     assert cli.returncode == 0, cli.stderr
     for f in ["r1.csv", "check.csv", "r1.meta.yaml", "dataset.yaml", "import.yaml"]:
         assert (tmp_path / "py-data" / f).read_bytes() == (tmp_path / "cli-data" / f).read_bytes(), f
 
     seen = []
-    study = symoro.identify(ARM, tmp_path / "py-data", tmp_path / "py-study", robot_dir=robot_dir, intervals_ms=[10],
+    study = symoro.identify(arm, tmp_path / "py-data", tmp_path / "py-study", robot_dir=robot_dir, intervals_ms=[10],
                             jobs=1, progress=lambda done, total, run: seen.append((done, total, run["id"])))
     assert [s[:2] for s in seen] == [(1, 3), (2, 3), (3, 3)]
-    cli = run([dynid, "identify", "--robot", "rx90", "--robots-dir", source_dir / "robots", "--data", tmp_path / "py-data",
+    cli = run([dynid, "identify", "--robot", robot, "--robots-dir", source_dir / "robots", "--data", tmp_path / "py-data",
                "-o", tmp_path / "cli-study", "--interval", "10", "--jobs", "1"])
     assert cli.returncode == 0, cli.stderr
     assert records(tmp_path / "py-study") == records(tmp_path / "cli-study")
@@ -121,14 +128,16 @@ def test_import_and_identify_equal_the_command_line(tmp_path, exports, dynid, so
 
     # The results as Python objects, and the physics: the identified model predicts the
     # held-out torque to near its noise, and tau = W phi holds with the accepted parameters.
-    assert study["robot"] == "rx90" and study["model"] == "full"
+    assert study["robot"] == robot and study["model"] == "full"
     assert len(study["runs"]) == 3 and study["selection"]["id"] in [r["id"] for r in study["runs"]]
-    assert list(study["parameters"]) == ARM.parameter_names
-    np.testing.assert_array_equal(study["phi"], [study["parameters"][n] for n in ARM.parameter_names])
+    assert list(study["parameters"]) == arm.parameter_names
+    np.testing.assert_array_equal(study["phi"], [study["parameters"][n] for n in arm.parameter_names])
     [v] = study["validation"]
-    # 0.02 N m of noise on every joint, and the unmodelled 0.05 N m offset on one
-    assert v["trajectory"] == "check" and 0.02 < v["rmse_rescue"] < 0.04
-    assert study["validation"][0]["tau_rescue"].shape[1] == ARM.nq
+    # 0.02 N m of noise on every joint, and the unmodelled 0.05 N m offset on one of nq: against
+    # the raw torque, about their sum (the study's own, filtered torque has less of the noise).
+    bound = 1.3 * np.sqrt(0.02**2 + 0.05**2 / arm.nq)
+    assert v["trajectory"] == "check" and v["rmse_rescue"] < bound and 0.018 < v["raw_rmse_rescue"] < bound
+    assert study["validation"][0]["tau_rescue"].shape[1] == arm.nq
 
 
 def read_csv_columns(path):
