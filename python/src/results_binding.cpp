@@ -104,15 +104,11 @@ void bind_results(py::module_& m) {
     const identify::StudyValidation before = identify::read_validation(before_dir);
     const identify::StudyValidation after = identify::read_validation(after_dir);
     const diagnose::GapComparison c = diagnose::compare_studies(before, after);
-    diagnose::GapReportOptions ro;  // labelled as dynid compare labels them
-    ro.before_label = before_dir.filename().string();
-    ro.after_label = after_dir.filename().string();
-    if (ro.before_label.empty() || ro.before_label == ro.after_label) ro.before_label = "before", ro.after_label = "after";
-    ro.figure_trajectory = trajectory;
-    for (int j : joints) {
-      if (j < 1 || j > c.joint_before.size())
-        throw py::value_error(fmt::format("joints: joint {} is not in 1..{}", j, c.joint_before.size()));
-      ro.figure_joints.push_back(j - 1);
+    diagnose::GapReportOptions ro;
+    try {
+      ro = diagnose::gap_report_options(before_dir, after_dir, c, trajectory, joints);
+    } catch (const std::invalid_argument& e) {
+      throw py::value_error(fmt::format("joints: {}", e.what()));
     }
     diagnose::write_gap_report(before, after, c, out, ro);
     py::list trajectories;

@@ -136,32 +136,11 @@ void bind_workflow(py::module_& m) {
                           const std::vector<std::filesystem::path>& heldout, double split, bool allow_implausible) {
     const identify::ModelDescription& d = identification_of(model)->description();
     io::DatasetImport di;
-    di.target.robot = d.robot;
-    for (const JointInfo& j : d.joints) {
-      di.target.joints.emplace_back(j.name);
-      di.target.prismatic.push_back(j.type == JointType::Prismatic);
-      di.target.lower.push_back(j.lower);
-      di.target.upper.push_back(j.upper);
-    }
+    di.target = io::import_target(d.robot, d.joints);
     // As dynid import: the arguments over the mapping file's settings (or the defaults).
     io::ImportMapping& mp = di.mapping;
     if (mapping) mp = io::read_import_mapping(*mapping);
-    for (const auto& [text, target] : std::vector<std::pair<const std::string*, std::string*>>{
-             {&time, &mp.time}, {&q, &mp.q}, {&qd, &mp.qd}, {&tau, &mp.tau}, {&q_ref, &mp.q_ref}, {&qd_ref, &mp.qd_ref},
-             {&qdd_ref, &mp.qdd_ref}})
-      if (!text->empty()) *target = *text;
-    if (!time_unit.empty())
-      mp.time_unit = choice<io::TimeUnit>(time_unit, "time_unit", {{"s", io::TimeUnit::s}, {"ms", io::TimeUnit::ms},
-                                                                    {"us", io::TimeUnit::us}, {"ns", io::TimeUnit::ns}});
-    if (!angle.empty()) mp.angle_unit = choice<io::AngleUnit>(angle, "angle", {{"rad", io::AngleUnit::rad}, {"deg", io::AngleUnit::deg}});
-    if (torque_scale != 0) mp.torque_scale = torque_scale;
-    if (!header.empty())
-      mp.header = choice<io::HeaderRow>(header, "header", {{"auto", io::HeaderRow::automatic}, {"yes", io::HeaderRow::present},
-                                                           {"no", io::HeaderRow::absent}});
-    if (!delimiter.empty())
-      mp.delimiter = choice<io::Delimiter>(delimiter, "delimiter", {{"auto", io::Delimiter::automatic}, {"comma", io::Delimiter::comma},
-                                                                     {"semicolon", io::Delimiter::semicolon},
-                                                                     {"whitespace", io::Delimiter::whitespace}});
+    io::apply_settings(mp, {time, q, qd, tau, q_ref, qd_ref, qdd_ref, time_unit, angle, header, delimiter, torque_scale});
     if (mp.time.empty() || mp.q.empty() || mp.tau.empty())
       throw py::value_error("say which columns hold time, q and tau: time=, q=, tau=, or mapping='map.yaml'");
     if (!names.empty() && names.size() != files.size())
@@ -211,6 +190,8 @@ void bind_workflow(py::module_& m) {
      py::arg("delimiter") = "", py::arg("mapping") = py::none(), py::arg("names") = std::vector<std::string>{},
      py::arg("heldout") = std::vector<std::filesystem::path>{}, py::arg("split") = 0.0, py::arg("allow_implausible") = false);
 
+  // dynid identify's defaults are StudyOptions' own: taken from it, so that they cannot drift.
+  const identify::StudyOptions defaults;
   m.def("identify", [](py::handle model, const std::filesystem::path& data, const std::filesystem::path& out,
                        const std::optional<std::filesystem::path>& robot_dir_arg,
                        const std::optional<std::filesystem::path>& design_arg,
@@ -354,12 +335,14 @@ void bind_workflow(py::module_& m) {
   }, py::arg("model"), py::arg("data"), py::arg("out"), py::kw_only(), py::arg("robot_dir") = py::none(),
      py::arg("design") = py::none(), py::arg("only") = std::vector<std::string>{},
      py::arg("validation") = std::vector<std::string>{}, py::arg("intervals_ms") = std::vector<double>{},
-     py::arg("jobs") = 0, py::arg("trial") = 1, py::arg("weighted") = false, py::arg("fresh") = false,
-     py::arg("in_process") = false, py::arg("torque_delay_ms") = 0.0, py::arg("clie_iterations") = 25,
-     py::arg("clie_std_bound") = 0.0, py::arg("clie_noise_floor") = 0.0, py::arg("projection_metric") = "information",
-     py::arg("consistency") = "pd", py::arg("physical_start") = false, py::arg("rescue_metric") = "all",
-     py::arg("rescue_prior") = py::none(), py::arg("rescue_prior_weight") = 1e-6,
-     py::arg("rescue_prior_weights") = std::vector<double>{}, py::arg("validation_ms") = 0.0, py::arg("report") = true,
+     py::arg("jobs") = defaults.threads, py::arg("trial") = defaults.trial, py::arg("weighted") = false, py::arg("fresh") = false,
+     py::arg("in_process") = !defaults.isolate, py::arg("torque_delay_ms") = defaults.preprocess.torque_delay * 1000, py::arg("clie_iterations") = defaults.clie.max_iterations,
+     py::arg("clie_std_bound") = defaults.clie.std_bound, py::arg("clie_noise_floor") = defaults.clie.noise_floor,
+     py::arg("projection_metric") = identify::to_string(defaults.projection_metric),
+     py::arg("consistency") = identify::to_string(defaults.consistency), py::arg("physical_start") = defaults.physical_start,
+     py::arg("rescue_metric") = defaults.rescue_metric_all_runs ? "all" : "run",
+     py::arg("rescue_prior") = py::none(), py::arg("rescue_prior_weight") = defaults.rescue_prior_weight,
+     py::arg("rescue_prior_weights") = std::vector<double>{}, py::arg("validation_ms") = defaults.validation_interval * 1000, py::arg("report") = true,
      py::arg("progress") = py::none());
 }
 

@@ -32,14 +32,10 @@ void run(const Common& common, const CompareOptions& o) {
     throw UsageError(fmt::format("cannot compare {} with {}: {}", o.before, o.after, e.what()));
   }
   diagnose::GapReportOptions ro;
-  ro.before_label = std::filesystem::path(o.before).filename().string();
-  ro.after_label = std::filesystem::path(o.after).filename().string();
-  if (ro.before_label.empty() || ro.before_label == ro.after_label) ro.before_label = "before", ro.after_label = "after";
-  ro.figure_trajectory = o.trajectory;
-  for (int j : o.joints) {
-    if (j < 1 || j > c.joint_before.size())
-      throw UsageError(fmt::format("--joints: joint {} is not in 1..{}", j, c.joint_before.size()));
-    ro.figure_joints.push_back(j - 1);
+  try {
+    ro = diagnose::gap_report_options(o.before, o.after, c, o.trajectory, o.joints);
+  } catch (const std::invalid_argument& e) {
+    throw UsageError(fmt::format("--joints: {}", e.what()));
   }
   std::vector<std::filesystem::path> files;
   try {

@@ -20,20 +20,8 @@ namespace import_detail {
 // The command line's settings over the mapping file's (or the defaults).
 inline io::ImportMapping mapping_of(const ImportOptions& o) {
   io::ImportMapping m = o.mapping.empty() ? io::ImportMapping{} : io::read_import_mapping(o.mapping);
-  for (const auto& [text, target] : std::vector<std::pair<const std::string*, std::string*>>{
-           {&o.time, &m.time}, {&o.q, &m.q}, {&o.qd, &m.qd}, {&o.tau, &m.tau},
-           {&o.q_ref, &m.q_ref}, {&o.qd_ref, &m.qd_ref}, {&o.qdd_ref, &m.qdd_ref}})
-    if (!text->empty()) *target = *text;
-  if (!o.time_unit.empty())
-    m.time_unit = o.time_unit == "ms" ? io::TimeUnit::ms : o.time_unit == "us" ? io::TimeUnit::us
-                  : o.time_unit == "ns" ? io::TimeUnit::ns : io::TimeUnit::s;
-  if (!o.angle.empty()) m.angle_unit = o.angle == "deg" ? io::AngleUnit::deg : io::AngleUnit::rad;
-  if (o.torque_scale != 0) m.torque_scale = o.torque_scale;
-  if (!o.header.empty())
-    m.header = o.header == "yes" ? io::HeaderRow::present : o.header == "no" ? io::HeaderRow::absent : io::HeaderRow::automatic;
-  if (!o.delimiter.empty())
-    m.delimiter = o.delimiter == "comma" ? io::Delimiter::comma : o.delimiter == "semicolon" ? io::Delimiter::semicolon
-                  : o.delimiter == "whitespace" ? io::Delimiter::whitespace : io::Delimiter::automatic;
+  io::apply_settings(m, {o.time, o.q, o.qd, o.tau, o.q_ref, o.qd_ref, o.qdd_ref, o.time_unit, o.angle, o.header,
+                         o.delimiter, o.torque_scale});
   if (m.time.empty() || m.q.empty() || m.tau.empty())
     throw UsageError("say which columns hold time, q and tau: --time, --q, --tau, or --mapping map.yaml");
   return m;
@@ -44,13 +32,7 @@ inline io::ImportMapping mapping_of(const ImportOptions& o) {
 template <class Full, class Model>
 void ImportCommand::run(const Common& common, const ImportOptions& o) {
   io::DatasetImport di;
-  di.target.robot = common.robot;
-  for (const JointInfo& j : Model::joints) {
-    di.target.joints.emplace_back(j.name);
-    di.target.prismatic.push_back(j.type == JointType::Prismatic);
-    di.target.lower.push_back(j.lower);
-    di.target.upper.push_back(j.upper);
-  }
+  di.target = io::import_target(common.robot, joint_list<Model>());
   di.mapping = import_detail::mapping_of(o);
   di.split = o.split;
   di.allow_implausible = o.allow_implausible;

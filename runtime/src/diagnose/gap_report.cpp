@@ -227,6 +227,22 @@ GapComparison compare_studies(const StudyValidation& before, const StudyValidati
   return c;
 }
 
+GapReportOptions gap_report_options(const std::filesystem::path& before_dir, const std::filesystem::path& after_dir,
+                                    const GapComparison& comparison, const std::string& trajectory,
+                                    const std::vector<int>& joints) {
+  GapReportOptions ro;
+  ro.before_label = before_dir.filename().string();
+  ro.after_label = after_dir.filename().string();
+  if (ro.before_label.empty() || ro.before_label == ro.after_label) ro.before_label = "before", ro.after_label = "after";
+  ro.figure_trajectory = trajectory;
+  for (int j : joints) {
+    if (j < 1 || j > comparison.joint_before.size())
+      throw std::invalid_argument(fmt::format("joint {} is not in 1..{}", j, comparison.joint_before.size()));
+    ro.figure_joints.push_back(j - 1);
+  }
+  return ro;
+}
+
 std::vector<std::filesystem::path> write_gap_report(const StudyValidation& before, const StudyValidation& after,
                                                     const GapComparison& c, const std::filesystem::path& dir,
                                                     const GapReportOptions& o) {

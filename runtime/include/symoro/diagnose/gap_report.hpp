@@ -45,6 +45,13 @@ struct GapReportOptions {
   std::vector<int> figure_joints;  // 0-based (default: the 3 joints whose error changed most)
 };
 
+// The options dynid compare and symoro.compare use: the study folders' names as labels
+// ("before" and "after" when a name is empty or both are equal), the plotted trajectory, and
+// 1-based joints (std::invalid_argument "joint J is not in 1..n" for one beyond the robot's).
+GapReportOptions gap_report_options(const std::filesystem::path& before_dir, const std::filesystem::path& after_dir,
+                                    const GapComparison& comparison, const std::string& trajectory,
+                                    const std::vector<int>& joints);
+
 // Writes <dir>/gap.md and <dir>/figures/*.svg atomically; returns the files written.
 std::vector<std::filesystem::path> write_gap_report(const identify::StudyValidation& before,
                                                     const identify::StudyValidation& after,

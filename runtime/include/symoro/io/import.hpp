@@ -30,6 +30,7 @@
 #include <vector>
 
 #include "symoro/io/log.hpp"
+#include "symoro/model_info.hpp"
 
 namespace symoro::io {
 
@@ -67,6 +68,22 @@ struct ImportTarget {
   std::vector<bool> prismatic;      // per joint (empty: all revolute)
   std::vector<double> lower, upper;  // position limits per joint, rad or m (empty: not checked)
 };
+
+// The target of a compiled model: its joints' names, types and position limits.
+ImportTarget import_target(const std::string& robot, const std::vector<JointInfo>& joints);
+
+// Settings given by name over a mapping (dynid import's options, symoro.import_logs' keywords);
+// "" (0 for torque_scale) leaves a setting as the mapping has it.
+struct MappingSettings {
+  std::string time, q, qd, tau, q_ref, qd_ref, qdd_ref;  // column selectors
+  std::string time_unit;  // s | ms | us | ns
+  std::string angle;      // rad | deg
+  std::string header;     // auto | yes | no
+  std::string delimiter;  // auto | comma | semicolon | whitespace
+  double torque_scale = 0;
+};
+// std::invalid_argument naming the setting and its choices for a word not among them.
+void apply_settings(ImportMapping& mapping, const MappingSettings& settings);
 
 // One input file, converted.
 struct ImportedLog {
