@@ -133,23 +133,25 @@ struct Kernels {
 
 }  // namespace detail
 
-template <class Model>
+template <class Full, class Model>
 ModelKernels model_kernels();
 
-// Model I of the tuple Models (and, when Tail, every later one).
-template <class Models, std::size_t I, bool Tail>
+// Model I of the tuple Models of the robot whose full model is Full (and, when Tail, every
+// later one).
+template <class Full, class Models, std::size_t I, bool Tail>
 void add_model_kernels(std::vector<ModelKernels>& out) {
   if constexpr (I < std::tuple_size_v<Models>) {
-    out.push_back(model_kernels<std::tuple_element_t<I, Models>>());
-    if constexpr (Tail) add_model_kernels<Models, I + 1, true>(out);
+    out.push_back(model_kernels<Full, std::tuple_element_t<I, Models>>());
+    if constexpr (Tail) add_model_kernels<Full, Models, I + 1, true>(out);
   }
 }
 
-template <class Model>
+template <class Full, class Model>
 ModelKernels model_kernels() {
   using K = detail::Kernels<Model>;
   ModelKernels k;
   k.identification = &identify::identification_model<Model>;
+  k.diagnosis = &diagnose::diagnosis_model<Full, Model>;
   k.nq = Model::nq;
   k.np = Model::np;
   k.ns = Model::ns;

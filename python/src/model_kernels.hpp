@@ -9,6 +9,7 @@
 #include <memory>
 #include <vector>
 
+#include "symoro/diagnose/diagnosis_model.hpp"
 #include "symoro/identify/identification_model.hpp"
 
 namespace symoro::python {
@@ -20,8 +21,10 @@ struct Batch {
 };
 
 struct ModelKernels {
-  // The model's description, its identification interface (studies) and its sizes.
+  // The model's description, its identification interface (studies), its diagnosis interface
+  // (diagnose) and its sizes.
   std::shared_ptr<const identify::IdentificationModel> (*identification)() = nullptr;
+  std::shared_ptr<const diagnose::DiagnosisModel> (*diagnosis)() = nullptr;
   int nq = 0, np = 0, ns = 0;
 
   // (n, nq, np)
@@ -52,7 +55,7 @@ struct ModelKernels {
   void (*base_from_standard)(const double* s, double* phi, Batch b) = nullptr;
 };
 
-template <class Model>
+template <class Full, class Model>
 ModelKernels model_kernels();
 
 // Every compiled robot model (generated: <build>/robot_units/python_robots.cpp).

@@ -17,6 +17,7 @@ namespace {
 struct Model {
   ModelKernels k;
   std::shared_ptr<const identify::IdentificationModel> id;
+  std::shared_ptr<const diagnose::DiagnosisModel> diagnosis;
   const identify::ModelDescription& d() const { return id->description(); }
   std::string variant() const { return d().variant.empty() ? "full" : d().variant; }
 };
@@ -209,7 +210,7 @@ void bind_models(py::module_& m) {
 
   m.def("model_list", [] {
     std::vector<std::shared_ptr<Model>> out;
-    for (const ModelKernels& k : all_model_kernels()) out.push_back(std::make_shared<Model>(Model{k, k.identification()}));
+    for (const ModelKernels& k : all_model_kernels()) out.push_back(std::make_shared<Model>(Model{k, k.identification(), k.diagnosis()}));
     return out;
   }, "every compiled robot model, the full model of each robot first");
 }
@@ -217,6 +218,11 @@ void bind_models(py::module_& m) {
 // The identification interface of a Model (for the workflow's functions).
 std::shared_ptr<const identify::IdentificationModel> identification_of(py::handle model) {
   return model.cast<const Model&>().id;
+}
+
+// Its diagnosis interface (symoro.diagnose).
+std::shared_ptr<const diagnose::DiagnosisModel> diagnosis_of(py::handle model) {
+  return model.cast<const Model&>().diagnosis;
 }
 
 }  // namespace symoro::python

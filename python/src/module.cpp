@@ -13,6 +13,7 @@ void bind_models(py::module_& m);
 void bind_workflow(py::module_& m);
 void bind_results(py::module_& m);
 void bind_export(py::module_& m);
+void bind_diagnose(py::module_& m);
 
 }  // namespace symoro::python
 
@@ -38,4 +39,5 @@ PYBIND11_MODULE(_symoro, m) {
   symoro::python::bind_workflow(m);
   symoro::python::bind_results(m);
   symoro::python::bind_export(m);
+  symoro::python::bind_diagnose(m);
 }

@@ -5,11 +5,8 @@
 // progress finish and are saved, a rerun resumes).
 #include <algorithm>
 #include <atomic>
-#include <chrono>
-#include <condition_variable>
 #include <mutex>
 #include <optional>
-#include <thread>
 
 #include <fmt/format.h>
 #include <pybind11/eigen.h>
@@ -17,6 +14,7 @@
 #include <pybind11/stl/filesystem.h>
 
 #include "arrays.hpp"
+#include "interruptible.hpp"
 #include "symoro/identify/report.hpp"
 #include "symoro/identify/robot_folder.hpp"
 #include "symoro/identify/study.hpp"
@@ -84,45 +82,6 @@ py::dict validation_record(const identify::ValidationRecord& v) {
   d["tau_measured"] = v.tau_measured;
   d["tau_rescue"] = v.tau_rescue;
   return d;
-}
-
-// Runs `work` in a thread of its own; this thread waits with the GIL released, checking every
-// 50 ms for a signal. On KeyboardInterrupt (or another signal handler's exception) it sets
-// `stop`, waits for `work` to end, and raises that exception.
-template <class Work>
-void run_interruptible(std::atomic<bool>& stop, Work&& work) {
-  std::mutex m;
-  std::condition_variable cv;
-  bool done = false;
-  std::exception_ptr error;
-  std::thread t([&] {
-    try {
-      work();
-    } catch (...) {
-      error = std::current_exception();
-    }
-    std::lock_guard<std::mutex> lock(m);
-    done = true;
-    cv.notify_all();
-  });
-  bool interrupted = false;
-  for (;;) {
-    {
-      py::gil_scoped_release release;
-      std::unique_lock<std::mutex> lock(m);
-      if (cv.wait_for(lock, std::chrono::milliseconds(50), [&] { return done; })) break;
-    }
-    if (!interrupted && PyErr_CheckSignals() != 0) {
-      interrupted = true;  // the exception stays set until the study has stopped
-      stop = true;
-    }
-  }
-  {
-    py::gil_scoped_release release;
-    t.join();
-  }
-  if (interrupted) throw py::error_already_set();
-  if (error) std::rethrow_exception(error);
 }
 
 }  // namespace

@@ -6,13 +6,14 @@
     symoro.import_logs(arm, "data", ["log.csv"], time="t", q="pos_*", tau="eff_*")
     study = symoro.identify(arm, "data", "study", robot_dir="robots/crane_x7")
     fits = symoro.predict(arm, study["phi"], "data")          # the model's torque on every run
+    found = symoro.diagnose(arm, "data", "diagnosis", robot_dir="robots/crane_x7")  # missing effects
     gap = symoro.compare("study", "study-diagnosed", "gap")   # two studies on their held-out runs
     symoro.export_urdf(arm, "study-physical", "arm.urdf", prior="zero")  # consistent inertials
 
 See docs/python.md.
 """
 
-from ._symoro import DataError, Model, StudyStopped, compare, export_urdf, identify, import_logs, predict
+from ._symoro import DataError, Model, StudyStopped, compare, diagnose, export_urdf, identify, import_logs, predict
 from . import models
 
-__all__ = ["DataError", "Model", "StudyStopped", "compare", "export_urdf", "identify", "import_logs", "models", "predict"]
+__all__ = ["DataError", "Model", "StudyStopped", "compare", "diagnose", "export_urdf", "identify", "import_logs", "models", "predict"]

@@ -2,15 +2,54 @@
 // every candidate effect on the fitting trajectories, keeps those that are significant and
 // improve the held-out ones (forward stepwise), localizes the residual before and after, and
 // writes a report and the robot.yaml variant that compiles the effects in (--apply adds it).
-#include <regex>
-
 #include <CLI/CLI.hpp>
+
+#include <fmt/format.h>
 
 #include "dynid_diagnose.hpp"
 #include "dynid_numbers.hpp"
-#include "symoro/diagnose/effects.hpp"
+#include "symoro/diagnose/dataset_diagnosis.hpp"
 
 namespace symoro::dynid {
+
+namespace {
+
+diagnose::DatasetDiagnosisOptions library_options(const Common& common, const DiagnoseOptions& o) {
+  diagnose::DatasetDiagnosisOptions d;
+  d.data = o.data;
+  d.out = o.out;
+  d.robot_dir = common.robot_dir();
+  d.train = o.train;
+  d.heldout = o.heldout;
+  d.trial = o.trial;
+  d.interval = o.interval_ms / 1000;
+  d.cutoff = o.cutoff;
+  d.only = o.only;
+  d.alpha = o.alpha;
+  d.min_gain = o.min_gain;
+  d.min_torque = o.min_torque;
+  d.backlash = !o.no_backlash;
+  d.params = o.params;
+  d.variant = o.variant;
+  return d;
+}
+
+}  // namespace
+
+void run_diagnose(const Common& common, const DiagnoseOptions& o, const diagnose::DiagnosisModel& model) {
+  diagnose::DatasetDiagnosisOptions d = library_options(common, o);
+  d.say = [](const std::string& line) { fmt::print("{}\n", line); };
+  try {
+    const diagnose::DatasetDiagnosis r = diagnose::diagnose_dataset(model, d);
+    if (o.apply.empty()) return;
+    const auto yaml = common.robot_dir() / "robot.yaml";
+    diagnose::add_variant_to_robot_yaml(yaml, r.variant_name, r.variant_yaml);
+    fmt::print("added variant '{}' to {}; regenerate (symoroc generate {} -o generated) and rebuild, then "
+               "dynid identify --model {}\n", r.variant_name, yaml.string(), common.robot_dir().string(), r.variant_name);
+  } catch (const diagnose::DiagnosisRequestError& e) {
+    throw UsageError(e.what());
+  }
+}
 
 void add_diagnose_commands(CLI::App& app, Common& common) {
   auto o = std::make_shared<DiagnoseOptions>();
@@ -42,15 +81,10 @@ void add_diagnose_commands(CLI::App& app, Common& common) {
   cmd->add_option("--variant", o->variant, "Name of the variant to write (default: <identified>_diagnosed)");
   cmd->add_flag("--apply", [o](std::int64_t) { o->apply = "yes"; }, "Add the variant to the robot's robot.yaml");
   cmd->callback([&common, o] {
-    // symoroc's rule for variant names, checked before any work.
-    static const std::regex lower_id("^[a-z][a-z0-9_]*$");
-    if (!o->variant.empty() && (!std::regex_match(o->variant, lower_id) || o->variant == "full" || o->variant == "param"))
-      throw UsageError("--variant '" + o->variant + "' must be a lower-case identifier other than 'full' and 'param' (symoroc's rule)");
-    for (const auto& e : o->only) {
-      diagnose::effect_kind(e);  // unknown names: a clear error first
-      if (e == "payload" && o->params.empty())
-        throw UsageError("--only payload needs --params: a refit absorbs a payload into the last link's parameters, "
-                         "so it is judged against an earlier identification held fixed");
+    try {  // the options' own rules, before any work
+      diagnose::check_request(library_options(common, *o));
+    } catch (const diagnose::DiagnosisRequestError& e) {
+      throw UsageError(e.what());
     }
     diagnose_units().model(common, o->model)(common, *o);
   });

@@ -1,11 +1,16 @@
-// dynid diagnose's options and its entry, compiled per model of each robot (any variant:
-// --model) in generated units; the body is in dynid_diagnose-inl.hpp.
+// dynid diagnose's options and its entry per model of each robot (any variant: --model), in
+// generated units that only fetch the model's DiagnosisModel (symoro::<robot>_diagnosis); the
+// diagnosis itself is symoro/diagnose/dataset_diagnosis.hpp's, compiled once.
 #pragma once
 
 #include <string>
 #include <vector>
 
 #include "dynid_dispatch.hpp"
+
+namespace symoro::diagnose {
+class DiagnosisModel;
+}  // namespace symoro::diagnose
 
 namespace symoro::dynid {
 
@@ -24,5 +29,8 @@ struct DiagnoseCommand {
 };
 
 const CommandTable<DiagnoseOptions>& diagnose_units();  // generated: dynid_tables.cpp
+
+// The command on one model (dynid_diagnose.cpp).
+void run_diagnose(const Common& common, const DiagnoseOptions& o, const diagnose::DiagnosisModel& model);
 
 }  // namespace symoro::dynid

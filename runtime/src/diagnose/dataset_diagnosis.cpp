@@ -1,0 +1,232 @@
+// The diagnosis of a dataset (dataset_diagnosis.hpp), for any model through its DiagnosisModel.
+#include "symoro/diagnose/dataset_diagnosis.hpp"
+
+#include <algorithm>
+#include <fstream>
+#include <regex>
+#include <sstream>
+#include <utility>
+
+#include <fmt/format.h>
+
+#include "symoro/control/description.hpp"
+#include "symoro/diagnose/effects.hpp"
+#include "symoro/identify/raw_torque.hpp"
+#include "symoro/io/atomic_file.hpp"
+#include "symoro/io/parameters_yaml.hpp"
+#include "symoro/preprocess/preprocess.hpp"
+#include "symoro/trajectory/sampled_reference.hpp"
+#include "symoro/twin/config.hpp"
+
+namespace symoro::diagnose {
+
+void check_request(const DatasetDiagnosisOptions& o) {
+  static const std::regex lower_id("^[a-z][a-z0-9_]*$");
+  if (!o.variant.empty() && (!std::regex_match(o.variant, lower_id) || o.variant == "full" || o.variant == "param"))
+    throw DiagnosisRequestError("--variant '" + o.variant + "' must be a lower-case identifier other than 'full' and 'param' "
+                                "(symoroc's rule)");
+  for (const auto& e : o.only) {
+    effect_kind(e);  // unknown names: a clear error first
+    if (e == "payload" && o.params.empty())
+      throw DiagnosisRequestError("--only payload needs --params: a refit absorbs a payload into the last link's parameters, "
+                                  "so it is judged against an earlier identification held fixed");
+  }
+}
+
+std::pair<std::vector<std::string>, std::vector<std::string>> diagnosis_runs(const io::Dataset& data,
+                                                                              const DatasetDiagnosisOptions& o) {
+  // Held out: family V, as a split at import records it; fitting: every other run of the trial.
+  auto pick = [&](bool heldout) {
+    std::vector<std::string> v;
+    for (const auto& r : data.runs)
+      if (r.trial == o.trial && (r.family == "V") == heldout && std::find(v.begin(), v.end(), r.trajectory) == v.end())
+        v.push_back(r.trajectory);
+    return v;
+  };
+  std::vector<std::string> train = o.train.empty() ? pick(false) : o.train, heldout = o.heldout.empty() ? pick(true) : o.heldout;
+  std::string all;
+  for (const auto& r : data.runs) all += fmt::format("{}{} (family {}, trial {})", all.empty() ? "" : ", ", r.trajectory, r.family, r.trial);
+  const auto manifest = (data.dir / "dataset.yaml").string();
+  if (train.empty())
+    throw DiagnosisRequestError(fmt::format("{}: no fitting run for trial {} (runs: {}); name them with --train", manifest, o.trial, all));
+  if (heldout.empty())
+    throw DiagnosisRequestError(fmt::format("{}: no held-out run (family V) for trial {} (runs: {}); name them with --heldout, "
+                                            "or split a long run at import (dynid import --split 0.7)", manifest, o.trial, all));
+  for (const auto* list : {&train, &heldout})
+    for (const auto& name : *list) {
+      bool found = false;
+      for (const auto& r : data.runs) found = found || (r.trajectory == name && r.trial == o.trial);
+      if (!found)
+        throw DiagnosisRequestError(fmt::format("{}: no run {} of trial {} to {} (runs: {}); choose others with --train / --heldout",
+                                                manifest, name, o.trial, list == &train ? "fit" : "hold out", all));
+    }
+  return {train, heldout};
+}
+
+namespace {
+
+// The held-out gap against the raw torque at the logs' own rate: the same fits (on the
+// diagnosis grid), evaluated on the raw-torque samples with a stack whose low-pass is above the
+// band (0.4 of the rate).
+void score_raw_torque(const DiagnosisModel& model, const DesignStack& train, const std::vector<std::pair<std::string, io::Log>>& heldout_logs,
+                      const StackOptions& so, const Eigen::VectorXd& held, Diagnosis& d) {
+  const identify::RawTorqueOptions ro;
+  std::vector<NamedSamples> raw_runs;
+  for (const auto& [name, log] : heldout_logs) raw_runs.push_back({name, identify::raw_torque_samples(log, ro)});
+  StackOptions rs = so;
+  rs.interval = raw_runs.front().samples.interval;
+  rs.cutoff = 0.4 / rs.interval;
+  DesignStack raw = model.stack_design(raw_runs, rs);
+  if (held.size()) raw.hold(held);
+  std::vector<Candidate> effects;
+  for (const auto& e : d.selection.effects) effects.push_back(e.candidate);
+  const Fit b = fit_with_effects(train, raw, {}, d.selection.weights);
+  const Fit a = fit_with_effects(train, raw, effects, d.selection.weights);
+  d.raw_before = b.heldout_rmse;
+  d.raw_after = a.heldout_rmse;
+  d.raw_total_before = b.heldout_total;
+  d.raw_total_after = a.heldout_total;
+  d.raw_filter = identify::raw_torque_filter_text(ro);
+}
+
+}  // namespace
+
+DatasetDiagnosis diagnose_dataset(const DiagnosisModel& model, const DatasetDiagnosisOptions& o) {
+  check_request(o);
+  const identify::ModelDescription& md = model.description();
+  auto say = [&](const std::string& line) {
+    if (o.say) o.say(line);
+  };
+  auto check_stop = [&] {
+    if (o.stop && o.stop()) throw DiagnosisStopped();
+  };
+  const io::Dataset data = io::read_dataset(o.data);
+  io::check_dataset_robot(data, md.robot);
+  const auto [train_names, heldout_names] = diagnosis_runs(data, o);
+  StackOptions so;
+  so.interval = o.interval;
+  so.cutoff = o.cutoff;
+  so.candidates.only = o.only;
+  io::Log first_train;  // the backlash stage's run
+  std::vector<std::pair<std::string, io::Log>> heldout_logs;  // for the raw-torque gap
+  auto stack = [&](const std::vector<std::string>& names, bool fitting) {
+    std::vector<NamedSamples> runs;
+    for (const auto& name : names) {
+      check_stop();
+      io::Log log = io::read_run_log(data.find(name, o.trial), md.robot, md.nq);
+      if (fitting && name == names.front()) first_train = log;
+      if (!fitting) heldout_logs.emplace_back(name, log);
+      runs.push_back({name, preprocess::preprocess(log, log.meta.sample_time > 0 ? log.meta.sample_time : 0.001, light_preprocessing())});
+    }
+    return model.stack_design(runs, so);
+  };
+  // The gap of an earlier identification as it stands: its parameters are held, not refitted
+  // (read first: a bad file is named before the logs are worked through).
+  Eigen::VectorXd held;
+  if (!o.params.empty()) {
+    std::vector<std::string> names;
+    for (const auto& p : md.parameters) names.emplace_back(p.name);
+    held = io::read_parameters_yaml(o.params.string(), names);
+  }
+  DesignStack train = stack(train_names, true), heldout = stack(heldout_names, false);
+  if (held.size()) {
+    train.hold(held);
+    heldout.hold(held);
+  }
+  DiagnosisOptions dopt;
+  dopt.selection.alpha = o.alpha;
+  dopt.selection.min_heldout_gain = o.min_gain;
+  dopt.selection.min_effect_torque = o.min_torque;
+  dopt.selection.candidates = so.candidates;
+  // A delay the controller description already models is not a missing effect.
+  const auto controller_path = o.robot_dir / control::controller_file_name();
+  if (!o.robot_dir.empty() && std::filesystem::exists(controller_path))
+    dopt.selection.modeled_delay = control::read_controller_description(controller_path, md.nq).communication_delay;
+  check_stop();
+  DatasetDiagnosis result;
+  Diagnosis& d = result.diagnosis;
+  d = diagnose(train, heldout, dopt);
+  check_stop();
+  try {
+    score_raw_torque(model, train, heldout_logs, so, held, d);
+    say(fmt::format("held-out rms residual against the raw torque: {:.4f} -> {:.4f} N m", d.raw_total_before, d.raw_total_after));
+  } catch (const std::exception& e) {
+    d.raw_note = e.what();
+  }
+  // Backlash from the closed loop's high band: the robot's digital twin replays the fitting
+  // run's own references. A stage that cannot run, or fails, is said in the report.
+  const std::string robot = o.robot_dir.empty() ? md.robot : o.robot_dir.filename().string();
+  const auto twin_path = o.robot_dir / "twin.yaml";
+  if (!o.backlash) {
+    d.backlash_note = "Not run (--no-backlash).";
+  } else if (o.robot_dir.empty()) {
+    d.backlash_note = "Not run: the stage simulates the robot's digital twin, and no robot folder was given.";
+  } else if (!std::filesystem::exists(twin_path)) {
+    d.backlash_note = fmt::format("Not run: the stage simulates the robot's digital twin, and {} has none ({} not found).",
+                                  robot, twin_path.string());
+  } else if (!first_train.has_references()) {
+    d.backlash_note = fmt::format("Not run: the log of {} has no reference columns (q_ref, qd_ref, qdd_ref) for the twin to "
+                                  "replay.", train_names.front());
+  } else {
+    check_stop();
+    try {
+      const twin::TwinConfig nominal = with_selected_effects(twin::read_twin_config(twin_path, md.nq), d.selection);
+      const auto reference = trajectory::sampled_reference(first_train, nominal.controller.period);
+      d.backlash = model.fit_backlash(first_train, reference, nominal, BacklashFitOptions{});
+      d.backlash_judged = true;
+    } catch (const std::exception& e) {
+      d.backlash_note = fmt::format("Failed after the selection, so no play is named: {}", e.what());
+    }
+  }
+  if (!d.backlash_note.empty()) say(fmt::format("backlash stage: {}", d.backlash_note));
+  d.robot = robot;
+  d.model = md.robot + (md.variant.empty() ? "" : "::" + md.variant);
+  d.cutoff = o.cutoff;
+  d.held_parameters = o.params.string();
+  for (const auto& e : d.selection.dropped) say(fmt::format("dropped: {}: {} ({})", e.candidate.label(), e.magnitude, e.reason));
+  for (const auto& e : d.selection.effects)
+    say(fmt::format("effect: {}: {} (F {:.1f}, held-out gain {:.1f} %)", e.candidate.label(), e.magnitude.text, e.f,
+                    100 * e.heldout_gain));
+  for (const auto& f : d.backlash.findings)
+    say(fmt::format("effect: backlash, joint {}: {:.3f} deg of play (high-band torque {:.3f} N m measured, {:.3f} simulated "
+                    "without it, {:.3f} with it)",
+                    f.joint, f.width * 180 / 3.14159265358979323846, f.measured, f.simulated_before, f.simulated_after));
+  if (d.backlash.delay > 0) say(fmt::format("actuation delay refined on the high band: {:.2f} ms", d.backlash.delay * 1e3));
+  if (d.selection.effects.empty() && d.backlash.findings.empty())
+    say(fmt::format("no missing effect found ({})", d.selection.stop_reason));
+  say(fmt::format("held-out rms residual: {:.4f} -> {:.4f} N m", d.selection.before.heldout_total, d.selection.after.heldout_total));
+  check_stop();  // the last chance: from here the report is written whole
+  result.files = write_diagnosis_report(d, o.out);
+  result.report = o.out / "diagnosis.md";
+  const std::string& base = md.variant;
+  result.variant_name = o.variant.empty() ? (base.empty() ? "diagnosed" : base + "_diagnosed") : o.variant;
+  result.variant_yaml = variant_yaml(d, result.variant_name, base.empty() ? "full" : base);
+  if (!result.variant_yaml.empty()) {
+    result.variant_file = o.out / "variant.yaml";
+    io::write_file_atomically(result.variant_file, "# Add under `variants:` of robots/" + robot + "/robot.yaml\n" + result.variant_yaml);
+    say(fmt::format("variant: {}", result.variant_file.string()));
+  }
+  say(fmt::format("report: {} ({} files)", result.report.string(), result.files.size()));
+  return result;
+}
+
+void add_variant_to_robot_yaml(const std::filesystem::path& yaml, const std::string& name, const std::string& variant) {
+  if (variant.empty()) throw DiagnosisRequestError("--apply: nothing to add (no effect found)");
+  // robot.yaml gains the variant at its end, which must be the `variants:` section; the file is
+  // replaced atomically, so an interrupted run leaves the old one.
+  std::ifstream in(yaml);
+  if (!in) throw DiagnosisRequestError(yaml.string() + ": cannot be read");
+  std::stringstream text;
+  text << in.rdbuf();
+  std::string s = text.str();
+  const auto at = s.rfind("\nvariants:");
+  if (at == std::string::npos) throw DiagnosisRequestError(yaml.string() + ": no top-level `variants:` section to add to");
+  for (auto p = s.find('\n', at + 1); p != std::string::npos && p + 1 < s.size(); p = s.find('\n', p + 1))
+    if (s[p + 1] != ' ' && s[p + 1] != '#' && s[p + 1] != '\n')
+      throw DiagnosisRequestError(yaml.string() + ": `variants:` must be the last section to add to it");
+  if (s.find("\n  " + name + ":") != std::string::npos) throw DiagnosisRequestError(yaml.string() + ": variant '" + name + "' exists");
+  if (!s.empty() && s.back() != '\n') s += '\n';
+  io::write_file_atomically(yaml, s + variant);
+}
+
+}  // namespace symoro::diagnose
