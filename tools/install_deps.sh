@@ -14,6 +14,7 @@ packages=(
   libtinyxml-dev  # symoroc model names the line of a malformed URDF (urdfdom's own XML parser)
   liborocos-kdl-dev  # the tests compare URDF models against KDL, an independent rigid-body library
   python3-dev pybind11-dev python3-numpy python3-pytest  # the Python package (python/) and its tests
+  libblas-dev liblapack-dev  # their static archives: the Python module's reference BLAS/LAPACK (python/CMakeLists.txt)
 )
 missing=()
 for p in "${packages[@]}"; do
