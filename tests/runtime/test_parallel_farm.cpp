@@ -5,6 +5,7 @@
 #include <sched.h>
 
 #include <algorithm>
+#include <chrono>
 #include <csignal>
 #include <cstdlib>
 #include <cstring>
@@ -12,6 +13,7 @@
 #include <set>
 #include <stdexcept>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -89,6 +91,46 @@ TEST_P(FarmModes, AThrowingTaskFailsAloneAndKeepsWhatItEmitted) {
   }
   EXPECT_EQ(s.tasks[3].failure, "log of task 3: line 7: not a number");
   EXPECT_EQ(c.results[3][0], "first of 3");
+}
+
+// Also run on 2 MPI ranks (runtime.mpi_farm_stop, MPI builds): the coordinator hands out every
+// task, its own workers' and the other ranks', so Farm::stop holds there too.
+TEST_P(FarmModes, StopHandsOutNoFurtherTaskAndTheRestEndStopped) {
+  const auto tasks = numbered(40);
+  Farm farm;
+  farm.work = [](const std::string& t, const std::function<void(const std::string&)>& emit) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    emit(t);
+  };
+  Collected c;
+  int asked = 0;
+  farm.stop = [&] {  // called one at a time with on_end, on the coordinator only
+    ++asked;
+    return c.ends.size() >= 4;
+  };
+  const FarmSummary s = run(tasks, farm, GetParam(), 2, c);
+  if (!symoro::parallel::place().coordinator()) {
+    EXPECT_EQ(asked, 0);
+    return;
+  }
+  EXPECT_TRUE(s.stopped);
+  ASSERT_EQ(s.tasks.size(), tasks.size());
+  // The tasks handed out are a prefix of the list, each finished with its result; the others
+  // end "stopped" without having run. At most the workers' tasks in flight (2 per rank) ran
+  // after the fourth ended.
+  std::size_t ran = 0;
+  while (ran < tasks.size() && !s.tasks[ran].failed) ++ran;
+  EXPECT_GE(ran, 4u);
+  EXPECT_LE(ran, 4u + 2u * static_cast<std::size_t>(s.ranks));
+  EXPECT_EQ(c.ends.size(), ran);
+  for (std::size_t i = 0; i < tasks.size(); ++i) {
+    if (i < ran) {
+      EXPECT_EQ(c.results[i], std::vector<std::string>{tasks[i]}) << i;
+    } else {
+      EXPECT_TRUE(s.tasks[i].failed && s.tasks[i].failure == "stopped") << i;
+      EXPECT_EQ(c.results.count(i), 0u) << i;
+    }
+  }
 }
 
 INSTANTIATE_TEST_SUITE_P(InProcessAndIsolated, FarmModes, ::testing::Values(false, true));

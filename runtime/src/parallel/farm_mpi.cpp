@@ -133,9 +133,12 @@ FarmSummary coordinate(const std::vector<std::string>& tasks, const Farm& farm, 
   summary.tasks.resize(tasks.size());
   std::mutex m;  // the list and the callbacks
   std::size_t next = 0;
+  // Every task is handed out here, to this rank's workers and to the others: Farm::stop is
+  // asked before each, as the local farm does; once stopped, every rank is told there is none.
   auto take_next = [&]() -> std::int64_t {
     std::lock_guard<std::mutex> lock(m);
-    return next < tasks.size() ? static_cast<std::int64_t>(next++) : -1;
+    if (!summary.stopped && next < tasks.size() && farm.stop && farm.stop()) summary.stopped = true;
+    return !summary.stopped && next < tasks.size() ? static_cast<std::int64_t>(next++) : -1;
   };
   auto ended = [&](TaskEnd e) {
     std::lock_guard<std::mutex> lock(m);
@@ -233,6 +236,7 @@ FarmSummary coordinate(const std::vector<std::string>& tasks, const Farm& farm, 
     }
   }
   for (auto& t : pool) t.join();
+  for (std::size_t i = next; i < tasks.size(); ++i) summary.tasks[i] = TaskEnd{i, 0, true, "stopped"};
   // The end, to every rank still there, with whether one was lost: then no rank calls
   // MPI_Finalize, which would wait for the lost one forever.
   std::string end;

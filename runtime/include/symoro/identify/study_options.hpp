@@ -112,7 +112,7 @@ struct StudyOptions {
   std::function<void(const RunRecord&)> on_run;
   // Asked (on the coordinator, from any thread) before each trajectory's runs start: true stops
   // the study. The runs in progress finish and are saved, no other starts, and Study::run throws
-  // StudyStopped; a rerun resumes. Not asked under MPI.
+  // StudyStopped on the coordinator (under MPI, the other ranks return); a rerun resumes.
   std::function<bool()> stop;
 
   // The options a run's result depends on, as text for its fingerprint.

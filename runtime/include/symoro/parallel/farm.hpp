@@ -72,8 +72,7 @@ struct Farm {
   std::function<void(const TaskEnd&)> on_end;
   // Rank 0 only, one call at a time with the others, before each task is handed out: true
   // stops the farm. No further task starts (those not started end failed, "stopped"); the tasks
-  // in flight finish and their results arrive. Honoured by the local farm (threads or isolated
-  // processes); under MPI it is not asked.
+  // in flight finish and their results arrive (on every rank, under MPI).
   std::function<bool()> stop;
 };
 
