@@ -27,12 +27,11 @@ function(symoro_robot_model_count yaml out)
   set(${out} ${count} PARENT_SCOPE)
 endfunction()
 
-# symoro_add_robot_identification(<name> <model count>): the static library
-# symoro::<name>_identification with each model's IdentificationModel
-# (symoro/identify/identification_model.hpp), the only part of identification compiled per
-# model: one unit per model (cmake/identification_unit.cpp.in), the last one also taking any model
-# beyond the count. Whatever studies the robot's models (dynid, tests, applications) links it.
-function(symoro_add_robot_identification name count)
+# symoro_robot_library(<name> <model count> <kind> <area> [<extra unit template>...]): the
+# static library symoro::<name>_<kind> over symoro_<area>, with one unit per model of the robot
+# from cmake/<kind>_unit.cpp.in (the last one also taking any model beyond the count), so that a
+# robot's models compile in parallel, and the extra units' templates configured once each.
+function(symoro_robot_library name count kind area)
   set(units "")
   math(EXPR last "${count} - 1")
   set(unit_robot ${name})
@@ -45,47 +44,21 @@ function(symoro_add_robot_identification name count)
       set(unit_tail false)
       set(unit_what "model ${i} of its Models")
     endif()
-    set(file "${CMAKE_BINARY_DIR}/robot_units/${name}/identification_${i}.cpp")
-    configure_file("${PROJECT_SOURCE_DIR}/cmake/identification_unit.cpp.in" "${file}" @ONLY)
+    set(file "${CMAKE_BINARY_DIR}/robot_units/${name}/${kind}_${i}.cpp")
+    configure_file("${PROJECT_SOURCE_DIR}/cmake/${kind}_unit.cpp.in" "${file}" @ONLY)
     list(APPEND units "${file}")
   endforeach()
-  set(target symoro_${name}_identification)
-  add_library(${target} STATIC ${units})
-  add_library(symoro::${name}_identification ALIAS ${target})
-  target_link_libraries(${target} PUBLIC symoro_robot_${name} symoro_identify)
-  set_target_properties(${target} PROPERTIES EXPORT_NAME ${name}_identification POSITION_INDEPENDENT_CODE ON)
-  install(TARGETS ${target} EXPORT symoroTargets ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR})
-endfunction()
-
-# symoro_add_robot_diagnosis(<name> <model count>): the static library symoro::<name>_diagnosis
-# with each model's DiagnosisModel (symoro/diagnose/diagnosis_model.hpp), the only part of the
-# diagnosis compiled per model: one unit per model (cmake/diagnosis_unit.cpp.in, the last one
-# also taking any model beyond the count) and one for the robot's twin (diagnosis_backlash.cpp.in).
-function(symoro_add_robot_diagnosis name count)
-  set(units "")
-  math(EXPR last "${count} - 1")
-  set(unit_robot ${name})
-  foreach(i RANGE 0 ${last})
-    set(unit_index ${i})
-    if(i EQUAL last)
-      set(unit_tail true)
-      set(unit_what "model ${i} of its Models, and any later one")
-    else()
-      set(unit_tail false)
-      set(unit_what "model ${i} of its Models")
-    endif()
-    set(file "${CMAKE_BINARY_DIR}/robot_units/${name}/diagnosis_${i}.cpp")
-    configure_file("${PROJECT_SOURCE_DIR}/cmake/diagnosis_unit.cpp.in" "${file}" @ONLY)
+  foreach(template IN LISTS ARGN)
+    string(REGEX REPLACE "[.]in$" "" file_name "${template}")
+    set(file "${CMAKE_BINARY_DIR}/robot_units/${name}/${file_name}")
+    configure_file("${PROJECT_SOURCE_DIR}/cmake/${template}" "${file}" @ONLY)
     list(APPEND units "${file}")
   endforeach()
-  set(file "${CMAKE_BINARY_DIR}/robot_units/${name}/diagnosis_backlash.cpp")
-  configure_file("${PROJECT_SOURCE_DIR}/cmake/diagnosis_backlash.cpp.in" "${file}" @ONLY)
-  list(APPEND units "${file}")
-  set(target symoro_${name}_diagnosis)
+  set(target symoro_${name}_${kind})
   add_library(${target} STATIC ${units})
-  add_library(symoro::${name}_diagnosis ALIAS ${target})
-  target_link_libraries(${target} PUBLIC symoro_robot_${name} symoro_${name}_identification symoro_diagnose)
-  set_target_properties(${target} PROPERTIES EXPORT_NAME ${name}_diagnosis POSITION_INDEPENDENT_CODE ON)
+  add_library(symoro::${name}_${kind} ALIAS ${target})
+  target_link_libraries(${target} PUBLIC symoro_robot_${name} symoro_${area})
+  set_target_properties(${target} PROPERTIES EXPORT_NAME ${name}_${kind} POSITION_INDEPENDENT_CODE ON)
   install(TARGETS ${target} EXPORT symoroTargets ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR})
 endfunction()
 
@@ -122,11 +95,17 @@ function(symoro_add_robot name robot_dir)
   # A variant added to robot.yaml reconfigures, so it gets its own dynid units.
   symoro_robot_model_count("${robot_dir}/robot.yaml" models)
   set_property(GLOBAL PROPERTY SYMORO_ROBOT_MODELS_${name} ${models})
+  # The only parts of identification and diagnosis compiled per model, each model's
+  # IdentificationModel (symoro/identify/identification_model.hpp) and DiagnosisModel
+  # (symoro/diagnose/diagnosis_model.hpp; the twin's backlash stage once per robot): whatever
+  # studies or diagnoses the robot's models (dynid, the Python package, tests, applications)
+  # links symoro::<name>_identification, symoro::<name>_diagnosis.
   if(TARGET symoro_identify)
-    symoro_add_robot_identification(${name} ${models})
+    symoro_robot_library(${name} ${models} identification identify)
   endif()
   if(TARGET symoro_diagnose)
-    symoro_add_robot_diagnosis(${name} ${models})
+    symoro_robot_library(${name} ${models} diagnosis diagnose diagnosis_backlash.cpp.in)
+    target_link_libraries(symoro_${name}_diagnosis PUBLIC symoro_${name}_identification)
   endif()
   set_property(DIRECTORY "${PROJECT_SOURCE_DIR}" APPEND PROPERTY CMAKE_CONFIGURE_DEPENDS "${robot_dir}/robot.yaml")
 endfunction()
