@@ -18,26 +18,16 @@
 #include "symoro/identify/report.hpp"
 #include "symoro/identify/robot_folder.hpp"
 #include "symoro/identify/study.hpp"
+#include "symoro/identify/study_request.hpp"
 #include "symoro/identify/validation_io.hpp"
 #include "symoro/io/folder_lock.hpp"
 #include "symoro/io/import.hpp"
-#include "symoro/io/parameters_yaml.hpp"
 
 namespace symoro::python {
 
 std::shared_ptr<const identify::IdentificationModel> identification_of(py::handle model);
 
 namespace {
-
-template <class E>
-E choice(const std::string& value, const char* name, std::initializer_list<std::pair<const char*, E>> choices) {
-  std::string list;
-  for (const auto& [text, e] : choices) {
-    if (value == text) return e;
-    list += (list.empty() ? "" : ", ") + std::string(text);
-  }
-  throw py::value_error(fmt::format("{}: '{}' is not one of {}", name, value, list));
-}
 
 py::dict run_record(const identify::RunRecord& r) {
   py::dict d;
@@ -149,8 +139,8 @@ void bind_workflow(py::module_& m) {
      py::arg("delimiter") = "", py::arg("mapping") = py::none(), py::arg("names") = std::vector<std::string>{},
      py::arg("heldout") = std::vector<std::filesystem::path>{}, py::arg("split") = 0.0, py::arg("allow_implausible") = false);
 
-  // dynid identify's defaults are StudyOptions' own: taken from it, so that they cannot drift.
-  const identify::StudyOptions defaults;
+  // dynid identify's defaults are the request's (StudyOptions' own): taken from it.
+  const identify::StudyRequest defaults;
   m.def("identify", [](py::handle model, const std::filesystem::path& data, const std::filesystem::path& out,
                        const std::optional<std::filesystem::path>& robot_dir_arg,
                        const std::optional<std::filesystem::path>& design_arg,
@@ -164,56 +154,39 @@ void bind_workflow(py::module_& m) {
     const std::shared_ptr<const identify::IdentificationModel> id = identification_of(model);
     const identify::ModelDescription& d = id->description();
     const std::filesystem::path robot_dir = robot_dir_arg.value_or(""), design = design_arg.value_or("");
-    // As dynid identify (runtime/tools/dynid_identify.cpp): the same options, the same defaults.
-    identify::StudyOptions so;
-    so.data = data;
-    so.out = out;
-    so.trial = trial;
-    so.threads = jobs;
-    so.fresh = fresh;
-    so.isolate = !in_process;
-    so.trajectories = only;
-    so.validation = validation;
-    if (!intervals_ms.empty()) {
-      so.intervals.clear();
-      for (double ms : intervals_ms) so.intervals.push_back(ms / 1000);
-    }
-    so.least_squares.weighted = weighted;
-    so.preprocess.torque_delay = torque_delay_ms / 1000;
-    so.clie.max_iterations = clie_iterations;
-    so.clie.std_bound = clie_std_bound;
-    so.clie.noise_floor = clie_noise_floor;
-    so.projection_metric = identify::projection_metric_from_string(projection_metric);
-    so.consistency = identify::consistency_from_string(consistency);
-    so.physical_start = physical_start;
-    if (physical_start && so.consistency != identify::Consistency::physical)
-      throw py::value_error("physical_start needs consistency='physical'");
-    so.rescue_metric_all_runs = choice<bool>(rescue_metric, "rescue_metric", {{"all", true}, {"run", false}});
-    so.rescue_prior_weight = rescue_prior_weight;
-    so.rescue_prior_weights = rescue_prior_weights;
-    so.validation_interval = validation_ms / 1000;
-    // The rescue's prior: an array of standard parameters, a parameters file, "zero", or
-    // robot.yaml's nominal parameters ("nominal"; by default when robot.yaml has them).
-    const bool named = py::isinstance<py::str>(rescue_prior);
-    const std::string prior_name = named ? rescue_prior.cast<std::string>() : "";
-    if (!rescue_prior.is_none() && !named) {
+    // As dynid identify: the same request, the same translation (identify/study_request.hpp).
+    identify::StudyRequest q;
+    q.data = data.string();
+    q.out = out.string();
+    q.trial = trial;
+    q.threads = jobs;
+    q.fresh = fresh;
+    q.in_process = in_process;
+    q.only = only;
+    q.validation = validation;
+    q.intervals_ms = intervals_ms;
+    q.weighted = weighted;
+    q.torque_delay_ms = torque_delay_ms;
+    q.clie_iterations = clie_iterations;
+    q.clie_std_bound = clie_std_bound;
+    q.clie_noise_floor = clie_noise_floor;
+    q.projection_metric = projection_metric;
+    q.consistency = consistency;
+    q.physical_start = physical_start;
+    q.rescue_metric = rescue_metric;
+    q.rescue_prior_weight = rescue_prior_weight;
+    q.rescue_prior_weights = rescue_prior_weights;
+    q.validation_ms = validation_ms;
+    // The rescue's prior: a name or a file as dynid's, or an array of standard parameters.
+    const bool array_prior = !rescue_prior.is_none() && !py::isinstance<py::str>(rescue_prior) &&
+                             !py::hasattr(rescue_prior, "__fspath__");
+    if (!rescue_prior.is_none() && !array_prior) q.rescue_prior = py::str(rescue_prior).cast<std::string>();
+    if (array_prior) q.rescue_prior = "zero";  // replaced below
+    identify::StudyOptions so = identify::study_options(q, d, robot_dir);
+    if (array_prior) {
       const StateArg s = state_arg(rescue_prior, "rescue_prior", static_cast<int>(d.standard.size()));
       so.rescue_prior = Eigen::Map<const Eigen::VectorXd>(s.data(), static_cast<Eigen::Index>(d.standard.size()));
       so.rescue_prior_source = "an array given from Python";
-    } else if (rescue_prior.is_none() || prior_name == "nominal") {
-      std::vector<double> s;
-      if (!robot_dir.empty() && identify::nominal_standard_parameters(robot_dir, d.standard, s)) {
-        so.rescue_prior = Eigen::Map<const Eigen::VectorXd>(s.data(), static_cast<Eigen::Index>(s.size()));
-        so.rescue_prior_source = "robot.yaml's nominal parameters";
-      } else if (prior_name == "nominal") {
-        throw py::value_error("rescue_prior='nominal': " + (robot_dir.empty() ? std::string("no robot_dir given")
-                                                                              : (robot_dir / "robot.yaml").string() + " has no nominal parameters"));
-      }
-    } else if (prior_name != "zero") {
-      std::vector<std::string> standard;
-      for (const auto& p : d.standard) standard.push_back(p.name);
-      so.rescue_prior = io::read_parameters_yaml(prior_name, standard);
-      so.rescue_prior_source = prior_name;
     }
     identify::ClosedLoopSource loop;
     if (!robot_dir.empty()) loop = identify::closed_loop_source(robot_dir, d, design);
@@ -294,14 +267,15 @@ void bind_workflow(py::module_& m) {
   }, py::arg("model"), py::arg("data"), py::arg("out"), py::kw_only(), py::arg("robot_dir") = py::none(),
      py::arg("design") = py::none(), py::arg("only") = std::vector<std::string>{},
      py::arg("validation") = std::vector<std::string>{}, py::arg("intervals_ms") = std::vector<double>{},
-     py::arg("jobs") = defaults.threads, py::arg("trial") = defaults.trial, py::arg("weighted") = false, py::arg("fresh") = false,
-     py::arg("in_process") = !defaults.isolate, py::arg("torque_delay_ms") = defaults.preprocess.torque_delay * 1000, py::arg("clie_iterations") = defaults.clie.max_iterations,
-     py::arg("clie_std_bound") = defaults.clie.std_bound, py::arg("clie_noise_floor") = defaults.clie.noise_floor,
-     py::arg("projection_metric") = identify::to_string(defaults.projection_metric),
-     py::arg("consistency") = identify::to_string(defaults.consistency), py::arg("physical_start") = defaults.physical_start,
-     py::arg("rescue_metric") = defaults.rescue_metric_all_runs ? "all" : "run",
+     py::arg("jobs") = defaults.threads, py::arg("trial") = defaults.trial, py::arg("weighted") = defaults.weighted,
+     py::arg("fresh") = defaults.fresh, py::arg("in_process") = defaults.in_process,
+     py::arg("torque_delay_ms") = defaults.torque_delay_ms, py::arg("clie_iterations") = defaults.clie_iterations,
+     py::arg("clie_std_bound") = defaults.clie_std_bound, py::arg("clie_noise_floor") = defaults.clie_noise_floor,
+     py::arg("projection_metric") = defaults.projection_metric, py::arg("consistency") = defaults.consistency,
+     py::arg("physical_start") = defaults.physical_start, py::arg("rescue_metric") = defaults.rescue_metric,
      py::arg("rescue_prior") = py::none(), py::arg("rescue_prior_weight") = defaults.rescue_prior_weight,
-     py::arg("rescue_prior_weights") = std::vector<double>{}, py::arg("validation_ms") = defaults.validation_interval * 1000, py::arg("report") = true,
+     py::arg("rescue_prior_weights") = defaults.rescue_prior_weights, py::arg("validation_ms") = defaults.validation_ms,
+     py::arg("report") = true,
      py::arg("progress") = py::none());
 }
 

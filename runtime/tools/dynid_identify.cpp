@@ -33,48 +33,11 @@ identify::StudyResult study(const Common& common, const IdentifyOptions& o,
                             bool quiet) {
   const identify::ModelDescription& d = model->description();
   identify::StudyOptions so;
-  so.data = o.data;
-  so.out = o.out;
-  so.trial = o.trial;
-  so.threads = o.threads;
-  so.fresh = o.fresh;
-  so.isolate = !o.in_process;
-  so.rank_timeout = o.rank_timeout;
-  so.trajectories = o.only;
-  so.validation = o.validation;
-  if (!o.intervals_ms.empty()) {
-    so.intervals.clear();
-    for (double ms : o.intervals_ms) so.intervals.push_back(ms / 1000);
+  try {
+    so = identify::study_options(o, d, common.robot_dir());
+  } catch (const identify::StudyRequestError& e) {
+    throw UsageError(e.what());
   }
-  so.least_squares.weighted = o.weighted;
-  so.preprocess.torque_delay = o.torque_delay_ms / 1000;
-  so.clie.max_iterations = o.clie_iterations;
-  so.clie.std_bound = o.clie_std_bound;
-  so.clie.noise_floor = o.clie_noise_floor;
-  so.projection_metric = identify::projection_metric_from_string(o.projection_metric);
-  so.consistency = identify::consistency_from_string(o.consistency);
-  so.physical_start = o.physical_start;
-  so.rescue_metric_all_runs = o.rescue_metric == "all";
-  so.rescue_prior_weight = o.rescue_prior_weight;
-  so.rescue_prior_weights = o.rescue_prior_weights;
-  // The rescue's prior: as given, else robot.yaml's nominal parameters when it has them.
-  if (o.rescue_prior.empty() || o.rescue_prior == "nominal") {
-    std::vector<double> s;
-    if (nominal_standard_parameters(common, d.standard, s)) {
-      so.rescue_prior = Eigen::Map<const Eigen::VectorXd>(s.data(), static_cast<Eigen::Index>(s.size()));
-      so.rescue_prior_source = "robot.yaml's nominal parameters";
-    } else if (o.rescue_prior == "nominal") {
-      throw UsageError((common.robot_dir() / "robot.yaml").string() + " has no nominal parameters for --rescue-prior nominal");
-    }
-  } else if (o.rescue_prior != "zero") {
-    std::vector<std::string> names;
-    for (const auto& p : d.standard) names.push_back(p.name);
-    so.rescue_prior = io::read_parameters_yaml(o.rescue_prior, names);
-    so.rescue_prior_source = o.rescue_prior;
-  }
-  if (o.physical_start && so.consistency != identify::Consistency::physical)
-    throw UsageError("--physical-start needs --consistency physical");
-  so.validation_interval = o.validation_ms / 1000;
   auto progress = std::make_shared<std::unique_ptr<Progress>>();
   so.on_start = [progress, quiet](int total, int skipped) {
     if (skipped > 0) fmt::print(stderr, "{} of {} runs already finished (same inputs): skipped\n", skipped, total);

@@ -11,28 +11,16 @@
 
 #include "dynid_dispatch.hpp"
 #include "symoro/identify/identification_model.hpp"
+#include "symoro/identify/study_request.hpp"
 #include "symoro/twin/config.hpp"
 
 namespace symoro::dynid {
 
-struct IdentifyOptions {
-  std::string data, out, model;
-  std::vector<double> intervals_ms;
-  std::vector<std::string> only, validation;
-  int threads = 0, trial = 1;
-  bool weighted = false, no_report = false, fresh = false, in_process = false, physical_start = false;
-  int clie_iterations = 25;
-  double validation_ms = 0;
-  double torque_delay_ms = 0;
-  std::string projection_metric = "information";
-  std::string consistency = "pd";
-  std::string rescue_metric = "all";
-  std::string rescue_prior;          // "" zero, "nominal" robot.yaml's, or a standard-parameter YAML
-  double rescue_prior_weight = 1e-6;
-  std::vector<double> rescue_prior_weights;  // chosen among by held-out error when given
-  double clie_std_bound = 0;
-  double clie_noise_floor = 0;  // identify::ClieOptions::noise_floor
-  double rank_timeout = 60;
+// The study's options are the library's request (symoro.identify takes the same), and the
+// command's own.
+struct IdentifyOptions : identify::StudyRequest {
+  std::string model;
+  bool no_report = false;
   // When set, the command hands its model here and runs nothing: the identify units double as
   // the registry of every robot's identification models (identification_model_of).
   std::function<void(std::shared_ptr<const identify::IdentificationModel>)> take_model;
