@@ -74,26 +74,29 @@ def read_csv_columns(path):
     return header, np.loadtxt(path, delimiter=",", skiprows=1)
 
 
-def test_predict_and_compare_equal_the_command_line(tmp_path, exports, dynid, source_dir):
+@pytest.mark.parametrize("robot", ["rx90", "stanford_rrp"])
+def test_predict_and_compare_equal_the_command_line(tmp_path, robot, dynid, source_dir):
     robots = source_dir / "robots"
-    symoro.import_logs(ARM, tmp_path / "data", exports, heldout=[exports[-1]], **MAPPING)
-    full = symoro.identify(ARM, tmp_path / "data", tmp_path / "full", intervals_ms=[10], jobs=1)
-    rigid = symoro.models.rx90.rigid  # without Coulomb friction, which the logs have
+    arm = getattr(symoro.models, robot).full
+    exports = make_exports(tmp_path, arm)
+    symoro.import_logs(arm, tmp_path / "data", exports, heldout=[exports[-1]], **MAPPING)
+    full = symoro.identify(arm, tmp_path / "data", tmp_path / "full", intervals_ms=[10], jobs=1)
+    rigid = getattr(symoro.models, robot).rigid  # without Coulomb friction, which the logs have
     symoro.identify(rigid, tmp_path / "data", tmp_path / "rigid", intervals_ms=[10], jobs=1)
 
     # predict: the accepted parameters on every run, against dynid predict's CSVs, and the physics
     # (the fitting runs' torque to the noise: 0.02 N m, the unmodelled offset 0.05 N m on joint 2).
     params = tmp_path / "full" / "report" / "parameters.yaml"
-    runs = symoro.predict(ARM, params, tmp_path / "data", interval_ms=10)
+    runs = symoro.predict(arm, params, tmp_path / "data", interval_ms=10)
     assert [r["name"] for r in runs] == ["r1", "r2", "r3", "check"]
-    again = symoro.predict(ARM, full["phi"], tmp_path / "data" / "r1.csv", interval_ms=10)
+    again = symoro.predict(arm, full["phi"], tmp_path / "data" / "r1.csv", interval_ms=10)
     assert np.array_equal(again[0]["tau_model"], runs[0]["tau_model"])
-    cli = run([dynid, "predict", "--robot", "rx90", "--robots-dir", robots, "--params", params, tmp_path / "data",
+    cli = run([dynid, "predict", "--robot", robot, "--robots-dir", robots, "--params", params, tmp_path / "data",
                "-o", tmp_path / "predicted", "--interval", "10"])
     assert cli.returncode == 0, cli.stderr
     for r in runs:
         header, table = read_csv_columns(tmp_path / "predicted" / f"{r['name']}.predicted.csv")
-        n = ARM.nq
+        n = arm.nq
         assert np.array_equal(table[:, 0], r["time"])
         for k, what in enumerate(["q", "qd", "qdd", "tau", "tau_model"]):
             assert np.array_equal(table[:, 1 + k * n:1 + (k + 1) * n], r[what]), what
@@ -101,23 +104,23 @@ def test_predict_and_compare_equal_the_command_line(tmp_path, exports, dynid, so
 
     # compare: gap.md as dynid compare writes it; the rigid model lacks the friction the logs have.
     gap = symoro.compare(tmp_path / "full", tmp_path / "rigid", tmp_path / "gap")
-    cli = run([dynid, "compare", "--robot", "rx90", "--before", tmp_path / "full", "--after", tmp_path / "rigid", "-o",
+    cli = run([dynid, "compare", "--robot", robot, "--before", tmp_path / "full", "--after", tmp_path / "rigid", "-o",
                tmp_path / "gap-cli"])
     assert cli.returncode == 0, cli.stderr
     assert (tmp_path / "gap" / "gap.md").read_text() == (tmp_path / "gap-cli" / "gap.md").read_text()
     assert gap["before_model"] == "full" and gap["after_model"] == "rigid"
     assert [t["trajectory"] for t in gap["trajectories"]] == ["check"]
     assert gap["rmse_after"] > gap["rmse_before"]  # friction the rigid model cannot fit
-    with pytest.raises(ValueError, match="joints: joint 9 is not in 1..6"):
+    with pytest.raises(ValueError, match=f"joints: joint 9 is not in 1..{arm.nq}"):
         symoro.compare(tmp_path / "full", tmp_path / "rigid", tmp_path / "gap2", joints=[9])
 
 
-def pseudo_inertia_eigenvalues(names, s):
+def pseudo_inertia_eigenvalues(names, s, nq):
     """Per link, the smallest eigenvalue of its 4 x 4 pseudo-inertia [[tr(I)/2 E - I, h], [h', m]] (I
     about the frame origin, h the first moments): >= 0 for a physically consistent body."""
     v = dict(zip(names, s))
     out = []
-    for j in range(1, ARM.nq + 1):
+    for j in range(1, nq + 1):
         g = lambda f: v.get(f"{f}{j}", 0.0)
         inertia = np.array([[g("XX"), g("XY"), g("XZ")], [g("XY"), g("YY"), g("YZ")], [g("XZ"), g("YZ"), g("ZZ")]])
         h = np.array([g("MX"), g("MY"), g("MZ")])
@@ -129,13 +132,16 @@ def pseudo_inertia_eigenvalues(names, s):
     return np.array(out)
 
 
-def test_export_urdf_equals_the_command_line(tmp_path, exports, dynid, source_dir):
-    symoro.import_logs(ARM, tmp_path / "data", exports, heldout=[exports[-1]], **MAPPING)
-    study = symoro.identify(ARM, tmp_path / "data", tmp_path / "physical", intervals_ms=[10], jobs=1, consistency="physical")
+@pytest.mark.parametrize("robot", ["rx90", "stanford_rrp"])
+def test_export_urdf_equals_the_command_line(tmp_path, robot, dynid, source_dir):
+    arm = getattr(symoro.models, robot).full
+    exports = make_exports(tmp_path, arm)
+    symoro.import_logs(arm, tmp_path / "data", exports, heldout=[exports[-1]], **MAPPING)
+    study = symoro.identify(arm, tmp_path / "data", tmp_path / "physical", intervals_ms=[10], jobs=1, consistency="physical")
     assert study["accepted"]
-    r = symoro.export_urdf(ARM, tmp_path / "physical", tmp_path / "py" / "rx90.urdf", prior="zero")
-    cli = run([dynid, "export", "--robot", "rx90", "--robots-dir", source_dir / "robots", "--study", tmp_path / "physical",
-               "--urdf", tmp_path / "cli" / "rx90.urdf", "--prior", "zero"])
+    r = symoro.export_urdf(arm, tmp_path / "physical", tmp_path / "py" / f"{robot}.urdf", prior="zero")
+    cli = run([dynid, "export", "--robot", robot, "--robots-dir", source_dir / "robots", "--study", tmp_path / "physical",
+               "--urdf", tmp_path / "cli" / f"{robot}.urdf", "--prior", "zero"])
     assert cli.returncode == 0, cli.stderr
     # The same files, bit for bit: the module carries dynid's reference BLAS/LAPACK (the SDP
     # solve's last digits depend on which one runs; python/CMakeLists.txt).
@@ -143,14 +149,14 @@ def test_export_urdf_equals_the_command_line(tmp_path, exports, dynid, source_di
         assert (tmp_path / "py" / name).read_bytes() == (tmp_path / "cli" / name).read_bytes(), name
     assert sorted(p.name for p in (tmp_path / "py").iterdir()) == sorted(p.name for p in (tmp_path / "cli").iterdir())
     cli_s = {row.split(",")[0]: float(row.split(",")[4])
-             for row in (tmp_path / "cli" / "rx90.standard.csv").read_text().splitlines()[1:]}
+             for row in (tmp_path / "cli" / f"{robot}.standard.csv").read_text().splitlines()[1:]}
     np.testing.assert_array_equal(r["s"], [cli_s[n] for n in r["standard_names"]])
     # The inertials reproduce the accepted parameters and are physically consistent bodies.
-    np.testing.assert_allclose(ARM.base_from_standard(r["s"]), study["phi"], rtol=0, atol=1e-7)
+    np.testing.assert_allclose(arm.base_from_standard(r["s"]), study["phi"], rtol=0, atol=1e-7)
     assert r["residual"] < 1e-7
-    assert np.all(pseudo_inertia_eigenvalues(r["standard_names"], r["s"]) > 0)
+    assert np.all(pseudo_inertia_eigenvalues(r["standard_names"], r["s"], arm.nq) > 0)
     with pytest.raises(ValueError, match="robot.yaml's nominal parameters are needed"):
-        symoro.export_urdf(ARM, tmp_path / "physical", tmp_path / "x.urdf")
+        symoro.export_urdf(arm, tmp_path / "physical", tmp_path / "x.urdf")
 
 
 def test_errors_carry_the_project_text(tmp_path, exports, dynid, source_dir):
