@@ -22,6 +22,7 @@
 #include "symoro/identify/validation_io.hpp"
 #include "symoro/io/folder_lock.hpp"
 #include "symoro/io/import.hpp"
+#include "symoro/parallel/farm.hpp"
 
 namespace symoro::python {
 
@@ -215,10 +216,14 @@ void bind_workflow(py::module_& m) {
     }
     identify::StudyResult r;
     std::optional<io::FolderLock> lock;
-    lock.emplace(out, "symoro.identify");  // one study per folder at a time
+    // Under mpirun (docs/scaling.md) every rank calls this; rank 0 holds the folder, gathers the
+    // records and reports, the others run their share of the runs and return None.
+    const bool coordinator = parallel::place().coordinator();
+    if (coordinator) lock.emplace(out, "symoro.identify");  // one study per folder at a time
     try {
       run_interruptible(stop, [&] {
         r = identify::Study(id, so, std::move(loop)).run();
+        if (!coordinator) return;
         identify::write_validation(r, out);
         if (report) identify::write_report(r, out / "report");
       });
@@ -227,6 +232,7 @@ void bind_workflow(py::module_& m) {
       throw;
     }
     if (callback_error) std::rethrow_exception(callback_error);
+    if (!coordinator) return py::object(py::none());
     // As dynid identify: a study without a model fails, after its records and report are written.
     identify::require_identified(r);
 
@@ -263,7 +269,7 @@ void bind_workflow(py::module_& m) {
     result["out"] = out;
     result["validation_file"] = out / "validation.yaml";
     result["report"] = report ? py::object(py::cast(out / "report" / "report.md")) : py::none();
-    return result;
+    return py::object(std::move(result));
   }, py::arg("model"), py::arg("data"), py::arg("out"), py::kw_only(), py::arg("robot_dir") = py::none(),
      py::arg("design") = py::none(), py::arg("only") = std::vector<std::string>{},
      py::arg("validation") = std::vector<std::string>{}, py::arg("intervals_ms") = std::vector<double>{},
