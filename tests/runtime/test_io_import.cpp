@@ -621,6 +621,10 @@ TEST_F(Import, ErrorsNameTheLine) {
   named.tau = "eff_*";
   const std::string three = "# comment\n\nt,pos_1,pos_2,pos_3,eff_1,eff_2\n0,1,2,3,4,5\n0.001,1,2,3,4,5\n";
   expect_error(import(three, named), f.string(), 3, "matches 3 columns numbered 1..3, but the robot 'arm2' has 2 joints");
+  // Numbered from 0 with the 1-based pattern: the 0-based one is named.
+  const std::string zero = "t,pos_0,pos_1,eff_1,eff_2\n0,1,2,4,5\n0.001,1,2,4,5\n";
+  expect_error(import(zero, named), f.string(), 1,
+               "matches 2 columns numbered 0..1, but the robot 'arm2' has 2 joints (shoulder, elbow); for numbers from 0 write 'pos_%'");
   const std::string one = "t,pos_1,eff_1,eff_2\n0,1,4,5\n0.001,1,4,5\n";
   expect_error(import(one, named), f.string(), 1, "no column 'pos_2' for joint 2");
   io::ImportMapping positions = two_mapping();
