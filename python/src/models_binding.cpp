@@ -39,6 +39,22 @@ py::array_t<double> doubles(const std::vector<double>& v) {
   return a;
 }
 
+// The arguments of a function of (q, qd, x) and phi, x being qdd or tau: each checked (in
+// that order), their common batch, and phi's row stride.
+struct StatePhiArgs {
+  StateArg q, qd, x, phi;
+  bool batch = false;
+  std::ptrdiff_t n = 1, ps = 0;
+};
+
+StatePhiArgs state_phi_args(const Model& m, py::handle q, py::handle qd, py::handle x, const char* x_name, py::handle phi) {
+  StatePhiArgs a{state_arg(q, "q", m.k.nq), state_arg(qd, "qd", m.k.nq), state_arg(x, x_name, m.k.nq),
+                 state_arg(phi, "phi", m.k.np)};
+  a.n = common_batch({{"q", &a.q}, {"qd", &a.qd}, {x_name, &a.x}}, a.batch);
+  a.ps = phi_stride(a.phi, "phi", a.n, a.batch);
+  return a;
+}
+
 template <class Info, class Get>
 std::vector<std::string> names(const std::vector<Info>& v, Get get) {
   std::vector<std::string> out;
@@ -98,11 +114,10 @@ void bind_models(py::module_& m) {
   }, py::arg("q"), py::arg("qd"), py::arg("qdd"), "W(q, qd, qdd): (nq, np), or (N, nq, np) for a batch; tau = W @ phi");
 
   model.def("inverse_dynamics", [](const Model& x, py::handle q, py::handle qd, py::handle qdd, py::handle phi) {
-    const StateArg a = state_arg(q, "q", x.k.nq), b = state_arg(qd, "qd", x.k.nq), c = state_arg(qdd, "qdd", x.k.nq),
-                   p = state_arg(phi, "phi", x.k.np);
-    bool batch = false;
-    const std::ptrdiff_t n = common_batch({{"q", &a}, {"qd", &b}, {"qdd", &c}}, batch);
-    const std::ptrdiff_t ps = phi_stride(p, "phi", n, batch);
+    const StatePhiArgs s = state_phi_args(x, q, qd, qdd, "qdd", phi);
+    const bool batch = s.batch;
+    const std::ptrdiff_t n = s.n, ps = s.ps;
+    const StateArg &a = s.q, &b = s.qd, &c = s.x, &p = s.phi;
     auto tau = output(batch, n, {x.k.nq});
     double* out = tau.mutable_data();
     run(batch, [&] { x.k.inverse_dynamics(a.data(), b.data(), c.data(), p.data(), out, {n, ps}); });
@@ -131,11 +146,10 @@ void bind_models(py::module_& m) {
   }, py::arg("q"), py::arg("qd"), py::arg("phi"), "h = ID(q, qd, 0; phi): Coriolis, centrifugal, gravity and friction");
 
   model.def("forward_dynamics", [](const Model& x, py::handle q, py::handle qd, py::handle tau, py::handle phi) {
-    const StateArg a = state_arg(q, "q", x.k.nq), b = state_arg(qd, "qd", x.k.nq), c = state_arg(tau, "tau", x.k.nq),
-                   p = state_arg(phi, "phi", x.k.np);
-    bool batch = false;
-    const std::ptrdiff_t n = common_batch({{"q", &a}, {"qd", &b}, {"tau", &c}}, batch);
-    const std::ptrdiff_t ps = phi_stride(p, "phi", n, batch);
+    const StatePhiArgs s = state_phi_args(x, q, qd, tau, "tau", phi);
+    const bool batch = s.batch;
+    const std::ptrdiff_t n = s.n, ps = s.ps;
+    const StateArg &a = s.q, &b = s.qd, &c = s.x, &p = s.phi;
     auto qdd = output(batch, n, {x.k.nq});
     double* out = qdd.mutable_data();
     run(batch, [&] { x.k.forward_dynamics(a.data(), b.data(), c.data(), p.data(), out, {n, ps}); });
@@ -143,11 +157,10 @@ void bind_models(py::module_& m) {
   }, py::arg("q"), py::arg("qd"), py::arg("tau"), py::arg("phi"), "qdd = M^-1 (tau - h): (nq,) or (N, nq)");
 
   model.def("inverse_dynamics_derivatives", [](const Model& x, py::handle q, py::handle qd, py::handle qdd, py::handle phi) {
-    const StateArg a = state_arg(q, "q", x.k.nq), b = state_arg(qd, "qd", x.k.nq), c = state_arg(qdd, "qdd", x.k.nq),
-                   p = state_arg(phi, "phi", x.k.np);
-    bool batch = false;
-    const std::ptrdiff_t n = common_batch({{"q", &a}, {"qd", &b}, {"qdd", &c}}, batch);
-    const std::ptrdiff_t ps = phi_stride(p, "phi", n, batch);
+    const StatePhiArgs s = state_phi_args(x, q, qd, qdd, "qdd", phi);
+    const bool batch = s.batch;
+    const std::ptrdiff_t n = s.n, ps = s.ps;
+    const StateArg &a = s.q, &b = s.qd, &c = s.x, &p = s.phi;
     auto tau = output(batch, n, {x.k.nq}), dq = output(batch, n, {x.k.nq, x.k.nq}), dqd = output(batch, n, {x.k.nq, x.k.nq});
     double *t = tau.mutable_data(), *o1 = dq.mutable_data(), *o2 = dqd.mutable_data();
     run(batch, [&] { x.k.inverse_dynamics_derivatives(a.data(), b.data(), c.data(), p.data(), t, o1, o2, {n, ps}); });
@@ -160,11 +173,10 @@ void bind_models(py::module_& m) {
      "{'tau', 'dq': d tau / d q, 'dqd': d tau / d qd}; d tau / d qdd is inertia(q, phi), d tau / d phi the regressor");
 
   model.def("forward_dynamics_derivatives", [](const Model& x, py::handle q, py::handle qd, py::handle tau, py::handle phi) {
-    const StateArg a = state_arg(q, "q", x.k.nq), b = state_arg(qd, "qd", x.k.nq), c = state_arg(tau, "tau", x.k.nq),
-                   p = state_arg(phi, "phi", x.k.np);
-    bool batch = false;
-    const std::ptrdiff_t n = common_batch({{"q", &a}, {"qd", &b}, {"tau", &c}}, batch);
-    const std::ptrdiff_t ps = phi_stride(p, "phi", n, batch);
+    const StatePhiArgs s = state_phi_args(x, q, qd, tau, "tau", phi);
+    const bool batch = s.batch;
+    const std::ptrdiff_t n = s.n, ps = s.ps;
+    const StateArg &a = s.q, &b = s.qd, &c = s.x, &p = s.phi;
     const int nq = x.k.nq;
     auto qdd = output(batch, n, {nq}), dq = output(batch, n, {nq, nq}), dqd = output(batch, n, {nq, nq}),
          dtau = output(batch, n, {nq, nq}), dphi = output(batch, n, {nq, x.k.np});
