@@ -7,7 +7,6 @@
 
 #include <algorithm>
 #include <filesystem>
-#include <fstream>
 #include <sstream>
 
 #include <fmt/format.h>
@@ -19,6 +18,7 @@
 #include "symoro/identify/excitation_design.hpp"
 #include "symoro/io/atomic_file.hpp"
 #include "symoro/io/parameters_yaml.hpp"
+#include "symoro/io/text_file.hpp"
 #include "symoro/trajectory/design.hpp"
 #include "symoro/trajectory/structured_design.hpp"
 
@@ -170,10 +170,7 @@ void run(const Common& common, const ExciteOptions& o) {
   so.joints = d.joints;
   so.seed = o.seed;
   if (!o.from_design.empty()) {
-    std::ifstream in(o.from_design);
-    std::stringstream all;
-    all << in.rdbuf();
-    text = all.str();
+    text = io::read_text_file(o.from_design);
   } else {
     try {
       text = trajectory::structured_design_yaml(so);

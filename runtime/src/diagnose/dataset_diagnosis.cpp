@@ -2,9 +2,7 @@
 #include "symoro/diagnose/dataset_diagnosis.hpp"
 
 #include <algorithm>
-#include <fstream>
 #include <regex>
-#include <sstream>
 #include <utility>
 
 #include <fmt/format.h>
@@ -14,6 +12,7 @@
 #include "symoro/identify/raw_torque.hpp"
 #include "symoro/io/atomic_file.hpp"
 #include "symoro/io/parameters_yaml.hpp"
+#include "symoro/io/text_file.hpp"
 #include "symoro/preprocess/preprocess.hpp"
 #include "symoro/trajectory/sampled_reference.hpp"
 #include "symoro/twin/config.hpp"
@@ -214,11 +213,7 @@ void add_variant_to_robot_yaml(const std::filesystem::path& yaml, const std::str
   if (variant.empty()) throw DiagnosisRequestError("--apply: nothing to add (no effect found)");
   // robot.yaml gains the variant at its end, which must be the `variants:` section; the file is
   // replaced atomically, so an interrupted run leaves the old one.
-  std::ifstream in(yaml);
-  if (!in) throw DiagnosisRequestError(yaml.string() + ": cannot be read");
-  std::stringstream text;
-  text << in.rdbuf();
-  std::string s = text.str();
+  std::string s = io::read_text_file(yaml);
   const auto at = s.rfind("\nvariants:");
   if (at == std::string::npos) throw DiagnosisRequestError(yaml.string() + ": no top-level `variants:` section to add to");
   for (auto p = s.find('\n', at + 1); p != std::string::npos && p + 1 < s.size(); p = s.find('\n', p + 1))

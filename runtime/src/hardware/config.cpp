@@ -1,15 +1,14 @@
 #include "symoro/hardware/config.hpp"
 
 #include <cmath>
-#include <fstream>
 #include <map>
 #include <set>
-#include <sstream>
 
 #include <fmt/format.h>
 #include <yaml-cpp/yaml.h>
 
 #include "symoro/error.hpp"
+#include "symoro/io/text_file.hpp"
 #include "symoro/io/yaml_keys.hpp"
 
 namespace symoro::hardware {
@@ -70,11 +69,8 @@ HardwareConfig read_hardware_config(const std::filesystem::path& path, const std
   HardwareConfig c;
   c.path = path.string();
   Reader r{c.path};
-  std::ifstream in(path);
-  if (!in) throw DataError(c.path, 0, "not found (the robot's hardware description)");
-  std::stringstream content;
-  content << in.rdbuf();
-  const YAML::Node root = io::load_yaml_text(content.str(), c.path);
+  const YAML::Node root =
+      io::load_yaml_text(io::read_text_file(path, "not found (the robot's hardware description)"), c.path);
   if (!root.IsMap()) throw DataError(c.path, 1, "expected a map of keys");
   r.keys(root, {"format", "bus", "models", "joints", "safety"}, "hardware.yaml");
   const std::string format = r.text(r.need(root, "format", "hardware.yaml"), "format");

@@ -3,8 +3,6 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
-#include <fstream>
-#include <sstream>
 
 #include <fmt/format.h>
 
@@ -12,6 +10,7 @@
 #include "import_detail.hpp"
 #include "symoro/error.hpp"
 #include "symoro/io/number_text.hpp"
+#include "symoro/io/text_file.hpp"
 
 namespace symoro::io::detail {
 
@@ -72,11 +71,7 @@ bool is_number(std::string_view text) {
 
 TextTable::TextTable(const std::filesystem::path& file, Delimiter delimiter, HeaderRow header)
     : file_(file.string()) {
-  std::ifstream in(file, std::ios::binary);
-  if (!in) throw DataError(file_, 0, "cannot open the file to import");
-  std::ostringstream content;
-  content << in.rdbuf();
-  bytes_ = content.str();
+  bytes_ = read_text_file(file, "cannot open the file to import");
   std::size_t start = bytes_.compare(0, 3, "\xEF\xBB\xBF") == 0 ? 3 : 0;  // UTF-8 byte order mark
   // A writer killed mid-row leaves a last line without its newline, whose last number may be
   // cut yet still parse ("-0" of "-0.737"): such a file is refused whole.

@@ -4,9 +4,7 @@
 #include <array>
 #include <charconv>
 #include <cmath>
-#include <fstream>
 #include <set>
-#include <sstream>
 #include <type_traits>
 
 #include <fmt/format.h>
@@ -15,6 +13,7 @@
 #include "cell_text.hpp"
 #include "symoro/error.hpp"
 #include "symoro/io/number_text.hpp"
+#include "symoro/io/text_file.hpp"
 #include "symoro/io/yaml_keys.hpp"
 
 namespace symoro::io::detail {
@@ -71,21 +70,13 @@ class SidecarReader {
   std::string file_;
 };
 
-std::string read_text(const std::filesystem::path& path, const std::string& missing_message) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw DataError(path.string(), 0, missing_message);
-  std::ostringstream content;
-  content << in.rdbuf();
-  return content.str();
-}
-
 }  // namespace
 
 Sidecar read_sidecar(const std::filesystem::path& yaml) {
   Sidecar sidecar;
   sidecar.file = yaml.string();
   const std::string& file = sidecar.file;
-  const std::string content = read_text(yaml, "missing or unreadable metadata sidecar (every log CSV needs one)");
+  const std::string content = read_text_file(yaml, "missing or unreadable metadata sidecar (every log CSV needs one)");
 
   const YAML::Node root = load_yaml_text(content, file);
   if (!root.IsMap()) throw DataError(file, line_of(root), "the metadata sidecar is not a map of keys");

@@ -2,9 +2,7 @@
 
 #include <algorithm>
 #include <cctype>
-#include <fstream>
 #include <map>
-#include <sstream>
 #include <utility>
 
 #include <fmt/format.h>
@@ -13,6 +11,7 @@
 
 #include "symoro/detail/yaml_checks.hpp"
 #include "symoro/error.hpp"
+#include "symoro/io/text_file.hpp"
 
 namespace symoro::io {
 
@@ -40,11 +39,7 @@ YAML::Node load_yaml_text(const std::string& text, const std::string& file) {
 }
 
 YAML::Node load_yaml_file(const std::filesystem::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw DataError(path.string(), 0, "cannot read the file");
-  std::ostringstream text;
-  text << in.rdbuf();
-  return load_yaml_text(text.str(), path.string());
+  return load_yaml_text(read_text_file(path), path.string());
 }
 
 std::string nearest_name(const std::string& name, const std::vector<std::string>& known) {

@@ -2,13 +2,13 @@
 
 #include <algorithm>
 #include <chrono>
-#include <fstream>
 #include <sstream>
 
 #include <fmt/format.h>
 
 #include "symoro/io/atomic_file.hpp"
 #include "symoro/io/dataset.hpp"
+#include "symoro/io/text_file.hpp"
 #include "symoro/parallel/farm.hpp"
 
 namespace symoro::twin {
@@ -104,11 +104,8 @@ TwinDatasetSummary make_twin_dataset(const RunTwin& run, const std::string& note
   d.robot = o.robot;
   d.twin = config.path;
   if (!o.overrides.empty()) {
-    std::ifstream in(o.overrides);
-    std::stringstream text;
-    text << in.rdbuf();
     d.twin_overrides = "twin_overrides.yaml";  // relative to the folder
-    io::write_file_atomically(o.out / d.twin_overrides, text.str());
+    io::write_file_atomically(o.out / d.twin_overrides, io::read_text_file(o.overrides));
   }
   d.twin_record = io::TwinDatasetRecord{o.seed, o.trials, config.effects.enabled()};
   for (const trajectory::Trajectory& t : trajs)
