@@ -32,3 +32,23 @@ install(FILES
   "${PROJECT_BINARY_DIR}/symoroConfig.cmake"
   "${PROJECT_BINARY_DIR}/symoroConfigVersion.cmake"
   DESTINATION ${CMAKE_INSTALL_LIBDIR}/cmake/symoro)
+
+# symoro_installable: every target `cmake --install` copies, so that a build of only what the
+# README's main command runs can be installed (tools/run_main.sh builds it; a fresh clone's install
+# once failed on the Python module, which no built target had made).
+add_custom_target(symoro_installable)
+set(_installable symoroc dynid ${_symoro_exported})
+foreach(robot IN LISTS SYMORO_ROBOTS)
+  list(APPEND _installable symoro_${robot}_identification symoro_${robot}_diagnosis)
+endforeach()
+if(TARGET _symoro)
+  list(APPEND _installable _symoro)
+endif()
+foreach(t IN LISTS _installable)
+  if(TARGET ${t})
+    get_target_property(_type ${t} TYPE)
+    if(NOT _type STREQUAL "INTERFACE_LIBRARY")
+      add_dependencies(symoro_installable ${t})
+    endif()
+  endif()
+endforeach()

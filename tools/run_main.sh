@@ -16,9 +16,10 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 bash tools/install_deps.sh
 cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release >/dev/null
-# Only what this script runs: symoroc, dynid (which builds every runtime library the install
-# step copies) and the RX-90 export writer; tools/run_tests.sh builds everything.
-cmake --build build -j"$(nproc)" --target symoroc dynid write_export
+# Only what this script runs and installs: symoroc, dynid, every library and the Python module
+# the install step copies (symoro_installable), and the RX-90 export writer; tools/run_tests.sh
+# builds everything.
+cmake --build build -j"$(nproc)" --target symoro_installable write_export
 build/codegen/symoroc check
 build/codegen/symoroc info robots/crane_x7
 prefix="$PWD/build/install"

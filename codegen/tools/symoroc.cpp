@@ -1,4 +1,4 @@
-// symoroc: the model compiler's command line (generate, check, info).
+// symoroc: the model compiler's command line (generate, check, info, model, build).
 #include <CLI/CLI.hpp>
 #include <fmt/core.h>
 
@@ -10,6 +10,7 @@
 
 #include "symoro/codegen/generator.hpp"
 #include "symoro/codegen/modeling.hpp"
+#include "symoro/codegen/robot_library.hpp"
 #include "symoro/grammar/parser.hpp"
 
 namespace fs = std::filesystem;
@@ -237,8 +238,27 @@ int main(int argc, char** argv) {
   mdl->add_flag("--no-coulomb", no_fs, "URDF: no FS (Coulomb friction) parameter per joint");
   mdl->add_flag("--force", force, "Replace files of the folder that differ");
 
+  std::vector<std::string> build_dirs;
+  RobotLibraryOptions build_options;
+  std::string build_cache;
+  auto* bld = app.add_subcommand("build", "Compile robot folders into robot libraries (the runtime loads them; "
+                                          "dynid and Python build on first use)");
+  bld->add_option("robot_dirs", build_dirs, "robots/<name> folders")->required()->check(CLI::ExistingDirectory);
+  bld->add_option("--cache", build_cache, "The robot cache (default: $SYMORO_CACHE_DIR, else ~/.cache/symoro/robots)");
+  bld->add_option("-j,--jobs", build_options.jobs, "Parallel compiles (default: the machine's cores)");
+  bld->add_flag("--force", build_options.force, "Rebuild even when the cache has the library");
+
   CLI11_PARSE(app, argc, argv);
   try {
+    if (*bld) {
+      build_options.cache_dir = build_cache;
+      build_options.progress = [](const std::string& line) { std::cerr << line << "\n"; };
+      for (const auto& dir : build_dirs) {
+        const RobotLibraryBuild b = build_robot_library(dir, build_options);
+        std::cout << b.library.string() << "\n";
+      }
+      return 0;
+    }
     if (*gen) return generate(gen_dirs, out_root);
     if (*chk) return check(robots, generated);
     if (*inf) return info(info_dir);
