@@ -246,10 +246,7 @@ RobotLibraryBuild build_robot_library(const fs::path& robot_dir, const RobotLibr
   const fs::path final_dir = cache / (robot.name + "-" + out.key);
   out.library = final_dir / ("lib" + robot.name + ".so");
   std::error_code ec;
-  if (!options.force && fs::exists(out.library, ec)) {
-    say(robot.name + ": " + out.library.string() + " (cached)");
-    return out;
-  }
+  if (!options.force && fs::exists(out.library, ec)) return out;  // cached
 
   // Build in a folder of its own, then move it into place.
   fs::create_directories(cache, ec);

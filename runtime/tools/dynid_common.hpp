@@ -20,10 +20,13 @@ class App;
 namespace symoro::dynid {
 
 struct Common {
-  std::string robot;
+  std::string robot;   // the robot's name (its folder's)
+  std::string folder;  // --robot given as a folder (robots/my_arm, ./arm): that folder
   std::string robots_dir = SYMORO_DEFAULT_ROBOTS_DIR;
   std::string design;  // --design: a trajectory design file instead of the robot's own
-  std::filesystem::path robot_dir() const { return std::filesystem::path(robots_dir) / robot; }
+  std::filesystem::path robot_dir() const {
+    return folder.empty() ? std::filesystem::path(robots_dir) / robot : std::filesystem::path(folder);
+  }
   // The trajectory design commands read: --design, else robots/<robot>/trajectories.yaml.
   std::filesystem::path design_path() const {
     return design.empty() ? robot_dir() / "trajectories.yaml" : std::filesystem::path(design);
@@ -31,9 +34,19 @@ struct Common {
 };
 
 // --robot (required) and --robots-dir, declared once for every command that reads a robot folder.
+// --robot takes a name under --robots-dir or a folder (a path with a '/'): its name is the
+// folder's.
 template <class App>
-void add_robot_options(App* cmd, Common& common, const std::string& robot_help = "Robot folder name under robots/") {
-  cmd->add_option("--robot", common.robot, robot_help)->required();
+void add_robot_options(App* cmd, Common& common,
+                       const std::string& robot_help = "Robot: a folder name under robots/, or a robot folder "
+                                                       "(robots/my_arm, ./my_arm)") {
+  cmd->add_option("--robot", common.robot, robot_help)->required()->transform([&common](std::string v) {
+    if (v.find('/') == std::string::npos) return v;
+    common.folder = v;
+    std::filesystem::path p(v);
+    if (!p.has_filename()) p = p.parent_path();  // robots/my_arm/
+    return p.filename().string();
+  });
   cmd->add_option("--robots-dir", common.robots_dir, "Where the robot folders are");
 }
 

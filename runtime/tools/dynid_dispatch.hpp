@@ -27,6 +27,14 @@ std::vector<SourceFile> robot_sources(const std::string& robot);
 // differ from those this dynid was compiled from: the compiled copy would be used silently.
 void check_robot_folder(const Common& common);
 
+// Whether common.robot is one this dynid was compiled with, from the folder it was compiled from
+// (a --robot folder elsewhere is loaded from its library, even under a compiled robot's name).
+bool compiled_robot(const Common& common);
+
+// The error of a command that needs a robot compiled into dynid (the twin, the controller, the
+// diagnosis and the export still do), for one that is not.
+std::string not_compiled(const Common& common);
+
 template <class Options>
 class CommandTable {
  public:
@@ -38,17 +46,19 @@ class CommandTable {
 
   // The command for common.robot (compiled for its full or identified model only).
   Run robot(const Common& common) const {
+    if (!compiled_robot(common)) throw UsageError(not_compiled(common));
     for (const auto& e : entries_)
       if (e.robot == common.robot && e.model.empty()) {
         check_robot_folder(common);
         return e.run;
       }
-    throw UsageError("unknown robot '" + common.robot + "'");
+    throw UsageError(not_compiled(common));
   }
 
   // The command for common.robot's model named `model` (a robot.yaml variant, or "full"; empty:
   // robot.yaml's `identified`); a usage error naming the robot's models if it has none such.
   Run model(const Common& common, const std::string& model) const {
+    if (!compiled_robot(common)) throw UsageError(not_compiled(common));
     std::string list;
     for (const auto& e : entries_) {
       if (e.robot != common.robot) continue;
@@ -58,7 +68,7 @@ class CommandTable {
       }
       if (!e.model.empty()) list += (list.empty() ? "" : ", ") + e.model;
     }
-    if (list.empty()) throw UsageError("unknown robot '" + common.robot + "'");
+    if (list.empty()) throw UsageError(not_compiled(common));
     throw UsageError("robot '" + common.robot + "' has no compiled model '" + model + "' (it has: " + list +
                      "); a variant just added to robot.yaml must be generated (symoroc generate robots/" + common.robot +
                      " -o generated) and dynid rebuilt");

@@ -1,14 +1,30 @@
 // dynid export --urdf: a study's accepted base parameters as a URDF of the robot with
 // physically consistent inertials (identify/physical_consistency.hpp, identify/urdf_export.hpp),
 // and the standard parameters beside it (<name>.standard.yaml, <name>.standard.csv).
+#include <algorithm>
+#include <cmath>
 #include <filesystem>
+#include <optional>
+#include <string>
+#include <vector>
 
 #include <CLI/CLI.hpp>
+#include <Eigen/QR>
 #include <fmt/format.h>
 #include <yaml-cpp/yaml.h>
 
 #include "dynid_export.hpp"
+#include "dynid_loaded_robot.hpp"
 #include "dynid_numbers.hpp"
+#include "dynid_urdf_into.hpp"
+#include "symoro/identify/model_export.hpp"
+#include "symoro/identify/regression.hpp"
+#include "symoro/identify/urdf_export.hpp"
+#include "symoro/io/atomic_file.hpp"
+#include "symoro/io/dataset.hpp"
+#include "symoro/io/parameters_yaml.hpp"
+#include "symoro/preprocess/preprocess.hpp"
+#include "symoro/twin/config.hpp"
 
 namespace symoro::dynid {
 
@@ -36,6 +52,149 @@ std::string study_model(const std::string& file) {
 }
 
 }  // namespace
+
+namespace export_detail {
+
+void write_text(const std::filesystem::path& file, const std::string& text) {
+  if (file.has_parent_path()) std::filesystem::create_directories(file.parent_path());
+  io::write_file_atomically(file, text);
+}
+
+// The study's fitting data: its representative run (parameters.yaml's source_run, e.g.
+// "PA11@10ms") of the dataset, preprocessed with the default options, through the full model's
+// regression (a variant's fixed parameters included).
+struct FittingRun {
+  std::string id;
+  int trial = 1;
+  identify::Regression reg;
+};
+
+FittingRun fitting_run(const identify::IdentificationModel& full, const std::filesystem::path& params,
+                       const std::string& data_dir, int trial) {
+  FittingRun f;
+  f.id = YAML::LoadFile(params.string())["source_run"].as<std::string>("");
+  f.trial = trial;
+  const auto at = f.id.find('@');
+  if (at == std::string::npos || f.id.size() < at + 4)
+    throw UsageError(fmt::format("{}: no source_run like PA11@10ms to measure the torque on", params.string()));
+  const io::Dataset data = io::read_dataset(data_dir);
+  io::Log log = io::read_run_log(data.find(f.id.substr(0, at), trial), full.description().robot, full.description().nq);
+  if (log.samples() > 0) log.time.array() -= log.time(0);
+  f.reg = full.stack_regression(preprocess::preprocess(log, std::stod(f.id.substr(at + 1)) / 1000, {}));
+  return f;
+}
+
+// R with |R d| = the RMS over the run's rows of W d: the metric of the predicted torque.
+Eigen::MatrixXd torque_metric_root(const identify::Regression& reg) {
+  const Eigen::MatrixXd W = reg.W / std::sqrt(static_cast<double>(std::max<Eigen::Index>(1, reg.W.rows())));
+  return Eigen::HouseholderQR<Eigen::MatrixXd>(W).matrixQR().topRows(W.cols()).triangularView<Eigen::Upper>();
+}
+
+std::string torque_cost(const FittingRun& f, const Eigen::VectorXd& phi, const Eigen::VectorXd& phi_consistent) {
+  auto rms = [](const Eigen::VectorXd& v) { return std::sqrt(v.squaredNorm() / std::max<Eigen::Index>(1, v.size())); };
+  const Eigen::VectorXd change = f.reg.W * (phi_consistent - phi);
+  return fmt::format("on {} (trial {}, {} samples), the nearest consistent vector (nearest in this run's predicted "
+                     "torque) changes the predicted torque by RMS {:.4g} N m (max {:.4g}); the fit's RMS residual "
+                     "goes from {:.4g} to {:.4g} N m",
+                     f.id, f.trial, f.reg.samples, rms(change), change.cwiseAbs().maxCoeff(), rms(f.reg.y - f.reg.W * phi),
+                     rms(f.reg.y - f.reg.W * phi_consistent));
+}
+
+}  // namespace export_detail
+
+void ExportCommand::run_model(const Common& common, const ExportOptions& o,
+                              const std::shared_ptr<const identify::IdentificationModel>& model,
+                              const std::shared_ptr<const identify::IdentificationModel>& parent, const TwinPrior& twin_prior) {
+  const identify::ModelDescription& d = model->description();
+  if (!model->supports_physical_consistency()) {
+    throw UsageError(fmt::format("model '{}' has model-gap effect parameters, which have no URDF counterpart and no "
+                                 "standard-parameter form: export a study of a model without effects",
+                                 d.variant));
+  } else {
+    const std::filesystem::path params = std::filesystem::path(o.study) / "report" / "parameters.yaml";
+    {
+      const YAML::Node root = YAML::LoadFile(params.string());
+      const std::string robot = root["robot"] ? root["robot"].as<std::string>() : std::string();
+      if (!robot.empty() && robot != common.robot)
+        throw UsageError(fmt::format("--robot {}, but {} is a study of '{}'", common.robot, params.string(), robot));
+    }
+    std::vector<std::string> names;
+    for (const auto& p : d.parameters) names.emplace_back(p.name);
+    const Eigen::VectorXd phi = io::read_parameters_yaml(params.string(), names);
+    const bool accepted = io::parameters_accepted(params.string());
+    if (!accepted && !o.not_accepted)
+      throw UsageError(params.string() + ": the study's final audit did not accept these parameters (accepted: false); "
+                                         "--not-accepted exports them anyway");
+
+    // The prior.
+    std::vector<std::string> standard_names;
+    for (const auto& p : d.standard) standard_names.emplace_back(p.name);
+    const int ns = static_cast<int>(d.standard.size());
+    Eigen::VectorXd prior;
+    std::string prior_what;
+    const auto twin_path = common.robot_dir() / "twin.yaml";
+    if (o.prior == "zero") {
+      prior = Eigen::VectorXd::Zero(ns);
+      prior_what = "zero (the consistent set nearest 0)";
+    } else if (!o.prior.empty()) {
+      prior = io::read_parameters_yaml(o.prior, standard_names);
+      prior_what = o.prior;
+    } else if (twin_prior && std::filesystem::exists(twin_path)) {  // a loaded robot has no twin
+      const twin::TwinConfig tc = twin::read_twin_config(twin_path, d.nq);
+      prior = twin_prior(tc);
+      prior_what = twin_path.string() + " (CAD truth)";
+    } else if (std::vector<double> nominal;
+               nominal_standard_parameters(common, d.standard, nominal)) {
+      // symoroc model's robot.yaml from a URDF: the URDF's own inertials.
+      prior = Eigen::Map<const Eigen::VectorXd>(nominal.data(), ns);
+      prior_what = (common.robot_dir() / "robot.yaml").string() + " (nominal: the URDF's inertials)";
+    } else {
+      throw UsageError(fmt::format("robot '{}' has no twin.yaml to take a prior from: give --prior <standard-parameter "
+                                   "YAML> or --prior zero (see dynid export --help)",
+                                   common.robot));
+    }
+
+    identify::ModelExportOptions eo;
+    eo.prior = prior;
+    eo.prior_what = prior_what;
+    eo.study = o.study;
+    eo.accepted = accepted;
+    eo.margin = o.margin;
+    eo.nearest = o.nearest;
+    std::optional<export_detail::FittingRun> fitting;
+    if (!o.data.empty()) {
+      fitting = export_detail::fitting_run(*parent, params, o.data, o.trial);
+      eo.base_metric_root = export_detail::torque_metric_root(fitting->reg);
+    }
+    eo.cost = [&](const Eigen::VectorXd& target, const Eigen::VectorXd& phi_consistent) {
+      return fitting ? export_detail::torque_cost(*fitting, target, phi_consistent)
+                     : std::string("--data <the study's dataset> measures the torque it costs on the fitting data (and takes "
+                                   "the nearest vector in that metric)");
+    };
+    const identify::ModelExport e = identify::export_model(*model, phi, eo);
+    const identify::ConsistencyResult& r = e.consistency;
+    const bool nearest = e.nearest;
+    const std::string& cost = e.cost;
+    const double residual = e.residual;
+    std::string urdf_text;
+    if (o.into.empty()) {
+      urdf_text = identify::urdf_text(e.description);
+    } else {
+      std::vector<std::string> notes;
+      urdf_text = urdf_into(e.description, (common.robot_dir() / "robot.yaml").string(), o.into, notes);
+      for (const auto& note : notes) fmt::print("{}\n", note);
+    }
+    const identify::ModelExportFiles files = identify::write_model_export(e, o.urdf, urdf_text);
+    if (nearest)
+      fmt::print("WARNING: {}; exported the nearest base vector with a consistent set ({:.4g} away); {}\n", r.message,
+                 r.base_distance, cost);
+    fmt::print("{}: {}; max |B s - phi| = {:.3g}, lambda_min = {:.4g}, prior {}\n",
+               nearest ? "standard parameters of the nearest consistent base vector" : "consistent standard parameters",
+               r.message, residual, r.lambda_min, prior_what);
+    fmt::print("urdf: {}\nstandard parameters: {}, {}\n", files.urdf.string(), files.yaml.string(), files.csv.string());
+  }
+}
+
 
 void add_export_commands(CLI::App& app, Common& common) {
   auto o = std::make_shared<ExportOptions>();
@@ -91,7 +250,12 @@ void add_export_commands(CLI::App& app, Common& common) {
     const std::string label = study_model(file);
     if (!o->model.empty() && o->model != label)
       throw UsageError(fmt::format("--model {}, but {} holds the parameters of model {}", o->model, file, label));
-    export_units().model(common, label)(common, *o);
+    if (compiled_robot(common)) {
+      export_units().model(common, label)(common, *o);
+    } else {  // a robot folder this dynid was not built with: its library (no twin: no CAD prior)
+      ExportCommand::run_model(common, *o, loaded_identification_model(common, label),
+                               loaded_identification_model(common, "full"), {});
+    }
   });
 }
 

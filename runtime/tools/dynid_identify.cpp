@@ -14,6 +14,7 @@
 #include <fmt/format.h>
 
 #include "dynid_identify.hpp"
+#include "dynid_loaded_robot.hpp"
 #include "dynid_numbers.hpp"
 #include "symoro/identify/report.hpp"
 #include "symoro/identify/robot_folder.hpp"
@@ -115,6 +116,7 @@ void IdentifyCommand::run_model(const Common& common, const IdentifyOptions& o,
 
 
 std::shared_ptr<const identify::IdentificationModel> identification_model_of(const Common& common, const std::string& model) {
+  if (!compiled_robot(common)) return loaded_identification_model(common, model);
   std::shared_ptr<const identify::IdentificationModel> out;
   IdentifyOptions o;
   o.take_model = [&out](std::shared_ptr<const identify::IdentificationModel> m) { out = std::move(m); };
@@ -203,7 +205,12 @@ void add_identify_commands(CLI::App& app, Common& common) {
     // One study per folder at a time (rank 0 writes it; the other ranks only compute).
     std::optional<io::FolderLock> lock;
     if (!o->out.empty() && parallel::place().coordinator()) lock.emplace(o->out, "dynid identify");
-    identify_units().model(common, o->model)(common, *o);
+    if (compiled_robot(common)) {
+      identify_units().model(common, o->model)(common, *o);
+    } else {  // a robot folder this dynid was not built with: its library; no twin, so no truth
+      IdentifyCommand::run_model(common, *o, loaded_identification_model(common, o->model),
+                                 [](const twin::TwinConfig&) { return Eigen::VectorXd(); });
+    }
   });
 }
 

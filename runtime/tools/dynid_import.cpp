@@ -1,12 +1,18 @@
 // dynid import: logs exported by a robot's own controller (CSV, ';' or whitespace, any rate)
 // into a dataset folder the other commands read: one project log per input, import.yaml (the
 // mapping used) and dataset.yaml, with an optional fitting / held-out split recorded there.
+#include <algorithm>
+#include <cmath>
 #include <string>
+#include <vector>
 
 #include <CLI/CLI.hpp>
+#include <fmt/format.h>
 
 #include "dynid_import.hpp"
+#include "dynid_loaded_robot.hpp"
 #include "dynid_numbers.hpp"
+#include "symoro/io/import.hpp"
 
 namespace symoro::dynid {
 
@@ -17,6 +23,56 @@ constexpr const char* selector_help =
     "list 'a,b,c', or 1-based positions ('2-8', '2,4,6')";
 
 }  // namespace
+
+namespace import_detail {
+
+// The command line's settings over the mapping file's (or the defaults).
+io::ImportMapping mapping_of(const ImportOptions& o) {
+  io::ImportMapping m = o.mapping.empty() ? io::ImportMapping{} : io::read_import_mapping(o.mapping);
+  io::apply_settings(m, {o.time, o.q, o.qd, o.tau, o.q_ref, o.qd_ref, o.qdd_ref, o.time_unit, o.angle, o.header,
+                         o.delimiter, o.torque_scale});
+  if (m.time.empty() || m.q.empty() || m.tau.empty())
+    throw UsageError("say which columns hold time, q and tau: --time, --q, --tau, or --mapping map.yaml");
+  return m;
+}
+
+}  // namespace import_detail
+
+void ImportCommand::run_joints(const Common& common, const ImportOptions& o, const std::vector<JointInfo>& joints) {
+  io::DatasetImport di;
+  di.target = io::import_target(common.robot, joints);
+  di.mapping = import_detail::mapping_of(o);
+  di.split = o.split;
+  di.allow_implausible = o.allow_implausible;
+  if (!o.names.empty() && o.names.size() != o.inputs.size())
+    throw UsageError(fmt::format("--name: {} names for {} input files", o.names.size(), o.inputs.size()));
+  for (const std::string& h : o.heldout)
+    if (std::find(o.inputs.begin(), o.inputs.end(), h) == o.inputs.end())
+      throw UsageError(fmt::format("--heldout {}: not one of the input files", h));
+  for (std::size_t i = 0; i < o.inputs.size(); ++i)
+    di.inputs.push_back({o.inputs[i], o.names.empty() ? "" : o.names[i],
+                         std::find(o.heldout.begin(), o.heldout.end(), o.inputs[i]) != o.heldout.end()});
+  const io::DatasetImportResult r = io::import_dataset(o.out, di);
+  for (const io::ImportedLog& l : r.logs) {
+    const io::Log& log = l.log;
+    fmt::print("{}: {} rows -> {}.csv: {} samples over {:.3f} s, sample time {:g} ms (median), {} stale rows kept, "
+               "{} duplicates dropped, velocity {}\n",
+               l.input.string(), l.rows, log.meta.trajectory, log.samples(), log.time[log.samples() - 1] - log.time[0],
+               log.meta.sample_time * 1e3, l.stale_lines.size(), l.duplicate_lines.size(),
+               log.meta.velocity == io::Velocity::measured ? "measured" : "differentiated from q");
+    if (!l.stale_lines.empty())
+      fmt::print("  stale rows (same state as the row before, new stamp) on lines {}{}\n", l.stale_lines.front(),
+                 l.stale_lines.size() > 1 ? fmt::format(" .. {}", l.stale_lines.back()) : "");
+  }
+  for (const auto& run : r.runs) {
+    fmt::print("run {} (family {}): {}", run.trajectory, run.family, run.file.filename().string());
+    if (std::isfinite(run.window_start) || std::isfinite(run.window_end))
+      fmt::print(", window [{:.6g}, {:.6g}) s", run.window_start, run.window_end);
+    fmt::print("\n");
+  }
+  fmt::print("dataset: {} (mapping kept in import.yaml)\n", r.dataset.string());
+}
+
 
 void add_import_commands(CLI::App& app, Common& common) {
   auto o = std::make_shared<ImportOptions>();
@@ -61,7 +117,12 @@ void add_import_commands(CLI::App& app, Common& common) {
                "[0.1 ms, 0.5 s] (refused by default: a unit declared wrong)");
   cmd->add_option("--name", o->names, "Run names, one per input (default: the file names' stems)")->delimiter(',');
   cmd->add_option("--heldout", o->heldout, "Inputs held out whole (family V)")->delimiter(',');
-  cmd->callback([&common, o] { import_units().robot(common)(common, *o); });
+  cmd->callback([&common, o] {
+    if (compiled_robot(common))
+      import_units().robot(common)(common, *o);
+    else  // a robot folder this dynid was not built with: its library's joints
+      ImportCommand::run_joints(common, *o, loaded_model(common, "").joints());
+  });
 }
 
 }  // namespace symoro::dynid

@@ -1,5 +1,5 @@
-// dynid import's options and its entry, compiled for each robot's identified model (its joints
-// name and type the columns) in generated units; the body is in dynid_import-inl.hpp.
+// dynid import's options and its entry: the robot's identified model's joints (they name and type
+// the columns), from a generated unit (dynid_import-inl.hpp) or a loaded robot library.
 #pragma once
 
 #include <string>
@@ -21,6 +21,8 @@ struct ImportCommand {
   using Options = ImportOptions;
   template <class Full, class Model>
   static void run(const Common& common, const Options& o);
+  // The body, compiled once (dynid_import.cpp): the exported logs mapped onto these joints.
+  static void run_joints(const Common& common, const Options& o, const std::vector<JointInfo>& joints);
 };
 
 const CommandTable<ImportOptions>& import_units();  // generated: dynid_tables.cpp

@@ -35,7 +35,12 @@ if(NOT EXISTS ${WORK}/samples/V01_t1_40ms.csv)
 endif()
 
 run(2 out twin run --robot no_such_robot --trajectory AG02 -o ${WORK}/x)
-expect("${out}" "unknown robot 'no_such_robot'")
+expect("${out}" "robot 'no_such_robot' \\([^)]*no_such_robot\\) is not compiled into this dynid")
+# A command that runs on any robot folder names what is missing: no folder, or no robot.yaml.
+run(2 out identify --robot no_such_robot --data ${WORK} -o ${WORK}/x)
+expect("${out}" "unknown robot 'no_such_robot': .*no_such_robot is not a folder")
+run(2 out identify --robot ${WORK}/ --data ${WORK} -o ${WORK}/x)
+expect("${out}" "is not a robot folder: it has no robot.yaml")
 run(1 out twin run --robot crane_x7 --trajectory AG99 -o ${WORK}/x)
 expect("${out}" "AG99")
 run(2 out twin run --robot crane_x7 --trajectory AG02 --effects friction -o ${WORK}/x)

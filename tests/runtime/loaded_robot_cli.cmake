@@ -1,0 +1,84 @@
+# A robot folder dynid was never built with, from its URDF alone (symoroc model), through the
+# commands that run on a robot library: dynid builds the folder's library into a fresh robot
+# cache on first use, imports a controller's CSV export of the UR5 (write_export: synthesized
+# from robots/ur5's generated model with Coulomb friction and an offset), identifies it on the
+# physical path, predicts with the result and exports it as a URDF; then the same through the
+# compiled robots/ur5: the studies' parameters and validation, the predictions and the URDFs are
+# the same numbers, digit for digit (one generated model, two ways to call it). A second study reuses the cached library (no build line). Run with
+# -DDYNID, -DSYMOROC, -DWRITE_EXPORT, -DURDF_DIR, -DWORK.
+file(REMOVE_RECURSE ${WORK})
+file(MAKE_DIRECTORY ${WORK})
+set(ENV{SYMORO_CACHE_DIR} ${WORK}/cache)
+include(${CMAKE_CURRENT_LIST_DIR}/cli_test_helpers.cmake)
+function(run expect_code out_var)  # dynid <arguments>
+  run_command(${expect_code} out ${DYNID} ${ARGN})
+  set(${out_var} "${out}" PARENT_SCOPE)
+endfunction()
+
+run_command(0 out ${SYMOROC} model ${URDF_DIR}/ur5_robot.urdf -o ${WORK}/robots/ur5 --name ur5)
+execute_process(COMMAND ${WRITE_EXPORT} ur5 ${WORK}/export.csv 40 5 RESULT_VARIABLE code)
+if(NOT code EQUAL 0)
+  message(FATAL_ERROR "write_export ur5 failed")
+endif()
+set(columns --name arm --time stamp_ms --time-unit ms --q "{name}_pos" --qd "{name}_vel" --tau "{name}_eff" --angle deg
+    --split 0.7)
+
+foreach(way loaded compiled)
+  if(way STREQUAL "loaded")
+    set(robot ${WORK}/robots/ur5)  # a folder: its library
+  else()
+    set(robot ur5)  # robots/ur5, compiled into dynid
+  endif()
+  run(0 out import --robot ${robot} -o ${WORK}/${way}-data ${WORK}/export.csv ${columns})
+  if(way STREQUAL "loaded")
+    expect("${out}" "ur5: built .*libur5.so")  # the first use builds the library
+  endif()
+  run(0 out identify --robot ${robot} --model full --data ${WORK}/${way}-data -o ${WORK}/${way}-study --interval 10
+      --consistency physical)
+  if(way STREQUAL "loaded" AND out MATCHES "built ")
+    message(FATAL_ERROR "the second use rebuilt the library:\n${out}")
+  endif()
+  expect("${out}" "validation arm_heldout")
+  file(READ ${WORK}/${way}-study/report/parameters.yaml params_${way})
+  file(READ ${WORK}/${way}-study/validation.yaml validation_${way})
+  run(0 out predict --robot ${robot} --model full --params ${WORK}/${way}-study/report/parameters.yaml
+      ${WORK}/${way}-data -o ${WORK}/${way}-predict)
+  set(predict_${way} "${out}")
+  # The URDF with consistent inertials nearest the URDF's own (robot.yaml's nominal).
+  run(0 out export --robot ${robot} --study ${WORK}/${way}-study --urdf ${WORK}/${way}-urdf/ur5.urdf)
+  file(READ ${WORK}/${way}-urdf/ur5.urdf urdf_${way})
+  file(READ ${WORK}/${way}-urdf/ur5.standard.yaml standard_${way})
+endforeach()
+
+# The same numbers both ways (the files name the same robot, its folders' digests aside).
+foreach(kind params validation urdf standard)
+  string(REGEX REPLACE "[0-9a-f]{32}" "<digest>" a "${${kind}_loaded}")
+  string(REGEX REPLACE "[0-9a-f]{32}" "<digest>" b "${${kind}_compiled}")
+  foreach(v a b)  # the folders' paths
+    string(REGEX REPLACE "(data|study|folder|dataset)[^\n]*" "" ${v} "${${v}}")
+    string(REGEX REPLACE "/[^ \n]*/ur5/(controller|robot).yaml" "<robot folder>/\\1.yaml" ${v} "${${v}}")
+    string(REGEX REPLACE "Study: [^\n]*" "" ${v} "${${v}}")
+  endforeach()
+  if(NOT a STREQUAL b)
+    file(WRITE ${WORK}/${kind}_loaded.txt "${a}")
+    file(WRITE ${WORK}/${kind}_compiled.txt "${b}")
+    message(FATAL_ERROR "${kind}: the loaded library's study differs from the compiled robot's "
+                        "(${WORK}/${kind}_loaded.txt, ${WORK}/${kind}_compiled.txt)")
+  endif()
+endforeach()
+string(REGEX MATCHALL "RMSE[^\n]*" a "${predict_loaded}")
+string(REGEX MATCHALL "RMSE[^\n]*" b "${predict_compiled}")
+if(NOT a STREQUAL b OR a STREQUAL "")
+  message(FATAL_ERROR "predict differs:\n${predict_loaded}\n---\n${predict_compiled}")
+endif()
+
+# An edited robot folder is another library: a joint limit changed, the library is rebuilt.
+file(READ ${WORK}/robots/ur5/robot.yaml yaml)
+string(REPLACE "velocity: 3.15" "velocity: 3.0" yaml "${yaml}")
+file(WRITE ${WORK}/robots/ur5/robot.yaml "${yaml}")
+run(0 out identify --robot ${WORK}/robots/ur5 --model full --data ${WORK}/loaded-data -o ${WORK}/edited-study
+    --interval 10 --no-report)
+expect("${out}" "ur5: built ")
+# A command that still needs a compiled robot says so.
+run(2 out twin run --robot ${WORK}/robots/ur5 --trajectory AG02 -o ${WORK}/x)
+expect("${out}" "is not compiled into this dynid")
