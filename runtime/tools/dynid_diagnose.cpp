@@ -7,8 +7,10 @@
 #include <fmt/format.h>
 
 #include "dynid_diagnose.hpp"
+#include "dynid_loaded_robot.hpp"
 #include "dynid_numbers.hpp"
 #include "symoro/diagnose/dataset_diagnosis.hpp"
+#include "symoro/diagnose/loaded_model.hpp"
 
 namespace symoro::dynid {
 
@@ -86,7 +88,11 @@ void add_diagnose_commands(CLI::App& app, Common& common) {
     } catch (const diagnose::DiagnosisRequestError& e) {
       throw UsageError(e.what());
     }
-    diagnose_units().model(common, o->model)(common, *o);
+    if (compiled_robot(common)) {
+      diagnose_units().model(common, o->model)(common, *o);
+    } else {  // a robot folder this dynid was not built with: its library
+      run_diagnose(common, *o, *diagnose::diagnosis_model(loaded_model(common, o->model), loaded_model(common, "full")));
+    }
   });
 }
 

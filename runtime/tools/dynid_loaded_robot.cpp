@@ -40,8 +40,8 @@ std::string not_compiled(const Common& common) {
   std::string known;
   for (const auto& r : robot_names()) known += (known.empty() ? "" : ", ") + r;
   return fmt::format("robot '{}' ({}) is not compiled into this dynid (its robots: {}): this command needs a compiled "
-                     "robot yet; import, identify, predict, compare and excite run on any robot folder through its "
-                     "robot library",
+                     "robot yet; import, identify, diagnose, predict, compare, excite and export run on any robot folder "
+                     "through its robot library",
                      common.robot, common.robot_dir().string(), known);
 }
 

@@ -1,6 +1,6 @@
 // A robot dynid was not built with: its folder's robot library (symoro/robot_abi.h), built into
 // the robot cache on first use and loaded. The commands that run through a library (import,
-// identify, predict, compare, excite, trajectories) take such a robot like a compiled one.
+// identify, diagnose, predict, compare, excite, export) take such a robot like a compiled one.
 #pragma once
 
 #include <memory>

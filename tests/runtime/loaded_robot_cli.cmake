@@ -2,9 +2,9 @@
 # commands that run on a robot library: dynid builds the folder's library into a fresh robot
 # cache on first use, imports a controller's CSV export of the UR5 (write_export: synthesized
 # from robots/ur5's generated model with Coulomb friction and an offset), identifies it on the
-# physical path, predicts with the result and exports it as a URDF; then the same through the
-# compiled robots/ur5: the studies' parameters and validation, the predictions and the URDFs are
-# the same numbers, digit for digit (one generated model, two ways to call it). A second study reuses the cached library (no build line). Run with
+# physical path, predicts with the result, exports it as a URDF and diagnoses its gap; then the
+# same through the compiled robots/ur5: the studies' parameters and validation, the predictions,
+# the URDFs and the diagnoses are the same numbers, digit for digit (one generated model, two ways to call it). A second study reuses the cached library (no build line). Run with
 # -DDYNID, -DSYMOROC, -DWRITE_EXPORT, -DURDF_DIR, -DWORK.
 file(REMOVE_RECURSE ${WORK})
 file(MAKE_DIRECTORY ${WORK})
@@ -48,15 +48,21 @@ foreach(way loaded compiled)
   run(0 out export --robot ${robot} --study ${WORK}/${way}-study --urdf ${WORK}/${way}-urdf/ur5.urdf)
   file(READ ${WORK}/${way}-urdf/ur5.urdf urdf_${way})
   file(READ ${WORK}/${way}-urdf/ur5.standard.yaml standard_${way})
+  # The model-gap diagnosis names the offset the export has (joint 6) and writes its variant.
+  run(0 out diagnose --robot ${robot} --model full --data ${WORK}/${way}-data -o ${WORK}/${way}-diagnosis)
+  expect("${out}" "effect: constant torque offset, joint 6")
+  file(READ ${WORK}/${way}-diagnosis/diagnosis.md diagnosis_${way})
+  file(READ ${WORK}/${way}-diagnosis/variant.yaml variant_${way})
 endforeach()
 
 # The same numbers both ways (the files name the same robot, its folders' digests aside).
-foreach(kind params validation urdf standard)
+foreach(kind params validation urdf standard diagnosis variant)
   string(REGEX REPLACE "[0-9a-f]{32}" "<digest>" a "${${kind}_loaded}")
   string(REGEX REPLACE "[0-9a-f]{32}" "<digest>" b "${${kind}_compiled}")
   foreach(v a b)  # the folders' paths
     string(REGEX REPLACE "(data|study|folder|dataset)[^\n]*" "" ${v} "${${v}}")
-    string(REGEX REPLACE "/[^ \n]*/ur5/(controller|robot).yaml" "<robot folder>/\\1.yaml" ${v} "${${v}}")
+    string(REGEX REPLACE "/[^ \n]*/ur5/(controller|robot|twin).yaml" "<robot folder>/\\1.yaml" ${v} "${${v}}")
+    string(REGEX REPLACE "/[^ \n]*/ur5([ )])" "<robot folder>\\1" ${v} "${${v}}")
     string(REGEX REPLACE "Study: [^\n]*" "" ${v} "${${v}}")
   endforeach()
   if(NOT a STREQUAL b)
