@@ -1,16 +1,19 @@
-// A compiled model as the Python package calls it: plain functions over a batch of states in
-// C-ordered float64 arrays (NumPy's layout), so that the binding code is compiled once and only
-// these loops are compiled per model (model_kernels-inl.hpp, one unit per robot model). Each
+// A robot model as the Python package calls it: functions over a batch of states in C-ordered
+// float64 arrays (NumPy's layout), so that the binding code is compiled once and only these loops
+// are compiled per model (model_kernels-inl.hpp, one unit per robot model), or written once over
+// a loaded robot library's functions (loaded_kernels.cpp). Each
 // computes what the generated function gives in C++, into the model's own fixed-size Eigen
 // types, then copies it out: the results are those of the C++ call, bit for bit.
 #pragma once
 
 #include <cstddef>
+#include <functional>
 #include <memory>
 #include <vector>
 
 #include "symoro/diagnose/diagnosis_model.hpp"
 #include "symoro/identify/identification_model.hpp"
+#include "symoro/robot/model_handle.hpp"
 
 namespace symoro::python {
 
@@ -23,36 +26,36 @@ struct Batch {
 struct ModelKernels {
   // The model's description, its identification interface (studies), its diagnosis interface
   // (diagnose) and its sizes.
-  std::shared_ptr<const identify::IdentificationModel> (*identification)() = nullptr;
-  std::shared_ptr<const diagnose::DiagnosisModel> (*diagnosis)() = nullptr;
+  std::function<std::shared_ptr<const identify::IdentificationModel>()> identification;
+  std::function<std::shared_ptr<const diagnose::DiagnosisModel>()> diagnosis;
   int nq = 0, np = 0, ns = 0;
 
   // (n, nq, np)
-  void (*regressor)(const double* q, const double* qd, const double* qdd, double* w, Batch b) = nullptr;
+  std::function<void(const double* q, const double* qd, const double* qdd, double* w, Batch b)> regressor;
   // (n, nq)
-  void (*inverse_dynamics)(const double* q, const double* qd, const double* qdd, const double* phi, double* tau,
-                           Batch b) = nullptr;
+  std::function<void(const double* q, const double* qd, const double* qdd, const double* phi, double* tau,
+                           Batch b)> inverse_dynamics;
   // (n, nq, nq)
-  void (*inertia)(const double* q, const double* phi, double* m, Batch b) = nullptr;
+  std::function<void(const double* q, const double* phi, double* m, Batch b)> inertia;
   // (n, nq)
-  void (*nonlinear_effects)(const double* q, const double* qd, const double* phi, double* h, Batch b) = nullptr;
+  std::function<void(const double* q, const double* qd, const double* phi, double* h, Batch b)> nonlinear_effects;
   // (n, nq)
-  void (*forward_dynamics)(const double* q, const double* qd, const double* tau, const double* phi, double* qdd,
-                           Batch b) = nullptr;
+  std::function<void(const double* q, const double* qd, const double* tau, const double* phi, double* qdd,
+                           Batch b)> forward_dynamics;
   // tau (n, nq), d tau / d q and d qd (n, nq, nq)
-  void (*inverse_dynamics_derivatives)(const double* q, const double* qd, const double* qdd, const double* phi,
-                                       double* tau, double* dq, double* dqd, Batch b) = nullptr;
+  std::function<void(const double* q, const double* qd, const double* qdd, const double* phi,
+                                       double* tau, double* dq, double* dqd, Batch b)> inverse_dynamics_derivatives;
   // qdd (n, nq), d qdd / d q, d qd, d tau (n, nq, nq), d phi (n, nq, np), min_pivot (n): where M
   // is not positive definite (min_pivot <= 0) the derivatives are NaN.
-  void (*forward_dynamics_derivatives)(const double* q, const double* qd, const double* tau, const double* phi,
+  std::function<void(const double* q, const double* qd, const double* tau, const double* phi,
                                        double* qdd, double* dq, double* dqd, double* dtau, double* dphi,
-                                       double* min_pivot, Batch b) = nullptr;
+                                       double* min_pivot, Batch b)> forward_dynamics_derivatives;
   // (n, 4, 4): the last arm frame in frame 0
-  void (*forward_kinematics)(const double* q, double* pose, Batch b) = nullptr;
+  std::function<void(const double* q, double* pose, Batch b)> forward_kinematics;
   // (n, 6, nq)
-  void (*jacobian)(const double* q, double* j, Batch b) = nullptr;
+  std::function<void(const double* q, double* j, Batch b)> jacobian;
   // (n, np) from (n, ns)
-  void (*base_from_standard)(const double* s, double* phi, Batch b) = nullptr;
+  std::function<void(const double* s, double* phi, Batch b)> base_from_standard;
 };
 
 template <class Full, class Model>
@@ -60,5 +63,9 @@ ModelKernels model_kernels();
 
 // Every compiled robot model (generated: <build>/robot_units/python_robots.cpp).
 std::vector<ModelKernels> all_model_kernels();
+
+// A model of a robot library loaded at run time (symoro.load; loaded_kernels.cpp): the same
+// loops over the library's functions. full: its robot's full model.
+ModelKernels loaded_kernels(const robot::ModelHandle& model, const robot::ModelHandle& full);
 
 }  // namespace symoro::python

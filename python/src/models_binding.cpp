@@ -1,11 +1,17 @@
-// symoro._symoro.Model: one compiled robot model's functions on NumPy arrays (docs/python.md).
+// symoro._symoro.Model: one robot model's functions on NumPy arrays (docs/python.md): a compiled
+// one (model_list) or one of a robot library loaded at run time (load_models).
 // A state is (nq,) or a batch (N, nq); results come back with the same leading N. Batches run
 // with the GIL released; one state keeps it (releasing costs more than the call).
+#include <filesystem>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include <fmt/format.h>
 #include <pybind11/stl.h>
+#include <pybind11/stl/filesystem.h>
+
+#include "symoro/robot/load_robot.hpp"
 
 #include "arrays.hpp"
 #include "model_kernels.hpp"
@@ -219,6 +225,23 @@ void bind_models(py::module_& m) {
     run(a.batch, [&] { x.k.base_from_standard(a.data(), out, {a.n, 0}); });
     return phi;
   }, py::arg("s"), "the base parameters phi (np,) of standard parameters s (ns,) in standard_names' order");
+
+  m.def("load_models", [](const std::filesystem::path& folder, const std::optional<std::filesystem::path>& cache_dir) {
+    robot::LoadOptions o;
+    if (cache_dir) o.cache_dir = *cache_dir;
+    std::shared_ptr<const robot::RobotLibrary> lib;
+    {
+      py::gil_scoped_release release;  // a first use compiles the library: seconds
+      lib = robot::load_robot(folder, o);
+    }
+    std::vector<std::shared_ptr<Model>> out;
+    for (int i = 0; i < lib->model_count(); ++i) {
+      const ModelKernels k = loaded_kernels(lib->model(i), lib->model(0));
+      out.push_back(std::make_shared<Model>(Model{k, k.identification(), k.diagnosis()}));
+    }
+    return py::make_tuple(lib->robot(), lib->model("").label(), out);
+  }, py::arg("folder"), py::arg("cache_dir") = py::none(),
+  "a robot folder's models through its robot library, built on first use: (robot, identified model, models)");
 
   m.def("model_list", [] {
     std::vector<std::shared_ptr<Model>> out;

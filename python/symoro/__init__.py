@@ -2,6 +2,7 @@
 
     import numpy as np, symoro
     arm = symoro.models.crane_x7.reduced          # a compiled robot model
+    my_arm = symoro.load("robots/my_arm")         # any robot folder, through its robot library
     W = arm.regressor(q, qd, qdd)                 # (nq, np), or (N, nq, np) for a batch
     symoro.import_logs(arm, "data", ["log.csv"], time="t", q="pos_*", tau="eff_*")
     study = symoro.identify(arm, "data", "study", robot_dir="robots/crane_x7")
@@ -15,5 +16,7 @@ See docs/python.md.
 
 from ._symoro import DataError, Model, StudyStopped, compare, diagnose, export_urdf, identify, import_logs, predict
 from . import models
+from .models import load
 
-__all__ = ["DataError", "Model", "StudyStopped", "compare", "diagnose", "export_urdf", "identify", "import_logs", "models", "predict"]
+__all__ = ["DataError", "Model", "StudyStopped", "compare", "diagnose", "export_urdf", "identify", "import_logs", "load",
+           "models", "predict"]

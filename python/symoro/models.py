@@ -29,6 +29,17 @@ class Robot:
         return f"<symoro robot {self.name}: models {', '.join(self.models)}>"
 
 
+def load(folder, cache_dir=None):
+    """A robot folder's models through its robot library, compiled on first use (seconds) into the
+    robot cache ($SYMORO_CACHE_DIR, else ~/.cache/symoro/robots) and loaded: any robot folder, no
+    rebuild of the package. Its models as attributes (robot.full, robot.<variant>), the robot itself
+    behaving as its full model; robot.identified is robot.yaml's identified model."""
+    name, identified, models = _symoro.load_models(str(folder), None if cache_dir is None else str(cache_dir))
+    robot = Robot(name, {m.name: m for m in models})
+    robot.identified = robot.models[identified]
+    return robot
+
+
 def _robots():
     robots = {}
     for m in _symoro.model_list():
