@@ -12,6 +12,7 @@
 #include <fmt/format.h>
 
 #include "symoro/identify/detail/physical_consistency_model.hpp"
+#include "symoro/identify/loaded_closed_loop.hpp"
 #include "symoro/identify/physical_projection.hpp"
 
 namespace symoro::identify {
@@ -203,12 +204,9 @@ class LoadedIdentificationModel final : public IdentificationModel {
   std::unique_ptr<InertiaFunction> inertia_function() const override {
     return std::make_unique<LoadedInertiaFunction>(m_);
   }
-  std::unique_ptr<ClosedLoop> closed_loop(const ClosedLoopSetup&, const trajectory::SampledReference&) const override {
-    throw std::runtime_error(fmt::format(
-        "robot '{}' is loaded at run time (a robot library): its closed-loop simulation (CLIE, closed-loop "
-        "validation) is not available through the library yet; run without a controller description "
-        "(controller.yaml), or build dynid with the robot in robots/",
-        d_.robot));
+  std::unique_ptr<ClosedLoop> closed_loop(const ClosedLoopSetup& setup,
+                                          const trajectory::SampledReference& reference) const override {
+    return identify::closed_loop(m_, setup, reference);
   }
 
   bool supports_physical_consistency() const override { return supports_; }

@@ -2,7 +2,8 @@
 // (symoro/robot/robot_library.hpp): the study, the audit, the SDP and the physical path compiled
 // once, calling the robot library's functions. Regressions, torques, inertia functions and the
 // physical path equal the generated Model's (identification_model<Model>()) bit for bit: the same
-// kernels, the same arithmetic around them.
+// kernels, the same arithmetic around them; the closed loop (CLIE) to round-off
+// (loaded_closed_loop.hpp).
 #pragma once
 
 #include <memory>

@@ -1,0 +1,332 @@
+// ClosedLoopSimulator<Model> (detail/closed_loop_model.hpp: the integration, the sensitivities,
+// where the steps lie, and why) written once over a loaded robot's ModelHandle: the same steps in
+// dynamic sizes, every buffer allocated once per simulation. CLIE and closed-loop validation of a
+// robot loaded at run time go through it.
+#include "symoro/identify/loaded_closed_loop.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
+#include <Eigen/Cholesky>
+
+#include "symoro/identify/detail/closed_loop_model.hpp"
+
+namespace symoro::identify {
+namespace {
+
+using robot::ModelHandle;
+using Vec = Eigen::VectorXd;
+using Mat = Eigen::MatrixXd;
+
+// detail::FfpdSensitivity in dynamic sizes: the same expressions in the same order.
+class DynamicFfpd {
+ public:
+  DynamicFfpd(const control::FfpdGains& g, int n, int np)
+      : inertia_(g.inertia), damping_(g.damping), kp_(g.kp), kv_(g.kv), q_prev_(n), qd_hat_(n), dq_prev_(n, np),
+        dqd_hat_(n, np) {
+    const double T = g.period, Tf = g.pseudo_derivative_time;
+    a_ = (2 * Tf - T) / (2 * Tf + T);
+    b_ = 2 / (2 * Tf + T);
+    position_gain_ = inertia_.cwiseProduct(kp_);
+    velocity_gain_ = inertia_.cwiseProduct(kv_);
+  }
+  void reset(bool sens, const Vec& q) {
+    q_prev_ = q;
+    qd_hat_.setZero();
+    if (sens) {
+      dq_prev_.setZero();
+      dqd_hat_.setZero();
+    }
+  }
+  void update(bool sens, const Vec& q, const Mat& dq, const Eigen::Ref<const Vec>& q_ref,
+              const Eigen::Ref<const Vec>& qd_ref, const Eigen::Ref<const Vec>& qdd_ref, Vec& u, Mat& du) {
+    qd_hat_ = a_ * qd_hat_ + b_ * (q - q_prev_);
+    q_prev_ = q;
+    u = inertia_.cwiseProduct(kv_.cwiseProduct(qd_ref - qd_hat_) + kp_.cwiseProduct(q_ref - q) + qdd_ref) +
+        damping_.cwiseProduct(qd_ref);
+    if (sens) {
+      dqd_hat_ = a_ * dqd_hat_ + b_ * (dq - dq_prev_);
+      dq_prev_ = dq;
+      du.noalias() = -(position_gain_.asDiagonal() * dq);
+      du.noalias() -= velocity_gain_.asDiagonal() * dqd_hat_;
+    }
+  }
+
+ private:
+  Vec inertia_, damping_, kp_, kv_, position_gain_, velocity_gain_;
+  double a_ = 0, b_ = 0;
+  Vec q_prev_, qd_hat_;
+  Mat dq_prev_, dqd_hat_;
+};
+
+class LoadedClosedLoop final : public ClosedLoop {
+ public:
+  LoadedClosedLoop(ModelHandle model, ClosedLoopSetup setup, const trajectory::SampledReference& reference)
+      : m_(std::move(model)), setup_(std::move(setup)), n_(m_.nq()), np_(m_.np()) {
+    detail::check_setup(setup_, n_);
+    if (reference.q.rows() != n_)
+      throw std::invalid_argument("closed-loop simulation: the reference " + reference.name + " has " +
+                                  std::to_string(reference.q.rows()) + " joints, the model " + std::to_string(n_));
+    if (!(std::abs(reference.period - period()) <= 1e-9 * period()))
+      throw std::invalid_argument("closed-loop simulation: the reference " + reference.name + " is sampled every " +
+                                  std::to_string(reference.period) + " s, the controller runs every " +
+                                  std::to_string(period()) + " s");
+    cycles_ = static_cast<int>(reference.q.cols());
+    pre_cycles_ = static_cast<int>(std::llround(setup_.pre_roll / period()));
+    q_ref_ = reference.q;
+    qd_ref_ = reference.qd;
+    qdd_ref_ = reference.qdd;
+  }
+
+  int joints() const override { return n_; }
+  const std::vector<ParameterInfo>& parameter_info() const override { return m_.parameters(); }
+  int cycles() const override { return cycles_; }
+  const ClosedLoopSetup& setup() const override { return setup_; }
+
+  bool simulate(const Eigen::VectorXd& phi, preprocess::Channels& tau, preprocess::Channels* dtau, Divergence* why,
+                preprocess::Channels* q) const override {
+    if (!dtau) return simulate_into(phi, tau, nullptr, why, q);
+    struct Store final : SensitivityRows {
+      preprocess::Channels& m;
+      Eigen::Index k = 0;
+      explicit Store(preprocess::Channels& out) : m(out) {}
+      void row(const double* d) override { m.row(k++) = Eigen::Map<const Eigen::RowVectorXd>(d, m.cols()); }
+    } store(*dtau);
+    dtau->resize(cycles_, n_ * np_);
+    return simulate_into(phi, tau, &store, why, q);
+  }
+  bool simulate(const Eigen::VectorXd& phi, preprocess::Channels& tau, SensitivityRows& dtau,
+                Divergence* why) const override {
+    return simulate_into(phi, tau, &dtau, why, nullptr);
+  }
+
+ private:
+  struct State {
+    Vec q, qd;
+    Mat S;  // 2n x np, q rows first (with sensitivities)
+  };
+  // Everything a simulation writes per step, sized once.
+  struct Work {
+    Mat M, fd_dq, fd_dqd, fd_dtau, fd_dphi;
+    Vec h, qdd1, qdd2;
+    Mat dqdd1, dqdd2, unused;
+    State mid;
+    Work(int n, int np)
+        : M(n, n), fd_dq(n, n), fd_dqd(n, n), fd_dtau(n, n), fd_dphi(n, np), h(n), qdd1(n), qdd2(n), dqdd1(n, np),
+          dqdd2(n, np), unused(n, np) {
+      mid.q.resize(n);
+      mid.qd.resize(n);
+      mid.S.resize(2 * n, np);
+    }
+  };
+
+  bool simulate_into(const Eigen::VectorXd& phi, preprocess::Channels& tau, SensitivityRows* dtau, Divergence* why,
+                     preprocess::Channels* q) const {
+    if (phi.size() != np_)
+      throw std::invalid_argument("closed-loop simulation: phi has " + std::to_string(phi.size()) +
+                                  " entries, the model " + std::to_string(np_));
+    Divergence stop;
+    const bool ok = run(dtau != nullptr, phi, tau, dtau, q, stop);
+    if (why) *why = ok ? Divergence{} : stop;
+    return ok;
+  }
+
+  // qdd = M^-1 (u - h) at x, and with sens its derivative d qdd / d phi. False on divergence.
+  bool acceleration(bool sens, const Vec& phi, const State& x, const Vec& u, const Mat& du, double t, Vec& qdd,
+                    Mat& dqdd, Work& w, Divergence& why) const {
+    if (!x.q.allFinite() || !x.qd.allFinite()) {
+      why = detail::not_finite(t);
+      return false;
+    }
+    if (sens) {
+      double pivot = 0;
+      if (!m_.forward_dynamics_derivatives(x.q.data(), x.qd.data(), u.data(), phi.data(), qdd.data(), w.fd_dq.data(),
+                                           w.fd_dqd.data(), w.fd_dtau.data(), w.fd_dphi.data(), &pivot)) {
+        why = detail::indefinite_inertia(t, pivot);
+        return false;
+      }
+      if (!qdd.allFinite()) {
+        why = detail::not_finite(t);
+        return false;
+      }
+      dqdd = w.fd_dphi;
+      dqdd.noalias() += w.fd_dq.lazyProduct(x.S.topRows(n_));
+      dqdd.noalias() += w.fd_dqd.lazyProduct(x.S.bottomRows(n_));
+      dqdd.noalias() += w.fd_dtau.lazyProduct(du);
+      return true;
+    }
+    m_.inertia(x.q.data(), phi.data(), w.M.data());
+    m_.nonlinear_effects(x.q.data(), x.qd.data(), phi.data(), w.h.data());
+    const Eigen::LDLT<Mat> ldlt(w.M);
+    const double pivot = ldlt.vectorD().minCoeff();
+    if (ldlt.info() != Eigen::Success || !(pivot > 0)) {
+      why = detail::indefinite_inertia(t, pivot);
+      return false;
+    }
+    qdd = ldlt.solve(u - w.h);
+    if (!qdd.allFinite()) {
+      why = detail::not_finite(t);
+      return false;
+    }
+    return true;
+  }
+
+  bool hold(bool sens, const Vec& phi, State& x, const Vec& u, const Mat& du, double length, double t0,
+            double sample_at, Vec& qs, Mat& dqs, Work& w, Divergence& why) const {
+    if (!(length > 0)) return true;
+    if (sens && !setup_.exact_sensitivities) return hold_frozen(phi, x, u, du, length, t0, sample_at, qs, dqs, w, why);
+    const int m = setup_.substeps;
+    const double h = length / m;
+    State& mid = w.mid;
+    for (int s = 0; s < m; ++s) {
+      const double ts = t0 + s * h;
+      if (!acceleration(sens, phi, x, u, du, ts, w.qdd1, w.dqdd1, w, why)) return false;
+      const double o = sample_at - s * h;
+      if (o >= 0 && (o < h || s == m - 1)) {
+        qs = x.q + o * x.qd + (0.5 * o * o) * w.qdd1;
+        if (sens) dqs = x.S.topRows(n_) + o * x.S.bottomRows(n_) + (0.5 * o * o) * w.dqdd1;
+        sample_at = -1;
+      }
+      mid.q = x.q + h * x.qd;
+      mid.qd = x.qd + h * w.qdd1;
+      if (sens) {
+        mid.S.topRows(n_) = x.S.topRows(n_) + h * x.S.bottomRows(n_);
+        mid.S.bottomRows(n_) = x.S.bottomRows(n_) + h * w.dqdd1;
+      }
+      if (!acceleration(sens, phi, mid, u, du, ts + h, w.qdd2, w.dqdd2, w, why)) return false;
+      x.q += (0.5 * h) * (x.qd + mid.qd);
+      x.qd += (0.5 * h) * (w.qdd1 + w.qdd2);
+      if (sens) {
+        x.S.topRows(n_) += (0.5 * h) * (x.S.bottomRows(n_) + mid.S.bottomRows(n_));
+        x.S.bottomRows(n_) += (0.5 * h) * (w.dqdd1 + w.dqdd2);
+      }
+    }
+    return true;
+  }
+
+  bool hold_frozen(const Vec& phi, State& x, const Vec& u, const Mat& du, double length, double t0, double sample_at,
+                   Vec& qs, Mat& dqs, Work& w, Divergence& why) const {
+    const int m = setup_.substeps;
+    const double h = length / m;
+    State& mid = w.mid;
+    for (int s = 0; s < m; ++s) {
+      const double ts = t0 + s * h;
+      if (!acceleration(false, phi, x, u, du, ts, w.qdd1, w.unused, w, why)) return false;
+      mid.q = x.q + (0.5 * h) * x.qd;
+      mid.qd = x.qd + (0.5 * h) * w.qdd1;
+      double pivot = 0;
+      if (!m_.forward_dynamics_derivatives(mid.q.data(), mid.qd.data(), u.data(), phi.data(), w.qdd2.data(),
+                                           w.fd_dq.data(), w.fd_dqd.data(), w.fd_dtau.data(), w.fd_dphi.data(),
+                                           &pivot)) {
+        why = detail::indefinite_inertia(ts, pivot);
+        return false;
+      }
+      const auto Sq = x.S.topRows(n_);
+      const auto Sqd = x.S.bottomRows(n_);
+      w.dqdd1 = w.fd_dphi;
+      w.dqdd1.noalias() += w.fd_dq.lazyProduct(Sq);
+      w.dqdd1.noalias() += w.fd_dqd.lazyProduct(Sqd);
+      w.dqdd1.noalias() += w.fd_dtau.lazyProduct(du);
+      const double o = sample_at - s * h;
+      if (o >= 0 && (o < h || s == m - 1)) {
+        qs = x.q + o * x.qd + (0.5 * o * o) * w.qdd1;
+        dqs = Sq + o * Sqd + (0.5 * o * o) * w.dqdd1;
+        sample_at = -1;
+      }
+      mid.q = x.q + h * x.qd;
+      mid.qd = x.qd + h * w.qdd1;
+      if (!acceleration(false, phi, mid, u, du, ts + h, w.qdd2, w.unused, w, why)) return false;
+      w.dqdd2 = w.dqdd1;
+      w.dqdd2.noalias() += h * w.fd_dq.lazyProduct(Sqd);
+      w.dqdd2.noalias() += h * w.fd_dqd.lazyProduct(w.dqdd1);
+      x.q += (0.5 * h) * (x.qd + mid.qd);
+      x.qd += (0.5 * h) * (w.qdd1 + w.qdd2);
+      x.S.topRows(n_) += h * Sqd + (0.5 * h * h) * w.dqdd1;
+      x.S.bottomRows(n_) += (0.5 * h) * (w.dqdd1 + w.dqdd2);
+    }
+    return true;
+  }
+
+  bool run(bool sens, const Vec& phi, preprocess::Channels& tau, SensitivityRows* dtau, preprocess::Channels* q_out,
+           Divergence& why) const {
+    const double T = period(), d = setup_.delay;
+    const int total = pre_cycles_ + cycles_;
+    const bool split = setup_.split_at_sampling;
+    tau.resize(cycles_, n_);
+    Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> dtau_row(n_, np_);
+    if (q_out) q_out->resize(cycles_, n_);
+
+    Work w(n_, np_);
+    DynamicFfpd controller(setup_.gains, n_, np_);
+    State x;
+    x.q = q_ref_.col(0);
+    x.qd = Vec::Zero(n_);
+    x.S.resize(2 * n_, np_);
+    controller.reset(sens, x.q);
+    Vec u_prev = Vec::Zero(n_), u(n_), qs = x.q;
+    Mat du_prev(n_, np_), du(n_, np_), dqs(n_, np_);
+    if (sens) {
+      x.S.setZero();
+      du_prev.setZero();
+      dqs.setZero();
+    }
+    const double t_first = -pre_cycles_ * T;
+    if (!split && !hold(sens, phi, x, u_prev, du_prev, d, t_first, -1, qs, dqs, w, why)) return false;
+
+    for (int c = 0; c < total; ++c) {
+      const int k = std::max(0, c - pre_cycles_);
+      const double t = t_first + c * T;
+      if (split) {
+        qs = x.q;
+        if (sens) dqs = x.S.topRows(n_);
+      }
+      for (int j = 0; j < n_; ++j) {
+        const double error = std::abs(q_ref_(j, k) - qs(j));
+        if (!std::isfinite(error)) {
+          why = detail::not_finite(t);
+          return false;
+        }
+        if (error > setup_.divergence_error) {
+          why = detail::tracking_divergence(t, j, error);
+          return false;
+        }
+      }
+      if (c >= pre_cycles_) {
+        tau.row(k) = u_prev.transpose();
+        if (sens) {
+          dtau_row = du_prev;
+          dtau->row(dtau_row.data());
+        }
+        if (q_out) q_out->row(k) = qs.transpose();
+      }
+      controller.update(sens, qs, dqs, q_ref_.col(k), qd_ref_.col(k), qdd_ref_.col(k), u, du);
+      if (c == total - 1) break;
+      if (split) {
+        if (!hold(sens, phi, x, u_prev, du_prev, d, t, -1, qs, dqs, w, why)) return false;
+        if (!hold(sens, phi, x, u, du, T - d, t + d, -1, qs, dqs, w, why)) return false;
+      } else if (!hold(sens, phi, x, u, du, T, t + d, T - d, qs, dqs, w, why)) {
+        return false;
+      }
+      u_prev = u;
+      if (sens) du_prev = du;
+    }
+    return true;
+  }
+
+  ModelHandle m_;
+  ClosedLoopSetup setup_;
+  int n_, np_;
+  int cycles_ = 0, pre_cycles_ = 0;
+  Eigen::MatrixXd q_ref_, qd_ref_, qdd_ref_;  // n x cycles: column k, the reference at k T
+};
+
+}  // namespace
+
+std::unique_ptr<ClosedLoop> closed_loop(const robot::ModelHandle& model, const ClosedLoopSetup& setup,
+                                        const trajectory::SampledReference& reference) {
+  return std::make_unique<LoadedClosedLoop>(model, setup, reference);
+}
+
+}  // namespace symoro::identify

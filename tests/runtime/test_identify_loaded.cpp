@@ -1,0 +1,138 @@
+// identify::identification_model(handle, full) (identify/loaded_model.hpp) against the generated
+// model's IdentificationModel, on the CRANE-X7's reduced model (fixed parameters at nonzero CAD
+// values, so the fixed torque and the held rows matter): the stacked regression, the open-loop
+// torque, the state derivatives, the inertia function and the physical path bit for bit; the
+// closed loop (loaded_closed_loop.hpp: dynamic sizes) to round-off, with its sensitivities, under
+// the experiment's controller on an excerpt of V01 at the twin's truth.
+#include <gtest/gtest.h>
+
+#include <random>
+#include <string>
+
+#include <symoro/crane_x7.hpp>
+
+#include "symoro/identify/identification_model.hpp"
+#include "symoro/identify/loaded_model.hpp"
+#include "symoro/robot/load_robot.hpp"
+#include "symoro/trajectory/design.hpp"
+#include "symoro/twin/config.hpp"
+#include "symoro/twin/truth.hpp"
+
+namespace symoro {
+namespace {
+
+using Full = crane_x7::Model;
+using Reduced = crane_x7::reduced::Model;
+constexpr int n = Full::nq;
+const std::string kRobot = std::string(SYMORO_ROBOTS_DIR) + "/crane_x7";
+
+std::shared_ptr<const identify::IdentificationModel> loaded(const std::string& label) {
+  robot::LoadOptions o;
+  o.cache_dir = SYMORO_TEST_ROBOT_CACHE;
+  const auto lib = robot::load_robot(kRobot, o);
+  return identify::identification_model(lib->model(label), lib->model(0));
+}
+
+twin::TwinConfig ideal_config() {
+  twin::TwinConfig c = twin::read_twin_config(kRobot + "/twin.yaml", n);
+  c.effects.disable_all();
+  return c;
+}
+
+Eigen::VectorXd reduced_truth() { return Reduced::from_parent(twin::make_truth<Full>(ideal_config()).phi); }
+
+preprocess::Samples random_samples(int count, unsigned seed) {
+  std::mt19937 g(seed);
+  std::uniform_real_distribution<double> u(-1.2, 1.2);
+  preprocess::Samples s;
+  for (auto* m : {&s.q, &s.qd, &s.qdd, &s.tau}) {
+    m->resize(count, n);
+    for (Eigen::Index i = 0; i < m->size(); ++i) m->data()[i] = u(g);
+  }
+  return s;
+}
+
+TEST(LoadedIdentificationModel, EqualsTheGeneratedModelsBitForBit) {
+  const auto a = loaded("reduced");
+  const auto b = identify::identification_model<Reduced>();
+  EXPECT_EQ(a->description().np, b->description().np);
+  EXPECT_EQ(a->description().variant, "reduced");
+  const preprocess::Samples s = random_samples(40, 7);
+  const identify::Regression ra = a->stack_regression(s), rb = b->stack_regression(s);
+  EXPECT_EQ(ra.W, rb.W);
+  EXPECT_EQ(ra.y, rb.y);
+  EXPECT_NE(ra.y, Eigen::Map<const Eigen::VectorXd>(s.tau.transpose().data(), s.tau.size()))  // a fixed torque
+      << "the reduced model's fixed parameters should add a torque";
+  const Eigen::VectorXd phi = reduced_truth();
+  EXPECT_EQ(a->open_loop_torque(s, phi), b->open_loop_torque(s, phi));
+  for (bool with_fixed : {true, false}) {
+    identify::StateDerivatives da, db;
+    a->state_derivatives(s.q.row(3).transpose(), s.qd.row(3).transpose(), s.qdd.row(3).transpose(), phi, with_fixed, da);
+    b->state_derivatives(s.q.row(3).transpose(), s.qd.row(3).transpose(), s.qdd.row(3).transpose(), phi, with_fixed, db);
+    EXPECT_EQ(da.tau, db.tau);
+    EXPECT_EQ(da.dq, db.dq);
+    EXPECT_EQ(da.dqd, db.dqd);
+    EXPECT_EQ(da.dqdd, db.dqdd);
+  }
+  const auto ia = a->inertia_function(), ib = b->inertia_function();
+  const Eigen::VectorXd q = s.q.row(5).transpose();
+  Eigen::MatrixXd Ca, Cb, Ma, Mb;
+  std::vector<Eigen::MatrixXd> La, Lb, dMa, dMb, d2Ma, d2Mb;
+  ia->basis(q, Ca, La);
+  ib->basis(q, Cb, Lb);
+  EXPECT_EQ(Ca, Cb);
+  EXPECT_EQ(La, Lb);
+  ia->inertia_second_derivatives(q, phi, Ma, dMa, d2Ma);
+  ib->inertia_second_derivatives(q, phi, Mb, dMb, d2Mb);
+  EXPECT_EQ(Ma, Mb);
+  EXPECT_EQ(dMa, dMb);
+  EXPECT_EQ(d2Ma, d2Mb);
+
+  // The physical path: the truth has a consistent set; a perturbed vector is projected the same.
+  ASSERT_TRUE(a->supports_physical_consistency());
+  EXPECT_EQ(a->physical_check(phi).ok(), b->physical_check(phi).ok());
+  EXPECT_TRUE(a->physical_check(phi).ok());
+  Eigen::VectorXd off = phi;
+  off(0) -= 10 * std::abs(phi(0)) + 0.05;  // ZZR1 far below what a physical arm can have
+  const Eigen::MatrixXd metric = (ra.W.transpose() * ra.W) / static_cast<double>(ra.W.rows()) +
+                                 1e-6 * Eigen::MatrixXd::Identity(phi.size(), phi.size());
+  const identify::PhysicalProjection pa = a->physical_projection(off, metric, 1e-7);
+  const identify::PhysicalProjection pb = b->physical_projection(off, metric, 1e-7);
+  EXPECT_EQ(pa.phi, pb.phi);
+  EXPECT_EQ(pa.status, pb.status);
+  EXPECT_EQ(pa.projected, pb.projected);
+  EXPECT_EQ(a->consistency_target(phi), b->consistency_target(phi));
+}
+
+TEST(LoadedIdentificationModel, ClosedLoopAgreesWithTheGeneratedSimulatorToRoundOff) {
+  const twin::TwinConfig config = ideal_config();
+  const auto design = trajectory::TrajectoryDesign::read(kRobot + "/trajectories.yaml",
+                                                         std::vector<JointInfo>(Full::joints.begin(), Full::joints.end()));
+  trajectory::Trajectory v = design.build("V01"), cut = v;
+  cut.segments.clear();
+  for (const auto& seg : v.segments)
+    if (seg.end() <= 3.2) cut.segments.push_back(seg);
+  for (bool exact : {false, true}) {
+    identify::ClosedLoopSetup setup = identify::closed_loop_setup(config.controller);
+    setup.exact_sensitivities = exact;
+    const auto reference = trajectory::sample(cut, setup.gains.period);
+    const auto a = loaded("reduced")->closed_loop(setup, reference);
+    const auto b = identify::identification_model<Reduced>()->closed_loop(setup, reference);
+    const Eigen::VectorXd phi = reduced_truth();
+    preprocess::Channels ta, tb, da, db;
+    identify::Divergence why;
+    ASSERT_TRUE(a->simulate(phi, ta, &da, &why)) << why.describe();
+    ASSERT_TRUE(b->simulate(phi, tb, &db, &why)) << why.describe();
+    ASSERT_EQ(ta.rows(), tb.rows());
+    ASSERT_GT(ta.rows(), 3000);
+    EXPECT_LE((ta - tb).cwiseAbs().maxCoeff(), 1e-9 * tb.cwiseAbs().maxCoeff());
+    EXPECT_LE((da - db).cwiseAbs().maxCoeff(), 1e-8 * db.cwiseAbs().maxCoeff());
+    // Without sensitivities the torque is the same simulation.
+    preprocess::Channels tc;
+    ASSERT_TRUE(a->simulate(phi, tc, nullptr, &why));
+    EXPECT_LE((tc - tb).cwiseAbs().maxCoeff(), 1e-9 * tb.cwiseAbs().maxCoeff());
+  }
+}
+
+}  // namespace
+}  // namespace symoro
