@@ -19,6 +19,8 @@
 namespace symoro::python {
 
 std::shared_ptr<const diagnose::DiagnosisModel> diagnosis_of(py::handle model);
+// A loaded model's robot folder when robot_dir is not given (models_binding.cpp).
+std::optional<std::filesystem::path> robot_dir_of(py::handle model, const std::optional<std::filesystem::path>& given);
 
 namespace {
 
@@ -99,12 +101,13 @@ void bind_diagnose(py::module_& m) {
   // dynid diagnose's defaults are DatasetDiagnosisOptions' own: taken from it.
   const diagnose::DatasetDiagnosisOptions defaults;
   m.def("diagnose", [](py::handle model, const std::filesystem::path& data, const std::filesystem::path& out,
-                       const std::optional<std::filesystem::path>& robot_dir, const std::vector<std::string>& train,
+                       const std::optional<std::filesystem::path>& robot_dir_given, const std::vector<std::string>& train,
                        const std::vector<std::string>& heldout, int trial, double interval_ms, double cutoff,
                        const std::vector<std::string>& only, double alpha, double min_gain, double min_torque, bool backlash,
                        const std::optional<std::filesystem::path>& params, const std::string& variant, bool apply,
                        py::object progress) {
     const auto dm = diagnosis_of(model);
+    const std::optional<std::filesystem::path> robot_dir = robot_dir_of(model, robot_dir_given);
     diagnose::DatasetDiagnosisOptions o;
     o.data = data;
     o.out = out;

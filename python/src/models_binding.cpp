@@ -24,6 +24,7 @@ struct Model {
   ModelKernels k;
   std::shared_ptr<const identify::IdentificationModel> id;
   std::shared_ptr<const diagnose::DiagnosisModel> diagnosis;
+  std::filesystem::path folder;  // a loaded model's robot folder (symoro.load); empty for a compiled one
   const identify::ModelDescription& d() const { return id->description(); }
   std::string variant() const { return d().variant.empty() ? "full" : d().variant; }
 };
@@ -81,6 +82,9 @@ void bind_models(py::module_& m) {
   py::class_<Model, std::shared_ptr<Model>> model(m, "Model", "A compiled robot model (symoro.models.<robot>.<model>)");
   model.def_property_readonly("robot", [](const Model& x) { return x.d().robot; })
       .def_property_readonly("name", &Model::variant, "the model's name: 'full' or a robot.yaml variant")
+      .def_property_readonly("folder", [](const Model& x) -> py::object {
+        return x.folder.empty() ? py::object(py::none()) : py::str(x.folder.string());
+      }, "a loaded model's robot folder (symoro.load), the workflow's default robot_dir; None for a compiled one")
       .def_property_readonly("nq", [](const Model& x) { return x.k.nq; }, "joints")
       .def_property_readonly("np", [](const Model& x) { return x.k.np; }, "identified base parameters (phi's size)")
       .def_property_readonly("ns", [](const Model& x) { return x.k.ns; }, "standard parameters (base_from_standard's input)")
@@ -237,7 +241,7 @@ void bind_models(py::module_& m) {
     std::vector<std::shared_ptr<Model>> out;
     for (int i = 0; i < lib->model_count(); ++i) {
       const ModelKernels k = loaded_kernels(lib->model(i), lib->model(0));
-      out.push_back(std::make_shared<Model>(Model{k, k.identification(), k.diagnosis()}));
+      out.push_back(std::make_shared<Model>(Model{k, k.identification(), k.diagnosis(), std::filesystem::absolute(folder)}));
     }
     return py::make_tuple(lib->robot(), lib->model("").label(), out);
   }, py::arg("folder"), py::arg("cache_dir") = py::none(),
@@ -253,6 +257,15 @@ void bind_models(py::module_& m) {
 // The identification interface of a Model (for the workflow's functions).
 std::shared_ptr<const identify::IdentificationModel> identification_of(py::handle model) {
   return model.cast<const Model&>().id;
+}
+
+// robot_dir as given, else a loaded model's own folder: the workflow then reads its robot.yaml
+// (the nominal prior, the controller description) as dynid does from --robot.
+std::optional<std::filesystem::path> robot_dir_of(py::handle model, const std::optional<std::filesystem::path>& given) {
+  if (given) return given;
+  const Model& m = model.cast<const Model&>();
+  if (m.folder.empty()) return std::nullopt;
+  return m.folder;
 }
 
 // Its diagnosis interface (symoro.diagnose).

@@ -21,6 +21,8 @@
 namespace symoro::python {
 
 std::shared_ptr<const identify::IdentificationModel> identification_of(py::handle model);
+// A loaded model's robot folder when robot_dir is not given (models_binding.cpp).
+std::optional<std::filesystem::path> robot_dir_of(py::handle model, const std::optional<std::filesystem::path>& given);
 
 namespace {
 
@@ -67,8 +69,9 @@ py::dict prediction_dict(const std::string& name, const identify::Prediction& p)
 
 void bind_results(py::module_& m) {
   m.def("predict", [](py::handle model, py::handle params, const std::filesystem::path& input, double interval_ms,
-                      double torque_delay_ms, int trial, const std::optional<std::filesystem::path>& robot_dir) {
+                      double torque_delay_ms, int trial, const std::optional<std::filesystem::path>& robot_dir_given) {
     const auto id = identification_of(model);
+    const std::optional<std::filesystem::path> robot_dir = robot_dir_of(model, robot_dir_given);
     const identify::ModelDescription& d = id->description();
     const Eigen::VectorXd phi = parameters_of(*id, params, robot_dir);
     // One log, or every run of a dataset's trial (as dynid predict).
@@ -144,9 +147,10 @@ void bind_results(py::module_& m) {
 
 void bind_export(py::module_& m) {
   m.def("export_urdf", [](py::handle model, const std::filesystem::path& study, const std::filesystem::path& urdf,
-                          py::handle prior, const std::optional<std::filesystem::path>& robot_dir, double margin,
+                          py::handle prior, const std::optional<std::filesystem::path>& robot_dir_given, double margin,
                           bool nearest, bool not_accepted) {
     const auto id = identification_of(model);
+    const std::optional<std::filesystem::path> robot_dir = robot_dir_of(model, robot_dir_given);
     const identify::ModelDescription& d = id->description();
     if (!id->supports_physical_consistency())
       throw py::value_error(fmt::format("model '{}' has model-gap effect parameters, which have no URDF counterpart and no "

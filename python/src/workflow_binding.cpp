@@ -27,6 +27,8 @@
 namespace symoro::python {
 
 std::shared_ptr<const identify::IdentificationModel> identification_of(py::handle model);
+// A loaded model's robot folder when robot_dir is not given (models_binding.cpp).
+std::optional<std::filesystem::path> robot_dir_of(py::handle model, const std::optional<std::filesystem::path>& given);
 
 namespace {
 
@@ -154,7 +156,8 @@ void bind_workflow(py::module_& m) {
                        bool report, py::object progress) {
     const std::shared_ptr<const identify::IdentificationModel> id = identification_of(model);
     const identify::ModelDescription& d = id->description();
-    const std::filesystem::path robot_dir = robot_dir_arg.value_or(""), design = design_arg.value_or("");
+    const std::filesystem::path robot_dir = robot_dir_of(model, robot_dir_arg).value_or(""),
+                                design = design_arg.value_or("");
     // As dynid identify: the same request, the same translation (identify/study_request.hpp).
     identify::StudyRequest q;
     q.data = data.string();

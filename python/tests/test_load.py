@@ -66,7 +66,8 @@ def test_a_loaded_models_study_equals_the_compiled_ones(tmp_path, rx90_copy):
     exports = make_exports(tmp_path, compiled)
     symoro.import_logs(loaded, tmp_path / "data", exports, heldout=[exports[-1]], **MAPPING)
     a = symoro.identify(loaded, tmp_path / "data", tmp_path / "loaded", intervals_ms=[10], jobs=1)
-    b = symoro.identify(compiled, tmp_path / "data", tmp_path / "compiled", intervals_ms=[10], jobs=1)
+    # The loaded model reads its folder (robot_dir's default); the compiled one is pointed at it.
+    b = symoro.identify(compiled, tmp_path / "data", tmp_path / "compiled", intervals_ms=[10], jobs=1, robot_dir=rx90_copy)
     assert np.array_equal(a["phi"], b["phi"])
     assert (tmp_path / "loaded" / "validation.yaml").read_bytes() == (tmp_path / "compiled" / "validation.yaml").read_bytes()
 
@@ -96,3 +97,28 @@ def test_a_robot_from_a_urdf_loads_and_its_functions_agree(tmp_path, source_dir)
     e = np.eye(arm.nq)
     dtau = np.stack([arm.inverse_dynamics(q, qd, qdd + e[k], phi) - tau for k in range(arm.nq)], axis=-1)
     np.testing.assert_allclose(dtau, M, rtol=1e-9, atol=1e-9)
+
+
+def test_a_loaded_model_reads_its_own_folder_as_dynid_does(tmp_path, source_dir, dynid):
+    """No robot_dir needed: the physical path leans on the folder's nominal parameters (a URDF's
+    inertials) and export_urdf takes them as its prior, as dynid does with --robot <folder>."""
+    symoroc = os.environ["SYMORO_SYMOROC"]
+    folder = tmp_path / "ur5"
+    subprocess.run([symoroc, "model", str(source_dir / "tests" / "urdf" / "ur5_robot.urdf"), "-o", str(folder), "--name",
+                    "ur5"], check=True, capture_output=True)
+    arm = symoro.load(folder).full
+    assert arm.folder == str(folder)
+    exports = make_exports(tmp_path, arm)
+    symoro.import_logs(arm, tmp_path / "data", exports, heldout=[exports[-1]], **MAPPING)
+    symoro.identify(arm, tmp_path / "data", tmp_path / "study", intervals_ms=[10], jobs=1, consistency="physical")
+    symoro.export_urdf(arm, tmp_path / "study", tmp_path / "py" / "ur5.urdf")
+    cli = subprocess.run([dynid, "identify", "--robot", str(folder), "--data", str(tmp_path / "data"), "-o",
+                          str(tmp_path / "cli-study"), "--interval", "10", "--jobs", "1", "--consistency", "physical"],
+                         capture_output=True, text=True)
+    assert cli.returncode == 0, cli.stderr
+    strip = lambda p: [l for l in p.read_text().splitlines() if "study" not in l and "digest" not in l]
+    assert strip(tmp_path / "study" / "report" / "parameters.yaml") == strip(tmp_path / "cli-study" / "report" / "parameters.yaml")
+    cli = subprocess.run([dynid, "export", "--robot", str(folder), "--study", str(tmp_path / "study"), "--urdf",
+                          str(tmp_path / "cli" / "ur5.urdf")], capture_output=True, text=True)
+    assert cli.returncode == 0, cli.stderr
+    assert (tmp_path / "py" / "ur5.urdf").read_bytes() == (tmp_path / "cli" / "ur5.urdf").read_bytes()
