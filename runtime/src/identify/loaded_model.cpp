@@ -85,34 +85,15 @@ class LoadedInertiaFunction final : public InertiaFunction {
 
 // consistency_structure<Model>() (physical_consistency_model.hpp) over handles.
 ConsistencyStructure consistency_structure(const ModelHandle& model, const ModelHandle& parent) {
-  ConsistencyStructure c;
-  c.B.resize(parent.np(), parent.ns());
+  Eigen::MatrixXd B(parent.np(), parent.ns());
   Eigen::VectorXd unit = Eigen::VectorXd::Zero(parent.ns()), column(parent.np());
   for (int k = 0; k < parent.ns(); ++k) {
     unit(k) = 1;
     parent.base_from_standard(unit.data(), column.data());
-    c.B.col(k) = column;
+    B.col(k) = column;
     unit(k) = 0;
   }
-  for (int k = 0; k < model.ns(); ++k) {
-    const StandardParameterInfo& p = model.standard_parameters()[static_cast<std::size_t>(k)];
-    const std::string family = p.family;
-    c.names.emplace_back(p.name);
-    c.group.push_back(detail::standard_group(family));
-    const int slot = detail::inertial_slot(family);
-    if (slot >= 0) {
-      auto it = c.links.begin();
-      while (it != c.links.end() && it->link != p.joint) ++it;
-      if (it == c.links.end()) {
-        c.links.emplace_back();
-        c.links.back().link = p.joint;
-        it = c.links.end() - 1;
-      }
-      it->index[static_cast<std::size_t>(slot)] = k;
-    }
-    if (family == "IA" || family == "FV" || family == "FS") c.nonnegative.push_back(k);
-  }
-  return c;
+  return identify::consistency_structure(model.standard_parameters(), std::move(B));
 }
 
 class LoadedIdentificationModel final : public IdentificationModel {

@@ -5,12 +5,16 @@
 // matched only the variant's own rows could give the fixed combinations any value.
 #pragma once
 
+#include <cstddef>
 #include <string>
 #include <type_traits>
+#include <utility>
+#include <vector>
 
 #include <Eigen/Core>
 
 #include "symoro/identify/physical_consistency.hpp"
+#include "symoro/model_info.hpp"
 
 namespace symoro::identify {
 namespace detail {
@@ -40,19 +44,14 @@ inline StandardGroup standard_group(const std::string& family) {
 
 }  // namespace detail
 
-template <class Model>
-ConsistencyStructure consistency_structure() {
-  // Effect parameters map onto themselves through a variant's own base_from_standard, which the
-  // parent's does not have: not supported yet.
-  static_assert(!detail::HasEffects<Model>::value, "consistency_structure: variants with effects are not supported");
-  using Parent = typename Model::Parent;
-  static_assert(Parent::ns == Model::ns, "consistency_structure: the variant's standard vector differs from its parent's");
+// The structure of a model whose standard parameters are `standard`, B its full model's
+// base_from_standard (np x ns, column k the image of unit vector k). For a generated Model
+// (below) and a loaded one (loaded_model.cpp) alike.
+inline ConsistencyStructure consistency_structure(const std::vector<StandardParameterInfo>& standard, Eigen::MatrixXd B) {
   ConsistencyStructure c;
-  c.B.resize(Parent::np, Parent::ns);
-  for (int k = 0; k < Parent::ns; ++k)
-    c.B.col(k) = Parent::base_from_standard(Eigen::Matrix<double, Parent::ns, 1>::Unit(k));
-  for (int k = 0; k < Model::ns; ++k) {
-    const auto& p = Model::standard_parameters[static_cast<std::size_t>(k)];
+  c.B = std::move(B);
+  for (std::size_t k = 0; k < standard.size(); ++k) {
+    const StandardParameterInfo& p = standard[k];
     const std::string family = p.family;
     c.names.emplace_back(p.name);
     c.group.push_back(detail::standard_group(family));
@@ -65,11 +64,24 @@ ConsistencyStructure consistency_structure() {
         c.links.back().link = p.joint;
         it = c.links.end() - 1;
       }
-      it->index[static_cast<std::size_t>(slot)] = k;
+      it->index[static_cast<std::size_t>(slot)] = static_cast<int>(k);
     }
-    if (family == "IA" || family == "FV" || family == "FS") c.nonnegative.push_back(k);
+    if (family == "IA" || family == "FV" || family == "FS") c.nonnegative.push_back(static_cast<int>(k));
   }
   return c;
+}
+
+template <class Model>
+ConsistencyStructure consistency_structure() {
+  // Effect parameters map onto themselves through a variant's own base_from_standard, which the
+  // parent's does not have: not supported yet.
+  static_assert(!detail::HasEffects<Model>::value, "consistency_structure: variants with effects are not supported");
+  using Parent = typename Model::Parent;
+  static_assert(Parent::ns == Model::ns, "consistency_structure: the variant's standard vector differs from its parent's");
+  Eigen::MatrixXd B(Parent::np, Parent::ns);
+  for (int k = 0; k < Parent::ns; ++k)
+    B.col(k) = Parent::base_from_standard(Eigen::Matrix<double, Parent::ns, 1>::Unit(k));
+  return consistency_structure({Model::standard_parameters.begin(), Model::standard_parameters.end()}, std::move(B));
 }
 
 // The target of consistent_standard_parameters for a Model's phi: the full base vector.
