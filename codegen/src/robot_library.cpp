@@ -14,6 +14,8 @@
 #include <cstring>
 #include <fstream>
 #include <iterator>
+#include <map>
+#include <mutex>
 #include <sstream>
 #include <thread>
 
@@ -190,14 +192,21 @@ std::string RobotToolchain::identity() const {
                                                 : "named by SYMORO_CXX") +
                      "): a robot library is compiled from its generated C++; install it, or set SYMORO_CXX to a "
                      "C++17 compiler");
-  const fs::path log = fs::temp_directory_path() / ("symoro-cc-version-" + std::to_string(getpid()) + ".txt");
+  // Once per compiler and process: every load forms the cache key with it.
+  static std::mutex mutex;
+  static std::map<std::string, std::string> known;
+  const std::lock_guard<std::mutex> lock(mutex);
+  if (const auto it = known.find(exe.string()); it != known.end()) return it->second;
+  static int calls = 0;
+  const fs::path log = fs::temp_directory_path() /
+                       ("symoro-cc-version-" + std::to_string(getpid()) + "-" + std::to_string(++calls) + ".txt");
   run_all({{exe.string(), "--version"}}, {log}, 1);
   std::ifstream in(log);
   std::string first;
   std::getline(in, first);
   std::error_code ec;
   fs::remove(log, ec);
-  return exe.string() + " | " + first;
+  return known[exe.string()] = exe.string() + " | " + first;
 }
 
 fs::path default_robot_cache_dir() {

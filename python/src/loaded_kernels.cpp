@@ -16,6 +16,13 @@ namespace {
 
 using RowMajor = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
 
+// Scratch for one state's column-major result, reused by the thread: no allocation per call.
+double* scratch(std::size_t size) {
+  thread_local std::vector<double> buffer;
+  if (buffer.size() < size) buffer.resize(size);
+  return buffer.data();
+}
+
 // A column-major r x c result into C order at out.
 void put(double* out, const double* column_major, int r, int c) {
   Eigen::Map<RowMajor>(out, r, c) = Eigen::Map<const Eigen::MatrixXd>(column_major, r, c);
@@ -35,10 +42,10 @@ ModelKernels loaded_kernels(const robot::ModelHandle& model, const robot::ModelH
   k.np = np;
   k.ns = ns;
   k.regressor = [m, nq, np](const double* q, const double* qd, const double* qdd, double* w, Batch b) {
-    std::vector<double> t(static_cast<std::size_t>(nq) * np);
+    double* t = scratch(static_cast<std::size_t>(nq) * np);
     for (std::ptrdiff_t i = 0; i < b.n; ++i) {
-      m.regressor(q + i * nq, qd + i * nq, qdd + i * nq, t.data());
-      put(w + i * nq * np, t.data(), nq, np);
+      m.regressor(q + i * nq, qd + i * nq, qdd + i * nq, t);
+      put(w + i * nq * np, t, nq, np);
     }
   };
   k.inverse_dynamics = [m, nq](const double* q, const double* qd, const double* qdd, const double* phi, double* tau,
@@ -47,10 +54,10 @@ ModelKernels loaded_kernels(const robot::ModelHandle& model, const robot::ModelH
       m.inverse_dynamics(q + i * nq, qd + i * nq, qdd + i * nq, phi + i * b.phi_stride, tau + i * nq);
   };
   k.inertia = [m, nq](const double* q, const double* phi, double* out, Batch b) {
-    std::vector<double> t(static_cast<std::size_t>(nq) * nq);
+    double* t = scratch(static_cast<std::size_t>(nq) * nq);
     for (std::ptrdiff_t i = 0; i < b.n; ++i) {
-      m.inertia(q + i * nq, phi + i * b.phi_stride, t.data());
-      put(out + i * nq * nq, t.data(), nq, nq);
+      m.inertia(q + i * nq, phi + i * b.phi_stride, t);
+      put(out + i * nq * nq, t, nq, nq);
     }
   };
   k.nonlinear_effects = [m, nq](const double* q, const double* qd, const double* phi, double* h, Batch b) {
@@ -97,10 +104,10 @@ ModelKernels loaded_kernels(const robot::ModelHandle& model, const robot::ModelH
     }
   };
   k.jacobian = [m, nq](const double* q, double* out, Batch b) {
-    std::vector<double> t(static_cast<std::size_t>(6) * nq);
+    double* t = scratch(static_cast<std::size_t>(6) * nq);
     for (std::ptrdiff_t i = 0; i < b.n; ++i) {
-      m.jacobian(q + i * nq, t.data());
-      put(out + i * 6 * nq, t.data(), 6, nq);
+      m.jacobian(q + i * nq, t);
+      put(out + i * 6 * nq, t, 6, nq);
     }
   };
   k.base_from_standard = [m, np, ns](const double* s, double* phi, Batch b) {

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <filesystem>
+#include <map>
 
 #include <fmt/format.h>
 
@@ -25,10 +26,13 @@ std::shared_ptr<const robot::RobotLibrary> library_of(const Common& common) {
   if (!std::filesystem::exists(dir / "robot.yaml"))
     throw UsageError(fmt::format("{} is not a robot folder: it has no robot.yaml (symoroc model <robot>.urdf -o {} "
                                  "writes one)", dir.string(), dir.string()));
+  // Once per command: its models (an export's and its full model, say) share the library.
+  static std::map<std::string, std::shared_ptr<const robot::RobotLibrary>> loaded;
+  if (const auto it = loaded.find(dir.string()); it != loaded.end()) return it->second;
   robot::LoadOptions lo;
   lo.progress = [](const std::string& line) { fmt::print(stderr, "{}\n", line); };
   try {
-    return robot::load_robot(dir, lo);
+    return loaded[dir.string()] = robot::load_robot(dir, lo);
   } catch (const robot::LoadError& e) {
     throw UsageError(e.what());
   }
