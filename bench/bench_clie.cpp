@@ -6,9 +6,12 @@
 // 20 % (alternating signs).
 //
 // The *ThroughInterface benchmarks make the same calls through identify::ClosedLoop, the virtual
-// interface the study is compiled against.
+// interface the study is compiled against; the *Runtime ones run what the study actually runs, the
+// one simulator over a model handle (identification_model<Reduced>(): dynamic sizes, the same bits).
 //
 //   bench_clie --benchmark_filter=Simulate
+#include <memory>
+
 #include <benchmark/benchmark.h>
 
 #include <symoro/crane_x7.hpp>
@@ -16,6 +19,8 @@
 #include "symoro/identify/clie.hpp"
 #include "symoro/identify/detail/clie_model.hpp"
 #include "symoro/identify/detail/closed_loop_model.hpp"
+#include "symoro/identify/identification_model.hpp"
+#include "symoro/trajectory/sampled_reference.hpp"
 #include "symoro/preprocess/preprocess.hpp"
 #include "symoro/trajectory/design.hpp"
 #include "symoro/twin/simulator.hpp"
@@ -37,6 +42,11 @@ struct Fixture {
   identify::ClosedLoopSimulator<Reduced> sim{identify::closed_loop_setup(config.controller), trajectory};
   // The exact derivatives of the discrete map (ClosedLoopSetup::exact_sensitivities).
   identify::ClosedLoopSimulator<Reduced> sim_exact{exact_setup(config), trajectory};
+  // What the runtime simulates (identification_model<Reduced>(): the one implementation over the
+  // model's handle, in dynamic sizes; bit for bit the fixed-size simulator's numbers).
+  std::unique_ptr<identify::ClosedLoop> runtime = identify::identification_model<Reduced>()->closed_loop(
+      identify::closed_loop_setup(config.controller),
+      symoro::trajectory::sample(trajectory, identify::closed_loop_setup(config.controller).gains.period));
 
   static identify::ClosedLoopSetup exact_setup(const symoro::twin::TwinConfig& c) {
     identify::ClosedLoopSetup s = identify::closed_loop_setup(c.controller);
@@ -85,7 +95,23 @@ void BM_SimulateWithSensitivitiesExact(benchmark::State& s) { simulate(s, true, 
 BENCHMARK(BM_SimulateWithSensitivities)->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(3);
 BENCHMARK(BM_SimulateWithSensitivitiesExact)->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(3);
 
-void clie_ag02(benchmark::State& state, Path path) {
+// The runtime's simulation (Fixture::runtime), what dynid and Python run.
+void simulate_runtime(benchmark::State& state, bool sensitivities) {
+  const Fixture& f = fixture();
+  symoro::preprocess::Channels tau, dtau;
+  double simulated = 0;
+  for (auto _ : state) {
+    if (!f.runtime->simulate(f.truth, tau, sensitivities ? &dtau : nullptr, nullptr)) state.SkipWithError("diverged");
+    simulated += (f.runtime->cycles() - 1) * f.runtime->period();
+  }
+  state.counters["sim_s_per_wall_s"] = benchmark::Counter(simulated, benchmark::Counter::kIsRate);
+}
+void BM_SimulateRuntime(benchmark::State& s) { simulate_runtime(s, false); }
+void BM_SimulateWithSensitivitiesRuntime(benchmark::State& s) { simulate_runtime(s, true); }
+BENCHMARK(BM_SimulateRuntime)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_SimulateWithSensitivitiesRuntime)->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(3);
+
+void clie_ag02(benchmark::State& state, Path path, bool runtime = false) {
   const Fixture& f = fixture();
   symoro::twin::RunOptions run;
   run.robot = "crane_x7";
@@ -96,7 +122,8 @@ void clie_ag02(benchmark::State& state, Path path) {
   for (int i = 0; i < phi0.size(); ++i) phi0(i) *= i % 2 ? 1.2 : 0.8;
   identify::ClieResult r;
   for (auto _ : state) {
-    r = identify::clie<Reduced>(simulator(f, path), samples, phi0, options);
+    r = runtime ? identify::clie(*f.runtime, samples, phi0, options)
+                : identify::clie<Reduced>(simulator(f, path), samples, phi0, options);
     if (!r.success) state.SkipWithError(r.termination.c_str());
   }
   state.counters["iterations"] = r.iterations;
@@ -113,5 +140,7 @@ void BM_ClieAG02At40ms(benchmark::State& s) { clie_ag02(s, Path::fast); }
 void BM_ClieAG02At40msExact(benchmark::State& s) { clie_ag02(s, Path::exact); }
 BENCHMARK(BM_ClieAG02At40ms)->Unit(benchmark::kSecond)->UseRealTime()->Iterations(1);
 BENCHMARK(BM_ClieAG02At40msExact)->Unit(benchmark::kSecond)->UseRealTime()->Iterations(1);
+void BM_ClieAG02At40msRuntime(benchmark::State& s) { clie_ag02(s, Path::fast, true); }
+BENCHMARK(BM_ClieAG02At40msRuntime)->Unit(benchmark::kSecond)->UseRealTime()->Iterations(1);
 
 }  // namespace

@@ -27,11 +27,13 @@ function(symoro_robot_model_count yaml out)
   set(${out} ${count} PARENT_SCOPE)
 endfunction()
 
-# symoro_robot_library(<name> <model count> <kind> <area> [<extra unit template>...]): the
-# static library symoro::<name>_<kind> over symoro_<area>, with one unit per model of the robot
-# from cmake/<kind>_unit.cpp.in (the last one also taking any model beyond the count), so that a
-# robot's models compile in parallel, and the extra units' templates configured once each.
+# symoro_robot_library(<name> <model count> <kind> <area> [PER_MODEL <template>...] [ONCE
+# <template>...]): the static library symoro::<name>_<kind> over symoro_<area>, with one unit per
+# model of the robot from each PER_MODEL template cmake/<t>_unit.cpp.in (the last one also taking
+# any model beyond the count), so that a robot's models compile in parallel, and one unit from
+# each ONCE template cmake/<t>.cpp.in (all models: index 0, tail).
 function(symoro_robot_library name count kind area)
+  cmake_parse_arguments(ARG "" "" "PER_MODEL;ONCE" ${ARGN})
   set(units "")
   math(EXPR last "${count} - 1")
   set(unit_robot ${name})
@@ -44,14 +46,18 @@ function(symoro_robot_library name count kind area)
       set(unit_tail false)
       set(unit_what "model ${i} of its Models")
     endif()
-    set(file "${CMAKE_BINARY_DIR}/robot_units/${name}/${kind}_${i}.cpp")
-    configure_file("${PROJECT_SOURCE_DIR}/cmake/${kind}_unit.cpp.in" "${file}" @ONLY)
-    list(APPEND units "${file}")
+    foreach(template IN LISTS ARG_PER_MODEL)
+      set(file "${CMAKE_BINARY_DIR}/robot_units/${name}/${template}_${i}.cpp")
+      configure_file("${PROJECT_SOURCE_DIR}/cmake/${template}_unit.cpp.in" "${file}" @ONLY)
+      list(APPEND units "${file}")
+    endforeach()
   endforeach()
-  foreach(template IN LISTS ARGN)
-    string(REGEX REPLACE "[.]in$" "" file_name "${template}")
-    set(file "${CMAKE_BINARY_DIR}/robot_units/${name}/${file_name}")
-    configure_file("${PROJECT_SOURCE_DIR}/cmake/${template}" "${file}" @ONLY)
+  set(unit_index 0)
+  set(unit_tail true)
+  set(unit_what "all its models")
+  foreach(template IN LISTS ARG_ONCE)
+    set(file "${CMAKE_BINARY_DIR}/robot_units/${name}/${template}.cpp")
+    configure_file("${PROJECT_SOURCE_DIR}/cmake/${template}.cpp.in" "${file}" @ONLY)
     list(APPEND units "${file}")
   endforeach()
   set(target symoro_${name}_${kind})
@@ -95,16 +101,17 @@ function(symoro_add_robot name robot_dir)
   # A variant added to robot.yaml reconfigures, so it gets its own dynid units.
   symoro_robot_model_count("${robot_dir}/robot.yaml" models)
   set_property(GLOBAL PROPERTY SYMORO_ROBOT_MODELS_${name} ${models})
-  # The only parts of identification and diagnosis compiled per model, each model's
-  # IdentificationModel (symoro/identify/identification_model.hpp) and DiagnosisModel
-  # (symoro/diagnose/diagnosis_model.hpp; the twin's backlash stage once per robot): whatever
-  # studies or diagnoses the robot's models (dynid, the Python package, tests, applications)
-  # links symoro::<name>_identification, symoro::<name>_diagnosis.
+  # What is compiled per model: its generated kernels in the robot library's C ABI
+  # (symoro/robot/compiled_model.hpp), under the runtime's one IdentificationModel and
+  # DiagnosisModel (symoro/identify/loaded_model.hpp, symoro/diagnose/loaded_model.hpp), and the
+  # twin's backlash stage once per robot: whatever studies or diagnoses the robot's models (dynid,
+  # the Python package, tests, applications) links symoro::<name>_identification,
+  # symoro::<name>_diagnosis.
   if(TARGET symoro_identify)
-    symoro_robot_library(${name} ${models} identification identify)
+    symoro_robot_library(${name} ${models} identification identify PER_MODEL kernels kernels_d2 ONCE identification)
   endif()
   if(TARGET symoro_diagnose)
-    symoro_robot_library(${name} ${models} diagnosis diagnose diagnosis_backlash.cpp.in)
+    symoro_robot_library(${name} ${models} diagnosis diagnose ONCE diagnosis diagnosis_backlash)
     target_link_libraries(symoro_${name}_diagnosis PUBLIC symoro_${name}_identification)
   endif()
   set_property(DIRECTORY "${PROJECT_SOURCE_DIR}" APPEND PROPERTY CMAKE_CONFIGURE_DEPENDS "${robot_dir}/robot.yaml")

@@ -1,6 +1,6 @@
-// ModelKernels of a loaded robot library's model (symoro.load): model_kernels-inl.hpp's loops
-// written once over the library's functions (symoro/robot_abi.h: column-major outputs), each
-// result turned into NumPy's C order. The values are the compiled model's, bit for bit.
+// ModelKernels over a model handle (a loaded robot library's, symoro.load, or a model linked into
+// the module, model_kernels-inl.hpp): the batch loops written once over its functions
+// (symoro/robot_abi.h: column-major outputs), each result turned into NumPy's C order.
 #include <limits>
 #include <vector>
 
@@ -31,13 +31,18 @@ void put(double* out, const double* column_major, int r, int c) {
 }  // namespace
 
 ModelKernels loaded_kernels(const robot::ModelHandle& model, const robot::ModelHandle& full) {
-  const robot::ModelHandle m = model;
-  const int nq = m.nq(), np = m.np(), ns = m.ns();
-  ModelKernels k;
+  ModelKernels k = handle_kernels(model);
   const auto id = identify::identification_model(model, full);
   const auto diagnosis = diagnose::diagnosis_model(model, full);
   k.identification = [id] { return id; };
   k.diagnosis = [diagnosis] { return diagnosis; };
+  return k;
+}
+
+ModelKernels handle_kernels(const robot::ModelHandle& model) {
+  const robot::ModelHandle m = model;
+  const int nq = m.nq(), np = m.np(), ns = m.ns();
+  ModelKernels k;
   k.nq = nq;
   k.np = np;
   k.ns = ns;

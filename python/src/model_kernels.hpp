@@ -1,9 +1,8 @@
 // A robot model as the Python package calls it: functions over a batch of states in C-ordered
-// float64 arrays (NumPy's layout), so that the binding code is compiled once and only these loops
-// are compiled per model (model_kernels-inl.hpp, one unit per robot model), or written once over
-// a loaded robot library's functions (loaded_kernels.cpp). Each
-// computes what the generated function gives in C++, into the model's own fixed-size Eigen
-// types, then copies it out: the results are those of the C++ call, bit for bit.
+// float64 arrays (NumPy's layout), written once over a model handle (loaded_kernels.cpp): a robot
+// library loaded at run time (symoro.load) or a model linked into the module
+// (model_kernels-inl.hpp). Each calls the generated function's C ABI kernel and copies its
+// column-major result out: the results are those of the C++ call, bit for bit.
 #pragma once
 
 #include <cstddef>
@@ -64,8 +63,11 @@ ModelKernels model_kernels();
 // Every compiled robot model (generated: <build>/robot_units/python_robots.cpp).
 std::vector<ModelKernels> all_model_kernels();
 
-// A model of a robot library loaded at run time (symoro.load; loaded_kernels.cpp): the same
-// loops over the library's functions. full: its robot's full model.
+// The batch loops over a model's functions, without its identification and diagnosis interfaces.
+ModelKernels handle_kernels(const robot::ModelHandle& model);
+
+// A model of a robot library loaded at run time (symoro.load; loaded_kernels.cpp): the loops and
+// its interfaces. full: its robot's full model.
 ModelKernels loaded_kernels(const robot::ModelHandle& model, const robot::ModelHandle& full);
 
 }  // namespace symoro::python

@@ -1,5 +1,5 @@
-// What a generated unit (units/*.cpp) compiles: one command for one robot, instantiated for the
-// model(s) it runs on, added to the command's table. Command is a struct with `Options` and
+// What a generated unit (units/<robot>/*.cpp) compiles: commands for one robot, each instantiated
+// for the model(s) it runs on, added to the command's table. Command is a struct with `Options` and
 // `template <class Full, class Model> static void run(const Common&, const Options&)`.
 #pragma once
 
@@ -31,8 +31,7 @@ void add_identified(CommandTable<typename Command::Options>& table, const char* 
 }
 
 // Commands on any model (--model <variant>): model I of Models, and with Tail every later one
-// too. The last unit of a robot is the tail, so a robot with more models than CMake counted in
-// its robot.yaml still has all of them (in fewer units); an index past the end adds nothing.
+// too (the generated units take I = 0 with Tail: every model of the robot).
 template <class Command, class Full, class Identified, class Models, std::size_t I, bool Tail>
 void add_variants(CommandTable<typename Command::Options>& table, const char* robot) {
   if constexpr (I < std::tuple_size_v<Models>) {

@@ -9,8 +9,6 @@
 #include <stdexcept>
 #include <string>
 
-#include <Eigen/Cholesky>
-
 #include "symoro/identify/detail/closed_loop_model.hpp"
 
 namespace symoro::identify {
@@ -109,12 +107,12 @@ class LoadedClosedLoop final : public ClosedLoop {
   };
   // Everything a simulation writes per step, sized once.
   struct Work {
-    Mat M, fd_dq, fd_dqd, fd_dtau, fd_dphi;
-    Vec h, qdd1, qdd2;
+    Mat M, L, fd_dq, fd_dqd, fd_dtau, fd_dphi;
+    Vec h, D, rhs, qdd1, qdd2;
     Mat dqdd1, dqdd2, unused;
     State mid;
     Work(int n, int np)
-        : M(n, n), fd_dq(n, n), fd_dqd(n, n), fd_dtau(n, n), fd_dphi(n, np), h(n), qdd1(n), qdd2(n), dqdd1(n, np),
+        : M(n, n), L(n, n), fd_dq(n, n), fd_dqd(n, n), fd_dtau(n, n), fd_dphi(n, np), h(n), D(n), rhs(n), qdd1(n), qdd2(n), dqdd1(n, np),
           dqdd2(n, np), unused(n, np) {
       mid.q.resize(n);
       mid.qd.resize(n);
@@ -152,20 +150,19 @@ class LoadedClosedLoop final : public ClosedLoop {
         return false;
       }
       dqdd = w.fd_dphi;
-      dqdd.noalias() += w.fd_dq.lazyProduct(x.S.topRows(n_));
-      dqdd.noalias() += w.fd_dqd.lazyProduct(x.S.bottomRows(n_));
-      dqdd.noalias() += w.fd_dtau.lazyProduct(du);
+      detail::add_product(dqdd, w.fd_dq, x.S.topRows(n_));
+      detail::add_product(dqdd, w.fd_dqd, x.S.bottomRows(n_));
+      detail::add_product(dqdd, w.fd_dtau, du);
       return true;
     }
     m_.inertia(x.q.data(), phi.data(), w.M.data());
     m_.nonlinear_effects(x.q.data(), x.qd.data(), phi.data(), w.h.data());
-    const Eigen::LDLT<Mat> ldlt(w.M);
-    const double pivot = ldlt.vectorD().minCoeff();
-    if (ldlt.info() != Eigen::Success || !(pivot > 0)) {
+    w.rhs = u - w.h;
+    const double pivot = detail::solve_spd(n_, w.M.data(), w.rhs.data(), qdd.data(), w.L.data(), w.D.data());
+    if (!(pivot > 0)) {
       why = detail::indefinite_inertia(t, pivot);
       return false;
     }
-    qdd = ldlt.solve(u - w.h);
     if (!qdd.allFinite()) {
       why = detail::not_finite(t);
       return false;
@@ -226,9 +223,9 @@ class LoadedClosedLoop final : public ClosedLoop {
       const auto Sq = x.S.topRows(n_);
       const auto Sqd = x.S.bottomRows(n_);
       w.dqdd1 = w.fd_dphi;
-      w.dqdd1.noalias() += w.fd_dq.lazyProduct(Sq);
-      w.dqdd1.noalias() += w.fd_dqd.lazyProduct(Sqd);
-      w.dqdd1.noalias() += w.fd_dtau.lazyProduct(du);
+      detail::add_product(w.dqdd1, w.fd_dq, Sq);
+      detail::add_product(w.dqdd1, w.fd_dqd, Sqd);
+      detail::add_product(w.dqdd1, w.fd_dtau, du);
       const double o = sample_at - s * h;
       if (o >= 0 && (o < h || s == m - 1)) {
         qs = x.q + o * x.qd + (0.5 * o * o) * w.qdd1;
@@ -239,8 +236,8 @@ class LoadedClosedLoop final : public ClosedLoop {
       mid.qd = x.qd + h * w.qdd1;
       if (!acceleration(false, phi, mid, u, du, ts + h, w.qdd2, w.unused, w, why)) return false;
       w.dqdd2 = w.dqdd1;
-      w.dqdd2.noalias() += h * w.fd_dq.lazyProduct(Sqd);
-      w.dqdd2.noalias() += h * w.fd_dqd.lazyProduct(w.dqdd1);
+      detail::add_product(w.dqdd2, w.fd_dq, Sqd, h);
+      detail::add_product(w.dqdd2, w.fd_dqd, w.dqdd1, h);
       x.q += (0.5 * h) * (x.qd + mid.qd);
       x.qd += (0.5 * h) * (w.qdd1 + w.qdd2);
       x.S.topRows(n_) += h * Sqd + (0.5 * h * h) * w.dqdd1;

@@ -19,8 +19,12 @@ const char* text(const char* s) { return s ? s : ""; }
 }  // namespace
 
 ModelHandle::ModelHandle(std::shared_ptr<const RobotLibrary> library, const symoro_abi_model* model)
-    : library_(std::move(library)), m_(model), robot_(library_->robot()), variant_(text(model->variant)),
-      description_(text(model->description)) {
+    : ModelHandle(library->robot(), model) {
+  library_ = std::move(library);
+}
+
+ModelHandle::ModelHandle(std::string robot, const symoro_abi_model* model)
+    : m_(model), robot_(std::move(robot)), variant_(text(model->variant)), description_(text(model->description)) {
   for (int i = 0; i < m_->np; ++i) {
     const auto& p = m_->parameters[i];
     parameters_.push_back({p.name, p.family, p.joint, p.unit});

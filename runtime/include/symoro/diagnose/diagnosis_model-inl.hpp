@@ -1,8 +1,8 @@
-// DiagnosisModel (diagnosis_model.hpp) for a generated model: the design stack compiled per
-// model, the backlash stage's simulation taken from robot_backlash<Full>, which is compiled once
-// per robot (diagnosis_backlash-inl.hpp: its own unit), not in every model's unit. Compiled into
-// symoro::<robot>_diagnosis (cmake/SymoroRobots.cmake); include it only to instantiate a model
-// that has no such library.
+// DiagnosisModel (diagnosis_model.hpp) for a generated model: the runtime's one implementation
+// (loaded_model.hpp) over the model's handle (its kernels in symoro::<robot>_identification), with
+// the backlash stage's simulation from robot_backlash<Full>, compiled once per robot
+// (diagnosis_backlash-inl.hpp: its own unit). Compiled into symoro::<robot>_diagnosis
+// (cmake/SymoroRobots.cmake); include it only to instantiate a model that has no such library.
 #pragma once
 
 #include <cstddef>
@@ -11,8 +11,8 @@
 #include <vector>
 
 #include "symoro/diagnose/diagnosis_model.hpp"
-#include "symoro/diagnose/stack_builder.hpp"
-#include "symoro/identify/identification_model.hpp"
+#include "symoro/diagnose/loaded_model.hpp"
+#include "symoro/robot/compiled_model.hpp"
 
 namespace symoro::diagnose {
 namespace detail {
@@ -22,33 +22,19 @@ template <class Full>
 BacklashFit robot_backlash(const io::Log& measured, const trajectory::SampledReference& reference,
                            const twin::TwinConfig& nominal, const BacklashFitOptions& options);
 
-template <class Full, class Model>
-class GeneratedDiagnosisModel final : public DiagnosisModel {
- public:
-  const identify::ModelDescription& description() const override {
-    return identify::identification_model<Model>()->description();
-  }
-  DesignStack stack_design(const std::vector<NamedSamples>& runs, const StackOptions& options) const override {
-    return diagnose::stack_design<Full, Model>(runs, options);
-  }
-  BacklashFit fit_backlash(const io::Log& measured, const trajectory::SampledReference& reference,
-                           const twin::TwinConfig& nominal, const BacklashFitOptions& options) const override {
-    return robot_backlash<Full>(measured, reference, nominal, options);
-  }
-};
-
 }  // namespace detail
 
 template <class Full, class Model>
 std::shared_ptr<const DiagnosisModel> diagnosis_model() {
-  static const std::shared_ptr<const DiagnosisModel> model = std::make_shared<detail::GeneratedDiagnosisModel<Full, Model>>();
+  static const std::shared_ptr<const DiagnosisModel> model =
+      diagnosis_model(robot::compiled_model<Model>(), robot::compiled_model<Full>(), &detail::robot_backlash<Full>);
   return model;
 }
 
 namespace detail {
 
 // Instantiates diagnosis_model<Full, M>() for model I of a robot's Models, and with Tail for
-// every later one too (cmake/diagnosis_unit.cpp.in: one unit per model of each robot).
+// every later one too (cmake/diagnosis.cpp.in: one unit per robot).
 using DiagnosisModelFactory = std::shared_ptr<const DiagnosisModel> (*)();
 template <class Full, class Models, std::size_t I, bool Tail>
 void instantiate_diagnosis_models(std::vector<DiagnosisModelFactory>& out) {

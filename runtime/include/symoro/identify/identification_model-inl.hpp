@@ -1,137 +1,33 @@
-// IdentificationModel (identification_model.hpp) for a generated Model: the templates over the
-// model (stack_regression, open_loop_torque, ClosedLoopSimulator, ModelInertiaFunction and the
-// physical path). Compiled once per model into symoro::<robot>_identification
-// (cmake/SymoroRobots.cmake); include it only to instantiate a model that has no such library.
+// identification_model<Model>() (identification_model.hpp) for a generated Model: the
+// IdentificationModel compiled once for every robot (loaded_model.hpp) over the model's handle
+// (symoro/robot/compiled_model.hpp), the same code a robot loaded at run time goes through. Per
+// model only the generated kernels compile, in units of their own (symoro::<robot>_identification,
+// cmake/SymoroRobots.cmake); for a model with no such library, also include
+// symoro/robot/compiled_model-inl.hpp and symoro/robot_abi_second_derivatives-inl.hpp.
 #pragma once
 
 #include <cstddef>
 #include <memory>
-#include <stdexcept>
-#include <string>
 #include <tuple>
 #include <vector>
 
-#include "symoro/identify/detail/closed_loop_model.hpp"
 #include "symoro/identify/identification_model.hpp"
-#include "symoro/identify/detail/inertia_function_model.hpp"
-#include "symoro/identify/physical_projection.hpp"
-#include "symoro/identify/regression.hpp"
-#include "symoro/identify/validation.hpp"
+#include "symoro/identify/loaded_model.hpp"
+#include "symoro/robot/compiled_model.hpp"
 
 namespace symoro::identify {
-namespace detail {
-
-template <class Model>
-class GeneratedIdentificationModel final : public IdentificationModel {
- public:
-  GeneratedIdentificationModel() {
-    d_.robot = Model::robot_name;
-    d_.variant = Model::variant_name;
-    d_.nq = Model::nq;
-    d_.np = Model::np;
-    d_.parameters.assign(Model::parameters.begin(), Model::parameters.end());
-    d_.joints.assign(Model::joints.begin(), Model::joints.end());
-    d_.standard.assign(Model::standard_parameters.begin(), Model::standard_parameters.end());
-    d_.frames.assign(Model::frames.begin(), Model::frames.end());
-    d_.gravity = Eigen::Vector3d(Model::gravity[0], Model::gravity[1], Model::gravity[2]);
-    for (const auto& f : Model::fixed_parameters) has_fixed_ = has_fixed_ || f.value != 0;
-  }
-  const ModelDescription& description() const override { return d_; }
-
-  Regression stack_regression(const preprocess::Samples& samples) const override {
-    return identify::stack_regression<Model>(samples);
-  }
-  Eigen::VectorXd base_from_standard(const Eigen::VectorXd& s) const override {
-    if (s.size() != Model::ns)
-      throw std::invalid_argument("base_from_standard: " + std::to_string(s.size()) + " standard parameters for " +
-                                  std::to_string(Model::ns));
-    return Model::base_from_standard(Eigen::Matrix<double, Model::ns, 1>(s));
-  }
-  Eigen::MatrixXd open_loop_torque(const preprocess::Samples& samples, const Eigen::VectorXd& phi) const override {
-    return identify::open_loop_torque<Model>(samples, phi);
-  }
-  void state_derivatives(const Eigen::VectorXd& q, const Eigen::VectorXd& qd, const Eigen::VectorXd& qdd,
-                         const Eigen::VectorXd& phi, bool with_fixed, StateDerivatives& out) const override {
-    using V = Eigen::Matrix<double, Model::nq, 1>;
-    const V Q = q, QD = qd, QDD = qdd;
-    const Eigen::Matrix<double, Model::np, 1> P = phi;
-    typename Model::template InverseDynamicsDerivatives<double> d;
-    Model::inverse_dynamics_derivatives(Q, QD, QDD, P, d);
-    Eigen::Matrix<double, Model::nq, Model::nq> M;
-    Model::inertia(Q, P, M);
-    out.tau = d.tau;
-    out.dq = d.dq;
-    out.dqd = d.dqd;
-    out.dqdd = M;
-    if (has_fixed_ && !with_fixed) {  // the fixed parameters' part, affine: subtract it at phi = 0
-      const Eigen::Matrix<double, Model::np, 1> zero = Eigen::Matrix<double, Model::np, 1>::Zero();
-      Model::inverse_dynamics_derivatives(Q, QD, QDD, zero, d);
-      Model::inertia(Q, zero, M);
-      out.tau -= d.tau;
-      out.dq -= d.dq;
-      out.dqd -= d.dqd;
-      out.dqdd -= M;
-    }
-  }
-  std::unique_ptr<InertiaFunction> inertia_function() const override { return make_inertia_function<Model>(); }
-  std::unique_ptr<ClosedLoop> closed_loop(const ClosedLoopSetup& setup,
-                                          const trajectory::SampledReference& reference) const override {
-    return std::make_unique<ClosedLoopSimulator<Model>>(setup, reference);
-  }
-
-  bool supports_physical_consistency() const override { return identify::supports_physical_consistency<Model>(); }
-  ConsistencyResult physical_check(const Eigen::VectorXd& phi) const override {
-    return identify::physical_check<Model>(phi);
-  }
-  PhysicalProjection physical_projection(const Eigen::VectorXd& phi0, const Eigen::MatrixXd& metric, double clearance,
-                                         const Eigen::VectorXd& prior, double prior_weight) const override {
-    ConsistencyOptions options;
-    options.prior_regularization = prior_weight;
-    return identify::physical_projection<Model>(phi0, prior, metric, clearance, options);
-  }
-  ConsistencyResult consistent_standard_parameters(const Eigen::VectorXd& phi, const Eigen::VectorXd& prior,
-                                                   const ConsistencyOptions& options) const override {
-    if constexpr (identify::supports_physical_consistency<Model>())
-      return identify::consistent_standard_parameters<Model>(phi, prior, options);
-    else
-      throw std::logic_error(unsupported());
-  }
-  Eigen::VectorXd consistency_target(const Eigen::VectorXd& phi) const override {
-    if constexpr (identify::supports_physical_consistency<Model>())
-      return identify::consistency_target<Model>(phi);
-    else
-      throw std::logic_error(unsupported());
-  }
-  Eigen::VectorXd parent_base_from_standard(const Eigen::VectorXd& s) const override {
-    if constexpr (identify::supports_physical_consistency<Model>()) {
-      using Parent = typename Model::Parent;
-      return Parent::base_from_standard(Eigen::Matrix<double, Parent::ns, 1>(s));
-    } else {
-      throw std::logic_error(unsupported());
-    }
-  }
-
- private:
-  static std::string unsupported() {
-    return std::string("the ") + Model::variant_name + " model has effect parameters, which have no standard-parameter form";
-  }
-  ModelDescription d_;
-  bool has_fixed_ = false;
-};
-
-}  // namespace detail
 
 template <class Model>
 std::shared_ptr<const IdentificationModel> identification_model() {
   static const std::shared_ptr<const IdentificationModel> model =
-      std::make_shared<detail::GeneratedIdentificationModel<Model>>();
+      identification_model(robot::compiled_model<Model>(), robot::compiled_model<typename Model::Parent>());
   return model;
 }
 
 namespace detail {
 
 // Instantiates identification_model<M>() for model I of a robot's Models, and with Tail for every
-// later one too (cmake/identification_unit.cpp.in: one unit per model of each robot). Each
+// later one too (cmake/identification.cpp.in: one unit per robot). Each
 // function's address goes to `out`, so that the unit emits its definition for the linker.
 using IdentificationModelFactory = std::shared_ptr<const IdentificationModel> (*)();
 template <class Models, std::size_t I, bool Tail>

@@ -1,8 +1,8 @@
 // What identification needs of a robot model, behind one small virtual interface, so that the
 // study (OLS/WLS, audit, SDP, CLIE, selection, rescue, validation) is compiled once for every
-// robot. A generated Model fills it in identification_model-inl.hpp; only that adapter (the
-// model's fixed-size regression, closed loop and inertia function) is compiled per model, once,
-// into symoro::<robot>_identification.
+// robot. One implementation serves every model (loaded_model.hpp, over a ModelHandle): a robot
+// library loaded at run time, or a generated Model linked in (identification_model-inl.hpp), of
+// which only the generated kernels compile per model, into symoro::<robot>_identification.
 // The generated functions are far longer than a virtual call, and every call here covers a
 // whole run or a whole pose (bench/bench_clie.cpp: simulation through the interface).
 #pragma once

@@ -19,7 +19,10 @@ class RobotLibrary;
 
 class ModelHandle {
  public:
+  // A model of a loaded library, which the handle keeps loaded.
   ModelHandle(std::shared_ptr<const RobotLibrary> library, const symoro_abi_model* model);
+  // A model linked into the program (compiled_model.hpp): its table has static storage.
+  ModelHandle(std::string robot, const symoro_abi_model* model);
 
   const std::string& robot() const { return robot_; }
   const std::string& variant() const { return variant_; }  // "" for the full model
@@ -86,7 +89,7 @@ class ModelHandle {
   Eigen::VectorXd base_from_standard(const Eigen::VectorXd& s) const;
 
  private:
-  std::shared_ptr<const RobotLibrary> library_;  // keeps the functions loaded
+  std::shared_ptr<const RobotLibrary> library_;  // keeps the functions loaded (null: linked in)
   const symoro_abi_model* m_;
   std::string robot_, variant_, description_;
   std::vector<ParameterInfo> parameters_;

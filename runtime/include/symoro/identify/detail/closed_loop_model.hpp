@@ -43,7 +43,6 @@
 #include <string>
 #include <vector>
 
-#include <Eigen/Cholesky>
 #include <Eigen/Core>
 
 #include "symoro/control/ffpd.hpp"
@@ -61,6 +60,92 @@ Divergence indefinite_inertia(double time, double smallest_pivot);
 Divergence not_finite(double time);
 // Throws std::invalid_argument when a setup cannot be simulated.
 void check_setup(const ClosedLoopSetup& setup, int joints);
+
+// dst += scale a b (column-major, a n x n, b n x c): for each of b's entries in column order,
+// dst's column j += a's column k times (scale b(k, j)). Element-wise operations only, in one
+// order, so the fixed-size simulator below and the dynamic-size one (loaded_closed_loop.cpp)
+// give the same bits: Eigen's lazy products reduce their inner sums in an order that depends on
+// the sizes (their sensitivities differed by 2e-13). Contiguous inner loops: they vectorize.
+template <int N, class Dst, class A, class B>
+inline void add_product_n(Dst& dst, const A& a, const B& b, double scale) {
+  using Column = Eigen::Matrix<double, N, 1>;
+  const Eigen::Index c = b.cols();
+  const double* a0 = a.data();
+  const Eigen::Index as = a.outerStride();
+  for (Eigen::Index j = 0; j < c; ++j) {
+    Eigen::Map<Column> d(dst.data() + j * dst.outerStride());
+    Column acc = d;  // d's column + its terms in k order, element by element, as written above
+    for (int k = 0; k < N; ++k) acc += Eigen::Map<const Column>(a0 + k * as) * (scale * b(k, j));
+    d = acc;
+  }
+}
+// a is n x n (the state's Jacobians). Sizes known at compile time, or up to 12 joints at run time,
+// go to loops of that size (unrolled: the dynamic-size simulation was 33 % slower with run-time
+// loop bounds); the arithmetic is the same either way.
+template <class Dst, class A, class B>
+inline void add_product(Dst& dst, const A& a, const B& b, double scale = 1.0) {
+  if constexpr (A::RowsAtCompileTime != Eigen::Dynamic) {
+    add_product_n<A::RowsAtCompileTime>(dst, a, b, scale);
+  } else {
+    switch (a.rows()) {
+      case 1: return add_product_n<1>(dst, a, b, scale);
+      case 2: return add_product_n<2>(dst, a, b, scale);
+      case 3: return add_product_n<3>(dst, a, b, scale);
+      case 4: return add_product_n<4>(dst, a, b, scale);
+      case 5: return add_product_n<5>(dst, a, b, scale);
+      case 6: return add_product_n<6>(dst, a, b, scale);
+      case 7: return add_product_n<7>(dst, a, b, scale);
+      case 8: return add_product_n<8>(dst, a, b, scale);
+      case 9: return add_product_n<9>(dst, a, b, scale);
+      case 10: return add_product_n<10>(dst, a, b, scale);
+      case 11: return add_product_n<11>(dst, a, b, scale);
+      case 12: return add_product_n<12>(dst, a, b, scale);
+      default: break;
+    }
+    const Eigen::Index n = a.rows(), c = b.cols();
+    for (Eigen::Index j = 0; j < c; ++j) {
+      double* d = dst.data() + j * dst.outerStride();
+      for (Eigen::Index k = 0; k < n; ++k) {
+        const double f = scale * b(k, j);
+        const double* ak = a.data() + k * a.outerStride();
+        for (Eigen::Index i = 0; i < n; ++i) d[i] += ak[i] * f;
+      }
+    }
+  }
+}
+
+// Solves M x = b for a symmetric M (column-major n x n, its lower triangle read) by an unpivoted
+// LDL^T in plain loops, with L (n x n) and D (n) the caller's scratch; returns the smallest pivot,
+// x set only when every pivot is > 0 (M positive definite). Plain loops in one order, for the
+// same reason as add_product: Eigen's LDLT runs its products through size-dependent kernels (the
+// fixed- and dynamic-size simulations differed by 1e-13 in tau).
+inline double solve_spd(int n, const double* M, const double* b, double* x, double* L, double* D) {
+  double min_pivot = 0;
+  for (int j = 0; j < n; ++j) {
+    double d = M[j + j * n];
+    for (int k = 0; k < j; ++k) d -= L[j + k * n] * L[j + k * n] * D[k];
+    if (j == 0 || d < min_pivot) min_pivot = d;
+    if (!(d > 0)) return min_pivot;
+    D[j] = d;
+    for (int i = j + 1; i < n; ++i) {
+      double s = M[i + j * n];
+      for (int k = 0; k < j; ++k) s -= L[i + k * n] * L[j + k * n] * D[k];
+      L[i + j * n] = s / d;
+    }
+  }
+  for (int i = 0; i < n; ++i) {  // L y = b
+    double s = b[i];
+    for (int k = 0; k < i; ++k) s -= L[i + k * n] * x[k];
+    x[i] = s;
+  }
+  for (int i = 0; i < n; ++i) x[i] /= D[i];
+  for (int i = n - 1; i >= 0; --i) {  // L^T x = D^-1 y
+    double s = x[i];
+    for (int k = i + 1; k < n; ++k) s -= L[k + i * n] * x[k];
+    x[i] = s;
+  }
+  return min_pivot;
+}
 
 // FfpdController's law, written out with fixed sizes so that the closed loop can carry its
 // derivative along phi (the gains are constants; only q depends on phi):
@@ -223,22 +308,21 @@ class ClosedLoopSimulator final : public ClosedLoop {
       }
       // Coefficient-wise products: at these fixed sizes they beat Eigen's blocked GEMM.
       dqdd = d.dphi;
-      dqdd.noalias() += d.dq.lazyProduct(x.S.template topRows<n>());
-      dqdd.noalias() += d.dqd.lazyProduct(x.S.template bottomRows<n>());
-      dqdd.noalias() += d.dtau.lazyProduct(du);
+      detail::add_product(dqdd, d.dq, x.S.template topRows<n>());
+      detail::add_product(dqdd, d.dqd, x.S.template bottomRows<n>());
+      detail::add_product(dqdd, d.dtau, du);
       return true;
     } else {
-      Mat M;
+      Mat M, L;
       Model::inertia(x.q, phi, M);
-      Vec h;
+      Vec h, D;
       Model::nonlinear_effects(x.q, x.qd, phi, h);
-      const Eigen::LDLT<Mat> ldlt(M);
-      const double pivot = ldlt.vectorD().minCoeff();
-      if (ldlt.info() != Eigen::Success || !(pivot > 0)) {
+      const Vec rhs = u - h;
+      const double pivot = detail::solve_spd(n, M.data(), rhs.data(), qdd.data(), L.data(), D.data());
+      if (!(pivot > 0)) {
         why = detail::indefinite_inertia(t, pivot);
         return false;
       }
-      qdd = ldlt.solve(u - h);
       if (!qdd.allFinite()) {
         why = detail::not_finite(t);
         return false;
@@ -313,9 +397,9 @@ class ClosedLoopSimulator final : public ClosedLoop {
       const auto Sq = x.S.template topRows<n>();
       const auto Sqd = x.S.template bottomRows<n>();
       dqdd1 = d.dphi;
-      dqdd1.noalias() += d.dq.lazyProduct(Sq);
-      dqdd1.noalias() += d.dqd.lazyProduct(Sqd);
-      dqdd1.noalias() += d.dtau.lazyProduct(du);
+      detail::add_product(dqdd1, d.dq, Sq);
+      detail::add_product(dqdd1, d.dqd, Sqd);
+      detail::add_product(dqdd1, d.dtau, du);
       const double o = sample_at - s * h;
       if (o >= 0 && (o < h || s == m - 1)) {
         qs = x.q + o * x.qd + (0.5 * o * o) * qdd1;
@@ -328,8 +412,8 @@ class ClosedLoopSimulator final : public ClosedLoop {
       // The second stage with the same Jacobians: its S differs from the first's by h (S_qd, d qdd1),
       // so d qdd2 = d qdd1 + h (d qdd/d q S_qd + d qdd/d qd d qdd1).
       dqdd2 = dqdd1;
-      dqdd2.noalias() += h * d.dq.lazyProduct(Sqd);
-      dqdd2.noalias() += h * d.dqd.lazyProduct(dqdd1);
+      detail::add_product(dqdd2, d.dq, Sqd, h);
+      detail::add_product(dqdd2, d.dqd, dqdd1, h);
       x.q += (0.5 * h) * (x.qd + mid.qd);
       x.qd += (0.5 * h) * (qdd1 + qdd2);
       // Heun on S: S_q += h/2 (S_qd + S_qd + h d qdd1), S_qd += h/2 (d qdd1 + d qdd2).

@@ -1,0 +1,33 @@
+// compiled_model<Model>() (compiled_model.hpp): the robot library's C ABI table of a generated
+// model (robot_abi_export-inl.hpp), built once, under a handle with no library to keep loaded.
+// Its second derivatives (robot_abi_second_derivatives-inl.hpp) compile in a unit of their own.
+#pragma once
+
+#include <cstddef>
+#include <tuple>
+#include <vector>
+
+#include "symoro/robot/compiled_model.hpp"
+#include "symoro/robot_abi_export-inl.hpp"
+
+namespace symoro::robot {
+
+template <class Model>
+const ModelHandle& compiled_model() {
+  static const symoro_abi_model table = abi_export::model_abi<Model>();
+  static const ModelHandle handle(Model::robot_name, &table);
+  return handle;
+}
+
+// Instantiates compiled_model<M>() for model I of a robot's Models, and with Tail for every later
+// one too (cmake/kernels_unit.cpp.in: one unit per model of each robot).
+using CompiledModelFactory = const ModelHandle& (*)();
+template <class Models, std::size_t I, bool Tail>
+void instantiate_compiled_models(std::vector<CompiledModelFactory>& out) {
+  if constexpr (I < std::tuple_size_v<Models>) {
+    out.push_back(&compiled_model<std::tuple_element_t<I, Models>>);
+    if constexpr (Tail) instantiate_compiled_models<Models, I + 1, true>(out);
+  }
+}
+
+}  // namespace symoro::robot
