@@ -14,6 +14,7 @@
 #include <symoro/crane_x7.hpp>
 
 #include "symoro/identify/identification_model.hpp"
+#include "symoro/identify/loaded_closed_loop.hpp"
 #include "symoro/identify/loaded_model.hpp"
 #include "symoro/robot/load_robot.hpp"
 #include "symoro/trajectory/design.hpp"
@@ -150,6 +151,15 @@ TEST(LoadedIdentificationModel, ClosedLoopEqualsTheFixedSizeSimulatorBitForBit) 
     ASSERT_TRUE(c->simulate(phi, tl, &dl, &why)) << why.describe();
     EXPECT_EQ(tl, ta);
     EXPECT_EQ(dl, da);
+    // The run-time-size simulator (a robot of 1 or more than 8 joints) gives the same bits.
+    robot::LoadOptions o;
+    o.cache_dir = SYMORO_TEST_ROBOT_CACHE;
+    const auto d = identify::detail::closed_loop_run_time_sizes(robot::load_robot(kRobot, o)->model("reduced"), setup,
+                                                                reference);
+    preprocess::Channels tr, dr;
+    ASSERT_TRUE(d->simulate(phi, tr, &dr, &why)) << why.describe();
+    EXPECT_EQ(tr, tb);
+    EXPECT_EQ(dr, db);
     // Without sensitivities: the same plain simulation, which the default (frozen) sensitivities
     // leave as it is; exact ones step the state through the derivatives' own qdd.
     preprocess::Channels tc, tp;

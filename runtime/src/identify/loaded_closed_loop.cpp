@@ -371,8 +371,14 @@ std::unique_ptr<ClosedLoop> closed_loop(const robot::ModelHandle& model, const C
     case 6: return std::make_unique<LoadedClosedLoop<6>>(model, setup, reference);
     case 7: return std::make_unique<LoadedClosedLoop<7>>(model, setup, reference);
     case 8: return std::make_unique<LoadedClosedLoop<8>>(model, setup, reference);
-    default: return std::make_unique<LoadedClosedLoop<Dynamic>>(model, setup, reference);
+    default: return detail::closed_loop_run_time_sizes(model, setup, reference);
   }
+}
+
+std::unique_ptr<ClosedLoop> detail::closed_loop_run_time_sizes(const robot::ModelHandle& model,
+                                                               const ClosedLoopSetup& setup,
+                                                               const trajectory::SampledReference& reference) {
+  return std::make_unique<LoadedClosedLoop<Dynamic>>(model, setup, reference);
 }
 
 }  // namespace symoro::identify
