@@ -28,54 +28,7 @@ struct Sizes {
   using Sens = Eigen::Matrix<double, N, Dynamic>;                                // n x np
   using SensX = Eigen::Matrix<double, N == Dynamic ? Dynamic : 2 * N, Dynamic>;  // 2n x np
   using SensRow = Eigen::Matrix<double, N, Dynamic, Eigen::RowMajor>;
-};
-
-// detail::FfpdSensitivity with a run-time parameter count: the same expressions in the same order.
-template <int N>
-class DynamicFfpd {
- public:
-  using Vec = typename Sizes<N>::Vec;
-  using Mat = typename Sizes<N>::Sens;
-  DynamicFfpd(const control::FfpdGains& g, int n, int np)
-      : inertia_(g.inertia), damping_(g.damping), kp_(g.kp), kv_(g.kv) {
-    q_prev_.resize(n);
-    qd_hat_.resize(n);
-    dq_prev_.resize(n, np);
-    dqd_hat_.resize(n, np);
-    const double T = g.period, Tf = g.pseudo_derivative_time;
-    a_ = (2 * Tf - T) / (2 * Tf + T);
-    b_ = 2 / (2 * Tf + T);
-    position_gain_ = inertia_.cwiseProduct(kp_);
-    velocity_gain_ = inertia_.cwiseProduct(kv_);
-  }
-  void reset(bool sens, const Vec& q) {
-    q_prev_ = q;
-    qd_hat_.setZero();
-    if (sens) {
-      dq_prev_.setZero();
-      dqd_hat_.setZero();
-    }
-  }
-  template <class R>
-  void update(bool sens, const Vec& q, const Mat& dq, const R& q_ref, const R& qd_ref, const R& qdd_ref, Vec& u,
-              Mat& du) {
-    qd_hat_ = a_ * qd_hat_ + b_ * (q - q_prev_);
-    q_prev_ = q;
-    u = inertia_.cwiseProduct(kv_.cwiseProduct(qd_ref - qd_hat_) + kp_.cwiseProduct(q_ref - q) + qdd_ref) +
-        damping_.cwiseProduct(qd_ref);
-    if (sens) {
-      dqd_hat_ = a_ * dqd_hat_ + b_ * (dq - dq_prev_);
-      dq_prev_ = dq;
-      du.noalias() = -(position_gain_.asDiagonal() * dq);
-      du.noalias() -= velocity_gain_.asDiagonal() * dqd_hat_;
-    }
-  }
-
- private:
-  Vec inertia_, damping_, kp_, kv_, position_gain_, velocity_gain_;
-  double a_ = 0, b_ = 0;
-  Vec q_prev_, qd_hat_;
-  Mat dq_prev_, dqd_hat_;
+  using Controller = detail::FfpdSensitivity<N, Dynamic>;
 };
 
 template <int N>
@@ -291,13 +244,14 @@ class LoadedClosedLoop final : public ClosedLoop {
     if (q_out) q_out->resize(cycles_, n_);
 
     Work w(n_, np_);
-    DynamicFfpd<N> controller(setup_.gains, n_, np_);
+    typename Sizes<N>::Controller controller(setup_.gains, np_);
     State x;
     x.q = q_ref_.col(0);
     x.qd.resize(n_);
     x.qd.setZero();
     x.S.resize(2 * n_, np_);
-    controller.reset(sens, x.q);
+    if (sens) controller.template reset<true>(x.q);
+    else controller.template reset<false>(x.q);
     Vec u_prev, u, qs = x.q;
     u_prev.resize(n_);
     u_prev.setZero();
@@ -338,7 +292,8 @@ class LoadedClosedLoop final : public ClosedLoop {
         }
         if (q_out) q_out->row(k) = qs.transpose();
       }
-      controller.update(sens, qs, dqs, q_ref_.col(k), qd_ref_.col(k), qdd_ref_.col(k), u, du);
+      if (sens) controller.template update<true>(qs, dqs, q_ref_.col(k), qd_ref_.col(k), qdd_ref_.col(k), u, du);
+      else controller.template update<false>(qs, dqs, q_ref_.col(k), qd_ref_.col(k), qdd_ref_.col(k), u, du);
       if (c == total - 1) break;
       if (split) {
         if (!hold(sens, phi, x, u_prev, du_prev, d, t, -1, qs, dqs, w, why)) return false;

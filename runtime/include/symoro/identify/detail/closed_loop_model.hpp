@@ -79,29 +79,14 @@ inline void add_product_n(Dst& dst, const A& a, const B& b, double scale) {
     d = acc;
   }
 }
-// a is n x n (the state's Jacobians). Sizes known at compile time, or up to 12 joints at run time,
-// go to loops of that size (unrolled: the dynamic-size simulation was 33 % slower with run-time
-// loop bounds); the arithmetic is the same either way.
+// a is n x n (the state's Jacobians): at a compile-time size the loops unroll (the runtime's
+// simulator takes 2 to 8 joints at compile-time sizes, loaded_closed_loop.cpp); the arithmetic is
+// the same either way.
 template <class Dst, class A, class B>
 inline void add_product(Dst& dst, const A& a, const B& b, double scale = 1.0) {
   if constexpr (A::RowsAtCompileTime != Eigen::Dynamic) {
     add_product_n<A::RowsAtCompileTime>(dst, a, b, scale);
   } else {
-    switch (a.rows()) {
-      case 1: return add_product_n<1>(dst, a, b, scale);
-      case 2: return add_product_n<2>(dst, a, b, scale);
-      case 3: return add_product_n<3>(dst, a, b, scale);
-      case 4: return add_product_n<4>(dst, a, b, scale);
-      case 5: return add_product_n<5>(dst, a, b, scale);
-      case 6: return add_product_n<6>(dst, a, b, scale);
-      case 7: return add_product_n<7>(dst, a, b, scale);
-      case 8: return add_product_n<8>(dst, a, b, scale);
-      case 9: return add_product_n<9>(dst, a, b, scale);
-      case 10: return add_product_n<10>(dst, a, b, scale);
-      case 11: return add_product_n<11>(dst, a, b, scale);
-      case 12: return add_product_n<12>(dst, a, b, scale);
-      default: break;
-    }
     const Eigen::Index n = a.rows(), c = b.cols();
     for (Eigen::Index j = 0; j < c; ++j) {
       double* d = dst.data() + j * dst.outerStride();
@@ -147,17 +132,24 @@ inline double solve_spd(int n, const double* M, const double* b, double* x, doub
   return min_pivot;
 }
 
-// FfpdController's law, written out with fixed sizes so that the closed loop can carry its
-// derivative along phi (the gains are constants; only q depends on phi):
+// FfpdController's law, written out so that the closed loop can carry its derivative along phi
+// (the gains are constants; only q depends on phi):
 //   d qd_hat_k = a d qd_hat_{k-1} + b (d q_k - d q_{k-1}),   d u = -M_hat (K_P d q + K_V d qd_hat).
+// n and np may be Eigen::Dynamic (the runtime's simulator: np always): sized from the gains and
+// `params` then.
 template <int n, int np>
 class FfpdSensitivity {
  public:
   using Vec = Eigen::Matrix<double, n, 1>;
   using SensQ = Eigen::Matrix<double, n, np>;
 
-  explicit FfpdSensitivity(const control::FfpdGains& g)
+  explicit FfpdSensitivity(const control::FfpdGains& g, Eigen::Index params = np)
       : inertia_(g.inertia), damping_(g.damping), kp_(g.kp), kv_(g.kv) {
+    const Eigen::Index joints = g.inertia.size();
+    q_prev_.resize(joints);
+    qd_hat_.resize(joints);
+    dq_prev_.resize(joints, params);
+    dqd_hat_.resize(joints, params);
     // The same expressions as FfpdController, so the two agree to the last bit.
     const double T = g.period, Tf = g.pseudo_derivative_time;
     a_ = (2 * Tf - T) / (2 * Tf + T);
@@ -177,8 +169,9 @@ class FfpdSensitivity {
     }
   }
 
-  template <bool Sens>
-  void update(const Vec& q, const SensQ& dq, const Vec& q_ref, const Vec& qd_ref, const Vec& qdd_ref, Vec& u,
+  // q_ref, qd_ref, qdd_ref: this cycle's reference (any column expression).
+  template <bool Sens, class Ref>
+  void update(const Vec& q, const SensQ& dq, const Ref& q_ref, const Ref& qd_ref, const Ref& qdd_ref, Vec& u,
               SensQ& du) {
     qd_hat_ = a_ * qd_hat_ + b_ * (q - q_prev_);
     q_prev_ = q;
