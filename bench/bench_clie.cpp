@@ -20,6 +20,7 @@
 #include "symoro/identify/detail/clie_model.hpp"
 #include "symoro/identify/detail/closed_loop_model.hpp"
 #include "symoro/identify/identification_model.hpp"
+#include "symoro/robot/compiled_model.hpp"
 #include "symoro/trajectory/sampled_reference.hpp"
 #include "symoro/preprocess/preprocess.hpp"
 #include "symoro/trajectory/design.hpp"
@@ -38,7 +39,7 @@ struct Fixture {
       symoro::trajectory::TrajectoryDesign::read(kRobot + "/trajectories.yaml",
                                                  std::vector<symoro::JointInfo>(Full::joints.begin(), Full::joints.end()))
           .build("AG02");
-  Eigen::VectorXd truth = Reduced::from_parent(symoro::twin::make_truth<Full>(config).phi);
+  Eigen::VectorXd truth = Reduced::from_parent(symoro::twin::make_truth(symoro::robot::compiled_model<Full>(), config).phi);
   identify::ClosedLoopSimulator<Reduced> sim{identify::closed_loop_setup(config.controller), trajectory};
   // The exact derivatives of the discrete map (ClosedLoopSetup::exact_sensitivities).
   identify::ClosedLoopSimulator<Reduced> sim_exact{exact_setup(config), trajectory};
@@ -115,7 +116,7 @@ void clie_ag02(benchmark::State& state, Path path, bool runtime = false) {
   const Fixture& f = fixture();
   symoro::twin::RunOptions run;
   run.robot = "crane_x7";
-  const symoro::io::Log log = symoro::twin::ClosedLoopTwin<Full>(f.config).run(f.trajectory, run);
+  const symoro::io::Log log = symoro::twin::ClosedLoopTwin(symoro::robot::compiled_model<Full>(), f.config).run(f.trajectory, run);
   identify::ClieOptions options;
   const symoro::preprocess::Samples samples = symoro::preprocess::preprocess(log, 0.04, options.preprocess);
   Eigen::VectorXd phi0 = f.truth;

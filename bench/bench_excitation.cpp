@@ -10,6 +10,7 @@
 
 #include "symoro/identify/excitation_design.hpp"
 #include "symoro/identify/identification_model.hpp"
+#include "symoro/robot/compiled_model.hpp"
 #include "symoro/twin/config.hpp"
 #include "symoro/twin/truth.hpp"
 
@@ -38,7 +39,7 @@ ExcitationDesignOptions crane_options(int starts) {
   o.limits.velocity = Eigen::VectorXd::Constant(Model::nq, 2.0);
   o.limits.acceleration = Eigen::VectorXd::Constant(Model::nq, 8.0);
   const auto c = symoro::twin::read_twin_config(std::string(SYMORO_ROBOTS_DIR) + "/crane_x7/twin.yaml", Model::nq, "");
-  o.nominal = symoro::twin::make_truth<Model>(c).phi;
+  o.nominal = symoro::twin::make_truth(symoro::robot::compiled_model<Model>(), c).phi;
   return o;
 }
 

@@ -14,6 +14,7 @@
 
 #include "symoro/identify/study.hpp"
 #include "symoro/io/import.hpp"
+#include "symoro/robot/compiled_model.hpp"
 #include "symoro/twin/config.hpp"
 #include "symoro/twin/truth.hpp"
 #include "synthetic_log.hpp"
@@ -29,7 +30,7 @@ const std::filesystem::path& export_csv() {
   static const std::filesystem::path file = [] {
     std::filesystem::create_directories(kDir);
     const auto twin = symoro::twin::read_twin_config(std::string(SYMORO_ROBOTS_DIR) + "/crane_x7/twin.yaml", Full::nq);
-    const Eigen::Matrix<double, Full::np, 1> phi = symoro::twin::make_truth<Full>(twin).phi;
+    const Eigen::Matrix<double, Full::np, 1> phi = symoro::twin::make_truth(symoro::robot::compiled_model<Full>(), twin).phi;
     const symoro::io::Log log = symoro::test::synthesize<Full>("arm", phi, 20.0, 3, 0.01);
     const auto f = kDir / "export.csv";
     symoro::test::write_export_csv<Full>(log, f);

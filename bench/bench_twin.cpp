@@ -4,6 +4,7 @@
 
 #include <symoro/crane_x7.hpp>
 
+#include "symoro/robot/compiled_model.hpp"
 #include "symoro/trajectory/design.hpp"
 #include "symoro/twin/simulator.hpp"
 
@@ -17,7 +18,7 @@ void run(benchmark::State& state, const std::string& trajectory, int effects) {
   if (effects == 0) c.effects.disable_all();
   if (effects == 2)
     for (const auto& e : symoro::twin::Effects::names()) c.effects.set(e, true);
-  const symoro::twin::ClosedLoopTwin<Model> twin(c);
+  const symoro::twin::ClosedLoopTwin twin(symoro::robot::compiled_model<Model>(), c);
   const auto design = symoro::trajectory::TrajectoryDesign::read(
       kRobot + "/trajectories.yaml", std::vector<symoro::JointInfo>(Model::joints.begin(), Model::joints.end()));
   const auto traj = design.build(trajectory);

@@ -7,13 +7,14 @@
 #include <random>
 #include <string>
 #include <symoro/crane_x7.hpp>
+#include "symoro/robot/compiled_model.hpp"
 #include "symoro/twin/config.hpp"
 #include "symoro/twin/truth.hpp"
 using Model = symoro::crane_x7::Model;
 int main(int argc, char** argv) {
   const double spread = argc > 1 ? std::stod(argv[1]) : 0.0;
   const auto c = symoro::twin::read_twin_config(std::string(SYMORO_ROBOTS_DIR) + "/crane_x7/twin.yaml", Model::nq, "");
-  auto s = symoro::twin::make_truth<Model>(c).standard;
+  auto s = symoro::twin::make_truth(symoro::robot::compiled_model<Model>(), c).standard;
   std::mt19937_64 rng(11);
   std::uniform_real_distribution<double> u(-spread, spread);
   // One factor per link (a link's mass scaled scales its moments and inertia alike), plus a

@@ -103,15 +103,14 @@ function(symoro_add_robot name robot_dir)
   set_property(GLOBAL PROPERTY SYMORO_ROBOT_MODELS_${name} ${models})
   # What is compiled per model: its generated kernels in the robot library's C ABI
   # (symoro/robot/compiled_model.hpp), under the runtime's one IdentificationModel and
-  # DiagnosisModel (symoro/identify/loaded_model.hpp, symoro/diagnose/loaded_model.hpp), and the
-  # twin's backlash stage once per robot: whatever studies or diagnoses the robot's models (dynid,
-  # the Python package, tests, applications) links symoro::<name>_identification,
-  # symoro::<name>_diagnosis.
+  # DiagnosisModel (symoro/identify/loaded_model.hpp, symoro/diagnose/loaded_model.hpp): whatever
+  # studies or diagnoses the robot's models (dynid, the Python package, tests, applications) links
+  # symoro::<name>_identification, symoro::<name>_diagnosis.
   if(TARGET symoro_identify)
     symoro_robot_library(${name} ${models} identification identify PER_MODEL kernels kernels_d2 ONCE identification)
   endif()
   if(TARGET symoro_diagnose)
-    symoro_robot_library(${name} ${models} diagnosis diagnose ONCE diagnosis diagnosis_backlash)
+    symoro_robot_library(${name} ${models} diagnosis diagnose ONCE diagnosis)
     target_link_libraries(symoro_${name}_diagnosis PUBLIC symoro_${name}_identification)
   endif()
   set_property(DIRECTORY "${PROJECT_SOURCE_DIR}" APPEND PROPERTY CMAKE_CONFIGURE_DEPENDS "${robot_dir}/robot.yaml")

@@ -1,5 +1,5 @@
 // ModelKernels over a model handle (a loaded robot library's, symoro.load, or a model linked into
-// the module, model_kernels-inl.hpp): the batch loops written once over its functions
+// the module, python_robots.cpp): the batch loops written once over its functions
 // (symoro/robot_abi.h: column-major outputs), each result turned into NumPy's C order.
 #include <limits>
 #include <vector>

@@ -1,7 +1,6 @@
 // A robot model as the Python package calls it: functions over a batch of states in C-ordered
 // float64 arrays (NumPy's layout), written once over a model handle (loaded_kernels.cpp): a robot
-// library loaded at run time (symoro.load) or a model linked into the module
-// (model_kernels-inl.hpp). Each calls the generated function's C ABI kernel and copies its
+// library loaded at run time (symoro.load) or a model linked into the module (python_robots.cpp). Each calls the generated function's C ABI kernel and copies its
 // column-major result out: the results are those of the C++ call, bit for bit.
 #pragma once
 
@@ -57,17 +56,14 @@ struct ModelKernels {
   std::function<void(const double* s, double* phi, Batch b)> base_from_standard;
 };
 
-template <class Full, class Model>
-ModelKernels model_kernels();
-
 // Every compiled robot model (generated: <build>/robot_units/python_robots.cpp).
 std::vector<ModelKernels> all_model_kernels();
 
 // The batch loops over a model's functions, without its identification and diagnosis interfaces.
 ModelKernels handle_kernels(const robot::ModelHandle& model);
 
-// A model of a robot library loaded at run time (symoro.load; loaded_kernels.cpp): the loops and
-// its interfaces. full: its robot's full model.
+// A model of a robot library loaded at run time (symoro.load) or linked in (loaded_kernels.cpp):
+// the loops and its interfaces. full: its robot's full model.
 ModelKernels loaded_kernels(const robot::ModelHandle& model, const robot::ModelHandle& full);
 
 }  // namespace symoro::python

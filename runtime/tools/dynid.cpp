@@ -8,7 +8,7 @@
 #include <CLI/CLI.hpp>
 
 #include "dynid_common.hpp"
-#include "dynid_dispatch.hpp"
+#include "dynid_robots.hpp"
 #include "symoro/error.hpp"
 #include "symoro/parallel/farm.hpp"
 

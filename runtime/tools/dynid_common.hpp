@@ -55,11 +55,6 @@ struct UsageError : std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
-template <class Model>
-std::vector<JointInfo> joint_list() {
-  return {Model::joints.begin(), Model::joints.end()};
-}
-
 // Counts finished items on stderr; redraws one line on a terminal, prints lines otherwise.
 class Progress {
  public:

@@ -1,11 +1,10 @@
-// dynid control's options and its entry, compiled for each robot's full model (the arm and its
-// twin) and identified model (--params' feedforward) in generated units; the body is in
-// dynid_control-inl.hpp.
+// dynid control's options and its body: the robot's full model (the arm, and its twin behind
+// --virtual) and its identified model (--params' feedforward).
 #pragma once
 
 #include <string>
 
-#include "dynid_dispatch.hpp"
+#include "dynid_common.hpp"
 
 namespace symoro::dynid {
 
@@ -28,12 +27,6 @@ struct ControlCliOptions {
   double hold_time = 0;  // s; 0: hardware.yaml's safety.hold_time
 };
 
-struct ControlCommand {
-  using Options = ControlCliOptions;
-  template <class Full, class Identified>
-  static void run(const Common& common, const Options& o);
-};
-
-const CommandTable<ControlCliOptions>& control_units();  // generated: dynid_tables.cpp
+void run_control_command(const Common& common, const ControlCliOptions& o);
 
 }  // namespace symoro::dynid

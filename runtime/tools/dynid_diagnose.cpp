@@ -7,7 +7,7 @@
 #include <fmt/format.h>
 
 #include "dynid_diagnose.hpp"
-#include "dynid_loaded_robot.hpp"
+#include "dynid_robots.hpp"
 #include "dynid_numbers.hpp"
 #include "symoro/diagnose/dataset_diagnosis.hpp"
 #include "symoro/diagnose/loaded_model.hpp"
@@ -88,11 +88,7 @@ void add_diagnose_commands(CLI::App& app, Common& common) {
     } catch (const diagnose::DiagnosisRequestError& e) {
       throw UsageError(e.what());
     }
-    if (compiled_robot(common)) {
-      diagnose_units().model(common, o->model)(common, *o);
-    } else {  // a robot folder this dynid was not built with: its library
-      run_diagnose(common, *o, *diagnose::diagnosis_model(loaded_model(common, o->model), loaded_model(common, "full")));
-    }
+    run_diagnose(common, *o, *diagnose::diagnosis_model(robot_model(common, o->model), full_model(common)));
   });
 }
 

@@ -1,12 +1,11 @@
-// dynid diagnose's options and its entry per model of each robot (any variant: --model), in
-// generated units that only fetch the model's DiagnosisModel (symoro::<robot>_diagnosis); the
-// diagnosis itself is symoro/diagnose/dataset_diagnosis.hpp's, compiled once.
+// dynid diagnose's options and its body on any model of any robot (--model): the model's
+// DiagnosisModel (symoro/diagnose/loaded_model.hpp) under symoro/diagnose/dataset_diagnosis.hpp.
 #pragma once
 
 #include <string>
 #include <vector>
 
-#include "dynid_dispatch.hpp"
+#include "dynid_common.hpp"
 
 namespace symoro::diagnose {
 class DiagnosisModel;
@@ -21,14 +20,6 @@ struct DiagnoseOptions {
   int trial = 1;
   double interval_ms = 10, cutoff = 5, alpha = 1e-3, min_gain = 0.02, min_torque = 0.003;
 };
-
-struct DiagnoseCommand {
-  using Options = DiagnoseOptions;
-  template <class Full, class Model>
-  static void run(const Common& common, const Options& o);
-};
-
-const CommandTable<DiagnoseOptions>& diagnose_units();  // generated: dynid_tables.cpp
 
 // The command on one model (dynid_diagnose.cpp).
 void run_diagnose(const Common& common, const DiagnoseOptions& o, const diagnose::DiagnosisModel& model);

@@ -13,6 +13,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include "dynid_identify.hpp"
+#include "dynid_robots.hpp"
 #include "dynid_numbers.hpp"
 #include "dynid_trajectories.hpp"
 #include "symoro/identify/excitation_design.hpp"
@@ -157,7 +158,7 @@ void warn_crossings(const std::vector<trajectory::Trajectory>& all, const std::v
 }
 
 void run(const Common& common, const ExciteOptions& o) {
-  const auto model = identification_model_of(common, o.model);
+  const auto model = identification_model(common, o.model);
   const identify::ModelDescription& d = model->description();
   const int n = d.nq;
   fs::create_directories(o.out);

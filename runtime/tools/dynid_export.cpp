@@ -14,7 +14,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include "dynid_export.hpp"
-#include "dynid_loaded_robot.hpp"
+#include "dynid_robots.hpp"
 #include "dynid_numbers.hpp"
 #include "dynid_urdf_into.hpp"
 #include "symoro/identify/model_export.hpp"
@@ -25,6 +25,7 @@
 #include "symoro/io/parameters_yaml.hpp"
 #include "symoro/preprocess/preprocess.hpp"
 #include "symoro/twin/config.hpp"
+#include "symoro/twin/truth.hpp"
 
 namespace symoro::dynid {
 
@@ -102,9 +103,10 @@ std::string torque_cost(const FittingRun& f, const Eigen::VectorXd& phi, const E
 
 }  // namespace export_detail
 
-void ExportCommand::run_model(const Common& common, const ExportOptions& o,
-                              const std::shared_ptr<const identify::IdentificationModel>& model,
-                              const std::shared_ptr<const identify::IdentificationModel>& parent, const TwinPrior& twin_prior) {
+void run_export(const Common& common, const ExportOptions& o, const std::string& label) {
+  // parent: the robot's full model (the fitting run's regression).
+  const std::shared_ptr<const identify::IdentificationModel> model = identification_model(common, label);
+  const std::shared_ptr<const identify::IdentificationModel> parent = identification_model(common, "full");
   const identify::ModelDescription& d = model->description();
   if (!model->supports_physical_consistency()) {
     throw UsageError(fmt::format("model '{}' has model-gap effect parameters, which have no URDF counterpart and no "
@@ -139,9 +141,9 @@ void ExportCommand::run_model(const Common& common, const ExportOptions& o,
     } else if (!o.prior.empty()) {
       prior = io::read_parameters_yaml(o.prior, standard_names);
       prior_what = o.prior;
-    } else if (twin_prior && std::filesystem::exists(twin_path)) {  // a loaded robot has no twin
+    } else if (std::filesystem::exists(twin_path)) {
       const twin::TwinConfig tc = twin::read_twin_config(twin_path, d.nq);
-      prior = twin_prior(tc);
+      prior = twin::make_truth(full_model(common), tc).standard;
       prior_what = twin_path.string() + " (CAD truth)";
     } else if (std::vector<double> nominal;
                nominal_standard_parameters(common, d.standard, nominal)) {
@@ -250,12 +252,7 @@ void add_export_commands(CLI::App& app, Common& common) {
     const std::string label = study_model(file);
     if (!o->model.empty() && o->model != label)
       throw UsageError(fmt::format("--model {}, but {} holds the parameters of model {}", o->model, file, label));
-    if (compiled_robot(common)) {
-      export_units().model(common, label)(common, *o);
-    } else {  // a robot folder this dynid was not built with: its library (no twin: no CAD prior)
-      ExportCommand::run_model(common, *o, loaded_identification_model(common, label),
-                               loaded_identification_model(common, "full"), {});
-    }
+    run_export(common, *o, label);
   });
 }
 

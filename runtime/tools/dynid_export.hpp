@@ -1,16 +1,9 @@
-// dynid export's options and its entry: a thin part per model of each robot (any variant:
-// --model) in generated units (dynid_export-inl.hpp), or a loaded robot's library; the body once.
+// dynid export's options and its body, on the model of any robot whose study it exports.
 #pragma once
 
-#include <functional>
-#include <memory>
 #include <string>
 
-#include <Eigen/Core>
-
-#include "dynid_dispatch.hpp"
-#include "symoro/identify/identification_model.hpp"
-#include "symoro/twin/config.hpp"
+#include "dynid_common.hpp"
 
 namespace symoro::dynid {
 
@@ -25,23 +18,9 @@ struct ExportOptions {
   bool force = false;  // overwrite the URDF and its .standard files
 };
 
-// The prior's standard parameters from the robot's twin.yaml (its CAD truth); empty for a robot
-// without a compiled twin.
-using TwinPrior = std::function<Eigen::VectorXd(const twin::TwinConfig&)>;
-
-struct ExportCommand {
-  using Options = ExportOptions;
-  // Per model (dynid_export-inl.hpp): hands the models to run_model.
-  template <class Full, class Model>
-  static void run(const Common& common, const Options& o);
-  // The body, compiled once (dynid_export.cpp): the study's accepted base vector -> the physically
-  // consistent standard parameters nearest the prior that map onto it exactly -> URDF +
-  // standard-parameter YAML/CSV. parent: the robot's full model (the fitting run's regression).
-  static void run_model(const Common& common, const Options& o,
-                        const std::shared_ptr<const identify::IdentificationModel>& model,
-                        const std::shared_ptr<const identify::IdentificationModel>& parent, const TwinPrior& twin_prior);
-};
-
-const CommandTable<ExportOptions>& export_units();  // generated: dynid_tables.cpp
+// The study's accepted base vector of model `label` -> the physically consistent standard
+// parameters nearest the prior (--prior; else the twin's CAD truth when the robot has a twin.yaml,
+// else robot.yaml's nominal) that map onto it exactly -> URDF + standard-parameter YAML/CSV.
+void run_export(const Common& common, const ExportOptions& o, const std::string& label);
 
 }  // namespace symoro::dynid

@@ -14,8 +14,9 @@
 #include <fmt/format.h>
 
 #include "dynid_identify.hpp"
-#include "dynid_loaded_robot.hpp"
+#include "dynid_robots.hpp"
 #include "dynid_numbers.hpp"
+#include "symoro/identify/loaded_model.hpp"
 #include "symoro/identify/report.hpp"
 #include "symoro/identify/robot_folder.hpp"
 #include "symoro/identify/study.hpp"
@@ -24,14 +25,14 @@
 #include "symoro/io/parameters_yaml.hpp"
 #include "symoro/parallel/farm.hpp"
 #include "symoro/twin/config.hpp"
+#include "symoro/twin/truth.hpp"
 
 namespace symoro::dynid {
 
 namespace identify_detail {
 
-identify::StudyResult study(const Common& common, const IdentifyOptions& o,
-                            const std::shared_ptr<const identify::IdentificationModel>& model, const TwinTruth& truth,
-                            bool quiet) {
+identify::StudyResult study(const Common& common, const IdentifyOptions& o, const robot::ModelHandle& handle,
+                            const std::shared_ptr<const identify::IdentificationModel>& model, bool quiet) {
   const identify::ModelDescription& d = model->description();
   identify::StudyOptions so;
   try {
@@ -62,17 +63,18 @@ identify::StudyResult study(const Common& common, const IdentifyOptions& o,
   // Coulomb friction and offsets where the variant has parameters for them.
   if (!result.data_twin.empty() && std::filesystem::exists(result.data_twin)) {
     const twin::TwinConfig tc = twin::read_twin_config(result.data_twin, d.nq, result.data_twin_overrides);
-    result.truth = truth(tc);
+    result.truth = twin::identified_truth(handle, tc);
   }
   return result;
 }
 
 }  // namespace identify_detail
 
-void IdentifyCommand::run_model(const Common& common, const IdentifyOptions& o,
-                                std::shared_ptr<const identify::IdentificationModel> model, const TwinTruth& truth) {
+void run_identify(const Common& common, const IdentifyOptions& o) {
   if (o.out.empty()) throw UsageError("--out is required");
-  const identify::StudyResult r = identify_detail::study(common, o, model, truth, false);
+  const robot::ModelHandle handle = robot_model(common, o.model);
+  const identify::StudyResult r =
+      identify_detail::study(common, o, handle, identify::identification_model(handle, full_model(common)), false);
   if (!parallel::place().coordinator()) return;  // rank 0 reports
   rusage usage{};
   getrusage(RUSAGE_SELF, &usage);
@@ -114,15 +116,6 @@ void IdentifyCommand::run_model(const Common& common, const IdentifyOptions& o,
   identify::require_identified(r);
 }
 
-
-std::shared_ptr<const identify::IdentificationModel> identification_model_of(const Common& common, const std::string& model) {
-  if (!compiled_robot(common)) return loaded_identification_model(common, model);
-  std::shared_ptr<const identify::IdentificationModel> out;
-  IdentifyOptions o;
-  o.take_model = [&out](std::shared_ptr<const identify::IdentificationModel> m) { out = std::move(m); };
-  (model.empty() ? identify_units().robot(common) : identify_units().model(common, model))(common, o);
-  return out;
-}
 
 void add_identify_commands(CLI::App& app, Common& common) {
   auto o = std::make_shared<IdentifyOptions>();
@@ -205,12 +198,7 @@ void add_identify_commands(CLI::App& app, Common& common) {
     // One study per folder at a time (rank 0 writes it; the other ranks only compute).
     std::optional<io::FolderLock> lock;
     if (!o->out.empty() && parallel::place().coordinator()) lock.emplace(o->out, "dynid identify");
-    if (compiled_robot(common)) {
-      identify_units().model(common, o->model)(common, *o);
-    } else {  // a robot folder this dynid was not built with: its library; no twin, so no truth
-      IdentifyCommand::run_model(common, *o, loaded_identification_model(common, o->model),
-                                 [](const twin::TwinConfig&) { return Eigen::VectorXd(); });
-    }
+    run_identify(common, *o);
   });
 }
 

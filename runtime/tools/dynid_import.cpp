@@ -10,7 +10,7 @@
 #include <fmt/format.h>
 
 #include "dynid_import.hpp"
-#include "dynid_loaded_robot.hpp"
+#include "dynid_robots.hpp"
 #include "dynid_numbers.hpp"
 #include "symoro/io/import.hpp"
 
@@ -38,7 +38,7 @@ io::ImportMapping mapping_of(const ImportOptions& o) {
 
 }  // namespace import_detail
 
-void ImportCommand::run_joints(const Common& common, const ImportOptions& o, const std::vector<JointInfo>& joints) {
+void run_import(const Common& common, const ImportOptions& o, const std::vector<JointInfo>& joints) {
   io::DatasetImport di;
   di.target = io::import_target(common.robot, joints);
   di.mapping = import_detail::mapping_of(o);
@@ -118,10 +118,7 @@ void add_import_commands(CLI::App& app, Common& common) {
   cmd->add_option("--name", o->names, "Run names, one per input (default: the file names' stems)")->delimiter(',');
   cmd->add_option("--heldout", o->heldout, "Inputs held out whole (family V)")->delimiter(',');
   cmd->callback([&common, o] {
-    if (compiled_robot(common))
-      import_units().robot(common)(common, *o);
-    else  // a robot folder this dynid was not built with: its library's joints
-      ImportCommand::run_joints(common, *o, loaded_model(common, "").joints());
+    run_import(common, *o, robot_model(common, "").joints());
   });
 }
 

@@ -1,11 +1,11 @@
-// dynid import's options and its entry: the robot's identified model's joints (they name and type
-// the columns), from a generated unit (dynid_import-inl.hpp) or a loaded robot library.
+// dynid import's options and its body: the exported logs mapped onto the robot's identified
+// model's joints (they name and type the columns).
 #pragma once
 
 #include <string>
 #include <vector>
 
-#include "dynid_dispatch.hpp"
+#include "dynid_common.hpp"
 
 namespace symoro::dynid {
 
@@ -17,14 +17,6 @@ struct ImportOptions {
   bool allow_implausible = false;
 };
 
-struct ImportCommand {
-  using Options = ImportOptions;
-  template <class Full, class Model>
-  static void run(const Common& common, const Options& o);
-  // The body, compiled once (dynid_import.cpp): the exported logs mapped onto these joints.
-  static void run_joints(const Common& common, const Options& o, const std::vector<JointInfo>& joints);
-};
-
-const CommandTable<ImportOptions>& import_units();  // generated: dynid_tables.cpp
+void run_import(const Common& common, const ImportOptions& o, const std::vector<JointInfo>& joints);
 
 }  // namespace symoro::dynid

@@ -14,6 +14,7 @@
 
 #include "dynid_common.hpp"
 #include "dynid_identify.hpp"
+#include "dynid_robots.hpp"
 #include "dynid_numbers.hpp"
 #include "symoro/io/dataset.hpp"
 #include "symoro/identify/prediction.hpp"
@@ -88,7 +89,7 @@ void run(const Common& common, const PredictOptions& o) {
       throw UsageError(fmt::format("--model {}, but {} holds the parameters of model {}", label, o.params, in_file));
     label = in_file;
   }
-  const auto model = identification_model_of(common, label);
+  const auto model = identification_model(common, label);
   const identify::ModelDescription& d = model->description();
   Eigen::VectorXd phi;
   if (o.params == "nominal") {

@@ -5,7 +5,7 @@
 
 #include <fmt/format.h>
 
-#include "dynid_dispatch.hpp"
+#include "dynid_robots.hpp"
 #include "symoro/error.hpp"
 #include "symoro/identify/robot_folder.hpp"
 #include "symoro/io/digest.hpp"

@@ -1,19 +1,22 @@
 // dynid trajectories: list the robot's designed identification trajectories or write them as
 // reference files (time, q_ref, qd_ref, qdd_ref at the control period).
+#include <filesystem>
+
 #include <CLI/CLI.hpp>
-
-#include "dynid_trajectories.hpp"
-#include "dynid_identify.hpp"
-#include "dynid_numbers.hpp"
-#include "symoro/identify/excitation_quality.hpp"
-
 #include <fmt/format.h>
+
+#include "dynid_numbers.hpp"
+#include "dynid_robots.hpp"
+#include "dynid_trajectories.hpp"
+#include "symoro/identify/excitation_quality.hpp"
+#include "symoro/io/log.hpp"
+#include "symoro/trajectory/design.hpp"
 
 namespace symoro::dynid {
 
 std::string trajectory_quality_table(const Common& common, const std::vector<trajectory::Trajectory>& trajectories,
                                      const TrajectoryOptions& o, const std::string& model_name) {
-  const auto model = identification_model_of(common, model_name);
+  const auto model = identification_model(common, model_name);
   std::string out;
   const identify::ModelDescription& d = model->description();
   const double interval = o.interval_ms / 1000;
@@ -49,6 +52,38 @@ std::string trajectory_quality_table(const Common& common, const std::vector<tra
   return out;
 }
 
+void run_trajectories(const Common& common, const TrajectoryOptions& o) {
+  const robot::ModelHandle full = full_model(common);
+  const auto design = trajectory::TrajectoryDesign::read(common.design_path(), full.joints());
+  const std::vector<std::string> names = o.only.empty() ? design.names() : o.only;
+  std::vector<std::string> joint_names;
+  for (const auto& j : full.joints()) joint_names.push_back(j.name);
+  if (o.out.empty() && o.quality) {
+    std::vector<trajectory::Trajectory> all;
+    for (const auto& name : names) all.push_back(design.build(name));
+    fmt::print("{}", trajectory_quality_table(common, all, o));
+    return;
+  }
+  if (o.out.empty()) {
+    fmt::print("{:<6} {:<4} {:>9}  {}\n", "name", "fam", "duration", "description");
+    double total = 0;
+    for (const auto& name : names) {
+      const auto t = design.build(name);
+      total += t.duration();
+      fmt::print("{:<6} {:<4} {:>8.1f}s  {}\n", t.name, t.family, t.duration(), t.description);
+    }
+    fmt::print("{} trajectories, {:.1f} s in all\n", names.size(), total);
+    return;
+  }
+  std::filesystem::create_directories(o.out);
+  Progress progress(static_cast<int>(names.size()), "reference");
+  for (const auto& name : names) {
+    const auto t = design.build(name);
+    io::write_log(std::filesystem::path(o.out) / (name + ".csv"), trajectory::reference_log(t, o.period, common.robot, joint_names));
+    progress.done(name, fmt::format("{:.1f} s", t.duration()));
+  }
+}
+
 void add_trajectory_commands(CLI::App& app, Common& common) {
   auto o = std::make_shared<TrajectoryOptions>();
   auto* cmd = app.add_subcommand("trajectories", "List the identification trajectories, or write them as reference files");
@@ -63,7 +98,7 @@ void add_trajectory_commands(CLI::App& app, Common& common) {
   cmd->add_option("--interval", o->interval_ms, "Sampling interval of --quality, ms (as in identification)")
       ->check(numbers::interval_ms())
       ->capture_default_str();
-  cmd->callback([&common, o] { trajectories_units().robot(common)(common, *o); });
+  cmd->callback([&common, o] { run_trajectories(common, *o); });
 }
 
 }  // namespace symoro::dynid

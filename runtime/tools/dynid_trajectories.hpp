@@ -1,11 +1,11 @@
-// dynid trajectories' options and its entry, compiled for each robot's full model in generated
-// units; the body is in dynid_trajectories-inl.hpp.
+// dynid trajectories' options: the robot's designed trajectories listed, judged or written as
+// reference files.
 #pragma once
 
 #include <string>
 #include <vector>
 
-#include "dynid_dispatch.hpp"
+#include "dynid_common.hpp"
 #include "symoro/trajectory/trajectory.hpp"
 
 namespace symoro::dynid {
@@ -23,12 +23,6 @@ struct TrajectoryOptions {
 std::string trajectory_quality_table(const Common& common, const std::vector<trajectory::Trajectory>& trajectories,
                                      const TrajectoryOptions& o, const std::string& model = "");
 
-struct TrajectoriesCommand {
-  using Options = TrajectoryOptions;
-  template <class Full, class Model>
-  static void run(const Common& common, const Options& o);
-};
-
-const CommandTable<TrajectoryOptions>& trajectories_units();  // generated: dynid_tables.cpp
+void run_trajectories(const Common& common, const TrajectoryOptions& o);
 
 }  // namespace symoro::dynid

@@ -1,12 +1,12 @@
-// dynid twin's options and its entry, compiled for each robot's full model in generated units;
-// the bodies of run, dataset and bench are in dynid_twin-inl.hpp.
+// dynid twin's options: one run, a whole dataset, or the speed measurement, on any robot with a
+// twin.yaml (its full model's handle drives the plant).
 #pragma once
 
 #include <cstdint>
 #include <string>
 #include <vector>
 
-#include "dynid_dispatch.hpp"
+#include "dynid_common.hpp"
 
 namespace symoro::dynid {
 
@@ -24,12 +24,6 @@ struct TwinOptions {
   double repeat_seconds = 3;
 };
 
-struct TwinCommand {
-  using Options = TwinOptions;
-  template <class Full, class Model>
-  static void run(const Common& common, const Options& o);
-};
-
-const CommandTable<TwinOptions>& twin_units();  // generated: dynid_tables.cpp
+void run_twin(const Common& common, const TwinOptions& o);
 
 }  // namespace symoro::dynid

@@ -34,9 +34,9 @@ if(NOT EXISTS ${WORK}/samples/V01_t1_40ms.csv)
   message(FATAL_ERROR "no samples written")
 endif()
 
+# Every command runs on any robot folder and names what is missing: no folder, or no robot.yaml.
 run(2 out twin run --robot no_such_robot --trajectory AG02 -o ${WORK}/x)
-expect("${out}" "robot 'no_such_robot' \\([^)]*no_such_robot\\) is not compiled into this dynid")
-# A command that runs on any robot folder names what is missing: no folder, or no robot.yaml.
+expect("${out}" "unknown robot 'no_such_robot': .*no_such_robot is not a folder")
 run(2 out identify --robot no_such_robot --data ${WORK} -o ${WORK}/x)
 expect("${out}" "unknown robot 'no_such_robot': .*no_such_robot is not a folder")
 run(2 out identify --robot ${WORK}/ --data ${WORK} -o ${WORK}/x)

@@ -12,6 +12,7 @@
 #include <symoro/hardware/config.hpp>
 #include <symoro/hardware/controller.hpp>
 #include <symoro/io/parameters_yaml.hpp>
+#include <symoro/robot/compiled_model.hpp>
 #include <symoro/twin_bus/twin_servo_backend.hpp>
 #include <symoro/io/log.hpp>
 #include <symoro/io/log_stream.hpp>
@@ -110,7 +111,7 @@ struct Rig {
                                                          const trajectory::Trajectory& traj) {
     Eigen::VectorXd q(Model::nq), qd(Model::nq), qdd(Model::nq);
     traj.evaluate(0, q, qd, qdd);
-    auto b = std::make_unique<TwinServoBackend<Model>>(twin, h, Eigen::Matrix<double, Model::nq, 1>(q));
+    auto b = std::make_unique<TwinServoBackend>(symoro::robot::compiled_model<Model>(), twin, h, q);
     backend = b.get();
     return b;
   }
@@ -126,7 +127,7 @@ struct Rig {
 
   HardwareConfig hw;
   Realtime realtime;  // while the virtual bus's thread starts
-  TwinServoBackend<Model>* backend = nullptr;
+  TwinServoBackend* backend = nullptr;
   dynamixel::VirtualBus virt;
   dynamixel::SerialPort port;
   dynamixel::Bus bus;

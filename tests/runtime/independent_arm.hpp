@@ -21,6 +21,7 @@
 #include <Eigen/Core>
 
 #include "symoro/io/log.hpp"
+#include "symoro/robot/compiled_model.hpp"
 #include "symoro/trajectory/sampled_reference.hpp"
 #include "symoro/twin/config.hpp"
 #include "symoro/twin/truth.hpp"
@@ -54,7 +55,7 @@ io::Log run_independent_arm(const twin::TwinConfig& c, const trajectory::Sampled
   links.effects.disable_all();
   links.effects.backlash = true;
   links.effects.backlash_width = play;
-  const twin::Truth<Model> truth = twin::make_truth<Model>(links);
+  const twin::Truth truth = twin::make_truth(symoro::robot::compiled_model<Model>(), links);
   const Eigen::Matrix<double, Model::np, 1> phi = truth.phi_links;
   Vec kt, unit, limit, lsb, ia, fv, stiffness, damping;
   for (int j = 0; j < n; ++j) {

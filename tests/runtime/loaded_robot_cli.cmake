@@ -4,8 +4,10 @@
 # from robots/ur5's generated model with Coulomb friction and an offset), identifies it on the
 # physical path, predicts with the result, exports it as a URDF and diagnoses its gap; then the
 # same through the compiled robots/ur5: the studies' parameters and validation, the predictions,
-# the URDFs and the diagnoses are the same numbers, digit for digit (one generated model, two ways to call it). A second study reuses the cached library (no build line). Run with
-# -DDYNID, -DSYMOROC, -DWRITE_EXPORT, -DURDF_DIR, -DWORK.
+# the URDFs and the diagnoses are the same numbers, digit for digit (one generated model, two ways
+# to call it). A second study reuses the cached library (no build line). Then the twin, the
+# trajectories and the controller on a copy of robots/crane_x7 loaded as a library. Run with
+# -DDYNID, -DSYMOROC, -DWRITE_EXPORT, -DURDF_DIR, -DWORK, -DSOURCE_ROBOTS, -DROBOT_CACHE.
 file(REMOVE_RECURSE ${WORK})
 file(MAKE_DIRECTORY ${WORK})
 set(ENV{SYMORO_CACHE_DIR} ${WORK}/cache)
@@ -85,6 +87,37 @@ file(WRITE ${WORK}/robots/ur5/robot.yaml "${yaml}")
 run(0 out identify --robot ${WORK}/robots/ur5 --model full --data ${WORK}/loaded-data -o ${WORK}/edited-study
     --interval 10 --no-report)
 expect("${out}" "ur5: built ")
-# A command that still needs a compiled robot says so.
+# A robot without a digital twin says so.
 run(2 out twin run --robot ${WORK}/robots/ur5 --trajectory AG02 -o ${WORK}/x)
-expect("${out}" "is not compiled into this dynid")
+expect("${out}" "robot 'ur5' has no digital twin \\(.*twin.yaml not found\\)")
+
+# The twin, the trajectories and the controller on a loaded robot: a copy of robots/crane_x7
+# elsewhere (its library from the robot cache the fixture robot_libraries built: the same key).
+# Its twin's log is the compiled robot's, bit for bit, with every effect on (backlash, payload,
+# noise, jitter, dropped samples); the controller drives its twin on the virtual bus.
+set(ENV{SYMORO_CACHE_DIR} ${ROBOT_CACHE})
+file(COPY ${SOURCE_ROBOTS}/crane_x7 DESTINATION ${WORK}/robots)
+file(WRITE ${WORK}/all-effects.yaml "effects:\n  backlash: {enabled: true}\n  payload: {enabled: true}\n"
+     "  coulomb: {enabled: true}\n  stribeck: {enabled: true}\n  torque_offset: {enabled: true}\n")
+foreach(way loaded compiled)
+  if(way STREQUAL "loaded")
+    set(robot ${WORK}/robots/crane_x7)
+  else()
+    set(robot crane_x7)
+  endif()
+  run(0 out twin run --robot ${robot} --trajectory PA03 --seed 5 --config ${WORK}/all-effects.yaml -o ${WORK}/twin-${way})
+  if(out MATCHES "built ")
+    message(FATAL_ERROR "the copy's library was rebuilt, not taken from ${ROBOT_CACHE}:\n${out}")
+  endif()
+  file(READ ${WORK}/twin-${way}/PA03_t1.csv twin_${way})
+  run(0 out trajectories --robot ${robot} --only PA03 V01)
+  set(trajectories_${way} "${out}")
+endforeach()
+if(NOT twin_loaded STREQUAL twin_compiled OR twin_loaded STREQUAL "")
+  message(FATAL_ERROR "the loaded robot's twin log differs from the compiled robot's (${WORK}/twin-loaded, ${WORK}/twin-compiled)")
+endif()
+if(NOT trajectories_loaded STREQUAL trajectories_compiled)
+  message(FATAL_ERROR "trajectories differ:\n${trajectories_loaded}\n---\n${trajectories_compiled}")
+endif()
+run(0 out control --robot ${WORK}/robots/crane_x7 --virtual --trajectory AG02 --seconds 0.5 -o ${WORK}/control.csv)
+expect("${out}" "completed; torque off confirmed")

@@ -14,6 +14,7 @@
 
 #include "symoro/io/log.hpp"
 #include "symoro/preprocess/preprocess.hpp"
+#include "symoro/robot/compiled_model.hpp"
 #include "symoro/trajectory/design.hpp"
 #include "symoro/twin/simulator.hpp"
 
@@ -25,7 +26,7 @@ const std::string kRobot = std::string(SYMORO_ROBOTS_DIR) + "/crane_x7";
 
 TEST(DataPath, TwinLogThroughPreprocessingSatisfiesTheTrueModel) {
   const auto config = symoro::twin::read_twin_config(kRobot + "/twin.yaml", n);  // noise, jitter, drops
-  const symoro::twin::ClosedLoopTwin<Model> twin(config);
+  const symoro::twin::ClosedLoopTwin twin(symoro::robot::compiled_model<Model>(), config);
   const auto design = symoro::trajectory::TrajectoryDesign::read(
       kRobot + "/trajectories.yaml", std::vector<symoro::JointInfo>(Model::joints.begin(), Model::joints.end()));
   const auto dir = std::filesystem::temp_directory_path() / "symoro_datapath_test";
@@ -75,7 +76,7 @@ TEST(DataPath, TwinLogThroughPreprocessingSatisfiesTheTrueModel) {
 // The same comparison fails when the data path is wrong: torque one interval late.
 TEST(DataPath, AShiftedTorqueIsNoticed) {
   const auto config = symoro::twin::read_twin_config(kRobot + "/twin.yaml", n);
-  const symoro::twin::ClosedLoopTwin<Model> twin(config);
+  const symoro::twin::ClosedLoopTwin twin(symoro::robot::compiled_model<Model>(), config);
   const auto design = symoro::trajectory::TrajectoryDesign::read(
       kRobot + "/trajectories.yaml", std::vector<symoro::JointInfo>(Model::joints.begin(), Model::joints.end()));
   symoro::twin::RunOptions ro;

@@ -19,6 +19,7 @@
 #include "symoro/diagnose/stack_builder.hpp"
 #include "symoro/diagnose/selection.hpp"
 #include "symoro/preprocess/preprocess.hpp"
+#include "symoro/robot/compiled_model.hpp"
 #include "symoro/trajectory/design.hpp"
 #include "symoro/twin/simulator.hpp"
 
@@ -53,7 +54,7 @@ struct Data {
 };
 
 Data simulate(const TwinConfig& c, std::uint64_t seed) {
-  const symoro::twin::ClosedLoopTwin<Full> twin(c);
+  const symoro::twin::ClosedLoopTwin twin(symoro::robot::compiled_model<Full>(), c);
   symoro::io::Log train_log, heldout_log;
   auto stack = [&](const std::vector<std::string>& names) {
     std::vector<NamedSamples> runs;
@@ -79,7 +80,7 @@ TwinConfig base_config() { return symoro::twin::read_twin_config(kRobot + "/twin
 // The closed-loop high-band stage on AG02: the robot's twin description (robots/crane_x7/twin.yaml,
 // none of the hidden effects) plus what the selection named.
 BacklashFit high_band(const Data& d, const Selection& s) {
-  const BacklashFit b = fit_backlash<Full>(d.train_log, symoro::trajectory::sampled_reference(d.train_log, 0.001), with_selected_effects(base_config(), s));
+  const BacklashFit b = fit_backlash(symoro::robot::compiled_model<Full>(), d.train_log, symoro::trajectory::sampled_reference(d.train_log, 0.001), with_selected_effects(base_config(), s));
   if (std::getenv("SYMORO_DIAGNOSE_VERBOSE")) {
     for (const auto& f : b.findings)
       std::cout << fmt::format("  -> backlash joint {}: {:.3f} deg ({:.4f} measured, {:.4f} +- {:.4f} before, {:.4f} after)\n",
@@ -229,7 +230,7 @@ TEST(DiagnoseTwin, Backlash) {
     symoro::twin::RunOptions ro;
     ro.robot = "crane_x7";
     ro.seed = 4242;
-    return high_band_rms(symoro::twin::ClosedLoopTwin<Full>(tc).run(design().build("V01"), ro));
+    return high_band_rms(symoro::twin::ClosedLoopTwin(symoro::robot::compiled_model<Full>(), tc).run(design().build("V01"), ro));
   };
   const Eigen::VectorXd measured = high_band_rms(d.heldout_log), before = simulate_v01(fitted);
   fitted.effects.backlash = true;
@@ -273,7 +274,7 @@ TEST(DiagnoseTwin, PayloadAgainstAnEarlierIdentification) {
   const Data before = simulate(base_config(), 17);
   const Eigen::VectorXd phi = fit_with_effects(before.train, before.heldout, {}, Eigen::VectorXd::Ones(n)).phi;
   // The twin's true parameters are not what is held: the estimate, with its own errors.
-  ASSERT_GT((phi - Reduced::from_parent(symoro::twin::make_truth<Full>(base_config()).phi)).norm(), 0.0);
+  ASSERT_GT((phi - Reduced::from_parent(symoro::twin::make_truth(symoro::robot::compiled_model<Full>(), base_config()).phi)).norm(), 0.0);
 
   Data clean = simulate(base_config(), 19);
   clean.train.hold(phi);

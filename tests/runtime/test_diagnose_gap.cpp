@@ -19,6 +19,7 @@
 #include "symoro/identify/study.hpp"
 #include "symoro/identify/validation_io.hpp"
 #include "symoro/io/atomic_file.hpp"
+#include "symoro/robot/compiled_model.hpp"
 #include "symoro/trajectory/design.hpp"
 #include "symoro/twin/simulator.hpp"
 #include "symoro/twin/truth.hpp"
@@ -78,7 +79,7 @@ identify::StudyResult study(const std::filesystem::path& out) {
                                                               std::vector<JointInfo>(Model::joints.begin(), Model::joints.end())),
                            identify::closed_loop_setup(twin::read_twin_config(kRobot + "/twin.yaml", Model::nq).controller));
   identify::StudyResult r = s.run();
-  r.truth = twin::identified_truth<Model>(hidden_effects());
+  r.truth = twin::identified_truth(symoro::robot::compiled_model<Model>(), hidden_effects());
   identify::write_validation(r, out);
   return r;
 }

@@ -28,7 +28,9 @@
 #include "symoro/diagnose/selection.hpp"
 #include "symoro/diagnose/stack_builder.hpp"
 #include "symoro/preprocess/preprocess.hpp"
+#include "symoro/robot/compiled_model.hpp"
 #include "symoro/trajectory/design.hpp"
+#include "symoro/twin/simulator.hpp"
 #include "test_support.hpp"
 
 namespace {
@@ -67,7 +69,7 @@ std::vector<int> play_joints(const BacklashFit& b) {
 template <class Full>
 BacklashFit backlash_stage(const io::Log& log, const TwinConfig& c, const Selection* s = nullptr) {
   const TwinConfig nominal = s ? with_selected_effects(c, *s) : c;
-  const BacklashFit b = fit_backlash<Full>(log, trajectory::sampled_reference(log, c.controller.period), nominal);
+  const BacklashFit b = fit_backlash(symoro::robot::compiled_model<Full>(), log, trajectory::sampled_reference(log, c.controller.period), nominal);
   print(b);
   return b;
 }
@@ -171,7 +173,7 @@ TEST(DiagnoseIndependentCrane, NoPlayIsNamedOnAnArmWithoutPlay) {
   ro.robot = "crane_x7";
   ro.seed = 5;
   const Eigen::VectorXd plain =
-      high_band_rms(twin::ClosedLoopTwin<Crane>(crane_twin()).run(trajectory::sampled_reference(r.fit, 0.001), ro));
+      high_band_rms(twin::ClosedLoopTwin(symoro::robot::compiled_model<Crane>(), crane_twin()).run(trajectory::sampled_reference(r.fit, 0.001), ro));
   int above = 0;
   for (int j = 0; j < Crane::nq; ++j) above += b.measured(j) > 1.5 * plain(j);
   EXPECT_GE(above, 1) << "the independent arm's high band is the twin's: the test tests nothing";
@@ -245,7 +247,7 @@ TwinConfig rx90_twin() {
   for (int j = 0; j < n; ++j) c.servos.push_back({"industrial", 1.0, 0.002, Rx::joints[j].effort, 1 << 18});
   c.effects.disable_all();
   c.effects.backlash_width = Eigen::VectorXd::Zero(n);
-  const auto phi = twin::make_truth<Rx>(c).phi;
+  const auto phi = twin::make_truth(symoro::robot::compiled_model<Rx>(), c).phi;
   Eigen::Matrix<double, n, n> M;
   Rx::inertia(Eigen::Matrix<double, n, 1>::Zero(), phi, M);
   c.controller.realization_inertia = M.diagonal();

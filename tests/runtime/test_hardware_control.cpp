@@ -3,7 +3,12 @@
 // (twin/simulator.hpp), and the twin's tracking-error bound; bus faults (CRC bursts, timeouts, a
 // lost servo, a hardware error, a non-finite command) must end in a safe state read back from
 // the virtual servos' control tables, with a log that io::read_log accepts up to the stop.
+#include <random>
+
+#include <symoro/ur5.hpp>
+
 #include "hardware_rig.hpp"
+#include "symoro/robot/compiled_model.hpp"
 
 namespace symoro::hardware {
 namespace {
@@ -79,7 +84,7 @@ TEST_F(HardwareControl, TracksFiveSecondsOverThePtyLikeTheTwin) {
   ASSERT_GE(judged_rows, log.samples() / 2) << "the machine stalled the loop too often, three runs in a row, to judge its tracking";
 
   // The reference: the twin's own closed loop of the same trajectory, no bus.
-  const twin::ClosedLoopTwin<Model> sim(twin_);
+  const twin::ClosedLoopTwin sim(symoro::robot::compiled_model<Model>(), twin_);
   twin::RunOptions ro;
   ro.robot = "crane_x7";
   twin::RunStats st;
@@ -233,6 +238,38 @@ TEST_F(HardwareControl, ANonFiniteCommandStopsAndIsNamed) {
   expect_log(r, csv);
 }
 
+// dynid control's feedforward for any robot is the handle's (one indirect call of the robot
+// library's kernel): the same torques and mass matrix as the generated model's inline call, bit
+// for bit, on the identified models of two robots; a vector of the wrong size is refused.
+template <class Identified>
+void expect_handle_feedforward_equals_inline(std::uint32_t seed) {
+  const robot::ModelHandle& handle = robot::compiled_model<Identified>();
+  std::mt19937 gen(seed);
+  std::uniform_real_distribution<double> u(-1.5, 1.5);
+  Eigen::VectorXd phi(Identified::np), q(Identified::nq), qd(Identified::nq), qdd(Identified::nq);
+  for (auto* v : {&phi, &q, &qd, &qdd})
+    for (Eigen::Index i = 0; i < v->size(); ++i) (*v)(i) = u(gen);
+  const auto ff_inline = model_feedforward<Identified>(phi), ff_handle = model_feedforward(handle, phi);
+  const auto m_inline = model_inertia<Identified>(phi), m_handle = model_inertia(handle, phi);
+  Eigen::VectorXd a, b;
+  Eigen::MatrixXd Ma, Mb;
+  for (int k = 0; k < 20; ++k) {
+    ff_inline(q, qd, qdd, a), ff_handle(q, qd, qdd, b);
+    m_inline(q, Ma), m_handle(q, Mb);
+    ASSERT_EQ(a.size(), Identified::nq);
+    EXPECT_EQ(a, b);
+    EXPECT_EQ(Ma, Mb);
+    q = q.unaryExpr([&](double x) { return x + u(gen); });
+  }
+  EXPECT_THROW(model_feedforward(handle, Eigen::VectorXd::Zero(Identified::np + 1)), std::invalid_argument);
+  EXPECT_THROW(model_inertia(handle, Eigen::VectorXd::Zero(1)), std::invalid_argument);
+}
+
+TEST(ModelFeedforward, ThroughTheHandleEqualsTheInlineCall) {
+  expect_handle_feedforward_equals_inline<crane_x7::IdentifiedModel>(3);
+  expect_handle_feedforward_equals_inline<ur5::IdentifiedModel>(4);
+}
+
 TEST_F(HardwareControl, ModelFeedforwardFromAStudysParameters) {
   using Identified = crane_x7::IdentifiedModel;
   const trajectory::Trajectory traj = first_seconds("AG02", 2.0);
@@ -269,7 +306,7 @@ TEST_F(HardwareControl, ModelFeedforwardFromAStudysParameters) {
   EXPECT_NE(r.at_stop.find("PD + the model's gravity"), std::string::npos) << r.at_stop;
   rig.expect_safe();
   // FF+PD alone (the twin's loop) leaves gravity to the PD; the model feedforward cancels it.
-  const twin::ClosedLoopTwin<Model> sim(twin_);
+  const twin::ClosedLoopTwin sim(symoro::robot::compiled_model<Model>(), twin_);
   twin::RunOptions ro;
   ro.robot = "crane_x7";
   twin::RunStats st;

@@ -20,6 +20,7 @@
 
 #include "symoro/identify/identification_model.hpp"  // inertia functions from symoro::<robot>_identification
 #include "symoro/identify/pd_audit.hpp"
+#include "symoro/robot/compiled_model.hpp"
 #include "symoro/twin/config.hpp"
 #include "symoro/twin/truth.hpp"
 
@@ -48,7 +49,7 @@ const VectorXd& crane_phi() {
   static const VectorXd phi = [] {
     const auto config =
         symoro::twin::read_twin_config(std::string(SYMORO_ROBOTS_DIR) + "/crane_x7/twin.yaml", Crane::nq);
-    const auto truth = symoro::twin::make_truth<symoro::crane_x7::Model>(config);
+    const auto truth = symoro::twin::make_truth(symoro::robot::compiled_model<symoro::crane_x7::Model>(), config);
     return VectorXd(Crane::base_from_standard(truth.standard));
   }();
   return phi;

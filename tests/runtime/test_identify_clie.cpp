@@ -26,6 +26,7 @@
 #include "symoro/preprocess/butterworth.hpp"
 #include "symoro/preprocess/preprocess.hpp"
 #include "symoro/preprocess/zero_phase.hpp"
+#include "symoro/robot/compiled_model.hpp"
 #include "symoro/trajectory/design.hpp"
 #include "symoro/twin/random.hpp"
 #include "symoro/twin/simulator.hpp"
@@ -62,7 +63,7 @@ const trajectory::Trajectory& short_trajectory() {
   return t;
 }
 
-Eigen::VectorXd full_truth() { return twin::make_truth<Full>(ideal_config()).phi; }
+Eigen::VectorXd full_truth() { return twin::make_truth(symoro::robot::compiled_model<Full>(), ideal_config()).phi; }
 Eigen::VectorXd reduced_truth() { return Reduced::from_parent(full_truth()); }
 
 int index_of(const char* name) {
@@ -245,9 +246,9 @@ TEST(ClosedLoopSimulator, ReproducesTheIdealTwin) {
     s.current_unit = 1e-12;
   }
   const trajectory::Trajectory& traj = short_trajectory();
-  const io::Log quantized = twin::ClosedLoopTwin<Full>(config).run(traj, {});
-  const io::Log unquantized = twin::ClosedLoopTwin<Full>(fine).run(traj, {});
-  const Eigen::VectorXd phi = twin::make_truth<Full>(config).phi;
+  const io::Log quantized = twin::ClosedLoopTwin(symoro::robot::compiled_model<Full>(), config).run(traj, {});
+  const io::Log unquantized = twin::ClosedLoopTwin(symoro::robot::compiled_model<Full>(), fine).run(traj, {});
+  const Eigen::VectorXd phi = twin::make_truth(symoro::robot::compiled_model<Full>(), config).phi;
 
   const identify::ClosedLoopSetup setup = identify::closed_loop_setup(config.controller);
   const auto sim_ptr = closed_loop<Full>(setup, traj);

@@ -14,6 +14,7 @@
 
 #include "symoro/identify/physical_consistency.hpp"
 #include "symoro/identify/detail/physical_consistency_model.hpp"
+#include "symoro/robot/compiled_model.hpp"
 #include "symoro/twin/config.hpp"
 #include "symoro/twin/truth.hpp"
 #include "consistency_test_support.hpp"
@@ -111,7 +112,7 @@ TEST(PhysicalConsistency, InconsistentPriorRx90) {
 // (the same base vector), with the entries B fixes on their own (FV, IA3..8, MX, ZZ7 ...) equal.
 TEST(PhysicalConsistency, CraneX7TwinTruth) {
   const auto config = symoro::twin::read_twin_config(std::string(SYMORO_ROBOTS_DIR) + "/crane_x7/twin.yaml", Crane::nq);
-  const VectorXd truth = symoro::twin::make_truth<Crane>(config).standard;
+  const VectorXd truth = symoro::twin::make_truth(symoro::robot::compiled_model<Crane>(), config).standard;
   const VectorXd phi = base_of<Crane>(truth);
   ASSERT_GT(smallest_link_eigenvalue<Crane>(truth), 0);
 

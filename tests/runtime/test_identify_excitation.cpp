@@ -19,6 +19,7 @@
 #include "symoro/identify/excitation_quality.hpp"
 #include "symoro/identify/identification_model.hpp"
 #include "symoro/mdh.hpp"
+#include "symoro/robot/compiled_model.hpp"
 #include "symoro/trajectory/design.hpp"
 #include "symoro/twin/config.hpp"
 #include "symoro/twin/truth.hpp"
@@ -33,7 +34,7 @@ using Ur5 = symoro::ur5::Model;
 // the UR5's URDF inertials (robot.yaml `nominal`, in the order of the standard parameters).
 Eigen::VectorXd crane_nominal() {
   const auto c = symoro::twin::read_twin_config(std::string(SYMORO_ROBOTS_DIR) + "/crane_x7/twin.yaml", Crane::nq, "");
-  return symoro::twin::make_truth<Crane>(c).phi;
+  return symoro::twin::make_truth(symoro::robot::compiled_model<Crane>(), c).phi;
 }
 
 Eigen::VectorXd ur5_nominal() {

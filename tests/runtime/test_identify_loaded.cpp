@@ -16,6 +16,7 @@
 #include "symoro/identify/identification_model.hpp"
 #include "symoro/identify/loaded_closed_loop.hpp"
 #include "symoro/identify/loaded_model.hpp"
+#include "symoro/robot/compiled_model.hpp"
 #include "symoro/robot/load_robot.hpp"
 #include "symoro/trajectory/design.hpp"
 #include "symoro/twin/config.hpp"
@@ -44,7 +45,7 @@ twin::TwinConfig ideal_config() {
   return c;
 }
 
-Eigen::VectorXd reduced_truth() { return Reduced::from_parent(twin::make_truth<Full>(ideal_config()).phi); }
+Eigen::VectorXd reduced_truth() { return Reduced::from_parent(twin::make_truth(symoro::robot::compiled_model<Full>(), ideal_config()).phi); }
 
 preprocess::Samples random_samples(int count, unsigned seed) {
   std::mt19937 g(seed);
@@ -118,8 +119,8 @@ TEST(LoadedIdentificationModel, LinkedModelIsTheLoadedOneBitForBit) {
   EXPECT_EQ(ra.W, rc.W);
   EXPECT_EQ(ra.y, rc.y);
   EXPECT_EQ(a->open_loop_torque(s, reduced_truth()), c->open_loop_torque(s, reduced_truth()));
-  EXPECT_EQ(a->parent_base_from_standard(twin::make_truth<Full>(ideal_config()).standard),
-            c->parent_base_from_standard(twin::make_truth<Full>(ideal_config()).standard));
+  EXPECT_EQ(a->parent_base_from_standard(twin::make_truth(symoro::robot::compiled_model<Full>(), ideal_config()).standard),
+            c->parent_base_from_standard(twin::make_truth(symoro::robot::compiled_model<Full>(), ideal_config()).standard));
 }
 
 TEST(LoadedIdentificationModel, ClosedLoopEqualsTheFixedSizeSimulatorBitForBit) {

@@ -17,6 +17,7 @@
 #include "symoro/identify/least_squares.hpp"
 #include "symoro/identify/regression.hpp"
 #include "symoro/preprocess/preprocess.hpp"
+#include "symoro/robot/compiled_model.hpp"
 #include "symoro/trajectory/design.hpp"
 #include "symoro/twin/simulator.hpp"
 
@@ -118,7 +119,7 @@ TEST(LeastSquares, RecoversTheTwinsWellExcitedParameters) {
   using Model = symoro::crane_x7::Model;
   const std::string robot = std::string(SYMORO_ROBOTS_DIR) + "/crane_x7";
   const auto config = symoro::twin::read_twin_config(robot + "/twin.yaml", Model::nq);
-  const symoro::twin::ClosedLoopTwin<Model> twin(config);
+  const symoro::twin::ClosedLoopTwin twin(symoro::robot::compiled_model<Model>(), config);
   const auto design = symoro::trajectory::TrajectoryDesign::read(
       robot + "/trajectories.yaml", std::vector<symoro::JointInfo>(Model::joints.begin(), Model::joints.end()));
   symoro::twin::RunOptions ro;

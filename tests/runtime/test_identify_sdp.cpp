@@ -23,6 +23,7 @@
 
 #include "symoro/identify/identification_model.hpp"  // inertia functions from symoro::<robot>_identification
 #include "symoro/identify/sdp_projection.hpp"
+#include "symoro/robot/compiled_model.hpp"
 #include "symoro/twin/config.hpp"
 #include "symoro/twin/truth.hpp"
 #include "affine_inertia.hpp"
@@ -190,7 +191,7 @@ double smallest_eigenvalue(const Eigen::MatrixXd& M) {
 // The CAD truth in the reduced base parameters: PD over the audit box (lambda_min ~ 0.004).
 Eigen::VectorXd truth_phi() {
   const auto config = symoro::twin::read_twin_config(SYMORO_ROBOTS_DIR "/crane_x7/twin.yaml", Reduced::nq);
-  const auto truth = symoro::twin::make_truth<symoro::crane_x7::Model>(config);
+  const auto truth = symoro::twin::make_truth(symoro::robot::compiled_model<symoro::crane_x7::Model>(), config);
   return Reduced::base_from_standard(truth.standard);
 }
 
@@ -494,7 +495,7 @@ class BigModelProjection : public testing::Test {
       phi0 = short_log_ols<Model>(truth, 1.0, 0.35, 1);
     } else {
       const auto config = symoro::twin::read_twin_config(SYMORO_ROBOTS_DIR "/crane_x7/twin.yaml", Model::nq);
-      truth = symoro::twin::make_truth<Model>(config).phi;
+      truth = symoro::twin::make_truth(symoro::robot::compiled_model<Model>(), config).phi;
       phi0 = short_log_ols<Model>(truth, 2.0, 0.1, 1);
     }
   }

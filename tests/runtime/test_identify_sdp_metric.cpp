@@ -16,6 +16,7 @@
 #include "affine_inertia.hpp"
 #include "symoro/identify/identification_model.hpp"  // inertia functions from symoro::<robot>_identification
 #include "symoro/identify/sdp_projection.hpp"
+#include "symoro/robot/compiled_model.hpp"
 #include "symoro/twin/config.hpp"
 #include "symoro/twin/truth.hpp"
 #include "test_support.hpp"
@@ -138,7 +139,7 @@ TEST(SdpMetric, CraneX7ReducedEachProjectionIsOptimalInItsMetric) {
   using Model = symoro::crane_x7::reduced::Model;
   const std::string robot = std::string(SYMORO_ROBOTS_DIR) + "/crane_x7";
   const auto tc = symoro::twin::read_twin_config(robot + "/twin.yaml", symoro::crane_x7::Model::nq);
-  const Eigen::VectorXd truth = Model::base_from_standard(symoro::twin::make_truth<symoro::crane_x7::Model>(tc).standard);
+  const Eigen::VectorXd truth = Model::base_from_standard(symoro::twin::make_truth(symoro::robot::compiled_model<symoro::crane_x7::Model>(), tc).standard);
   metric_and_euclidean_are_each_optimal<Model>(truth, 3);
 }
 

@@ -19,6 +19,7 @@
 #include "symoro/io/dataset.hpp"
 #include "symoro/identify/validation.hpp"
 #include "symoro/identify/study.hpp"
+#include "symoro/robot/compiled_model.hpp"
 #include "twin_dataset.hpp"
 #include "symoro/io/atomic_file.hpp"
 #include "symoro/trajectory/design.hpp"
@@ -165,7 +166,7 @@ void validation_is_near_the_twins_floor() {
   ASSERT_EQ(r.validation.size(), 1u);
   const auto& v = r.validation.front();
   const auto tc = twin::read_twin_config(kRobot + "/twin.yaml", Full::nq);
-  const Eigen::VectorXd truth = Model::base_from_standard(twin::make_truth<Full>(tc).standard);
+  const Eigen::VectorXd truth = Model::base_from_standard(twin::make_truth(symoro::robot::compiled_model<Full>(), tc).standard);
   const identify::ClosedLoopSimulator<Model> sim(setup(), design().build("V02"));
   const auto log = io::read_log(dataset() / "V02_t1.csv");
   const auto s = preprocess::preprocess(log, v.interval);

@@ -11,6 +11,7 @@
 
 #include <symoro/crane_x7.hpp>
 
+#include "symoro/robot/compiled_model.hpp"
 #include "symoro/twin/config.hpp"
 #include "symoro/twin/kinematics.hpp"
 #include "symoro/twin/plant.hpp"
@@ -21,6 +22,7 @@ namespace {
 using Model = symoro::crane_x7::Model;
 using namespace symoro::twin;
 constexpr int n = Model::nq;
+using JointVec = Eigen::Matrix<double, n, 1>;
 const std::string kTwin = std::string(SYMORO_ROBOTS_DIR) + "/crane_x7/twin.yaml";
 
 TwinConfig config() { return read_twin_config(kTwin, n); }
@@ -67,7 +69,7 @@ UrdfBodies urdf_bodies(const TwinConfig& c, const Eigen::VectorXd& q) {
 }
 
 TEST(TwinTruth, FactsHandChecks) {
-  const auto truth = make_truth<Model>(config());
+  const auto truth = make_truth(symoro::robot::compiled_model<Model>(), config());
   // FACTS.md: MYR2 about -0.236 kg m, MYR4 about -0.129 kg m with the URDF values.
   EXPECT_NEAR(phi_of(truth.phi, "MYR2"), -0.236, 0.002);
   EXPECT_NEAR(phi_of(truth.phi, "MYR4"), -0.129, 0.002);
@@ -83,7 +85,7 @@ TEST(TwinTruth, FactsHandChecks) {
 
 TEST(TwinTruth, KineticEnergyMatchesUrdfFrames) {
   const TwinConfig c = config();
-  const auto truth = make_truth<Model>(c);
+  const auto truth = make_truth(symoro::robot::compiled_model<Model>(), c);
   std::mt19937_64 rng(7);
   std::uniform_real_distribution<double> u(-1.5, 1.5);
   for (int trial = 0; trial < 20; ++trial) {
@@ -103,7 +105,7 @@ TEST(TwinTruth, KineticEnergyMatchesUrdfFrames) {
 
 TEST(TwinTruth, GravityTorqueMatchesUrdfFrames) {
   const TwinConfig c = config();
-  const auto truth = make_truth<Model>(c);
+  const auto truth = make_truth(symoro::robot::compiled_model<Model>(), c);
   std::mt19937_64 rng(8);
   std::uniform_real_distribution<double> u(-1.5, 1.5);
   const Eigen::Vector3d g(0, 0, -9.80665);
@@ -125,14 +127,14 @@ TEST(TwinTruth, RejectsAMismatchedChain) {
   TwinConfig c = config();
   c.chain.base_in_urdf.linear().setIdentity();  // x forward: joint 2 would turn the other way
   try {
-    make_truth<Model>(c);
+    make_truth(symoro::robot::compiled_model<Model>(), c);
     FAIL() << "a wrong base_in_urdf was accepted";
   } catch (const symoro::DataError& e) {
     EXPECT_NE(std::string(e.what()).find("does not move with model frame"), std::string::npos) << e.what();
   }
   c = config();
   c.chain.joints[2].axis = -c.chain.joints[2].axis;  // shoulder_tilt reversed
-  EXPECT_THROW(make_truth<Model>(c), symoro::DataError);
+  EXPECT_THROW(make_truth(symoro::robot::compiled_model<Model>(), c), symoro::DataError);
 }
 
 TEST(TwinConfigFile, ErrorsNameFileAndLine) {
@@ -175,15 +177,15 @@ TEST(TwinPlant, ConservesEnergyWithoutFrictionAndControl) {
   TwinConfig c = config();
   c.effects.disable_all();
   c.viscous.setZero();
-  const auto truth = make_truth<Model>(c);
-  Plant<Model>::Vec q0;
+  const auto truth = make_truth(symoro::robot::compiled_model<Model>(), c);
+  JointVec q0;
   q0 << 0.3, 0.8, -0.4, -1.2, 0.5, 0.7, -0.3, 0.2;
-  Plant<Model> plant(truth, c, q0);
+  Plant plant(symoro::robot::compiled_model<Model>(), truth, c, q0);
   const auto energy = [&] { return plant.kinetic_energy() + potential(c, plant.q()); };
   const double e0 = energy();
   double swing = 0, drift = 0;
   for (int k = 0; k < 2000; ++k) {  // 2 s of free fall and swinging
-    plant.advance(0.001, Plant<Model>::Vec::Zero());
+    plant.advance(0.001, JointVec::Zero());
     swing = std::max(swing, plant.kinetic_energy());
     drift = std::max(drift, std::abs(energy() - e0));
   }
@@ -196,17 +198,17 @@ TEST(TwinPlant, StepIsConvergedFarBelowTheEncoderResolution) {
   TwinConfig c = config();
   c.effects.disable_all();
   c.effects.coulomb = true;  // the stiffest smooth term of the rigid plant
-  const auto truth = make_truth<Model>(c);
-  Plant<Model>::Vec q0, tau;
+  const auto truth = make_truth(symoro::robot::compiled_model<Model>(), c);
+  JointVec q0, tau;
   q0 << 0.3, 0.8, -0.4, -1.2, 0.5, 0.7, -0.3, 0.2;
   tau << 0.2, 1.0, 0.1, 0.5, 0.05, 0.05, 0.02, 0.01;
-  Plant<Model> coarse(truth, c, q0);
+  Plant coarse(symoro::robot::compiled_model<Model>(), truth, c, q0);
   TwinConfig fine_c = c;
   fine_c.max_step = c.max_step / 16;
-  Plant<Model> fine(truth, fine_c, q0);
+  Plant fine(symoro::robot::compiled_model<Model>(), truth, fine_c, q0);
   double worst = 0;
   for (int k = 0; k < 1000; ++k) {
-    const Plant<Model>::Vec t = tau * std::sin(0.01 * k);  // a held, changing command
+    const JointVec t = tau * std::sin(0.01 * k);  // a held, changing command
     coarse.advance(0.0009, t), fine.advance(0.0009, t);
     coarse.advance(0.0001, t), fine.advance(0.0001, t);
     worst = std::max(worst, (coarse.q() - fine.q()).cwiseAbs().maxCoeff());
@@ -224,7 +226,7 @@ namespace {
 // must be near the true diagonal inertia at posture A, where the paper fitted them.
 TEST(TwinConfigFile, RealizationInertiaIsTheDiagonalAtPostureA) {
   const TwinConfig c = config();
-  const auto truth = make_truth<Model>(c);
+  const auto truth = make_truth(symoro::robot::compiled_model<Model>(), c);
   Eigen::VectorXd q = Eigen::VectorXd::Zero(n);
   q(3) = -M_PI / 2;
   Eigen::Matrix<double, n, n> M;
@@ -255,7 +257,7 @@ TEST(TwinTracking, LoopGainMatchesTheContinuousLimit) {
 
 TEST(TwinTracking, ErrorStaysWithinTheDerivedBound) {
   const TwinConfig c = config();  // default effects: noise, jitter, dropped samples
-  const ClosedLoopTwin<Model> twin(c);
+  const ClosedLoopTwin twin(symoro::robot::compiled_model<Model>(), c);
   const auto design = symoro::trajectory::TrajectoryDesign::read(
       std::string(SYMORO_ROBOTS_DIR) + "/crane_x7/trajectories.yaml",
       std::vector<symoro::JointInfo>(Model::joints.begin(), Model::joints.end()));
@@ -286,8 +288,8 @@ TEST(TwinTracking, ErrorStaysWithinTheDerivedBound) {
 
 namespace {
 
-Plant<Model>::Vec posture_a() {
-  Plant<Model>::Vec q = Plant<Model>::Vec::Zero();
+JointVec posture_a() {
+  JointVec q = JointVec::Zero();
   q(3) = -M_PI / 2;
   return q;
 }
@@ -302,24 +304,24 @@ TEST(TwinEffects, BacklashIsResolvedAndHoldsTheLinkAgainstTheGear) {
   const double width = c.effects.backlash_width(1);
   c.effects.backlash_width.setZero();
   c.effects.backlash_width(1) = width;
-  const auto truth = make_truth<Model>(c);
-  Plant<Model> plant(truth, c, posture_a());
+  const auto truth = make_truth(symoro::robot::compiled_model<Model>(), c);
+  Plant plant(symoro::robot::compiled_model<Model>(), truth, c, posture_a());
   EXPECT_LE(plant.max_step(), 0.3 / (2 * M_PI * c.effects.backlash_frequency) + 1e-15);
   // Under the FF+PD controller (stable, unlike an open-loop hold), swinging joint 2 by 0.2 rad
   // and back: the step the plant chose is converged (1/8 of it agrees to a fraction of a count).
   const Eigen::VectorXd zero = Eigen::VectorXd::Zero(n);
-  Plant<Model>::Vec g;
+  JointVec g;
   Model::inverse_dynamics(posture_a(), zero, zero, truth.phi, g);
   TwinConfig fine_c = c;
   fine_c.max_step = plant.max_step() / 8;
-  Plant<Model> fine(truth, fine_c, posture_a());
+  Plant fine(symoro::robot::compiled_model<Model>(), truth, fine_c, posture_a());
   symoro::control::FfpdController ca(controller_gains(c)), cb(controller_gains(c));
   ca.reset(posture_a()), cb.reset(posture_a());
   double worst = 0;
   for (int k = 0; k < 2000; ++k) {
     Eigen::VectorXd ref = posture_a();
     ref(1) += 0.2 * std::sin(M_PI * k / 1000.0);
-    const Plant<Model>::Vec ua = ca.update(plant.q(), ref, zero, zero), ub = cb.update(fine.q(), ref, zero, zero);
+    const JointVec ua = ca.update(plant.q(), ref, zero, zero), ub = cb.update(fine.q(), ref, zero, zero);
     plant.advance(0.001, ua), fine.advance(0.001, ub);
     worst = std::max(worst, (plant.q() - fine.q()).cwiseAbs().maxCoeff());
   }
@@ -338,17 +340,17 @@ TEST(TwinEffects, BacklashIsResolvedAndHoldsTheLinkAgainstTheGear) {
 TEST(TwinEffects, PayloadAddsItsWeightToTheGravityTorques) {
   TwinConfig c = config();
   c.effects.disable_all();
-  const auto plain = make_truth<Model>(c);
+  const auto plain = make_truth(symoro::robot::compiled_model<Model>(), c);
   c.effects.payload = true;
-  const auto loaded = make_truth<Model>(c);
+  const auto loaded = make_truth(symoro::robot::compiled_model<Model>(), c);
   const Eigen::VectorXd zero = Eigen::VectorXd::Zero(n);
   Eigen::VectorXd q = posture_a();
   q(1) = 0.4, q(5) = 0.3;
-  Plant<Model>::Vec t0, t1;
+  JointVec t0, t1;
   Model::inverse_dynamics(q, zero, zero, plain.phi, t0);
   Model::inverse_dynamics(q, zero, zero, loaded.phi, t1);
   // The payload's weight m g acting at its position p: holding torques a_j x (p - o_j) . (m g e_z).
-  const auto T = mdh_poses(frame_list<Model>(), q);
+  const auto T = mdh_poses(symoro::robot::compiled_model<Model>().frames(), q);
   const Eigen::Vector3d p = T[6] * c.effects.payload_com;
   for (int j = 0; j < n; ++j) {
     const Eigen::Vector3d a = T[j].linear().col(2), o = T[j].translation();
@@ -359,7 +361,7 @@ TEST(TwinEffects, PayloadAddsItsWeightToTheGravityTorques) {
 
 TEST(TwinRun, LogHasTheServosResolutionAndIsReproducible) {
   const TwinConfig c = config();
-  const ClosedLoopTwin<Model> twin(c);
+  const ClosedLoopTwin twin(symoro::robot::compiled_model<Model>(), c);
   const auto design = symoro::trajectory::TrajectoryDesign::read(
       std::string(SYMORO_ROBOTS_DIR) + "/crane_x7/trajectories.yaml",
       std::vector<symoro::JointInfo>(Model::joints.begin(), Model::joints.end()));
@@ -399,7 +401,7 @@ TEST(TwinRun, CommandReachesTheLogOneCycleLater) {
   c.effects.disable_all();
   // A fine encoder: no count hunting at rest, so only the timing shows.
   for (auto& s : c.servos) s.encoder_counts = 1 << 30;
-  const ClosedLoopTwin<Model> twin(c);
+  const ClosedLoopTwin twin(symoro::robot::compiled_model<Model>(), c);
   symoro::trajectory::Trajectory step;
   step.name = "step";
   symoro::trajectory::Segment hold;
@@ -446,7 +448,7 @@ TEST(TwinEffects, ActuationDelayShiftsTheTorqueTheLinkReceives) {
   RunOptions ro;
   ro.pre_roll = 1.0;
   auto response = [&](const TwinConfig& cfg) {
-    const ClosedLoopTwin<Model> twin(cfg);
+    const ClosedLoopTwin twin(symoro::robot::compiled_model<Model>(), cfg);
     return Eigen::MatrixXd(twin.run(reference(0.01), ro).q - twin.run(reference(0.0), ro).q);
   };
   const Eigen::MatrixXd base = response(c);

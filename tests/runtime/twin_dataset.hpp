@@ -8,6 +8,7 @@
 
 #include "symoro/io/dataset.hpp"
 #include "symoro/io/log.hpp"
+#include "symoro/robot/compiled_model.hpp"
 #include "symoro/trajectory/design.hpp"
 #include "symoro/twin/simulator.hpp"
 
@@ -21,7 +22,7 @@ void write_twin_dataset(const std::filesystem::path& dir, const twin::TwinConfig
                         std::uint64_t seed, const std::string& twin_file = "") {
   std::filesystem::remove_all(dir);
   std::filesystem::create_directories(dir);
-  const twin::ClosedLoopTwin<Full> tw(config);
+  const twin::ClosedLoopTwin tw(symoro::robot::compiled_model<Full>(), config);
   io::Dataset d;
   d.dir = dir;
   d.robot = Full::robot_name;

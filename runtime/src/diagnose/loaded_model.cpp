@@ -30,32 +30,27 @@ StackModel stack_model(const ModelHandle& m, const ModelHandle& full) {
 
 class LoadedDiagnosisModel final : public DiagnosisModel {
  public:
-  LoadedDiagnosisModel(const ModelHandle& model, const ModelHandle& full, BacklashFitter backlash)
-      : identification_(identify::identification_model(model, full)), stack_(stack_model(model, full)),
-        backlash_(backlash) {}
+  LoadedDiagnosisModel(const ModelHandle& model, const ModelHandle& full)
+      : identification_(identify::identification_model(model, full)), stack_(stack_model(model, full)), full_(full) {}
   const identify::ModelDescription& description() const override { return identification_->description(); }
   DesignStack stack_design(const std::vector<NamedSamples>& runs, const StackOptions& options) const override {
     return diagnose::stack_design(stack_, runs, options);
   }
   BacklashFit fit_backlash(const io::Log& measured, const trajectory::SampledReference& reference,
                            const twin::TwinConfig& nominal, const BacklashFitOptions& options) const override {
-    if (backlash_) return backlash_(measured, reference, nominal, options);
-    throw std::runtime_error("robot '" + identification_->description().robot +
-                             "' is loaded at run time (a robot library): the backlash stage simulates its digital twin, "
-                             "which runs only for a robot compiled into the program yet");
+    return diagnose::fit_backlash(full_, measured, reference, nominal, options);
   }
 
  private:
   std::shared_ptr<const identify::IdentificationModel> identification_;
   StackModel stack_;
-  BacklashFitter backlash_;
+  ModelHandle full_;  // the twin's plant
 };
 
 }  // namespace
 
-std::shared_ptr<const DiagnosisModel> diagnosis_model(const robot::ModelHandle& model, const robot::ModelHandle& full,
-                                                      BacklashFitter backlash) {
-  return std::make_shared<LoadedDiagnosisModel>(model, full, backlash);
+std::shared_ptr<const DiagnosisModel> diagnosis_model(const robot::ModelHandle& model, const robot::ModelHandle& full) {
+  return std::make_shared<LoadedDiagnosisModel>(model, full);
 }
 
 }  // namespace symoro::diagnose

@@ -37,6 +37,12 @@ std::string describe_run(const RunStats& s) {
                      s.max_error.maxCoeff() * 180 / 3.14159265358979323846, s.dropped, s.saturated);
 }
 
+TwinDatasetSummary make_twin_dataset(const ClosedLoopTwin& twin, const std::vector<trajectory::Trajectory>& trajectories,
+                                     const TwinDatasetOptions& o) {
+  return make_twin_dataset([&twin](const trajectory::Trajectory& t, const RunOptions& ro, RunStats* st) { return twin.run(t, ro, st); },
+                           twin.notes(), twin.config(), trajectories, o);
+}
+
 TwinDatasetSummary make_twin_dataset(const RunTwin& run, const std::string& notes, const TwinConfig& config,
                                      const std::vector<trajectory::Trajectory>& trajs, const TwinDatasetOptions& o) {
   std::filesystem::create_directories(o.out);

@@ -1,7 +1,6 @@
 // DiagnosisModel (diagnosis_model.hpp) for a generated model: the runtime's one implementation
-// (loaded_model.hpp) over the model's handle (its kernels in symoro::<robot>_identification), with
-// the backlash stage's simulation from robot_backlash<Full>, compiled once per robot
-// (diagnosis_backlash-inl.hpp: its own unit). Compiled into symoro::<robot>_diagnosis
+// (loaded_model.hpp) over the model's handle (its kernels in symoro::<robot>_identification), the
+// backlash stage's twin on the full model's. Compiled into symoro::<robot>_diagnosis
 // (cmake/SymoroRobots.cmake); include it only to instantiate a model that has no such library.
 #pragma once
 
@@ -15,19 +14,10 @@
 #include "symoro/robot/compiled_model.hpp"
 
 namespace symoro::diagnose {
-namespace detail {
-
-// fit_backlash<Full> (backlash_fit.hpp), defined in diagnosis_backlash-inl.hpp.
-template <class Full>
-BacklashFit robot_backlash(const io::Log& measured, const trajectory::SampledReference& reference,
-                           const twin::TwinConfig& nominal, const BacklashFitOptions& options);
-
-}  // namespace detail
-
 template <class Full, class Model>
 std::shared_ptr<const DiagnosisModel> diagnosis_model() {
   static const std::shared_ptr<const DiagnosisModel> model =
-      diagnosis_model(robot::compiled_model<Model>(), robot::compiled_model<Full>(), &detail::robot_backlash<Full>);
+      diagnosis_model(robot::compiled_model<Model>(), robot::compiled_model<Full>());
   return model;
 }
 

@@ -1,10 +1,8 @@
 // What the diagnosis needs of a robot model, behind one small virtual interface, so that the
 // whole diagnosis of a dataset (diagnose_dataset.hpp: the stepwise selection, the raw-torque
-// gap, the backlash stage, the report and the variant) is compiled once for every robot. Only
-// the parts templated on the generated model are compiled per model, once, into
-// symoro::<robot>_diagnosis (cmake/SymoroRobots.cmake): the design stack (stack_builder.hpp) of
-// each model, and the twin's closed loop for the backlash stage (backlash_fit.hpp), once per
-// robot. dynid diagnose and the Python package both call it.
+// gap, the backlash stage, the report and the variant) is compiled once for every robot: one
+// implementation over robot::ModelHandle (loaded_model.hpp), for a loaded robot library and a
+// linked model alike. dynid diagnose and the Python package both call it.
 #pragma once
 
 #include <memory>
@@ -28,15 +26,14 @@ class DiagnosisModel {
   // stack_design<Full, Model>: the regression of the diagnosed model, the full model's extra
   // columns and the candidate effects, over runs preprocessed at their own rate.
   virtual DesignStack stack_design(const std::vector<NamedSamples>& runs, const StackOptions& options) const = 0;
-  // fit_backlash<Full>: the closed-loop high-band stage on the robot's twin.
+  // fit_backlash: the closed-loop high-band stage on the robot's twin (its full model's plant).
   virtual BacklashFit fit_backlash(const io::Log& measured, const trajectory::SampledReference& reference,
                                    const twin::TwinConfig& nominal, const BacklashFitOptions& options) const = 0;
 };
 
 // The interface of model Model of the robot whose full model is Full, one shared instance per
 // model. Defined in diagnosis_model-inl.hpp and compiled for every model of a robot into
-// symoro::<robot>_diagnosis: link it (or include the -inl header, and
-// diagnosis_backlash-inl.hpp, to compile it here).
+// symoro::<robot>_diagnosis: link it (or include the -inl header to compile it here).
 template <class Full, class Model>
 std::shared_ptr<const DiagnosisModel> diagnosis_model();
 

@@ -37,6 +37,7 @@
 #include "symoro/dynamixel/bus.hpp"
 #include "symoro/hardware/config.hpp"
 #include "symoro/model_info.hpp"
+#include "symoro/robot/model_handle.hpp"
 #include "symoro/trajectory/trajectory.hpp"
 
 namespace symoro::hardware {
@@ -156,7 +157,16 @@ ControlResult run_control(dynamixel::Bus& bus, const HardwareConfig& hw, const s
 // twice), then reads Torque Enable back; true when every servo answered 0.
 bool safe_stop(dynamixel::Bus& bus, const HardwareConfig& hw);
 
-// The identified model's inverse dynamics as a feedforward: tau = ID(q_ref, qd_ref, qdd_ref; phi).
+// The identified model's inverse dynamics as a feedforward: tau = ID(q_ref, qd_ref, qdd_ref; phi),
+// and its mass matrix, for ControlOptions::inertia: any robot's model through its handle (one
+// indirect call each; no allocation once tau and M are sized). std::invalid_argument when phi is
+// not the model's size.
+std::function<void(const Eigen::VectorXd&, const Eigen::VectorXd&, const Eigen::VectorXd&, Eigen::VectorXd&)>
+model_feedforward(const robot::ModelHandle& model, const Eigen::VectorXd& phi);
+std::function<void(const Eigen::VectorXd&, Eigen::MatrixXd&)> model_inertia(const robot::ModelHandle& model,
+                                                                            const Eigen::VectorXd& phi);
+
+// The same for a generated Model linked statically (a real-time application).
 template <class Model>
 auto model_feedforward(const Eigen::VectorXd& phi) {
   using Vec = Eigen::Matrix<double, Model::nq, 1>;
@@ -169,7 +179,6 @@ auto model_feedforward(const Eigen::VectorXd& phi) {
   };
 }
 
-// The identified model's mass matrix, for ControlOptions::inertia.
 template <class Model>
 auto model_inertia(const Eigen::VectorXd& phi) {
   using Vec = Eigen::Matrix<double, Model::nq, 1>;

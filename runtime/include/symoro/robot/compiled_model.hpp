@@ -5,6 +5,12 @@
 // them): link that library, or include the -inl header to compile a model here.
 #pragma once
 
+#include <cstddef>
+#include <tuple>
+#include <type_traits>
+#include <utility>
+#include <vector>
+
 #include "symoro/robot/model_handle.hpp"
 
 namespace symoro::robot {
@@ -12,5 +18,30 @@ namespace symoro::robot {
 // The model's handle (static storage; its functions the robot library's C ABI kernels).
 template <class Model>
 const ModelHandle& compiled_model();
+
+// A robot linked into the program: its models' handles (the full model first, then its variants
+// as robot.yaml lists them) and the index of robot.yaml's `identified` one. Each robot's library
+// symoro::<robot>_identification defines `const LinkedRobot& symoro::robot::linked::<robot>()`
+// (cmake/identification.cpp.in), so that a program compiled once (dynid) can list its linked
+// robots without including their headers.
+struct LinkedRobot {
+  std::vector<const ModelHandle*> models;
+  int identified = 0;
+};
+
+namespace detail {
+template <class Models, class Identified, std::size_t... I>
+LinkedRobot linked_robot(std::index_sequence<I...>) {
+  LinkedRobot r;
+  r.models = {&compiled_model<std::tuple_element_t<I, Models>>()...};
+  ((r.identified = std::is_same_v<std::tuple_element_t<I, Models>, Identified> ? static_cast<int>(I) : r.identified), ...);
+  return r;
+}
+}  // namespace detail
+
+template <class Models, class Identified>
+LinkedRobot linked_robot() {
+  return detail::linked_robot<Models, Identified>(std::make_index_sequence<std::tuple_size_v<Models>>{});
+}
 
 }  // namespace symoro::robot

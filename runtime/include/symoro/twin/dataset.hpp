@@ -37,7 +37,7 @@ struct TwinDatasetSummary {
   int ranks = 1, workers = 1;
 };
 
-// One closed-loop run of a twin (ClosedLoopTwin<Model>::run).
+// One closed-loop run of a twin (ClosedLoopTwin::run).
 using RunTwin = std::function<io::Log(const trajectory::Trajectory&, const RunOptions&, RunStats*)>;
 
 // The runs and the manifest. `notes` and `config` are the twin's (ClosedLoopTwin::notes and
@@ -46,12 +46,9 @@ using RunTwin = std::function<io::Log(const trajectory::Trajectory&, const RunOp
 TwinDatasetSummary make_twin_dataset(const RunTwin& run, const std::string& notes, const TwinConfig& config,
                                      const std::vector<trajectory::Trajectory>& trajectories, const TwinDatasetOptions& o);
 
-template <class Model>
-TwinDatasetSummary make_twin_dataset(const ClosedLoopTwin<Model>& twin, const std::vector<trajectory::Trajectory>& trajectories,
-                                     const TwinDatasetOptions& o) {
-  return make_twin_dataset([&twin](const trajectory::Trajectory& t, const RunOptions& ro, RunStats* st) { return twin.run(t, ro, st); },
-                           twin.notes(), twin.config(), trajectories, o);
-}
+// The same with the twin's own runs.
+TwinDatasetSummary make_twin_dataset(const ClosedLoopTwin& twin, const std::vector<trajectory::Trajectory>& trajectories,
+                                     const TwinDatasetOptions& o);
 
 // A run's log file in a dataset: <trajectory>_t<trial>.csv.
 std::string run_file_name(const std::string& trajectory, int trial);

@@ -2,7 +2,7 @@
 // plant (twin/plant.hpp, the robot's full model plus the twin's mechanical effects), so the real
 // driver (SerialPort, Bus, the control loop) talks to a simulated arm over a real byte stream.
 //
-//   auto backend = std::make_unique<TwinServoBackend<crane_x7::Model>>(twin_config, hw, q0);
+//   auto backend = std::make_unique<TwinServoBackend>(full_model, twin_config, hw, q0);
 //   auto* twin = backend.get();   // inspect after the bus is idle
 //   dynamixel::VirtualBus bus(servos_from(hw), std::move(backend));
 //
@@ -19,6 +19,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <stdexcept>
+#include <string>
 #include <vector>
 
 #include <Eigen/Core>
@@ -27,6 +28,7 @@
 #include "symoro/dynamixel/servo_backend.hpp"
 #include "symoro/dynamixel/virtual_bus.hpp"
 #include "symoro/hardware/config.hpp"
+#include "symoro/robot/model_handle.hpp"
 #include "symoro/twin/config.hpp"
 #include "symoro/twin/plant.hpp"
 #include "symoro/twin/truth.hpp"
@@ -49,61 +51,28 @@ inline std::vector<dynamixel::VirtualServo> virtual_servos(const hardware::Hardw
   return out;
 }
 
-template <class Model>
 class TwinServoBackend : public dynamixel::ServoBackend {
  public:
-  static constexpr int n = Model::nq;
-  using Vec = Eigen::Matrix<double, n, 1>;
+  // full: the robot's full model (the twin's plant); q0: the arm's initial joint angles (at rest).
+  TwinServoBackend(const robot::ModelHandle& full, const twin::TwinConfig& config, const hardware::HardwareConfig& hw,
+                   const Eigen::VectorXd& q0);
 
-  // q0: the arm's initial joint angles (at rest).
-  TwinServoBackend(const twin::TwinConfig& config, const hardware::HardwareConfig& hw, const Vec& q0)
-      : truth_(twin::make_truth<Model>(config)), plant_(truth_, config, q0) {
-    if (static_cast<int>(hw.joints.size()) != n || static_cast<int>(config.servos.size()) != n)
-      throw std::invalid_argument("TwinServoBackend: hardware.yaml and twin.yaml need one servo per joint");
-    for (int j = 0; j < n; ++j) {
-      const double scale = config.effects.torque_constant_error ? config.effects.torque_constant_scale(j) : 1.0;
-      kt_(j) = config.servos[j].torque_constant * scale;
-      dir_(j) = hw.joints[j].direction;
-      offset_(j) = (hw.joints[j].zero - dynamixel::xseries::kCenterPosition) * dynamixel::xseries::kPositionUnit;
-    }
-    current_.setZero();
-  }
-
-  std::size_t size() const override { return n; }
-
-  void advance(double time) override {
-    if (!started_) {
-      started_ = true;
-      time_ = time;
-      return;
-    }
-    const double dt = time - time_;
-    if (!(dt > 0)) return;
-    time_ = time;
-    // Servo currents -> joint torques (direction), held over dt.
-    plant_.advance(dt, kt_.cwiseProduct(dir_).cwiseProduct(current_));
-    ++steps_;
-  }
-
+  std::size_t size() const override { return static_cast<std::size_t>(plant_.joints()); }
+  void advance(double time) override;
   void set_current(std::size_t index, double amps) override { current_(static_cast<int>(index)) = amps; }
-
-  dynamixel::JointState state(std::size_t index) const override {
-    const int j = static_cast<int>(index);
-    // Servo angle such that the controller's (pulses - zero) * direction gives q.
-    return {dir_(j) * plant_.q()(j) + offset_(j), dir_(j) * plant_.qd()(j), current_(j)};
-  }
+  dynamixel::JointState state(std::size_t index) const override;
 
   // The twin's true joint state (rad, rad/s), and the time it has been integrated to.
-  Vec q() const { return plant_.q(); }
-  Vec qd() const { return plant_.qd(); }
+  Eigen::VectorXd q() const { return plant_.q(); }
+  Eigen::VectorXd qd() const { return plant_.qd(); }
   double time() const { return time_; }
   std::uint64_t steps() const { return steps_; }
-  const twin::Truth<Model>& truth() const { return truth_; }
+  const twin::Truth& truth() const { return truth_; }
 
  private:
-  twin::Truth<Model> truth_;
-  twin::Plant<Model> plant_;
-  Vec kt_, dir_, offset_, current_;
+  twin::Truth truth_;
+  twin::Plant plant_;
+  Eigen::VectorXd kt_, dir_, offset_, current_, torque_;
   double time_ = 0;
   bool started_ = false;
   std::uint64_t steps_ = 0;

@@ -1,4 +1,4 @@
-#include "dynid_loaded_robot.hpp"
+#include "dynid_robots.hpp"
 
 #include <algorithm>
 #include <filesystem>
@@ -6,7 +6,6 @@
 
 #include <fmt/format.h>
 
-#include "dynid_dispatch.hpp"
 #include "symoro/identify/loaded_model.hpp"
 #include "symoro/robot/load_robot.hpp"
 
@@ -38,26 +37,33 @@ std::shared_ptr<const robot::RobotLibrary> library_of(const Common& common) {
   }
 }
 
-}  // namespace
-
-std::string not_compiled(const Common& common) {
-  std::string known;
-  for (const auto& r : robot_names()) known += (known.empty() ? "" : ", ") + r;
-  return fmt::format("robot '{}' ({}) is not compiled into this dynid (its robots: {}): this command needs a compiled "
-                     "robot yet; import, identify, diagnose, predict, compare, excite and export run on any robot folder "
-                     "through its robot library",
-                     common.robot, common.robot_dir().string(), known);
+// A linked robot's model by label, as a robot library names them.
+robot::ModelHandle linked_model(const Common& common, const robot::LinkedRobot& linked, const std::string& label) {
+  if (label.empty()) return *linked.models[linked.identified];
+  std::string list;
+  for (const robot::ModelHandle* m : linked.models) {
+    if (m->label() == label) return *m;
+    list += (list.empty() ? "" : ", ") + m->label();
+  }
+  throw UsageError(fmt::format("robot '{}' has no compiled model '{}' (it has: {}); a variant just added to robot.yaml must be "
+                               "generated (symoroc generate robots/{} -o generated) and dynid rebuilt",
+                               common.robot, label, list, common.robot));
 }
 
+}  // namespace
+
 bool compiled_robot(const Common& common) {
-  const auto& names = robot_names();
-  if (std::find(names.begin(), names.end(), common.robot) == names.end()) return false;
+  if (!linked_robot(common.robot)) return false;
   if (common.folder.empty()) return true;
   std::error_code ec;
   return std::filesystem::equivalent(common.robot_dir(), std::filesystem::path(common.robots_dir) / common.robot, ec);
 }
 
-robot::ModelHandle loaded_model(const Common& common, const std::string& label) {
+robot::ModelHandle robot_model(const Common& common, const std::string& label) {
+  if (compiled_robot(common)) {
+    check_robot_folder(common);
+    return linked_model(common, *linked_robot(common.robot), label);
+  }
   const auto lib = library_of(common);
   try {
     return lib->model(label);
@@ -66,14 +72,8 @@ robot::ModelHandle loaded_model(const Common& common, const std::string& label) 
   }
 }
 
-std::shared_ptr<const identify::IdentificationModel> loaded_identification_model(const Common& common,
-                                                                                 const std::string& label) {
-  const auto lib = library_of(common);
-  try {
-    return identify::identification_model(lib->model(label), lib->model(0));
-  } catch (const robot::LoadError& e) {
-    throw UsageError(e.what());
-  }
+std::shared_ptr<const identify::IdentificationModel> identification_model(const Common& common, const std::string& label) {
+  return identify::identification_model(robot_model(common, label), full_model(common));
 }
 
 }  // namespace symoro::dynid

@@ -1,0 +1,53 @@
+// The robots dynid reaches, as robot::ModelHandles: a robot it was built with (linked in: its
+// kernels in symoro::<robot>_identification, listed by the generated dynid_tables.cpp) and any
+// other robot folder, through its robot library (symoro/robot_abi.h), built into the robot cache
+// on first use and loaded. Every command is compiled once and runs on both alike.
+#pragma once
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "dynid_common.hpp"
+#include "symoro/identify/identification_model.hpp"
+#include "symoro/robot/compiled_model.hpp"
+#include "symoro/robot/model_handle.hpp"
+
+namespace symoro::dynid {
+
+// The robots of robots/ this dynid was built with, in folder order (generated).
+const std::vector<std::string>& robot_names();
+
+// A robot this dynid was built with, its models linked in; null for another name (generated).
+const robot::LinkedRobot* linked_robot(const std::string& robot);
+
+// The files a robot's code was generated from, with their digests (generated/<robot>/source.hpp,
+// gathered in the generated dynid_tables.cpp).
+struct SourceFile {
+  const char* name;
+  const char* digest;
+};
+std::vector<SourceFile> robot_sources(const std::string& robot);
+
+// Refuses (UsageError) a robot folder (--robots-dir/<robot>) whose robot.yaml or model files
+// differ from those this dynid was compiled from: the compiled copy would be used silently.
+void check_robot_folder(const Common& common);
+
+// Whether common.robot is one this dynid was compiled with, from the folder it was compiled from
+// (a --robot folder elsewhere is loaded from its library, even under a compiled robot's name).
+bool compiled_robot(const Common& common);
+
+// Model `label` of common.robot ("full", a robot.yaml variant, "" robot.yaml's `identified`):
+// linked in (compiled_robot; the folder checked by check_robot_folder), else from its library,
+// whose build prints one line on stderr. UsageError for a folder that is no robot or a model it
+// has not; the library's errors (a failed build, a missing compiler) as they are.
+robot::ModelHandle robot_model(const Common& common, const std::string& label);
+
+// The robot's full model (the twin's plant, a variant's parent).
+inline robot::ModelHandle full_model(const Common& common) { return robot_model(common, "full"); }
+
+// The IdentificationModel of model `label` (identify::identification_model over its handle and
+// its robot's full model's).
+std::shared_ptr<const identify::IdentificationModel> identification_model(const Common& common, const std::string& label);
+
+}  // namespace symoro::dynid
