@@ -1,12 +1,11 @@
-// Excitation for any robot folder (compiled per robot, so also for a folder the suite has never
-// seen, tools/run_tests.sh): the structured families generated from the joints build inside
-// every limit, and an optimized Fourier design from the middle of the box meets every limit on a
-// 0.5 ms grid, checked here with the series' own formula and the generated inverse dynamics
-// with robot.yaml's nominal parameters (a 0.5 kg link per joint when it has none), and excites
-// every base parameter, with a larger log det than the structured single-joint trajectory of
-// the same length (and a smaller kappa where that one is poorly conditioned).
-#include SYMORO_ROBOT_HEADER
-
+// Excitation for any robot folder (compiled once, each robot through its library: also a folder
+// the suite has never seen, tools/run_tests.sh): the structured families generated from the
+// joints build inside every limit, and an optimized Fourier design from the middle of the box
+// meets every limit on a 0.5 ms grid, checked here with the series' own formula and the
+// generated inverse dynamics with robot.yaml's nominal parameters (a 0.5 kg link per joint when
+// it has none), and excites every base parameter, with a larger log det than the structured
+// single-joint trajectory of the same length (and a smaller kappa where that one is poorly
+// conditioned). The robot's identified model (robot.yaml's `identified`).
 #include <yaml-cpp/yaml.h>
 
 #include <algorithm>
@@ -17,51 +16,67 @@
 #include <string>
 #include <unistd.h>
 
+#include <memory>
+
 #include <gtest/gtest.h>
 
+#include "robot_folders.hpp"
 #include "symoro/identify/excitation_design.hpp"
 #include "symoro/identify/excitation_quality.hpp"
-#include "symoro/identify/identification_model.hpp"
+#include "symoro/identify/loaded_model.hpp"
 #include "symoro/trajectory/design.hpp"
 #include "symoro/trajectory/structured_design.hpp"
 
 namespace {
 
-using Model = SYMORO_ROBOT_NS::Model;
 namespace fs = std::filesystem;
 using namespace symoro;
 
-std::vector<JointInfo> joints() { return {Model::joints.begin(), Model::joints.end()}; }
-
-bool revolute_only() {
-  for (const auto& j : Model::joints)
-    if (j.type != JointType::Revolute) return false;
-  return true;
-}
-
-// robot.yaml's nominal, else every link a 0.5 kg point 0.1 m along its x axis (a made-up arm
-// whose torques are still of a plausible size).
-Eigen::Matrix<double, Model::np, 1> nominal_phi() {
-  const YAML::Node nominal = YAML::LoadFile(std::string(SYMORO_ROBOT_DIR) + "/robot.yaml")["nominal"];
-  Eigen::Matrix<double, Model::ns, 1> s = Eigen::Matrix<double, Model::ns, 1>::Zero();
-  for (int k = 0; k < Model::ns; ++k) {
-    const std::string name = Model::standard_parameters[k].name, family = Model::standard_parameters[k].family;
-    if (nominal && nominal[name]) s(k) = nominal[name].as<double>();
-    else if (!nominal && family == "M") s(k) = 0.5;
-    else if (!nominal && family == "MX") s(k) = 0.05;
-    else if (!nominal && (family == "XX" || family == "YY" || family == "ZZ")) s(k) = 0.01;
+// Param: a robot folder (robot_folders.hpp).
+class Excite : public ::testing::TestWithParam<std::string> {
+ protected:
+  void SetUp() override {
+    const auto lib = test::test_library(GetParam());
+    model_ = std::make_unique<robot::ModelHandle>(lib->model(""));
+    full_ = std::make_unique<robot::ModelHandle>(lib->model(0));
   }
-  return Model::base_from_standard(s);
-}
+  const robot::ModelHandle& model() const { return *model_; }  // the identified model
+  const robot::ModelHandle& full() const { return *full_; }
+  const std::vector<JointInfo>& joints() const { return model_->joints(); }
 
-trajectory::StructuredDesignOptions structured_options() {
-  trajectory::StructuredDesignOptions o;
-  o.robot = Model::robot_name;
-  o.joints = joints();
-  return o;
-}
+  bool revolute_only() const {
+    for (const auto& j : joints())
+      if (j.type != JointType::Revolute) return false;
+    return true;
+  }
 
-TEST(Excite, StructuredFamiliesBuildInsideTheLimits) {
+  // robot.yaml's nominal, else every link a 0.5 kg point 0.1 m along its x axis (a made-up arm
+  // whose torques are still of a plausible size).
+  Eigen::VectorXd nominal_phi() const {
+    const YAML::Node nominal = YAML::LoadFile(GetParam() + "/robot.yaml")["nominal"];
+    Eigen::VectorXd s = Eigen::VectorXd::Zero(model().ns());
+    for (int k = 0; k < model().ns(); ++k) {
+      const std::string name = model().standard_parameters()[k].name, family = model().standard_parameters()[k].family;
+      if (nominal && nominal[name]) s(k) = nominal[name].as<double>();
+      else if (!nominal && family == "M") s(k) = 0.5;
+      else if (!nominal && family == "MX") s(k) = 0.05;
+      else if (!nominal && (family == "XX" || family == "YY" || family == "ZZ")) s(k) = 0.01;
+    }
+    return model().base_from_standard(s);
+  }
+
+  trajectory::StructuredDesignOptions structured_options() const {
+    trajectory::StructuredDesignOptions o;
+    o.robot = model().robot();
+    o.joints = joints();
+    return o;
+  }
+
+ private:
+  std::unique_ptr<robot::ModelHandle> model_, full_;
+};
+
+TEST_P(Excite, StructuredFamiliesBuildInsideTheLimits) {
   if (!revolute_only()) {  // the design format is in degrees: refused, naming the prismatic joint
     try {
       trajectory::structured_design_yaml(structured_options());
@@ -79,16 +94,16 @@ TEST(Excite, StructuredFamiliesBuildInsideTheLimits) {
   fs::remove(file);
 }
 
-TEST(Excite, OptimizedDesignMeetsEveryLimitAndExcitesEveryParameter) {
-  const auto model = identify::identification_model<Model>();
-  const int n = Model::nq;
+TEST_P(Excite, OptimizedDesignMeetsEveryLimitAndExcitesEveryParameter) {
+  const auto identification = identify::identification_model(model(), full());
+  const int n = model().nq();
   identify::ExcitationDesignOptions o;
   trajectory::StructuredDesignOptions so = structured_options();
   Eigen::VectorXd lo(n), hi(n);
   if (revolute_only()) {
     trajectory::structured_box(so, lo, hi);
   } else {
-    for (int j = 0; j < n; ++j) lo(j) = Model::joints[j].lower, hi(j) = Model::joints[j].upper;
+    for (int j = 0; j < n; ++j) lo(j) = joints()[j].lower, hi(j) = joints()[j].upper;
   }
   o.start = (lo + hi) / 2;
   o.limits.lower = lo;
@@ -96,8 +111,8 @@ TEST(Excite, OptimizedDesignMeetsEveryLimitAndExcitesEveryParameter) {
   o.limits.velocity.resize(n);
   o.limits.torque.resize(n);
   for (int j = 0; j < n; ++j) {
-    o.limits.velocity(j) = 0.5 * Model::joints[j].velocity;
-    o.limits.torque(j) = Model::joints[j].effort;
+    o.limits.velocity(j) = 0.5 * joints()[j].velocity;
+    o.limits.torque(j) = joints()[j].effort;
   }
   o.limits.acceleration = 3.0 * o.limits.velocity;
   o.nominal = nominal_phi();
@@ -106,18 +121,16 @@ TEST(Excite, OptimizedDesignMeetsEveryLimitAndExcitesEveryParameter) {
   o.starts = 2;
   identify::ExcitationDesign d;
   try {
-    d = identify::design_excitation(*model, o);
+    d = identify::design_excitation(*identification, o);
   } catch (const identify::ExcitationInfeasible& e) {
     FAIL() << "the design from the middle of the box was refused: " << e.what();
   }
   const auto& t = d.trajectory;
-  Eigen::VectorXd q, qd, qdd;
-  Eigen::Matrix<double, Model::nq, 1> tau;
+  Eigen::VectorXd q, qd, qdd, tau;
   double worst = 1e9;
   for (double time = 0; time <= t.period(); time += 5e-4) {
     t.evaluate(time, q, qd, qdd);
-    Model::inverse_dynamics(Eigen::Matrix<double, n, 1>(q), Eigen::Matrix<double, n, 1>(qd), Eigen::Matrix<double, n, 1>(qdd),
-                            Eigen::Matrix<double, Model::np, 1>(o.nominal), tau);
+    tau = model().inverse_dynamics(q, qd, qdd, o.nominal);
     for (int j = 0; j < n; ++j)
       worst = std::min({worst, hi(j) - q(j), q(j) - lo(j), o.limits.velocity(j) - std::abs(qd(j)),
                         o.limits.acceleration(j) - std::abs(qdd(j)), o.limits.torque(j) - std::abs(tau(j))});
@@ -125,7 +138,7 @@ TEST(Excite, OptimizedDesignMeetsEveryLimitAndExcitesEveryParameter) {
   EXPECT_GE(worst, 0);
   t.evaluate(0, q, qd, qdd);
   EXPECT_LT((q - o.start).norm() + qd.norm() + qdd.norm(), 1e-12);
-  const auto optimized = identify::excitation_quality(*model, t.sample(0.001), 0.01);
+  const auto optimized = identify::excitation_quality(*identification, t.sample(0.001), 0.01);
   EXPECT_TRUE(optimized.unexcited.empty());
   EXPECT_TRUE(std::isfinite(optimized.kappa_scaled));
   if (!revolute_only()) return;
@@ -140,12 +153,14 @@ TEST(Excite, OptimizedDesignMeetsEveryLimitAndExcitesEveryParameter) {
   singles.q.conservativeResize(Eigen::NoChange, cycles);
   singles.qd.conservativeResize(Eigen::NoChange, cycles);
   singles.qdd.conservativeResize(Eigen::NoChange, cycles);
-  const auto structured = identify::excitation_quality(*model, singles, 0.01);
+  const auto structured = identify::excitation_quality(*identification, singles, 0.01);
   EXPECT_GT(optimized.log_det_scaled, structured.log_det_scaled);
   // D-optimality is not kappa: where the singles are already well conditioned (the planar 2R
   // arm: 4.5) the optimum may trade a little kappa for information; where they are poorly
   // conditioned (every arm of robots/ but the planar one), it must improve kappa too.
   if (structured.kappa_scaled > 10) EXPECT_LT(optimized.kappa_scaled, structured.kappa_scaled);
 }
+
+INSTANTIATE_TEST_SUITE_P(Robots, Excite, ::testing::ValuesIn(test::test_robot_folders()), test::folder_test_name);
 
 }  // namespace

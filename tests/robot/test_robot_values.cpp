@@ -6,7 +6,7 @@
 // terms (test_support.hpp) and central differences for the derivative functions. What only a
 // template can check (the generated code in Jets, the output forms into blocks) stays in
 // test_robot.cpp and test_robot_derivatives_*.cpp, built for the small shipped robots only
-// (tests/CMakeLists.txt).
+// (tests/CMakeLists.txt). Any robot folder joins with SYMORO_TEST_ROBOT_DIRS (robot_folders.hpp).
 #include <algorithm>
 #include <cmath>
 #include <map>
@@ -21,6 +21,7 @@
 #include <gtest/gtest.h>
 
 #include "symoro/grammar/parser.hpp"
+#include "robot_folders.hpp"
 #include "symoro/robot/load_robot.hpp"
 #include "test_support.hpp"
 
@@ -39,28 +40,7 @@ constexpr double kFdTol = 1e-6;
 constexpr double kSameValue = 1e-12;
 constexpr int kStates = 5;
 
-std::vector<std::string> test_robots() {
-  std::vector<std::string> out;
-  std::stringstream in(SYMORO_TEST_ROBOTS);
-  for (std::string name; std::getline(in, name, ',');)
-    if (!name.empty()) out.push_back(name);
-  return out;
-}
-
-std::string robot_dir(const std::string& robot) { return std::string(SYMORO_ROBOTS_DIR) + "/" + robot; }
-
-// The robot's library, loaded once per process (built into the test cache by the
-// robot_libraries fixture, tests/CMakeLists.txt).
-std::shared_ptr<const robot::RobotLibrary> library(const std::string& robot) {
-  static std::map<std::string, std::shared_ptr<const robot::RobotLibrary>> loaded;
-  auto& lib = loaded[robot];
-  if (!lib) {
-    robot::LoadOptions o;
-    o.cache_dir = SYMORO_TEST_ROBOT_CACHE;
-    lib = robot::load_robot(robot_dir(robot), o);
-  }
-  return lib;
-}
+std::shared_ptr<const robot::RobotLibrary> library(const std::string& folder) { return test_library(folder); }
 
 struct State {
   VectorXd q, qd, qdd;
@@ -91,7 +71,7 @@ std::vector<std::string> names(const std::vector<ParameterInfo>& parameters) {
 // One model of the robot under test, with the handle-based forms of test_support.hpp's helpers.
 class RobotValues : public ::testing::TestWithParam<std::string> {
  protected:
-  const Reference& ref() const { return reference(robot_dir(GetParam())); }
+  const Reference& ref() const { return reference(GetParam()); }
 
   // check(model, full, state, phi) at kStates random states with order-1 random phi, for every
   // model of the robot.
@@ -502,7 +482,7 @@ TEST_P(RobotValues, ParametersAreTheBaseParametersOfTheFilesAndMapToTheParent) {
 // the symbolic entries link by link, family by family; a variant may drop some, keeping the order).
 TEST_P(RobotValues, JointsFramesGravityAndStandardParametersFollowTheFiles) {
   const grammar::Table& table = ref().geometry();
-  const grammar::ParFile par = grammar::read_par_file(par_file_path(robot_dir(GetParam())));
+  const grammar::ParFile par = grammar::read_par_file(par_file_path(GetParam()));
   const auto entry = [&](const std::string& name) -> const grammar::ParEntry& {
     for (const auto& e : par.entries)
       if (e.name == name) return e;
@@ -566,8 +546,8 @@ TEST_P(RobotValues, JointsFramesGravityAndStandardParametersFollowTheFiles) {
   });
 }
 
-INSTANTIATE_TEST_SUITE_P(Robots, RobotValues, ::testing::ValuesIn(test_robots()),
-                         [](const ::testing::TestParamInfo<std::string>& info) { return info.param; });
+// Param: a robot folder (robot_folders.hpp).
+INSTANTIATE_TEST_SUITE_P(Robots, RobotValues, ::testing::ValuesIn(test_robot_folders()), folder_test_name);
 
 }  // namespace
 }  // namespace symoro::test
