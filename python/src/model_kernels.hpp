@@ -1,7 +1,8 @@
 // A robot model as the Python package calls it: functions over a batch of states in C-ordered
 // float64 arrays (NumPy's layout), written once over a model handle (loaded_kernels.cpp): a robot
-// library loaded at run time (symoro.load) or a model linked into the module (python_robots.cpp). Each calls the generated function's C ABI kernel and copies its
-// column-major result out: the results are those of the C++ call, bit for bit.
+// library loaded at run time (symoro.load) or a model linked into the module (python_robots.cpp).
+// Each calls the generated function's C ABI kernel and copies its column-major result out: the
+// results are those of the C++ call, bit for bit.
 #pragma once
 
 #include <cstddef>

@@ -90,7 +90,7 @@ void run_control_command(const Common& common, const ControlCliOptions& o) {
     if (o.ideal) tc->effects.disable_all();
   }
   const trajectory::Trajectory traj =
-      trajectory::TrajectoryDesign::read(common.design_path(), joints).build(o.trajectory);
+      read_design(common, joints).build(o.trajectory);
 
   hardware::ControlOptions co;
   co.robot = common.robot;

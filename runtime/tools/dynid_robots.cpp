@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <filesystem>
 #include <map>
+#include <set>
 
 #include <fmt/format.h>
 
@@ -52,6 +53,15 @@ robot::ModelHandle linked_model(const Common& common, const robot::LinkedRobot& 
 
 }  // namespace
 
+trajectory::TrajectoryDesign read_design(const Common& common, const std::vector<JointInfo>& joints) {
+  const std::filesystem::path path = common.design_path();
+  if (common.design.empty() && !std::filesystem::exists(path))
+    throw UsageError(fmt::format("robot '{}' has no trajectory design ({} not found): dynid excite --robot {} -o <folder> "
+                                 "designs one, which --design <folder>/trajectories.yaml then uses",
+                                 common.robot, path.string(), common.robot_dir().string()));
+  return trajectory::TrajectoryDesign::read(path, joints);
+}
+
 bool compiled_robot(const Common& common) {
   if (!linked_robot(common.robot)) return false;
   if (common.folder.empty()) return true;
@@ -61,7 +71,10 @@ bool compiled_robot(const Common& common) {
 
 robot::ModelHandle robot_model(const Common& common, const std::string& label) {
   if (compiled_robot(common)) {
-    check_robot_folder(common);
+    // Once per folder: a command asks for several models (its own, the full one), each file
+    // digested once.
+    static std::set<std::string> checked;
+    if (checked.insert(common.robot_dir().string()).second) check_robot_folder(common);
     return linked_model(common, *linked_robot(common.robot), label);
   }
   const auto lib = library_of(common);

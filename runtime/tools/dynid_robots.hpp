@@ -12,6 +12,7 @@
 #include "symoro/identify/identification_model.hpp"
 #include "symoro/robot/compiled_model.hpp"
 #include "symoro/robot/model_handle.hpp"
+#include "symoro/trajectory/design.hpp"
 
 namespace symoro::dynid {
 
@@ -49,5 +50,9 @@ inline robot::ModelHandle full_model(const Common& common) { return robot_model(
 // The IdentificationModel of model `label` (identify::identification_model over its handle and
 // its robot's full model's).
 std::shared_ptr<const identify::IdentificationModel> identification_model(const Common& common, const std::string& label);
+
+// The trajectory design the command reads (Common::design_path) for these joints; a robot folder
+// without one gets a UsageError saying how to make one (dynid excite).
+trajectory::TrajectoryDesign read_design(const Common& common, const std::vector<JointInfo>& joints);
 
 }  // namespace symoro::dynid

@@ -54,7 +54,7 @@ std::string trajectory_quality_table(const Common& common, const std::vector<tra
 
 void run_trajectories(const Common& common, const TrajectoryOptions& o) {
   const robot::ModelHandle full = full_model(common);
-  const auto design = trajectory::TrajectoryDesign::read(common.design_path(), full.joints());
+  const auto design = read_design(common, full.joints());
   const std::vector<std::string> names = o.only.empty() ? design.names() : o.only;
   std::vector<std::string> joint_names;
   for (const auto& j : full.joints()) joint_names.push_back(j.name);

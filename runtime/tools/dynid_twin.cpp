@@ -40,10 +40,6 @@ twin::ClosedLoopTwin make_twin(const Common& common, const TwinOptions& o) {
   return twin::ClosedLoopTwin(std::move(full), std::move(c));
 }
 
-trajectory::TrajectoryDesign read_design(const Common& common, const std::vector<JointInfo>& joints) {
-  return trajectory::TrajectoryDesign::read(common.design_path(), joints);
-}
-
 void twin_run(const Common& common, const TwinOptions& o) {
   const twin::ClosedLoopTwin sim = make_twin(common, o);
   const auto traj = read_design(common, sim.model().joints()).build(o.trajectory);

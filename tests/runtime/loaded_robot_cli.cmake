@@ -90,6 +90,8 @@ expect("${out}" "ur5: built ")
 # A robot without a digital twin says so.
 run(2 out twin run --robot ${WORK}/robots/ur5 --trajectory AG02 -o ${WORK}/x)
 expect("${out}" "robot 'ur5' has no digital twin \\(.*twin.yaml not found\\)")
+run(2 out trajectories --robot ${WORK}/robots/ur5)
+expect("${out}" "robot 'ur5' has no trajectory design \\(.*trajectories.yaml not found\\): dynid excite")
 
 # The twin, the trajectories and the controller on a loaded robot: a copy of robots/crane_x7
 # elsewhere (its library from the robot cache the fixture robot_libraries built: the same key).

@@ -60,7 +60,7 @@ io::Log ClosedLoopTwin::run(const trajectory::SampledReference& ref, const RunOp
     lsb(j) = 2 * 3.14159265358979323846 / s.encoder_counts;
   }
   // The encoders' reading of q (quantized, with noise when enabled).
-  auto encoder = [&](const Vec& q, Vec& m) {
+  auto encoder = [&](const Eigen::Ref<const Vec>& q, Vec& m) {
     for (int j = 0; j < n; ++j) {
       const double sd = e.encoder_noise_per_joint.size() == n ? e.encoder_noise_per_joint(j) : e.encoder_noise;
       const double noise = e.sensor_noise ? sd * rng.normal() : 0.0;
