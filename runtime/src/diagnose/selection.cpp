@@ -4,6 +4,8 @@
 #include <cmath>
 #include <limits>
 #include <set>
+#include <utility>
+#include <vector>
 
 #include <Eigen/Cholesky>
 #include <Eigen/Eigenvalues>
@@ -118,19 +120,38 @@ bool linearized(const std::vector<Candidate>& effects) {
 
 double pooled(const Eigen::VectorXd& tau) { return tau.size() ? tau.mean() : 1.0; }
 
+// The stack's segments as [begin, end) sample ranges (each segment is one contiguous piece).
+std::vector<std::pair<Eigen::Index, Eigen::Index>> segment_ranges(const DesignStack& d) {
+  std::vector<std::pair<Eigen::Index, Eigen::Index>> out;
+  const auto S = static_cast<Eigen::Index>(d.samples());
+  for (Eigen::Index a = 0, b = 0; a < S; a = b) {
+    while (b < S && d.segment[static_cast<std::size_t>(b)] == d.segment[static_cast<std::size_t>(a)]) ++b;
+    out.emplace_back(a, b);
+  }
+  return out;
+}
+
+// sum_s x_s x_{s+k} over the pairs of samples k apart within one segment.
+double lagged_product(const std::vector<std::pair<Eigen::Index, Eigen::Index>>& segments, const Eigen::VectorXd& x, int k) {
+  double c = 0;
+  for (const auto& [a, b] : segments)
+    if (b - a > k) c += x.segment(a, b - a - k).dot(x.segment(a + k, b - a - k));
+  return c;
+}
+
 // Per joint, the residual's autocovariance gamma(0..L) along the segments, cut before the first
 // non-positive autocorrelation (the window of autocorrelation_time()).
 std::vector<std::vector<double>> autocovariance(const DesignStack& d, const Eigen::MatrixXd& r, int max_lag) {
   const int S = d.samples();
+  const auto segments = segment_ranges(d);
   std::vector<std::vector<double>> g(static_cast<std::size_t>(r.cols()));
   for (Eigen::Index j = 0; j < r.cols(); ++j) {
-    const double var = r.col(j).squaredNorm();
+    const Eigen::VectorXd x = r.col(j);
+    const double var = x.squaredNorm();
     g[j].push_back(var / std::max(S, 1));
     if (!(var > 0)) continue;
     for (int k = 1; k <= max_lag && k < S; ++k) {
-      double c = 0;
-      for (int s = 0; s + k < S; ++s)
-        if (d.segment[s] == d.segment[s + k]) c += r(s, j) * r(s + k, j);
+      const double c = lagged_product(segments, x, k);
       if (c <= 0) break;
       g[j].push_back(c / S);
     }
@@ -145,16 +166,19 @@ std::vector<std::vector<double>> autocovariance(const DesignStack& d, const Eige
 Eigen::MatrixXd score_covariance(const DesignStack& d, const Eigen::MatrixXd& Z, const std::vector<std::vector<double>>& g) {
   const int n = d.joints, S = d.samples();
   const Eigen::Index m = Z.cols();
-  Eigen::MatrixXd V = Eigen::MatrixXd::Zero(m, m);
+  const auto segments = segment_ranges(d);
+  Eigen::MatrixXd V = Eigen::MatrixXd::Zero(m, m), Ck(m, m);
   for (int j = 0; j < n; ++j) {
     Eigen::MatrixXd Zj(S, m);
     for (int s = 0; s < S; ++s) Zj.row(s) = Z.row(static_cast<Eigen::Index>(s) * n + j);
     if (Zj.squaredNorm() == 0) continue;
     V += g[j][0] * Zj.transpose() * Zj;
     for (std::size_t k = 1; k < g[j].size(); ++k) {
-      Eigen::MatrixXd Ck = Eigen::MatrixXd::Zero(m, m);
-      for (int s = 0; s + static_cast<int>(k) < S; ++s)
-        if (d.segment[s] == d.segment[s + k]) Ck.noalias() += Zj.row(s).transpose() * Zj.row(s + k);
+      // Within each segment, rows s against rows s + k: one product per segment and lag.
+      const auto lag = static_cast<Eigen::Index>(k);
+      Ck.setZero();
+      for (const auto& [a, b] : segments)
+        if (b - a > lag) Ck.noalias() += Zj.middleRows(a, b - a - lag).transpose() * Zj.middleRows(a + lag, b - a - lag);
       V += g[j][k] * (Ck + Ck.transpose());
     }
   }
@@ -255,16 +279,15 @@ void backward_check(const DesignStack& train, const DesignStack& heldout, const 
 
 Eigen::VectorXd autocorrelation_time(const DesignStack& d, const Eigen::MatrixXd& r, int max_lag) {
   const int S = d.samples();
+  const auto segments = segment_ranges(d);
   Eigen::VectorXd out = Eigen::VectorXd::Ones(r.cols());
   for (Eigen::Index j = 0; j < r.cols(); ++j) {
-    const double var = r.col(j).squaredNorm();
+    const Eigen::VectorXd x = r.col(j);
+    const double var = x.squaredNorm();
     if (!(var > 0)) continue;
     double sum = 0;
     for (int k = 1; k <= max_lag && k < S; ++k) {
-      double c = 0;
-      for (int s = 0; s + k < S; ++s)
-        if (d.segment[s] == d.segment[s + k]) c += r(s, j) * r(s + k, j);
-      const double rho = c / var;
+      const double rho = lagged_product(segments, x, k) / var;
       if (rho <= 0) break;
       sum += rho;
     }
