@@ -1,9 +1,7 @@
 #!/usr/bin/env bash
 # Every test: install what is missing, build, run the GoogleTest suite through ctest, check
 # generated/ against a fresh compilation, drop an unseen robot folder in and run its generic
-# tests, and fuzz the grammar for a bounded time (FUZZ_SECONDS, default 60) and the DYNAMIXEL
-# decoder (FUZZ_DYNAMIXEL_SECONDS, default 20) and the file readers (FUZZ_IO_SECONDS each,
-# default 20).
+# tests, and fuzz the grammar, the DYNAMIXEL decoder and the file readers for a bounded time.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash tools/install_deps.sh
@@ -24,33 +22,40 @@ for t in test_robot_values test_excite; do
   SYMORO_TEST_ROBOT_DIRS="$PWD/$scratch/unseen_arm" "build/tests/$t" --gtest_filter='*/unseen_arm' --gtest_brief=1
 done
 
-# Grammar fuzzing with clang's libFuzzer, bounded in time.
+# Fuzzing with clang's libFuzzer, each target bounded in time: the grammar (FUZZ_SECONDS, default
+# 60), the DYNAMIXEL Protocol 2.0 decoder (FUZZ_DYNAMIXEL_SECONDS, default 20) and the file readers:
+# the log reader, the importer's reader and dataset.yaml (FUZZ_IO_SECONDS each, default 20). A
+# fuzzer is one process on one core: the grammar on one lane, the others one after another on a
+# second (when there are two cores), so that each keeps its whole time and the step takes ~80 s.
 cmake -S . -B build/fuzz -G Ninja -DSYMORO_BUILD_FUZZER=ON -DCMAKE_CXX_COMPILER=clang++ -DCMAKE_BUILD_TYPE=RelWithDebInfo >/dev/null
-cmake --build build/fuzz -j"$jobs" --target fuzz_grammar
-mkdir -p build/fuzz/corpus
-cp tests/fuzz/corpus/* build/fuzz/corpus/
-build/fuzz/tests/fuzz/fuzz_grammar -max_total_time="${FUZZ_SECONDS:-60}" -max_len=4096 -timeout=10 \
-  -dict=tests/fuzz/grammar.dict build/fuzz/corpus 2>build/fuzz/fuzz.log || { tail -40 build/fuzz/fuzz.log; exit 1; }
-grep -E "^Done|#[0-9]+.*DONE" build/fuzz/fuzz.log | tail -1
-
-# DYNAMIXEL Protocol 2.0 decoder fuzzing, bounded in time (FUZZ_DYNAMIXEL_SECONDS, default 20).
-cmake --build build/fuzz -j"$jobs" --target fuzz_dynamixel
-mkdir -p build/fuzz/corpus_dynamixel
-cp tests/fuzz/corpus_dynamixel/* build/fuzz/corpus_dynamixel/
-build/fuzz/tests/fuzz/fuzz_dynamixel -max_total_time="${FUZZ_DYNAMIXEL_SECONDS:-20}" -max_len=2048 -timeout=10 \
-  build/fuzz/corpus_dynamixel 2>build/fuzz/fuzz_dynamixel.log || { tail -40 build/fuzz/fuzz_dynamixel.log; exit 1; }
-grep -E "^Done|#[0-9]+.*DONE" build/fuzz/fuzz_dynamixel.log | tail -1
-
-# The file readers' fuzzing, bounded in time (FUZZ_IO_SECONDS each, default 20): the log reader,
-# the importer's reader and dataset.yaml.
-cmake --build build/fuzz -j"$jobs" --target fuzz_log fuzz_import fuzz_dataset
-for t in log import dataset; do
-  mkdir -p build/fuzz/corpus_$t
-  cp tests/fuzz/corpus_$t/* build/fuzz/corpus_$t/
-  build/fuzz/tests/fuzz/fuzz_$t -max_total_time="${FUZZ_IO_SECONDS:-20}" -max_len=4096 -timeout=10 \
-    -artifact_prefix=build/fuzz/ build/fuzz/corpus_$t 2>build/fuzz/fuzz_$t.log || { tail -40 build/fuzz/fuzz_$t.log; exit 1; }
-  grep -E "^Done|#[0-9]+.*DONE" build/fuzz/fuzz_$t.log | tail -1
-done
+cmake --build build/fuzz -j"$jobs" --target fuzz_grammar fuzz_dynamixel fuzz_log fuzz_import fuzz_dataset
+fuzz() {  # fuzz <target> <corpus folder under tests/fuzz> <seconds> [libFuzzer options...]
+  local target=$1 corpus=$2 seconds=$3
+  shift 3
+  mkdir -p "build/fuzz/$corpus"
+  cp "tests/fuzz/$corpus"/* "build/fuzz/$corpus/"
+  if ! "build/fuzz/tests/fuzz/$target" -max_total_time="$seconds" -timeout=10 -artifact_prefix=build/fuzz/ "$@" \
+      "build/fuzz/$corpus" 2>"build/fuzz/$target.log"; then
+    echo "$target failed:"; tail -40 "build/fuzz/$target.log"; return 1
+  fi
+  echo "$target: $(grep -E "^Done|#[0-9]+.*DONE" "build/fuzz/$target.log" | tail -1)"
+}
+fuzz_others() {
+  fuzz fuzz_dynamixel corpus_dynamixel "${FUZZ_DYNAMIXEL_SECONDS:-20}" -max_len=2048 &&
+    fuzz fuzz_log corpus_log "${FUZZ_IO_SECONDS:-20}" -max_len=4096 &&
+    fuzz fuzz_import corpus_import "${FUZZ_IO_SECONDS:-20}" -max_len=4096 &&
+    fuzz fuzz_dataset corpus_dataset "${FUZZ_IO_SECONDS:-20}" -max_len=4096
+}
+if [ "$jobs" -ge 2 ]; then
+  fuzz fuzz_grammar corpus "${FUZZ_SECONDS:-60}" -max_len=4096 -dict=tests/fuzz/grammar.dict &
+  grammar=$! grammar_rc=0 others_rc=0
+  fuzz_others || others_rc=$?
+  wait "$grammar" || grammar_rc=$?
+  if [ "$grammar_rc" -ne 0 ] || [ "$others_rc" -ne 0 ]; then exit 1; fi
+else
+  fuzz fuzz_grammar corpus "${FUZZ_SECONDS:-60}" -max_len=4096 -dict=tests/fuzz/grammar.dict
+  fuzz_others
+fi
 
 # The whole suite last, so its summary closes the output.
 ctest --test-dir build --output-on-failure -j"$jobs"
