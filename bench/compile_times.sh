@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Compile time per translation unit from a build's .ninja_log (the last build of each object):
-# what each robot compiles (its libraries' units: kernels_<i> and kernels_d2_<i> per model,
-# identification and diagnosis once), the slowest units overall, and the sum. Run after a clean build for comparable numbers
+# what each robot compiles (kernels.o: symoroc build of the robot's library, all its models'
+# kernels, one after another; the units of its identification and diagnosis libraries), the
+# slowest units overall, and the sum. Run after a clean build for comparable numbers
 # (a warm rebuild lists only what it rebuilt, and -j2 under other load inflates every time):
 #   cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release && ninja -C build -j2
 #   bash bench/compile_times.sh build [top N]
@@ -17,10 +18,10 @@ latest=$(awk 'NR == FNR { known[$1] = 1; next }
               FNR > 1 && ($4 in known) { t[$4] = ($2 - $1) / 1000 }
               END { for (o in t) printf "%.1f %s\n", t[o], o }' <(echo "$known") "$log" | sort -rn)
 echo "## Each robot's units (symoro::<robot>_identification, _diagnosis: robot_units/<robot>/*)"
-echo "$latest" | awk '$2 ~ /\/robot_units\/[^\/]+\/[a-z_0-9]+\.cpp\.o$/ { n = split($2, p, "/"); printf "%8.1f s  %s/%s\n", $1, p[n-1], p[n] }' | sort -k3
+echo "$latest" | awk '$2 !~ /^\// && $2 ~ /robot_units\/[^\/]+\/([a-z_0-9]+\.cpp\.o|kernels\.o)$/ { n = split($2, p, "/"); printf "%8.1f s  %s/%s\n", $1, p[n-1], p[n] }' | sort -k3
 echo
 echo "## Per robot (sum)"
-echo "$latest" | awk '$2 ~ /\/robot_units\/[^\/]+\/[a-z_0-9]+\.cpp\.o$/ { n = split($2, p, "/"); s[p[n-1]] += $1; c[p[n-1]]++ } END { for (r in s) printf "%8.1f s  %s (%d units)\n", s[r], r, c[r] }' | sort -k3
+echo "$latest" | awk '$2 !~ /^\// && $2 ~ /robot_units\/[^\/]+\/([a-z_0-9]+\.cpp\.o|kernels\.o)$/ { n = split($2, p, "/"); s[p[n-1]] += $1; c[p[n-1]]++ } END { for (r in s) printf "%8.1f s  %s (%d units)\n", s[r], r, c[r] }' | sort -k3
 echo
 echo "## The $top slowest units"
 echo "$latest" | head -n "$top" | awk '{ printf "%8.1f s  %s\n", $1, $2 }'

@@ -4,7 +4,7 @@
 
 # symoro_robot_model_count(<robot.yaml> <out var>): 1 (the full model) + the variants robot.yaml
 # lists in block style (`variants:`, then one `  <name>:` line each; flow style counts 0). Only
-# how dynid splits its units (runtime/tools): a count that is off still compiles every model.
+# how the templated tests split their units (tests/CMakeLists.txt).
 function(symoro_robot_model_count yaml out)
   file(STRINGS "${yaml}" lines)
   set(count 1)
@@ -27,35 +27,12 @@ function(symoro_robot_model_count yaml out)
   set(${out} ${count} PARENT_SCOPE)
 endfunction()
 
-# symoro_robot_library(<name> <model count> <kind> <area> [PER_MODEL <template>...] [ONCE
-# <template>...]): the static library symoro::<name>_<kind> over symoro_<area>, with one unit per
-# model of the robot from each PER_MODEL template cmake/<t>_unit.cpp.in (the last one also taking
-# any model beyond the count), so that a robot's models compile in parallel, and one unit from
-# each ONCE template cmake/<t>.cpp.in (all models: index 0, tail).
-function(symoro_robot_library name count kind area)
-  cmake_parse_arguments(ARG "" "" "PER_MODEL;ONCE" ${ARGN})
+# symoro_robot_library(<name> <kind> <area> <template>...): the static library symoro::<name>_<kind>
+# over symoro_<area>, with one unit from each template cmake/<t>.cpp.in (all the robot's models).
+function(symoro_robot_library name kind area)
   set(units "")
-  math(EXPR last "${count} - 1")
   set(unit_robot ${name})
-  foreach(i RANGE 0 ${last})
-    set(unit_index ${i})
-    if(i EQUAL last)
-      set(unit_tail true)
-      set(unit_what "model ${i} of its Models, and any later one")
-    else()
-      set(unit_tail false)
-      set(unit_what "model ${i} of its Models")
-    endif()
-    foreach(template IN LISTS ARG_PER_MODEL)
-      set(file "${CMAKE_BINARY_DIR}/robot_units/${name}/${template}_${i}.cpp")
-      configure_file("${PROJECT_SOURCE_DIR}/cmake/${template}_unit.cpp.in" "${file}" @ONLY)
-      list(APPEND units "${file}")
-    endforeach()
-  endforeach()
-  set(unit_index 0)
-  set(unit_tail true)
-  set(unit_what "all its models")
-  foreach(template IN LISTS ARG_ONCE)
+  foreach(template IN LISTS ARGN)
     set(file "${CMAKE_BINARY_DIR}/robot_units/${name}/${template}.cpp")
     configure_file("${PROJECT_SOURCE_DIR}/cmake/${template}.cpp.in" "${file}" @ONLY)
     list(APPEND units "${file}")
@@ -66,6 +43,30 @@ function(symoro_robot_library name count kind area)
   target_link_libraries(${target} PUBLIC symoro_robot_${name} symoro_${area})
   set_target_properties(${target} PROPERTIES EXPORT_NAME ${name}_${kind} POSITION_INDEPENDENT_CODE ON)
   install(TARGETS ${target} EXPORT symoroTargets ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR})
+endfunction()
+
+# symoro_robot_kernels(<name> <robot dir> <headers>...): the robot's generated kernels, compiled
+# once, by symoroc build: its robot library into the build tree's robot cache (what dynid, the
+# Python package and the tests load for a folder, found there with no compile) and the same
+# objects, partially linked, into robot_units/<name>/kernels.o, which symoro::<name>_identification
+# holds (compiled_model<Model>()). It reruns when the robot's files, its generated headers, the
+# ABI's headers or the configured compiler and flags change.
+function(symoro_robot_kernels name robot_dir)
+  set(objects "${CMAKE_BINARY_DIR}/robot_units/${name}/kernels.o")
+  file(GLOB inputs CONFIGURE_DEPENDS "${robot_dir}/*")
+  set(abi "")
+  foreach(h robot_abi.h robot_abi_export.hpp robot_abi_export-inl.hpp robot_abi_second_derivatives-inl.hpp scalar.hpp
+            model_info.hpp spd_inverse.hpp)
+    list(APPEND abi "${PROJECT_SOURCE_DIR}/runtime/include/symoro/${h}")
+  endforeach()
+  add_custom_command(
+    OUTPUT "${objects}"
+    COMMAND symoroc build "${robot_dir}" --cache "${PROJECT_BINARY_DIR}/robot_cache" --jobs 1 --objects "${objects}"
+    DEPENDS ${inputs} ${ARGN} ${abi} "${PROJECT_BINARY_DIR}/codegen/config/robot_library_config.hpp"
+    COMMENT "symoroc build: ${name}'s kernels (its robot library and kernels.o)"
+    VERBATIM)
+  set_source_files_properties("${objects}" PROPERTIES EXTERNAL_OBJECT TRUE GENERATED TRUE)
+  target_sources(symoro_${name}_identification PRIVATE "${objects}")
 endfunction()
 
 # symoro_add_robot(<name> <robot dir>)
@@ -98,19 +99,25 @@ function(symoro_add_robot name robot_dir)
   install(TARGETS ${target} EXPORT symoroTargets)
   install(DIRECTORY "${include_dir}/" DESTINATION ${CMAKE_INSTALL_INCLUDEDIR})
   set_property(GLOBAL APPEND PROPERTY SYMORO_ROBOTS ${name})
-  # A variant added to robot.yaml reconfigures, so it gets its own dynid units.
+  # The number of models (tests/CMakeLists.txt splits a robot's templated tests by it).
   symoro_robot_model_count("${robot_dir}/robot.yaml" models)
   set_property(GLOBAL PROPERTY SYMORO_ROBOT_MODELS_${name} ${models})
-  # What is compiled per model: its generated kernels in the robot library's C ABI
-  # (symoro/robot/compiled_model.hpp), under the runtime's one IdentificationModel and
-  # DiagnosisModel (symoro/identify/loaded_model.hpp, symoro/diagnose/loaded_model.hpp): whatever
-  # studies or diagnoses the robot's models (dynid, the Python package, tests, applications) links
+  # What is compiled per robot: its generated kernels in the robot library's C ABI, once
+  # (symoro_robot_kernels), under the runtime's one IdentificationModel and DiagnosisModel
+  # (symoro/identify/loaded_model.hpp, symoro/diagnose/loaded_model.hpp): whatever studies or
+  # diagnoses the robot's models (dynid, the Python package, tests, applications) links
   # symoro::<name>_identification, symoro::<name>_diagnosis.
   if(TARGET symoro_identify)
-    symoro_robot_library(${name} ${models} identification identify PER_MODEL kernels kernels_d2 ONCE identification)
+    symoro_robot_library(${name} identification identify kernels identification)
+    if(EXISTS "${committed}/symoro/${name}.hpp")
+      file(GLOB_RECURSE headers CONFIGURE_DEPENDS "${committed}/*.hpp")
+    else()
+      set(headers "${include_dir}/symoro/${name}.hpp")
+    endif()
+    symoro_robot_kernels(${name} "${robot_dir}" ${headers})
   endif()
   if(TARGET symoro_diagnose)
-    symoro_robot_library(${name} ${models} diagnosis diagnose ONCE diagnosis)
+    symoro_robot_library(${name} diagnosis diagnose diagnosis)
     target_link_libraries(symoro_${name}_diagnosis PUBLIC symoro_${name}_identification)
   endif()
   set_property(DIRECTORY "${PROJECT_SOURCE_DIR}" APPEND PROPERTY CMAKE_CONFIGURE_DEPENDS "${robot_dir}/robot.yaml")

@@ -169,6 +169,27 @@ std::pair<std::string, std::string> model_names(const std::string& robot, const 
   return {"symoro/" + robot + "/" + variant + "/all.hpp", "::symoro::" + robot + "::" + variant + "::Model"};
 }
 
+// The models' objects of a built library (its folder's src/*.o but the entry, robot.o), partially
+// linked into one relocatable object at options.objects, for a program that links the robot's
+// kernels (compiled_model<Model>()): one file whatever the number of models, replaced whole.
+void write_objects(const fs::path& library_dir, const RobotLibraryOptions& options) {
+  std::vector<std::string> objects;
+  std::error_code ec;
+  for (const auto& e : fs::directory_iterator(library_dir / "src", ec))
+    if (e.path().extension() == ".o" && e.path().filename() != "robot.o") objects.push_back(e.path().string());
+  if (objects.empty())
+    throw BuildError("the robot library in " + library_dir.string() + " has no model objects (src/*.o): rebuild it with --force");
+  std::sort(objects.begin(), objects.end());
+  const fs::path out = options.objects;
+  fs::create_directories(out.parent_path().empty() ? fs::path(".") : out.parent_path(), ec);
+  const fs::path partial = out.string() + ".part-" + std::to_string(getpid());
+  std::vector<std::string> link = {resolve_compiler(options.toolchain.compiler).string(), "-r", "-nostdlib", "-o", partial.string()};
+  link.insert(link.end(), objects.begin(), objects.end());
+  run_all({link}, {fs::path(out.string() + ".log")}, 1);
+  fs::rename(partial, out, ec);
+  if (ec) throw BuildError("cannot write " + out.string() + ": " + ec.message());
+}
+
 }  // namespace
 
 RobotToolchain RobotToolchain::configured() {
@@ -242,8 +263,8 @@ RobotLibraryBuild build_robot_library(const fs::path& robot_dir, const RobotLibr
   // symoro's headers the units compile (the ABI, its export, the generated code's support).
   for (const auto& d : tc.include_dirs) {
     key_text += '\0' + d;
-    for (const char* h : {"robot_abi.h", "robot_abi_export-inl.hpp", "robot_abi_second_derivatives-inl.hpp",
-                          "scalar.hpp", "model_info.hpp", "spd_inverse.hpp"}) {
+    for (const char* h : {"robot_abi.h", "robot_abi_export.hpp", "robot_abi_export-inl.hpp",
+                          "robot_abi_second_derivatives-inl.hpp", "scalar.hpp", "model_info.hpp", "spd_inverse.hpp"}) {
       std::ifstream in(fs::path(d) / "symoro" / h, std::ios::binary);
       if (in) key_text += '\0' + std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
     }
@@ -255,7 +276,10 @@ RobotLibraryBuild build_robot_library(const fs::path& robot_dir, const RobotLibr
   const fs::path final_dir = cache / (robot.name + "-" + out.key);
   out.library = final_dir / ("lib" + robot.name + ".so");
   std::error_code ec;
-  if (!options.force && fs::exists(out.library, ec)) return out;  // cached
+  if (!options.force && fs::exists(out.library, ec)) {  // cached
+    if (!options.objects.empty()) write_objects(final_dir, options);
+    return out;
+  }
 
   // Build in a folder of its own, then move it into place.
   fs::create_directories(cache, ec);
@@ -281,11 +305,14 @@ RobotLibraryBuild build_robot_library(const fs::path& robot_dir, const RobotLibr
   std::string declarations, entries;
   for (std::size_t i = 0; i < gen.models.size(); ++i) {
     const auto [header, type] = model_names(robot.name, gen.models[i].name);
-    const std::string fn = "symoro_model_" + std::to_string(i);
+    // Named after the robot: the objects of several robots link into one program (--objects).
+    const std::string fn = "symoro_" + robot.name + "_model_" + std::to_string(i);
     const fs::path unit = work / "src" / (fn + ".cpp");
     write_file(unit, "// Written by symoroc build for robot " + robot.name + ": model " + gen.models[i].name +
                          " in the robot library's C ABI; do not edit.\n"
                          "#include \"symoro/robot_abi_export-inl.hpp\"\n#include \"" + header + "\"\n\n"
+                         "// For a program that links these objects too (compiled_model<Model>()).\n"
+                         "template symoro_abi_model symoro::abi_export::model_abi<" + type + ">();\n\n"
                          "symoro_abi_model " + fn + "() { return symoro::abi_export::model_abi<" + type + ">(); }\n");
     declarations += "symoro_abi_model " + fn + "();\n";
     entries += "      " + fn + "(),\n";
@@ -347,6 +374,7 @@ RobotLibraryBuild build_robot_library(const fs::path& robot_dir, const RobotLibr
     if (!fs::exists(out.library)) throw BuildError("cannot move the robot library into " + final_dir.string());
   }
   say(robot.name + ": built " + out.library.string() + " in " + std::to_string(out.compile_seconds) + " s");
+  if (!options.objects.empty()) write_objects(final_dir, options);
   return out;
 }
 

@@ -247,11 +247,18 @@ int main(int argc, char** argv) {
   bld->add_option("--cache", build_cache, "The robot cache (default: $SYMORO_CACHE_DIR, else ~/.cache/symoro/robots)");
   bld->add_option("-j,--jobs", build_options.jobs, "Parallel compiles (default: the machine's cores)");
   bld->add_flag("--force", build_options.force, "Rebuild even when the cache has the library");
+  std::string build_objects;
+  bld->add_option("--objects", build_objects,
+                  "Also write the models' objects, partially linked, to this file (one robot folder): what a program "
+                  "linking the robot statically takes, compiled once with its library");
 
   CLI11_PARSE(app, argc, argv);
   try {
     if (*bld) {
       build_options.cache_dir = build_cache;
+      if (!build_objects.empty() && build_dirs.size() != 1)
+        throw std::runtime_error("--objects takes one robot folder, not " + std::to_string(build_dirs.size()));
+      build_options.objects = build_objects;
       build_options.progress = [](const std::string& line) { std::cerr << line << "\n"; };
       for (const auto& dir : build_dirs) {
         const RobotLibraryBuild b = build_robot_library(dir, build_options);

@@ -264,6 +264,45 @@ TEST(RobotLibrary, TheCacheIsReusedAndKeyedByTheGeneratedCode) {
   EXPECT_EQ(symoro::robot::load_robot(robot_dir("planar2r"), options())->model("full").joints()[0].velocity, 3.0);
 }
 
+// symoroc build --objects: the library's model objects for a program that links the robot
+// statically (symoro::<robot>_identification), the same objects whether the library was just
+// built or found in the cache; the library's entry points are not among them (two robots' would
+// clash in one program), and a cached library without its objects names the way out.
+TEST(RobotLibrary, ItsObjectsAreWhatAProgramLinksStatically) {
+  const fs::path scratch = scratch_root() / "objects";
+  fs::remove_all(scratch);
+  symoro::codegen::RobotLibraryOptions o;
+  o.cache_dir = scratch / "cache";
+  o.objects = scratch / "fresh" / "kernels.o";
+  const auto built = symoro::codegen::build_robot_library(robot_dir("planar2r"), o);
+  ASSERT_TRUE(built.built);
+  o.objects = scratch / "cached" / "kernels.o";
+  ASSERT_FALSE(symoro::codegen::build_robot_library(robot_dir("planar2r"), o).built);
+  for (const char* which : {"fresh", "cached"}) {
+    const fs::path objects = scratch / which / "kernels.o";
+    ASSERT_TRUE(fs::exists(objects)) << which;
+    const fs::path listing = scratch / (std::string(which) + ".nm");
+    ASSERT_EQ(std::system(("nm -C --defined-only '" + objects.string() + "' > '" + listing.string() + "'").c_str()), 0);
+    std::ifstream in(listing);
+    const std::string symbols((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    for (const char* model : {"symoro::planar2r::Model", "symoro::planar2r::effects::Model"}) {
+      EXPECT_NE(symbols.find(std::string("symoro::abi_export::model_abi<") + model + ">()"), std::string::npos) << which << " " << model;
+      EXPECT_NE(symbols.find(std::string("symoro::abi_export::inertia_second_derivatives<") + model + ">"), std::string::npos)
+          << which << " " << model;
+    }
+    EXPECT_NE(symbols.find("symoro_planar2r_model_1()"), std::string::npos) << which;
+    EXPECT_EQ(symbols.find("symoro_robot"), std::string::npos) << which << ": the library's entry is not for static linking";
+  }
+  for (const auto& e : fs::directory_iterator(built.library.parent_path() / "src"))
+    if (e.path().extension() == ".o") fs::remove(e.path());
+  try {
+    symoro::codegen::build_robot_library(robot_dir("planar2r"), o);
+    ADD_FAILURE() << "objects written from a library folder without them";
+  } catch (const symoro::codegen::BuildError& e) {
+    EXPECT_NE(std::string(e.what()).find("has no model objects (src/*.o): rebuild it with --force"), std::string::npos) << e.what();
+  }
+}
+
 TEST(RobotLibraryRefusals, AStaleFolderNamesTheFileAndBothDigests) {
   const fs::path dir = scratch_copy("planar2r", "stale");
   const auto lib = symoro::robot::load_robot(dir, options());

@@ -16,13 +16,9 @@
 
 #include "symoro/model_info.hpp"
 #include "symoro/robot_abi.h"
+#include "symoro/robot_abi_export.hpp"
 
 namespace symoro::abi_export {
-
-// M, dM/dq and d2M/dq2 of a model (robot_abi_second_derivatives-inl.hpp): Jets, compiled in a
-// unit of their own so that a model's two halves compile in parallel.
-template <class Model>
-void inertia_second_derivatives(const double* q, const double* phi, double* m, double* dm, double* d2m);
 
 template <class T, class = void>
 struct Effects {
@@ -142,7 +138,6 @@ struct Kernels {
   }
 };
 
-// The C description and kernels of one generated Model (static storage).
 template <class Model>
 symoro_abi_model model_abi() {
   using K = Kernels<Model>;

@@ -33,6 +33,9 @@ struct RobotLibraryOptions {
   std::filesystem::path cache_dir;  // empty: default_robot_cache_dir()
   int jobs = 0;                     // parallel compiles; 0: the machine's cores
   bool force = false;               // rebuild even when the cache has it
+  // When set: the models' objects also go, partially linked, into this one object file, for a
+  // program that links the robot's kernels statically (symoro::<robot>_identification).
+  std::filesystem::path objects;
   std::function<void(const std::string&)> progress;  // one line per step, when set
 };
 

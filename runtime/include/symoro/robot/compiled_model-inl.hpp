@@ -1,6 +1,7 @@
 // compiled_model<Model>() (compiled_model.hpp): the robot library's C ABI table of a generated
-// model (robot_abi_export-inl.hpp), built once, under a handle with no library to keep loaded.
-// Its second derivatives (robot_abi_second_derivatives-inl.hpp) compile in a unit of their own.
+// model, under a handle with no library to keep loaded. The table's function, model_abi<Model>(),
+// is only declared here (robot_abi_export.hpp): its definition, the model's kernels, is compiled
+// once, by symoroc build, into the objects the program links (symoroc build --objects).
 #pragma once
 
 #include <cstddef>
@@ -8,7 +9,7 @@
 #include <vector>
 
 #include "symoro/robot/compiled_model.hpp"
-#include "symoro/robot_abi_export-inl.hpp"
+#include "symoro/robot_abi_export.hpp"
 
 namespace symoro::robot {
 
@@ -20,7 +21,7 @@ const ModelHandle& compiled_model() {
 }
 
 // Instantiates compiled_model<M>() for model I of a robot's Models, and with Tail for every later
-// one too (cmake/kernels_unit.cpp.in: one unit per model of each robot).
+// one too (cmake/kernels.cpp.in).
 using CompiledModelFactory = const ModelHandle& (*)();
 template <class Models, std::size_t I, bool Tail>
 void instantiate_compiled_models(std::vector<CompiledModelFactory>& out) {

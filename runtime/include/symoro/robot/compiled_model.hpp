@@ -1,8 +1,8 @@
 // A generated Model linked into the program, as the same ModelHandle a loaded robot library gives
 // (model_handle.hpp): the runtime compiled once reaches a shipped robot and a loaded one through
-// one interface. Declared here, defined in compiled_model-inl.hpp and compiled once per model into
-// symoro::<robot>_abi (cmake/SymoroRobots.cmake: the model's kernels, as its robot library holds
-// them): link that library, or include the -inl header to compile a model here.
+// one interface. Declared here, defined in compiled_model-inl.hpp over the model's C ABI table,
+// whose kernels are the objects of the robot's own library (symoroc build --objects): link
+// symoro::<robot>_identification (cmake/SymoroRobots.cmake), which holds both.
 #pragma once
 
 #include <cstddef>
