@@ -11,7 +11,6 @@
 #include <vector>
 
 #include <Eigen/QR>
-#include <Eigen/SVD>
 #include <ceres/cost_function.h>
 #include <gtest/gtest.h>
 
@@ -347,12 +346,11 @@ TEST(Clie, RecoversKnownParametersFromSimulatedData) {
     for (int j = 0; j < n; ++j) J.row(s * n + j) = dtau.row(k).segment(j * Reduced::np, Reduced::np);
   }
   const double sigma = rms(lowpassed(Channels(log.tau) - tau, 0.02));
-  // Columns scaled to unit norm for the SVD: std_i = sigma / |J_i| |V_i. / s|.
+  // Columns scaled to unit norm (A = J / |J_i|): std_i = sigma / |J_i| sqrt(((A'A)^-1)_ii).
   const Eigen::VectorXd column = J.colwise().norm().transpose();
-  const Eigen::BDCSVD<Eigen::MatrixXd> svd(J * column.cwiseInverse().asDiagonal(), Eigen::ComputeThinV);
-  const Eigen::MatrixXd spread = svd.matrixV() * svd.singularValues().cwiseInverse().asDiagonal();
-  const Eigen::VectorXd relative_std =
-      (sigma * spread.rowwise().norm()).cwiseQuotient(column).cwiseQuotient(truth.cwiseAbs());
+  const Eigen::MatrixXd A = J * column.cwiseInverse().asDiagonal();
+  const Eigen::VectorXd spread = (A.transpose() * A).inverse().diagonal().cwiseSqrt();
+  const Eigen::VectorXd relative_std = (sigma * spread).cwiseQuotient(column).cwiseQuotient(truth.cwiseAbs());
 
   Eigen::VectorXd phi0 = truth;
   for (int i = 0; i < Reduced::np; ++i) phi0(i) *= (i % 2 ? 1.25 : 0.75);
