@@ -55,8 +55,7 @@ function(symoro_robot_kernels name robot_dir)
   set(objects "${CMAKE_BINARY_DIR}/robot_units/${name}/kernels.o")
   file(GLOB inputs CONFIGURE_DEPENDS "${robot_dir}/*")
   set(abi "")
-  foreach(h robot_abi.h robot_abi_export.hpp robot_abi_export-inl.hpp robot_abi_second_derivatives-inl.hpp scalar.hpp
-            model_info.hpp spd_inverse.hpp)
+  foreach(h IN LISTS SYMORO_ROBOT_ABI_HEADERS)  # codegen/CMakeLists.txt: the cache key's headers
     list(APPEND abi "${PROJECT_SOURCE_DIR}/runtime/include/symoro/${h}")
   endforeach()
   add_custom_command(

@@ -263,8 +263,7 @@ RobotLibraryBuild build_robot_library(const fs::path& robot_dir, const RobotLibr
   // symoro's headers the units compile (the ABI, its export, the generated code's support).
   for (const auto& d : tc.include_dirs) {
     key_text += '\0' + d;
-    for (const char* h : {"robot_abi.h", "robot_abi_export.hpp", "robot_abi_export-inl.hpp",
-                          "robot_abi_second_derivatives-inl.hpp", "scalar.hpp", "model_info.hpp", "spd_inverse.hpp"}) {
+    for (const char* h : {SYMORO_ROBOT_ABI_HEADERS}) {
       std::ifstream in(fs::path(d) / "symoro" / h, std::ios::binary);
       if (in) key_text += '\0' + std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
     }

@@ -1,11 +1,7 @@
 // The inertia matrix's second derivatives along q for the robot library's C ABI
-// (symoro/robot_abi.h), in their own unit per model: Jets over the generated first derivatives
-// are half of a model's compile time, and compile beside the other half.
+// (symoro/robot_abi.h), in their own unit per model (symoroc build): Jets over the generated first
+// derivatives are half of a model's compile time, and compile beside the other half.
 #pragma once
-
-#include <cstddef>
-#include <tuple>
-#include <vector>
 
 #include <Eigen/Core>
 #include <ceres/jet.h>
@@ -36,17 +32,6 @@ void inertia_second_derivatives(const double* q, const double* phi, double* m, d
           d2m[(k * n + l) * n * n + i + j * n] = e.v(0);
         }
       }
-  }
-}
-
-// Instantiates inertia_second_derivatives<M> for model I of a robot's Models, and with Tail for
-// every later one too (cmake/kernels_d2_unit.cpp.in: one unit per model of each robot).
-using SecondDerivatives = void (*)(const double*, const double*, double*, double*, double*);
-template <class Models, std::size_t I, bool Tail>
-void instantiate_second_derivatives(std::vector<SecondDerivatives>& out) {
-  if constexpr (I < std::tuple_size_v<Models>) {
-    out.push_back(&inertia_second_derivatives<std::tuple_element_t<I, Models>>);
-    if constexpr (Tail) instantiate_second_derivatives<Models, I + 1, true>(out);
   }
 }
 
