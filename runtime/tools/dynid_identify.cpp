@@ -6,6 +6,7 @@
 #include <sys/resource.h>
 
 #include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <memory>
 #include <optional>
@@ -100,8 +101,10 @@ void run_identify(const Common& common, const IdentifyOptions& o) {
                  v.trajectory, v.interval * 1e3, v.kind, v.rmse_clie, v.rmse_rescue, v.mne_clie, v.mne_rescue,
                  v.note.empty() ? "" : "; " + v.note);
       if (std::isfinite(v.raw_rmse_rescue))
-        fmt::print("validation {} against the raw torque, open loop: RMSE {:.4f} / {:.4f} N m (final / accepted)\n", v.trajectory,
-                   v.raw_rmse_clie, v.raw_rmse_rescue);
+        fmt::print("validation {} against the raw torque, open loop: RMSE {:.4f} / {:.4f} N m (final / accepted), mean of the "
+                   "joints' RMSE {:.4f} N m (accepted)\n",
+                   v.trajectory, v.raw_rmse_clie, v.raw_rmse_rescue,
+                   v.raw_rmse_joint_rescue.size() > 0 ? v.raw_rmse_joint_rescue.mean() : std::nan(""));
     }
   }
   // The held-out series on disk: dynid compare reads them to set two model variants side by side.

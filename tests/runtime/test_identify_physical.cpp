@@ -8,6 +8,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <string>
+#include <type_traits>
 
 #include <unistd.h>
 
@@ -196,7 +197,10 @@ class PhysicalStudy : public ::testing::Test {
     return identify::Study(identify::identification_model<Model>(), o, std::move(none)).run();
   }
 
-  static constexpr double kNoise = 0.3, kOffset = 0.1;
+  // Noise enough that some OLS vectors pass the audit but have no consistent set, the case both
+  // tests are about: 0.3 N m on the CRANE-X7's reduced model; the RX-90's logs, filtered whole with
+  // their moving ends' settling time left out (preprocess/edges.hpp), need 1 N m for it.
+  static constexpr double kNoise = std::is_same_v<Model, Rx90> ? 1.0 : 0.3, kOffset = 0.1;
   std::filesystem::path dir_;
   VectorXd truth_;
 };
@@ -233,7 +237,7 @@ TYPED_TEST(PhysicalStudy, AcceptsAVectorWithAConsistentSetAndValidatesLikeThePdP
     not_pd += !r.ols_pd;
   }
   // All-pose PD is necessary, not sufficient: OLS vectors that pass the audit but have no
-  // consistent set (measured: 4 of 6 on the CRANE-X7, 2 of 6 on the RX-90, none of them non-PD).
+  // consistent set (measured: 4 of 6 on the CRANE-X7 at 0.3 N m, 4 of 6 on the RX-90 at 1 N m, none of them non-PD).
   std::printf("  %s: %d of 6 OLS vectors have no consistent set, %d are not PD\n", Model::description, inconsistent, not_pd);
   EXPECT_GT(inconsistent, not_pd);
 

@@ -289,14 +289,35 @@ std::string raw_validation_table(const StudyResult& study) {
   for (const auto& v : study.validation)
     if (std::isfinite(v.raw_rmse_rescue)) filter = v.raw_filter;
   if (filter.empty()) return "";
-  MarkdownTable table({"Trajectory", "Final RMSE [N m]", "Accepted RMSE [N m]", "Accepted, per joint [N m]"});
+  MarkdownTable table({"Trajectory", "Final RMSE [N m]", "Accepted RMSE [N m]", "Accepted, mean of the joints' RMSE [N m]",
+                        "Accepted, per joint [N m]"});
   for (const auto& v : study.validation) {
     if (!std::isfinite(v.raw_rmse_rescue)) continue;
     std::string joints;
     for (Eigen::Index j = 0; j < v.raw_rmse_joint_rescue.size(); ++j) joints += (j ? ", " : "") + sig(v.raw_rmse_joint_rescue(j), 3);
-    table.row({v.trajectory, sig(v.raw_rmse_clie, 6), sig(v.raw_rmse_rescue, 6), joints});
+    const double mean = v.raw_rmse_joint_rescue.size() > 0 ? v.raw_rmse_joint_rescue.mean() : std::nan("");
+    table.row({v.trajectory, sig(v.raw_rmse_clie, 6), sig(v.raw_rmse_rescue, 6), sig(mean, 6), joints});
   }
-  return "\nAgainst the raw measured torque, open loop at the log's own rate: " + filter + ".\n\n" + table.str() + "\n";
+  return "\nAgainst the raw measured torque, open loop at the log's own rate: " + filter +
+         ". RMSE: over all joints and samples together, sqrt(sum e^2 / (samples x joints)); mean of the joints' RMSE: the "
+         "average over joints of sqrt(sum_k e_j(k)^2 / samples) (docs/identification.md, \"Validation against the raw "
+         "torque\", rescores it with NumPy).\n\n" +
+         table.str() + "\n";
+}
+
+// Where the preprocessing left samples out at a moving log end (preprocess/edges.hpp), if anywhere.
+std::string edge_note(const StudyResult& study) {
+  std::string runs, held;
+  for (const auto& r : study.runs)
+    if (r.edge_samples > 0) runs += fmt::format("{}{} at {} ms: {}", runs.empty() ? "" : ", ", r.trajectory, interval_ms(r.interval), r.edge_samples);
+  for (const auto& v : study.validation)
+    if (v.edge_samples > 0) held += fmt::format("{}{}: {}", held.empty() ? "" : ", ", v.trajectory, v.edge_samples);
+  if (runs.empty() && held.empty()) return "";
+  return "\nLeft out of fitting and scoring: the samples within the low-pass's settling time (6 time constants) of a log "
+         "end where the arm moves, whose acceleration the filter's end padding gets wrong (docs/identification.md, \"The "
+         "ends of a log\"). " +
+         (runs.empty() ? std::string() : "Identification runs: " + runs + ". ") +
+         (held.empty() ? std::string() : "Held out: " + held + ".") + "\n";
 }
 
 std::string validation_table(const StudyResult& study) {
@@ -322,6 +343,7 @@ std::string validation_table(const StudyResult& study) {
   for (const auto& v : study.validation)
     if (!v.note.empty()) out += fmt::format("- {}: {}\n", v.trajectory, v.note);
   out += raw_validation_table(study);
+  out += edge_note(study);
 
   // Per joint, when the records carry it.
   int joints = 0;

@@ -54,6 +54,7 @@ std::string run_record_text(const RunRecord& r, const std::string& fingerprint) 
   y << YAML::Key << "failure" << YAML::Value << r.failure;
   y << YAML::Key << "clie_ran" << YAML::Value << r.clie_ran;
   y << YAML::Key << "samples" << YAML::Value << r.samples;
+  if (r.edge_samples > 0) y << YAML::Key << "edge_samples" << YAML::Value << r.edge_samples;
   y << YAML::Key << "kappa" << YAML::Value << r.kappa;
   y << YAML::Key << "kappa_scaled" << YAML::Value << r.kappa_scaled;
   y << YAML::Key << "log_det_scaled" << YAML::Value << r.log_det_scaled;
@@ -107,6 +108,7 @@ RunRecord parse(const YAML::Node& n) {
   r.clie_ran = n["clie_ran"] ? n["clie_ran"].as<bool>() : true;
   if (r.failed) return r;  // nothing else was computed
   r.samples = n["samples"].as<int>();
+  r.edge_samples = n["edge_samples"] ? n["edge_samples"].as<int>() : 0;
   r.kappa = n["kappa"].as<double>();
   r.kappa_scaled = n["kappa_scaled"].as<double>();
   r.log_det_scaled = n["log_det_scaled"].as<double>();

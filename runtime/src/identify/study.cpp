@@ -472,6 +472,7 @@ class StudyRun {
         const RawTorqueScore raw_clie = raw_torque_error(raw_samples, open, sel.phi_clie),
                              raw = raw_torque_error(raw_samples, open, out.phi_rescue);
         ValidationRecord& v = out.validation.back();
+        v.edge_samples = s.report.edge_samples;
         v.raw_rmse_clie = raw_clie.error.rmse;
         v.raw_rmse_rescue = raw.error.rmse;
         v.raw_rmse_joint_rescue = raw.error.rmse_joint;

@@ -32,10 +32,10 @@ std::string StudyOptions::describe() const {
                                    ? fmt::format(" | consistency physical {} {} {}", physical_start, physical_clearance, physical_rescue_clearance)
                                    : "";
   return fmt::format(
-      "pre {} {} {} {} {} {} {} {} | ls {} {} | audit {} {} {} {} {} | proj {} {} {} {} {} {} | margins {} | "
+      "pre {} {} {} {} {} {} {} {} {} | ls {} {} | audit {} {} {} {} {} | proj {} {} {} {} {} {} | margins {} | "
       "clie {} {} {} {} {} {} {} {} {} {} {} | metric {} {}",
       p.base_period, p.max_gap, p.filter_order, p.derivative_cutoff, p.anti_alias_fraction, p.drop_stale,
-      p.use_logged_velocity, p.torque_delay, least_squares.weighted,
+      p.use_logged_velocity, p.torque_delay, p.trim_settling ? "windows-whole edges-trimmed" : "windows-whole", least_squares.weighted,
       least_squares.wls_iterations, a.samples, a.starts, a.seed, a.max_iterations, a.tolerance, projection.accept_slack,
       projection.rescue_floor, projection.max_rounds, projection.poses_per_round, projection.weights.size(), projection.shortfall_raise,
       fmt::join(margins, ","), c.max_iterations, c.function_tolerance, c.parameter_tolerance, c.gradient_tolerance,

@@ -86,6 +86,7 @@ RunRecord identify_run(const IdentificationModel& model, const io::Log& log, con
   auto t = std::chrono::steady_clock::now();
   const preprocess::Samples s = preprocess::preprocess(log, interval, o.preprocess);
   r.samples = static_cast<int>(s.time.size());
+  r.edge_samples = s.report.edge_samples;
   const Regression reg = model.stack_regression(s);
   LeastSquaresResult ls;
   try {

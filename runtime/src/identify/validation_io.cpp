@@ -149,6 +149,7 @@ std::vector<std::filesystem::path> write_validation(const StudyResult& study, co
     y << YAML::BeginMap;
     y << YAML::Key << "trajectory" << YAML::Value << v.trajectory;
     y << YAML::Key << "interval" << YAML::Value << v.interval;
+    if (v.edge_samples > 0) y << YAML::Key << "edge_samples" << YAML::Value << v.edge_samples;
     y << YAML::Key << "kind" << YAML::Value << v.kind;
     y << YAML::Key << "note" << YAML::Value << v.note;
     y << YAML::Key << "joints" << YAML::Value << static_cast<int>(v.tau_measured.cols());
@@ -209,6 +210,7 @@ StudyValidation read_validation(const std::filesystem::path& study_dir) {
     ValidationRecord v;
     v.trajectory = as<std::string>(t, "trajectory", file);
     v.interval = as<double>(t, "interval", file);
+    v.edge_samples = t["edge_samples"] ? as<int>(t, "edge_samples", file) : 0;
     v.kind = t["kind"] ? as<std::string>(t, "kind", file) : "closed-loop";  // studies before open-loop validation
     v.note = t["note"] ? as<std::string>(t, "note", file) : "";
     if (v.kind != "closed-loop" && v.kind != "open-loop")

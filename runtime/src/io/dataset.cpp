@@ -1,6 +1,7 @@
 #include "symoro/io/dataset.hpp"
 
 #include <cmath>
+#include <memory>
 
 #include <fmt/format.h>
 #include <yaml-cpp/yaml.h>
@@ -172,6 +173,10 @@ Log read_run_log(const DatasetRun& run) {
                     fmt::format("run {}: its window [{}, {}) s holds none of the log's samples ({} to {} s)",
                                 run.trajectory, number_text(run.window_start), number_text(run.window_end),
                                 number_text(log.time[0]), number_text(log.time[log.samples() - 1])));
+  // The window's rows are contiguous (time increases): the file stays with the window.
+  auto file = std::make_shared<const Log>(log);
+  log.file = file;
+  log.file_row = rows.front();
   Eigen::VectorXd time(static_cast<Eigen::Index>(rows.size()));
   for (std::size_t i = 0; i < rows.size(); ++i) time[static_cast<Eigen::Index>(i)] = log.time[rows[i]];
   log.time = std::move(time);

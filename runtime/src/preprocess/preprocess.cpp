@@ -13,6 +13,7 @@
 #include "symoro/preprocess/butterworth.hpp"
 #include "symoro/preprocess/channels.hpp"
 #include "symoro/preprocess/derivatives.hpp"
+#include "symoro/preprocess/edges.hpp"
 #include "symoro/preprocess/resample.hpp"
 #include "symoro/preprocess/time_axis.hpp"
 #include "symoro/preprocess/zero_phase.hpp"
@@ -118,7 +119,11 @@ double base_period(const io::Log& log, const Options& options) {
   return io::median_sample_time(log.time, log.meta.trajectory.empty() ? "log" : log.meta.trajectory);
 }
 
-Samples preprocess(const io::Log& raw, double interval, const Options& options) {
+namespace {
+
+// preprocess() of a whole log; the times of the target samples left out in the settling time at
+// a moving end go to edge_times.
+Samples preprocess_whole(const io::Log& raw, double interval, const Options& options, std::vector<double>& edge_times) {
   const std::string source = raw.meta.trajectory.empty() ? "log" : raw.meta.trajectory;
   validate_options(options);
   const double period = base_period(raw, options);
@@ -160,6 +165,9 @@ Samples preprocess(const io::Log& raw, double interval, const Options& options) 
   const auto sections = butterworth_lowpass(options.filter_order, report.cutoff, 1 / period);
   const int padding = zero_phase_padding(sections);
   const int min_samples = std::max(padding + 1, 4);  // padding < length; 4 for the differences
+  const int settle = settling_samples(sections);
+  report.settling_seconds = settle * period;
+  const Eigen::ArrayXd quantum = options.trim_settling ? smallest_steps(log.q) : Eigen::ArrayXd();
 
   const Eigen::Index joints = log.joints();
   std::vector<PieceSamples> kept;
@@ -176,11 +184,28 @@ Samples preprocess(const io::Log& raw, double interval, const Options& options) 
     const GridInterpolation interpolation = grid_interpolation(log.time, stamps, piece);
     Channels q = interpolation.apply(log.q);
     Channels tau = interpolation.apply(log.tau);
+    // Whether the arm moves at each end, judged on q before the filter (edges.hpp).
+    const int reach = std::min(settle, piece.grid_samples());
+    const bool start_moves = options.trim_settling && moving_at_end(q, reach, true, quantum);
+    const bool end_moves = options.trim_settling && moving_at_end(q, reach, false, quantum);
+    report.moving_ends += int(start_moves) + int(end_moves);
     filtfilt(sections, padding, q);
     if (options.filter_torque) filtfilt(sections, padding, tau);
     if (options.torque_delay != 0) shift_later(tau, options.torque_delay / period);
 
-    const std::vector<int> rows = target_rows(piece.first_index, piece.grid_samples(), stride);
+    std::vector<int> rows = target_rows(piece.first_index, piece.grid_samples(), stride);
+    if (start_moves || end_moves) {
+      std::vector<int> kept_rows;
+      const int last = piece.grid_samples() - 1;
+      for (int r : rows) {
+        if ((start_moves && r < settle) || (end_moves && r > last - settle))
+          edge_times.push_back(stamps.t0 + static_cast<double>((piece.first_index + r) / stride) * interval);
+        else
+          kept_rows.push_back(r);
+      }
+      rows = std::move(kept_rows);
+    }
+    if (rows.empty()) continue;  // all of it within the settling time of a moving end
     Derivatives d = finite_differences(q, period, rows);
     if (options.use_logged_velocity) {
       // The logged velocity through the filter q had; its difference is the acceleration.
@@ -203,6 +228,11 @@ Samples preprocess(const io::Log& raw, double interval, const Options& options) 
     p.qdd = std::move(d.second);
     kept.push_back(std::move(p));
   }
+  if (kept.empty() && !edge_times.empty())
+    throw DataError(source, 0,
+                    fmt::format("log too short: every sample lies within the {:.3g} s settling time of the {:.3g} Hz "
+                                "filter at an end where the arm moves ({} samples)",
+                                report.settling_seconds, report.cutoff, edge_times.size()));
   if (kept.empty())
     throw DataError(source, 0,
                     fmt::format("log too short for the filter: the longest piece has {} samples "
@@ -231,6 +261,72 @@ Samples preprocess(const io::Log& raw, double interval, const Options& options) 
     row += n;
   }
   report.kept_samples = static_cast<int>(total);
+  report.edge_samples = static_cast<int>(edge_times.size());
+  return out;
+}
+
+// The file `log` was cut from, when its rows are that file's rows file_row.. (same q, tau and qd,
+// stamps moved by one offset: a caller may count time from the window's start): else null, and
+// the window is filtered alone.
+const io::Log* source_file(const io::Log& log, double& offset) {
+  const io::Log* file = log.file.get();
+  const Eigen::Index n = log.samples(), first = log.file_row;
+  if (!file || n == 0 || first < 0 || first + n > file->samples() || file->joints() != log.joints() ||
+      file->qd.cols() != log.qd.cols())
+    return nullptr;
+  offset = log.time(0) - file->time(first);
+  for (Eigen::Index k = 0; k < n; ++k)
+    if (std::abs(file->time(first + k) + offset - log.time(k)) > 1e-9 * std::max(1.0, std::abs(log.time(k)))) return nullptr;
+  const auto same = [&](const Eigen::MatrixXd& window, const Eigen::MatrixXd& whole) {
+    return window.rows() == n && whole.rows() == file->samples() && (window.array() == whole.middleRows(first, n).array()).all();
+  };
+  if (!same(log.q, file->q) || !same(log.tau, file->tau) || (log.qd.cols() > 0 && !same(log.qd, file->qd))) return nullptr;
+  return file;
+}
+
+}  // namespace
+
+Samples preprocess(const io::Log& log, double interval, const Options& options) {
+  std::vector<double> edge_times;
+  double offset = 0;
+  const io::Log* file = source_file(log, offset);
+  if (!file) return preprocess_whole(log, interval, options, edge_times);
+  // The whole file, on the window's clock and under its name; then the samples within the
+  // window's first and last stamps (half a base period of slack: stamps jitter about the grid).
+  io::Log whole;
+  whole.meta = log.meta;
+  whole.time = file->time.array() + offset;
+  whole.q = file->q;
+  whole.qd = file->qd;
+  whole.tau = file->tau;
+  Samples all = preprocess_whole(whole, interval, options, edge_times);
+  const double slack = 0.5 * all.report.base_period;
+  const double from = log.time(0) - slack, to = log.time(log.samples() - 1) + slack;
+  std::vector<Eigen::Index> keep;
+  for (Eigen::Index k = 0; k < all.time.size(); ++k)
+    if (from <= all.time(k) && all.time(k) < to) keep.push_back(k);
+  if (keep.empty())
+    throw DataError(log.meta.trajectory.empty() ? "log" : log.meta.trajectory, 0,
+                    fmt::format("no sample at {} s intervals is left within the window [{}, {}] s", interval,
+                                log.time(0), log.time(log.samples() - 1)));
+  Samples out;
+  out.interval = interval;
+  out.time = all.time(keep);
+  for (auto [to_m, from_m] : {std::pair{&out.q, &all.q}, std::pair{&out.qd, &all.qd}, std::pair{&out.qdd, &all.qdd},
+                              std::pair{&out.tau, &all.tau}})
+    *to_m = (*from_m)(keep, Eigen::all);
+  for (Eigen::Index k : keep) out.piece.push_back(all.piece[static_cast<std::size_t>(k)]);
+  out.report = all.report;
+  out.report.raw_samples = log.samples();
+  out.report.context_rows = file->samples() - log.samples();
+  out.report.kept_samples = static_cast<int>(keep.size());
+  // The window's share of the edges: the file's ends it reaches.
+  const double middle = 0.5 * (from + to);
+  int before = 0, after = 0;
+  for (double t : edge_times)
+    if (from <= t && t < to) ++(t < middle ? before : after);
+  out.report.edge_samples = before + after;
+  out.report.moving_ends = int(before > 0) + int(after > 0);
   return out;
 }
 
@@ -243,7 +339,12 @@ std::string Report::summary() const {
   if (dropped_pieces > 0)
     line += fmt::format(" ({} too short for the filter dropped with {} samples)", dropped_pieces,
                         dropped_samples);
-  line += fmt::format(", low-pass {:.3g} Hz, {} samples kept", cutoff, kept_samples);
+  line += fmt::format(", low-pass {:.3g} Hz", cutoff);
+  if (context_rows > 0) line += fmt::format(", filtered with the {} rows of its file around it", context_rows);
+  if (edge_samples > 0)
+    line += fmt::format(", {} samples within the filter's settling time ({:.3g} s) of {} moving end{} left out", edge_samples,
+                        settling_seconds, moving_ends, moving_ends == 1 ? "" : "s");
+  line += fmt::format(", {} samples kept", kept_samples);
   return line;
 }
 

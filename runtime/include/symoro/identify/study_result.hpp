@@ -20,6 +20,9 @@ struct RunRecord {
   std::string failure;
   double interval = 0;       // s
   int samples = 0;           // target-grid samples (rows of W are samples x joints)
+  // Target samples left out within the filter's settling time of a log end where the arm moves
+  // (preprocess/edges.hpp); recorded only when there are some.
+  int edge_samples = 0;
   // OLS
   double kappa = 0;          // sigma_max / sigma_min of the stacked W (paper's kappa)
   double kappa_scaled = 0;   // the same with unit-norm columns (conditioning, not units)
@@ -92,6 +95,7 @@ struct ValidationRecord {
   std::string kind = "closed-loop";  // or "open-loop"
   std::string note;                  // why open loop, or where a simulation diverged ("" if neither)
   double interval = 0;
+  int edge_samples = 0;  // as RunRecord's, of the held-out log at `interval`
   // Per joint rmse_j / rms(tau_m,j) of the accepted (rescue) vector: comparable across joints.
   Eigen::VectorXd nrmse_joint_rescue;
   double rmse_clie = 0, rmse_rescue = 0;   // N m, over all joints and samples

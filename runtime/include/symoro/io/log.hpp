@@ -28,6 +28,7 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -57,6 +58,12 @@ struct Log {
   Eigen::VectorXd time;                 // s
   Eigen::MatrixXd q, qd, tau;           // samples x joints
   Eigen::MatrixXd q_ref, qd_ref, qdd_ref;
+  // A window of a longer file (a dataset run's window, io::read_run_log): that file as read, and
+  // the row of it where this log's rows begin. Preprocessing filters the whole file and keeps
+  // this log's samples, so that a window cut in mid-motion has no filter edge (preprocess.hpp).
+  // Null for a whole file.
+  std::shared_ptr<const Log> file;
+  Eigen::Index file_row = 0;
   int samples() const { return static_cast<int>(time.size()); }
   int joints() const { return static_cast<int>(q.cols()); }  // 0 in a reference file
   bool has_references() const { return q_ref.cols() > 0; }

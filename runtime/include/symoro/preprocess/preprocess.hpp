@@ -42,6 +42,9 @@ struct Options {
   // false: the torque is only brought onto the grid (interpolated between its stamps), not
   // low-passed: the raw measured torque, against which a model is scored (identify/raw_torque.hpp).
   bool filter_torque = true;
+  // Leave out the target samples within the filter's settling time of an end where the arm
+  // moves (edges.hpp; counted in Report::edge_samples). false: keep them, transients and all.
+  bool trim_settling = true;
 };
 
 // The base period preprocess() uses for `log`: options.base_period when positive, else the
@@ -62,6 +65,14 @@ struct Report {
   int dropped_pieces = 0;
   int dropped_samples = 0;    // raw samples in the dropped pieces
   double cutoff = 0;          // Hz, the low-pass actually used
+  // Target samples within the filter's settling time (settling_seconds) of a piece's end where
+  // the arm moves, left out (edges.hpp), and how many such ends there were.
+  int edge_samples = 0;
+  int moving_ends = 0;
+  double settling_seconds = 0;
+  // A window of a longer file (io::Log::file: a dataset run's window): the file's rows around
+  // it that were filtered through and not returned. 0 for a whole log.
+  int context_rows = 0;
   int kept_samples = 0;       // target-grid samples returned
   std::string summary() const;  // one line for logs and reports
 };
@@ -75,6 +86,9 @@ struct Samples {
   Report report;
 };
 
+// A log cut from a longer file (io::Log::file, io::read_run_log) is filtered as that whole file,
+// and only the samples within its own first and last stamps are returned: a window cut in
+// mid-motion has no filter edge where it was cut, and its samples are those of the uncut file.
 // Throws DataError when the log cannot give samples at this interval (too short, interval
 // not a multiple of the base period: the message lists the nearest valid ones) or is inconsistent: time not strictly increasing, a value not
 // finite, q and tau of different shapes, stamps whose median interval is not base_period within

@@ -7,7 +7,8 @@
 // end tends to 0 whatever the true qdd, and the error decays with the filter's slowest time
 // constant tau (measured: ~1.5 |qdd_end| at the end, /4 per tau; below the encoder noise after
 // 5-6 tau, i.e. ~0.15 s at 15 Hz, ~0.5 s at 5 Hz). Logs that start and end at rest (qdd = 0)
-// are unaffected; pieces split at a long gap in mid-motion are.
+// are unaffected; pieces split at a long gap in mid-motion are: preprocess() leaves the settling
+// time at such ends out (edges.hpp).
 #pragma once
 
 #include <memory>
