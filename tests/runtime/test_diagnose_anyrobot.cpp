@@ -245,6 +245,12 @@ TEST(DiagnoseVariant, EverySelectedWidthIsKept) {
   EXPECT_NE(y.find("      smooth_coulomb: {joints: [2, 4], velocity: [0.03, 0.01]}\n"), std::string::npos) << y;
   EXPECT_NE(y.find("      offset: [5]\n"), std::string::npos) << y;
   EXPECT_EQ(y.find("# also"), std::string::npos) << y;
+  EXPECT_NE(y.find("    base: reduced\n"), std::string::npos) << y;
+  // A diagnosis of the full model: robot.yaml knows no variant "full" (symoroc refused "base: full"
+  // after dynid diagnose --apply), the full model is where every variant starts.
+  const std::string of_full = symoro::diagnose::variant_yaml(d, "diagnosed", "full");
+  EXPECT_EQ(of_full.find("base:"), std::string::npos) << of_full;
+  EXPECT_NE(of_full.find("    effects:\n"), std::string::npos) << of_full;
 }
 
 }  // namespace

@@ -310,7 +310,8 @@ std::string variant_yaml(const Diagnosis& d, const std::string& name, const std:
   if (effects.empty() && notes.empty()) return {};
   std::string y = "  " + name + ":\n";
   y += "    description: " + base + " with the effects dynid diagnose found\n";
-  y += "    base: " + base + "\n";
+  // The full model is every variant's starting point, not a variant robot.yaml can name.
+  if (base != "full") y += "    base: " + base + "\n";
   if (!effects.empty()) y += "    effects:\n" + effects;
   y += notes;
   return y;
