@@ -194,6 +194,16 @@ void run_export(const Common& common, const ExportOptions& o, const std::string&
                nearest ? "standard parameters of the nearest consistent base vector" : "consistent standard parameters",
                r.message, residual, r.lambda_min, prior_what);
     fmt::print("urdf: {}\nstandard parameters: {}, {}\n", files.urdf.string(), files.yaml.string(), files.csv.string());
+    // What a URDF consumer loses: the rotor inertia (a simulator's joint armature).
+    std::string rotor;
+    for (std::size_t k = 0; k < e.description.names.size(); ++k)
+      if (std::string(e.description.names[k].family) == "IA" && e.description.s(static_cast<Eigen::Index>(k)) != 0)
+        rotor += fmt::format("{}{} {:.6g}", rotor.empty() ? "" : ", ", e.description.names[k].name,
+                             e.description.s(static_cast<Eigen::Index>(k)));
+    if (!rotor.empty())
+      fmt::print("rotor inertia has no URDF field: the URDF holds it only as comments, which URDF readers ignore; a "
+                 "simulator takes it from {} (MuJoCo: each joint's armature): {}\n",
+                 files.yaml.string(), rotor);
   }
 }
 

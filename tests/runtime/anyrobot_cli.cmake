@@ -85,6 +85,8 @@ foreach(robot rx90 stanford_rrp)
   expect("${out}" "holds the parameters of model full")
   run(0 out export --robot ${robot} --study ${w}/study-${after} --urdf ${w}/urdf/${robot}.urdf --prior zero --nearest)
   expect("${out}" "urdf: .*${robot}.urdf")
+  # The rotor inertia the URDF cannot hold is said, with where a simulator takes it from.
+  expect("${out}" "rotor inertia has no URDF field: .*${robot}.standard.yaml \\(MuJoCo: each joint's armature\\): IA[0-9]")
   foreach(f ${robot}.urdf ${robot}.standard.yaml ${robot}.standard.csv)
     if(NOT EXISTS ${w}/urdf/${f})
       message(FATAL_ERROR "dynid export wrote no ${f}")
