@@ -812,16 +812,22 @@ TEST(PreprocessReport, SummaryIsOneLine) {
 
 namespace {
 
+// A log of n rows and `joints` joints on the 1 ms period, its values to be filled in.
+symoro::io::Log sized_log(const char* name, int n, int joints) {
+  symoro::io::Log log;
+  log.meta.trajectory = name;
+  log.meta.sample_time = kH;
+  log.time.resize(n);
+  log.q.resize(n, joints);
+  log.qd.resize(n, joints);
+  log.tau.resize(n, joints);
+  return log;
+}
+
 // q = 0.8 sin(pi t) rad on exact 1 ms stamps from t = 0, qd its derivative, a smooth tau.
 symoro::io::Log clean_sine_log(double seconds) {
   const int n = static_cast<int>(std::lround(seconds / kH)) + 1;
-  symoro::io::Log log;
-  log.meta.trajectory = "sine";
-  log.meta.sample_time = kH;
-  log.time.resize(n);
-  log.q.resize(n, 1);
-  log.qd.resize(n, 1);
-  log.tau.resize(n, 1);
+  symoro::io::Log log = sized_log("sine", n, 1);
   for (int k = 0; k < n; ++k) {
     const double t = k * kH;
     log.time[k] = t;
@@ -1078,13 +1084,7 @@ TEST(PreprocessEdges, MovingEndsLoseTheSettlingTimeAndWhatRemainsIsTheMotion) {
 TEST(PreprocessEdges, EndsAtRestKeepEverySample) {
   const double seconds = 10, w = 2 * kPi / seconds;
   const int n = static_cast<int>(seconds / kH) + 1;
-  symoro::io::Log log;
-  log.meta.trajectory = "rest to rest";
-  log.meta.sample_time = kH;
-  log.time.resize(n);
-  log.q.resize(n, 2);
-  log.qd.resize(n, 2);
-  log.tau.resize(n, 2);
+  symoro::io::Log log = sized_log("rest to rest", n, 2);
   for (int k = 0; k < n; ++k) {
     const double t = k * kH;
     log.time[k] = t;
