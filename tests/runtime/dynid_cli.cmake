@@ -88,6 +88,15 @@ file(READ ${WORK}/hidden/dataset.yaml manifest)
 expect("${manifest}" "twin_overrides: \"?twin_overrides.yaml\"?")
 file(READ ${WORK}/hidden/twin_overrides.yaml kept)
 expect("${kept}" "torque: \\[0, 0, 0, 0, 0.02")
+# A split of a log with references (a controller's): the held-out window starts in mid-motion,
+# where no grid point of the whole file need fall; it is filtered as the whole file, and its
+# closed loop, from its own first row, still meets its samples at whole cycles.
+file(WRITE ${WORK}/window/dataset.yaml "format: symoro-dataset 1\nrobot: \"crane_x7\"\nruns:\n"
+  "  - {trajectory: \"V01\", family: \"AG\", trial: 1, file: \"${WORK}/hidden/V01_t1.csv\", window: [-.inf, 10.0213]}\n"
+  "  - {trajectory: \"V01_held\", family: \"V\", trial: 1, file: \"${WORK}/hidden/V01_t1.csv\", window: [10.0213, .inf]}\n")
+run(0 out identify --robot crane_x7 --data ${WORK}/window -o ${WORK}/window/study --only V01 --interval 10
+    --validation V01_held --no-report)
+expect("${out}" "validation V01_held at 10 ms, closed-loop: RMSE")
 # Models by name: an unknown one is named with the robot's compiled models.
 run(2 out diagnose --robot crane_x7 --data ${ds} -o ${WORK}/diag --model nope)
 expect("${out}" "no compiled model 'nope' \\(it has: full, reduced, reduced_diagnosed")

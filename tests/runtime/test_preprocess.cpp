@@ -1140,11 +1140,17 @@ TEST(PreprocessEdges, AWindowIsTheUncutFilesSamples) {
     EXPECT_EQ(s.report.raw_samples, part.samples());
     EXPECT_EQ(s.report.moving_ends, 1) << run->trajectory << ": only the file's own end is an edge";
     ASSERT_GT(s.time.size(), 100);
-    // The uncut file's samples at the same instants.
+    // The uncut file's samples at the same instants: its times count from the file's first stamp,
+    // the window's from its own first stamp (a closed loop's cycle 0), each in whole base periods;
+    // they differ by the two first stamps' jitter.
+    for (Eigen::Index i = 0; i < s.time.size(); ++i) {
+      const double cycles = (s.time[i] - part.time(0)) / kH;
+      EXPECT_NEAR(cycles, std::round(cycles), 1e-6);
+    }
     Eigen::Index at = 0;
-    while (at < whole.time.size() && whole.time[at] < s.time[0] - 1e-9) ++at;
+    while (at < whole.time.size() && whole.time[at] < s.time[0] - 0.5 * kH) ++at;
     ASSERT_LE(at + s.time.size(), whole.time.size());
-    EXPECT_NEAR(whole.time[at], s.time[0], 1e-12);
+    EXPECT_NEAR(whole.time[at], s.time[0], 2 * r.jitter + 1e-12);  // both first stamps jitter
     for (auto [a, b] : {std::pair{&s.q, &whole.q}, std::pair{&s.qdd, &whole.qdd}, std::pair{&s.tau, &whole.tau}})
       EXPECT_LT((*a - b->middleRows(at, s.time.size())).cwiseAbs().maxCoeff(), 1e-12 * (1 + b->cwiseAbs().maxCoeff()));
     // The same window on a clock that starts at its first row (the study's).

@@ -291,8 +291,8 @@ Samples preprocess(const io::Log& log, double interval, const Options& options) 
   double offset = 0;
   const io::Log* file = source_file(log, offset);
   if (!file) return preprocess_whole(log, interval, options, edge_times);
-  // The whole file, on the window's clock and under its name; then the samples within the
-  // window's first and last stamps (half a base period of slack: stamps jitter about the grid).
+  // The whole file, on the window's clock and under its name; then the samples on the base-grid
+  // points of the window's first to last rows.
   io::Log whole;
   whole.meta = log.meta;
   whole.time = file->time.array() + offset;
@@ -300,18 +300,24 @@ Samples preprocess(const io::Log& log, double interval, const Options& options) 
   whole.qd = file->qd;
   whole.tau = file->tau;
   Samples all = preprocess_whole(whole, interval, options, edge_times);
-  const double slack = 0.5 * all.report.base_period;
-  const double from = log.time(0) - slack, to = log.time(log.samples() - 1) + slack;
+  const double period = all.report.base_period, t0 = whole.time(0);
+  const auto grid_index = [&](double t) { return std::llround((t - t0) / period); };
+  const long long first = grid_index(log.time(0)), last = grid_index(log.time(log.samples() - 1));
   std::vector<Eigen::Index> keep;
   for (Eigen::Index k = 0; k < all.time.size(); ++k)
-    if (from <= all.time(k) && all.time(k) < to) keep.push_back(k);
+    if (const long long i = grid_index(all.time(k)); first <= i && i <= last) keep.push_back(k);
   if (keep.empty())
     throw DataError(log.meta.trajectory.empty() ? "log" : log.meta.trajectory, 0,
                     fmt::format("no sample at {} s intervals is left within the window [{}, {}] s", interval,
                                 log.time(0), log.time(log.samples() - 1)));
   Samples out;
   out.interval = interval;
-  out.time = all.time(keep);
+  // Times from the window's first stamp in whole base periods, as a log cut there has them (a
+  // closed loop's cycle 0 is that row): the grid point of that row, not the file's first stamp,
+  // is the origin (they differ by the row's stamp jitter).
+  out.time.resize(static_cast<Eigen::Index>(keep.size()));
+  for (std::size_t k = 0; k < keep.size(); ++k)
+    out.time(static_cast<Eigen::Index>(k)) = log.time(0) + static_cast<double>(grid_index(all.time(keep[k])) - first) * period;
   for (auto [to_m, from_m] : {std::pair{&out.q, &all.q}, std::pair{&out.qd, &all.qd}, std::pair{&out.qdd, &all.qdd},
                               std::pair{&out.tau, &all.tau}})
     *to_m = (*from_m)(keep, Eigen::all);
@@ -321,10 +327,10 @@ Samples preprocess(const io::Log& log, double interval, const Options& options) 
   out.report.context_rows = file->samples() - log.samples();
   out.report.kept_samples = static_cast<int>(keep.size());
   // The window's share of the edges: the file's ends it reaches.
-  const double middle = 0.5 * (from + to);
+  const long long middle = (first + last) / 2;
   int before = 0, after = 0;
   for (double t : edge_times)
-    if (from <= t && t < to) ++(t < middle ? before : after);
+    if (const long long i = grid_index(t); first <= i && i <= last) ++(i < middle ? before : after);
   out.report.edge_samples = before + after;
   out.report.moving_ends = int(before > 0) + int(after > 0);
   return out;
