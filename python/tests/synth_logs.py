@@ -25,8 +25,8 @@ def true_phi(arm=ARM):
 
 def ramp(t, seconds, rise=1.0):
     """A smooth window 0 -> 1 -> 0 (quintic rise and fall over `rise` s) and its two derivatives:
-    the logs start and end at rest, as a recording does (the study's zero-phase filter has end
-    transients on a log cut in mid-motion)."""
+    the logs start and end at rest, as a recording does (a log cut in mid-motion loses the
+    zero-phase filter's settling time at its ends; these keep every sample)."""
     def up(x):
         x = np.clip(x, 0, 1)
         inside = (x > 0) & (x < 1)
