@@ -61,7 +61,12 @@ py::dict prediction_dict(const std::string& name, const identify::Prediction& p)
   x["rmse"] = p.rmse;
   x["rms"] = p.rms;
   x["raw_rmse"] = p.raw.error.rmse_joint;
+  x["raw_rmse_overall"] = p.raw.error.rmse;
   x["raw_samples"] = p.raw.samples;
+  // What the preprocessing left out or filtered through (preprocess/edges.hpp), and its line.
+  x["edge_samples"] = p.samples.report.edge_samples;
+  x["context_rows"] = p.samples.report.context_rows;
+  x["preprocessing"] = p.samples.report.summary();
   return x;
 }
 
@@ -100,7 +105,7 @@ void bind_results(py::module_& m) {
   }, py::arg("model"), py::arg("params"), py::arg("input"), py::kw_only(), py::arg("interval_ms") = 10.0,
      py::arg("torque_delay_ms") = 0.0, py::arg("trial") = 1, py::arg("robot_dir") = py::none(),
      "The model's torque on a log or a dataset's runs: a list of {'name', 'time', 'q', 'qd', 'qdd', 'tau', 'tau_model', "
-     "'rmse', 'rms', 'raw_rmse', 'raw_samples'}; params: an array, a parameters file or 'nominal' (with robot_dir)");
+     "'rmse', 'rms', 'raw_rmse', 'raw_rmse_overall', 'raw_samples', 'edge_samples', 'context_rows', 'preprocessing'}; params: an array, a parameters file or 'nominal' (with robot_dir)");
 
   m.def("compare", [](const std::filesystem::path& before_dir, const std::filesystem::path& after_dir,
                       const std::filesystem::path& out, const std::string& trajectory, const std::vector<int>& joints) {

@@ -88,6 +88,12 @@ def test_the_held_out_raw_score_is_what_numpy_gives(tmp_path, robot):
     predicted = symoro.predict(arm, study["phi"], tmp_path / "data", interval_ms=10)
     raw = [p for p in predicted if p["name"] == "cut_heldout"][0]["raw_rmse"]
     assert raw.mean() == pytest.approx(mean_joint, rel=0.05)
+    held_prediction = [p for p in predicted if p["name"] == "cut_heldout"][0]
+    assert held_prediction["raw_rmse_overall"] == pytest.approx(held[0]["raw_rmse_rescue"], rel=1e-12)
+    # The held-out window reaches the log's moving end: its settling time is left out and said; the
+    # fitting part of the file around it was filtered through.
+    assert held_prediction["edge_samples"] > 0 and held_prediction["context_rows"] > 10000
+    assert "moving end left out" in held_prediction["preprocessing"]
     assert np.sqrt(np.mean(raw**2)) == pytest.approx(held[0]["raw_rmse_rescue"], rel=1e-12)
     # At what the truth itself scores (the torque's noise and the 16-bit encoder's quantization through
     # the acceleration: 0.14 N m on the RX-90), not twice that.
