@@ -45,6 +45,7 @@ struct ExciteOptions {
   double table = -1;                    // m below frame 0; < 0: none
   std::vector<std::string> half_spaces;  // "frame:nx,ny,nz:offset"
   double interval_ms = 10;
+  std::vector<std::string> compare;  // logs of reference motions rated beside the design
 };
 
 std::vector<double> numbers_of(const std::string& text, char sep, const std::string& what) {
@@ -275,6 +276,7 @@ void run(const Common& common, const ExciteOptions& o) {
   // 4. The excitation quality of each, side by side.
   TrajectoryOptions to;
   to.interval_ms = o.interval_ms;
+  to.compare = o.compare;
   const std::string table = trajectory_quality_table(common, all, to, o.model);
   fmt::print("{}", table);
   io::write_file_atomically(fs::path(o.out) / "quality.txt", table);
@@ -310,6 +312,9 @@ void add_excite_commands(CLI::App& app, Common& common) {
   cmd->add_option("--table", o->table, "A table this far below frame 0's origin (m, along gravity): every frame origin "
                                        "from 3 on stays above it (1 cm clearance)");
   cmd->add_option("--half-space", o->half_spaces, "frame:nx,ny,nz:offset: that frame's origin p keeps n.p <= offset (m, frame 0)");
+  cmd->add_option("--compare", o->compare, "Logs of reference motions (e.g. a published trajectory's recording, imported) "
+                                            "rated beside the design in the quality table")
+      ->check(CLI::ExistingFile);
   cmd->add_option("--interval", o->interval_ms, "Sampling interval of the quality table, ms")->check(numbers::interval_ms())->capture_default_str();
   cmd->callback([&common, o] { run(common, *o); });
 }

@@ -1,15 +1,21 @@
 // dynid trajectories: list the robot's designed identification trajectories or write them as
 // reference files (time, q_ref, qd_ref, qdd_ref at the control period).
+#include <algorithm>
+#include <cmath>
 #include <filesystem>
+#include <limits>
 
 #include <CLI/CLI.hpp>
+#include <Eigen/Cholesky>
 #include <fmt/format.h>
 
 #include "dynid_numbers.hpp"
 #include "dynid_robots.hpp"
 #include "dynid_trajectories.hpp"
 #include "symoro/identify/excitation_quality.hpp"
+#include "symoro/identify/study_options.hpp"
 #include "symoro/io/log.hpp"
+#include "symoro/preprocess/preprocess.hpp"
 #include "symoro/trajectory/design.hpp"
 
 namespace symoro::dynid {
@@ -21,25 +27,49 @@ std::string trajectory_quality_table(const Common& common, const std::vector<tra
   const identify::ModelDescription& d = model->description();
   const double interval = o.interval_ms / 1000;
   out += fmt::format("excitation of {} model {} ({} base parameters) at {:.0f} ms: kappa of W, kappa of W and log det of W'W with "
-                     "unit columns (<= 0, 0 when the columns are orthogonal), the weakest direction's largest components\n",
+                     "unit columns (<= 0, 0 when the columns are orthogonal), log det of W'W / N per sample (the model's SI "
+                     "units, N samples: larger is more information per sample), the weakest direction's largest components\n",
              common.robot, d.variant.empty() ? "full" : d.variant, d.np, o.interval_ms);
-  out += fmt::format("{:<6} {:<4} {:>8} {:>11} {:>11} {:>10}  {}\n", "name", "fam", "duration", "kappa", "kappa_scl", "logdet_scl",
-             "weakest");
-  auto row = [&](const std::string& name, const std::string& family, double duration, const identify::ExcitationQuality& q) {
+  out += fmt::format("{:<6} {:<4} {:>8} {:>11} {:>11} {:>10} {:>10}  {}\n", "name", "fam", "duration", "kappa", "kappa_scl",
+                     "logdet_scl", "logdet/N", "weakest");
+  auto row = [&](const std::string& name, const std::string& family, double duration, const Eigen::MatrixXd& W) {
+    const identify::ExcitationQuality q = identify::excitation_quality(W, d.parameters);
     std::string weakest;
     if (!q.unexcited.empty()) weakest = fmt::format("{} parameters not excited (e.g. {})", q.unexcited.size(), q.unexcited.front());
     for (const auto& [p, v] : q.weakest) weakest += fmt::format("{}{} {:+.2f}", weakest.empty() ? "" : ", ", p, v);
-    out += fmt::format("{:<6} {:<4} {:>7.1f}s {:>11.4g} {:>11.4g} {:>10.3f}  {}\n", name, family, duration, q.kappa, q.kappa_scaled,
-               q.log_det_scaled, weakest);
+    // log det (W'W / N) = 2 sum log diag(L), L L' = W'W / N; -inf when W'W is singular.
+    const double samples = static_cast<double>(W.rows() / std::max(1, d.nq));
+    const Eigen::LLT<Eigen::MatrixXd> llt(Eigen::MatrixXd(W.transpose() * W) / samples);
+    const double per_sample = llt.info() == Eigen::Success && llt.matrixLLT().diagonal().minCoeff() > 0
+                                  ? 2 * llt.matrixLLT().diagonal().array().log().sum()
+                                  : -std::numeric_limits<double>::infinity();
+    out += fmt::format("{:<6} {:<4} {:>7.1f}s {:>11.4g} {:>11.4g} {:>10.3f} {:>10.2f}  {}\n", name, family, duration, q.kappa,
+                       q.kappa_scaled, q.log_det_scaled, per_sample, weakest);
   };
   std::vector<Eigen::MatrixXd> Ws;
   Eigen::Index rows = 0;
   double total = 0;
   for (const auto& t : trajectories) {
     Ws.push_back(model->stack_regression(identify::reference_samples(trajectory::sample(t, o.period), interval)).W);
-    row(t.name, t.family, t.duration(), identify::excitation_quality(Ws.back(), d.parameters));
+    row(t.name, t.family, t.duration(), Ws.back());
     rows += Ws.back().rows();
     total += t.duration();
+  }
+  // The reference motions the user compares with (not in the stacked design below).
+  for (const auto& file : o.compare) {
+    const io::Log log = io::read_log(file);
+    if (log.joints() != d.nq && !log.has_references())
+      throw UsageError(fmt::format("--compare {}: {} joints, the model {}", file, log.joints(), d.nq));
+    const std::string name = std::filesystem::path(file).stem().string();
+    const double duration = log.time(log.samples() - 1) - log.time(0);
+    if (log.has_references()) {
+      const auto period = log.meta.sample_time > 0 ? log.meta.sample_time : o.period;
+      row(name, "ref", duration,
+          model->stack_regression(identify::reference_samples(trajectory::sampled_reference(log, period), interval)).W);
+    } else {
+      row(name, "ref", duration,
+          model->stack_regression(preprocess::preprocess(log, interval, identify::StudyOptions{}.preprocess)).W);
+    }
   }
   // All of them stacked: the design as a whole.
   Eigen::MatrixXd all(rows, d.np);
@@ -48,7 +78,7 @@ std::string trajectory_quality_table(const Common& common, const std::vector<tra
     all.middleRows(at, W.rows()) = W;
     at += W.rows();
   }
-  if (trajectories.size() > 1) row("all", "", total, identify::excitation_quality(all, d.parameters));
+  if (trajectories.size() > 1) row("all", "", total, all);
   return out;
 }
 
@@ -98,6 +128,9 @@ void add_trajectory_commands(CLI::App& app, Common& common) {
   cmd->add_option("--interval", o->interval_ms, "Sampling interval of --quality, ms (as in identification)")
       ->check(numbers::interval_ms())
       ->capture_default_str();
+  cmd->add_option("--compare", o->compare, "With --quality: logs of reference motions (e.g. a published trajectory's "
+                                            "recording, imported) rated beside the design")
+      ->check(CLI::ExistingFile);
   cmd->callback([&common, o] { run_trajectories(common, *o); });
 }
 

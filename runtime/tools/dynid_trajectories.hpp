@@ -16,6 +16,10 @@ struct TrajectoryOptions {
   double period = 0.001;
   bool quality = false;      // print each trajectory's excitation quality (identify/excitation_quality.hpp)
   double interval_ms = 10;   // ... at this sampling interval
+  // Logs (symoro-log CSV, e.g. dynid import's) of reference motions rated beside the designed
+  // ones: their reference columns when they have them, else their measured motion as the study
+  // preprocesses it (a published trajectory's recording).
+  std::vector<std::string> compare;
 };
 
 // The excitation quality of each trajectory and of all of them together, for the robot's model

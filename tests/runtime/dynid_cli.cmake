@@ -97,6 +97,17 @@ file(WRITE ${WORK}/window/dataset.yaml "format: symoro-dataset 1\nrobot: \"crane
 run(0 out identify --robot crane_x7 --data ${WORK}/window -o ${WORK}/window/study --only V01 --interval 10
     --validation V01_held --no-report)
 expect("${out}" "validation V01_held at 10 ms, closed-loop: RMSE")
+# A recorded motion rated beside the design (--compare): the twin's log of V01 replays V01's
+# reference, so its row must carry the designed V01's numbers exactly.
+run(0 out trajectories --robot crane_x7 --quality --only V01 --compare ${WORK}/hidden/V01_t1.csv)
+string(REGEX MATCH "\nV01 +V +[0-9.]+s +([^\n]+)" designed "${out}")
+set(designed "${CMAKE_MATCH_1}")
+string(REGEX MATCH "\nV01_t1 +ref +[0-9.]+s +([^\n]+)" recorded "${out}")
+set(recorded "${CMAKE_MATCH_1}")
+if(designed STREQUAL "" OR NOT designed STREQUAL recorded)
+  message(FATAL_ERROR "--compare: the recorded V01 is not rated as the designed one:\n${out}")
+endif()
+expect("${out}" "logdet/N")
 # Models by name: an unknown one is named with the robot's compiled models.
 run(2 out diagnose --robot crane_x7 --data ${ds} -o ${WORK}/diag --model nope)
 expect("${out}" "no compiled model 'nope' \\(it has: full, reduced, reduced_diagnosed")
