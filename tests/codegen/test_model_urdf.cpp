@@ -21,6 +21,7 @@
 #include <kdl/chainidsolver_recursive_newton_euler.hpp>
 #include <urdf_parser/urdf_parser.h>
 
+#include "../removed_at_exit.hpp"
 #include "dynid_urdf_into.hpp"
 #include "relative_difference.hpp"
 #include "symoro/codegen/graph_evaluator.hpp"
@@ -100,7 +101,7 @@ using test::relative_difference;
 void expect_matches_kdl(const Case& c) {
   SCOPED_TRACE(c.label);
   const Modeling m = model_from_urdf(c.urdf.string(), c.options);
-  const fs::path dir = fs::temp_directory_path() / ("symoro_urdf_" + std::to_string(::getpid())) / m.robot;
+  const fs::path dir = symoro::test::removed_at_exit("symoro_urdf_" + std::to_string(::getpid())) / m.robot;
   fs::create_directories(dir);
   for (const auto& f : m.files) std::ofstream(dir / f.name) << f.text;
   RobotModel ours = load_robot(dir.string());
@@ -222,7 +223,7 @@ const char* kTestArm = R"(<?xml version="1.0"?>
 )";
 
 TEST(ModelFromUrdf, EveryKindOfJointMatchesKdl) {
-  const fs::path p = fs::temp_directory_path() / ("symoro_test_arm_" + std::to_string(::getpid()) + ".urdf");
+  const fs::path p = symoro::test::removed_at_exit("symoro_test_arm_" + std::to_string(::getpid()) + ".urdf");
   std::ofstream(p) << kTestArm;
   Case c{"test arm", p, {}};
   c.options.base_link = "base";
@@ -239,7 +240,7 @@ namespace {
 
 // The message of the error model_from_urdf raises on `text`.
 std::string error_of(const std::string& text, ModelingOptions o = {}) {
-  const fs::path p = fs::temp_directory_path() / ("symoro_bad_" + std::to_string(::getpid()) + ".urdf");
+  const fs::path p = symoro::test::removed_at_exit("symoro_bad_" + std::to_string(::getpid()) + ".urdf");
   std::ofstream(p) << text;
   try {
     model_from_urdf(p.string(), o);
@@ -277,7 +278,7 @@ TEST(ModelFromUrdf, BadInputIsNamed) {
   lock.locked = {{"j1", 0.1}};
   EXPECT_NE(error_of(arm(fixed), lock).find("--lock j1: not a moving joint off the chain"), std::string::npos);
   // An inconsistent inertial is a warning that names the link, not an error.
-  const fs::path p = fs::temp_directory_path() / ("symoro_warn_" + std::to_string(::getpid()) + ".urdf");
+  const fs::path p = symoro::test::removed_at_exit("symoro_warn_" + std::to_string(::getpid()) + ".urdf");
   std::ofstream(p) << R"(<robot name="w"><link name="b"/><link name="l1"><inertial><mass value="1"/><inertia ixx="1" ixy="0" ixz="0" iyy="1" iyz="0" izz="3"/></inertial></link>
 <joint name="j1" type="revolute"><parent link="b"/><child link="l1"/><axis xyz="0 0 1"/><limit lower="-1" upper="1" velocity="1" effort="1"/></joint></robot>)";
   const Modeling m = model_from_urdf(p.string());
@@ -319,7 +320,7 @@ void expect_written_into(double extra_mass, bool expect_whole) {
   o.locked = {{"panda_finger_joint1", 0.02}, {"panda_finger_joint2", 0.02}};
   const fs::path user = kUrdfs / "panda.urdf";
   const Modeling m = model_from_urdf(user.string(), o);
-  const fs::path dir = fs::temp_directory_path() / ("symoro_into_" + std::to_string(::getpid())) / m.robot;
+  const fs::path dir = symoro::test::removed_at_exit("symoro_into_" + std::to_string(::getpid())) / m.robot;
   fs::create_directories(dir);
   for (const auto& f : m.files) std::ofstream(dir / f.name) << f.text;
   const RobotModel r = load_robot(dir.string());

@@ -11,6 +11,7 @@
 #include <fstream>
 #include <random>
 
+#include "../removed_at_exit.hpp"
 #include "relative_difference.hpp"
 #include "symoro/codegen/graph_evaluator.hpp"
 #include "symoro/codegen/modeling.hpp"
@@ -33,7 +34,7 @@ fs::path par_of(const fs::path& dir) {
 // The robot folder symoroc model writes, with the robot's robot.yaml copied in.
 fs::path model_folder(const std::string& robot, int frame) {
   const fs::path src = kRobots / robot;
-  const fs::path out = fs::temp_directory_path() / ("symoro_model_" + std::to_string(::getpid())) / robot;
+  const fs::path out = symoro::test::removed_at_exit("symoro_model_" + std::to_string(::getpid())) / robot;
   fs::create_directories(out);
   const fs::path par = par_of(src);
   fs::copy_file(par, out / par.filename(), fs::copy_options::overwrite_existing);

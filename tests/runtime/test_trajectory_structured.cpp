@@ -20,6 +20,7 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include "../removed_at_exit.hpp"
 #include "symoro/error.hpp"
 #include "symoro/trajectory/design.hpp"
 #include "symoro/trajectory/fourier.hpp"
@@ -38,7 +39,7 @@ std::vector<JointInfo> joints_of() {
 }
 
 fs::path write_temp(const std::string& name, const std::string& text) {
-  const fs::path dir = fs::temp_directory_path() / ("symoro_structured_" + std::to_string(::getpid()));
+  const fs::path dir = symoro::test::removed_at_exit("symoro_structured_" + std::to_string(::getpid()));
   fs::create_directories(dir);
   std::ofstream(dir / name) << text;
   return dir / name;
