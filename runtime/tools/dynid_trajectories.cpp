@@ -58,8 +58,8 @@ std::string trajectory_quality_table(const Common& common, const std::vector<tra
   // The reference motions the user compares with (not in the stacked design below).
   for (const auto& file : o.compare) {
     const io::Log log = io::read_log(file);
-    if (log.joints() != d.nq && !log.has_references())
-      throw UsageError(fmt::format("--compare {}: {} joints, the model {}", file, log.joints(), d.nq));
+    const auto joints = log.has_references() ? log.q_ref.cols() : log.joints();
+    if (joints != d.nq) throw UsageError(fmt::format("--compare {}: {} joints, the model {}", file, joints, d.nq));
     const std::string name = std::filesystem::path(file).stem().string();
     const double duration = log.time(log.samples() - 1) - log.time(0);
     if (log.has_references()) {

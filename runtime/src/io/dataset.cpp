@@ -174,14 +174,20 @@ Log read_run_log(const DatasetRun& run) {
                                 run.trajectory, number_text(run.window_start), number_text(run.window_end),
                                 number_text(log.time[0]), number_text(log.time[log.samples() - 1])));
   // The window's rows are contiguous (time increases): the file stays with the window.
-  auto file = std::make_shared<const Log>(log);
-  log.file = file;
-  log.file_row = rows.front();
-  Eigen::VectorXd time(static_cast<Eigen::Index>(rows.size()));
-  for (std::size_t i = 0; i < rows.size(); ++i) time[static_cast<Eigen::Index>(i)] = log.time[rows[i]];
-  log.time = std::move(time);
-  for (Eigen::MatrixXd* m : {&log.q, &log.qd, &log.tau, &log.q_ref, &log.qd_ref, &log.qdd_ref}) *m = rows_of(*m, rows);
-  return log;
+  const auto file = std::make_shared<const Log>(std::move(log));
+  Log window;
+  window.meta = file->meta;
+  window.file = file;
+  window.file_row = rows.front();
+  window.time.resize(static_cast<Eigen::Index>(rows.size()));
+  for (std::size_t i = 0; i < rows.size(); ++i) window.time[static_cast<Eigen::Index>(i)] = file->time[rows[i]];
+  window.q = rows_of(file->q, rows);
+  window.qd = rows_of(file->qd, rows);
+  window.tau = rows_of(file->tau, rows);
+  window.q_ref = rows_of(file->q_ref, rows);
+  window.qd_ref = rows_of(file->qd_ref, rows);
+  window.qdd_ref = rows_of(file->qdd_ref, rows);
+  return window;
 }
 
 Log read_run_log(const DatasetRun& run, const std::string& robot, int joints) {

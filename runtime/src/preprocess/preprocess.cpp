@@ -266,15 +266,15 @@ Samples preprocess_whole(const io::Log& raw, double interval, const Options& opt
 }
 
 // The file `log` was cut from, when its rows are that file's rows file_row.. (same q, tau and qd,
-// stamps moved by one offset: a caller may count time from the window's start): else null, and
-// the window is filtered alone.
-const io::Log* source_file(const io::Log& log, double& offset) {
+// the same sample_time, stamps moved by one offset: a caller may count time from the window's
+// start): else null, and the window is filtered alone.
+const io::Log* source_file(const io::Log& log) {
   const io::Log* file = log.file.get();
   const Eigen::Index n = log.samples(), first = log.file_row;
   if (!file || n == 0 || first < 0 || first + n > file->samples() || file->joints() != log.joints() ||
-      file->qd.cols() != log.qd.cols())
+      file->qd.cols() != log.qd.cols() || file->meta.sample_time != log.meta.sample_time)
     return nullptr;
-  offset = log.time(0) - file->time(first);
+  const double offset = log.time(0) - file->time(first);
   for (Eigen::Index k = 0; k < n; ++k)
     if (std::abs(file->time(first + k) + offset - log.time(k)) > 1e-9 * std::max(1.0, std::abs(log.time(k)))) return nullptr;
   const auto same = [&](const Eigen::MatrixXd& window, const Eigen::MatrixXd& whole) {
@@ -288,21 +288,14 @@ const io::Log* source_file(const io::Log& log, double& offset) {
 
 Samples preprocess(const io::Log& log, double interval, const Options& options) {
   std::vector<double> edge_times;
-  double offset = 0;
-  const io::Log* file = source_file(log, offset);
+  const io::Log* file = source_file(log);
   if (!file) return preprocess_whole(log, interval, options, edge_times);
-  // The whole file, on the window's clock and under its name; then the samples on the base-grid
-  // points of the window's first to last rows.
-  io::Log whole;
-  whole.meta = log.meta;
-  whole.time = file->time.array() + offset;
-  whole.q = file->q;
-  whole.qd = file->qd;
-  whole.tau = file->tau;
-  Samples all = preprocess_whole(whole, interval, options, edge_times);
-  const double period = all.report.base_period, t0 = whole.time(0);
+  // The whole file, on its own clock; then the samples on the base-grid points of the window's
+  // first to last rows.
+  Samples all = preprocess_whole(*file, interval, options, edge_times);
+  const double period = all.report.base_period, t0 = file->time(0);
   const auto grid_index = [&](double t) { return std::llround((t - t0) / period); };
-  const long long first = grid_index(log.time(0)), last = grid_index(log.time(log.samples() - 1));
+  const long long first = grid_index(file->time(log.file_row)), last = grid_index(file->time(log.file_row + log.samples() - 1));
   std::vector<Eigen::Index> keep;
   for (Eigen::Index k = 0; k < all.time.size(); ++k)
     if (const long long i = grid_index(all.time(k)); first <= i && i <= last) keep.push_back(k);
@@ -312,9 +305,9 @@ Samples preprocess(const io::Log& log, double interval, const Options& options) 
                                 log.time(0), log.time(log.samples() - 1)));
   Samples out;
   out.interval = interval;
-  // Times from the window's first stamp in whole base periods, as a log cut there has them (a
-  // closed loop's cycle 0 is that row): the grid point of that row, not the file's first stamp,
-  // is the origin (they differ by the row's stamp jitter).
+  // Times from the window's first stamp, on the caller's clock, in whole base periods, as a log cut
+  // there has them (a closed loop's cycle 0 is that row): the grid point of that row, not the
+  // file's first stamp, is the origin (they differ by the row's stamp jitter).
   out.time.resize(static_cast<Eigen::Index>(keep.size()));
   for (std::size_t k = 0; k < keep.size(); ++k)
     out.time(static_cast<Eigen::Index>(k)) = log.time(0) + static_cast<double>(grid_index(all.time(keep[k])) - first) * period;
