@@ -11,6 +11,7 @@
 #include <symoro/dynamixel/virtual_bus.hpp>
 #include <symoro/hardware/config.hpp>
 #include <symoro/hardware/controller.hpp>
+#include <symoro/hardware/loop_clock.hpp>
 #include <symoro/io/parameters_yaml.hpp>
 #include <symoro/robot/compiled_model.hpp>
 #include <symoro/twin_bus/twin_servo_backend.hpp>
@@ -101,9 +102,18 @@ struct Realtime {
   bool on = false;
 };
 
+// The arm and the loop run on the rig's stepped clock (hardware/loop_clock.hpp; run() gives it
+// to the loop): no time passes on the arm while the host is slow, so a loaded machine cannot move
+// it between cycles. Paced (the default), the loop still keeps real time, so that signals and
+// fault injectors meet it when they would meet the arm; unpaced it runs as fast as the bus.
 struct Rig {
-  Rig(const twin::TwinConfig& twin, const HardwareConfig& h, const trajectory::Trajectory& traj)
-      : hw(h), realtime(), virt(virtual_servos(h), make_backend(twin, h, traj)), port(virt.device(), h.baud), bus(port) {
+  Rig(const twin::TwinConfig& twin, const HardwareConfig& h, const trajectory::Trajectory& traj, bool paced = true)
+      : hw(h),
+        realtime(),
+        clock(paced),
+        virt(virtual_servos(h), make_backend(twin, h, traj), [this] { return clock.seconds(); }),
+        port(virt.device(), h.baud),
+        bus(port) {
     realtime.release();  // the virtual servos' thread keeps it
   }
 
@@ -127,6 +137,7 @@ struct Rig {
 
   HardwareConfig hw;
   Realtime realtime;  // while the virtual bus's thread starts
+  SteppedClock clock;
   TwinServoBackend* backend = nullptr;
   dynamixel::VirtualBus virt;
   dynamixel::SerialPort port;
@@ -166,6 +177,7 @@ class HardwareControl : public ::testing::Test {
     std::atomic<double> timeline{-1e9};
     std::atomic<bool> finished{false};
     o.timeline = &timeline;
+    if (!o.clock) o.clock = &rig.clock;
     std::thread injector;
     if (inject)
       injector = std::thread([&rig, &timeline, &finished, after, inject] {

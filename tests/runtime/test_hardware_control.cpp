@@ -39,99 +39,94 @@ TEST_F(HardwareControl, TracksFiveSecondsOverThePtyLikeTheTwin) {
   const trajectory::Trajectory traj = first_seconds("AG02", 5.0);
   ASSERT_GE(traj.duration(), 5.0);
   ASSERT_LE(traj.duration(), 12.0);
-  // What the loop could control: a row is judged only when the 1 kHz loop ran undisturbed over
-  // the settling time before it (5 / w of the slowest joint's error dynamics, K_P = w^2: a
-  // disturbance has decayed to under 1 %). A stall of a loaded machine (a skipped deadline, a
-  // failed sync read: the arm runs on held currents meanwhile) shows in the log as a gap in the
-  // time stamps, since only fresh cycles write a row. The bounds below never change. A stall is
-  // the host's (this test runs alone, RUN_SERIAL), and the process's first run stalls most (here
-  // 1882-2548 of ~5600 rows judged against 3102-4560 for the second, also in CI): a run that
-  // leaves fewer than half of its rows to judge is repeated, up to three runs; if none does, the
-  // test fails, saying so.
-  const double settle = 5 / gains_.kp.cwiseSqrt().minCoeff();
-  std::unique_ptr<Rig> rig;
-  io::Log log;
-  std::vector<bool> judged;
-  int judged_rows = 0;
-  for (int attempt = 1; attempt <= 3; ++attempt) {
-    rig = std::make_unique<Rig>(twin_, hw_, traj);
-    const std::string csv = (dir_ / ("AG02_" + std::to_string(attempt) + ".csv")).string();
-    const ControlResult r = run(*rig, traj, csv, options());
-    ASSERT_EQ(r.reason, StopReason::completed) << r.message;
-    EXPECT_TRUE(r.torque_off_confirmed);
-    rig->expect_safe();
-    expect_log(r, csv);
-    log = io::read_log(csv);
-    EXPECT_EQ(r.stop_action, StopAction::hold) << r.at_stop;  // the end of a run is a stop too
-    EXPECT_NEAR(r.held, hw_.safety.hold_time, 1e-9) << r.at_stop;
-    const int expected = static_cast<int>(std::llround(traj.duration() / 0.001)) + 1;
-    EXPECT_GE(log.samples(), expected * 90 / 100);  // cycles lost to a loaded machine are dropped rows
-    EXPECT_GT(r.timing.cycles, expected);
-    EXPECT_NEAR(r.timing.period_mean, 0.001, 0.0001);  // absolute deadlines: no drift
-    judged.assign(log.samples(), false);
-    double last_gap = -1e9;
-    judged_rows = 0;
-    for (int k = 1; k < log.samples(); ++k) {
-      if (log.time(k) - log.time(k - 1) > 1.5e-3) last_gap = log.time(k);
-      judged[k] = log.time(k) - last_gap >= settle;
-      judged_rows += judged[k];
-    }
-    std::printf("run %d: rows judged: %d of %d (undisturbed for %.0f ms before; %lld failed reads, %lld skipped deadlines)\n", attempt,
-                judged_rows, log.samples(), settle * 1e3, static_cast<long long>(r.timing.read_failures),
-                static_cast<long long>(r.timing.skipped));
-    if (judged_rows >= log.samples() / 2) break;
-  }
-  ASSERT_GE(judged_rows, log.samples() / 2) << "the machine stalled the loop too often, three runs in a row, to judge its tracking";
+  // The loop and the emulated arm run on the rig's stepped clock, unpaced: every cycle happens
+  // at its deadline on the arm's time however long the host takes, so the machine's load cannot
+  // change what is judged here (real-time behaviour: bench_control_loop). The bus is still the
+  // real driver over a pseudo-terminal, made patient: a transaction waits up to 1 s of real time
+  // for the emulated servos' thread. Before each step, a ping answered proves the arm took the
+  // cycle's command (sent before it): the rows are then the same on any machine.
+  Rig rig(twin_, hw_, traj, /*paced=*/false);
+  const std::uint8_t first_id = hw_.ids().front();
+  int unanswered = 0;
+  rig.clock.set_before_step([&rig, &unanswered, first_id] {
+    for (int attempt = 0; attempt < 5; ++attempt)
+      if (rig.bus.ping(first_id, std::chrono::steady_clock::now() + std::chrono::seconds(1)).has_data()) return;
+    ++unanswered;
+  });
+  dynamixel::BusOptions patient = rig.bus.options();
+  patient.margin = std::chrono::milliseconds(1000);
+  patient.retries = 3;
+  rig.bus.set_options(patient);
+  const std::string csv = (dir_ / "AG02.csv").string();
+  const ControlResult r = run(rig, traj, csv, options());
+  ASSERT_EQ(r.reason, StopReason::completed) << r.message;
+  EXPECT_TRUE(r.torque_off_confirmed);
+  rig.expect_safe();
+  expect_log(r, csv);
+  const io::Log log = io::read_log(csv);
+  EXPECT_EQ(r.stop_action, StopAction::hold) << r.at_stop;  // the end of a run is a stop too
+  EXPECT_NEAR(r.held, hw_.safety.hold_time, 1e-9) << r.at_stop;
+  // On time every cycle: one row per period from t = 0 to the end, none lost.
+  EXPECT_EQ(unanswered, 0);
+  EXPECT_EQ(r.timing.overruns, 0);
+  EXPECT_EQ(r.timing.read_failures, 0) << "a transaction waited more than 1 s for the emulated servos";
+  const int expected = static_cast<int>(std::llround(traj.duration() / 0.001)) + 1;
+  ASSERT_EQ(log.samples(), expected);
+  for (int k = 0; k < log.samples(); ++k) ASSERT_NEAR(log.time(k), k * 0.001, 1e-9) << "row " << k;
 
-  // The reference: the twin's own closed loop of the same trajectory, no bus.
-  const twin::ClosedLoopTwin sim(symoro::robot::compiled_model<Model>(), twin_);
+  // The reference: the twin's own closed loop of the same trajectory, no bus, with the stepped
+  // loop's timing: the state read at t_k, the command in effect from t_k (no bus delay), the
+  // same pre-roll.
+  twin::TwinConfig reference = twin_;
+  reference.controller.communication_delay = 0;
+  const twin::ClosedLoopTwin sim(symoro::robot::compiled_model<Model>(), reference);
   twin::RunOptions ro;
   ro.robot = "crane_x7";
+  ro.pre_roll = hw_.safety.pre_roll;
   twin::RunStats st;
   const io::Log ref = sim.run(traj, ro, &st);
+  ASSERT_EQ(ref.samples(), log.samples());
+  const double lsb = 2 * 3.14159265358979323846 / 4096;
 
-  // Joint paths agree sample by sample (reference interpolated at the bus run's times).
-  Eigen::VectorXd worst_joint = Eigen::VectorXd::Zero(Model::nq), max_error = Eigen::VectorXd::Zero(Model::nq);
-  for (int k = 0; k < log.samples(); ++k) {
-    if (!judged[k]) continue;
-    const double t = log.time(k);
-    const double x = std::clamp(t / 0.001, 0.0, static_cast<double>(ref.samples() - 1));
-    const int i = std::min(static_cast<int>(x), ref.samples() - 2);
-    const double w = x - i;
+  // Same controller, same plant, same timing: the bus run's rows are the twin's, up to what the
+  // two paths round differently (a servo's current in its units after the direction, the plant
+  // integrated to a clock counted in nanoseconds: its steps differ by 1e-16 s). Measured: at
+  // most 1 encoder step on every joint, 0.2-0.55 steps RMS. At this scale the quantized loop is
+  // chaotic (a 0.2 ms delay moves the twin's own rows as much), so 2 steps is the tolerance; a
+  // wrong direction, zero, unit or torque constant moves the arm by degrees.
+  Eigen::VectorXd q_diff = Eigen::VectorXd::Zero(Model::nq), tau_diff = Eigen::VectorXd::Zero(Model::nq);
+  Eigen::VectorXd max_error = Eigen::VectorXd::Zero(Model::nq);
+  for (int k = 0; k < log.samples(); ++k)
     for (int j = 0; j < Model::nq; ++j) {
-      // Compare tracking errors (q_ref - q) at the same instant: insensitive to the row's time
-      // stamp jitter along the reference.
-      const double e_bus = log.q_ref(k, j) - log.q(k, j);
-      const double e_ref = (1 - w) * (ref.q_ref(i, j) - ref.q(i, j)) + w * (ref.q_ref(i + 1, j) - ref.q(i + 1, j));
-      worst_joint(j) = std::max(worst_joint(j), std::abs(e_bus - e_ref));
-      max_error(j) = std::max(max_error(j), std::abs(e_bus));
+      EXPECT_NEAR(log.q_ref(k, j), ref.q_ref(k, j), 1e-12) << "row " << k << " joint " << j + 1;
+      q_diff(j) = std::max(q_diff(j), std::abs(log.q(k, j) - ref.q(k, j)));
+      tau_diff(j) = std::max(tau_diff(j), std::abs(log.tau(k, j) - ref.tau(k, j)));
+      max_error(j) = std::max(max_error(j), std::abs(log.q_ref(k, j) - log.q(k, j)));
     }
-  }
-  std::printf("bus run: max |q_ref - q| per joint (deg) over the judged rows:");
-    for (int j = 0; j < Model::nq; ++j) std::printf(" %.3f", max_error(j) * kDeg);
-  std::printf("\ntwin run (no bus):                     ");
+  std::printf("bus run: max |q_ref - q| per joint (deg):");
+  for (int j = 0; j < Model::nq; ++j) std::printf(" %.3f", max_error(j) * kDeg);
+  std::printf("\ntwin run (no bus):                       ");
   for (int j = 0; j < Model::nq; ++j) std::printf(" %.3f", st.max_error(j) * kDeg);
-  std::printf("\nmax |e_bus - e_twin| per joint (deg):  ");
-  for (int j = 0; j < Model::nq; ++j) std::printf(" %.3f", worst_joint(j) * kDeg);
+  std::printf("\nmax |q_bus - q_twin| (encoder steps):     ");
+  for (int j = 0; j < Model::nq; ++j) std::printf(" %.1f", q_diff(j) / lsb);
+  std::printf("\nmax |tau_bus - tau_twin| (N m):            ");
+  for (int j = 0; j < Model::nq; ++j) std::printf(" %.4f", tau_diff(j));
   std::printf("\n");
-  // The tracking-error bound of the twin's loop (with its 0.9 ms delay: the bus is faster here).
-  const Eigen::VectorXd sup_w = twin::unmodeled_torque(twin_, traj, [&](const Eigen::VectorXd& q, const Eigen::VectorXd& qd, const Eigen::VectorXd& qdd) {
+  // The tracking-error bound of that loop (twin/tracking_bound.hpp: the controller, its timing,
+  // the plant's unmodelled torque along the trajectory).
+  const Eigen::VectorXd sup_w = twin::unmodeled_torque(reference, traj, [&](const Eigen::VectorXd& q, const Eigen::VectorXd& qd, const Eigen::VectorXd& qdd) {
     Eigen::Matrix<double, Model::nq, 1> tau;
     Model::inverse_dynamics(Eigen::Matrix<double, Model::nq, 1>(q), Eigen::Matrix<double, Model::nq, 1>(qd),
-                            Eigen::Matrix<double, Model::nq, 1>(qdd), rig->backend->truth().phi, tau);
+                            Eigen::Matrix<double, Model::nq, 1>(qdd), rig.backend->truth().phi, tau);
     return Eigen::VectorXd(tau);
   });
-  const Eigen::VectorXd bound = twin::tracking_error_bound(twin_, sup_w);
-  std::printf("tracking-error bound (deg):            ");
+  const Eigen::VectorXd bound = twin::tracking_error_bound(reference, sup_w);
+  std::printf("tracking-error bound (deg):              ");
   for (int j = 0; j < Model::nq; ++j) std::printf(" %.3f", bound(j) * kDeg);
   std::printf("\n");
   for (int j = 0; j < Model::nq; ++j) {
-    const double lsb = 2 * 3.14159265358979323846 / 4096;
-    // The bound holds for the twin's fixed timing; the bus's own timing differs a little.
-    EXPECT_LE(max_error(j), 2 * bound(j) + 2 * lsb) << "joint " << j + 1 << " bound " << bound(j) * kDeg << " deg";
-    // Same loop, same plant: the errors agree to a fraction of the error itself plus a few
-    // encoder steps (the bus's delay and timing differ from the twin's fixed 0.9 ms).
-    EXPECT_LE(worst_joint(j), 0.5 * st.max_error(j) + 4 * lsb) << "joint " << j + 1;
+    EXPECT_LE(max_error(j), bound(j) + 2 * lsb) << "joint " << j + 1 << " bound " << bound(j) * kDeg << " deg";
+    EXPECT_LE(q_diff(j), 2 * lsb) << "joint " << j + 1;
   }
 }
 

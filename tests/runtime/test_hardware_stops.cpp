@@ -95,6 +95,7 @@ TEST_F(HardwareControl, CurrentLimitStops) {
   };
   const std::string csv = (dir_ / "current.csv").string();
   o.timeline = &timeline;
+  o.clock = &rig.clock;
   const ControlResult r = run_control(rig.bus, hw_, js, gains_, traj, csv, o);
   EXPECT_EQ(r.reason, StopReason::current_limit) << r.message;
   EXPECT_EQ(r.stop_action, StopAction::torque_off);  // a servo past its current is not obeying
@@ -142,14 +143,15 @@ TEST_F(HardwareControl, SigintStopsSafely) {
   expect_log(r, csv);
 }
 
-// Keeps the bus busy (pings) for `seconds` of wall time: the twin's plant integrates up to each
+// Moves the rig's clock on by `seconds`, then pings: the twin's plant integrates up to each
 // instruction's arrival, so this lets the arm move as its servos' state (torque off) says.
 void let_time_pass(Rig& rig, double seconds) {
-  const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(seconds);
-  while (std::chrono::steady_clock::now() < end) {
-    rig.bus.ping(rig.hw.ids()[0], std::chrono::steady_clock::now() + std::chrono::milliseconds(50));
-    std::this_thread::sleep_for(std::chrono::milliseconds(2));
-  }
+  const std::atomic<int> no_stop{0};
+  rig.clock.sleep_until(rig.clock.now() + std::chrono::duration_cast<std::chrono::steady_clock::duration>(std::chrono::duration<double>(seconds)),
+                        no_stop, 0);
+  for (int attempt = 0; attempt < 5; ++attempt)
+    if (rig.bus.ping(rig.hw.ids()[0], std::chrono::steady_clock::now() + std::chrono::seconds(1)).has_data()) return;
+  ADD_FAILURE() << "the arm's servos did not answer a ping";
 }
 
 // How far the arm moved from the last logged pose (deg, the largest joint).
@@ -281,14 +283,22 @@ TEST_F(HardwareControl, ASigtermAfterTheDelayEndsTheHold) {
   o.seconds = 2.0;
   const std::string csv = (dir_ / "late_sigterm.csv").string();
   StopSignals signals;
-  const ControlResult r = run(rig, traj, csv, o, 0.5, [](Rig&) {
+  const auto delay = std::chrono::milliseconds(static_cast<int>(kStopEscalationDelay * 1e3) + 200);
+  std::atomic<std::chrono::steady_clock::rep> first{0};
+  const ControlResult r = run(rig, traj, csv, o, 0.5, [&first, delay](Rig&) {
+    first = std::chrono::steady_clock::now().time_since_epoch().count();
     ::kill(::getpid(), SIGTERM);
-    std::this_thread::sleep_for(std::chrono::milliseconds(static_cast<int>(kStopEscalationDelay * 1e3) + 200));
+    std::this_thread::sleep_for(delay);
     ::kill(::getpid(), SIGTERM);
   });
+  const auto ended = std::chrono::steady_clock::now();
   EXPECT_EQ(r.reason, StopReason::signal) << r.message;
   EXPECT_NE(r.at_stop.find("a further stop request"), std::string::npos) << r.at_stop;
-  EXPECT_GT(r.held, kStopEscalationDelay - 0.1) << r.at_stop;
+  // The first signal did not end the hold: it lasted until the second, `delay` later in real
+  // time (the rig's clock leaves out the time a loaded host kept the loop waiting, so r.held
+  // may be less).
+  EXPECT_GE(ended - std::chrono::steady_clock::time_point(std::chrono::steady_clock::duration(first.load())), delay) << r.at_stop;
+  EXPECT_GT(r.held, 0.0) << r.at_stop;
   EXPECT_LT(r.held, 20.0) << r.at_stop;
   EXPECT_TRUE(r.torque_off_confirmed);
   rig.expect_safe();

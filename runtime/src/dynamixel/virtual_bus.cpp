@@ -103,8 +103,8 @@ std::vector<VirtualServo> crane_x7_servos() {
   return servos;
 }
 
-VirtualBus::VirtualBus(std::vector<VirtualServo> servos, std::unique_ptr<ServoBackend> backend)
-    : backend_(std::move(backend)) {
+VirtualBus::VirtualBus(std::vector<VirtualServo> servos, std::unique_ptr<ServoBackend> backend, std::function<double()> plant_clock)
+    : backend_(std::move(backend)), plant_clock_(std::move(plant_clock)) {
   if (!backend_ || backend_->size() != servos.size())
     throw std::invalid_argument("virtual bus: the backend must have one joint per servo");
   servos_.resize(servos.size());
@@ -159,7 +159,7 @@ VirtualBus::VirtualBus(std::vector<VirtualServo> servos, std::unique_ptr<ServoBa
     throw;
   }
   start_ = std::chrono::steady_clock::now();
-  backend_->advance(0.0);
+  backend_->advance(clock());
   thread_ = std::thread([this] { run(); });
 }
 
@@ -172,6 +172,7 @@ VirtualBus::~VirtualBus() {
 }
 
 double VirtualBus::clock() const {
+  if (plant_clock_) return plant_clock_();
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
 }
 

@@ -68,7 +68,7 @@ std::string Loop::joint_name(int j) const { return fmt::format("servo ID {} (joi
 
 Loop::Loop(Bus& bus, const HardwareConfig& hw, const std::vector<JointInfo>& joints, const control::FfpdGains& gains,
      const trajectory::Trajectory& traj, const ControlOptions& o)
-    : bus_(bus), hw_(hw), joints_(joints), gains_(gains), traj_(traj), o_(o), n_(static_cast<int>(joints.size())), ids_(hw.ids()) {
+    : bus_(bus), hw_(hw), joints_(joints), gains_(gains), traj_(traj), o_(o), clock_(o.clock ? *o.clock : steady_loop_clock()), n_(static_cast<int>(joints.size())), ids_(hw.ids()) {
   if (static_cast<int>(hw.joints.size()) != n_) throw std::invalid_argument("run_control: hardware.yaml and the robot differ in joints");
   if (traj.joints() != n_) throw DataError(traj.name, 0, fmt::format("the trajectory has {} joints, the robot {}", traj.joints(), n_));
   if (gains.inertia.size() != n_) throw std::invalid_argument("run_control: FF+PD gains for another joint count");
@@ -208,7 +208,7 @@ void Loop::setup() {
 }
 
 bool Loop::read_state(Clock::time_point deadline, bool setup) {
-  const auto t0 = Clock::now();
+  const auto t0 = Clock::now();  // the time the bus takes, on the steady clock whatever the loop's
   const auto replies = bus_.sync_read(ids_, xs::kPresentCurrentVelocityPosition.address, xs::kPresentCurrentVelocityPosition.size, deadline);
   timing_.read_max = std::max(timing_.read_max, seconds(Clock::now() - t0));
   bool all = true;
@@ -318,15 +318,15 @@ StopNow Loop::loop() {
                  approach_, distance, hw_.safety.pre_roll, T_ * 1e3);
 
   const auto T = std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(T_));
-  const auto start = Clock::now() + T;
+  const auto start = clock_.now() + T;
   Clock::time_point previous_wake{};
   double period_sum = 0, period_sq = 0, latency_sum = 0, work_sum = 0;
   std::int64_t periods = 0;
   timing_.period_min = 1e9;
   for (std::int64_t k = 0;; ++k) {
     const auto deadline = start + k * T;
-    sleep_until(deadline, *stop_, stops_seen_);
-    const auto wake = Clock::now();
+    clock_.sleep_until(deadline, *stop_, stops_seen_);
+    const auto wake = clock_.now();
     ++timing_.cycles;
     const double latency = seconds(wake - deadline);
     latency_sum += latency;
@@ -344,7 +344,7 @@ StopNow Loop::loop() {
     period_stats_ = {period_sum, period_sq, latency_sum, work_sum, static_cast<double>(periods)};
     if (stop_->load(std::memory_order_relaxed) > stops_seen_) return {StopReason::signal, "stop requested (SIGINT/SIGTERM)"};
 
-    const bool fresh = read_state(std::max(deadline + T * 8 / 10, wake + T / 2));
+    const bool fresh = read_state(clock_.io_deadline(std::max(deadline + T * 8 / 10, wake + T / 2)));
     // Every cycle, on what is known: a servo that did not answer keeps its last state (its
     // staleness is counted by the watchdog), the others are current.
     check_limits();
@@ -371,7 +371,7 @@ StopNow Loop::loop() {
     }
     timing_.saturated += saturated;
     if (!bus_.sync_write(ids_, xs::kGoalCurrent, dynamixel::Span<const std::int32_t>(command_.data(), command_.size()),
-                         std::max(deadline + T * 95 / 100, Clock::now() + T / 4)))
+                         clock_.io_deadline(std::max(deadline + T * 95 / 100, clock_.now() + T / 4))))
       ++timing_.write_failures;
 
     if (t >= -1e-9 && fresh) {
@@ -383,7 +383,7 @@ StopNow Loop::loop() {
       log_->append(seconds(wake - (start + k_traj0 * T)), q_.data(), ctrl.velocity().data(), tau_meas_.data(), qr_.data(),
                    qdr_.data(), qddr_.data());
     }
-    const auto done = Clock::now();
+    const auto done = clock_.now();
     const double work = seconds(done - wake);
     work_sum += work;
     timing_.work_max = std::max(timing_.work_max, work);

@@ -17,6 +17,7 @@
 #include "symoro/dynamixel/bus.hpp"
 #include "symoro/hardware/config.hpp"
 #include "symoro/hardware/controller.hpp"
+#include "symoro/hardware/loop_clock.hpp"
 #include "symoro/io/log_stream.hpp"
 
 namespace symoro::hardware::detail {
@@ -24,10 +25,6 @@ namespace symoro::hardware::detail {
 using Clock = std::chrono::steady_clock;
 
 inline double seconds(Clock::duration d) { return std::chrono::duration<double>(d).count(); }
-
-// Sleeps until `t` (absolute, CLOCK_MONOTONIC); a signal wakes it early only when the stop
-// requests have passed `seen`.
-void sleep_until(Clock::time_point t, const std::atomic<int>& stop, int seen);
 
 // Outside the 1 kHz loop (start, stop) transactions may take their time: a servo (or, on the
 // virtual bus, the emulating thread) that answers late is waited for and retried.
@@ -58,7 +55,7 @@ class Loop {
  private:
   std::string joint_name(int j) const;
   void setup();
-  bool read_state(Clock::time_point deadline, bool setup = false);
+  bool read_state(Clock::time_point deadline, bool setup = false);  // deadline: on the steady clock
   void check_limits();
   void check_current();
   double reference(double s);
@@ -78,6 +75,7 @@ class Loop {
   const control::FfpdGains& gains_;
   const trajectory::Trajectory& traj_;
   const ControlOptions& o_;
+  LoopClock& clock_;  // the loop's and the hold's time (o_.clock, else the steady clock)
   int n_;
   std::vector<std::uint8_t> ids_;
   const std::atomic<int>* stop_ = nullptr;

@@ -4,8 +4,6 @@
 
 #include "control_loop.hpp"
 
-#include <time.h>
-
 #include <algorithm>
 #include <cerrno>
 #include <cmath>
@@ -115,13 +113,6 @@ PatientBus::PatientBus(Bus& bus) : bus_(bus), saved_(bus.options()) {
 }
 PatientBus::~PatientBus() { bus_.set_options(saved_); }
 
-void sleep_until(Clock::time_point t, const std::atomic<int>& stop, int seen) {
-  const auto ns = std::chrono::duration_cast<std::chrono::nanoseconds>(t.time_since_epoch()).count();
-  timespec ts{static_cast<time_t>(ns / 1'000'000'000), static_cast<long>(ns % 1'000'000'000)};
-  // libstdc++'s steady_clock is CLOCK_MONOTONIC.
-  while (clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &ts, nullptr) == EINTR)
-    if (stop.load(std::memory_order_relaxed) > seen) return;
-}
 }  // namespace detail
 
 bool safe_stop(Bus& bus, const HardwareConfig& hw) {

@@ -84,17 +84,17 @@ std::string Loop::hold(const Eigen::VectorXd& gravity, ControlResult& result) {
   const auto T = std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(T_));
   const std::int64_t cycles = std::max<std::int64_t>(1, std::llround(hw_.safety.hold_time / T_));
   const int seen = stop_->load();  // a request from now on ends the hold
-  const auto start = Clock::now() + T;
+  const auto start = clock_.now() + T;
   int stale = 0;
   for (std::int64_t k = 0; k < cycles; ++k) {
     const auto deadline = start + k * T;
-    sleep_until(deadline, *stop_, seen);
+    clock_.sleep_until(deadline, *stop_, seen);
     result.held = k * T_;
     if (stop_->load() > seen) return "a further stop request";
-    const auto wake = Clock::now();
+    const auto wake = clock_.now();
     bool fresh = false;
     try {
-      fresh = read_state(std::max(deadline + T * 8 / 10, wake + T / 2), /*setup=*/true);  // counts no watchdog of the run
+      fresh = read_state(clock_.io_deadline(std::max(deadline + T * 8 / 10, wake + T / 2)), /*setup=*/true);  // counts no watchdog of the run
       if (fresh) check_current();
     } catch (const StopNow& fault) {
       return fault.message;
@@ -110,7 +110,7 @@ std::string Loop::hold(const Eigen::VectorXd& gravity, ControlResult& result) {
       command_[j] = static_cast<std::int32_t>(std::clamp(raw, -bound, bound));
     }
     bus_.sync_write(ids_, xs::kGoalCurrent, dynamixel::Span<const std::int32_t>(command_.data(), command_.size()),
-                    std::max(deadline + T * 95 / 100, Clock::now() + T / 4));
+                    clock_.io_deadline(std::max(deadline + T * 95 / 100, clock_.now() + T / 4)));
   }
   result.held = cycles * T_;
   return "";

@@ -15,7 +15,8 @@
 //                      Operating Mode not a defined mode, Torque Enable not 0/1, ...).
 // Goal Current drives the backend only with torque on, Operating Mode current (0) and no hardware
 // error; other modes are not emulated (the motor gets no current). The baud rate is stored but
-// a pty has none: bytes arrive at once.
+// a pty has none: bytes arrive at once. The backend integrates on the wall clock, or on the
+// controller's own clock when given one.
 //
 // Fault injection, thread-safe, for the next instructions: corrupted CRCs, dropped replies, a
 // servo that stops answering (and acting), a hardware error (alert bit 7 in every status packet,
@@ -25,6 +26,7 @@
 #include <chrono>
 #include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <mutex>
 #include <string>
@@ -63,7 +65,10 @@ struct VirtualBusStats {
 class VirtualBus {
  public:
   // Servo i of `servos` is joint i of `backend` (sizes must match; IDs distinct, 0..252).
-  VirtualBus(std::vector<VirtualServo> servos, std::unique_ptr<ServoBackend> backend);
+  // `plant_clock`: the time (s) the backend integrates to at each instruction, called on the
+  // bus's thread; empty: the wall clock since construction. A test that steps the controller's
+  // clock (hardware::SteppedClock) gives that clock's seconds, so the arm moves on the loop's time.
+  VirtualBus(std::vector<VirtualServo> servos, std::unique_ptr<ServoBackend> backend, std::function<double()> plant_clock = {});
   ~VirtualBus();
   VirtualBus(const VirtualBus&) = delete;
   VirtualBus& operator=(const VirtualBus&) = delete;
@@ -125,6 +130,7 @@ class VirtualBus {
   std::string device_;
   std::thread thread_;
   std::chrono::steady_clock::time_point start_;
+  std::function<double()> plant_clock_;
 
   mutable std::mutex mutex_;  // servos_, backend_, faults, stats
   std::size_t corrupt_count_ = 0;

@@ -1,5 +1,6 @@
 // The arm's 1 kHz control loop over a DYNAMIXEL bus (paper Sec. III): every period, paced by
-// absolute deadlines (clock_nanosleep TIMER_ABSTIME on CLOCK_MONOTONIC, the steady clock),
+// absolute deadlines (clock_nanosleep TIMER_ABSTIME on CLOCK_MONOTONIC, the steady clock; a
+// test may give the loop a clock it steps, loop_clock.hpp),
 //   1. Sync Read Present Current, Velocity and Position (one 10-byte read, all servos),
 //   2. convert to joint units (hardware.yaml: zero, direction, torque constant),
 //   3. check the safety limits, compute the paper's FF+PD with pseudo differentiation
@@ -36,6 +37,7 @@
 #include "symoro/control/ffpd.hpp"
 #include "symoro/dynamixel/bus.hpp"
 #include "symoro/hardware/config.hpp"
+#include "symoro/hardware/loop_clock.hpp"
 #include "symoro/model_info.hpp"
 #include "symoro/robot/model_handle.hpp"
 #include "symoro/trajectory/trajectory.hpp"
@@ -110,6 +112,9 @@ struct ControlOptions {
   // pre-roll) here every cycle, so another thread can act on the controller's own timeline
   // (tests inject faults this way, never at a wall-clock time).
   std::atomic<double>* timeline = nullptr;
+  // The time the loop and the hold run on (loop_clock.hpp); nullptr: the steady clock, as the
+  // arm needs. A test gives a SteppedClock, so that a loaded machine cannot make the loop late.
+  LoopClock* clock = nullptr;
 };
 
 struct ControlResult {
