@@ -1,6 +1,7 @@
 // dynid control: run a designed trajectory on the real arm (DYNAMIXEL bus at --port) with the
 // paper's FF+PD at 1 kHz, or with --virtual on the emulated servo chain driving the digital twin
 // (a pseudo-terminal: the same driver, bytes and timing path), and write its log.
+#include <csignal>
 #include <pthread.h>
 #include <sched.h>
 
@@ -50,6 +51,11 @@ std::filesystem::path free_log_path(const std::filesystem::path& out, const std:
 }  // namespace
 
 void run_control_command(const Common& common, const ControlCliOptions& o) {
+  // A closed terminal or pipe must neither end a run nor the command: SIGPIPE is ignored until
+  // dynid exits (the report is written first, then flushed at exit), and from here on every
+  // signal that would end dynid is a stop request.
+  std::signal(SIGPIPE, SIG_IGN);
+  hardware::StopSignals signals;
   const std::string out = free_log_path(o.out, o.if_exists).string();  // before anything moves
   const robot::ModelHandle full = full_model(common);
   const std::vector<JointInfo>& joints = full.joints();
@@ -160,7 +166,6 @@ void run_control_command(const Common& common, const ControlCliOptions& o) {
   }
   dynamixel::SerialPort port(device, hw.baud);
   dynamixel::Bus bus(port);
-  hardware::StopSignals signals;
   const hardware::ControlResult r = hardware::run_control(bus, hw, joints, gains, traj, out, co);
   fmt::print("{}: {} rows, {:.3f} s of {}; max |q_ref - q| per joint (deg):", out, r.rows, r.trajectory_time, o.trajectory);
   for (int j = 0; j < r.max_error.size(); ++j) fmt::print(" {:.3f}", r.max_error(j) * 180 / 3.14159265358979323846);

@@ -360,6 +360,25 @@ if(TIMEOUT)
       message(FATAL_ERROR "timeout's pair of SIGTERMs ended the hold:\n${out}")
     endif()
   endforeach()
+  # A dropped SSH session (SIGHUP) and Ctrl-\ (SIGQUIT) stop as SIGTERM does: hold, then torque
+  # off, the signal named (they used to end dynid at once: rc 129 and 131, no hold).
+  foreach(sig HUP QUIT)
+    run_command(124 out ${TIMEOUT} -s ${sig} 3 ${DYNID} control --robot crane_x7 --virtual --trajectory AG02 --hold-time 0.5
+        -o ${WORK}/control/sig${sig}.csv)
+    expect("${out}" "stop: signal: stop requested \\(SIG${sig}\\)")
+    expect("${out}" "at stop: hold 0.500 s at the stop pose")
+    expect("${out}" "torque off confirmed")
+  endforeach()
+endif()
+# A closed stdout and stderr (| head -1) must not end the run: SIGPIPE is ignored while the arm
+# runs (it used to end dynid with rc 141 and 0 samples recorded). The log is whole and says why
+# the run stopped.
+find_program(BASH bash)
+if(BASH)
+  run_command(0 out ${BASH} -o pipefail -c "'${DYNID}' control --robot crane_x7 --virtual --trajectory AG02 --seconds 1 -o '${WORK}/control/piped.csv' 2>&1 | head -1 >/dev/null")
+  file(READ ${WORK}/control/piped.meta.yaml meta)
+  expect("${meta}" "stop: completed")
+  expect("${meta}" "samples: [1-9]")
 endif()
 run(2 out control --robot crane_x7 --port ${WORK}/no_such_tty --seconds 1 -o ${WORK}/control/real2.csv --watchdog 500)
 expect("${out}" "--watchdog 500: at most 50 cycles on a real port")

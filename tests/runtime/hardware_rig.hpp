@@ -105,13 +105,17 @@ struct Realtime {
 // The arm and the loop run on the rig's stepped clock (hardware/loop_clock.hpp; run() gives it
 // to the loop): no time passes on the arm while the host is slow, so a loaded machine cannot move
 // it between cycles. Paced (the default), the loop still keeps real time, so that signals and
-// fault injectors meet it when they would meet the arm; unpaced it runs as fast as the bus.
+// fault injectors meet it when they would meet the arm; unpaced it runs as fast as the bus. On
+// the wall clock the arm integrates in real time (a controller in another process).
+enum class RigClock { paced, unpaced, wall };
+
 struct Rig {
-  Rig(const twin::TwinConfig& twin, const HardwareConfig& h, const trajectory::Trajectory& traj, bool paced = true)
+  Rig(const twin::TwinConfig& twin, const HardwareConfig& h, const trajectory::Trajectory& traj, RigClock mode = RigClock::paced)
       : hw(h),
         realtime(),
-        clock(paced),
-        virt(virtual_servos(h), make_backend(twin, h, traj), [this] { return clock.seconds(); }),
+        clock(mode == RigClock::paced),
+        virt(virtual_servos(h), make_backend(twin, h, traj),
+             mode == RigClock::wall ? std::function<double()>() : [this] { return clock.seconds(); }),
         port(virt.device(), h.baud),
         bus(port) {
     realtime.release();  // the virtual servos' thread keeps it

@@ -33,6 +33,42 @@ TEST_F(HardwareControl, ConfigErrorsNameFileAndLine) {
   broken.replace(broken.find("model: XM540-W270, zero"), 17, "model: XM999-W999");
   std::ofstream(bad) << broken;
   EXPECT_THROW(read_hardware_config(bad, joints()), DataError);
+  // No value switches a limit off: each is bounded, and the error names the file's line.
+  for (const auto& [from, to] : std::vector<std::pair<std::string, std::string>>{{"velocity_factor: 1.0", "velocity_factor: 100"},
+                                                                                 {"position_tolerance: 0.05", "position_tolerance: 1e9"},
+                                                                                 {"current_trip_factor: 1.5", "current_trip_factor: 0.5"},
+                                                                                 {"approach_speed: 0.3", "approach_speed: 5"},
+                                                                                 {"pre_roll: 0.5", "pre_roll: -1"},
+                                                                                 {"hold_time: 2.0", "hold_time: 1000"},
+                                                                                 {"zero: 2048", "zero: 99999"}}) {
+    broken = text;
+    const auto at = broken.find(from);
+    ASSERT_NE(at, std::string::npos) << from;
+    broken.replace(at, from.size(), to);
+    std::ofstream(bad) << broken;
+    const std::string key = from.substr(0, from.find(':'));
+    try {
+      read_hardware_config(bad, joints());
+      ADD_FAILURE() << to << " was accepted";
+    } catch (const DataError& e) {
+      EXPECT_GT(e.line(), 0) << e.what();
+      EXPECT_NE(std::string(e.what()).find(key), std::string::npos) << e.what();
+    }
+  }
+  // The servos' bus watchdog: 20 ms units up to 127, or 0; the file's 0.1 s is 5 units.
+  EXPECT_NEAR(read_hardware_config(kRobot / "hardware.yaml", joints()).safety.bus_watchdog, 0.1, 1e-12);
+  for (const char* value : {"3", "-0.1", "nan"}) {
+    broken = text;
+    broken.replace(broken.find("bus_watchdog: 0.1"), 17, std::string("bus_watchdog: ") + value);
+    std::ofstream(bad) << broken;
+    try {
+      read_hardware_config(bad, joints());
+      ADD_FAILURE() << "bus_watchdog " << value << " was accepted";
+    } catch (const DataError& e) {
+      EXPECT_GT(e.line(), 0);
+      EXPECT_NE(std::string(e.what()).find("safety.bus_watchdog"), std::string::npos) << e.what();
+    }
+  }
 }
 
 TEST_F(HardwareControl, TracksFiveSecondsOverThePtyLikeTheTwin) {
@@ -45,7 +81,7 @@ TEST_F(HardwareControl, TracksFiveSecondsOverThePtyLikeTheTwin) {
   // real driver over a pseudo-terminal, made patient: a transaction waits up to 1 s of real time
   // for the emulated servos' thread. Before each step, a ping answered proves the arm took the
   // cycle's command (sent before it): the rows are then the same on any machine.
-  Rig rig(twin_, hw_, traj, /*paced=*/false);
+  Rig rig(twin_, hw_, traj, RigClock::unpaced);
   const std::uint8_t first_id = hw_.ids().front();
   int unanswered = 0;
   rig.clock.set_before_step([&rig, &unanswered, first_id] {

@@ -2,6 +2,8 @@
 // servo is silent), SIGINT, and what the arm does at a stop (hardware.yaml safety.at_stop: hold
 // the stop pose, then torque off; or torque off at once), each read back from the emulated servos.
 #include <signal.h>
+#include <sys/resource.h>
+#include <sys/wait.h>
 #include <unistd.h>
 
 #include "hardware_rig.hpp"
@@ -320,6 +322,191 @@ TEST_F(HardwareControl, AStopBeforeTheTrajectoryLeavesAnEmptyLogThatSaysWhy) {
   EXPECT_TRUE(r.torque_off_confirmed);
   rig.expect_safe();
   expect_log(r, csv);
+}
+
+// Every signal whose default would end the process stops the run as SIGINT does: the stop pose
+// held, then torque off, the stop in the log's notes and the signal named (an SSH session that
+// drops sends SIGHUP, Ctrl-\ SIGQUIT). Without a handler each of these ends the test program.
+TEST_F(HardwareControl, EverySignalThatWouldEndTheProcessStopsLikeSigint) {
+  const trajectory::Trajectory traj = first_seconds("AG02", 1.0);
+  for (const auto& [sig, name] : {std::pair<int, const char*>{SIGHUP, "SIGHUP"}, {SIGQUIT, "SIGQUIT"}, {SIGUSR1, "SIGUSR1"}}) {
+    SCOPED_TRACE(name);
+    Rig rig(twin_, hw_, traj);
+    ControlOptions o = options();
+    o.seconds = 1.0;
+    const std::string csv = (dir_ / fmt::format("{}.csv", name)).string();
+    StopSignals signals;
+    const ControlResult r = run(rig, traj, csv, o, 0.3, [sig = sig](Rig&) { ::kill(::getpid(), sig); });
+    EXPECT_EQ(r.reason, StopReason::signal) << r.message;
+    EXPECT_NE(r.message.find(name), std::string::npos) << r.message;
+    EXPECT_EQ(r.stop_action, StopAction::hold) << r.at_stop;
+    EXPECT_NEAR(r.held, hw_.safety.hold_time, 1e-9) << r.at_stop;
+    EXPECT_TRUE(r.torque_off_confirmed);
+    rig.expect_safe();
+    expect_log(r, csv);
+  }
+  // The rest of the list: a handler is installed for each while StopSignals lives, and the
+  // previous disposition is back after.
+  {
+    StopSignals signals;
+    for (int sig : stop_signals()) {
+      struct sigaction now {};
+      sigaction(sig, nullptr, &now);
+      EXPECT_TRUE(now.sa_flags & SA_SIGINFO) << "signal " << sig << " has no stop handler";
+    }
+  }
+  struct sigaction after {};
+  sigaction(SIGHUP, nullptr, &after);
+  EXPECT_EQ(after.sa_handler, SIG_DFL);
+}
+
+// A closed pipe (dynid control ... | head -1) raises SIGPIPE at the next write: ignored while the
+// arm runs, the write fails instead and the run goes on to its end.
+TEST_F(HardwareControl, AClosedPipeDoesNotEndTheRun) {
+  const trajectory::Trajectory traj = first_seconds("AG02", 1.0);
+  Rig rig(twin_, hw_, traj);
+  ControlOptions o = options();
+  o.seconds = 1.0;
+  const std::string csv = (dir_ / "sigpipe.csv").string();
+  StopSignals signals;
+  std::atomic<long> written{1};
+  const ControlResult r = run(rig, traj, csv, o, 0.3, [&written](Rig&) {
+    int fd[2];
+    if (::pipe(fd) != 0) return;
+    ::close(fd[0]);
+    written = ::write(fd[1], "x", 1);  // SIGPIPE: would end the process
+    ::close(fd[1]);
+  });
+  EXPECT_EQ(written.load(), -1);
+  EXPECT_EQ(r.reason, StopReason::completed) << r.message;
+  EXPECT_TRUE(r.torque_off_confirmed);
+  rig.expect_safe();
+  expect_log(r, csv);
+}
+
+// SIGKILL (or a crash) ends the controller with no stop at all: the servos' own Bus
+// Watchdog(98), which the loop sets before torque on (safety.bus_watchdog), stops them once the
+// bus stays silent that long. The controller runs in a child process on the emulated servos
+// (wall clock); the parent kills it in the middle of the trajectory and reads the servos back.
+TEST_F(HardwareControl, ASigkilledControllerLeavesTheServosToTheirBusWatchdog) {
+  const trajectory::Trajectory traj = first_seconds("AG02", 3.0);
+  ASSERT_NEAR(hw_.safety.bus_watchdog, 0.1, 1e-12);  // the default: 5 units of 20 ms
+  Rig rig(twin_, hw_, traj, RigClock::wall);
+  const std::string csv = (dir_ / "killed.csv").string();
+  ControlOptions o = options();
+  o.seconds = 3.0;
+  o.verbose = false;
+  const pid_t child = ::fork();
+  ASSERT_GE(child, 0);
+  if (child == 0) {  // the controller: only its own work, then _exit (no test machinery)
+    run_control(rig.bus, hw_, joints(), gains_, traj, csv, o);
+    ::_exit(0);
+  }
+  const auto since = [](std::chrono::steady_clock::time_point t) {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
+  };
+  const std::uint8_t id = hw_.ids().front();
+  const auto start = std::chrono::steady_clock::now();
+  while (since(start) < 20 && !(rig.virt.value(id, xs::kTorqueEnable) == 1 && rig.virt.value(id, xs::kBusWatchdog) == 5))
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  ASSERT_EQ(rig.virt.value(id, xs::kBusWatchdog), 5) << "the controller never armed the servos' bus watchdog";
+  std::this_thread::sleep_for(std::chrono::milliseconds(700));  // the loop runs the trajectory
+  ASSERT_EQ(::kill(child, SIGKILL), 0);
+  int status = 0;
+  ASSERT_EQ(::waitpid(child, &status, 0), child);
+  ASSERT_TRUE(WIFSIGNALED(status) && WTERMSIG(status) == SIGKILL) << "the controller ended before it was killed";
+  const auto killed = std::chrono::steady_clock::now();
+  // Within the watchdog's 100 ms (and the emulation's 2 ms check) every servo has stopped: its
+  // item reads -1, it drives no current, and a new goal is refused until the watchdog is cleared.
+  for (std::uint8_t s : hw_.ids()) {
+    while (since(killed) < 2 && rig.virt.value(s, xs::kBusWatchdog) != -1) std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    EXPECT_EQ(rig.virt.value(s, xs::kBusWatchdog), -1) << "servo " << int(s);
+    EXPECT_EQ(rig.virt.value(s, xs::kTorqueEnable), 1) << "servo " << int(s);  // stopped, not switched off
+  }
+  EXPECT_LT(since(killed), 0.5);
+  for (std::uint8_t s : hw_.ids()) {
+    const auto r = rig.bus.read(s, xs::kPresentCurrent, std::chrono::steady_clock::now() + std::chrono::milliseconds(200));
+    ASSERT_TRUE(r.has_data()) << "servo " << int(s);
+    EXPECT_EQ(r.get<std::int16_t>(0), 0) << "servo " << int(s) << " still drives its motor";
+  }
+  const auto refused = rig.bus.write(id, xs::kGoalCurrent, 10, std::chrono::steady_clock::now() + std::chrono::milliseconds(200));
+  EXPECT_EQ(refused.outcome, dynamixel::Outcome::error_status);
+  // Torque off still works on a tripped servo; clearing the watchdog (as the next run's setup
+  // does) makes its goal writable again.
+  EXPECT_TRUE(safe_stop(rig.bus, hw_));
+  for (std::uint8_t s : hw_.ids()) {
+    EXPECT_EQ(rig.virt.value(s, xs::kTorqueEnable), 0) << "servo " << int(s);
+    EXPECT_TRUE(rig.bus.write(s, xs::kBusWatchdog, 0, std::chrono::steady_clock::now() + std::chrono::milliseconds(200)).has_data());
+  }
+  EXPECT_TRUE(safe_stop(rig.bus, hw_));
+  rig.expect_safe();
+}
+
+// A computer that stalls the loop past the servos' bus watchdog has let them stop: after the gap
+// the loop reads the item back and ends the run as a watchdog stop, torque off at once. The
+// stall is the loop's own (a feedforward that sleeps 150 ms once), on the wall clock.
+TEST_F(HardwareControl, AStallPastTheBusWatchdogStopsTheRun) {
+  const trajectory::Trajectory traj = first_seconds("AG02", 2.0);
+  Rig rig(twin_, hw_, traj, RigClock::wall);
+  ControlOptions o = options();
+  o.seconds = 2.0;
+  o.clock = &steady_loop_clock();
+  std::atomic<double> timeline{-1e9};
+  std::atomic<bool> stalled{false};
+  const control::FfpdGains g = gains_;
+  o.feedforward = [&timeline, &stalled, g](const Eigen::VectorXd& q, const Eigen::VectorXd& qd, const Eigen::VectorXd& qdd,
+                                           Eigen::VectorXd& tau) {
+    tau = g.inertia.cwiseProduct(qdd) + g.damping.cwiseProduct(qd);  // FF+PD's own realization
+    if (timeline.load() >= 0.3 && !stalled.exchange(true)) std::this_thread::sleep_for(std::chrono::milliseconds(150));
+    (void)q;
+  };
+  o.timeline = &timeline;
+  const std::string csv = (dir_ / "stall.csv").string();
+  const ControlResult r = run_control(rig.bus, hw_, joints(), gains_, traj, csv, o);
+  EXPECT_TRUE(stalled.load());
+  EXPECT_EQ(r.reason, StopReason::bus_watchdog) << r.message;
+  EXPECT_NE(r.message.find("stopped by its bus watchdog"), std::string::npos) << r.message;
+  EXPECT_EQ(r.stop_action, StopAction::torque_off) << r.at_stop;
+  EXPECT_LT(r.trajectory_time, 0.5);
+  EXPECT_TRUE(r.torque_off_confirmed);
+  expect_log(r, csv);
+}
+
+// The disk fills up in the middle of a run (the file size limit, which fails a write as a full
+// disk does): the run stops as an error naming the log, holds, turns torque off and reports
+// all of it; the log on disk ends on its last whole row and its sidecar says it is incomplete.
+// It used to end with only "cannot write the log", no stop report, and a CSV cut mid-number.
+TEST_F(HardwareControl, AFullDiskStopsTheRunSafelyAndLeavesAWholeLog) {
+  const trajectory::Trajectory traj = first_seconds("AG02", 2.0);
+  Rig rig(twin_, hw_, traj);
+  ControlOptions o = options();
+  o.seconds = 2.0;
+  o.log_flush = std::chrono::milliseconds(20);
+  const std::string csv = (dir_ / "full.csv").string();
+  struct rlimit saved {};
+  ASSERT_EQ(::getrlimit(RLIMIT_FSIZE, &saved), 0);
+  const auto previous = std::signal(SIGXFSZ, SIG_IGN);
+  struct rlimit small = saved;
+  small.rlim_cur = 200'000;  // about 0.4 s of rows of 8 joints
+  ASSERT_EQ(::setrlimit(RLIMIT_FSIZE, &small), 0);
+  const ControlResult r = run(rig, traj, csv, o);
+  ::setrlimit(RLIMIT_FSIZE, &saved);
+  std::signal(SIGXFSZ, previous);
+  EXPECT_EQ(r.reason, StopReason::error) << r.message;
+  EXPECT_NE(r.message.find("cannot write the log"), std::string::npos) << r.message;
+  EXPECT_NE(r.message.find("full.csv"), std::string::npos) << r.message;
+  EXPECT_EQ(r.stop_action, StopAction::hold) << r.at_stop;
+  EXPECT_TRUE(r.torque_off_confirmed);
+  EXPECT_LT(r.trajectory_time, 1.5);
+  rig.expect_safe();
+  const io::Log log = io::read_log(csv);
+  EXPECT_EQ(log.samples(), r.rows);
+  EXPECT_GT(r.rows, 100);
+  EXPECT_NE(log.meta.notes.find("LOG INCOMPLETE"), std::string::npos) << log.meta.notes;
+  EXPECT_NE(log.meta.notes.find("at stop: " + r.at_stop), std::string::npos) << log.meta.notes;
+  std::ifstream in(csv, std::ios::binary);
+  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  EXPECT_EQ(text.back(), '\n');
 }
 
 }  // namespace

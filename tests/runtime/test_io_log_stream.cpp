@@ -1,13 +1,17 @@
 // io::LogStream, the control loop's log: every flush leaves a readable log, and a stalled writer
 // neither blocks the producer nor loses a row it accepted.
 #include <fcntl.h>
+#include <sys/resource.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
 #include <algorithm>
 #include <atomic>
 #include <chrono>
+#include <csignal>
 #include <filesystem>
+#include <fstream>
+#include <iterator>
 #include <string>
 #include <thread>
 #include <vector>
@@ -17,6 +21,8 @@
 
 #include <symoro/io/log.hpp>
 #include <symoro/io/log_stream.hpp>
+
+#include "symoro/error.hpp"
 
 namespace symoro::io {
 namespace {
@@ -108,6 +114,70 @@ TEST(LogStream, AStalledWriterNeitherBlocksAppendNorLosesAnAcceptedRow) {
     previous = t;
     EXPECT_EQ(std::count(lines[i].begin(), lines[i].end(), ','), 60);
   }
+  std::filesystem::remove_all(dir);
+}
+
+// A full disk (here the file size limit, RLIMIT_FSIZE, which fails a write as a full disk does,
+// after a part of it) in the middle of a run: the CSV ends on its last whole row, the sidecar
+// counts exactly those rows and says the log is incomplete and why, the rows after are counted
+// as lost, and close() throws the reason. It used to end mid-number with a sidecar that counted
+// rows the file did not hold.
+TEST(LogStream, AFullDiskEndsTheLogOnItsLastWholeRowAndSaysSo) {
+  const auto dir = temp_dir();
+  const auto csv = dir / "full.csv";
+  LogMetadata meta;
+  meta.robot = "crane_x7";
+  meta.trajectory = "T";
+  meta.source = "robot";
+  meta.sample_time = 0.001;
+  meta.joints = {"a", "b"};
+  meta.notes = "run notes";
+  struct rlimit saved {};
+  ASSERT_EQ(::getrlimit(RLIMIT_FSIZE, &saved), 0);
+  const auto previous = std::signal(SIGXFSZ, SIG_IGN);  // the write fails (EFBIG) instead
+  constexpr rlim_t kLimit = 40'000;
+  struct rlimit small = saved;
+  small.rlim_cur = kLimit;
+  ASSERT_EQ(::setrlimit(RLIMIT_FSIZE, &small), 0);
+  constexpr int kRows = 2000;
+  std::int64_t written = 0, lost = 0;
+  std::string error;
+  {
+    LogStream s(csv, meta, true, std::chrono::milliseconds(5));
+    const double v[2] = {0.123456789012, -9.87654321098};
+    for (int k = 0; k < kRows; ++k) {
+      ASSERT_TRUE(s.append(k * 0.001, v, v, v, v, v, v));
+      if (k % 200 == 0) s.flush();
+    }
+    s.flush();
+    EXPECT_TRUE(s.failed());
+    try {
+      s.close();
+      ADD_FAILURE() << "close() did not say the log is short";
+    } catch (const DataError& e) {
+      error = e.what();
+    }
+    written = s.written();
+    lost = s.lost();
+  }
+  ::setrlimit(RLIMIT_FSIZE, &saved);
+  std::signal(SIGXFSZ, previous);
+  EXPECT_NE(error.find("cannot write the log"), std::string::npos) << error;
+  EXPECT_GT(written, 10);
+  EXPECT_LT(written, kRows);
+  EXPECT_EQ(written + lost, kRows);
+  // The CSV: whole rows only, as many as the sidecar says, within the limit.
+  std::ifstream in(csv, std::ios::binary);
+  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  ASSERT_FALSE(text.empty());
+  EXPECT_EQ(text.back(), '\n');
+  EXPECT_LE(text.size(), kLimit);
+  EXPECT_EQ(std::count(text.begin(), text.end(), '\n'), written + 1);  // and the header
+  const Log log = read_log(csv);
+  EXPECT_EQ(log.samples(), written);
+  EXPECT_EQ(log.time(written - 1), (written - 1) * 0.001);
+  EXPECT_NE(log.meta.notes.find("run notes"), std::string::npos) << log.meta.notes;
+  EXPECT_NE(log.meta.notes.find("LOG INCOMPLETE: cannot write the log"), std::string::npos) << log.meta.notes;
   std::filesystem::remove_all(dir);
 }
 

@@ -54,6 +54,7 @@ constexpr Rule kRules[] = {
     {xs::kTorqueEnable, Check::range, false, 0, 1},
     {xs::kStatusReturnLevel, Check::range, false, 0, 2},
     {xs::kHardwareErrorStatus, Check::read_only, false, 0, 0},
+    {xs::kBusWatchdog, Check::range, true, 0, 127},
     {xs::kGoalCurrent, Check::goal_current, true, 0, 0},
     {xs::kGoalVelocity, Check::goal_velocity, true, 0, 0},
     {xs::kGoalPosition, Check::goal_position, false, 0, 0},
@@ -232,7 +233,7 @@ void VirtualBus::update_command(std::size_t index) {
   const bool drive = get(t, xs::kTorqueEnable, false) == 1 &&
                      get(t, xs::kOperatingMode, false) ==
                          static_cast<std::int32_t>(xs::OperatingMode::current) &&
-                     get(t, xs::kHardwareErrorStatus, false) == 0;
+                     get(t, xs::kHardwareErrorStatus, false) == 0 && get(t, xs::kBusWatchdog, true) != -1;
   const double amps = drive ? get(t, xs::kGoalCurrent, true) * xs::kCurrentUnit : 0.0;
   backend_->set_current(index, amps);
 }
@@ -268,6 +269,9 @@ ErrorNumber VirtualBus::apply_write(Servo& servo, std::uint16_t address, ByteVie
                                ? load_le_signed(p, r->item.size)
                                : static_cast<std::int32_t>(load_le_unsigned(p, r->item.size));
     bool in_range = true;
+    // A tripped bus watchdog makes the goal values read-only: writes get a Data Range Error.
+    const bool goal = r->check == Check::goal_current || r->check == Check::goal_velocity || r->check == Check::goal_position;
+    if (goal && get(t, xs::kBusWatchdog, true) == -1) return ErrorNumber::data_range_error;
     switch (r->check) {
       case Check::range:
         in_range = v >= r->min && v <= r->max;
@@ -344,6 +348,8 @@ void VirtualBus::process(const DecodeEvent& event, double now) {
   const Packet& p = event.packet;
   if (p.is_status()) return;  // another device's status: not for the servos
   ++stats_.instructions;
+  trip_bus_watchdogs(now);  // a silence that ended with this packet may have tripped them first
+  last_instruction_ = now;
   backend_->advance(now);
   const bool broadcast = p.id == kBroadcastId;
   // Level 0: ping only; 1: ping and reads; 2: everything (the factory value).
@@ -464,13 +470,41 @@ void VirtualBus::send_pending() {
   pending_.clear();
 }
 
+void VirtualBus::trip_bus_watchdogs(double now) {
+  for (std::size_t i = 0; i < servos_.size(); ++i) {
+    std::uint8_t* t = servos_[i].table;
+    const std::int32_t limit = get(t, xs::kBusWatchdog, true);
+    if (servos_[i].dead || limit <= 0 || get(t, xs::kTorqueEnable, false) != 1) continue;
+    const double at = last_instruction_ + limit * xs::kBusWatchdogUnit;
+    if (now <= at) continue;
+    backend_->advance(at);  // the servo stops when its limit passes, not when this is noticed
+    put(t, xs::kBusWatchdog, -1);
+    update_command(i);
+  }
+}
+
+bool VirtualBus::bus_watchdog_armed() const {
+  for (const Servo& s : servos_)
+    if (get(s.table, xs::kBusWatchdog, true) > 0 && get(s.table, xs::kTorqueEnable, false) == 1) return true;
+  return false;
+}
+
 void VirtualBus::run() {
   std::uint8_t buffer[1024];
   for (;;) {
     pollfd fds[2] = {{master_, POLLIN, 0}, {wake_[0], POLLIN, 0}};
-    const int r = ::poll(fds, 2, 100);
+    bool armed = false;
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      armed = bus_watchdog_armed();
+    }
+    const int r = ::poll(fds, 2, armed ? 2 : 100);  // an armed bus watchdog is checked every 2 ms
     if (r < 0 && errno != EINTR) return;
     if (fds[1].revents) return;
+    if (armed) {
+      std::lock_guard<std::mutex> lock(mutex_);
+      trip_bus_watchdogs(clock());
+    }
     if (!(fds[0].revents & POLLIN)) continue;
     const ssize_t n = ::read(master_, buffer, sizeof buffer);
     if (n <= 0) continue;

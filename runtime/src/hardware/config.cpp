@@ -1,5 +1,7 @@
 #include "symoro/hardware/config.hpp"
 
+#include "symoro/dynamixel/control_table.hpp"
+
 #include <cmath>
 #include <map>
 #include <set>
@@ -65,6 +67,18 @@ struct Reader {
 
 const char* to_string(StopAction action) { return action == StopAction::hold ? "hold" : "torque_off"; }
 
+const SafetyBound& safety_bound(const std::string& key) {
+  static const std::map<std::string, SafetyBound> bounds = {
+      {"position_tolerance", {0, 0.2, false, "rad", "past robot.yaml's joint limits"}},
+      {"velocity_factor", {0, 1.5, true, "", "times robot.yaml's velocity limits"}},
+      {"current_trip_factor", {1, 3, false, "", "times the joints' current limits (commands are saturated at 1)"}},
+      {"approach_speed", {0, 1, true, "rad/s", "towards the trajectory's start"}},
+      {"pre_roll", {0, 10, false, "s", "holding the start posture"}},
+      {"hold_time", {0, 600, true, "s", "holding the stop pose before torque off (as dynid control --hold-time)"}},
+  };
+  return bounds.at(key);
+}
+
 HardwareConfig read_hardware_config(const std::filesystem::path& path, const std::vector<JointInfo>& robot_joints) {
   HardwareConfig c;
   c.path = path.string();
@@ -80,7 +94,11 @@ HardwareConfig read_hardware_config(const std::filesystem::path& path, const std
   r.keys(bus, {"baud", "return_delay_time", "period"}, "bus");
   c.baud = static_cast<std::uint32_t>(r.integer(r.need(bus, "baud", "bus"), "bus.baud", 9600, 4'500'000));
   if (bus["return_delay_time"]) c.return_delay_time = static_cast<int>(r.integer(bus["return_delay_time"], "bus.return_delay_time", 0, 254));
-  if (bus["period"]) c.period = r.positive(bus["period"], "bus.period");
+  if (bus["period"]) {
+    c.period = r.number(bus["period"], "bus.period");
+    if (!(c.period >= 0.0002 && c.period <= 0.02))
+      r.fail(bus["period"], fmt::format("bus.period: {} s is outside [0.0002, 0.02] s: the loop runs at 50 Hz to 5 kHz", c.period));
+  }
 
   std::map<std::string, ServoModel> models;
   const YAML::Node ms = r.need(root, "models", "hardware.yaml");
@@ -116,7 +134,9 @@ HardwareConfig read_hardware_config(const std::filesystem::path& path, const std
     const auto m = models.find(model);
     if (m == models.end()) r.fail(j["model"], fmt::format("{}: unknown servo model '{}' (not under models:)", where, model));
     h.model = m->second;
-    if (j["zero"]) h.zero = static_cast<std::int32_t>(r.integer(j["zero"], where + ".zero", -1'048'575, 1'048'575));
+    // Within one revolution of the encoder (4096 pulses): a zero turns away puts every reading
+    // that far from the joint's limits.
+    if (j["zero"]) h.zero = static_cast<std::int32_t>(r.integer(j["zero"], where + ".zero", 0, 4095));
     if (j["direction"]) {
       h.direction = static_cast<int>(r.integer(j["direction"], where + ".direction", -1, 1));
       if (h.direction == 0) r.fail(j["direction"], where + ".direction: expected 1 or -1");
@@ -129,23 +149,40 @@ HardwareConfig read_hardware_config(const std::filesystem::path& path, const std
   }
 
   if (const YAML::Node s = root["safety"]) {
-    r.keys(s, {"watchdog_cycles", "position_tolerance", "velocity_factor", "current_trip_factor", "approach_speed", "pre_roll", "at_stop", "hold_time"},
+    r.keys(s, {"watchdog_cycles", "position_tolerance", "velocity_factor", "current_trip_factor", "approach_speed", "pre_roll", "at_stop", "hold_time",
+                  "bus_watchdog"},
            "safety");
     if (s["watchdog_cycles"]) c.safety.watchdog_cycles = static_cast<int>(r.integer(s["watchdog_cycles"], "safety.watchdog_cycles", 1, kMaxWatchdogCycles));
-    if (s["position_tolerance"]) c.safety.position_tolerance = r.number(s["position_tolerance"], "safety.position_tolerance");
-    if (s["velocity_factor"]) c.safety.velocity_factor = r.positive(s["velocity_factor"], "safety.velocity_factor");
-    if (s["current_trip_factor"]) c.safety.current_trip_factor = r.positive(s["current_trip_factor"], "safety.current_trip_factor");
-    if (s["approach_speed"]) c.safety.approach_speed = r.positive(s["approach_speed"], "safety.approach_speed");
-    if (s["pre_roll"]) c.safety.pre_roll = r.number(s["pre_roll"], "safety.pre_roll");
+    // Each limit within a range that keeps it a limit (safety_bound): 1e9 rad of tolerance or
+    // 100 times the velocity limit would switch it off.
+    const auto bounded = [&](const char* key, double& value) {
+      if (!s[key]) return;
+      const SafetyBound& b = safety_bound(key);
+      const double v = r.number(s[key], std::string("safety.") + key);
+      if (!(v >= b.lower && v <= b.upper) || (b.lower_open && v == b.lower))
+        r.fail(s[key], fmt::format("safety.{}: {} is outside {}{}, {}] {}: {}", key, v, b.lower_open ? "(" : "[", b.lower, b.upper,
+                                   b.unit, b.why));
+      value = v;
+    };
+    bounded("position_tolerance", c.safety.position_tolerance);
+    bounded("velocity_factor", c.safety.velocity_factor);
+    bounded("current_trip_factor", c.safety.current_trip_factor);
+    bounded("approach_speed", c.safety.approach_speed);
+    bounded("pre_roll", c.safety.pre_roll);
     if (s["at_stop"]) {
       const std::string a = r.text(s["at_stop"], "safety.at_stop");
       if (a == "hold") c.safety.at_stop = StopAction::hold;
       else if (a == "torque_off") c.safety.at_stop = StopAction::torque_off;
       else r.fail(s["at_stop"], fmt::format("safety.at_stop: '{}', expected hold or torque_off", a));
     }
-    if (s["hold_time"]) c.safety.hold_time = r.positive(s["hold_time"], "safety.hold_time");
-    if (c.safety.position_tolerance < 0) r.fail(s["position_tolerance"], "safety.position_tolerance: must not be negative");
-    if (c.safety.pre_roll < 0) r.fail(s["pre_roll"], "safety.pre_roll: must not be negative");
+    bounded("hold_time", c.safety.hold_time);
+    if (s["bus_watchdog"]) {
+      const double w = r.number(s["bus_watchdog"], "safety.bus_watchdog");
+      const double units = std::ceil(w / dynamixel::xseries::kBusWatchdogUnit - 1e-9);
+      if (!(w == 0 || (units >= 1 && units <= 127)))
+        r.fail(s["bus_watchdog"], fmt::format("safety.bus_watchdog: {} s; the servos' Bus Watchdog takes 0 (off) or 0.02 to 2.54 s", w));
+      c.safety.bus_watchdog = w;
+    }
   }
   return c;
 }

@@ -90,6 +90,8 @@ Loop::Loop(Bus& bus, const HardwareConfig& hw, const std::vector<JointInfo>& joi
   }
   command_.assign(n_, 0);
   stale_.assign(n_, 0);
+  if (hw.safety.bus_watchdog > 0)
+    bus_watchdog_units_ = static_cast<int>(std::ceil(hw.safety.bus_watchdog / xs::kBusWatchdogUnit - 1e-9));
   tau_meas_.assign(n_, 0.0);
 }
 
@@ -148,11 +150,23 @@ ControlResult Loop::run(const std::string& csv) {
   log.set_notes(fmt::format("{}{}stop: {}: {}; at stop: {}; torque off {}; timing: {}", o_.notes, o_.notes.empty() ? "" : "; ",
                             to_string(stop.reason), stop.message, result.at_stop,
                             result.torque_off_confirmed ? "confirmed" : "NOT confirmed for every servo", summary));
-  log.close();
+  try {
+    log.close();
+  } catch (const std::exception& e) {
+    // The log ends short (a full disk): its CSV on its last whole row, its sidecar saying so.
+    // A run that lost its log is no success, whatever stopped it; the report still follows.
+    const std::string lost = fmt::format("{} ({} rows on disk, {} lost)", e.what(), log.written(), log.lost());
+    if (result.reason == StopReason::completed) {
+      result.reason = StopReason::error;
+      result.message = lost;
+    } else if (result.message.find(log.error()) == std::string::npos) {
+      result.message += "; " + lost;
+    }
+  }
   result.rows = log.written();
   if (o_.verbose)
-    std::fprintf(stderr, "stop: %s: %s\nat stop: %s\ntorque off %s; %lld log rows in %s\n%s\n", to_string(stop.reason),
-                 stop.message.c_str(), result.at_stop.c_str(), result.torque_off_confirmed ? "confirmed" : "NOT confirmed for every servo", static_cast<long long>(result.rows),
+    std::fprintf(stderr, "stop: %s: %s\nat stop: %s\ntorque off %s; %lld log rows in %s\n%s\n", to_string(result.reason),
+                 result.message.c_str(), result.at_stop.c_str(), result.torque_off_confirmed ? "confirmed" : "NOT confirmed for every servo", static_cast<long long>(result.rows),
                  csv.c_str(), timing_.summary().c_str());
   return result;
 }
@@ -191,7 +205,18 @@ void Loop::setup() {
     expect_ok(j, delay, "reading Return Delay Time");
     if (delay.get<std::uint8_t>(0) != hw_.return_delay_time)
       expect_ok(j, bus_.write(id, xs::kReturnDelayTime, hw_.return_delay_time, wait()), "Return Delay Time");
+    // Bus Watchdog 0 first: it clears a trip an earlier run left (the goal values refuse writes
+    // until then). Firmware before v38 has no such item: it matters only when the file asks for it.
+    const Reply clear = bus_.write(id, xs::kBusWatchdog, 0, wait());
+    if (bus_watchdog_units_ > 0 && !clear.has_data())
+      throw StopNow{StopReason::setup_failed,
+                    fmt::format("{} refused Bus Watchdog(98) ({}): its firmware may predate v38; hardware.yaml's "
+                                "safety.bus_watchdog: 0 runs without the servos' own watchdog",
+                                joint_name(j), dynamixel::to_string(clear.outcome))};
     expect_ok(j, bus_.write(id, xs::kGoalCurrent, 0, wait()), "Goal Current 0");
+    if (bus_watchdog_units_ > 0)
+      expect_ok(j, bus_.write(id, xs::kBusWatchdog, bus_watchdog_units_, wait()),
+                fmt::format("Bus Watchdog {} ({} ms, safety.bus_watchdog)", bus_watchdog_units_, bus_watchdog_units_ * 20).c_str());
   }
   // The start pose, before torque is on.
   bool fresh = false;
@@ -253,6 +278,20 @@ bool Loop::read_state(Clock::time_point deadline, bool setup) {
     stale_cycles_ = 0;
   }
   return all;
+}
+
+void Loop::check_bus_watchdog(Clock::duration away) {
+  if (bus_watchdog_units_ <= 0) return;
+  const double limit = bus_watchdog_units_ * xs::kBusWatchdogUnit;
+  // Only a gap near the limit can have tripped it: then ask the servos (a read, outside the
+  // cycle's budget; the cycle is late anyway).
+  if (seconds(away) < limit - 2 * T_) return;
+  const auto replies = bus_.sync_read(ids_, xs::kBusWatchdog.address, xs::kBusWatchdog.size, Clock::now() + std::chrono::milliseconds(50));
+  for (int j = 0; j < n_; ++j)
+    if (replies[j].has_data() && replies[j].get<std::int8_t>(0) == -1)
+      throw StopNow{StopReason::bus_watchdog,
+                    fmt::format("{} stopped by its bus watchdog: the loop was away {:.0f} ms, past its {:.0f} ms (safety.bus_watchdog)",
+                                joint_name(j), 1e3 * seconds(away), 1e3 * limit)};
 }
 
 void Loop::check_limits() {
@@ -340,9 +379,13 @@ StopNow Loop::loop() {
       timing_.period_max = std::max(timing_.period_max, p);
       timing_.jitter_max = std::max(timing_.jitter_max, std::abs(p - T_));
     }
+    if (previous_wake != Clock::time_point{}) check_bus_watchdog(wake - previous_wake);
     previous_wake = wake;
     period_stats_ = {period_sum, period_sq, latency_sum, work_sum, static_cast<double>(periods)};
-    if (stop_->load(std::memory_order_relaxed) > stops_seen_) return {StopReason::signal, "stop requested (SIGINT/SIGTERM)"};
+    if (stop_->load(std::memory_order_relaxed) > stops_seen_) {
+      const std::string sig = stop_ == &stop_flag() ? last_stop_signal() : "";
+      return {StopReason::signal, sig.empty() ? "stop requested" : "stop requested (" + sig + ")"};
+    }
 
     const bool fresh = read_state(clock_.io_deadline(std::max(deadline + T * 8 / 10, wake + T / 2)));
     // Every cycle, on what is known: a servo that did not answer keeps its last state (its
@@ -382,6 +425,9 @@ StopNow Loop::loop() {
       }
       log_->append(seconds(wake - (start + k_traj0 * T)), q_.data(), ctrl.velocity().data(), tau_meas_.data(), qr_.data(),
                    qdr_.data(), qddr_.data());
+      // A run whose log cannot be written stops (safely): its rows would be lost.
+      if (log_->failed())
+        throw StopNow{StopReason::error, fmt::format("{}: {} ({} rows on disk)", log_->path().string(), log_->error(), log_->written())};
     }
     const auto done = clock_.now();
     const double work = seconds(done - wake);

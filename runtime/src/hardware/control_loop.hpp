@@ -57,6 +57,9 @@ class Loop {
   void setup();
   bool read_state(Clock::time_point deadline, bool setup = false);  // deadline: on the steady clock
   void check_limits();
+  // After a gap of `away` between cycles that may have passed the servos' Bus Watchdog: reads it
+  // and stops (watchdog) when a servo tripped.
+  void check_bus_watchdog(Clock::duration away);
   void check_current();
   double reference(double s);
   void plan();  // the approach from the measured start pose (q0_) to the trajectory's start
@@ -87,6 +90,7 @@ class Loop {
   std::vector<int> stale_;
   std::int64_t stale_cycles_ = 0;
   int watchdog_ = 3;
+  int bus_watchdog_units_ = 0;  // Bus Watchdog(98) written before torque on (20 ms units; 0: off)
   int alert_id_ = -1;
   bool torque_on_ = false;  // Torque Enable 1 was written to every servo
   bool feedforward_checked_ = false;  // the model feedforward passed check_feedforward()

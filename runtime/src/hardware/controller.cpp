@@ -24,6 +24,7 @@ const char* to_string(StopReason reason) {
     case StopReason::signal: return "signal";
     case StopReason::watchdog: return "watchdog";
     case StopReason::servo_lost: return "servo_lost";
+    case StopReason::bus_watchdog: return "bus_watchdog";
     case StopReason::hardware_error: return "hardware_error";
     case StopReason::position_limit: return "position_limit";
     case StopReason::velocity_limit: return "velocity_limit";
@@ -44,62 +45,6 @@ std::string TimingStats::summary() const {
       cycles, period_mean * 1e6, period_std * 1e6, period_min * 1e6, period_max * 1e6, jitter_max * 1e6, latency_mean * 1e6,
       latency_max * 1e6, work_mean * 1e6, work_max * 1e6, read_max * 1e6, overruns, skipped, read_failures, max_stale,
       write_failures, saturated, bus.transactions, bus.retries, bus.timeouts, bus.crc_errors, bus.corrupt, bus.alerts);
-}
-
-// ---- Signals --------------------------------------------------------------------------------------
-
-namespace {
-// Lock-free, so the handler may touch it (a signal handler may only use lock-free atomics).
-std::atomic<int> g_stop{0};
-static_assert(std::atomic<int>::is_always_lock_free, "the stop flag must be lock-free for the signal handler");
-// When the last counted request arrived (CLOCK_MONOTONIC, ns; 0: none yet), and whether it was a
-// Ctrl-C typed at the terminal.
-std::atomic<long long> g_last_ns{0};
-std::atomic<bool> g_last_typed{false};
-static_assert(std::atomic<long long>::is_always_lock_free && std::atomic<bool>::is_always_lock_free,
-              "the signal handler's state must be lock-free");
-
-// One stop request per deliberate act. GNU timeout and systemd send SIGTERM to the process and
-// again to its group, microseconds apart: counted twice, that pair would end the hold at once
-// and drop the arm. So a further signal counts only when it comes kStopEscalationDelay after the
-// last counted one, or when it and that one are both Ctrl-C typed at the terminal (the kernel
-// sends those, si_code SI_KERNEL; kill(), timeout and systemd send SI_USER).
-extern "C" void stop_signal_handler(int sig, siginfo_t* info, void*) {
-  timespec ts{};
-  clock_gettime(CLOCK_MONOTONIC, &ts);  // async-signal-safe
-  const long long now = static_cast<long long>(ts.tv_sec) * 1'000'000'000LL + ts.tv_nsec;
-  const bool typed = sig == SIGINT && info != nullptr && info->si_code == SI_KERNEL;
-  const long long last = g_last_ns.load(std::memory_order_relaxed);
-  const long long delay = std::llround(kStopEscalationDelay * 1e9);
-  if (last != 0 && now - last < delay && !(typed && g_last_typed.load(std::memory_order_relaxed))) return;
-  g_last_ns.store(now, std::memory_order_relaxed);
-  g_last_typed.store(typed, std::memory_order_relaxed);
-  g_stop.fetch_add(1, std::memory_order_relaxed);
-}
-}  // namespace
-
-std::atomic<int>& stop_flag() { return g_stop; }
-
-StopSignals::StopSignals() : previous_(new struct sigaction[2]) {
-  g_stop.store(0);
-  g_last_ns.store(0);
-  g_last_typed.store(false);
-  struct sigaction sa {};
-  sa.sa_sigaction = stop_signal_handler;
-  sigemptyset(&sa.sa_mask);
-  sigaddset(&sa.sa_mask, SIGINT);  // one handler at a time: the pair's check and update stay whole
-  sigaddset(&sa.sa_mask, SIGTERM);
-  sa.sa_flags = SA_SIGINFO;  // no SA_RESTART: a sleeping loop wakes up at once
-  sigaction(SIGINT, &sa, &previous_[0]);
-  sigaction(SIGTERM, &sa, &previous_[1]);
-}
-
-StopSignals::~StopSignals() {
-  sigaction(SIGINT, &previous_[0], nullptr);
-  sigaction(SIGTERM, &previous_[1], nullptr);
-  delete[] previous_;
-  g_stop.store(0);  // served its run: a later run without handlers must not stop at once
-  g_last_ns.store(0);
 }
 
 // ---- Safe stop --------------------------------------------------------------------------------

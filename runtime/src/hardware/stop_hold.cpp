@@ -25,6 +25,9 @@ void Loop::at_stop(const StopNow& stop, ControlResult& result) {
     case StopReason::servo_lost:
       result.at_stop = "torque off at once: the servos' state is lost, no pose to hold";
       return;
+    case StopReason::bus_watchdog:
+      result.at_stop = "torque off at once: the servos stopped themselves (their bus watchdog), nothing to hold with";
+      return;
     case StopReason::hardware_error:
       result.at_stop = "torque off at once: a servo reports a hardware error";
       return;
@@ -86,6 +89,7 @@ std::string Loop::hold(const Eigen::VectorXd& gravity, ControlResult& result) {
   const int seen = stop_->load();  // a request from now on ends the hold
   const auto start = clock_.now() + T;
   int stale = 0;
+  Clock::time_point previous_wake{};
   for (std::int64_t k = 0; k < cycles; ++k) {
     const auto deadline = start + k * T;
     clock_.sleep_until(deadline, *stop_, seen);
@@ -94,6 +98,8 @@ std::string Loop::hold(const Eigen::VectorXd& gravity, ControlResult& result) {
     const auto wake = clock_.now();
     bool fresh = false;
     try {
+      if (previous_wake != Clock::time_point{}) check_bus_watchdog(wake - previous_wake);
+      previous_wake = wake;
       fresh = read_state(clock_.io_deadline(std::max(deadline + T * 8 / 10, wake + T / 2)), /*setup=*/true);  // counts no watchdog of the run
       if (fresh) check_current();
     } catch (const StopNow& fault) {

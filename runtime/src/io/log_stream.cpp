@@ -10,6 +10,8 @@
 #include <cstdio>
 #include <cstring>
 
+#include <fmt/format.h>
+
 #include "log_columns.hpp"
 #include "log_sidecar.hpp"
 #include "symoro/error.hpp"
@@ -52,6 +54,7 @@ LogStream::LogStream(std::filesystem::path csv, LogMetadata meta, bool reference
     ::close(fd_);
     throw DataError(csv_.string(), 0, std::string("cannot write the log: ") + std::strerror(e));
   }
+  whole_ = static_cast<off_t>(header.size());
   write_sidecar(0);
   thread_ = std::thread([this] { run(); });
 }
@@ -131,6 +134,10 @@ std::size_t LogStream::drain() {
 }
 
 void LogStream::write_out(const std::vector<double>& rows, std::size_t count) {
+  if (failed_.load(std::memory_order_relaxed)) {  // the file ends on its last whole row: no more
+    lost_.fetch_add(static_cast<std::int64_t>(count), std::memory_order_relaxed);
+    return;
+  }
   text_.clear();
   char number[max_number_chars];
   for (std::size_t r = 0; r < count; ++r) {
@@ -146,27 +153,76 @@ void LogStream::write_out(const std::vector<double>& rows, std::size_t count) {
     const ssize_t w = ::write(fd_, text_.data() + done, text_.size() - done);
     if (w < 0 && errno == EINTR) continue;
     if (w <= 0) {
-      std::lock_guard<std::mutex> lock(mutex_);
-      if (error_.empty()) error_ = std::string("cannot write the log: ") + std::strerror(errno);
+      // A full disk (or a file size limit) stops the log where its last whole row ends: the
+      // part of this batch that got out is cut off, the rest of the run's rows are counted as
+      // lost, and the sidecar says the log is incomplete.
+      const int e = w < 0 ? errno : ENOSPC;
+      const bool cut = ::ftruncate(fd_, whole_) == 0;
+      (void)::lseek(fd_, whole_, SEEK_SET);
+      {
+        std::lock_guard<std::mutex> lock(mutex_);
+        if (error_.empty()) error_ = std::string("cannot write the log: ") + std::strerror(e);
+        if (!cut) error_ += "; and cannot cut its last partial row";
+      }
+      lost_.fetch_add(static_cast<std::int64_t>(count), std::memory_order_relaxed);
+      failed_.store(true, std::memory_order_release);
+      write_incomplete_sidecar();
       return;
     }
     done += static_cast<std::size_t>(w);
   }
+  whole_ += static_cast<off_t>(text_.size());
   const std::int64_t total = written_.fetch_add(static_cast<std::int64_t>(count)) + static_cast<std::int64_t>(count);
   try {
     write_sidecar(total);
   } catch (const std::exception& e) {
-    std::lock_guard<std::mutex> lock(mutex_);
-    if (error_.empty()) error_ = e.what();
+    // No room for the new sidecar (a full disk takes it before the CSV's next block): the log
+    // stops here too, its CSV whole, its sidecar rewritten in place to say so.
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      std::string why = e.what();  // "<sidecar>: error: writing failed: <reason>; the previous file ..."
+      why = why.substr(0, why.find("; the previous file"));
+      if (error_.empty()) error_ = "cannot write the log's sidecar: " + why;
+    }
+    failed_.store(true, std::memory_order_release);
+    write_incomplete_sidecar();
   }
 }
 
-void LogStream::write_sidecar(std::int64_t samples) {
+void LogStream::write_incomplete_sidecar() {
+  try {
+    write_sidecar(written_.load());
+  } catch (const std::exception&) {
+    // The disk has no room for a new sidecar beside the old: rewrite the old one in place
+    // (its blocks are there), so that it says what the CSV holds and why it ends.
+    const std::filesystem::path sidecar = metadata_path(csv_);
+    const std::string text = sidecar_text(written_.load());
+    const int fd = ::open(sidecar.c_str(), O_WRONLY | O_CLOEXEC);
+    if (fd >= 0) {
+      std::size_t done = 0;
+      while (done < text.size()) {
+        const ssize_t w = ::pwrite(fd, text.data() + done, text.size() - done, static_cast<off_t>(done));
+        if (w < 0 && errno == EINTR) continue;
+        if (w <= 0) break;
+        done += static_cast<std::size_t>(w);
+      }
+      if (done == text.size()) (void)::ftruncate(fd, static_cast<off_t>(done));
+      ::fsync(fd);
+      ::close(fd);
+    }
+  }
+}
+
+std::string LogStream::sidecar_text(std::int64_t samples) const {
   Log log;
   {
     std::lock_guard<std::mutex> lock(mutex_);
     log.meta = meta_;
     log.meta.notes = notes_;
+    // A log cut short says so wherever it is read (read_log's notes, dynid's output).
+    if (!error_.empty())
+      log.meta.notes += fmt::format("{}LOG INCOMPLETE: {} after {} rows; the rows recorded after them are lost",
+                                    log.meta.notes.empty() ? "" : "; ", error_, samples);
   }
   log.time = Eigen::VectorXd::Zero(samples);
   log.q.resize(0, n_);
@@ -177,9 +233,10 @@ void LogStream::write_sidecar(std::int64_t samples) {
     log.qd_ref.resize(0, n_);
     log.qdd_ref.resize(0, n_);
   }
-  const std::filesystem::path sidecar = metadata_path(csv_);
-  write_file_atomically(sidecar, detail::sidecar_text(log, sidecar.string()));
+  return detail::sidecar_text(log, metadata_path(csv_).string());
 }
+
+void LogStream::write_sidecar(std::int64_t samples) { write_file_atomically(metadata_path(csv_), sidecar_text(samples)); }
 
 void LogStream::flush() {
   std::unique_lock<std::mutex> lock(mutex_);
@@ -200,11 +257,15 @@ void LogStream::close() {
   // The writer is gone: this thread is the queue's only consumer now. Rows appended after its
   // last pass are written, then the final sidecar.
   drain();
-  try {
-    write_sidecar(written_.load());
-  } catch (const std::exception& e) {
-    std::lock_guard<std::mutex> lock(mutex_);
-    if (error_.empty()) error_ = e.what();
+  if (failed_.load()) {
+    write_incomplete_sidecar();
+  } else {
+    try {
+      write_sidecar(written_.load());
+    } catch (const std::exception& e) {
+      std::lock_guard<std::mutex> lock(mutex_);
+      if (error_.empty()) error_ = e.what();
+    }
   }
   ::fsync(fd_);
   ::close(fd_);
@@ -221,5 +282,11 @@ std::int64_t LogStream::appended() const { return appended_.load(); }
 std::int64_t LogStream::written() const { return written_.load(); }
 std::int64_t LogStream::rejected() const { return rejected_.load(); }
 std::int64_t LogStream::overflowed() const { return overflowed_.load(); }
+std::int64_t LogStream::lost() const { return lost_.load(); }
+bool LogStream::failed() const { return failed_.load(std::memory_order_acquire); }
+std::string LogStream::error() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return error_;
+}
 
 }  // namespace symoro::io

@@ -36,6 +36,11 @@ inline constexpr Item kMinPositionLimit{52, 4};
 inline constexpr Item kTorqueEnable{64, 1};
 inline constexpr Item kStatusReturnLevel{68, 1};
 inline constexpr Item kHardwareErrorStatus{70, 1};
+// Bus Watchdog (firmware 38 and later), signed: 0 off (and clears a trip), 1..127 on with a
+// limit of that many 20 ms units between instruction packets while torque is on, -1 tripped:
+// the servo stopped and its goal values refuse writes (Data Range Error) until it is cleared.
+inline constexpr Item kBusWatchdog{98, 1};
+inline constexpr double kBusWatchdogUnit = 0.020;  // s
 inline constexpr Item kGoalCurrent{102, 2};  // signed
 inline constexpr Item kGoalVelocity{104, 4};
 inline constexpr Item kGoalPosition{116, 4};

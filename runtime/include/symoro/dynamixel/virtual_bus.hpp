@@ -13,8 +13,10 @@
 //   data length error: a write that covers part of an item;
 //   data range error : a value outside the item's range (Goal Current beyond +-Current Limit(38),
 //                      Operating Mode not a defined mode, Torque Enable not 0/1, ...).
-// Goal Current drives the backend only with torque on, Operating Mode current (0) and no hardware
-// error; other modes are not emulated (the motor gets no current). The baud rate is stored but
+// Goal Current drives the backend only with torque on, Operating Mode current (0), no hardware
+// error and no tripped Bus Watchdog(98); other modes are not emulated (the motor gets no
+// current). The bus watchdog counts the time since the last instruction packet on the bus (to
+// any servo), on the backend's clock. The baud rate is stored but
 // a pty has none: bytes arrive at once. The backend integrates on the wall clock, or on the
 // controller's own clock when given one.
 //
@@ -121,6 +123,10 @@ class VirtualBus {
   }
   void send_pending();
   double clock() const;
+  // Bus Watchdog(98): a servo with torque on whose limit has passed since the last instruction
+  // packet on the bus stops (goal current off, the item -1); the caller holds mutex_.
+  void trip_bus_watchdogs(double now);
+  bool bus_watchdog_armed() const;
 
   std::vector<Servo> servos_;
   std::unique_ptr<ServoBackend> backend_;
@@ -131,6 +137,7 @@ class VirtualBus {
   std::thread thread_;
   std::chrono::steady_clock::time_point start_;
   std::function<double()> plant_clock_;
+  double last_instruction_ = 0;  // clock() at the last instruction packet (mutex_)
 
   mutable std::mutex mutex_;  // servos_, backend_, faults, stats
   std::size_t corrupt_count_ = 0;

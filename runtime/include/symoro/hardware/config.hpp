@@ -54,6 +54,10 @@ struct Safety {
   double pre_roll = 0.5;              // s holding the start posture before the trajectory
   StopAction at_stop = StopAction::hold;  // safety.at_stop: hold | torque_off
   double hold_time = 2.0;             // s of hold before torque off (safety.hold_time, > 0)
+  // The servos' own Bus Watchdog(98), set before torque on: a servo that hears no instruction
+  // packet for this long (the controller crashed, was killed with SIGKILL, or stalled) stops
+  // driving its motor by itself. s, rounded up to 20 ms units, 0.02..2.54; 0: off.
+  double bus_watchdog = 0.1;
 };
 
 struct HardwareConfig {
@@ -66,6 +70,17 @@ struct HardwareConfig {
 
   std::vector<std::uint8_t> ids() const;
 };
+
+// The range hardware.yaml may set a safety limit to (safety.<key>), so that no value switches
+// the limit off: position_tolerance, velocity_factor, current_trip_factor, approach_speed,
+// pre_roll, hold_time. std::out_of_range for another key.
+struct SafetyBound {
+  double lower, upper;
+  bool lower_open;  // (lower, upper] rather than [lower, upper]
+  const char* unit;
+  const char* why;
+};
+const SafetyBound& safety_bound(const std::string& key);
 
 // Reads hardware.yaml; `robot_joints` (the model's joints) fixes the order and count: the file
 // lists one entry per joint, by name. Throws DataError(file, line, ...).

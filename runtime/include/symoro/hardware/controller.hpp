@@ -13,7 +13,7 @@
 // safety.approach_speed), pre-roll (hold, safety.pre_roll), trajectory (logged, t = 0 at its
 // start), then the end of the trajectory or of `seconds`.
 //
-// Safe stop, whatever ends the run (completion, SIGINT/SIGTERM through the stop flag, watchdog:
+// Safe stop, whatever ends the run (completion, a stop signal through the stop flag, watchdog:
 // watchdog_cycles consecutive failed sync reads, a servo's hardware alert, a servo that stops
 // answering, a joint beyond its position, velocity or current limit, a non-finite command, an
 // exception): first what hardware.yaml's safety.at_stop says (hold the stop pose with the run's
@@ -46,9 +46,10 @@ namespace symoro::hardware {
 
 enum class StopReason {
   completed,       // the trajectory (or the requested seconds) ran to its end
-  signal,          // the stop flag (SIGINT / SIGTERM) was set
+  signal,          // the stop flag was raised (a stop signal: stop_signals())
   watchdog,        // watchdog_cycles consecutive sync reads failed (state too old)
   servo_lost,      // a servo stopped answering (named in the message)
+  bus_watchdog,    // the loop was away past safety.bus_watchdog: a servo stopped itself
   hardware_error,  // a servo's alert bit: Hardware Error Status named in the message
   position_limit,
   velocity_limit,
@@ -81,7 +82,7 @@ struct ControlOptions {
   double seconds = 0;  // run only this much of the trajectory (0: all of it)
   // Stop requests, counted (a signal handler may touch a lock-free atomic): one more than at
   // the start stops the run, a further one ends the hold at once. nullptr: the process's
-  // SIGINT/SIGTERM count (stop_flag()).
+  // stop signals count (stop_flag()).
   const std::atomic<int>* stop = nullptr;
   // Extra joint torque added to FF+PD (N m), from the references: e.g. model_feedforward.
   // When set, the FF+PD's own realization feedforward (M-hat qdd_ref + D-hat qd_ref) is
@@ -132,15 +133,21 @@ struct ControlResult {
   std::string at_stop;        // one line: what was done and why (also in the log's notes)
 };
 
-// The process-wide count of stop requests, raised by the SIGINT/SIGTERM handler of StopSignals.
+// The process-wide count of stop requests, raised by the signal handler of StopSignals.
 std::atomic<int>& stop_flag();
-// A further SIGINT/SIGTERM counts as a new request (it ends the hold at a stop) only when it
-// arrives this long after the last counted one, or when both are Ctrl-C typed at the terminal:
-// `timeout` and systemd send SIGTERM to the process and to its group within microseconds, and
-// that pair is one request (docs/safety.md).
+// The name of the signal behind the last counted request ("SIGHUP"), "" when none.
+std::string last_stop_signal();
+// A further stop signal counts as a new request (it ends the hold at a stop) only when it
+// arrives this long after the last counted one, or when both are typed at the terminal (Ctrl-C,
+// Ctrl-\): `timeout` and systemd send SIGTERM to the process and to its group within
+// microseconds, and that pair is one request (docs/safety.md).
 inline constexpr double kStopEscalationDelay = 0.5;  // s
-// Installs SIGINT and SIGTERM handlers that only count in stop_flag() (clearing it first), and
-// restores the previous handlers when destroyed.
+// The signals StopSignals turns into stop requests: every catchable one whose default action
+// ends the process (SIGINT, SIGTERM, SIGHUP, SIGQUIT, SIGUSR1, SIGUSR2, SIGALRM, ..., the
+// real-time signals), but SIGPIPE, which it ignores, and the faults no program continues after.
+const std::vector<int>& stop_signals();
+// While it lives: handlers for stop_signals() that only count in stop_flag() (cleared first),
+// and SIGPIPE ignored; the previous dispositions are restored when it is destroyed.
 class StopSignals {
  public:
   StopSignals();
@@ -149,7 +156,9 @@ class StopSignals {
   StopSignals& operator=(const StopSignals&) = delete;
 
  private:
-  struct sigaction* previous_;
+  std::vector<int> signals_;
+  std::vector<struct sigaction> previous_;
+  struct sigaction pipe_previous_ {};
 };
 
 // Runs `traj` on the arm behind `bus` with FF+PD `gains` (period = hw.period), logging to `csv`.

@@ -18,6 +18,8 @@
 // behind by `capacity` rows, further rows are dropped and counted (overflowed()).
 #pragma once
 
+#include <sys/types.h>
+
 #include <atomic>
 #include <chrono>
 #include <condition_variable>
@@ -62,12 +64,20 @@ class LogStream {
   std::int64_t written() const;   // rows on disk (and in the sidecar)
   std::int64_t rejected() const;
   std::int64_t overflowed() const;
+  // A write that failed (a full disk): the CSV then ends on its last whole row, the sidecar
+  // counts those rows and its notes say "LOG INCOMPLETE: <the reason>", the rows appended later
+  // are lost (counted) and close() throws with the reason. Any thread may ask.
+  bool failed() const;
+  std::string error() const;  // the first I/O error ("" when none)
+  std::int64_t lost() const;  // rows accepted by append() that never reached the file
 
  private:
   void run();
   std::size_t drain();  // pops whole rows into rows_ and writes them (the writer thread / close())
   void write_out(const std::vector<double>& rows, std::size_t count);
   void write_sidecar(std::int64_t samples);
+  std::string sidecar_text(std::int64_t samples) const;
+  void write_incomplete_sidecar();  // atomically, else in place when there is no room for a new one
 
   std::filesystem::path csv_;
   LogMetadata meta_;
@@ -83,7 +93,8 @@ class LogStream {
   double last_time_ = 0;
   bool has_last_ = false;
   std::atomic<bool> closed_{false};
-  std::atomic<std::int64_t> appended_{0}, rejected_{0}, overflowed_{0}, written_{0};
+  std::atomic<std::int64_t> appended_{0}, rejected_{0}, overflowed_{0}, written_{0}, lost_{0};
+  std::atomic<bool> failed_{false};
 
   // Between the writer thread and flush()/set_notes()/close() (never the producer's path).
   mutable std::mutex mutex_;
@@ -93,6 +104,7 @@ class LogStream {
   std::string notes_;
   std::string error_;  // first I/O error of the writer
   int fd_ = -1;
+  off_t whole_ = 0;           // the CSV's size up to its last whole row (the writer's)
   std::vector<double> rows_;  // the writer's batch
   std::string text_;          // the writer's formatting buffer
   std::thread thread_;
