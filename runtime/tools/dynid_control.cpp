@@ -1,11 +1,14 @@
 // dynid control: run a designed trajectory on the real arm (DYNAMIXEL bus at --port) with the
 // paper's FF+PD at 1 kHz, or with --virtual on the emulated servo chain driving the digital twin
 // (a pseudo-terminal: the same driver, bytes and timing path), and write its log.
-#include <csignal>
+#include <fcntl.h>
 #include <pthread.h>
 #include <sched.h>
+#include <unistd.h>
 
 #include <algorithm>
+#include <csignal>
+#include <cstring>
 #include <filesystem>
 #include <memory>
 #include <optional>
@@ -33,20 +36,43 @@ namespace symoro::dynid {
 
 namespace {
 
-// The log's path: -o as given when free; with "new-name" the first free <stem>-<k><ext>.
-std::filesystem::path free_log_path(const std::filesystem::path& out, const std::string& if_exists) {
-  auto taken = [](const std::filesystem::path& p) {
-    return std::filesystem::exists(p) || std::filesystem::exists(io::metadata_path(p));
-  };
-  if (!taken(out)) return out;
-  if (if_exists != "new-name")
-    throw UsageError(fmt::format("{} exists: a run never overwrites a log; choose another -o, or --if-exists new-name",
-                                 out.string()));
-  for (int k = 1;; ++k) {
-    const auto p = out.parent_path() / fmt::format("{}-{}{}", out.stem().string(), k, out.extension().string());
-    if (!taken(p)) return p;
+// The log's path, claimed: -o as given when free, with "new-name" the first free
+// <stem>-<k><ext>. The CSV is created empty at once (O_EXCL), so that two runs started together
+// never write one log (both used to report its rows while one run was lost); a claim still empty
+// when the command ends (it failed before the run) is removed.
+class LogClaim {
+ public:
+  LogClaim(const std::filesystem::path& out, const std::string& if_exists) {
+    if (!out.parent_path().empty()) std::filesystem::create_directories(out.parent_path());
+    for (int k = 0;; ++k) {
+      const auto p = k == 0 ? out : out.parent_path() / fmt::format("{}-{}{}", out.stem().string(), k, out.extension().string());
+      bool taken = std::filesystem::exists(io::metadata_path(p));
+      if (!taken) {
+        const int fd = ::open(p.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0644);
+        if (fd >= 0) {
+          ::close(fd);
+          path_ = p;
+          return;
+        }
+        if (errno != EEXIST) throw UsageError(fmt::format("cannot create the log {}: {}", p.string(), std::strerror(errno)));
+        taken = true;
+      }
+      if (if_exists != "new-name")
+        throw UsageError(fmt::format("{} exists: a run never overwrites a log; choose another -o, or --if-exists new-name",
+                                     p.string()));
+    }
   }
-}
+  ~LogClaim() {
+    std::error_code ec;
+    if (std::filesystem::file_size(path_, ec) == 0 && !ec) std::filesystem::remove(path_, ec);
+  }
+  LogClaim(const LogClaim&) = delete;
+  LogClaim& operator=(const LogClaim&) = delete;
+  const std::filesystem::path& path() const { return path_; }
+
+ private:
+  std::filesystem::path path_;
+};
 
 }  // namespace
 
@@ -56,7 +82,8 @@ void run_control_command(const Common& common, const ControlCliOptions& o) {
   // signal that would end dynid is a stop request.
   std::signal(SIGPIPE, SIG_IGN);
   hardware::StopSignals signals;
-  const std::string out = free_log_path(o.out, o.if_exists).string();  // before anything moves
+  const LogClaim claim(o.out, o.if_exists);  // before anything moves
+  const std::string out = claim.path().string();
   const robot::ModelHandle full = full_model(common);
   const std::vector<JointInfo>& joints = full.joints();
   const auto hw_path = o.hardware.empty() ? common.robot_dir() / "hardware.yaml" : std::filesystem::path(o.hardware);

@@ -20,6 +20,7 @@
 #include "symoro/identify/model_export.hpp"
 #include "symoro/identify/regression.hpp"
 #include "symoro/identify/urdf_export.hpp"
+#include "symoro/io/folder_lock.hpp"
 #include "symoro/io/atomic_file.hpp"
 #include "symoro/io/dataset.hpp"
 #include "symoro/io/parameters_yaml.hpp"
@@ -246,8 +247,12 @@ void add_export_commands(CLI::App& app, Common& common) {
                                          "instead of failing");
   cmd->add_flag("--force", o->force, "Overwrite the URDF and its .standard.yaml/.csv when they exist");
   cmd->callback([&common, o] {
-    // Like import and control: an existing file is replaced only when the user says so, and
-    // before any work is done.
+    // One export to a URDF at a time (its own lock file beside it, held to the end: two at once
+    // both passed the check below, and the last writer won), and, like import and control, an
+    // existing file is replaced only when the user says so, before any work is done.
+    const std::filesystem::path target(o->urdf);
+    const io::FolderLock lock(target.parent_path().empty() ? std::filesystem::path(".") : target.parent_path(), "dynid export",
+                              "." + target.filename().string() + ".lock");
     std::filesystem::path stem = o->urdf;
     stem.replace_extension();
     for (const std::filesystem::path& f : {std::filesystem::path(o->urdf), std::filesystem::path(stem.string() + ".standard.yaml"),

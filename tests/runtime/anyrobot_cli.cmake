@@ -31,6 +31,23 @@ foreach(robot rx90 stanford_rrp)
   expect("${out}" "stale")
   file(READ ${w}/data/dataset.yaml manifest)
   expect("${manifest}" "trajectory: \"?arm_heldout\"?, family: \"?V\"?")
+  # Two imports into one folder at once: one imports, the other is refused (both used to exit 0
+  # and one input was lost).
+  if(robot STREQUAL "rx90")
+    find_program(BASH bash)
+    set(args import --robot ${robot} -o '${w}/race' '${w}/export.csv' --time stamp_ms --time-unit ms --q '{name}_pos'
+        --qd '{name}_vel' --tau '{name}_eff' --angle deg)
+    string(REPLACE ";" " " args "${args}")
+    run_command(0 out ${BASH} -c "('${DYNID}' ${args} --name one > '${w}/race-a.out' 2>&1 && echo RESULT-ok >> '${w}/race-a.out' || echo RESULT-refused >> '${w}/race-a.out') & ('${DYNID}' ${args} --name two > '${w}/race-b.out' 2>&1 && echo RESULT-ok >> '${w}/race-b.out' || echo RESULT-refused >> '${w}/race-b.out') & wait")
+    file(READ ${w}/race-a.out a)
+    file(READ ${w}/race-b.out b)
+    string(REGEX MATCHALL "RESULT-ok" oks "${a}${b}")
+    list(LENGTH oks n)
+    if(NOT n EQUAL 1)
+      message(FATAL_ERROR "two imports into one folder: ${n} succeeded:\n${a}\n${b}")
+    endif()
+    expect("${a}${b}" "(in use by pid [0-9]+ \\(dynid import\\)|exists already; the importer never replaces a file)")
+  endif()
   # Importing again never replaces what is there.
   run(1 out import --robot ${robot} -o ${w}/data ${w}/export.csv --name arm --time stamp_ms --time-unit ms
       --q "{name}_pos" --qd "{name}_vel" --tau "{name}_eff" --angle deg --split 0.7)

@@ -13,9 +13,9 @@
 
 namespace symoro::io {
 
-FolderLock::FolderLock(const std::filesystem::path& folder, const std::string& what) {
+FolderLock::FolderLock(const std::filesystem::path& folder, const std::string& what, const std::string& name) {
   std::filesystem::create_directories(folder);
-  const std::filesystem::path file = folder / ".lock";
+  const std::filesystem::path file = folder / name;
   fd_ = ::open(file.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
   if (fd_ < 0) throw DataError(file.string(), 0, fmt::format("cannot open the folder's lock file: {}", std::strerror(errno)));
   if (::flock(fd_, LOCK_EX | LOCK_NB) != 0) {

@@ -10,8 +10,9 @@
 
 #include "symoro/error.hpp"
 #include "symoro/io/atomic_file.hpp"
-#include "symoro/io/import.hpp"
 #include "symoro/io/dataset.hpp"
+#include "symoro/io/folder_lock.hpp"
+#include "symoro/io/import.hpp"
 #include "symoro/io/number_text.hpp"
 #include "symoro/io/yaml_text.hpp"
 
@@ -75,7 +76,9 @@ DatasetImportResult import_dataset(const std::filesystem::path& out, const Datas
     result.logs.push_back(std::move(imported));
   }
 
-  // Never replace a file: an earlier import or recording in this folder stays as it was.
+  // One import into a folder at a time (two at once both passed the check below and one input
+  // was lost), then never replace a file: an earlier import or recording stays as it was.
+  const FolderLock lock(out, "dynid import");
   const fs::path manifest = out / "dataset.yaml", record = out / "import.yaml";
   std::vector<fs::path> targets{manifest, record};
   for (const ImportedLog& l : result.logs) {

@@ -12,8 +12,9 @@ namespace symoro::io {
 class FolderLock {
  public:
   // Creates the folder when needed and takes the lock; throws DataError naming the folder and the
-  // holder's pid when another process has it.
-  FolderLock(const std::filesystem::path& folder, const std::string& what);
+  // holder's pid when another process has it. `name`: the lock file in the folder (".lock"; one
+  // file's own lock, e.g. ".arm.urdf.lock", lets other files of the folder be written meanwhile).
+  FolderLock(const std::filesystem::path& folder, const std::string& what, const std::string& name = ".lock");
   ~FolderLock();
   FolderLock(const FolderLock&) = delete;
   FolderLock& operator=(const FolderLock&) = delete;
