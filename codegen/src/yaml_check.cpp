@@ -27,6 +27,7 @@ YAML::Node load_yaml_file(const std::string& path) {
   std::ostringstream content;
   content << in.rdbuf();
   const std::string text = content.str();
+  ::symoro::detail::check_yaml_structure(text, Fail{path});
   YAML::Node root;
   try {
     root = YAML::Load(text);

@@ -22,6 +22,7 @@
 #include "symoro/io/text_file.hpp"
 #include "symoro/trajectory/design.hpp"
 #include "symoro/trajectory/structured_design.hpp"
+#include "symoro/io/yaml_keys.hpp"
 
 namespace symoro::dynid {
 
@@ -180,7 +181,7 @@ void run(const Common& common, const ExciteOptions& o) {
       throw UsageError(e.what());
     }
   }
-  const YAML::Node design = YAML::Load(text);
+  const YAML::Node design = io::load_yaml_text(text, o.from_design.empty() ? std::string("the structured design") : o.from_design);
   Eigen::VectorXd velocity, acceleration;
   fastest_level(design, n, velocity, acceleration);
   const double margin = design["limits"]["position_margin"].as<double>() * kDeg;

@@ -27,6 +27,7 @@
 #include "symoro/preprocess/preprocess.hpp"
 #include "symoro/twin/config.hpp"
 #include "symoro/twin/truth.hpp"
+#include "symoro/io/yaml_keys.hpp"
 
 namespace symoro::dynid {
 
@@ -35,8 +36,9 @@ namespace {
 // The model label the study was identified with (report/parameters.yaml `model:`; "" is the
 // full model), to pick the instantiation when --model is not given.
 std::string study_model(const std::string& file) {
+  if (!std::filesystem::exists(file)) throw UsageError(file + ": not found (is --study a dynid identify folder with its report?)");
   try {
-    const YAML::Node root = YAML::LoadFile(file);
+    const YAML::Node root = io::load_yaml_file(file);
     // A study that produced no model says so here, before its (empty) parameter list is read
     // against the model's names.
     const YAML::Node list = root["parameters"];
@@ -74,7 +76,7 @@ struct FittingRun {
 FittingRun fitting_run(const identify::IdentificationModel& full, const std::filesystem::path& params,
                        const std::string& data_dir, int trial) {
   FittingRun f;
-  f.id = YAML::LoadFile(params.string())["source_run"].as<std::string>("");
+  f.id = io::load_yaml_file(params)["source_run"].as<std::string>("");
   f.trial = trial;
   const auto at = f.id.find('@');
   if (at == std::string::npos || f.id.size() < at + 4)
@@ -116,7 +118,7 @@ void run_export(const Common& common, const ExportOptions& o, const std::string&
   } else {
     const std::filesystem::path params = std::filesystem::path(o.study) / "report" / "parameters.yaml";
     {
-      const YAML::Node root = YAML::LoadFile(params.string());
+      const YAML::Node root = io::load_yaml_file(params);
       const std::string robot = root["robot"] ? root["robot"].as<std::string>() : std::string();
       if (!robot.empty() && robot != common.robot)
         throw UsageError(fmt::format("--robot {}, but {} is a study of '{}'", common.robot, params.string(), robot));

@@ -23,6 +23,7 @@
 #include "symoro/io/log.hpp"
 #include "symoro/io/number_text.hpp"
 #include "symoro/io/parameters_yaml.hpp"
+#include "symoro/io/yaml_keys.hpp"
 
 namespace symoro::dynid {
 
@@ -39,8 +40,9 @@ struct PredictOptions {
 
 // The model label a parameters file was identified with (its `model:`; "" the full model).
 std::string file_model(const std::string& file) {
+  if (!std::filesystem::exists(file)) throw UsageError(file + ": not found");
   try {
-    const YAML::Node root = YAML::LoadFile(file);
+    const YAML::Node root = io::load_yaml_file(file);
     const std::string m = root["model"] ? root["model"].as<std::string>() : std::string();
     return m.empty() ? "full" : m;
   } catch (const YAML::BadFile&) {

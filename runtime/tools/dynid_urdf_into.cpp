@@ -17,6 +17,7 @@
 #include "symoro/io/number_text.hpp"
 #include "symoro/mdh.hpp"
 #include "symoro/urdf_geometry.hpp"
+#include "symoro/io/yaml_keys.hpp"
 
 namespace symoro::dynid {
 
@@ -48,7 +49,7 @@ Isometry3d xyz_rpy(const YAML::Node& n) {
 Origin read_origin(const std::string& robot_yaml) {
   Origin o;
   try {
-    const YAML::Node u = YAML::LoadFile(robot_yaml)["urdf"];
+    const YAML::Node u = io::load_yaml_file(robot_yaml)["urdf"];
     if (!u) throw UsageError(robot_yaml + " has no `urdf:` section: --into needs a robot symoroc model made from a URDF");
     o.base_link = u["base_link"].as<std::string>();
     o.joints = u["joints"].as<std::vector<std::string>>();

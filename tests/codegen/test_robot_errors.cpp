@@ -135,6 +135,16 @@ TEST_F(BrokenRobot, UnclosedQuoteIsASyntaxError) {
   expect_error(R"(robot\.yaml:\d+:\d+: error: YAML syntax error: )");
 }
 
+// A self-merging alias crashed symoroc generate (a stack overflow); a second document was
+// ignored. Both are refused at their line.
+TEST_F(BrokenRobot, ACycleOfAliasesOrASecondDocumentIsRefusedAtItsLine) {
+  add_variants("  loop: &s {<<: *s}\n");
+  expect_error(R"(robot\.yaml:\d+:\d+: error: a YAML alias inside the node its anchor names: a cycle)");
+  start_from("stanford_rrp");
+  std::ofstream(dir_ / "robot.yaml", std::ios::app) << "---\nname: other\n";
+  expect_error(R"(robot\.yaml:\d+:\d+: error: a second YAML document)");
+}
+
 TEST_F(BrokenRobot, VariantPatternThatMatchesNothing) {
   add_variants("  light:\n    fixed: {\"XY*\": 0}\n");
   expect_error(R"(robot\.yaml:\d+:1: error: variant light: 'XY\*' matches no base parameter)");

@@ -6,12 +6,15 @@
 #include <algorithm>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <sstream>
 #include <stdexcept>
 #include <string>
 #include <vector>
 
+#include <fmt/format.h>
 #include <gtest/gtest.h>
+#include <yaml-cpp/yaml.h>
 #include <symoro/crane_x7.hpp>
 #include <unistd.h>
 
@@ -250,6 +253,63 @@ TEST_F(YamlKeys, HardwareConfigRefusesTyposOnTwoRobots) {
   expect_unknown(read2, h, 9, "watchdog_cylces", "watchdog_cycles");
   write(h, edited(arm2, "torque_constant", "torque_konstant"));
   expect_unknown(read2, h, 4, "torque_konstant", "torque_constant");
+}
+
+// ---- anchors, aliases and documents ------------------------------------------------------------
+
+// A self-merging alias crashed every reader (a stack overflow); ten levels of ten aliases ran
+// for minutes; a second document was ignored. Refused in every reader at its line, before any
+// node is built (anchors alone stay allowed: twin.yaml uses them).
+TEST_F(YamlKeys, AnchorsAliasesAndASecondDocumentAreRefusedByEveryReader) {
+  std::string laughs = "lol: &l0 [x, x, x, x, x, x, x, x, x, x]\n";
+  for (int k = 1; k < 10; ++k) {
+    laughs += fmt::format("l{}: &l{} [", k, k);
+    for (int i = 0; i < 10; ++i) laughs += fmt::format("{}*l{}", i ? ", " : "", k - 1);
+    laughs += "]\n";
+  }
+  struct Poison {
+    const char* name;
+    std::string text;  // appended to a valid file
+    std::string message;
+  };
+  const std::vector<Poison> poisons = {{"self-merge", "zz: &s {<<: *s}\n", "a cycle no reader can follow"},
+                                       {"billion laughs", laughs, "YAML aliases expand this document past 1000000 nodes"},
+                                       {"alias", "zz: *nothing\n", "the referenced anchor is not defined"},
+                                       {"second document", "---\nformat: other\n", "a second YAML document"}};
+  fs::create_directories(dir_ / "data");
+  write(dir_ / "data" / "a.csv", "");
+  const std::string dataset = "format: symoro-dataset 1\nrobot: arm6\nruns:\n  - {trajectory: a, family: F, trial: 1, file: a.csv}\n";
+  struct Reader {
+    const char* name;
+    fs::path file;
+    std::string valid;
+    std::function<void()> read;
+  };
+  const fs::path h = dir_ / "hardware.yaml", c = dir_ / "controller.yaml";
+  const std::vector<Reader> readers = {
+      {"hardware.yaml", h, read(kCrane / "hardware.yaml"), [&] { symoro::hardware::read_hardware_config(h, crane_joints()); }},
+      {"controller.yaml", c, read(kCrane / "controller.yaml"), [&] { symoro::control::read_controller_description(c, 8); }},
+      {"dataset.yaml", dir_ / "data" / "dataset.yaml", dataset, [&] { symoro::io::read_dataset(dir_ / "data"); }},
+      {"YAML text", dir_ / "text.yaml", "format: x\n", [&] { symoro::io::load_yaml_file(dir_ / "text.yaml"); }},
+  };
+  for (const Reader& r : readers) {
+    for (const Poison& p : poisons) {
+      SCOPED_TRACE(std::string(r.name) + ", " + p.name);
+      const std::string text = r.valid + p.text;
+      write(r.file, text);
+      // At the poison's line (the laughs: the line whose alias passes the bound).
+      const int first = 1 + static_cast<int>(std::count(r.valid.begin(), r.valid.end(), '\n'));
+      const int last = static_cast<int>(std::count(text.begin(), text.end(), '\n'));
+      try {
+        r.read();
+        ADD_FAILURE() << "accepted";
+      } catch (const DataError& e) {
+        EXPECT_GE(e.line(), first) << e.what();
+        EXPECT_LE(e.line(), std::string(p.name) == "billion laughs" ? last : first) << e.what();
+        EXPECT_NE(std::string(e.what()).find(p.message), std::string::npos) << e.what();
+      }
+    }
+  }
 }
 
 // ---- twin.yaml and its override file -----------------------------------------------------------

@@ -8,6 +8,7 @@
 #include "symoro/control/description.hpp"
 #include "symoro/error.hpp"
 #include "symoro/trajectory/design.hpp"
+#include "symoro/io/yaml_keys.hpp"
 
 namespace symoro::identify {
 
@@ -29,7 +30,7 @@ bool nominal_standard_parameters(const std::filesystem::path& robot_dir, const s
   const std::filesystem::path yaml = robot_dir / "robot.yaml";
   YAML::Node nominal;
   try {
-    nominal = YAML::LoadFile(yaml.string())["nominal"];
+    nominal = io::load_yaml_file(yaml)["nominal"];
   } catch (const YAML::Exception& e) {
     throw DataError(yaml.string(), e.mark.line + 1, e.msg);
   }

@@ -7,6 +7,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include "symoro/io/atomic_file.hpp"
+#include "symoro/io/yaml_keys.hpp"
 #include "yaml_vector.hpp"
 
 namespace symoro::identify {
@@ -151,7 +152,7 @@ RunRecord parse(const YAML::Node& n) {
 
 RunRecord run_record_from_text(const std::string& text) {
   try {
-    return parse(YAML::Load(text));
+    return parse(io::load_yaml_text(text, "a run record"));
   } catch (const YAML::Exception& e) {
     throw std::runtime_error(std::string("a run record that does not parse: ") + e.what());
   }
@@ -160,7 +161,7 @@ RunRecord run_record_from_text(const std::string& text) {
 std::optional<RunRecord> load_run(const std::filesystem::path& file, const std::string& fingerprint) {
   if (!std::filesystem::exists(file)) return std::nullopt;
   try {
-    const YAML::Node n = YAML::LoadFile(file.string());
+    const YAML::Node n = io::load_yaml_file(file);
     if (n["fingerprint"].as<std::string>() != fingerprint) return std::nullopt;
     if (!n["failed"].as<bool>(false) && !n["log_det_scaled"]) return std::nullopt;  // a record before issue 29: done again
     return parse(n);

@@ -10,6 +10,7 @@
 #include "symoro/io/atomic_file.hpp"
 #include "yaml_vector.hpp"
 #include "symoro/io/number_text.hpp"
+#include "symoro/io/yaml_keys.hpp"
 
 namespace symoro::identify {
 
@@ -184,7 +185,7 @@ StudyValidation read_validation(const std::filesystem::path& study_dir) {
                              "validation trajectories?");
   YAML::Node root;
   try {
-    root = YAML::LoadFile(file);
+    root = io::load_yaml_file(file);  // anchors, aliases and a second document refused
   } catch (const YAML::ParserException& e) {
     throw DataError(file, e.mark.line + 1, e.msg);
   }

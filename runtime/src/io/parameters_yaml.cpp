@@ -68,7 +68,7 @@ std::string parameters_digest(const std::string& robot, const std::string& model
 ParametersIntegrity parameters_integrity(const std::string& path, const std::vector<std::string>& names) {
   const Eigen::VectorXd phi = read_parameters_yaml(path, names);
   const bool accepted = parameters_accepted(path);
-  const YAML::Node root = YAML::LoadFile(path);  // read and checked above
+  const YAML::Node root = load_yaml_file(path);  // read and checked above
   const auto text = [&](const char* key) {
     const YAML::Node n = root[key];
     return n && n.IsScalar() ? n.as<std::string>() : std::string();

@@ -27,6 +27,7 @@ struct Fail {
 }  // namespace
 
 YAML::Node load_yaml_text(const std::string& text, const std::string& file) {
+  ::symoro::detail::check_yaml_structure(text, Fail{file});
   YAML::Node root;
   try {
     root = YAML::Load(text);

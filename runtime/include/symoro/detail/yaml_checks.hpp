@@ -7,10 +7,13 @@
 #include <algorithm>
 #include <cctype>
 #include <map>
+#include <sstream>
 #include <string>
 #include <utility>
 #include <vector>
 
+#include <yaml-cpp/anchor.h>
+#include <yaml-cpp/eventhandler.h>
 #include <yaml-cpp/yaml.h>
 
 namespace symoro::detail {
@@ -107,6 +110,78 @@ void check_keys(const YAML::Node& map, const std::vector<std::string>& known, co
     }
     const auto [at, fresh] = seen.emplace(key, line);
     if (!fresh) fail(line, column, "key '" + key + "' appears twice in " + where + " (first on line " + std::to_string(at->second) + ")");
+  }
+}
+
+// What a YAML document may hold before any node is built, from the parser's events: one
+// document (a second one, after '---', would be ignored), and aliases that neither name a node
+// they sit inside (a cycle: `&s {<<: *s}` crashed every reader) nor expand the document past
+// kMaxYamlNodes nodes (ten levels of ten aliases, the "billion laughs", ran for minutes). Anchors
+// themselves are fine (twin.yaml names its servo models with them). A syntax error is left to
+// the loader, which reports it.
+inline constexpr long long kMaxYamlNodes = 1'000'000;
+
+template <class Fail>
+void check_yaml_structure(const std::string& text, const Fail& fail) {
+  struct Events : YAML::EventHandler {
+    explicit Events(const Fail& f) : fail(f) {}
+    const Fail& fail;
+    int documents = 0;
+    long long nodes = 0;                                       // after expanding the aliases so far
+    std::vector<std::pair<YAML::anchor_t, long long>> open;    // anchored containers being read
+    std::map<YAML::anchor_t, long long> size;                  // each anchored node's expanded size
+    void node(const YAML::Mark& mark, long long count) {
+      nodes += count;
+      if (nodes > kMaxYamlNodes)
+        fail(mark.line + 1, mark.column + 1,
+             "YAML aliases expand this document past " + std::to_string(kMaxYamlNodes) + " nodes: refused");
+    }
+    void leaf(const YAML::Mark& mark, YAML::anchor_t anchor) {
+      node(mark, 1);
+      if (anchor != YAML::NullAnchor) size[anchor] = 1;
+    }
+    void start(const YAML::Mark& mark, YAML::anchor_t anchor) {
+      node(mark, 1);
+      open.emplace_back(anchor, nodes - 1);
+    }
+    void end() {
+      if (open.empty()) return;
+      const auto [anchor, first] = open.back();
+      open.pop_back();
+      if (anchor != YAML::NullAnchor) size[anchor] = nodes - first;
+    }
+    void OnDocumentStart(const YAML::Mark& mark) override {
+      if (++documents > 1) fail(mark.line + 1, mark.column + 1, "a second YAML document ('---'): one document per file");
+    }
+    void OnDocumentEnd() override {}
+    void OnNull(const YAML::Mark& mark, YAML::anchor_t anchor) override { leaf(mark, anchor); }
+    void OnAlias(const YAML::Mark& mark, YAML::anchor_t anchor) override {
+      for (const auto& o : open)
+        if (o.first == anchor)
+          fail(mark.line + 1, mark.column + 1, "a YAML alias inside the node its anchor names: a cycle no reader can follow");
+      const auto it = size.find(anchor);
+      node(mark, it == size.end() ? 1 : it->second);
+    }
+    void OnScalar(const YAML::Mark& mark, const std::string&, YAML::anchor_t anchor, const std::string&) override {
+      leaf(mark, anchor);
+    }
+    void OnSequenceStart(const YAML::Mark& mark, const std::string&, YAML::anchor_t anchor, YAML::EmitterStyle::value) override {
+      start(mark, anchor);
+    }
+    void OnSequenceEnd() override { end(); }
+    void OnMapStart(const YAML::Mark& mark, const std::string&, YAML::anchor_t anchor, YAML::EmitterStyle::value) override {
+      start(mark, anchor);
+    }
+    void OnMapEnd() override { end(); }
+  };
+  std::istringstream in(text);
+  YAML::Parser parser(in);
+  Events events(fail);
+  try {
+    while (parser.HandleNextDocument(events)) {
+    }
+  } catch (const YAML::ParserException&) {
+    // the loader reports it
   }
 }
 
