@@ -6,6 +6,7 @@
 // base_from_standard) must equal KDL's at random states. Three public arms (tests/urdf) and one
 // written here with a prismatic joint, rpy origins, a non-z axis, a negative axis, a fixed link
 // and a locked off-chain joint.
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -254,6 +255,33 @@ std::string arm(const std::string& joint2) {
   return std::string(R"(<robot name="a"><link name="b"/><link name="l1"><inertial><mass value="1"/><inertia ixx="1" ixy="0" ixz="0" iyy="1" iyz="0" izz="1"/></inertial></link>
 <joint name="j1" type="revolute"><parent link="b"/><child link="l1"/><axis xyz="0 0 1"/><limit lower="-1" upper="1" velocity="1" effort="1"/></joint>
 <link name="l2"/>)") + (joint2.find("\"l3\"") != std::string::npos ? "<link name=\"l3\"/>" : "") + joint2 + "</robot>";
+}
+
+// Sizes no serial arm has: elements nested 100,000 deep (the XML parser's recursion crashed
+// symoroc after 18 s), 2,001 links (minutes of chain search), a chain of 100 moving joints.
+TEST(ModelFromUrdf, SizesNoArmHasAreRefusedAtOnce) {
+  const int deep = 100000;
+  std::string nested = "<robot name=\"r\">\n<link name=\"l0\"/>\n";
+  for (int k = 0; k < deep; ++k) nested += "<a>";
+  for (int k = 0; k < deep; ++k) nested += "</a>";
+  nested += "\n</robot>\n";
+  const std::string too_deep = error_of(nested);
+  EXPECT_NE(too_deep.find(".urdf:3:"), std::string::npos) << too_deep;
+  EXPECT_NE(too_deep.find("elements nested more than 100 deep"), std::string::npos) << too_deep;
+  const auto chain = [](int links) {
+    std::string t = "<robot name=\"r\">\n<link name=\"l0\"/>\n";
+    for (int i = 1; i < links; ++i)
+      t += fmt::format(R"(<link name="l{}"><inertial><mass value="1"/><inertia ixx="1" ixy="0" ixz="0" iyy="1" iyz="0" izz="1"/></inertial></link>
+<joint name="j{}" type="revolute"><parent link="l{}"/><child link="l{}"/><axis xyz="0 0 1"/><limit lower="-1" upper="1" velocity="1" effort="1"/></joint>
+)", i, i, i - 1, i);
+    return t + "</robot>\n";
+  };
+  const std::string many = error_of(chain(2001));
+  EXPECT_NE(many.find("2001 links: more than the 2000"), std::string::npos) << many;
+  const std::string long_chain = error_of(chain(101));
+  EXPECT_NE(long_chain.find("100 moving joints between 'l0' and 'l100': symoroc models serial arms of at most 64"), std::string::npos)
+      << long_chain;
+  EXPECT_NE(long_chain.find(".urdf:132:"), std::string::npos) << long_chain;  // the 65th joint's line
 }
 
 TEST(ModelFromUrdf, BadInputIsNamed) {

@@ -1,8 +1,10 @@
 #include "urdf_chain.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <fstream>
 #include <functional>
 #include <map>
@@ -118,6 +120,52 @@ std::string xyz_rpy(const Isometry3d& T) {
   return "{xyz: [" + n(p.x()) + ", " + n(p.y()) + ", " + n(p.z()) + "], rpy: [" + n(roll) + ", " + n(pitch) + ", " + n(yaw) + "]}";
 }
 
+// A URDF is a few elements deep (robot > link > inertial > origin); a file nested far deeper is
+// no URDF, and the XML parser's recursion would overflow the stack on it (a segmentation fault
+// after 18 s at 100,000 levels). The first element past kMaxXmlDepth, or 0 when none is.
+constexpr int kMaxXmlDepth = 100;
+int too_deep_line(const std::string& text) {
+  int depth = 0, line = 1;
+  for (std::size_t i = 0; i < text.size(); ++i) {
+    const char c = text[i];
+    if (c == '\n') ++line;
+    if (c != '<') continue;
+    auto skip_to = [&](const char* end) {  // past `end`, counting lines
+      const std::size_t at = text.find(end, i);
+      const std::size_t stop = at == std::string::npos ? text.size() : at + std::strlen(end);
+      line += static_cast<int>(std::count(text.begin() + static_cast<std::ptrdiff_t>(i), text.begin() + static_cast<std::ptrdiff_t>(stop), '\n'));
+      i = stop - 1;
+    };
+    if (text.compare(i, 4, "<!--") == 0) { skip_to("-->"); continue; }
+    if (text.compare(i, 9, "<![CDATA[") == 0) { skip_to("]]>"); continue; }
+    if (text.compare(i, 2, "<?") == 0 || text.compare(i, 2, "<!") == 0) { skip_to(">"); continue; }
+    const bool closing = i + 1 < text.size() && text[i + 1] == '/';
+    // The tag's end, past quoted attribute values.
+    std::size_t k = i + 1;
+    char quote = 0;
+    for (; k < text.size(); ++k) {
+      if (text[k] == '\n') ++line;
+      if (quote) {
+        if (text[k] == quote) quote = 0;
+      } else if (text[k] == '"' || text[k] == '\'') {
+        quote = text[k];
+      } else if (text[k] == '>') {
+        break;
+      }
+    }
+    const bool self_closing = k < text.size() && k > i && text[k - 1] == '/';
+    if (closing) --depth;
+    else if (!self_closing && ++depth > kMaxXmlDepth) return line;
+    i = k;
+  }
+  return 0;
+}
+
+// A serial arm's URDF has tens of links; the chain's search and the model's generation grow with
+// their number (20,000 links ran for minutes).
+constexpr std::size_t kMaxUrdfLinks = 2000;
+constexpr int kMaxChainJoints = 64;
+
 }  // namespace
 
 UrdfChain read_urdf_chain(const std::string& path, const ModelingOptions& options) {
@@ -137,6 +185,8 @@ UrdfChain read_urdf_chain(const std::string& path, const ModelingOptions& option
     }
     return 0;
   };
+  if (const int line = too_deep_line(text))
+    throw InputError(path, line, 0, "elements nested more than " + std::to_string(kMaxXmlDepth) + " deep: not a URDF");
   // Malformed XML is reported where it is (urdfdom says only that parsing failed).
   {
     TiXmlDocument doc;
@@ -149,6 +199,9 @@ UrdfChain read_urdf_chain(const std::string& path, const ModelingOptions& option
     model = urdf::parseURDF(text);
     if (!model) throw InputError(path, 0, 0, "not a valid URDF" + (capture.messages.empty() ? std::string() : ": " + capture.messages));
   }
+  if (model->links_.size() > kMaxUrdfLinks)
+    throw InputError(path, 0, 0, std::to_string(model->links_.size()) + " links: more than the " + std::to_string(kMaxUrdfLinks) +
+                                     " a robot description may have here (symoroc models serial arms)");
   auto link = [&](const std::string& name, const char* what) {
     urdf::LinkConstSharedPtr l = model->getLink(name);
     if (!l) throw InputError(path, 0, 0, std::string(what) + " '" + name + "' is not a link of the URDF");
@@ -211,6 +264,10 @@ UrdfChain read_urdf_chain(const std::string& path, const ModelingOptions& option
   }
   const int n = static_cast<int>(chain.size());
   if (n == 0) throw InputError(path, 0, 0, "no moving joint between '" + base->name + "' and '" + tip->name + "'");
+  if (n > kMaxChainJoints)
+    throw InputError(path, line_of("joint", chain[kMaxChainJoints]->name), 0,
+                     std::to_string(n) + " moving joints between '" + base->name + "' and '" + tip->name + "': symoroc models serial arms of at most " +
+                         std::to_string(kMaxChainJoints));
   for (const auto& [name, value] : options.locked) {
     const auto j = model->getJoint(name);
     if (!j || !moving(*j) || on_chain.count(name))
