@@ -1,6 +1,7 @@
 // What comes after a study, from Python (docs/python.md): a model's torque on logs (predict, as
 // dynid predict) and two studies side by side on their held-out trajectories (compare, as dynid
 // compare), returned as NumPy arrays and dicts.
+#include <cmath>
 #include <filesystem>
 #include <optional>
 
@@ -75,6 +76,12 @@ py::dict prediction_dict(const std::string& name, const identify::Prediction& p)
 void bind_results(py::module_& m) {
   m.def("predict", [](py::handle model, py::handle params, const std::filesystem::path& input, double interval_ms,
                       double torque_delay_ms, int trial, const std::optional<std::filesystem::path>& robot_dir_given) {
+    // dynid predict's ranges (a NaN or infinite value is named, never computed with).
+    if (!(std::isfinite(interval_ms) && interval_ms >= 1 && interval_ms <= 10000))
+      throw py::value_error(fmt::format("interval_ms {}: must be from 1 to 10000", interval_ms));
+    if (!(std::isfinite(torque_delay_ms) && torque_delay_ms >= -1000 && torque_delay_ms <= 1000))
+      throw py::value_error(fmt::format("torque_delay_ms {}: must be from -1000 to 1000", torque_delay_ms));
+    if (trial < 1) throw py::value_error(fmt::format("trial {}: must be 1 or more", trial));
     const auto id = identification_of(model);
     const std::optional<std::filesystem::path> robot_dir = robot_dir_of(model, robot_dir_given);
     const identify::ModelDescription& d = id->description();

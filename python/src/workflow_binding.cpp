@@ -148,7 +148,7 @@ void bind_workflow(py::module_& m) {
                        const std::optional<std::filesystem::path>& robot_dir_arg,
                        const std::optional<std::filesystem::path>& design_arg,
                        const std::vector<std::string>& only, const std::vector<std::string>& validation,
-                       const std::vector<double>& intervals_ms, int jobs, int trial, bool weighted, bool fresh,
+                       const std::vector<double>& intervals_ms, std::optional<int> jobs, int trial, bool weighted, bool fresh,
                        bool in_process, double torque_delay_ms, int clie_iterations, double clie_std_bound,
                        double clie_noise_floor, const std::string& projection_metric, const std::string& consistency,
                        bool physical_start, const std::string& rescue_metric, py::object rescue_prior,
@@ -163,7 +163,9 @@ void bind_workflow(py::module_& m) {
     q.data = data.string();
     q.out = out.string();
     q.trial = trial;
-    q.threads = jobs;
+    q.threads = jobs.value_or(0);  // None: every core (StudyOptions' 0); a value given is checked
+    if (jobs && (*jobs < 1 || *jobs > 1024))
+      throw py::value_error(fmt::format("--jobs {}: must be from 1 to 1024 (None: every core)", *jobs));
     q.fresh = fresh;
     q.in_process = in_process;
     q.only = only;
@@ -276,7 +278,7 @@ void bind_workflow(py::module_& m) {
   }, py::arg("model"), py::arg("data"), py::arg("out"), py::kw_only(), py::arg("robot_dir") = py::none(),
      py::arg("design") = py::none(), py::arg("only") = std::vector<std::string>{},
      py::arg("validation") = std::vector<std::string>{}, py::arg("intervals_ms") = std::vector<double>{},
-     py::arg("jobs") = defaults.threads, py::arg("trial") = defaults.trial, py::arg("weighted") = defaults.weighted,
+     py::arg("jobs") = py::none(), py::arg("trial") = defaults.trial, py::arg("weighted") = defaults.weighted,
      py::arg("fresh") = defaults.fresh, py::arg("in_process") = defaults.in_process,
      py::arg("torque_delay_ms") = defaults.torque_delay_ms, py::arg("clie_iterations") = defaults.clie_iterations,
      py::arg("clie_std_bound") = defaults.clie_std_bound, py::arg("clie_noise_floor") = defaults.clie_noise_floor,

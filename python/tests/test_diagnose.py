@@ -97,6 +97,13 @@ def test_apply_and_errors_as_the_command_line(tmp_path, dynid, source_dir):
     assert "needs --params" in same_error(dict(only=["payload"]), ["--only", "payload"])
     with pytest.raises(ValueError, match="apply: needs robot_dir"):
         symoro.diagnose(arm, data, tmp_path / "x", apply=True)
+    # Numbers dynid refuses are refused here too, before any work (alpha=nan was computed with).
+    for kwargs, pattern in [(dict(alpha=float("nan")), "--alpha nan: must be > 0 and <= 0.5"),
+                            (dict(alpha=0.9), "--alpha 0.9"), (dict(trial=0), "--trial 0"),
+                            (dict(interval_ms=float("inf")), "--interval inf"), (dict(min_gain=-1), "--min-gain -1"),
+                            (dict(cutoff=0), "--cutoff 0")]:
+        with pytest.raises(ValueError, match=pattern.replace("+", "\\+")):
+            symoro.diagnose(arm, data, tmp_path / "x", **kwargs)
     assert not (tmp_path / "x").exists() and not (tmp_path / "y").exists()
 
 

@@ -176,6 +176,20 @@ def test_errors_carry_the_project_text(tmp_path, exports, dynid, source_dir):
         symoro.import_logs(ARM, tmp_path / "data", exports[:1], **{**MAPPING, "time_unit": "min"})
     with pytest.raises(symoro.DataError, match="dataset.yaml: error: not found"):
         symoro.identify(ARM, tmp_path, tmp_path / "study")
+    # What dynid identify's options refuse, symoro.identify refuses (intervals_ms=[nan] aborted
+    # Python with "double free or corruption"; jobs=0 and -3 were taken), before any work.
+    for kwargs, pattern in [(dict(intervals_ms=[float("nan")]), "--interval nan: must be from 1 to 10000 ms"),
+                            (dict(intervals_ms=[0.5]), "--interval 0.5"), (dict(jobs=0), "--jobs 0"),
+                            (dict(jobs=-3), "--jobs -3"), (dict(trial=0), "--trial 0"),
+                            (dict(torque_delay_ms=float("inf")), "--torque-delay inf"),
+                            (dict(validation_ms=float("nan")), "--validation-interval nan")]:
+        with pytest.raises(ValueError, match=pattern):
+            symoro.identify(ARM, tmp_path, tmp_path / "refused", **kwargs)
+    assert not (tmp_path / "refused").exists()
+    for kwargs, pattern in [(dict(interval_ms=float("nan")), "interval_ms nan"), (dict(torque_delay_ms=float("inf")), "torque_delay_ms inf"),
+                            (dict(trial=0), "trial 0")]:
+        with pytest.raises(ValueError, match=pattern):
+            symoro.predict(ARM, "nominal", exports[0], **kwargs)
 
 
 def test_ctrl_c_stops_a_study_and_a_rerun_resumes(tmp_path, exports, source_dir):

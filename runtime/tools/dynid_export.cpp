@@ -254,7 +254,7 @@ void add_export_commands(CLI::App& app, Common& common) {
     // existing file is replaced only when the user says so, before any work is done.
     const std::filesystem::path target(o->urdf);
     const io::FolderLock lock(target.parent_path().empty() ? std::filesystem::path(".") : target.parent_path(), "dynid export",
-                              "." + target.filename().string() + ".lock");
+                              "." + target.filename().string() + ".lock", /*remove_when_done=*/true);
     std::filesystem::path stem = o->urdf;
     stem.replace_extension();
     for (const std::filesystem::path& f : {std::filesystem::path(o->urdf), std::filesystem::path(stem.string() + ".standard.yaml"),

@@ -2,6 +2,7 @@
 #include "symoro/diagnose/dataset_diagnosis.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <regex>
 #include <utility>
 
@@ -20,6 +21,17 @@
 namespace symoro::diagnose {
 
 void check_request(const DatasetDiagnosisOptions& o) {
+  // The ranges dynid diagnose's options check, for every caller (Python passed alpha=nan).
+  const auto range = [](const char* option, double v, double lo, double hi, bool lo_open, const char* what) {
+    if (!(std::isfinite(v) && (lo_open ? v > lo : v >= lo) && v <= hi))
+      throw DiagnosisRequestError(fmt::format("{} {}: must be {}", option, v, what));
+  };
+  if (o.trial < 1 || o.trial > 1'000'000) throw DiagnosisRequestError(fmt::format("--trial {}: must be from 1 to 1000000", o.trial));
+  range("--interval", o.interval * 1000, 1, 10000, false, "from 1 to 10000 ms");
+  range("--cutoff", o.cutoff, 0, 1e5, true, "> 0 and <= 1e5 Hz");
+  range("--alpha", o.alpha, 0, 0.5, true, "> 0 and <= 0.5");
+  range("--min-gain", o.min_gain, 0, 1, false, ">= 0 and <= 1");
+  range("--min-torque", o.min_torque, 0, 1e6, false, ">= 0 and <= 1e6 N m");
   static const std::regex lower_id("^[a-z][a-z0-9_]*$");
   if (!o.variant.empty() && (!std::regex_match(o.variant, lower_id) || o.variant == "full" || o.variant == "param"))
     throw DiagnosisRequestError("--variant '" + o.variant + "' must be a lower-case identifier other than 'full' and 'param' "

@@ -1,12 +1,43 @@
 // A user's study request into StudyOptions (study_request.hpp).
 #include "symoro/identify/study_request.hpp"
 
+#include <cmath>
+
+#include <fmt/format.h>
+
 #include "symoro/identify/robot_folder.hpp"
 #include "symoro/io/parameters_yaml.hpp"
 
 namespace symoro::identify {
 
+namespace {
+// The ranges dynid identify's options check (dynid_numbers.hpp), for every caller: a NaN
+// interval reached the study from Python and aborted it ("double free or corruption").
+void check_range(const char* option, double v, double lo, double hi, bool lo_open, const char* range) {
+  if (!(std::isfinite(v) && (lo_open ? v > lo : v >= lo) && v <= hi))
+    throw StudyRequestError(fmt::format("{} {}: must be {}", option, v, range));
+}
+void check_count(const char* option, long long v, long long lo, long long hi) {
+  if (v < lo || v > hi) throw StudyRequestError(fmt::format("{} {}: must be from {} to {}", option, v, lo, hi));
+}
+}  // namespace
+
+void check_request(const StudyRequest& r) {
+  for (double ms : r.intervals_ms) check_range("--interval", ms, 1, 10000, false, "from 1 to 10000 ms");
+  check_count("--trial", r.trial, 1, 1'000'000);
+  if (r.threads != 0) check_count("--jobs", r.threads, 1, 1024);  // 0: every core (the default)
+  check_range("--rank-timeout", r.rank_timeout, 0, 1e6, true, "> 0 and <= 1e6 s");
+  check_range("--torque-delay", r.torque_delay_ms, -1000, 1000, false, "from -1000 to 1000 ms");
+  check_count("--clie-iterations", r.clie_iterations, 0, 100000);
+  check_range("--clie-std-bound", r.clie_std_bound, 0, 1e6, false, ">= 0 and <= 1e6");
+  check_range("--clie-noise-floor", r.clie_noise_floor, 0, 1e6, false, ">= 0 and <= 1e6");
+  if (r.validation_ms != 0) check_range("--validation-interval", r.validation_ms, 1, 10000, false, "from 1 to 10000 ms");
+  check_range("--rescue-prior-weight", r.rescue_prior_weight, 0, 1e6, true, "> 0 and <= 1e6");
+  for (double w : r.rescue_prior_weights) check_range("--rescue-prior-weights", w, 0, 1e6, true, "> 0 and <= 1e6");
+}
+
 StudyOptions study_options(const StudyRequest& r, const ModelDescription& d, const std::filesystem::path& robot_dir) {
+  check_request(r);
   StudyOptions so;
   so.data = r.data;
   so.out = r.out;

@@ -2,6 +2,7 @@
 
 #include <fcntl.h>
 #include <sys/file.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <cerrno>
@@ -13,13 +14,26 @@
 
 namespace symoro::io {
 
-FolderLock::FolderLock(const std::filesystem::path& folder, const std::string& what, const std::string& name) {
+FolderLock::FolderLock(const std::filesystem::path& folder, const std::string& what, const std::string& name, bool remove_when_done)
+    : file_(folder / name), remove_(remove_when_done) {
   std::filesystem::create_directories(folder);
-  const std::filesystem::path file = folder / name;
-  fd_ = ::open(file.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
-  if (fd_ < 0) throw DataError(file.string(), 0, fmt::format("cannot open the folder's lock file: {}", std::strerror(errno)));
-  if (::flock(fd_, LOCK_EX | LOCK_NB) != 0) {
-    const int err = errno;
+  const std::filesystem::path& file = file_;
+  int err = 0;
+  for (;;) {
+    fd_ = ::open(file.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
+    if (fd_ < 0) throw DataError(file.string(), 0, fmt::format("cannot open the folder's lock file: {}", std::strerror(errno)));
+    if (::flock(fd_, LOCK_EX | LOCK_NB) != 0) {
+      err = errno;
+      break;
+    }
+    // Held: unless a holder that removes its file when done removed this one just before (a
+    // lock on a file no one else finds); then again, on the file the name now gives.
+    struct stat held {}, named {};
+    if (::fstat(fd_, &held) == 0 && ::stat(file.c_str(), &named) == 0 && held.st_ino == named.st_ino && held.st_dev == named.st_dev)
+      break;
+    ::close(fd_);
+  }
+  if (err != 0) {
     // The holder writes its pid just after it takes the lock: a refusal in between waits a little
     // for it (at most 0.2 s) so that the message can name it.
     char holder[256] = {};
@@ -46,6 +60,7 @@ FolderLock::FolderLock(const std::filesystem::path& folder, const std::string& w
 FolderLock::~FolderLock() {
   if (fd_ >= 0) {
     [[maybe_unused]] const int t = ::ftruncate(fd_, 0);
+    if (remove_) ::unlink(file_.c_str());  // while still held: a later one creates its own
     ::close(fd_);  // releases the lock
   }
 }

@@ -44,6 +44,11 @@ struct StudyRequestError : std::invalid_argument {
   using std::invalid_argument::invalid_argument;
 };
 
+// Every number of the request within dynid identify's ranges (finite, intervals 1-10000 ms,
+// jobs 1-1024, ...); StudyRequestError naming the option and the value otherwise. study_options
+// calls it first.
+void check_request(const StudyRequest& request);
+
 // The study's options for `model`; robot_dir: the robot folder whose robot.yaml holds the
 // nominal parameters (empty: none). The progress and stop callbacks are the caller's to set.
 StudyOptions study_options(const StudyRequest& request, const ModelDescription& model,
