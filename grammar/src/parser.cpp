@@ -662,8 +662,12 @@ namespace {
 
 std::string read_file(const std::string& path) {
   std::error_code ec;
+  const auto st = std::filesystem::status(path, ec);
+  // A device (/dev/zero never ends) or a FIFO (blocks without a writer) is no model file.
+  if (!ec && std::filesystem::exists(st) && !std::filesystem::is_regular_file(st) && !std::filesystem::is_directory(st))
+    throw ParseError(path, 0, 0, "not a regular file (a device, a FIFO or a socket): only files are read", "");
   std::ifstream in;
-  if (!std::filesystem::is_directory(path, ec)) in.open(path, std::ios::binary);
+  if (!std::filesystem::is_directory(st)) in.open(path, std::ios::binary);
   if (!in) throw ParseError(path, 0, 0, "cannot open file", "");
   std::string text{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
   if (in.bad()) throw ParseError(path, 0, 0, "cannot read file", "");

@@ -303,7 +303,7 @@ void add_excite_commands(CLI::App& app, Common& common) {
       ->capture_default_str();
   cmd->add_option("--harmonics", o->harmonics, "Harmonics of each series")->check(numbers::count(2, 20))->capture_default_str();
   cmd->add_option("--period", o->period, "Period of each series, s (default: from the joints' box and speed, 5-60 s)")
-      ->check(numbers::positive(3600, "> 0 and <= 3600 s"));
+      ->check(numbers::checked(0.5, 3600, false, false, "from 0.5 to 3600 s"));
   cmd->add_option("--periods", o->periods, "Periods each optimized trajectory runs")->check(numbers::count(1, 100))->capture_default_str();
   cmd->add_option("--starts", o->starts, "Random starts of each optimization")->check(numbers::count(1, 100))->capture_default_str();
   cmd->add_option("--seed", o->seed, "Seed of the starts and of the validation waypoints")->capture_default_str();

@@ -122,7 +122,9 @@ void add_trajectory_commands(CLI::App& app, Common& common) {
       ->check(CLI::ExistingFile);
   cmd->add_option("-o,--output", o->out, "Write <name>.csv and <name>.meta.yaml here (default: list only)");
   cmd->add_option("--only", o->only, "Only these trajectories");
-  cmd->add_option("--period", o->period, "Sample period of the reference files, s")->check(numbers::positive(10, "> 0 and <= 10 s"));
+  // At least 0.1 ms (10 kHz): --period 1e-9 ran out of memory, 1e-6 wrote 7.9 GB.
+  cmd->add_option("--period", o->period, "Sample period of the reference files, s")
+      ->check(numbers::checked(1e-4, 10, false, false, "from 0.0001 to 10 s"));
   cmd->add_flag("--quality", o->quality, "Print each trajectory's excitation of the robot's identified model: kappa, "
                                          "kappa and log det with unit columns, the weakest direction");
   cmd->add_option("--interval", o->interval_ms, "Sampling interval of --quality, ms (as in identification)")

@@ -125,7 +125,7 @@ expect("${out}" "bad")
 foreach(case "identify|--interval|nan" "identify|--interval|inf" "identify|--interval|0" "identify|--interval|-10"
              "identify|--interval|1e-300" "identify|--trial|0" "identify|--validation-interval|nan"
              "control|--seconds|nan" "control|--seconds|1e400" "control|--trial|1.5" "diagnose|--alpha|nan"
-             "export|--margin|inf")
+             "export|--margin|inf" "trajectories|--period|1e-9" "trajectories|--period|1e-6" "excite|--period|1e-9")
   string(REPLACE "|" ";" case "${case}")
   list(GET case 0 command)
   list(GET case 1 option)
@@ -134,6 +134,8 @@ foreach(case "identify|--interval|nan" "identify|--interval|inf" "identify|--int
     set(rest --robot crane_x7 --data ${ds} -o ${WORK}/numbers)
   elseif(command STREQUAL "control")
     set(rest --robot crane_x7 --virtual -o ${WORK}/numbers.csv)
+  elseif(command STREQUAL "trajectories" OR command STREQUAL "excite")
+    set(rest --robot crane_x7 -o ${WORK}/numbers)
   else()
     set(rest --robot crane_x7 --study ${WORK} --urdf ${WORK}/numbers.urdf)
   endif()

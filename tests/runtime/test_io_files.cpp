@@ -1,21 +1,27 @@
 // Files the runtime guards: the folder lock (two studies never write one folder at once) and
 // content digests (a log edited in place is a new log; a parameters file edited after identify
 // wrote it is known to be edited).
+#include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
 #include <Eigen/Core>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <random>
 #include <string>
 
 #include <gtest/gtest.h>
+#include <yaml-cpp/yaml.h>
 
 #include "symoro/error.hpp"
+#include "symoro/io/dataset.hpp"
 #include "symoro/io/digest.hpp"
 #include "symoro/io/folder_lock.hpp"
+#include "symoro/io/log.hpp"
 #include "symoro/io/parameters_yaml.hpp"
+#include "symoro/io/yaml_keys.hpp"
 
 namespace symoro::io {
 namespace {
@@ -55,6 +61,38 @@ TEST(FolderLock, ASecondHolderIsRefusedWithTheFirstsPid) {
   }
   // Released with its holder: the folder can be taken again.
   EXPECT_NO_THROW(FolderLock again(dir / "study", "dynid identify"));
+  std::filesystem::remove_all(dir);
+}
+
+// /dev/zero grew a reader to 23 GB before it was killed; a FIFO with no writer blocked it for
+// ever; /dev/urandom read garbage for minutes. Every reader refuses what is not a regular file,
+// at once, whatever name leads to it (a log, its sidecar, dataset.yaml, a YAML file).
+TEST(Readers, RefuseDevicesAndFifosAtOnce) {
+  const auto dir = std::filesystem::temp_directory_path() / ("symoro_devices_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  const auto fifo = dir / "fifo";
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  for (const std::filesystem::path target : {std::filesystem::path("/dev/zero"), std::filesystem::path("/dev/urandom"), fifo}) {
+    SCOPED_TRACE(target.string());
+    const auto log = dir / "run.csv", sidecar = dir / "run.meta.yaml", manifest = dir / "dataset.yaml";
+    for (const auto& link : {log, sidecar, manifest}) {
+      std::filesystem::remove(link);
+      std::filesystem::create_symlink(target, link);
+    }
+    const auto refused = [&](const std::function<void()>& read, const std::filesystem::path& named) {
+      try {
+        read();
+        ADD_FAILURE() << "read " << named;
+      } catch (const symoro::DataError& e) {
+        EXPECT_EQ(e.file(), named.string()) << e.what();
+        EXPECT_NE(std::string(e.what()).find("not a regular file"), std::string::npos) << e.what();
+      }
+    };
+    refused([&] { symoro::io::read_log(log); }, log);
+    refused([&] { symoro::io::read_log_metadata(log); }, sidecar);
+    refused([&] { symoro::io::read_dataset(dir); }, manifest);
+    refused([&] { symoro::io::load_yaml_file(sidecar); }, sidecar);
+  }
   std::filesystem::remove_all(dir);
 }
 

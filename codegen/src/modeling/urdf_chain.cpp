@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <filesystem>
 #include <fstream>
 #include <functional>
 #include <map>
@@ -169,6 +170,12 @@ constexpr int kMaxChainJoints = 64;
 }  // namespace
 
 UrdfChain read_urdf_chain(const std::string& path, const ModelingOptions& options) {
+  {
+    std::error_code ec;
+    const auto st = std::filesystem::status(path, ec);
+    if (!ec && std::filesystem::exists(st) && !std::filesystem::is_regular_file(st))
+      throw InputError(path, 0, 0, "not a regular file (a folder, a device, a FIFO or a socket): only files are read");
+  }
   std::ifstream in(path, std::ios::binary);
   if (!in) throw InputError(path, 0, 0, "cannot read the file");
   std::stringstream buffer;

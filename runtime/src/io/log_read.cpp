@@ -19,6 +19,7 @@
 #include "symoro/error.hpp"
 #include "symoro/io/log.hpp"
 #include "symoro/io/number_text.hpp"
+#include "symoro/io/text_file.hpp"
 
 namespace symoro::io {
 
@@ -28,6 +29,7 @@ using detail::Group;
 namespace {
 
 std::string read_bytes(const std::filesystem::path& path) {
+  check_regular_file(path);
   std::FILE* f = std::fopen(path.c_str(), "rb");
   if (!f) throw DataError(path.string(), 0, fmt::format("cannot open the log ({})", std::strerror(errno)));
   std::string bytes;
