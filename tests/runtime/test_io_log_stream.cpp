@@ -33,15 +33,21 @@ std::filesystem::path temp_dir() {
   return d;
 }
 
-TEST(LogStream, EveryFlushLeavesAReadableLog) {
-  const auto dir = temp_dir();
-  const auto csv = dir / "stream.csv";
+// A robot's log of two joints at 1 kHz.
+LogMetadata two_joints() {
   LogMetadata meta;
   meta.robot = "crane_x7";
   meta.trajectory = "T";
   meta.source = "robot";
   meta.sample_time = 0.001;
   meta.joints = {"a", "b"};
+  return meta;
+}
+
+TEST(LogStream, EveryFlushLeavesAReadableLog) {
+  const auto dir = temp_dir();
+  const auto csv = dir / "stream.csv";
+  LogMetadata meta = two_joints();
   {
     LogStream s(csv, meta, true, std::chrono::milliseconds(10));
     const double v[2] = {0.5, -0.25};
@@ -125,12 +131,7 @@ TEST(LogStream, AStalledWriterNeitherBlocksAppendNorLosesAnAcceptedRow) {
 TEST(LogStream, AFullDiskEndsTheLogOnItsLastWholeRowAndSaysSo) {
   const auto dir = temp_dir();
   const auto csv = dir / "full.csv";
-  LogMetadata meta;
-  meta.robot = "crane_x7";
-  meta.trajectory = "T";
-  meta.source = "robot";
-  meta.sample_time = 0.001;
-  meta.joints = {"a", "b"};
+  LogMetadata meta = two_joints();
   meta.notes = "run notes";
   struct rlimit saved {};
   ASSERT_EQ(::getrlimit(RLIMIT_FSIZE, &saved), 0);
