@@ -96,8 +96,7 @@ void bind_results(py::module_& m) {
       if (logs.empty()) throw py::value_error(fmt::format("{}: no run of trial {}", input.string(), trial));
     } else {
       io::Log log = io::read_log(input);
-      if (log.joints() != d.nq)
-        throw py::value_error(fmt::format("{} has {} joints, the model of {} {}", input.string(), log.joints(), d.robot, d.nq));
+      io::check_log_robot(log, input, d.robot, d.nq);
       logs.emplace_back(input.stem().string(), std::move(log));
     }
     std::vector<identify::Prediction> out(logs.size());

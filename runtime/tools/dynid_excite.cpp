@@ -6,6 +6,7 @@
 #include <CLI/CLI.hpp>
 
 #include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <sstream>
 
@@ -36,6 +37,7 @@ struct ExciteOptions {
   std::string model;        // "" robot.yaml's identified
   std::string from_design;  // structured families from this file instead of the generator
   std::string params;       // nominal phi; "" robot.yaml's nominal
+  bool force = false;       // replace trajectories.yaml and quality.txt in -o
   int optimized = 3;
   int harmonics = 5;
   double period = 0;  // s; 0: from the limits (auto_period)
@@ -57,9 +59,9 @@ std::vector<double> numbers_of(const std::string& text, char sep, const std::str
     try {
       std::size_t used = 0;
       out.push_back(std::stod(item, &used));
-      if (used != item.size()) throw std::invalid_argument(item);
+      if (used != item.size() || !std::isfinite(out.back()) || std::abs(out.back()) > 1e6) throw std::invalid_argument(item);
     } catch (const std::exception&) {
-      throw UsageError(fmt::format("{}: '{}' is not a number", what, item));
+      throw UsageError(fmt::format("{}: '{}' is not a finite number within 1e6", what, item));
     }
   }
   return out;
@@ -163,8 +165,12 @@ void run(const Common& common, const ExciteOptions& o) {
   const auto model = identification_model(common, o.model);
   const identify::ModelDescription& d = model->description();
   const int n = d.nq;
-  fs::create_directories(o.out);
   const fs::path design_file = fs::path(o.out) / "trajectories.yaml";
+  // Like import, control and export: what is there stays unless the user says so.
+  for (const fs::path& f : {design_file, fs::path(o.out) / "quality.txt"})
+    if (fs::exists(f) && !o.force)
+      throw UsageError(fmt::format("{} exists: dynid excite does not replace it; choose another -o, or --force", f.string()));
+  fs::create_directories(o.out);
 
   // 1. The structured families.
   std::string text;
@@ -247,7 +253,7 @@ void run(const Common& common, const ExciteOptions& o) {
     for (std::size_t s = 0; s < r.starts.size(); ++s)
       starts += fmt::format("{}{}{:.2f} ({}, {} it, {:.1f} s{})", s ? "; " : "", static_cast<int>(s) == r.chosen ? "*" : "",
                             r.starts[s].criterion, r.starts[s].status, r.starts[s].iterations, r.starts[s].seconds,
-                            r.starts[s].passed ? "" : ", fails " + r.starts[s].worst.constraint);
+                            r.starts[s].passed ? "" : !r.starts[s].solved ? ", no design" : ", fails " + r.starts[s].worst.constraint);
     fmt::print("{} from {}: log det {:.2f} in {:.1f} s; starts: {}\n", eo.name, posture, r.criterion, r.seconds, starts);
     std::string tight;
     for (const auto& s : r.slack) tight += fmt::format("{}{} {:.3g} ({}, t = {:.2f} s)", tight.empty() ? "" : ", ", s.constraint, s.slack, s.where, s.time);
@@ -308,14 +314,16 @@ void add_excite_commands(CLI::App& app, Common& common) {
   cmd->add_option("--starts", o->starts, "Random starts of each optimization")->check(numbers::count(1, 100))->capture_default_str();
   cmd->add_option("--seed", o->seed, "Seed of the starts and of the validation waypoints")->capture_default_str();
   cmd->add_option("--torque-fraction", o->torque_fraction, "Torque limit as a fraction of each joint's effort limit")
-      ->check(CLI::Range(0.01, 1.0))
+      ->check(numbers::checked(0.01, 1, false, false, "from 0.01 to 1"))  // CLI::Range let NaN through
       ->capture_default_str();
   cmd->add_option("--table", o->table, "A table this far below frame 0's origin (m, along gravity): every frame origin "
-                                       "from 3 on stays above it (1 cm clearance)");
+                                       "from 3 on stays above it (1 cm clearance)")
+      ->check(numbers::checked(0, 100, false, false, "from 0 to 100 m"));  // -5 meant no table, nan and 1e300 were taken
   cmd->add_option("--half-space", o->half_spaces, "frame:nx,ny,nz:offset: that frame's origin p keeps n.p <= offset (m, frame 0)");
   cmd->add_option("--compare", o->compare, "Logs of reference motions (e.g. a published trajectory's recording, imported) "
                                             "rated beside the design in the quality table")
       ->check(CLI::ExistingFile);
+  cmd->add_flag("--force", o->force, "Replace trajectories.yaml and quality.txt when -o holds them");
   cmd->add_option("--interval", o->interval_ms, "Sampling interval of the quality table, ms")->check(numbers::interval_ms())->capture_default_str();
   cmd->callback([&common, o] { run(common, *o); });
 }

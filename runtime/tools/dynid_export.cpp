@@ -126,6 +126,15 @@ void run_export(const Common& common, const ExportOptions& o, const std::string&
     std::vector<std::string> names;
     for (const auto& p : d.parameters) names.emplace_back(p.name);
     const Eigen::VectorXd phi = io::read_parameters_yaml(params.string(), names);
+    // As control refuses it: a file whose digest no longer matches is not as identify wrote it
+    // (a value or the flag edited), and the URDF would carry the edit as identified.
+    const io::ParametersIntegrity integrity = io::parameters_integrity(params.string(), names);
+    if (!integrity.intact && !o.not_accepted)
+      throw UsageError(fmt::format("{}: the file is not as identify wrote it: {}; --not-accepted exports it anyway", params.string(),
+                                   integrity.why));
+    if (!integrity.intact)
+      fmt::print(stderr, "export: {}: the file is not as identify wrote it: {} (exported anyway: --not-accepted)\n", params.string(),
+                 integrity.why);
     const bool accepted = io::parameters_accepted(params.string());
     if (!accepted && !o.not_accepted)
       throw UsageError(params.string() + ": the study's final audit did not accept these parameters (accepted: false); "
@@ -238,7 +247,7 @@ void add_export_commands(CLI::App& app, Common& common) {
       ->check(numbers::non_negative(1, ">= 0 and <= 1"))
       ->capture_default_str();
   cmd->add_flag("--not-accepted", o->not_accepted, "Export even when the study's final audit did not accept its "
-                                                   "parameters");
+                                                   "parameters, or the file is not as identify wrote it (edited)");
   cmd->add_option("--data", o->data, "The study's dataset: when no consistent set reproduces the accepted parameters, "
                                      "the nearest consistent vector is the one that changes the predicted torque on "
                                      "the study's fitting run least, and that change is reported")

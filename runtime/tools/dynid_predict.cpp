@@ -115,8 +115,7 @@ void run(const Common& common, const PredictOptions& o) {
     if (logs.empty()) throw UsageError(fmt::format("{}: no run of trial {}", input.string(), o.trial));
   } else {
     io::Log log = io::read_log(input);
-    if (log.joints() != d.nq)
-      throw UsageError(fmt::format("{} has {} joints, the model of {} {}", input.string(), log.joints(), common.robot, d.nq));
+    io::check_log_robot(log, input, d.robot, d.nq);
     logs.emplace_back(input.stem().string(), std::move(log));
   }
   const fs::path out(o.out);

@@ -218,6 +218,21 @@ std::string urdf_into(const identify::UrdfDescription& d, const std::string& rob
     const urdf::JointConstSharedPtr joint = model->getJoint(origin.joints[k - 1]);
     if (!joint) throw UsageError(fmt::format("{}: no joint '{}' (robot.yaml urdf joints)", user_urdf, origin.joints[k - 1]));
     const std::string chain_link = joint->child_link_name;
+    // The URDF's joint must be the model's: its axis along frame k's z and, for a revolute
+    // joint, on that line. Another arm's URDF (an origin changed) would get inertials computed
+    // for this arm's frames, silently.
+    if (T.count(joint->parent_link_name)) {
+      const Isometry3d J = T[joint->parent_link_name] * pose(joint->parent_to_joint_origin_transform);
+      const Vector3d a = (J.linear() * Vector3d(joint->axis.x, joint->axis.y, joint->axis.z)).normalized();
+      const Vector3d z = F[k].linear().col(2), o = F[k].translation(), r = J.translation() - o;
+      const double angle = std::acos(std::min(1.0, std::abs(a.dot(z))));
+      const double off = joint->type == urdf::Joint::PRISMATIC ? 0.0 : (r - r.dot(z) * z).norm();
+      if (!(angle <= 1e-6) || !(off <= 1e-6))
+        throw UsageError(fmt::format("{}: joint '{}' is not the model's joint {}: its axis is {:.4g} deg from the model's and "
+                                     "{:.4g} mm off it. This URDF's geometry differs from the one symoroc model read ({}'s "
+                                     "`urdf:` record); export into that URDF, or model this one",
+                                     user_urdf, joint->name, k, angle * 180 / M_PI, off * 1e3, robot_yaml));
+    }
     // The identified body of model link k, about frame k's origin.
     identify::UrdfInertial id = identify::link_inertial(d, k);
     Body identified;

@@ -125,7 +125,8 @@ expect("${out}" "bad")
 foreach(case "identify|--interval|nan" "identify|--interval|inf" "identify|--interval|0" "identify|--interval|-10"
              "identify|--interval|1e-300" "identify|--trial|0" "identify|--validation-interval|nan"
              "control|--seconds|nan" "control|--seconds|1e400" "control|--trial|1.5" "diagnose|--alpha|nan"
-             "export|--margin|inf" "trajectories|--period|1e-9" "trajectories|--period|1e-6" "excite|--period|1e-9")
+             "export|--margin|inf" "trajectories|--period|1e-9" "trajectories|--period|1e-6" "excite|--period|1e-9"
+             "excite|--torque-fraction|nan" "excite|--table|nan" "excite|--table|-5" "excite|--table|1e300")
   string(REPLACE "|" ";" case "${case}")
   list(GET case 0 command)
   list(GET case 1 option)
@@ -168,6 +169,10 @@ run(0 out control --robot crane_x7 --virtual --trajectory AG02 --seconds 1 -o ${
 expect("${out}" "completed; torque off confirmed")
 expect("${out}" "overruns")
 run(0 out preprocess --robot crane_x7 ${WORK}/control/run.csv --interval 40 -o ${WORK}/control/samples)
+# A log of one robot predicted with another's model is refused, naming its sidecar (a UR5 model
+# on an RX-90 log printed an RMSE of 77 N m and exited 0).
+run(1 out predict --robot ur5 --params nominal ${WORK}/control/run.csv -o ${WORK}/control/ur5.csv)
+expect("${out}" "run.meta.yaml: error: the log is of robot 'crane_x7', the model of 'ur5'")
 # excite: CRANE-X7's own design plus one optimized series (a short one: 3 harmonics, 6 s), which
 # the twin and the controller on the virtual bus then run from the written design file; limits
 # that cannot be met are refused with the constraint and the joint.
@@ -194,6 +199,13 @@ expect("${out}" "excite OF01: no posture can start it: A: torque limit of joint 
 if(EXISTS ${WORK}/excite-bad/trajectories.yaml)
   message(FATAL_ERROR "a refused design wrote trajectories.yaml")
 endif()
+# A half-space that is not a number is refused (a NaN one reached Ipopt, which said "invalid
+# number", and the design was written with rc 0); a folder that holds a design is not replaced
+# without --force.
+run(2 out excite --robot crane_x7 -o ${WORK}/excite-nan --optimized 1 --harmonics 3 --period 6 --starts 1 --half-space 3:0,0,nan:0.1)
+expect("${out}" "--half-space normal: 'nan' is not a finite number")
+run(2 out excite --robot crane_x7 -o ${WORK}/excite --from-design ${SOURCE_ROBOTS}/crane_x7/trajectories.yaml --optimized 0)
+expect("${out}" "excite/trajectories.yaml exists: dynid excite does not replace it; choose another -o, or --force")
 # A log the controller wrote (its time starts after the approach and pre-roll, at t > 0; its
 # reference columns are the controller's) through identify with CLIE: the closed loop replays
 # the log's own references, from its first stamp.
@@ -300,6 +312,21 @@ run(0 out export --robot crane_x7 --study ${WORK}/control/study-physical --urdf 
 file(MAKE_DIRECTORY ${WORK}/control/folder.urdf)
 run(2 out export --robot crane_x7 --study ${WORK}/control/study-physical --urdf ${WORK}/control/folder.urdf)
 expect("${out}" "folder.urdf is a directory")
+# A study whose parameters file was edited after identify wrote it (its digest no longer matches)
+# is refused, as control refuses it (it used to be exported with rc 0, the edit as identified).
+file(REMOVE_RECURSE ${WORK}/edited-study)
+file(COPY ${WORK}/control/study-physical/ DESTINATION ${WORK}/edited-study)
+file(READ ${WORK}/edited-study/report/parameters.yaml params)
+string(REGEX REPLACE "(name: \"ZZR2\", unit: \"[^\"]*\", value: )([0-9])" "\\19\\2" edited "${params}")
+if(edited STREQUAL params)
+  message(FATAL_ERROR "no ZZR2 value to edit in the study's parameters.yaml")
+endif()
+file(WRITE ${WORK}/edited-study/report/parameters.yaml "${edited}")
+run(2 out export --robot crane_x7 --study ${WORK}/edited-study --urdf ${WORK}/edited.urdf)
+expect("${out}" "parameters.yaml: the file is not as identify wrote it")
+if(EXISTS ${WORK}/edited.urdf)
+  message(FATAL_ERROR "an edited study was exported")
+endif()
 file(READ ${WORK}/control/crane-physical.urdf urdf)
 if(urdf MATCHES "WARNING")
   message(FATAL_ERROR "the physical study's export warns:\n${urdf}")

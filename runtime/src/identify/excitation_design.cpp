@@ -281,6 +281,14 @@ Eigen::VectorXd random_start(const FourierBasis& basis, const ExcitationDesignOp
   return basis.coefficients(t);
 }
 
+// The statuses after which Ipopt's point is a design (optimal, acceptable, or stopped by a limit
+// at a point it computed normally); the rest (invalid number, restoration failed, infeasible,
+// errors) leave no design.
+bool solved(Ipopt::ApplicationReturnStatus s) {
+  return s == Ipopt::Solve_Succeeded || s == Ipopt::Solved_To_Acceptable_Level || s == Ipopt::Maximum_Iterations_Exceeded ||
+         s == Ipopt::Maximum_CpuTime_Exceeded || s == Ipopt::Search_Direction_Becomes_Too_Small || s == Ipopt::Feasible_Point_Found;
+}
+
 std::string status_name(Ipopt::ApplicationReturnStatus s) {
   switch (s) {
     case Ipopt::Solve_Succeeded: return "converged";
@@ -408,6 +416,7 @@ ExcitationDesign design_excitation(const IdentificationModel& model, const Excit
       if (app->Initialize("") != Ipopt::Solve_Succeeded) throw std::runtime_error("design_excitation: Ipopt did not initialize");
       const Ipopt::ApplicationReturnStatus status = app->OptimizeTNLP(owner);
       result.status = status_name(status);
+      result.solved = solved(status);
       if (const auto stats = app->Statistics(); Ipopt::IsValid(stats)) result.iterations = stats->IterationCount();
     }
     result.criterion = -std::numeric_limits<double>::infinity();
@@ -417,7 +426,10 @@ ExcitationDesign design_excitation(const IdentificationModel& model, const Excit
         const auto slack = check_excitation(model, basis.trajectory(problem->solution(), options.name), options);
         result.worst = *std::min_element(slack.begin(), slack.end(),
                                          [](const ExcitationSlack& a, const ExcitationSlack& b) { return a.slack < b.slack; });
-        result.passed = result.worst.slack >= 0;
+        // A start counts only when its solve ended normally and its point passes the dense check:
+        // a point Ipopt left after "invalid number" or "restoration failed" is no design, even
+        // inside the limits (a NaN torque limit gave one, written with rc 0).
+        result.passed = result.solved && result.worst.slack >= 0;
       }
     }
     result.seconds = std::chrono::duration<double>(Clock::now() - ts).count();
@@ -427,6 +439,11 @@ ExcitationDesign design_excitation(const IdentificationModel& model, const Excit
       out.chosen = s;
     }
     out.starts.push_back(result);
+  }
+  if (out.chosen < 0 && std::none_of(out.starts.begin(), out.starts.end(), [](const ExcitationStart& r) { return r.solved; })) {
+    std::string statuses;
+    for (const auto& r : out.starts) statuses += (statuses.empty() ? "" : ", ") + r.status;
+    throw ExcitationInfeasible("no start's solve ended normally (Ipopt: " + statuses + ")");
   }
   if (out.chosen < 0) {
     const auto& w = std::min_element(out.starts.begin(), out.starts.end(), [](const ExcitationStart& a, const ExcitationStart& b) {

@@ -190,6 +190,13 @@ Log read_run_log(const DatasetRun& run) {
   return window;
 }
 
+void check_log_robot(const Log& log, const std::filesystem::path& csv, const std::string& robot, int joints) {
+  if (!log.meta.robot.empty() && log.meta.robot != robot)
+    throw DataError(metadata_path(csv).string(), 0, fmt::format("the log is of robot '{}', the model of '{}'", log.meta.robot, robot));
+  if (log.joints() != joints)
+    throw DataError(csv.string(), 0, fmt::format("the log has {} joints, the model of {} {}", log.joints(), robot, joints));
+}
+
 Log read_run_log(const DatasetRun& run, const std::string& robot, int joints) {
   Log log = read_run_log(run);
   if (!log.meta.robot.empty() && log.meta.robot != robot)

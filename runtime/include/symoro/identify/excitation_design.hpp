@@ -67,7 +67,8 @@ struct ExcitationStart {
   std::string status;    // Ipopt's return status
   int iterations = 0;
   double seconds = 0;
-  bool passed = false;   // the dense check
+  bool solved = false;   // Ipopt's status: a normal end (converged, acceptable, a limit reached)
+  bool passed = false;   // solved, and the dense check passed
   ExcitationSlack worst; // the tightest limit of the dense check
 };
 
