@@ -59,6 +59,16 @@ foreach(robot rx90 stanford_rrp)
   expect("${out}" "export.csv:[0-9]+: error: joint [0-9]+ '[a-z0-9_]+' is at -?[0-9.e+-]+ rad, far outside its limits")
   expect("${out}" "import with --allow-implausible")
   run(0 out import -o ${w}/deg-as-rad ${deg_as_rad} --allow-implausible)
+  # Torques 1000 times too large (a scale the wrong way round, mN m taken for N m) are refused at
+  # their line, beyond 5 times the joint's effort limit, with the override (they imported, rc 0).
+  if(robot STREQUAL "rx90")
+    set(milli --robot ${robot} ${w}/export.csv --name arm --time stamp_ms --time-unit ms --q "{name}_pos" --qd "{name}_vel"
+        --tau "{name}_eff" --angle deg --torque-scale 1000)
+    run(1 out import -o ${w}/milli ${milli})
+    expect("${out}" "export.csv:[0-9]+: error: joint [0-9]+ '[a-z0-9_]+' has a torque of -?[0-9.e+-]+ N m, beyond 5 times its effort limit")
+    expect("${out}" "--torque-scale")
+    run(0 out import -o ${w}/milli ${milli} --allow-implausible)
+  endif()
   run(1 out import -o ${w}/split-1e-9 --robot ${robot} ${w}/export.csv --name arm --time stamp_ms --time-unit ms
       --q "{name}_pos" --qd "{name}_vel" --tau "{name}_eff" --angle deg --split 1e-9)
   expect("${out}" "split 1e-09 at [0-9.e+-]+ s leaves 1 of the [0-9]+ samples in the fitting part")

@@ -27,6 +27,10 @@ constexpr double kRevoluteMargin = 0.5, kPrismaticMargin = 0.05;
 constexpr double kMinStep = 1e-4, kMaxStep = 0.5;
 
 constexpr const char* kOverride = "if the values are right, import with --allow-implausible";
+// A logged torque past this many times the joint's effort limit is a unit mistake (mN m read as
+// N m, a scale the wrong way round: 1000 times off), not a robot; past kMaxTorque it is no
+// torque at all (1e308 imported with rc 0, then identification failed without saying why).
+constexpr double kEffortFactor = 5, kMaxTorque = 1e6;
 
 // 3 significant digits are enough evidence; number_text would print 58.70000000000001.
 std::string g(double v) { return fmt::format("{:.6g}", v); }
@@ -73,6 +77,34 @@ void check_plausible(const ImportedLog& imported, const ImportMapping& mapping, 
                                 "max({} {}, half its range)): {} {}",
                                 worst_joint + 1, target.joints[j], g(q), unit, as_written, g(lo), g(hi), unit, g(margin),
                                 unit, prismatic ? kPrismaticMargin : kRevoluteMargin, unit, hint, kOverride));
+  }
+
+  // Torques: the sample farthest beyond kEffortFactor times its joint's effort limit.
+  double worst_ratio = 1;
+  worst_row = -1;
+  for (Eigen::Index j = 0; j < log.tau.cols(); ++j) {
+    const double effort = target.effort.size() == static_cast<std::size_t>(n) ? target.effort[static_cast<std::size_t>(j)] : 0.0;
+    const double bound = effort > 0 ? kEffortFactor * effort : kMaxTorque;
+    for (Eigen::Index k = 0; k < log.samples(); ++k) {
+      const double ratio = std::abs(log.tau(k, j)) / bound;
+      if (ratio > worst_ratio) {
+        worst_ratio = ratio;
+        worst_row = k;
+        worst_joint = j;
+      }
+    }
+  }
+  if (worst_row >= 0) {
+    const std::size_t j = static_cast<std::size_t>(worst_joint);
+    const double effort = target.effort.size() == static_cast<std::size_t>(n) ? target.effort[j] : 0.0;
+    const bool prismatic = !target.prismatic.empty() && target.prismatic[j];
+    const std::string unit = prismatic ? "N" : "N m";
+    const std::string limit = effort > 0 ? fmt::format("{} times its effort limit {} {}", kEffortFactor, g(effort), unit)
+                                         : fmt::format("{} {}", g(kMaxTorque), unit);
+    throw DataError(file, imported.lines[static_cast<std::size_t>(worst_row)],
+                    fmt::format("joint {} '{}' has a torque of {} {}, beyond {}: is the torque unit right (--torque-scale, "
+                                "units.torque_scale: the factor from the file's unit to {})? {}",
+                                worst_joint + 1, target.joints[j], g(log.tau(worst_row, worst_joint)), unit, limit, unit, kOverride));
   }
 
   const double step = log.meta.sample_time;  // the median interval, to the us

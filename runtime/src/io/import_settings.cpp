@@ -35,6 +35,7 @@ ImportTarget import_target(const std::string& robot, const std::vector<JointInfo
     t.prismatic.push_back(j.type == JointType::Prismatic);
     t.lower.push_back(j.lower);
     t.upper.push_back(j.upper);
+    t.effort.push_back(j.effort);
   }
   return t;
 }

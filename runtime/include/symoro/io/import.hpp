@@ -67,6 +67,7 @@ struct ImportTarget {
   std::vector<std::string> joints;  // names, in the model's order
   std::vector<bool> prismatic;      // per joint (empty: all revolute)
   std::vector<double> lower, upper;  // position limits per joint, rad or m (empty: not checked)
+  std::vector<double> effort;        // torque (force) limits per joint, N m or N (empty or 0: not checked)
 };
 
 // The target of a compiled model: its joints' names, types and position limits.
