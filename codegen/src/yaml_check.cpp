@@ -2,13 +2,13 @@
 
 #include <algorithm>
 #include <cctype>
-#include <filesystem>
 #include <fstream>
 #include <map>
 #include <sstream>
 #include <utility>
 
 #include "symoro/codegen/robot_spec.hpp"
+#include "symoro/detail/regular_file.hpp"
 #include "symoro/detail/yaml_checks.hpp"
 
 namespace symoro::codegen {
@@ -23,10 +23,7 @@ struct Fail {
 }  // namespace
 
 YAML::Node load_yaml_file(const std::string& path) {
-  std::error_code ec;
-  const auto st = std::filesystem::status(path, ec);
-  if (!ec && std::filesystem::exists(st) && !std::filesystem::is_regular_file(st))
-    throw InputError(path, 0, 0, "not a regular file (a folder, a device, a FIFO or a socket): only files are read");
+  if (const std::string why = ::symoro::detail::not_a_regular_file(path); !why.empty()) throw InputError(path, 0, 0, why);
   std::ifstream in(path, std::ios::binary);
   if (!in) throw InputError(path, 0, 0, "cannot open file");
   std::ostringstream content;

@@ -5,7 +5,6 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
-#include <filesystem>
 #include <fstream>
 #include <functional>
 #include <map>
@@ -20,6 +19,7 @@
 
 #include "equation_text.hpp"
 #include "symoro/codegen/robot_spec.hpp"
+#include "symoro/detail/regular_file.hpp"
 #include "symoro/urdf_geometry.hpp"
 
 namespace symoro::codegen::modeling {
@@ -170,12 +170,7 @@ constexpr int kMaxChainJoints = 64;
 }  // namespace
 
 UrdfChain read_urdf_chain(const std::string& path, const ModelingOptions& options) {
-  {
-    std::error_code ec;
-    const auto st = std::filesystem::status(path, ec);
-    if (!ec && std::filesystem::exists(st) && !std::filesystem::is_regular_file(st))
-      throw InputError(path, 0, 0, "not a regular file (a folder, a device, a FIFO or a socket): only files are read");
-  }
+  if (const std::string why = ::symoro::detail::not_a_regular_file(path); !why.empty()) throw InputError(path, 0, 0, why);
   std::ifstream in(path, std::ios::binary);
   if (!in) throw InputError(path, 0, 0, "cannot read the file");
   std::stringstream buffer;
