@@ -23,10 +23,7 @@ namespace {
 // conditioning of M for the forward dynamics). The Jets are Duals along a random direction v
 // (jet_support.hpp), compared with the generated derivative times v.
 constexpr double kJetTol = 1e-10;
-// Central differences with h = 1e-6: truncation ~h^2, round-off ~1e-16/h.
-constexpr double kFdStep = 1e-6;
-constexpr double kFdTol = 1e-6;
-constexpr int kStates = 5;
+// Central differences: kFdStep, kFdTol and kStates (test_support.hpp).
 
 template <class Model>
 class RobotDerivatives : public ::testing::Test {

@@ -25,11 +25,7 @@ namespace {
 // Newton-Euler and the generated code evaluate the same expressions in a different order: 1e-9
 // of the object's magnitude leaves room for that round-off (about 1e-13 to 1e-15 in practice).
 constexpr double kRelTol = 1e-9;
-// Central differences with h = 1e-6: truncation about h^2 and round-off about 1e-16/h, both far
-// below 1e-6 of the derivative's magnitude.
-constexpr double kFdStep = 1e-6;
-constexpr double kFdTol = 1e-6;
-constexpr int kStates = 5;
+// Central differences: kFdStep, kFdTol and kStates (test_support.hpp).
 constexpr double kSameArithmetic = 1e-14;
 
 template <class Model>

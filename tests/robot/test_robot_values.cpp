@@ -33,12 +33,9 @@ using Eigen::MatrixXd;
 using Eigen::VectorXd;
 
 // As test_robot.cpp: round-off of two evaluation orders times M's conditioning; central
-// differences with h = 1e-6 (truncation ~h^2, round-off ~1e-16/h).
+// differences as test_support.hpp's kFdStep, kFdTol.
 constexpr double kRelTol = 1e-9;
-constexpr double kFdStep = 1e-6;
-constexpr double kFdTol = 1e-6;
 constexpr double kSameValue = 1e-12;
-constexpr int kStates = 5;
 
 std::shared_ptr<const robot::RobotLibrary> library(const std::string& folder) { return test_library(folder); }
 

@@ -22,6 +22,12 @@
 
 namespace symoro::test {
 
+// Central differences with h = 1e-6 (truncation ~h^2, round-off ~1e-16/h) held to 1e-6 of the
+// derivative's magnitude, at kStates random states: the generated-model tests' common settings.
+inline constexpr double kFdStep = 1e-6;
+inline constexpr double kFdTol = 1e-6;
+inline constexpr int kStates = 5;
+
 // |actual - expected| <= rel_tol * scale entry by entry, where scale is the largest magnitude
 // in either object: a relative error of the object as a whole, so that entries which cancel to
 // nearly 0 are not held to a relative precision no floating-point evaluation has. `columns`

@@ -1,3 +1,4 @@
+#include "symoro/detail/numbers.hpp"
 #include "symoro/diagnose/localize.hpp"
 
 #include <algorithm>
@@ -15,7 +16,7 @@ namespace {
 
 constexpr double pi = 3.14159265358979323846;
 constexpr double deg_per_rad = 180 / pi;
-constexpr double nan = std::numeric_limits<double>::quiet_NaN();
+using symoro::detail::nan;
 
 using Index = Eigen::Index;
 

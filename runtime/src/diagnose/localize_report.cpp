@@ -1,3 +1,4 @@
+#include "symoro/detail/numbers.hpp"
 #include "symoro/diagnose/localize_report.hpp"
 
 #include <algorithm>
@@ -15,20 +16,20 @@ namespace symoro::diagnose {
 namespace {
 
 using Index = Eigen::Index;
-constexpr double nan = std::numeric_limits<double>::quiet_NaN();
+using symoro::detail::nan;
 
 // --- Text ---------------------------------------------------------------------------------
 
 std::string fixed(double v, int decimals) { return std::isfinite(v) ? fmt::format("{:.{}f}", v, decimals) : "n/a"; }
 
 // Three significant digits, fixed notation.
-std::string sig3(double v) {
+std::string sig3_text(double v) {
   if (!std::isfinite(v)) return "n/a";
   if (v == 0) return "0";
   return fixed(v, std::clamp(2 - static_cast<int>(std::floor(std::log10(std::abs(v)))), 0, 9));
 }
 
-std::string percent(double fraction) { return std::isfinite(fraction) ? fixed(100 * fraction, 0) + " %" : "n/a"; }
+std::string percent_text(double fraction) { return std::isfinite(fraction) ? fixed(100 * fraction, 0) + " %" : "n/a"; }
 
 std::string heading(int level, const std::string& text) {
   return std::string(static_cast<std::size_t>(std::clamp(level, 1, 6)), '#') + " " + text + "\n\n";
@@ -248,13 +249,13 @@ std::string localization_markdown(const Localization& loc, const std::vector<std
       Index b = 0;
       jl.band_power_fraction.maxCoeff(&b);
       if (static_cast<std::size_t>(b) < loc.bands.size())
-        band = loc.bands[static_cast<std::size_t>(b)] + " (" + percent(jl.band_power_fraction(b)) + ")";
+        band = loc.bands[static_cast<std::size_t>(b)] + " (" + percent_text(jl.band_power_fraction(b)) + ")";
     }
-    main.row({jl.name, sig3(jl.residual_rms),
-              percent(jl.torque_rms > 0 ? jl.residual_rms / jl.torque_rms : nan),
-              rev ? percent(rev->sse_share) : "n/a", rev ? percent(rev->fraction) : "n/a",
-              std::isfinite(jl.direction_step) ? sig3(jl.direction_step) + " ± " + sig3(jl.direction_step_se) : "n/a",
-              fixed(jl.torque_lag * 1000, 2), fixed(jl.torque_lag_adjusted * 1000, 2), sig3(jl.peak_frequency), band, fixed(jl.velocity_correlation, 2),
+    main.row({jl.name, sig3_text(jl.residual_rms),
+              percent_text(jl.torque_rms > 0 ? jl.residual_rms / jl.torque_rms : nan),
+              rev ? percent_text(rev->sse_share) : "n/a", rev ? percent_text(rev->fraction) : "n/a",
+              std::isfinite(jl.direction_step) ? sig3_text(jl.direction_step) + " ± " + sig3_text(jl.direction_step_se) : "n/a",
+              fixed(jl.torque_lag * 1000, 2), fixed(jl.torque_lag_adjusted * 1000, 2), sig3_text(jl.peak_frequency), band, fixed(jl.velocity_correlation, 2),
               fixed(jl.velocity_lag * 1000, 1)});
   }
   md += main.str() + "\n";
@@ -266,8 +267,8 @@ std::string localization_markdown(const Localization& loc, const std::vector<std
   markdown::Table regimes({"joint", "regime", "samples", "mean [N m]", "rms [N m]", "rms / overall", "SSE share"}, markdown::Align::first_left);
   for (const auto& jl : loc.joints)
     for (const auto& r : jl.regimes)
-      regimes.row({jl.name, r.regime, fmt::format("{} ({})", r.samples, percent(r.fraction)), sig3(r.mean),
-                   sig3(r.rms), fixed(r.rms_ratio, 2), percent(r.sse_share)});
+      regimes.row({jl.name, r.regime, fmt::format("{} ({})", r.samples, percent_text(r.fraction)), sig3_text(r.mean),
+                   sig3_text(r.rms), fixed(r.rms_ratio, 2), percent_text(r.sse_share)});
   md += regimes.str() + "\n";
 
   md += heading(heading_level + 1, "Residual power by frequency band");
@@ -284,9 +285,9 @@ std::string localization_markdown(const Localization& loc, const std::vector<std
   markdown::Table bands(header, markdown::Align::first_left);
   for (const auto& jl : loc.joints) {
     std::vector<std::string> cells{jl.name};
-    for (Index b = 0; b < jl.band_power_fraction.size(); ++b) cells.push_back(percent(jl.band_power_fraction(b)));
+    for (Index b = 0; b < jl.band_power_fraction.size(); ++b) cells.push_back(percent_text(jl.band_power_fraction(b)));
     cells.resize(loc.bands.size() + 1, "n/a");
-    cells.push_back(sig3(jl.peak_frequency));
+    cells.push_back(sig3_text(jl.peak_frequency));
     bands.row(cells);
   }
   md += bands.str() + "\n";

@@ -9,6 +9,7 @@
 
 #include <fmt/format.h>
 
+#include "symoro/detail/numbers.hpp"
 #include "symoro/identify/pca.hpp"
 
 namespace symoro::identify::report_detail {
@@ -23,7 +24,7 @@ double median(std::vector<double> v) {
 
 namespace {
 
-constexpr double nan = std::numeric_limits<double>::quiet_NaN();
+using symoro::detail::nan;
 
 int parameter_count(const StudyResult& study) {
   if (!study.names.empty()) return static_cast<int>(study.names.size());

@@ -1,3 +1,4 @@
+#include "symoro/detail/numbers.hpp"
 #include "symoro/identify/reproduction.hpp"
 
 #include <algorithm>
@@ -12,7 +13,7 @@ namespace symoro::identify {
 
 namespace {
 
-constexpr double nan = std::numeric_limits<double>::quiet_NaN();
+using symoro::detail::nan;
 
 // The paper's numbers (CRANE-X7, 39-parameter model, real arm): Table III's PD-OLS counts per
 // interval (10, 20, 40, 80 ms, of 40 runs each), Table VII's mean RMSE, Appendix A's kappa range.

@@ -7,6 +7,7 @@
 #include <sstream>
 
 #include "design_data.hpp"
+#include "symoro/detail/numbers.hpp"
 #include "symoro/error.hpp"
 #include "symoro/trajectory/fourier.hpp"
 
@@ -14,7 +15,7 @@ namespace symoro::trajectory {
 
 namespace {
 
-constexpr double kDeg = 3.14159265358979323846 / 180.0;
+using symoro::detail::kDeg;
 
 std::string text(double value) {
   std::ostringstream out;

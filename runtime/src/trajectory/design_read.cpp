@@ -10,6 +10,7 @@
 #include <sstream>
 
 #include "design_data.hpp"
+#include "symoro/detail/numbers.hpp"
 #include "symoro/error.hpp"
 #include "symoro/io/yaml_keys.hpp"
 
@@ -19,7 +20,7 @@ int Design::levels() const { return speed_factors.empty() ? 0 : static_cast<int>
 
 namespace {
 
-constexpr double kDeg = 3.14159265358979323846 / 180.0;
+using symoro::detail::kDeg;
 
 std::string degrees(double rad) {
   std::ostringstream out;

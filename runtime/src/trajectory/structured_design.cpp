@@ -1,3 +1,4 @@
+#include "symoro/detail/numbers.hpp"
 #include "symoro/trajectory/structured_design.hpp"
 
 #include <algorithm>
@@ -11,7 +12,7 @@ namespace symoro::trajectory {
 
 namespace {
 
-constexpr double kDeg = 3.14159265358979323846 / 180.0;
+using symoro::detail::kDeg;
 constexpr double kMaxHalfBox = 120 * kDeg;
 constexpr double kMaxAmplitude = 60 * kDeg;
 
