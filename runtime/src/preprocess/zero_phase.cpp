@@ -7,7 +7,8 @@
 
 namespace symoro::preprocess {
 
-namespace {
+// Named, not anonymous: SampledZeroPhase::State (a class with linkage) holds one.
+namespace zero_phase_detail {
 
 // A cascade in direct form II transposed running over rows of channels, its state carried
 // from one stretch of rows to the next (padding, data, padding).
@@ -73,7 +74,9 @@ class Cascade {
   Eigen::ArrayXXd z1_, z2_;  // channels x sections
 };
 
-}  // namespace
+}  // namespace zero_phase_detail
+
+using zero_phase_detail::Cascade;
 
 int zero_phase_padding(const std::vector<Biquad>& sections) {
   return static_cast<int>(std::ceil(3 * slowest_time_constant(sections)));
