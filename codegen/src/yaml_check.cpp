@@ -28,7 +28,8 @@ YAML::Node load_yaml_file(const std::string& path) {
   if (!in) throw InputError(path, 0, 0, "cannot open file");
   std::ostringstream content;
   content << in.rdbuf();
-  const std::string text = content.str();
+  std::string text = content.str();
+  if (text.compare(0, 3, "\xEF\xBB\xBF") == 0) text.erase(0, 3);  // a UTF-8 byte order mark is no content
   ::symoro::detail::check_yaml_structure(text, Fail{path});
   YAML::Node root;
   try {

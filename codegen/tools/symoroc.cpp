@@ -2,6 +2,8 @@
 #include <CLI/CLI.hpp>
 #include <fmt/core.h>
 
+#include <cerrno>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
@@ -11,7 +13,11 @@
 #include "symoro/codegen/generator.hpp"
 #include "symoro/codegen/modeling.hpp"
 #include "symoro/codegen/robot_library.hpp"
+#include "symoro/codegen/robot_name.hpp"
 #include "symoro/grammar/parser.hpp"
+
+#include <fcntl.h>
+#include <unistd.h>
 
 namespace fs = std::filesystem;
 using namespace symoro::codegen;
@@ -25,16 +31,50 @@ std::string read_text(const fs::path& p) {
   return s.str();
 }
 
-// Writes through a temporary file and a rename, so a reader never sees half a header.
-void write_atomically(const fs::path& p, const std::string& text) {
-  fs::create_directories(p.parent_path());
-  const fs::path tmp = p.string() + ".tmp";
-  {
-    std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
-    out << text;
-    if (!out.flush()) throw std::runtime_error("cannot write " + tmp.string());
+// Writes files that belong together (a robot folder's model files, a robot's headers) all or
+// none: each goes to "<name>.tmp", complete and fsynced, before any takes its name, so that a
+// failure (a full disk) leaves every file as it was and no temporary file behind, and says why.
+void write_all_or_none(const std::vector<std::pair<fs::path, std::string>>& files) {
+  std::vector<fs::path> temps;
+  auto fail = [&](const fs::path& file, int error) {
+    for (const auto& t : temps) ::unlink(t.c_str());
+    const std::string why = error == ENOSPC ? "no space left on device" : std::strerror(error);
+    throw std::runtime_error("cannot write " + file.string() + " (" + why + "); no file of the " +
+                             std::to_string(files.size()) + " was changed");
+  };
+  for (const auto& [file, text] : files) {
+    std::error_code ec;
+    if (file.has_parent_path()) fs::create_directories(file.parent_path(), ec);
+    if (ec) fail(file, ec.value());
+    const fs::path tmp = file.string() + ".tmp";
+    const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0666);
+    if (fd < 0) fail(file, errno);
+    temps.push_back(tmp);
+    const char* p = text.data();
+    std::size_t left = text.size();
+    int error = 0;
+    while (left > 0 && error == 0) {
+      const ssize_t done = ::write(fd, p, left);
+      if (done < 0 && errno == EINTR) continue;
+      if (done <= 0) {
+        error = done < 0 ? errno : EIO;
+      } else {
+        p += done;
+        left -= static_cast<std::size_t>(done);
+      }
+    }
+    if (error == 0 && ::fsync(fd) != 0) error = errno;
+    if (::close(fd) != 0 && error == 0) error = errno;
+    if (error != 0) fail(file, error);
   }
-  fs::rename(tmp, p);
+  for (std::size_t i = 0; i < files.size(); ++i) {
+    std::error_code ec;
+    fs::rename(temps[i], files[i].first, ec);
+    if (ec) {
+      for (std::size_t k = i; k < temps.size(); ++k) ::unlink(temps[k].c_str());
+      throw std::runtime_error("cannot rename " + temps[i].string() + " to " + files[i].first.string() + ": " + ec.message());
+    }
+  }
 }
 
 std::vector<fs::path> robot_dirs(const fs::path& robots) {
@@ -68,10 +108,12 @@ int generate(const std::vector<std::string>& dirs, const std::string& out_root) 
     RobotModel robot = load_robot(dir);
     const Generation gen = generate_robot(robot);
     std::set<std::string> fresh;
+    std::vector<std::pair<fs::path, std::string>> files;
     for (const auto& f : gen.files) {
-      write_atomically(fs::path(out_root) / f.path, f.content);
+      files.emplace_back(fs::path(out_root) / f.path, f.content);
       fresh.insert(f.path);
     }
+    write_all_or_none(files);
     for (const auto& old : files_under(out_root, fs::path(out_root) / robot.name))
       if (!fresh.count(old)) fs::remove(fs::path(out_root) / old);  // stale output of an old variant
     fmt::print("{}: {} files, {} models\n", robot.name, gen.files.size(), gen.models.size());
@@ -180,8 +222,11 @@ int model(const std::string& input, const std::string& out_dir, const ModelingOp
   const fs::path in(input);
   const bool urdf = in.extension() == ".urdf" || in.extension() == ".xml";
   if (!urdf && in.extension() != ".par") throw std::runtime_error(input + ": symoroc model reads a .par or a .urdf");
+  const fs::path dir = fs::path(out_dir).lexically_normal();
+  // The folder's name becomes the robot's namespace at symoroc generate: refuse it now.
+  const std::string folder = (dir.has_filename() ? dir.filename() : dir.parent_path().filename()).string();
+  if (const std::string why = robot_name_problem(folder); !why.empty()) throw std::runtime_error(out_dir + ": " + why + " (the folder's name)");
   Modeling m = urdf ? model_from_urdf(input, options) : model_from_par(input, options);
-  const fs::path dir(out_dir);
   if (!urdf) m.files.insert(m.files.begin(), {in.filename().string(), read_text(in)});
   std::vector<std::string> changed;
   for (const auto& f : m.files)
@@ -191,8 +236,9 @@ int model(const std::string& input, const std::string& out_dir, const ModelingOp
     for (const auto& c : changed) list += " " + c;
     throw std::runtime_error(dir.string() + " already has other versions of" + list + ": pass --force to replace them");
   }
-  fs::create_directories(dir);
-  for (const auto& f : m.files) write_atomically(dir / f.name, f.text);
+  std::vector<std::pair<fs::path, std::string>> files;
+  for (const auto& f : m.files) files.emplace_back(dir / f.name, f.text);
+  write_all_or_none(files);
   fmt::print("{}: {} base parameters, {} files in {}\n", m.robot, m.base_parameters.size(), m.files.size(), dir.string());
   for (const auto& note : m.notes) fmt::print("  {}\n", note);
   if (!fs::exists(dir / "robot.yaml"))
@@ -270,11 +316,7 @@ int main(int argc, char** argv) {
     if (*chk) return check(robots, generated);
     if (*inf) return info(info_dir);
     if (*mdl) {
-      for (const auto& l : locks) {
-        const auto eq = l.find('=');
-        if (eq == std::string::npos) throw std::runtime_error("--lock " + l + ": write joint=position");
-        model_options.locked[l.substr(0, eq)] = std::stod(l.substr(eq + 1));
-      }
+      for (const auto& l : locks) add_lock(model_options, l);
       model_options.rotor_inertia = !no_ia;
       model_options.viscous = !no_fv;
       model_options.coulomb = !no_fs;

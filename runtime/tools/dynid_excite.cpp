@@ -188,6 +188,17 @@ void run(const Common& common, const ExciteOptions& o) {
     }
   }
   const YAML::Node design = io::load_yaml_text(text, o.from_design.empty() ? std::string("the structured design") : o.from_design);
+  // Another robot's design was reported at the temporary file it became (its joints differ).
+  if (!o.from_design.empty()) {
+    const YAML::Node robot = design.IsMap() ? design["robot"] : YAML::Node();
+    if (!robot || !robot.IsScalar())
+      throw UsageError(fmt::format("{}: no `robot:`: --from-design takes a trajectory design of {} (e.g. its trajectories.yaml)",
+                                   o.from_design, common.robot));
+    if (robot.as<std::string>() != common.robot)
+      throw UsageError(fmt::format("{}:{}: the design is of robot '{}', not {}: --from-design takes a design of the robot "
+                                   "being excited",
+                                   o.from_design, robot.Mark().line + 1, robot.as<std::string>(), common.robot));
+  }
   Eigen::VectorXd velocity, acceleration;
   fastest_level(design, n, velocity, acceleration);
   const double margin = design["limits"]["position_margin"].as<double>() * kDeg;
@@ -312,7 +323,7 @@ void add_excite_commands(CLI::App& app, Common& common) {
       ->check(numbers::checked(0.5, 3600, false, false, "from 0.5 to 3600 s"));
   cmd->add_option("--periods", o->periods, "Periods each optimized trajectory runs")->check(numbers::count(1, 100))->capture_default_str();
   cmd->add_option("--starts", o->starts, "Random starts of each optimization")->check(numbers::count(1, 100))->capture_default_str();
-  cmd->add_option("--seed", o->seed, "Seed of the starts and of the validation waypoints")->capture_default_str();
+  cmd->add_option("--seed", o->seed, "Seed of the starts and of the validation waypoints")->capture_default_str()->check(numbers::seed());
   cmd->add_option("--torque-fraction", o->torque_fraction, "Torque limit as a fraction of each joint's effort limit")
       ->check(numbers::checked(0.01, 1, false, false, "from 0.01 to 1"))  // CLI::Range let NaN through
       ->capture_default_str();

@@ -33,6 +33,14 @@ inline CLI::Validator checked(double lo, double hi, bool lo_open, bool integer, 
 
 inline CLI::Validator positive(double hi, const std::string& range) { return checked(0, hi, true, false, range); }
 inline CLI::Validator non_negative(double hi, const std::string& range) { return checked(0, hi, false, false, range); }
+// A seed (std::uint64_t): CLI11 read "-1" into it as 2^64 - 1, so a sign is refused.
+inline CLI::Validator seed() {
+  return CLI::Validator(
+      [](std::string& text) -> std::string {
+        return text.find('-') == std::string::npos ? std::string() : fmt::format("'{}': a seed is a whole number of at least 0", text);
+      },
+      "a whole number >= 0");
+}
 inline CLI::Validator count(double lo, double hi) {
   return checked(lo, hi, false, true, fmt::format("a whole number from {} to {}", lo, hi));
 }

@@ -138,7 +138,7 @@ void add_twin_commands(CLI::App& app, Common& common) {
   run->add_option("--trajectory", o->trajectory, "Trajectory name (see dynid trajectories)")->required();
   run->add_option("-o,--output", o->out, "Output directory")->required();
   run->add_option("--trial", o->trial, "Trial number")->check(numbers::count(1, 1e6));
-  run->add_option("--seed", o->seed, "Dataset seed (the run's seed derives from it, the trajectory and the trial)");
+  run->add_option("--seed", o->seed, "Dataset seed (the run's seed derives from it, the trajectory and the trial)")->check(numbers::seed());
   run->callback([&common, o] {
     o->mode = TwinOptions::Mode::run;
     run_twin(common, *o);
@@ -148,7 +148,7 @@ void add_twin_commands(CLI::App& app, Common& common) {
   add_config_options(data, common, *o);
   data->add_option("-o,--output", o->out, "Output directory")->required();
   data->add_option("--trials", o->trials, "Repeated trials per trajectory")->check(numbers::count(1, 1e4));
-  data->add_option("--seed", o->seed, "Dataset seed");
+  data->add_option("--seed", o->seed, "Dataset seed")->check(numbers::seed());
   data->add_option("--jobs", o->jobs, "Worker threads per rank (default: the cores, shared among the MPI ranks on a machine)")->check(numbers::count(1, 1024));
   data->add_option("--only", o->only, "Only these trajectories");
   data->callback([&common, o] {

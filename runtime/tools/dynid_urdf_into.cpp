@@ -10,6 +10,8 @@
 #include <Eigen/Geometry>
 #include <fmt/format.h>
 #include <fmt/ranges.h>
+#include <console_bridge/console.h>
+#include <tinyxml.h>
 #include <urdf_parser/urdf_parser.h>
 #include <yaml-cpp/yaml.h>
 
@@ -187,8 +189,19 @@ std::string urdf_into(const identify::UrdfDescription& d, const std::string& rob
   std::stringstream buffer;
   buffer << in.rdbuf();
   std::string x = buffer.str();
+  // Malformed XML where it is (urdfdom printed "line 100 in ./urdf_parser/src/model.cpp"), and
+  // urdfdom's own messages in the error rather than on the console.
+  {
+    TiXmlDocument doc;
+    doc.Parse(x.c_str());
+    if (doc.Error())
+      throw UsageError(fmt::format("{}:{}:{}: malformed XML: {}", user_urdf, doc.ErrorRow(), doc.ErrorCol(), doc.ErrorDesc()));
+  }
+  const console_bridge::LogLevel level = console_bridge::getLogLevel();
+  console_bridge::setLogLevel(console_bridge::CONSOLE_BRIDGE_LOG_NONE);
   const urdf::ModelInterfaceSharedPtr model = urdf::parseURDF(x);
-  if (!model) throw UsageError(user_urdf + ": not a valid URDF");
+  console_bridge::setLogLevel(level);
+  if (!model) throw UsageError(user_urdf + ": not a valid URDF (symoroc model " + user_urdf + " says why)");
   const int n = static_cast<int>(d.joints.size());
   if (static_cast<int>(origin.joints.size()) != n || static_cast<int>(origin.links.size()) != n)
     throw UsageError(fmt::format("{}: `urdf:` lists {} joints, the model has {}", robot_yaml, origin.joints.size(), n));

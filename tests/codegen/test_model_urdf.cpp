@@ -27,6 +27,7 @@
 #include "relative_difference.hpp"
 #include "symoro/codegen/graph_evaluator.hpp"
 #include "symoro/codegen/modeling.hpp"
+#include "symoro/codegen/robot_name.hpp"
 #include "symoro/codegen/robot_model.hpp"
 
 namespace symoro::codegen {
@@ -315,6 +316,93 @@ TEST(ModelFromUrdf, BadInputIsNamed) {
   EXPECT_TRUE(warned);
 }
 
+// Values urdfdom takes without a word (issue 42, item 13): a NaN, infinite, textual or empty inertia
+// became 0, a NaN mass dropped the whole inertial, 1e300 was accepted and an origin of 1e300 wrote
+// nan into robot.yaml; inverted limits became +-pi; a xacro macro was ignored. Each is an error
+// naming the line, the link or joint, the attribute and the value.
+TEST(ModelFromUrdf, ValuesUrdfdomTakesSilentlyAreRefusedWhereTheyAre) {
+  // arm() with the first link's inertial, the first joint's origin or its limits replaced.
+  auto with = [](const std::string& from, const std::string& to) {
+    std::string a = arm(R"(<joint name="j2" type="revolute"><parent link="l1"/><child link="l2"/><axis xyz="0 0 1"/><limit lower="-1" upper="1" velocity="1" effort="1"/></joint>)");
+    const std::size_t at = a.find(from);
+    EXPECT_NE(at, std::string::npos) << from;
+    return a.replace(at, from.size(), to);
+  };
+  const std::string ixx = R"(ixx="1")", mass = R"(<mass value="1"/>)";
+  for (const std::string bad : {"nan", "inf", "-inf", "heavy", "", "1e300", "1 2"}) {
+    const std::string e = error_of(with(ixx, "ixx=\"" + bad + "\""));
+    EXPECT_NE(e.find(".urdf:1:"), std::string::npos) << bad << ": " << e;
+    EXPECT_NE(e.find("link 'l1': <inertia ixx=\"" + bad + "\">"), std::string::npos) << bad << ": " << e;
+  }
+  for (const std::string bad : {"nan", "-1", "1e300", "one"}) {
+    const std::string e = error_of(with(mass, "<mass value=\"" + bad + "\"/>"));
+    EXPECT_NE(e.find("link 'l1': <mass value=\"" + bad + "\">"), std::string::npos) << bad << ": " << e;
+  }
+  EXPECT_NE(error_of(with(R"(ixy="0" )", "")).find("link 'l1': <inertia> has no ixy"), std::string::npos);
+  const std::string far = error_of(with(R"(<axis xyz="0 0 1"/><limit lower="-1" upper="1")",
+                                        R"(<origin xyz="1e300 0 0"/><axis xyz="0 0 1"/><limit lower="-1" upper="1")"));
+  EXPECT_NE(far.find(".urdf:2:"), std::string::npos) << far;
+  EXPECT_NE(far.find("joint 'j1': <origin xyz=\"1e300 0 0\">: 1e300 is beyond +-1000 m"), std::string::npos) << far;
+  const std::string rpy = error_of(with(R"(<axis xyz="0 0 1"/><limit lower="-1" upper="1")",
+                                        R"(<origin rpy="0 nan 0"/><axis xyz="0 0 1"/><limit lower="-1" upper="1")"));
+  EXPECT_NE(rpy.find("joint 'j1': <origin rpy=\"0 nan 0\">: 'nan' is not a finite number"), std::string::npos) << rpy;
+  const std::string inverted = error_of(with(R"(<limit lower="-1" upper="1")", R"(<limit lower="2" upper="-2")"));
+  EXPECT_NE(inverted.find("joint 'j1': <limit lower=\"2\" upper=\"-2\"> has its lower limit above its upper one"), std::string::npos)
+      << inverted;
+  EXPECT_NE(error_of(with(R"(velocity="1")", R"(velocity="-3")")).find("joint 'j1': <limit velocity=\"-3\"> is outside 0"),
+            std::string::npos);
+  const std::string xacro = error_of(with(R"(<link name="l2"/>)", "<xacro:include filename=\"hand.xacro\"/>\n<link name=\"l2\"/>"));
+  EXPECT_NE(xacro.find("<xacro:include> is a xacro macro: expand the file with xacro first"), std::string::npos) << xacro;
+  const std::string expression = error_of(with(R"(velocity="1")", R"(velocity="${v_max}")"));
+  EXPECT_NE(expression.find("holds a xacro expression"), std::string::npos) << expression;
+
+  // --lock: a position outside the locked joint's limits, and no position at all.
+  const std::string finger = arm(R"(<joint name="f" type="prismatic"><parent link="l1"/><child link="l2"/><axis xyz="1 0 0"/><limit lower="0" upper="0.04" velocity="1" effort="1"/></joint>)");
+  ModelingOptions lock;
+  lock.tip_link = "l1";  // the finger hangs off the chain
+  lock.locked = {{"f", -5}};
+  const std::string outside = error_of(finger, lock);
+  EXPECT_NE(outside.find(".urdf:3:"), std::string::npos) << outside;
+  EXPECT_NE(outside.find("--lock f=-5: outside the joint's limits 0 .. 0.04"), std::string::npos) << outside;
+  lock.locked = {{"f", 0.02}};
+  EXPECT_EQ(error_of(finger, lock), "no error");
+  for (const std::string spec : {"=", "=abc", "f=", "f=nan", "f=1e300", "f", "f=0.01m"}) {
+    ModelingOptions o;
+    try {
+      add_lock(o, spec);
+      ADD_FAILURE() << spec << " accepted";
+    } catch (const std::invalid_argument& e) {
+      EXPECT_EQ(std::string(e.what()).rfind("--lock '" + spec + "': ", 0), 0u) << e.what();
+    }
+  }
+  ModelingOptions o;
+  add_lock(o, "f= 0.02 ");
+  EXPECT_EQ(o.locked.at("f"), 0.02);
+}
+
+// Usable input the model changes is said on the console (Modeling::notes): names that are no C++
+// identifier, and empty limits.
+TEST(ModelFromUrdf, NamesAndLimitsTheModelChangesAreWarnedAbout) {
+  const fs::path p = symoro::test::removed_at_exit("symoro_names_" + std::to_string(::getpid()) + ".urdf");
+  std::ofstream(p) << R"(<robot name="bras-léger"><link name="b"/><link name="l1"><inertial><mass value="1"/><inertia ixx="1" ixy="0" ixz="0" iyy="1" iyz="0" izz="1"/></inertial></link>
+<joint name="épaule" type="revolute"><parent link="b"/><child link="l1"/><axis xyz="0 0 1"/><limit lower="0" upper="0" velocity="1" effort="1"/></joint></robot>)";
+  const Modeling m = model_from_urdf(p.string());
+  std::string notes;
+  for (const auto& n : m.notes) notes += n + "\n";
+  EXPECT_NE(notes.find("the robot's name 'bras-léger' is no C++ identifier: written as 'bras_l__ger'"), std::string::npos) << notes;
+  EXPECT_NE(notes.find("joint 'épaule' (line 2) is no C++ identifier: robot.yaml names it '__paule'"), std::string::npos) << notes;
+  EXPECT_NE(notes.find("joint 'épaule' (line 2) has empty limits (0 .. 0): robot.yaml gets -pi .. pi"), std::string::npos) << notes;
+}
+
+// The folder's name is the robot's namespace: `class`, `int` or `std` generated code that did not
+// compile.
+TEST(RobotName, KeywordsAndNamesTheGeneratedCodeUsesAreRefused) {
+  for (const std::string bad : {"class", "int", "std", "Eigen", "detail", "and", "co_await", "a__b", "_Arm", "2arm", "arm-2", "bras_é", ""})
+    EXPECT_NE(robot_name_problem(bad), "") << bad;
+  for (const std::string good : {"crane_x7", "ur5", "Panda", "_arm", "classic", "integer", "stdarm"}) EXPECT_EQ(robot_name_problem(good), "") << good;
+  EXPECT_NE(robot_name_problem("class").find("is a C++ keyword"), std::string::npos);
+}
+
 }  // namespace
 }  // namespace symoro::codegen
 
@@ -414,6 +502,34 @@ void expect_written_into(double extra_mass, bool expect_whole) {
     if (name.rfind("IA", 0) == 0) continue;  // no URDF field
     EXPECT_NEAR(rb.spec.nominal.at(name), d.s(static_cast<Eigen::Index>(i)), 1e-12 * scale) << name;
   }
+}
+
+// dynid export --into a malformed URDF: its line and column, not urdfdom's "line 100 in
+// ./urdf_parser/src/model.cpp" on the console (issue 42, item 17).
+TEST(ModelFromUrdf, AMalformedIntoUrdfIsNamedAtItsLine) {
+  ModelingOptions o;
+  o.tip_link = "panda_hand";
+  o.locked = {{"panda_finger_joint1", 0.02}, {"panda_finger_joint2", 0.02}};
+  const Modeling m = model_from_urdf((kUrdfs / "panda.urdf").string(), o);
+  const fs::path dir = symoro::test::removed_at_exit("symoro_into_bad_" + std::to_string(::getpid())) / m.robot;
+  fs::create_directories(dir);
+  for (const auto& f : m.files) std::ofstream(dir / f.name) << f.text;
+  const fs::path mine = dir / "mine.urdf";
+  std::ofstream(mine) << "<robot name=\"x\">\n<link name=\"a\">\n</robot>\n";
+  std::vector<std::string> notes;
+  testing::internal::CaptureStderr();
+  try {
+    dynid::urdf_into({}, (dir / "robot.yaml").string(), mine.string(), notes);
+    ADD_FAILURE() << "a malformed URDF accepted";
+  } catch (const std::exception& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find(mine.string() + ":3:"), std::string::npos) << what;
+    EXPECT_NE(what.find("malformed XML"), std::string::npos) << what;
+  }
+  // Well-formed XML that is no URDF: urdfdom's reason is not printed past the error.
+  std::ofstream(mine) << "<robot name=\"x\"><link name=\"a\"/><link name=\"b\"/></robot>\n";
+  EXPECT_THROW(dynid::urdf_into({}, (dir / "robot.yaml").string(), mine.string(), notes), std::exception);
+  EXPECT_EQ(testing::internal::GetCapturedStderr(), "");
 }
 
 TEST(ModelFromUrdf, IdentifiedInertialsGoIntoTheUsersUrdf) {

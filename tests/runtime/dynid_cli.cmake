@@ -91,9 +91,13 @@ expect("${kept}" "torque: \\[0, 0, 0, 0, 0.02")
 # A split of a log with references (a controller's): the held-out window starts in mid-motion,
 # where no grid point of the whole file need fall; it is filtered as the whole file, and its
 # closed loop, from its own first row, still meets its samples at whole cycles.
+# (The log is linked into the folder: a dataset's logs are in its folder.)
+file(MAKE_DIRECTORY ${WORK}/window)
+file(CREATE_LINK ${WORK}/hidden/V01_t1.csv ${WORK}/window/V01_t1.csv SYMBOLIC)
+file(CREATE_LINK ${WORK}/hidden/V01_t1.meta.yaml ${WORK}/window/V01_t1.meta.yaml SYMBOLIC)
 file(WRITE ${WORK}/window/dataset.yaml "format: symoro-dataset 1\nrobot: \"crane_x7\"\nruns:\n"
-  "  - {trajectory: \"V01\", family: \"AG\", trial: 1, file: \"${WORK}/hidden/V01_t1.csv\", window: [-.inf, 10.0213]}\n"
-  "  - {trajectory: \"V01_held\", family: \"V\", trial: 1, file: \"${WORK}/hidden/V01_t1.csv\", window: [10.0213, .inf]}\n")
+  "  - {trajectory: \"V01\", family: \"AG\", trial: 1, file: \"V01_t1.csv\", window: [-.inf, 10.0213]}\n"
+  "  - {trajectory: \"V01_held\", family: \"V\", trial: 1, file: \"V01_t1.csv\", window: [10.0213, .inf]}\n")
 run(0 out identify --robot crane_x7 --data ${WORK}/window -o ${WORK}/window/study --only V01 --interval 10
     --validation V01_held --no-report)
 expect("${out}" "validation V01_held at 10 ms, closed-loop: RMSE")
@@ -149,6 +153,12 @@ foreach(case "identify|--interval|nan" "identify|--interval|inf" "identify|--int
   if(EXISTS ${WORK}/numbers OR EXISTS ${WORK}/numbers.csv)
     message(FATAL_ERROR "${command} ${option} ${value} wrote something")
   endif()
+endforeach()
+# A negative seed wrapped to 2^64 - 1 (issue 42, item 17).
+foreach(command "excite" "twin|run|--trajectory|V01" "twin|dataset")
+  string(REPLACE "|" ";" command "${command}")
+  run(105 out ${command} --robot crane_x7 -o ${WORK}/numbers --seed -1)
+  expect("${out}" "--seed: '-1': a seed is a whole number of at least 0")
 endforeach()
 
 # A robot folder that differs from the one dynid was compiled from is refused, on two robots: a
@@ -206,6 +216,9 @@ run(2 out excite --robot crane_x7 -o ${WORK}/excite-nan --optimized 1 --harmonic
 expect("${out}" "--half-space normal: 'nan' is not a finite number")
 run(2 out excite --robot crane_x7 -o ${WORK}/excite --from-design ${SOURCE_ROBOTS}/crane_x7/trajectories.yaml --optimized 0)
 expect("${out}" "excite/trajectories.yaml exists: dynid excite does not replace it; choose another -o, or --force")
+# Another robot's design is named as such, at its robot: line (it was reported at a temporary file).
+run(2 out excite --robot rx90 -o ${WORK}/excite-other --from-design ${SOURCE_ROBOTS}/crane_x7/trajectories.yaml --optimized 0)
+expect("${out}" "crane_x7/trajectories.yaml:21: the design is of robot 'crane_x7', not rx90")
 # A log the controller wrote (its time starts after the approach and pre-roll, at t > 0; its
 # reference columns are the controller's) through identify with CLIE: the closed loop replays
 # the log's own references, from its first stamp.

@@ -21,6 +21,7 @@ namespace fs = std::filesystem;
 using symoro::DataError;
 using symoro::io::AtomicFile;
 using symoro::io::write_file_atomically;
+using symoro::io::write_files_atomically;
 
 namespace {
 
@@ -69,7 +70,9 @@ pid_t dead_pid() {
 
 }  // namespace
 
-TEST_F(AtomicFiles, TheNextWriteRemovesOnlyStaleTemporaryFilesOfItsTarget) {
+// A writer killed (kill -9 during a 412 MB import) leaves its temporary file: the next write into
+// the folder removes it, whatever file it was for, and never a live writer's or another host's.
+TEST_F(AtomicFiles, TheNextWriteIntoTheFolderRemovesItsDeadWritersTemporaryFiles) {
   const fs::path target = dir_ / "big.csv";
   const pid_t dead = dead_pid();
   // A live process other than this one: a child waiting on a pipe until the test ends.
@@ -93,14 +96,16 @@ TEST_F(AtomicFiles, TheNextWriteRemovesOnlyStaleTemporaryFilesOfItsTarget) {
   const fs::path other_host = dir_ / (".big.csv.symoro-tmp.another-host." + std::to_string(dead) + ".0");
   const fs::path not_ours = dir_ / (".big.csv.symoro-tmp.x." + std::to_string(dead));
   const fs::path no_pid = AtomicFile::temp_path(target, 4294967296L + dead, 0);  // wraps to `dead` as an int
-  for (const fs::path& p : {stale, stale_later, mine, living, other_target, other_host, not_ours, no_pid}) touch(p);
+  const fs::path other_living = AtomicFile::temp_path(dir_ / "other.csv", live, 3);
+  const fs::path dotted_target = AtomicFile::temp_path(dir_ / "run.2.csv", dead, 1);
+  for (const fs::path& p : {stale, stale_later, mine, living, other_target, other_host, not_ours, no_pid, other_living, dotted_target})
+    touch(p);
   EXPECT_EQ(stale.filename().string().rfind(".big.csv.symoro-tmp.", 0), 0u) << stale;
 
   write_file_atomically(target, "time\n");
   EXPECT_EQ(read_text(target), "time\n");
-  EXPECT_FALSE(fs::exists(stale));
-  EXPECT_FALSE(fs::exists(stale_later));
-  for (const fs::path& p : {mine, living, other_target, other_host, not_ours, no_pid}) EXPECT_TRUE(fs::exists(p)) << p;
+  for (const fs::path& p : {stale, stale_later, other_target, dotted_target}) EXPECT_FALSE(fs::exists(p)) << p;
+  for (const fs::path& p : {mine, living, other_host, not_ours, no_pid, other_living}) EXPECT_TRUE(fs::exists(p)) << p;
   ::close(pipe_fds[1]);
   ::waitpid(live, nullptr, 0);
   // The write's own temporary file is gone too: the folder holds the target and the kept files.
@@ -109,7 +114,7 @@ TEST_F(AtomicFiles, TheNextWriteRemovesOnlyStaleTemporaryFilesOfItsTarget) {
     (void)e;
     ++entries;
   }
-  EXPECT_EQ(entries, 7);
+  EXPECT_EQ(entries, 7);  // the target and the six kept
 }
 
 TEST_F(AtomicFiles, AnAbandonedWriteLeavesNothing) {
@@ -158,4 +163,28 @@ TEST_F(AtomicFiles, AFullDiskSaysSoAndWhetherAPreviousFileIsKept) {
       << what;
   EXPECT_EQ(read_text(target), "time\n0\n");
   EXPECT_EQ(std::distance(fs::directory_iterator(dir_), fs::directory_iterator()), 1);
+}
+
+// Files that belong together (dynid export: a URDF and its .standard.yaml and .csv) are written all
+// or none: on a full disk the URDF was written without the other two, and the rerun refused.
+TEST_F(AtomicFiles, AGroupIsWrittenAllOrNone) {
+  if (::geteuid() != 0) GTEST_SKIP() << "mounting a small tmpfs needs root";
+  if (::mount("tmpfs", dir_.c_str(), "tmpfs", 0, "size=64k") != 0)
+    GTEST_SKIP() << "cannot mount a tmpfs on " << dir_ << ": " << std::strerror(errno);
+  mounted_ = true;
+  const fs::path urdf = dir_ / "arm.urdf", yaml = dir_ / "arm.standard.yaml", csv = dir_ / "arm.standard.csv";
+  write_files_atomically({{urdf, "<robot/>\n"}, {yaml, "a: 1\n"}, {csv, "a,1\n"}});
+  EXPECT_EQ(read_text(urdf), "<robot/>\n");
+  EXPECT_EQ(read_text(yaml), "a: 1\n");
+  EXPECT_EQ(read_text(csv), "a,1\n");
+
+  // The last file does not fit: none of the three changes, and no temporary file stays.
+  const std::string what = error_of([&] {
+    write_files_atomically({{urdf, "<robot name='b'/>\n"}, {yaml, "a: 2\n"}, {csv, std::string(1 << 20, '2')}});
+  });
+  EXPECT_NE(what.find(": error: writing failed: no space left on device"), std::string::npos) << what;
+  EXPECT_EQ(read_text(urdf), "<robot/>\n");
+  EXPECT_EQ(read_text(yaml), "a: 1\n");
+  EXPECT_EQ(read_text(csv), "a,1\n");
+  EXPECT_EQ(std::distance(fs::directory_iterator(dir_), fs::directory_iterator()), 3);
 }

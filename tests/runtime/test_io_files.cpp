@@ -96,6 +96,47 @@ TEST(Readers, RefuseDevicesAndFifosAtOnce) {
   std::filesystem::remove_all(dir);
 }
 
+// A 100 MB scalar was echoed whole in the error (100-200 MB of output): a message keeps its head
+// and tail and says how much it left out (issue 42, item 17).
+TEST(Readers, AHugeValueIsNotEchoedWhole) {
+  const std::filesystem::path dir = std::filesystem::temp_directory_path() / ("symoro_huge_" + std::to_string(::getpid()));
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  const std::string key(10 << 20, 'k');
+  std::ofstream(dir / "dataset.yaml") << "robot: arm\n? " << key << "\n: 1\n";  // an explicit key: no 1024-character bound
+  try {
+    symoro::io::read_dataset(dir);
+    ADD_FAILURE() << "a 10 MB unknown key accepted";
+  } catch (const symoro::DataError& e) {
+    const std::string what = e.what();
+    EXPECT_LT(what.size(), 3000u);
+    EXPECT_NE(what.find("characters left out"), std::string::npos) << what.substr(0, 300);
+    EXPECT_NE(what.find((dir / "dataset.yaml").string()), std::string::npos) << what.substr(0, 300);
+  }
+  std::filesystem::remove_all(dir);
+  const symoro::DataError short_one("f.yaml", 3, "short");
+  EXPECT_STREQ(short_one.what(), "f.yaml:3: error: short");
+}
+
+// --params given a CSV said "operator[] call on a scalar" (issue 42, item 17).
+TEST(Readers, AParametersFileThatIsNoMapIsNamed) {
+  const std::filesystem::path csv = std::filesystem::temp_directory_path() / ("symoro_params_" + std::to_string(::getpid()) + ".csv");
+  std::ofstream(csv) << "name,value\nXX1,0.1\nXY1,0.2\n";
+  for (const std::function<void()>& read : std::vector<std::function<void()>>{
+           [&] { read_parameters_yaml(csv.string(), {"XX1", "XY1"}); }, [&] { parameters_accepted(csv.string()); },
+           [&] { parameters_integrity(csv.string(), {"XX1", "XY1"}); }}) {
+    try {
+      read();
+      ADD_FAILURE() << "a CSV read as parameters";
+    } catch (const DataError& e) {
+      EXPECT_EQ(std::string(e.what()),
+                csv.string() + ":1: error: not a parameters file: a YAML map with a 'parameters:' list (a study's "
+                               "report/parameters.yaml) was expected; a .csv is not read here");
+    }
+  }
+  std::filesystem::remove(csv);
+}
+
 TEST(Digest, FileDigestIsTheBytesDigestAndSeesOneChangedByte) {
   const auto dir = scratch("digest");
   std::mt19937 rng(7);

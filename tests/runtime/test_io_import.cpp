@@ -409,6 +409,22 @@ TEST_F(Import, DatasetWindowsAreChecked) {
 // The manifest's one writer against its one reader: every field, awkward names (quotes, a
 // colon, a '#', a backslash, a control byte), numbers that need all 17 digits, open windows,
 // and files given absolute or relative to the folder.
+// A run's file outside the dataset folder was used without a word (issue 42, item 17).
+TEST_F(Import, ARunFileOutsideTheDatasetFolderIsRefused) {
+  fs::create_directories(dir_ / "data" / "sub");
+  write_text(dir_ / "outside.csv", "");
+  write_text(dir_ / "data" / "sub" / "in.csv", "");
+  const fs::path manifest = dir_ / "data" / "dataset.yaml";
+  for (const std::string& file : std::vector<std::string>{"../outside.csv", (dir_ / "outside.csv").string(), "sub/../../outside.csv"}) {
+    write_text(manifest, "format: symoro-dataset 1\nrobot: arm2\nruns:\n  - trajectory: a\n    family: F\n    trial: 1\n"
+                         "    file: " + file + "\n");
+    expect_error([&] { io::read_dataset(dir_ / "data"); }, manifest.string(), 7,
+                 "file '" + file + "' is outside the dataset folder: a dataset's logs are in its folder");
+  }
+  write_text(manifest, "format: symoro-dataset 1\nrobot: arm2\nruns:\n  - {trajectory: a, family: F, trial: 1, file: sub/../sub/in.csv}\n");
+  EXPECT_EQ(io::read_dataset(dir_ / "data").runs.at(0).file, dir_ / "data" / "sub" / "in.csv");
+}
+
 TEST_F(Import, DatasetManifestReadsBackWhatWasWritten) {
   const fs::path data = dir_ / "data";
   fs::create_directories(data);
@@ -576,6 +592,48 @@ TEST_F(Import, RefusesAnImplausibleSampleTime) {
   EXPECT_NO_THROW(io::import_dataset(dir_ / "slowest", limited_import(f, ms)));
 }
 
+// Issue 42, items 15 and 17: radians declared as degrees imported silently; a 24 h gap was
+// accepted; stamps of 1e15 ms were read as a 0.977 ms sample time.
+TEST_F(Import, FlagsRadiansDeclaredAsDegreesAndGapsAndReadsEpochStampsExactly) {
+  const fs::path f = dir_ / "rad.txt";
+  write_text(f, two_rows(50, 0.001));  // q1 0 .. 0.49, q2 0.5: radians
+  io::ImportMapping deg = two_mapping();
+  deg.angle_unit = io::AngleUnit::deg;
+  expect_error([&] { io::import_dataset(dir_ / "data", limited_import(f, deg)); }, f.string(), 0,
+               "the angles are declared in deg, but every joint stays within +-0.5 and moves at most 0.49 as written: "
+               "these look like radians (--angle rad, units.angle: rad)? if the values are right, import with "
+               "--allow-implausible");
+  io::DatasetImport allowed = limited_import(f, deg);
+  allowed.allow_implausible = true;
+  EXPECT_NO_THROW(io::import_dataset(dir_ / "allowed", allowed));
+  EXPECT_NO_THROW(io::import_dataset(dir_ / "rad", limited_import(f, two_mapping())));
+
+  std::string text;
+  for (int k = 0; k < 50; ++k) text += num(k * 0.001 + (k >= 25 ? 86400 : 0)) + " " + num(0.01 * k) + " 0.5 1 2\n";
+  write_text(f, text);
+  expect_error([&] { io::import_dataset(dir_ / "data", limited_import(f, two_mapping())); }, f.string(), 26,
+               "a gap of 86400 s since line 25 (8.64e+07 times the median step 0.001 s): a log is one recording; split "
+               "the file there, or if the values are right, import with --allow-implausible");
+  allowed = limited_import(f, two_mapping());
+  allowed.allow_implausible = true;
+  EXPECT_NO_THROW(io::import_dataset(dir_ / "gap", allowed));
+
+  // Milliseconds since an epoch: exact steps, counted from the first stamp, and said.
+  text.clear();
+  for (int k = 0; k < 50; ++k) text += std::to_string(1000000000000000LL + k) + " " + num(0.01 * k) + " 0.5 1 2\n";
+  write_text(f, text);
+  io::ImportMapping ms = two_mapping();
+  ms.time_unit = io::TimeUnit::ms;
+  const io::Log log = io::import_dataset(dir_ / "epoch", limited_import(f, ms)).logs[0].log;
+  EXPECT_EQ(log.meta.sample_time, 0.001);
+  EXPECT_EQ(log.time[0], 0.0);
+  EXPECT_EQ(log.time[49], 0.049);
+  EXPECT_NE(log.meta.notes.find("time counted from the first stamp"), std::string::npos) << log.meta.notes;
+  // Stamps that double precision holds are kept as written.
+  write_text(f, two_rows(50, 1));
+  EXPECT_EQ(io::import_dataset(dir_ / "plain", limited_import(f, ms)).logs[0].log.time[49], 0.049);
+}
+
 // A split that leaves a part too small to use (--split 1e-9: one sample) is refused.
 TEST_F(Import, RefusesASplitLeavingAPartOfTooFewSamples) {
   write_six(dir_ / "a.csv", 300);
@@ -661,6 +719,10 @@ TEST_F(Import, RefusesALastLineWithoutNewline) {
   expect_error([&] { io::import_log(f, two_mapping(), two_joints()); }, f.string(), 4, "no newline at its end");
   write_text(f, good + "0.002 2 2 2 2\n");
   EXPECT_EQ(io::import_log(f, two_mapping(), two_joints()).rows, 3);
+  // Line ends of CR alone were reported as a cut last line (issue 42, item 17).
+  write_text(f, "0 0 0 0 0\r0.001 1 1 1 1\r0.002 2 2 2 2\r");
+  expect_error([&] { io::import_log(f, two_mapping(), two_joints()); }, f.string(), 1,
+               "the lines end in CR alone (no LF anywhere): convert the line ends to LF or CR LF");
 }
 
 // A NUL byte in a field is shown escaped; the message does not stop at it.

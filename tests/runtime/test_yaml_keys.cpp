@@ -312,6 +312,29 @@ TEST_F(YamlKeys, AnchorsAliasesAndASecondDocumentAreRefusedByEveryReader) {
   }
 }
 
+// A UTF-8 byte order mark (a Windows editor's) before a dataset.yaml with quoted values was
+// reported as an open quote on line 10: it is no content, and the file reads as without it; an
+// error after it keeps its line.
+TEST_F(YamlKeys, AByteOrderMarkIsNoContent) {
+  fs::create_directories(dir_ / "data");
+  write(dir_ / "data" / "a.csv", "");
+  const std::string dataset =
+      "format: \"symoro-dataset 1\"\nrobot: 'arm6'\nruns:\n  - {trajectory: \"a\", family: F, trial: 1, file: 'a.csv'}\n";
+  write(dir_ / "data" / "dataset.yaml", "\xEF\xBB\xBF" + dataset);
+  const symoro::io::Dataset d = symoro::io::read_dataset(dir_ / "data");
+  EXPECT_EQ(d.robot, "arm6");
+  ASSERT_EQ(d.runs.size(), 1u);
+  EXPECT_EQ(d.runs[0].trajectory, "a");
+  write(dir_ / "data" / "dataset.yaml", "\xEF\xBB\xBF" + dataset + "windw: 1\n");
+  try {
+    symoro::io::read_dataset(dir_ / "data");
+    ADD_FAILURE() << "a typo accepted";
+  } catch (const DataError& e) {
+    EXPECT_EQ(e.line(), 5) << e.what();
+    EXPECT_EQ(std::string(e.what()).find("quote"), std::string::npos) << e.what();
+  }
+}
+
 // ---- twin.yaml and its override file -----------------------------------------------------------
 
 TEST_F(YamlKeys, TwinConfigAndOverridesRefuseTypos) {

@@ -2,9 +2,9 @@
 // grammar's ParseError; a missing or doubled file is an InputError on the folder.
 #include <algorithm>
 #include <filesystem>
-#include <regex>
 
 #include "stages.hpp"
+#include "symoro/codegen/robot_name.hpp"
 #include "symoro/codegen/source_digest.hpp"
 #include "symoro/grammar/parser.hpp"
 
@@ -18,9 +18,7 @@ namespace {
 void check_folder(const fs::path& dir, RobotModel& m) {
   m.dir = dir.string();
   m.name = (dir.has_filename() ? dir.filename() : dir.parent_path().filename()).string();
-  static const std::regex ident("^[A-Za-z_][A-Za-z0-9_]*$");
-  if (!std::regex_match(m.name, ident))
-    throw InputError(m.dir, 0, 0, "the robot folder name must be a C++ identifier (it names the namespace)");
+  if (const std::string why = robot_name_problem(m.name); !why.empty()) throw InputError(m.dir, 0, 0, why + " (the folder's name)");
   if (!fs::is_directory(dir)) throw InputError(m.dir, 0, 0, "not a directory");
 }
 

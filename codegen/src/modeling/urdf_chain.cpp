@@ -18,6 +18,7 @@
 #include <urdf_parser/urdf_parser.h>
 
 #include "equation_text.hpp"
+#include "urdf_checks.hpp"
 #include "symoro/codegen/robot_spec.hpp"
 #include "symoro/detail/regular_file.hpp"
 #include "symoro/urdf_geometry.hpp"
@@ -194,6 +195,7 @@ UrdfChain read_urdf_chain(const std::string& path, const ModelingOptions& option
     TiXmlDocument doc;
     doc.Parse(text.c_str());
     if (doc.Error()) throw InputError(path, doc.ErrorRow(), doc.ErrorCol(), std::string("malformed XML: ") + doc.ErrorDesc());
+    check_urdf_values(doc, path);
   }
   urdf::ModelInterfaceSharedPtr model;
   {
@@ -274,6 +276,13 @@ UrdfChain read_urdf_chain(const std::string& path, const ModelingOptions& option
     const auto j = model->getJoint(name);
     if (!j || !moving(*j) || on_chain.count(name))
       throw InputError(path, j ? line_of("joint", name) : 0, 0, "--lock " + name + ": not a moving joint off the chain");
+    const std::string lock = "--lock " + name + "=" + number_text(value);
+    if (!std::isfinite(value) || std::abs(value) > 1e3) throw InputError(path, line_of("joint", name), 0, lock + ": not a position");
+    const bool bounded = j->type == urdf::Joint::REVOLUTE || j->type == urdf::Joint::PRISMATIC;
+    if (bounded && j->limits && j->limits->lower <= j->limits->upper &&
+        (value < j->limits->lower || value > j->limits->upper))
+      throw InputError(path, line_of("joint", name), 0,
+                       lock + ": outside the joint's limits " + number_text(j->limits->lower) + " .. " + number_text(j->limits->upper));
   }
 
   // Every link under the base at q = 0 (off-chain moving joints at their locked positions), and
@@ -443,7 +452,10 @@ UrdfChain read_urdf_chain(const std::string& path, const ModelingOptions& option
                         ") is not physically consistent (a negative mass or principal moment, or the triangle inequality broken)");
 
   // ---- the .par
-  out.name = identifier(options.name.empty() ? model->getName() : options.name);
+  const std::string given_name = options.name.empty() ? model->getName() : options.name;
+  out.name = identifier(given_name);
+  if (out.name != given_name)
+    out.notes.push_back("warning: the robot's name '" + given_name + "' is no C++ identifier: written as '" + out.name + "'");
   auto column = [&](auto get) {
     std::string s = "{";
     for (int k = 0; k < n; ++k) s += (k ? "," : "") + get(k);
@@ -506,9 +518,14 @@ UrdfChain read_urdf_chain(const std::string& path, const ModelingOptions& option
     if (j.type == urdf::Joint::CONTINUOUS) comment += " continuous: +-2 pi written;";
     if (!(lower < upper)) {
       comment += " the URDF's limits are empty: +-pi written;";
+      out.notes.push_back("warning: joint '" + j.name + "' (line " + std::to_string(line_of("joint", j.name)) + ") has empty limits (" +
+                          number_text(lower) + " .. " + number_text(upper) + "): robot.yaml gets -pi .. pi");
       lower = -M_PI;
       upper = M_PI;
     }
+    if (identifier(j.name) != j.name)
+      out.notes.push_back("warning: joint '" + j.name + "' (line " + std::to_string(line_of("joint", j.name)) +
+                          ") is no C++ identifier: robot.yaml names it '" + identifier(j.name) + "'");
     if (!(velocity > 0)) {
       velocity = 1;
       comment += " no velocity limit in the URDF: 1 written;";

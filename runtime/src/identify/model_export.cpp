@@ -8,15 +8,6 @@
 
 namespace symoro::identify {
 
-namespace {
-
-void write_text(const std::filesystem::path& file, const std::string& text) {
-  if (file.has_parent_path()) std::filesystem::create_directories(file.parent_path());
-  io::write_file_atomically(file, text);
-}
-
-}  // namespace
-
 ModelExport export_model(const IdentificationModel& model, const Eigen::VectorXd& phi, const ModelExportOptions& o) {
   const ModelDescription& md = model.description();
   ConsistencyOptions co;
@@ -76,9 +67,11 @@ ModelExportFiles write_model_export(const ModelExport& e, const std::filesystem:
   const std::string header =
       "# Physically consistent standard parameters (dynid export) reproducing a study's accepted base\n"
       "# parameters; the URDF " + urdf.filename().string() + " holds them but for IA.\n" + e.header;
-  write_text(f.urdf, urdf_text);
-  write_text(f.yaml, standard_parameters_yaml(e.description, header));
-  write_text(f.csv, standard_parameters_csv(e.description));
+  if (urdf.has_parent_path()) std::filesystem::create_directories(urdf.parent_path());
+  // All three or none: a URDF without its .standard files makes the rerun refuse (a full disk).
+  io::write_files_atomically({{f.urdf, urdf_text},
+                              {f.yaml, standard_parameters_yaml(e.description, header)},
+                              {f.csv, standard_parameters_csv(e.description)}});
   return f;
 }
 

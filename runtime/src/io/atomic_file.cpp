@@ -34,25 +34,27 @@ bool all_digits(std::string_view s) {
   return true;
 }
 
-// Removes ".<name>.symoro-tmp.<host>.<pid>.<n>" files of this host whose process is gone: a
-// writer killed (kill -9, a crash) before it could remove its own. ESRCH is the only proof; a
-// process we may not signal (EPERM) is alive.
+// Removes the ".<name>.symoro-tmp.<host>.<pid>.<n>" files of this host in the target's folder,
+// whatever their target, whose process is gone: writers killed (kill -9, a crash) before they
+// could remove their own (a 332 MB one stayed when another file was written beside it). ESRCH is
+// the only proof; a process we may not signal (EPERM) is alive.
 void remove_stale_temps(const std::filesystem::path& target) {
   namespace fs = std::filesystem;
   const fs::path dir = target.parent_path().empty() ? fs::path(".") : target.parent_path();
-  const std::string prefix = "." + target.filename().string() + std::string(temp_tag) + host_name() + ".";
+  const std::string mark = std::string(temp_tag) + host_name() + ".";
   std::error_code ec;
   for (fs::directory_iterator it(dir, ec), end; !ec && it != end; it.increment(ec)) {
     const std::string name = it->path().filename().string();
-    if (name.compare(0, prefix.size(), prefix) != 0) continue;
-    const std::string_view rest = std::string_view(name).substr(prefix.size());  // "<pid>.<n>"
+    const std::size_t at = name.rfind(mark);
+    if (name.empty() || name[0] != '.' || at == std::string::npos || at < 2) continue;
+    const std::string_view rest = std::string_view(name).substr(at + mark.size());  // "<pid>.<n>"
     const std::size_t dot = rest.find('.');
     if (dot == std::string_view::npos || !all_digits(rest.substr(0, dot)) || !all_digits(rest.substr(dot + 1))) continue;
     const long pid = std::stol(std::string(rest.substr(0, dot)));
     if (pid <= 0 || pid > INT_MAX || pid == static_cast<long>(::getpid())) continue;  // not a pid, or ours
     if (::kill(static_cast<pid_t>(pid), 0) == 0 || errno != ESRCH) continue;
     std::error_code ignored;
-    fs::remove(it->path(), ignored);
+    if (it->is_regular_file(ignored)) fs::remove(it->path(), ignored);
   }
 }
 
@@ -146,7 +148,8 @@ AtomicFile::~AtomicFile() {
   std::filesystem::remove(temp_, ec);
 }
 
-void AtomicFile::commit() {
+void AtomicFile::finish() {
+  if (finished_) return;
   out_.flush();
   int error = buffer_->error();
   if (error == 0 && !out_) error = EIO;
@@ -154,14 +157,20 @@ void AtomicFile::commit() {
   if (error == 0 && ::fsync(buffer_->fd()) != 0) error = errno;
   buffer_->close_fd();
   if (error == 0) error = buffer_->error();
-  std::error_code ec;
   if (error != 0) {
+    std::error_code ec;
     std::filesystem::remove(temp_, ec);
     const bool previous = std::filesystem::exists(target_, ec);
     throw DataError(target_.string(), 0,
                     "writing failed: " + reason(error) +
                         (previous ? "; the previous file is left as it was" : "; nothing is written under this name"));
   }
+  finished_ = true;
+}
+
+void AtomicFile::commit() {
+  finish();
+  std::error_code ec;
   std::filesystem::rename(temp_, target_, ec);
   if (ec) {
     const std::string why = ec.value() == ENOSPC ? reason(ENOSPC) : ec.message();  // before remove() resets ec
@@ -175,6 +184,18 @@ void write_file_atomically(const std::filesystem::path& target, const std::strin
   AtomicFile f(target);
   f.stream() << content;
   f.commit();
+}
+
+void write_files_atomically(const std::vector<std::pair<std::filesystem::path, std::string>>& files) {
+  std::vector<std::unique_ptr<AtomicFile>> open;
+  for (const auto& [target, content] : files) {
+    open.push_back(std::make_unique<AtomicFile>(target));
+    open.back()->stream() << content;
+  }
+  // Every file complete on disk before the first takes its name: a full disk fails here, and the
+  // destructors remove every temporary file.
+  for (auto& f : open) f->finish();
+  for (auto& f : open) f->commit();
 }
 
 }  // namespace symoro::io

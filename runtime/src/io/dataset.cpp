@@ -94,8 +94,17 @@ Dataset read_dataset(const std::filesystem::path& dir) {
       check_keys(r, kRunKeys, manifest.string(), "a run");
       for (const char* key : {"trajectory", "family", "trial", "file"})
         if (!r[key]) throw DataError(manifest.string(), line(r), fmt::format("run without '{}'", key));
+      // A log outside the folder was used without a word: a dataset is its folder (a link in it
+      // reaches a log elsewhere, said where the user made it).
+      const std::filesystem::path listed = std::filesystem::path(r["file"].as<std::string>()).lexically_normal();
+      if (listed.empty()) throw DataError(manifest.string(), line(r["file"]), "file: a run needs its log's file name");
+      if (listed.is_absolute() || *listed.begin() == "..")
+        throw DataError(manifest.string(), line(r["file"]),
+                        fmt::format("file '{}' is outside the dataset folder: a dataset's logs are in its folder (copy the "
+                                    "log in, or link it there)",
+                                    r["file"].as<std::string>()));
       DatasetRun run{r["trajectory"].as<std::string>(), r["family"].as<std::string>(), r["trial"].as<int>(),
-                     d.dir / r["file"].as<std::string>()};
+                     d.dir / listed};
       if (!std::filesystem::exists(run.file))
         throw DataError(manifest.string(), line(r), fmt::format("listed file {} does not exist", run.file.string()));
       if (const YAML::Node w = r["window"]) {

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <vector>
 
 #include <fmt/format.h>
 
@@ -189,6 +190,22 @@ ImportedLog import_log(const std::filesystem::path& input, const ImportMapping& 
     }
   };
   for (Eigen::Index k = 0; k < rows; ++k) log.time[k] = values[kept[static_cast<std::size_t>(k)] * width] / divisor;
+  // Stamps far from 0 (1e15 ms since an epoch) hold no 1 ms step in double precision once in s
+  // (read as 0.977 ms): then the times count from the first stamp, the difference taken in the
+  // file's unit, where it is exact.
+  bool rebased = false;
+  if (rows >= 2) {
+    std::vector<double> steps;
+    for (std::size_t i = 1; i < kept.size(); ++i) steps.push_back(values[kept[i] * width] - values[kept[i - 1] * width]);
+    std::nth_element(steps.begin(), steps.begin() + static_cast<std::ptrdiff_t>(steps.size() / 2), steps.end());
+    const double step = steps[steps.size() / 2] / divisor;
+    const double t_max = std::max(std::abs(log.time[0]), std::abs(log.time[rows - 1]));
+    rebased = std::nextafter(t_max, INFINITY) - t_max > 1e-4 * step;
+  }
+  if (rebased) {
+    const double first = values[kept[0] * width];
+    for (Eigen::Index k = 0; k < rows; ++k) log.time[k] = (values[kept[static_cast<std::size_t>(k)] * width] - first) / divisor;
+  }
   for (std::size_t r : kept) out.lines.push_back(lines[r]);
   fill(group("q"), log.q, false);
   fill(group("tau"), log.tau, true);
@@ -216,7 +233,11 @@ ImportedLog import_log(const std::filesystem::path& input, const ImportMapping& 
   meta.velocity = has_qd ? Velocity::measured : Velocity::differentiated;
   meta.notes = fmt::format("imported from {}: {} rows, {} stale rows kept, {} duplicate rows dropped{}",
                            input.filename().string(), out.rows, out.stale_lines.size(), out.duplicate_lines.size(),
-                           has_qd ? "" : "; qd differentiated from q");
+                           has_qd ? "" : "; qd differentiated from q") +
+               (rebased ? fmt::format("; time counted from the first stamp ({} {} in the file: too large for the sample "
+                                      "time in double precision)",
+                                      number_text(values[kept[0] * width]), detail::time_unit_name(mapping.time_unit))
+                        : std::string());
   for (const Group& g : groups)
     for (std::size_t j = 0; j < g.columns.size(); ++j)
       out.columns[g.key == "time" ? "time" : g.key + std::to_string(j + 1)] = table.column_label(g.columns[j]);

@@ -31,6 +31,9 @@ constexpr const char* kOverride = "if the values are right, import with --allow-
 // N m, a scale the wrong way round: 1000 times off), not a robot; past kMaxTorque it is no
 // torque at all (1e308 imported with rc 0, then identification failed without saying why).
 constexpr double kEffortFactor = 5, kMaxTorque = 1e6;
+// A pause in a recording: the logger stalled, or two sessions were concatenated. Stale rows and
+// jitter are milliseconds; a second and a thousand steps are no sampling.
+constexpr double kMaxGap = 1.0, kMaxGapSteps = 1000;
 
 // 3 significant digits are enough evidence; number_text would print 58.70000000000001.
 std::string g(double v) { return fmt::format("{:.6g}", v); }
@@ -105,6 +108,37 @@ void check_plausible(const ImportedLog& imported, const ImportMapping& mapping, 
                     fmt::format("joint {} '{}' has a torque of {} {}, beyond {}: is the torque unit right (--torque-scale, "
                                 "units.torque_scale: the factor from the file's unit to {})? {}",
                                 worst_joint + 1, target.joints[j], g(log.tau(worst_row, worst_joint)), unit, limit, unit, kOverride));
+  }
+
+  // Radians declared as degrees: every revolute joint within +-2 pi as written and none moving
+  // 2 pi (6 "degrees") over the whole log, which no identification log does.
+  if (mapping.angle_unit == AngleUnit::deg && log.samples() > 1) {
+    double largest = 0, widest = 0;
+    int revolute = 0;
+    for (Eigen::Index j = 0; j < n; ++j) {
+      if (!target.prismatic.empty() && target.prismatic[static_cast<std::size_t>(j)]) continue;
+      ++revolute;
+      const double lo = log.q.col(j).minCoeff() * 180 / kPi, hi = log.q.col(j).maxCoeff() * 180 / kPi;
+      largest = std::max({largest, std::abs(lo), std::abs(hi)});
+      widest = std::max(widest, hi - lo);
+    }
+    if (revolute > 0 && largest <= 2 * kPi && widest < 2 * kPi)
+      throw DataError(file, 0,
+                      fmt::format("the angles are declared in deg, but every joint stays within +-{} and moves at most {} as "
+                                  "written: these look like radians (--angle rad, units.angle: rad)? {}",
+                                  g(largest), g(widest), kOverride));
+  }
+
+  // A gap no recording has (24 h accepted): past kMaxGapSteps median steps and kMaxGap s.
+  const double median_step = log.meta.sample_time;
+  for (Eigen::Index k = 1; k < log.samples(); ++k) {
+    const double gap = log.time[k] - log.time[k - 1];
+    if (gap > kMaxGap && gap > kMaxGapSteps * median_step)
+      throw DataError(file, imported.lines[static_cast<std::size_t>(k)],
+                      fmt::format("a gap of {} s since line {} ({} times the median step {} s): a log is one recording; "
+                                  "split the file there, or {}",
+                                  g(gap), imported.lines[static_cast<std::size_t>(k - 1)], g(gap / median_step), g(median_step),
+                                  kOverride));
   }
 
   const double step = log.meta.sample_time;  // the median interval, to the us

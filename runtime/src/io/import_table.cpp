@@ -73,6 +73,12 @@ TextTable::TextTable(const std::filesystem::path& file, Delimiter delimiter, Hea
     : file_(file.string()) {
   bytes_ = read_text_file(file, "cannot open the file to import");
   std::size_t start = bytes_.compare(0, 3, "\xEF\xBB\xBF") == 0 ? 3 : 0;  // UTF-8 byte order mark
+  // Line ends of CR alone (classic Mac OS, some loggers): the whole file is one line without a
+  // newline, and was reported as cut.
+  if (bytes_.find('\n') == std::string::npos && bytes_.find('\r') != std::string::npos)
+    throw DataError(file_, 1,
+                    "the lines end in CR alone (no LF anywhere): convert the line ends to LF or CR LF (e.g. tr '\\r' "
+                    "'\\n')");
   // A writer killed mid-row leaves a last line without its newline, whose last number may be
   // cut yet still parse ("-0" of "-0.737"): such a file is refused whole.
   if (!bytes_.empty() && bytes_.back() != '\n')

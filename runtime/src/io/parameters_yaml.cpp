@@ -15,11 +15,27 @@
 
 namespace symoro::io {
 
-Eigen::VectorXd read_parameters_yaml(const std::string& path, const std::vector<std::string>& names) {
+namespace {
+
+// The file's top level, a map: a CSV given as --params read as one scalar, and the next lookup
+// said "operator[] call on a scalar".
+YAML::Node parameters_root(const std::string& path) {
   if (!std::filesystem::is_regular_file(path)) throw DataError(path, 0, "not found");
   const YAML::Node root = load_yaml_file(path);
+  if (!root.IsMap())
+    throw DataError(path, 1, "not a parameters file: a YAML map with a 'parameters:' list (a study's report/parameters.yaml) "
+                             "was expected" + std::string(path.size() > 4 && path.compare(path.size() - 4, 4, ".csv") == 0
+                                                              ? "; a .csv is not read here"
+                                                              : ""));
+  return root;
+}
+
+}  // namespace
+
+Eigen::VectorXd read_parameters_yaml(const std::string& path, const std::vector<std::string>& names) {
+  const YAML::Node root = parameters_root(path);
   const auto line = [](const YAML::Node& n) { return n.Mark().is_null() ? 0 : n.Mark().line + 1; };
-  const YAML::Node list = root.IsMap() ? root["parameters"] : YAML::Node();
+  const YAML::Node list = root["parameters"];
   if (!list || !list.IsSequence()) throw DataError(path, 0, "no 'parameters:' list (a study's report/parameters.yaml)");
   std::map<std::string, std::pair<double, int>> values;
   for (const YAML::Node& p : list) {
@@ -46,8 +62,7 @@ Eigen::VectorXd read_parameters_yaml(const std::string& path, const std::vector<
 }
 
 bool parameters_accepted(const std::string& path) {
-  if (!std::filesystem::is_regular_file(path)) throw DataError(path, 0, "not found");
-  const YAML::Node root = load_yaml_file(path);
+  const YAML::Node root = parameters_root(path);
   const YAML::Node flag = root["accepted"];
   if (!flag) return false;
   try {
@@ -68,7 +83,7 @@ std::string parameters_digest(const std::string& robot, const std::string& model
 ParametersIntegrity parameters_integrity(const std::string& path, const std::vector<std::string>& names) {
   const Eigen::VectorXd phi = read_parameters_yaml(path, names);
   const bool accepted = parameters_accepted(path);
-  const YAML::Node root = load_yaml_file(path);  // read and checked above
+  const YAML::Node root = parameters_root(path);  // read and checked above
   const auto text = [&](const char* key) {
     const YAML::Node n = root[key];
     return n && n.IsScalar() ? n.as<std::string>() : std::string();

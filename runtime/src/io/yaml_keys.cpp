@@ -26,7 +26,11 @@ struct Fail {
 };
 }  // namespace
 
-YAML::Node load_yaml_text(const std::string& text, const std::string& file) {
+YAML::Node load_yaml_text(const std::string& raw, const std::string& file) {
+  // A UTF-8 byte order mark (Windows editors write one) is no content; left in, it was reported as
+  // an open quote on line 10.
+  const bool bom = raw.compare(0, 3, "\xEF\xBB\xBF") == 0;
+  const std::string text = bom ? raw.substr(3) : raw;
   ::symoro::detail::check_yaml_structure(text, Fail{file});
   YAML::Node root;
   try {

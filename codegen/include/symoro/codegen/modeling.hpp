@@ -39,6 +39,10 @@ struct ModelingOptions {
   bool coulomb = true;        // ... FS
 };
 
+// "joint=position" (symoroc model --lock) into `options.locked`; throws std::invalid_argument
+// naming the option and the value when it is no name and finite position within +-1000.
+void add_lock(ModelingOptions& options, const std::string& spec);
+
 // Errors name the file, line and column (grammar::ParseError, InputError).
 Modeling model_from_par(const std::string& par_path, const ModelingOptions& options = {});
 

@@ -106,7 +106,10 @@ ImportedLog import_log(const std::filesystem::path& input, const ImportMapping& 
 // naming the file, the evidence and --allow-implausible, which skips the check, when
 //   a joint's position is beyond a limit by more than max(0.5 rad, half the joint's range)
 //     (revolute; prismatic: max(0.05 m, half the range)); joints without finite limits pass;
-//   the median time step is outside [0.1 ms, 0.5 s].
+//   the median time step is outside [0.1 ms, 0.5 s];
+//   a gap between two rows exceeds 1 s and 1000 median steps;
+//   the angles are declared in deg but every revolute joint stays within +-2 pi and moves less
+//     than 2 pi as written (radians declared as degrees).
 // import_dataset calls it on every input unless DatasetImport::allow_implausible.
 void check_plausible(const ImportedLog& imported, const ImportMapping& mapping, const ImportTarget& target);
 
