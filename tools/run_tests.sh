@@ -43,7 +43,7 @@ fuzz() {  # fuzz <target> <corpus folder under tests/fuzz> <seconds> [libFuzzer 
 }
 fuzz_first_lane() {
   fuzz fuzz_grammar corpus "${FUZZ_SECONDS:-60}" -max_len=4096 -dict=tests/fuzz/grammar.dict &&
-    fuzz fuzz_yaml corpus_yaml "${FUZZ_IO_SECONDS:-20}" -max_len=4096
+    fuzz fuzz_yaml corpus_yaml "${FUZZ_IO_SECONDS:-20}" -max_len=16384
 }
 fuzz_second_lane() {
   # urdfdom leaks what it parsed of a URDF with a joint cycle: suppressed for it alone.

@@ -1,17 +1,23 @@
 // libFuzzer entry point for the runtime's other YAML readers (dataset.yaml has fuzz_dataset): the
 // input as an import mapping (io::read_import_mapping), as a parameters file (read_parameters_yaml,
-// parameters_accepted, parameters_integrity) and as a log's sidecar (read_log_metadata). Any input
-// must either read or throw DataError; another exception, a crash, a sanitizer report or a hang is
-// a bug.
+// parameters_accepted, parameters_integrity), as a log's sidecar (read_log_metadata), as
+// hardware.yaml, controller.yaml, twin.yaml and a trajectory design for a 2-joint arm, and as
+// symoroc's robot.yaml. Any input must either read or throw DataError (InputError for robot.yaml);
+// another exception, a crash, a sanitizer report or a hang is a bug.
 #include <cstddef>
 #include <cstdint>
 #include <string_view>
 
 #include "fuzz_files.hpp"
+#include "symoro/codegen/robot_spec.hpp"
+#include "symoro/control/description.hpp"
 #include "symoro/error.hpp"
+#include "symoro/hardware/config.hpp"
 #include "symoro/io/import.hpp"
 #include "symoro/io/log.hpp"
 #include "symoro/io/parameters_yaml.hpp"
+#include "symoro/trajectory/design.hpp"
+#include "symoro/twin/config.hpp"
 
 namespace {
 
@@ -43,5 +49,20 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   either_reads_or_refuses([&] { io::parameters_accepted(params.string()); });
   either_reads_or_refuses([&] { io::parameters_integrity(params.string(), names); });
   either_reads_or_refuses([&] { io::read_log_metadata(csv); });
+  const fs::path hardware = dir / "hardware.yaml", controller = dir / "controller.yaml", twin = dir / "twin.yaml";
+  for (const fs::path& f : {hardware, controller, twin}) symoro::fuzz::write_bytes(f, bytes);
+  const std::vector<symoro::JointInfo> joints = {{"j1", symoro::JointType::Revolute, -2, 2, 3, 10, -2, 2},
+                                                 {"j2", symoro::JointType::Prismatic, 0, 0.2, 1, 50, 0, 0.2}};
+  either_reads_or_refuses([&] { symoro::hardware::read_hardware_config(hardware, joints); });
+  either_reads_or_refuses([&] { symoro::control::read_controller_description(controller, 2); });
+  either_reads_or_refuses([&] { symoro::twin::read_twin_config(twin, 2); });
+  const fs::path design = dir / "trajectories.yaml", robot = dir / "robot.yaml";
+  symoro::fuzz::write_bytes(design, bytes);
+  either_reads_or_refuses([&] { symoro::trajectory::TrajectoryDesign::read(design, joints); });
+  symoro::fuzz::write_bytes(robot, bytes);
+  try {
+    symoro::codegen::read_robot_spec(robot.string());
+  } catch (const symoro::codegen::InputError&) {
+  }
   return 0;
 }

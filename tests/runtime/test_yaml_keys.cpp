@@ -357,6 +357,20 @@ TEST_F(YamlKeys, TwinConfigAndOverridesRefuseTypos) {
   expect_unknown(read_override, o, 2, "colomb", "coulomb");
   write(o, "effects:\n  coulomb:\n    enabled: 'false\n");
   expect_syntax_error(read_override, o, 3, "has no closing quote");
+  // A file that is a scalar or a list: yaml-cpp's BadSubscript escaped every handler (fuzz_yaml).
+  for (const char* text : {"just text\n", "- a\n- b\n"}) {
+    write(t, text);
+    try {
+      read_twin();
+      ADD_FAILURE() << "accepted: " << text;
+    } catch (const DataError& e) {
+      EXPECT_EQ(e.line(), 1) << e.what();
+      EXPECT_NE(std::string(e.what()).find("expected a YAML map of sections"), std::string::npos) << e.what();
+    }
+    write(o, text);
+    write(t, crane);
+    EXPECT_THROW(read_override(), DataError) << text;
+  }
 }
 
 // ---- trajectories.yaml -------------------------------------------------------------------------

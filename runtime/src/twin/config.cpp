@@ -304,7 +304,11 @@ class Reader {
 
 YAML::Node load(const std::filesystem::path& path) {
   if (!std::filesystem::exists(path)) throw DataError(path.string(), 0, "no such file");
-  return io::load_yaml_file(path);
+  YAML::Node root = io::load_yaml_file(path);
+  // A scalar or a list: the first lookup threw yaml-cpp's BadSubscript past every handler (fuzz_yaml).
+  if (!root.IsMap() && !root.IsNull())
+    throw DataError(path.string(), root.Mark().is_null() ? 1 : root.Mark().line + 1, "expected a YAML map of sections (twin.yaml)");
+  return root;
 }
 
 }  // namespace
