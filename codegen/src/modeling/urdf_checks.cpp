@@ -1,6 +1,5 @@
 #include "urdf_checks.hpp"
 
-#include <cerrno>
 #include <cmath>
 #include <cstdlib>
 #include <sstream>
@@ -31,7 +30,6 @@ std::string number_problem(const std::string& text, double& value) {
   const std::size_t e = text.find_last_not_of(" \t\r\n");
   const std::string t = text.substr(b, e - b + 1);
   char* end = nullptr;
-  errno = 0;
   value = std::strtod(t.c_str(), &end);
   if (end != t.c_str() + t.size()) return "is not a number";
   if (!std::isfinite(value)) return "is not a finite number";

@@ -2,10 +2,12 @@
 // as s) gives values that no robot logs; identification would accept them and fit nonsense.
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include <fmt/format.h>
 
 #include "import_detail.hpp"
+#include "symoro/detail/numbers.hpp"
 #include "symoro/error.hpp"
 #include "symoro/io/import.hpp"
 #include "symoro/io/number_text.hpp"
@@ -14,7 +16,7 @@ namespace symoro::io {
 
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
+using symoro::detail::kPi;
 
 // "Far" beyond a limit: a robot overshoots its soft limits, or is calibrated off, by far less
 // than half its range (and than 0.5 rad, for joints of a small range such as a gripper's);
@@ -35,6 +37,23 @@ constexpr double kEffortFactor = 5, kMaxTorque = 1e6;
 // jitter are milliseconds; a second and a thousand steps are no sampling.
 constexpr double kMaxGap = 1.0, kMaxGapSteps = 1000;
 
+// The sample (row, joint) whose score most exceeds `floor` (row -1: none does).
+struct Worst {
+  Eigen::Index row = -1, joint = -1;
+};
+template <class Score>
+Worst worst_sample(Eigen::Index joints, Eigen::Index rows, double floor, Score score) {
+  Worst w;
+  double most = floor;
+  for (Eigen::Index j = 0; j < joints; ++j)
+    for (Eigen::Index k = 0; k < rows; ++k)
+      if (const double v = score(k, j); v > most) {
+        most = v;
+        w = {k, j};
+      }
+  return w;
+}
+
 // 3 significant digits are enough evidence; number_text would print 58.70000000000001.
 std::string g(double v) { return fmt::format("{:.6g}", v); }
 
@@ -47,28 +66,22 @@ void check_plausible(const ImportedLog& imported, const ImportMapping& mapping, 
   const bool checked = target.lower.size() == static_cast<std::size_t>(n) && target.upper.size() == target.lower.size();
 
   // The sample farthest beyond its joint's margin, over all joints.
-  double worst_excess = 0;
-  Eigen::Index worst_row = -1, worst_joint = -1;
-  for (Eigen::Index j = 0; checked && j < n; ++j) {
+  const auto margin_of = [&](Eigen::Index j) {
     const double lo = target.lower[static_cast<std::size_t>(j)], hi = target.upper[static_cast<std::size_t>(j)];
-    if (!std::isfinite(lo) || !std::isfinite(hi) || !(hi > lo)) continue;  // no limits to judge by
     const bool prismatic = !target.prismatic.empty() && target.prismatic[static_cast<std::size_t>(j)];
-    const double margin = std::max(prismatic ? kPrismaticMargin : kRevoluteMargin, 0.5 * (hi - lo));
-    for (Eigen::Index k = 0; k < log.samples(); ++k) {
-      const double q = log.q(k, j);
-      const double excess = std::max(lo - q, q - hi) - margin;
-      if (excess > worst_excess) {
-        worst_excess = excess;
-        worst_row = k;
-        worst_joint = j;
-      }
-    }
-  }
+    return std::max(prismatic ? kPrismaticMargin : kRevoluteMargin, 0.5 * (hi - lo));
+  };
+  Worst worst = worst_sample(checked ? n : 0, log.samples(), 0, [&](Eigen::Index k, Eigen::Index j) {
+    const double lo = target.lower[static_cast<std::size_t>(j)], hi = target.upper[static_cast<std::size_t>(j)];
+    if (!std::isfinite(lo) || !std::isfinite(hi) || !(hi > lo)) return -std::numeric_limits<double>::infinity();  // no limits to judge by
+    return std::max(lo - log.q(k, j), log.q(k, j) - hi) - margin_of(j);
+  });
+  Eigen::Index worst_row = worst.row, worst_joint = worst.joint;
   if (worst_row >= 0) {
     const std::size_t j = static_cast<std::size_t>(worst_joint);
     const bool prismatic = !target.prismatic.empty() && target.prismatic[j];
     const double lo = target.lower[j], hi = target.upper[j], q = log.q(worst_row, worst_joint);
-    const double margin = std::max(prismatic ? kPrismaticMargin : kRevoluteMargin, 0.5 * (hi - lo));
+    const double margin = margin_of(worst_joint);
     const std::string unit = prismatic ? "m" : "rad";
     const bool degrees = !prismatic && mapping.angle_unit == AngleUnit::deg;
     const std::string as_written = degrees ? fmt::format(" ({} as written, read as deg)", g(q * 180 / kPi)) : "";
@@ -83,20 +96,12 @@ void check_plausible(const ImportedLog& imported, const ImportMapping& mapping, 
   }
 
   // Torques: the sample farthest beyond kEffortFactor times its joint's effort limit.
-  double worst_ratio = 1;
-  worst_row = -1;
-  for (Eigen::Index j = 0; j < log.tau.cols(); ++j) {
+  worst = worst_sample(log.tau.cols(), log.samples(), 1, [&](Eigen::Index k, Eigen::Index j) {
     const double effort = target.effort.size() == static_cast<std::size_t>(n) ? target.effort[static_cast<std::size_t>(j)] : 0.0;
-    const double bound = effort > 0 ? kEffortFactor * effort : kMaxTorque;
-    for (Eigen::Index k = 0; k < log.samples(); ++k) {
-      const double ratio = std::abs(log.tau(k, j)) / bound;
-      if (ratio > worst_ratio) {
-        worst_ratio = ratio;
-        worst_row = k;
-        worst_joint = j;
-      }
-    }
-  }
+    return std::abs(log.tau(k, j)) / (effort > 0 ? kEffortFactor * effort : kMaxTorque);
+  });
+  worst_row = worst.row;
+  worst_joint = worst.joint;
   if (worst_row >= 0) {
     const std::size_t j = static_cast<std::size_t>(worst_joint);
     const double effort = target.effort.size() == static_cast<std::size_t>(n) ? target.effort[j] : 0.0;
