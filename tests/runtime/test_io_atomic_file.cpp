@@ -2,8 +2,11 @@
 // of the same target once its process is gone, never while it lives; failures name the system's
 // reason (a rename onto a directory, a full disk) and say whether a previous file is kept.
 #include <sys/mount.h>
+#include <sys/resource.h>
 #include <sys/wait.h>
 #include <unistd.h>
+
+#include <csignal>
 
 #include <cerrno>
 #include <cstring>
@@ -44,7 +47,25 @@ class AtomicFiles : public ::testing::Test {
   }
   void TearDown() override {
     if (mounted_) ::umount(dir_.c_str());
+    if (limited_) {
+      ::setrlimit(RLIMIT_FSIZE, &saved_limit_);
+      std::signal(SIGXFSZ, saved_handler_);
+    }
     fs::remove_all(dir_);
+  }
+  // A disk that holds 64 KiB: a tmpfs on the test's folder when the test may mount one (root),
+  // else the file size limit (RLIMIT_FSIZE, SIGXFSZ ignored), which fails a write past 64 KiB
+  // the same way with EFBIG. The reason a failed write gives is returned.
+  std::string small_disk() {
+    mounted_ = ::geteuid() == 0 && ::mount("tmpfs", dir_.c_str(), "tmpfs", 0, "size=64k") == 0;
+    if (mounted_) return "no space left on device";
+    EXPECT_EQ(::getrlimit(RLIMIT_FSIZE, &saved_limit_), 0);
+    saved_handler_ = std::signal(SIGXFSZ, SIG_IGN);
+    struct rlimit small = saved_limit_;
+    small.rlim_cur = 64 << 10;
+    EXPECT_EQ(::setrlimit(RLIMIT_FSIZE, &small), 0);
+    limited_ = true;
+    return std::strerror(EFBIG);
   }
   // The message of the DataError `f` throws ("" when it does not).
   template <class F>
@@ -57,7 +78,9 @@ class AtomicFiles : public ::testing::Test {
     return "";
   }
   fs::path dir_;
-  bool mounted_ = false;
+  bool mounted_ = false, limited_ = false;
+  struct rlimit saved_limit_ {};
+  void (*saved_handler_)(int) = SIG_DFL;
 };
 
 // A process that has exited and been reaped: its pid is no longer alive.
@@ -139,18 +162,14 @@ TEST_F(AtomicFiles, ARenameFailureNamesItsReason) {
   EXPECT_EQ(std::distance(fs::directory_iterator(dir_), fs::directory_iterator()), 1);
 }
 
-// A full disk: a 64 KiB tmpfs (mounting needs root; skipped otherwise). Without a previous file
-// the message does not pretend one was kept; with one, it is kept as it was.
+// A full disk (small_disk). Without a previous file the message does not pretend one was kept;
+// with one, it is kept as it was.
 TEST_F(AtomicFiles, AFullDiskSaysSoAndWhetherAPreviousFileIsKept) {
-  if (::geteuid() != 0) GTEST_SKIP() << "mounting a small tmpfs needs root";
-  if (::mount("tmpfs", dir_.c_str(), "tmpfs", 0, "size=64k") != 0)
-    GTEST_SKIP() << "cannot mount a tmpfs on " << dir_ << ": " << std::strerror(errno);
-  mounted_ = true;
+  const std::string reason = small_disk();
   const fs::path target = dir_ / "big.csv";
   const std::string big(1 << 20, '1');
   std::string what = error_of([&] { write_file_atomically(target, big); });
-  EXPECT_NE(what.find(target.string() + ": error: writing failed: no space left on device; nothing is written under "
-                                        "this name"),
+  EXPECT_NE(what.find(target.string() + ": error: writing failed: " + reason + "; nothing is written under this name"),
             std::string::npos)
       << what;
   EXPECT_EQ(what.find("previous file"), std::string::npos) << what;
@@ -158,7 +177,7 @@ TEST_F(AtomicFiles, AFullDiskSaysSoAndWhetherAPreviousFileIsKept) {
 
   write_file_atomically(target, "time\n0\n");
   what = error_of([&] { write_file_atomically(target, big); });
-  EXPECT_NE(what.find("writing failed: no space left on device; the previous file is left as it was"),
+  EXPECT_NE(what.find("writing failed: " + reason + "; the previous file is left as it was"),
             std::string::npos)
       << what;
   EXPECT_EQ(read_text(target), "time\n0\n");
@@ -166,12 +185,10 @@ TEST_F(AtomicFiles, AFullDiskSaysSoAndWhetherAPreviousFileIsKept) {
 }
 
 // Files that belong together (dynid export: a URDF and its .standard.yaml and .csv) are written all
-// or none: on a full disk the URDF was written without the other two, and the rerun refused.
+// or none: on a full disk (small_disk) the URDF was written without the other two, and the rerun
+// refused.
 TEST_F(AtomicFiles, AGroupIsWrittenAllOrNone) {
-  if (::geteuid() != 0) GTEST_SKIP() << "mounting a small tmpfs needs root";
-  if (::mount("tmpfs", dir_.c_str(), "tmpfs", 0, "size=64k") != 0)
-    GTEST_SKIP() << "cannot mount a tmpfs on " << dir_ << ": " << std::strerror(errno);
-  mounted_ = true;
+  const std::string reason = small_disk();
   const fs::path urdf = dir_ / "arm.urdf", yaml = dir_ / "arm.standard.yaml", csv = dir_ / "arm.standard.csv";
   write_files_atomically({{urdf, "<robot/>\n"}, {yaml, "a: 1\n"}, {csv, "a,1\n"}});
   EXPECT_EQ(read_text(urdf), "<robot/>\n");
@@ -182,7 +199,7 @@ TEST_F(AtomicFiles, AGroupIsWrittenAllOrNone) {
   const std::string what = error_of([&] {
     write_files_atomically({{urdf, "<robot name='b'/>\n"}, {yaml, "a: 2\n"}, {csv, std::string(1 << 20, '2')}});
   });
-  EXPECT_NE(what.find(": error: writing failed: no space left on device"), std::string::npos) << what;
+  EXPECT_NE(what.find(": error: writing failed: " + reason), std::string::npos) << what;
   EXPECT_EQ(read_text(urdf), "<robot/>\n");
   EXPECT_EQ(read_text(yaml), "a: 1\n");
   EXPECT_EQ(read_text(csv), "a,1\n");
