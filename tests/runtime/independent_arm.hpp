@@ -4,8 +4,8 @@
 //   plant   the generated model's forward dynamics, semi-implicit Euler at 0.1 ms (the twin
 //           integrates its own way); a joint with play gets a rotor (inertia, viscous friction)
 //           coupled to its link through a dead zone and a stiff damped contact at 150 Hz,
-//           damping ratio 0.25 (the twin's mesh: 100 Hz, 0.1); optional smooth Coulomb friction
-//           on the links;
+//           damping ratio 0.25 (the twin's mesh: 100 Hz, 0.1); optional smooth Coulomb and
+//           Stribeck friction on the links;
 //   loop    1 kHz FF+PD with the controller description's gains, but the velocity is a backward
 //           difference through a 80 Hz first-order low-pass (the twin: Tustin's pseudo-derivative
 //           with Tf); the command takes effect after the bus delay and is held;
@@ -31,6 +31,9 @@ namespace symoro::test {
 struct IndependentArmOptions {
   Eigen::VectorXd play;     // rad, total play per joint (empty or 0: rigid)
   Eigen::VectorXd coulomb;  // N m, smooth Coulomb friction at the links (empty: none)
+  // N m, static friction above Coulomb's that fades with speed, exp(-(|qd|/vs)^shape) (empty: none)
+  Eigen::VectorXd stribeck;
+  double stribeck_velocity = 0.1, stribeck_shape = 2;
   double mesh_frequency = 150, mesh_damping = 0.25;
   double velocity_cutoff = 80;  // Hz
   double encoder_noise = 0.3;   // counts
@@ -50,6 +53,12 @@ io::Log run_independent_arm(const twin::TwinConfig& c, const trajectory::Sampled
   std::normal_distribution<double> gauss(0, 1);
   const Vec play = o.play.size() ? Vec(o.play) : Vec::Zero();
   const Vec coulomb = o.coulomb.size() ? Vec(o.coulomb) : Vec::Zero();
+  const Vec stribeck = o.stribeck.size() ? Vec(o.stribeck) : Vec::Zero();
+  // The links' friction: smooth through zero speed (tanh over 0.01 rad/s), so that the
+  // integrator needs no stick-slip logic.
+  auto friction = [&](int j, double v) {
+    return (coulomb(j) + stribeck(j) * std::exp(-std::pow(std::abs(v) / o.stribeck_velocity, o.stribeck_shape))) * std::tanh(v / 0.01);
+  };
   // The links' parameters: rotors and viscous friction of joints with play move to their rotors.
   twin::TwinConfig links = c;
   links.effects.disable_all();
@@ -86,7 +95,7 @@ io::Log run_independent_arm(const twin::TwinConfig& c, const trajectory::Sampled
     for (int s = 0; s < steps; ++s) {
       Vec tau = motor, tm = Vec::Zero();
       for (int j = 0; j < n; ++j) {
-        tau(j) -= coulomb(j) * std::tanh(qd(j) / 0.01);
+        tau(j) -= friction(j, qd(j));
         if (!(play(j) > 0)) continue;
         const double gap = qm(j) - q(j), half = play(j) / 2;
         double mesh = 0;
@@ -95,7 +104,7 @@ io::Log run_independent_arm(const twin::TwinConfig& c, const trajectory::Sampled
           if (mesh * gap < 0) mesh = 0;  // a contact pushes, never pulls
         }
         tm(j) = motor(j) - fv(j) * qdm(j) - mesh;
-        tau(j) = mesh - coulomb(j) * std::tanh(qd(j) / 0.01);
+        tau(j) = mesh - friction(j, qd(j));
       }
       Vec qdd;
       Model::forward_dynamics(q, qd, tau, phi, qdd);

@@ -227,9 +227,10 @@ TYPED_TEST(AnyRobotGap, AControllersCsvThroughImportIdentifyDiagnoseAndCompare) 
 
 namespace {
 
-// --apply keeps every selected effect: Coulomb friction selected with different tanh widths on
-// two joints becomes one smooth_coulomb entry with a width per joint (a variant holds one
-// entry per effect; the second width used to become a comment, and the applied model lost it).
+// --apply keeps every selected effect: Coulomb friction selected with different velocity
+// spreads on two joints becomes one smooth_coulomb entry with a width per joint (a variant holds
+// one entry per effect; the second width used to become a comment, and the applied model lost
+// it). The width is the tanh's of the spread's erf slope at rest: spread sqrt(pi / 2).
 TEST(DiagnoseVariant, EverySelectedWidthIsKept) {
   using symoro::diagnose::EffectKind;
   symoro::diagnose::Diagnosis d;
@@ -242,7 +243,7 @@ TEST(DiagnoseVariant, EverySelectedWidthIsKept) {
     d.selection.effects.push_back(e);
   }
   const std::string y = symoro::diagnose::variant_yaml(d, "reduced_diagnosed", "reduced");
-  EXPECT_NE(y.find("      smooth_coulomb: {joints: [2, 4], velocity: [0.03, 0.01]}\n"), std::string::npos) << y;
+  EXPECT_NE(y.find("      smooth_coulomb: {joints: [2, 4], velocity: [0.0375994, 0.0125331]}\n"), std::string::npos) << y;
   EXPECT_NE(y.find("      offset: [5]\n"), std::string::npos) << y;
   EXPECT_EQ(y.find("# also"), std::string::npos) << y;
   EXPECT_NE(y.find("    base: reduced\n"), std::string::npos) << y;

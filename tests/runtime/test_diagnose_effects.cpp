@@ -329,11 +329,14 @@ TEST(DiagnoseEffects, TermsMatchTheCompiledVariant) {
     Eigen::Vector2d q(u(rng), u(rng)), qd(u(rng) * 0.1, u(rng) * 0.1), qdd(u(rng), u(rng));
     Eigen::Matrix<double, 2, E::np> W;
     E::regressor(q, qd, qdd, W);
+    // The sample-local terms a variant compiles as they are; friction is the law averaged over
+    // the velocity spread, which at a vanishing spread is the compiled law itself.
     auto check = [&](EffectKind kind, int joint, std::vector<const char*> names, std::vector<int> orders = {}) {
       Candidate c;
       c.kind = kind;
       c.joint = joint;
       c.stribeck_velocity = 0.05;
+      c.coulomb_velocity = 1e-9;
       c.orders = orders;
       std::vector<double> v(names.size());
       effect_terms(c, q(joint - 1), qd(joint - 1), v.data());
@@ -347,7 +350,7 @@ TEST(DiagnoseEffects, TermsMatchTheCompiledVariant) {
     check(EffectKind::Stribeck, 2, {"FST2"});
     check(EffectKind::ViscousAsymmetry, 2, {"FVA2"});
     check(EffectKind::PositionHarmonics, 1, {"HS1_1", "HC1_1", "HS1_2", "HC1_2"}, {1, 2});
-    // Coulomb: the compiled FS1 is OpenSYMORO's sign(qd), the diagnosis's tanh(qd / vc) tends to it.
+    // Coulomb: the compiled FS1 is OpenSYMORO's sign(qd), the diagnosis's erf tends to it.
     Candidate c;
     c.kind = EffectKind::Coulomb;
     c.joint = 1;
@@ -355,11 +358,20 @@ TEST(DiagnoseEffects, TermsMatchTheCompiledVariant) {
     double v = 0;
     effect_terms(c, q(0), qd(0), &v);
     EXPECT_NEAR(W(0, column("FS1")), v, 1e-12);
-    // smooth_coulomb (what dynid diagnose writes for Coulomb): the very tanh(qd / vc) term.
+    // smooth_coulomb (what dynid diagnose writes for Coulomb, planar2r's at width 0.04): tanh of
+    // the erf's slope at rest, spread = width / sqrt(pi / 2). Both odd, so they agree to the
+    // speed squared near rest (relative), and both tend to the sign away from it.
     c.joint = 2;
-    c.coulomb_velocity = 0.04;
-    effect_terms(c, q(1), qd(1), &v);
-    EXPECT_NEAR(W(1, column("FC2")), v, 1e-14);
+    c.coulomb_velocity = 0.04 / std::sqrt(M_PI / 2);
+    for (double slow : {1e-5, -3e-5}) {
+      Eigen::Vector2d qd_slow(0, slow);
+      Eigen::Matrix<double, 2, E::np> Ws;
+      E::regressor(q, qd_slow, qdd, Ws);
+      effect_terms(c, q(1), slow, &v);
+      EXPECT_NEAR(Ws(1, column("FC2")), v, 1e-6 * std::abs(v)) << slow;  // a third of (qd / width)^2
+    }
+    effect_terms(c, q(1), 0.5, &v);
+    EXPECT_NEAR(v, 1.0, 1e-12);
     EXPECT_EQ(W(0, column("FC2")), 0.0);
   }
 }

@@ -239,12 +239,14 @@ std::string variant_yaml(const Diagnosis& d, const std::string& name, const std:
   for (const auto& e : d.selection.effects) {
     const Candidate& c = e.candidate;
     switch (c.kind) {
-      // Coulomb friction as the diagnosis fitted it, tanh(qd / width): the files' sign(qd)
-      // column is biased towards 0 by velocity noise at slow motion.
-      case EffectKind::Coulomb: scaled["smooth_coulomb"][c.joint] = c.coulomb_velocity; break;
+      // Coulomb friction smoothed as the diagnosis found the logs' velocity spread: the files'
+      // sign(qd) column is biased towards 0 by it at slow motion. The variant's tanh(qd / width)
+      // has the slope at rest of the diagnosis's erf (width = spread sqrt(pi / 2)).
+      case EffectKind::Coulomb: scaled["smooth_coulomb"][c.joint] = c.coulomb_velocity * std::sqrt(std::acos(-1.0) / 2); break;
       case EffectKind::Offset: joints["offset"].push_back(c.joint); break;
       case EffectKind::ViscousAsymmetry: joints["viscous_asymmetry"].push_back(c.joint); break;
       case EffectKind::InertiaProducts: joints["inertia_products"].push_back(c.joint); break;
+      // The law itself, sign(qd) exp(-(qd / vs)^2): its level is the law's (effects.hpp).
       case EffectKind::Stribeck: scaled["stribeck"][c.joint] = c.stribeck_velocity; break;
       case EffectKind::PositionHarmonics: {
         std::string orders;

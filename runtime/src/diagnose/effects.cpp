@@ -11,8 +11,6 @@ namespace {
 
 constexpr double kDeg = 180.0 / 3.14159265358979323846;
 
-double sign(double x) { return x > 0 ? 1.0 : (x < 0 ? -1.0 : 0.0); }
-
 std::string joint_text(const DesignStack& d, int j) {
   return j >= 1 && j <= static_cast<int>(d.joint_names.size()) ? fmt::format("joint {} ({})", j, d.joint_names[j - 1])
                                                                 : fmt::format("joint {}", j);
@@ -59,7 +57,7 @@ EffectKind effect_kind(const std::string& name) {
 
 std::string Candidate::key() const {
   std::string k = std::string(effect_info(kind).name) + ":" + std::to_string(joint);
-  if (kind == EffectKind::Stribeck) k += fmt::format("@{:g}", stribeck_velocity);
+  if (kind == EffectKind::Stribeck) k += fmt::format("@{:g}~{:g}", stribeck_velocity, coulomb_velocity);
   if (kind == EffectKind::Coulomb) k += fmt::format("@{:g}", coulomb_velocity);
   return k;
 }
@@ -67,25 +65,66 @@ std::string Candidate::key() const {
 std::string Candidate::label() const {
   const EffectInfo& e = effect_info(kind);
   std::string s = e.title;
-  if (kind == EffectKind::Stribeck) s += fmt::format(" (vs = {:g} rad/s)", stribeck_velocity);
-  if (kind == EffectKind::Coulomb) s += fmt::format(" (tanh width {:g} rad/s)", coulomb_velocity);
+  if (kind == EffectKind::Stribeck) s += fmt::format(" (vs = {:g} rad/s, velocity spread {:g} rad/s)", stribeck_velocity, coulomb_velocity);
+  if (kind == EffectKind::Coulomb) s += fmt::format(" (velocity spread {:g} rad/s)", coulomb_velocity);
   if (kind == EffectKind::InertiaProducts || kind == EffectKind::Payload) return s + fmt::format(", link {}", joint);
   if (joint == 0) return s;
   return s + fmt::format(", joint {}", joint);
 }
 
+namespace {
+
+bool wanted(const CandidateOptions& o, EffectKind k) {
+  if (o.only.empty()) return true;
+  for (const auto& n : o.only)
+    if (n == effect_info(k).name) return true;
+  return false;
+}
+
+// Joint j's Coulomb candidates, one per spread, and Stribeck candidates, one per velocity and
+// spread of at most half of it.
+void add_friction(const DesignStack& d, const CandidateOptions& o, int j, const std::vector<double>& spreads,
+                  const std::vector<double>& velocities, std::vector<Candidate>& out) {
+  auto make = [&](EffectKind k, const std::string& parameter) {
+    Candidate c;
+    c.kind = k;
+    c.joint = j;
+    c.parameters = {parameter};
+    c.units = {"N*m"};
+    return c;
+  };
+  // Named as the variant compiles it (smooth_coulomb: FC<j>); not a candidate where the model
+  // already has Coulomb friction on the joint (OpenSYMORO's FS<j>, or a compiled FC<j>).
+  const std::string fc = fmt::format("FC{}", j), fst = fmt::format("FST{}", j);
+  if (wanted(o, EffectKind::Coulomb) && !has_parameter(d, fmt::format("FS{}", j)) && !has_parameter(d, fc))
+    for (double spread : spreads) {
+      out.push_back(make(EffectKind::Coulomb, fc));
+      out.back().coulomb_velocity = spread;
+    }
+  if (wanted(o, EffectKind::Stribeck) && !has_parameter(d, fst))
+    for (double vs : velocities)
+      for (double spread : spreads)
+        if (2 * spread <= vs) {
+          out.push_back(make(EffectKind::Stribeck, fst));
+          out.back().stribeck_velocity = vs;
+          out.back().coulomb_velocity = spread;
+        }
+}
+
+}  // namespace
+
+std::vector<Candidate> friction_options(const DesignStack& d, const CandidateOptions& o, int joint) {
+  std::vector<Candidate> out;
+  add_friction(d, o, joint, o.refined_spreads, o.refined_stribeck_velocities, out);
+  return out;
+}
+
 std::vector<Candidate> candidates(const DesignStack& d, const CandidateOptions& o) {
   std::vector<Candidate> out;
-  auto wanted = [&](EffectKind k) {
-    if (o.only.empty()) return true;
-    for (const auto& n : o.only)
-      if (n == effect_info(k).name) return true;
-    return false;
-  };
   const int n = d.joints;
   for (int j = 1; j <= n; ++j) {
     auto add = [&](EffectKind k, std::vector<std::string> params, std::vector<std::string> units) {
-      if (!wanted(k)) return static_cast<Candidate*>(nullptr);
+      if (!wanted(o, k)) return static_cast<Candidate*>(nullptr);
       for (const auto& p : params)
         if (has_parameter(d, p)) return static_cast<Candidate*>(nullptr);
       Candidate c;
@@ -96,13 +135,7 @@ std::vector<Candidate> candidates(const DesignStack& d, const CandidateOptions& 
       out.push_back(c);
       return &out.back();
     };
-    // Named as the variant compiles it (smooth_coulomb: FC<j>); not a candidate where the model
-    // already has Coulomb friction on the joint (OpenSYMORO's FS<j>, or a compiled FC<j>).
-    if (!has_parameter(d, fmt::format("FS{}", j)))
-      for (double vc : o.coulomb_velocities)
-        if (Candidate* c = add(EffectKind::Coulomb, {fmt::format("FC{}", j)}, {"N*m"})) c->coulomb_velocity = vc;
-    for (double vs : o.stribeck_velocities)
-      if (Candidate* c = add(EffectKind::Stribeck, {fmt::format("FST{}", j)}, {"N*m"})) c->stribeck_velocity = vs;
+    add_friction(d, o, j, o.coulomb_velocities, o.stribeck_velocities, out);
     add(EffectKind::Offset, {fmt::format("OFF{}", j)}, {"N*m"});
     add(EffectKind::ViscousAsymmetry, {fmt::format("FVA{}", j)}, {"N*m*s/rad"});
     std::vector<std::string> hp, hu;
@@ -117,7 +150,7 @@ std::vector<Candidate> candidates(const DesignStack& d, const CandidateOptions& 
     add(EffectKind::TorqueConstant, {fmt::format("KTE{}", j)}, {"1"});
     if (drive) add(EffectKind::Backlash, {fmt::format("BL{}", j)}, {"rad"});
     // Products of inertia of link j from the full model.
-    if (wanted(EffectKind::InertiaProducts)) {
+    if (wanted(o, EffectKind::InertiaProducts)) {
       Candidate c;
       c.kind = EffectKind::InertiaProducts;
       c.joint = j;
@@ -134,7 +167,7 @@ std::vector<Candidate> candidates(const DesignStack& d, const CandidateOptions& 
   }
   // A payload changes the last link's inertial parameters, which a refit absorbs: it is a
   // candidate only when the identified parameters are held.
-  if (wanted(EffectKind::Payload) && d.held() && d.payload_link > 0 && d.payload_map.cols() == 4) {
+  if (wanted(o, EffectKind::Payload) && d.held() && d.payload_link > 0 && d.payload_map.cols() == 4) {
     Candidate c;
     c.kind = EffectKind::Payload;
     c.joint = d.payload_link;
@@ -142,7 +175,7 @@ std::vector<Candidate> candidates(const DesignStack& d, const CandidateOptions& 
     c.units = {"kg", "kg*m", "kg*m", "kg*m"};
     out.push_back(c);
   }
-  if (wanted(EffectKind::ActuationDelay)) {
+  if (wanted(o, EffectKind::ActuationDelay)) {
     Candidate c;
     c.kind = EffectKind::ActuationDelay;
     c.parameters = {"DELAY"};
@@ -219,12 +252,15 @@ bool sample_local(EffectKind kind) {
 
 void effect_terms(const Candidate& c, double q, double qd, double* out) {
   switch (c.kind) {
+    // The laws sign(v) and sign(v) exp(-(v / vs)^2) averaged over v ~ N(qd, spread^2).
     case EffectKind::Coulomb:
-      out[0] = std::tanh(qd / c.coulomb_velocity);
+      out[0] = std::erf(qd / (std::sqrt(2.0) * c.coulomb_velocity));
       break;
     case EffectKind::Stribeck: {
-      const double v = qd / c.stribeck_velocity;
-      out[0] = sign(qd) * std::exp(-v * v);
+      // The product of the two Gaussians (the law's exp(-a v^2), the spread's) is one Gaussian
+      // in v, centred at b qd / (a + b), over which the sign's mean is an erf.
+      const double a = 1 / (c.stribeck_velocity * c.stribeck_velocity), b = 1 / (2 * c.coulomb_velocity * c.coulomb_velocity);
+      out[0] = std::sqrt(b / (a + b)) * std::exp(-a * b / (a + b) * qd * qd) * std::erf(b * qd / std::sqrt(a + b));
       break;
     }
     case EffectKind::Offset:

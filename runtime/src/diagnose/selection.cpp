@@ -14,111 +14,25 @@
 #include <boost/math/distributions/fisher_f.hpp>
 #include <fmt/format.h>
 
+#include "friction_smoothing.hpp"
+#include "nested_fit.hpp"
+
 namespace symoro::diagnose {
 
 namespace {
 
-// Per-row weights (row s * n + j gets w_j).
-Eigen::VectorXd row_weights(const DesignStack& d, const Eigen::VectorXd& w) {
-  Eigen::VectorXd r(d.rows());
-  for (int s = 0; s < d.samples(); ++s) r.segment(static_cast<Eigen::Index>(s) * d.joints, d.joints) = w;
-  return r;
-}
-
-Eigen::MatrixXd per_sample(const DesignStack& d, const Eigen::VectorXd& stacked) {
-  Eigen::MatrixXd m(d.samples(), d.joints);
-  for (int s = 0; s < d.samples(); ++s) m.row(s) = stacked.segment(static_cast<Eigen::Index>(s) * d.joints, d.joints).transpose();
-  return m;
-}
-
-Eigen::VectorXd joint_rms(const DesignStack& d, const Eigen::VectorXd& r) {
-  const Eigen::MatrixXd m = per_sample(d, r);
-  return (m.colwise().squaredNorm() / std::max(1, d.samples())).cwiseSqrt().transpose();
-}
-
-// The identified parameters the fit estimates: all of them, or none when they are held.
-Eigen::Index free_parameters(const DesignStack& d) { return d.held() ? 0 : d.W.cols(); }
-
-// The current model's design on a stack: W (unless its parameters are held), then each
-// effect's columns (evaluated at `state`).
-Eigen::MatrixXd design(const DesignStack& d, const std::vector<Candidate>& effects, const FitState& state) {
-  const Eigen::Index np = free_parameters(d);
-  Eigen::Index cols = np;
-  std::vector<Eigen::MatrixXd> blocks;
-  for (const auto& e : effects) {
-    blocks.push_back(effect_columns(e, d, state));
-    cols += blocks.back().cols();
-  }
-  Eigen::MatrixXd A(d.rows(), cols);
-  A.leftCols(np) = d.W.leftCols(np);
-  Eigen::Index c = np;
-  for (const auto& b : blocks) {
-    A.middleCols(c, b.cols()) = b;
-    c += b.cols();
-  }
-  return A;
-}
-
-// Weighted LS with unit-norm columns: beta and, optionally, its covariance factor.
-struct Solve {
-  Eigen::VectorXd beta;
-  Eigen::VectorXd sd;   // sqrt(diag(sigma^2 (A'WA)^-1)), times sqrt(autocorrelation time)
-  Eigen::MatrixXd cov;  // sigma^2 tau_int (A'WA)^-1, in beta's units
-};
-
-// Scales the columns of As to unit norm (zero columns stay) and returns the scales: the
-// candidates' units differ by orders of magnitude.
-Eigen::VectorXd unit_columns(Eigen::MatrixXd& As) {
-  Eigen::VectorXd scale = As.colwise().norm().transpose();
-  for (Eigen::Index i = 0; i < scale.size(); ++i) {
-    if (!(scale(i) > 0)) scale(i) = 1;
-    As.col(i) /= scale(i);
-  }
-  return scale;
-}
-
-Solve weighted_ls(const Eigen::MatrixXd& A, const Eigen::VectorXd& y, const Eigen::VectorXd& rw, double tau_int) {
-  if (A.cols() == 0) return {};  // nothing to fit (held parameters, no effect)
-  Eigen::MatrixXd As = rw.asDiagonal() * A;
-  const Eigen::VectorXd scale = unit_columns(As);
-  const Eigen::VectorXd ys = rw.cwiseProduct(y);
-  const Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(As);
-  Solve s;
-  s.beta = qr.solve(ys).cwiseQuotient(scale);
-  const Eigen::VectorXd r = ys - As * qr.solve(ys);
-  // Var(beta) ~ sigma^2 tau_int (A'WA)^-1: autocorrelated errors carry 1/tau_int of the
-  // information of independent ones.
-  const double sigma2 = r.squaredNorm() / std::max<double>(1.0, static_cast<double>(A.rows() - A.cols()));
-  const Eigen::MatrixXd G = As.transpose() * As;
-  const Eigen::MatrixXd Ginv = G.ldlt().solve(Eigen::MatrixXd::Identity(G.rows(), G.cols()));
-  s.sd = (sigma2 * tau_int * Ginv.diagonal()).cwiseMax(0).cwiseSqrt().cwiseQuotient(scale);
-  const Eigen::VectorXd inv = scale.cwiseInverse();
-  s.cov = sigma2 * tau_int * (inv.asDiagonal() * Ginv * inv.asDiagonal());
-  return s;
-}
-
-FitState state_of(const DesignStack& d, const Eigen::MatrixXd& A, const Eigen::VectorXd& beta, Eigen::Index np) {
-  FitState f;
-  f.tau_model = A * beta + d.tau0;
-  f.phi = d.held() ? d.held_phi : Eigen::VectorXd(beta.head(np));
-  return f;
-}
-
-FitState base_state(const DesignStack& d, const Eigen::VectorXd& phi) {
-  FitState f;
-  f.tau_model = d.held() ? d.tau0 : Eigen::VectorXd(d.W * phi + d.tau0);
-  f.phi = d.held() ? d.held_phi : phi;
-  return f;
-}
-
-bool linearized(const std::vector<Candidate>& effects) {
-  for (const auto& e : effects)
-    if (e.kind == EffectKind::TorqueConstant || e.kind == EffectKind::ActuationDelay || e.kind == EffectKind::Backlash)
-      return true;
-  return false;
-}
-
-double pooled(const Eigen::VectorXd& tau) { return tau.size() ? tau.mean() : 1.0; }
+using detail::base_state;
+using detail::design;
+using detail::free_parameters;
+using detail::heldout_sse;
+using detail::joint_rms;
+using detail::linearized;
+using detail::per_sample;
+using detail::pooled_time;
+using detail::row_weights;
+using detail::Solve;
+using detail::state_of;
+using detail::weighted_ls;
 
 // The stack's segments as [begin, end) sample ranges (each segment is one contiguous piece).
 std::vector<std::pair<Eigen::Index, Eigen::Index>> segment_ranges(const DesignStack& d) {
@@ -195,15 +109,6 @@ bool matters(const Candidate& c, const CandidateTest& t, const DesignStack& d, c
     return !t.magnitude.empty() && std::abs(t.magnitude[0]) >= o.min_delay_periods * log_period(d);
   }
   return t.effect_rms >= o.min_effect_torque;
-}
-
-// Held-out weighted SSE of a fit on the joints in `on` (all when empty).
-double heldout_sse(const Fit& f, const Eigen::VectorXd& weights, const std::vector<int>& on, int samples) {
-  double sse = 0;
-  for (Eigen::Index j = 0; j < f.heldout_rmse.size(); ++j)
-    if (on.empty() || std::find(on.begin(), on.end(), static_cast<int>(j) + 1) != on.end())
-      sse += std::pow(weights(j) * f.heldout_rmse(j), 2) * samples;
-  return sse;
 }
 
 // The backward check (selection.hpp): every chosen effect refitted with all the others; the
@@ -319,7 +224,7 @@ Fit fit_with_effects(const DesignStack& train, const DesignStack& heldout, const
   // Standard deviations with the residual's autocorrelation time.
   const Eigen::VectorXd r = A.cols() ? Eigen::VectorXd(y - A * s.beta) : y;
   const Eigen::MatrixXd rs = per_sample(train, rw.cwiseProduct(r));
-  const double tau_int = pooled(autocorrelation_time(train, rs, 400));
+  const double tau_int = pooled_time(autocorrelation_time(train, rs, 400));
   const Solve sd = weighted_ls(A, y, rw, tau_int);
   Fit f;
   f.phi = train.held() ? train.held_phi : Eigen::VectorXd(s.beta.head(np));
@@ -353,8 +258,6 @@ Selection select_effects(const DesignStack& train, const DesignStack& heldout, c
     sel.weights = plain.train_rmse.cwiseMax(1e-9).cwiseInverse();
   }
   sel.before = fit_with_effects(train, heldout, {}, sel.weights);
-  const Eigen::VectorXd rw = row_weights(train, sel.weights), rwh = row_weights(heldout, sel.weights);
-  const Eigen::VectorXd y = train.target(), yh = heldout.target();
   const std::vector<Candidate> all = candidates(train, o.candidates);
   std::vector<Candidate> chosen;
   std::set<std::string> taken;  // "<effect>:<joint>": one Stribeck velocity per joint, once
@@ -362,33 +265,15 @@ Selection select_effects(const DesignStack& train, const DesignStack& heldout, c
 
   Fit current = sel.before;
   while (static_cast<int>(chosen.size()) < o.max_effects) {
-    // The current design, refitted (so its residual is orthogonal to it); linearized columns
-    // are evaluated about the current fit's torques.
-    FitState st, sh;
-    st.phi = sh.phi = current.phi;
-    st.tau_model = current.train_tau;
-    sh.tau_model = current.heldout_tau;
-    const Eigen::MatrixXd A = design(train, chosen, st), Ah = design(heldout, chosen, sh);
-    Eigen::MatrixXd As = rw.asDiagonal() * A;
-    const Eigen::VectorXd scale = unit_columns(As);
-    const Eigen::VectorXd ys = rw.cwiseProduct(y);
-    // With held parameters and no effect yet the design is empty: the residual is y itself.
-    const bool empty = As.cols() == 0;
-    const Eigen::VectorXd beta_s = empty ? Eigen::VectorXd() : Eigen::VectorXd(Eigen::ColPivHouseholderQR<Eigen::MatrixXd>(As).solve(ys));
-    const Eigen::VectorXd r = empty ? ys : Eigen::VectorXd(ys - As * beta_s);
-    const Eigen::VectorXd beta = beta_s.cwiseQuotient(scale);
-    const Eigen::VectorXd rh = rwh.cwiseProduct(empty ? yh : Eigen::VectorXd(yh - Ah * beta));
-    const Eigen::MatrixXd G = As.transpose() * As;
-    const Eigen::LDLT<Eigen::MatrixXd> Gf(empty ? Eigen::MatrixXd::Identity(1, 1) : G);
+    const detail::NestedDesign nd = detail::nested_design(train, heldout, chosen, current, sel.weights);
+    const Eigen::MatrixXd& As = nd.As;
+    const Eigen::VectorXd& r = nd.r;
     const double rss0 = r.squaredNorm();
-    const Eigen::Index N = A.rows(), p = A.cols();
+    const Eigen::Index N = nd.A.rows(), p = nd.A.cols();
 
     SelectionStep step;
-    step.autocorrelation_time = pooled(autocorrelation_time(train, per_sample(train, r), o.max_lag));
+    step.autocorrelation_time = pooled_time(autocorrelation_time(train, per_sample(train, r), o.max_lag));
     const double dof = static_cast<double>(N) / static_cast<double>(std::max<Eigen::Index>(1, N - p));
-    // The current fit's torques, for linearized candidates.
-    FitState cst = state_of(train, A, beta, np), csh = state_of(heldout, Ah, beta, np);
-
     std::vector<const Candidate*> pool;
     for (const auto& c : all)
       if (!taken.count(slot(c))) pool.push_back(&c);
@@ -403,29 +288,20 @@ Selection select_effects(const DesignStack& train, const DesignStack& heldout, c
       CandidateTest t;
       t.key = c->key();
       t.label = c->label();
-      const Eigen::MatrixXd Ctr = effect_columns(*c, train, cst);
-      Eigen::MatrixXd C = rw.asDiagonal() * Ctr;
-      const Eigen::Index m = C.cols();
-      t.columns = static_cast<int>(m);
-      Eigen::VectorXd cs = C.colwise().norm().transpose();
-      if (!(cs.minCoeff() > 0)) {
-        t.absorbed = true;  // not excited by these data
-        step.tests.push_back(t);
-        continue;
-      }
-      for (Eigen::Index i = 0; i < m; ++i) C.col(i) /= cs(i);
-      const Eigen::MatrixXd AC = As.transpose() * C;
-      const Eigen::MatrixXd K = empty ? Eigen::MatrixXd(0, m) : Eigen::MatrixXd(Gf.solve(AC));
-      const Eigen::MatrixXd ZZ = C.transpose() * C - AC.transpose() * K;
-      const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(ZZ);
-      if (!(eig.eigenvalues().minCoeff() > 1e-8)) {
+      const Eigen::MatrixXd Ctr = effect_columns(*c, train, nd.train_state);
+      const Eigen::MatrixXd Ch = effect_columns(*c, heldout, nd.heldout_state);
+      const detail::AddedColumns ac = detail::add_columns(nd, Ctr, Ch);
+      t.columns = static_cast<int>(Ctr.cols());
+      if (ac.absorbed) {
         t.absorbed = true;
         step.tests.push_back(t);
         continue;
       }
-      const Eigen::VectorXd Cr = C.transpose() * r;
-      const Eigen::VectorXd theta_s = ZZ.ldlt().solve(Cr);
-      const double reduction = Cr.dot(theta_s);
+      const Eigen::Index m = Ctr.cols();
+      const Eigen::MatrixXd& C = ac.C;
+      const Eigen::VectorXd& Cr = ac.Cr;
+      const Eigen::VectorXd& theta_s = ac.theta_s;
+      const double reduction = ac.reduction;
       // Test with the long-run (autocorrelation-consistent) variance of the score, the
       // candidate's own columns against the autocorrelation of the residual the candidate
       // leaves (the alternative's): an offset is judged against the residual's slow drift, a
@@ -434,10 +310,10 @@ Selection select_effects(const DesignStack& train, const DesignStack& heldout, c
       // that residual is the effect itself, its uncentred autocovariance stays at the
       // effect's square over every lag, and the effect capped its own F (F 9-13 for an
       // offset that removed 99 % of the held-out error).
-      const Eigen::MatrixXd Z = C - As * K;
+      const Eigen::MatrixXd Z = C - As * ac.K;
       const Eigen::MatrixXd r1 = per_sample(train, Eigen::VectorXd(r - Z * theta_s));
       const Eigen::MatrixXd V = dof * score_covariance(train, Z, autocovariance(train, r1, o.max_lag));
-      const double df2 = static_cast<double>(N) / pooled(autocorrelation_time(train, r1, o.max_lag)) - static_cast<double>(p + m);
+      const double df2 = static_cast<double>(N) / pooled_time(autocorrelation_time(train, r1, o.max_lag)) - static_cast<double>(p + m);
       t.df2 = df2;
       const Eigen::LDLT<Eigen::MatrixXd> Vf(V);
       const double stat = Vf.info() == Eigen::Success ? Cr.dot(Vf.solve(Cr)) : 0.0;
@@ -449,10 +325,9 @@ Selection select_effects(const DesignStack& train, const DesignStack& heldout, c
       }
       t.significant = t.p_value < step.level;
       // Held out: the refit with the candidate, on the joints it acts on.
-      const Eigen::VectorXd dbeta = empty ? Eigen::VectorXd() : Eigen::VectorXd((-K * theta_s).cwiseQuotient(scale));
-      const Eigen::VectorXd theta = theta_s.cwiseQuotient(cs);
-      const Eigen::MatrixXd Ch = effect_columns(*c, heldout, csh);
-      const Eigen::VectorXd rh1 = rh - rwh.cwiseProduct(empty ? Eigen::VectorXd(Ch * theta) : Eigen::VectorXd(Ah * dbeta + Ch * theta));
+      const Eigen::VectorXd& theta = ac.theta;
+      const Eigen::VectorXd& rh = nd.rh;
+      const Eigen::VectorXd& rh1 = ac.rh1;
       double sse0 = 0, sse1 = 0, total0 = 0, total1 = 0;
       std::vector<bool> acts_on(n, false);
       for (int j = 0; j < n; ++j) {
@@ -534,6 +409,7 @@ Selection select_effects(const DesignStack& train, const DesignStack& heldout, c
     current = fit_with_effects(train, heldout, chosen, sel.weights);
   }
   if (sel.stop_reason.empty()) sel.stop_reason = "the maximum number of effects was reached";
+  detail::choose_friction_smoothing(train, heldout, o, sel.weights, chosen, sel.effects);
   backward_check(train, heldout, o, sel.weights, chosen, sel);
   std::vector<Eigen::VectorXd> sds;
   sel.after = fit_with_effects(train, heldout, chosen, sel.weights, &sds);

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <set>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -59,9 +60,16 @@ DesignStack stack_design(const StackModel& m, const std::vector<NamedSamples>& r
     d.full_extra_joints.push_back(full.joint);
   }
   const Eigen::Index pe = static_cast<Eigen::Index>(extra.size());
+  // The sample-local candidates, and the friction a named joint's is chosen from again
+  // (friction_smoothing.hpp), each once.
   std::vector<Candidate> local;
-  for (const auto& c : candidates(d, o.candidates))
-    if (sample_local(c.kind)) local.push_back(c);
+  std::set<std::string> keys;
+  auto keep = [&](const Candidate& c) {
+    if (sample_local(c.kind) && keys.insert(c.key()).second) local.push_back(c);
+  };
+  for (const auto& c : candidates(d, o.candidates)) keep(c);
+  for (int j = 1; j <= n; ++j)
+    for (const auto& c : friction_options(d, o.candidates, j)) keep(c);
 
   // The pieces and the samples each keeps (multiples of the interval on the log's clock).
   struct Piece {

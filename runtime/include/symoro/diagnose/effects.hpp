@@ -68,7 +68,12 @@ struct Candidate {
   EffectKind kind = EffectKind::Offset;
   int joint = 0;                    // 1-based joint or link (payload: its link); 0 for the whole robot
   double stribeck_velocity = 0.05;  // rad/s
-  double coulomb_velocity = 0.01;   // rad/s, tanh width
+  // rad/s, Coulomb and Stribeck: the spread of the true velocity about the logged one near
+  // rest (quantization, a servo hunting about a held posture). The friction the torque shows
+  // is the friction law averaged over that spread: the columns are the law's expectation
+  // under it (a sharp sign gave a Stribeck level a third of its size), and the magnitudes are
+  // the law's own.
+  double coulomb_velocity = 0.01;
   std::vector<int> orders;          // position_harmonics
   std::vector<int> full_columns;    // inertia_products: columns of DesignStack::full_extra
   std::vector<std::string> parameters, units;
@@ -77,8 +82,14 @@ struct Candidate {
 };
 
 struct CandidateOptions {
-  std::vector<double> coulomb_velocities{0.01, 0.03, 0.1};   // rad/s, one candidate each
-  std::vector<double> stribeck_velocities{0.02, 0.05, 0.1};  // rad/s, one candidate each
+  // rad/s: the forward steps' Coulomb candidates, one per velocity spread, and Stribeck
+  // candidates, one per velocity and spread of at most half of it (closer, a Stribeck term is
+  // the spread's shape, not friction).
+  std::vector<double> coulomb_velocities{0.01, 0.03, 0.1};
+  std::vector<double> stribeck_velocities{0.02, 0.05, 0.1};
+  // What a joint's friction is chosen from again once named (friction_options; a superset).
+  std::vector<double> refined_spreads{0.005, 0.01, 0.02, 0.03, 0.04, 0.06, 0.1};
+  std::vector<double> refined_stribeck_velocities{0.02, 0.05, 0.07, 0.1, 0.15};
   std::vector<int> harmonic_orders{1, 2};
   std::vector<std::string> only;  // effect names to consider (empty: all)
 };
@@ -87,6 +98,9 @@ struct CandidateOptions {
 // (a parameter of the same name), inertia products only for links whose full-model columns
 // exist in the stack, torque-constant and backlash only where IA and FV are identified.
 std::vector<Candidate> candidates(const DesignStack& d, const CandidateOptions& options = {});
+// Joint j's Coulomb and Stribeck candidates over the refined spreads and velocities (when the
+// options allow those effects): what the joint's friction is chosen from once named.
+std::vector<Candidate> friction_options(const DesignStack& d, const CandidateOptions& options, int joint);
 
 // What a linearized candidate needs from the current fit.
 struct FitState {
