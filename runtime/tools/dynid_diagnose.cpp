@@ -46,8 +46,14 @@ void run_diagnose(const Common& common, const DiagnoseOptions& o, const diagnose
     if (o.apply.empty()) return;
     const auto yaml = common.robot_dir() / "robot.yaml";
     diagnose::add_variant_to_robot_yaml(yaml, r.variant_name, r.variant_yaml);
-    fmt::print("added variant '{}' to {}; regenerate (symoroc generate {} -o generated) and rebuild, then "
-               "dynid identify --model {}\n", r.variant_name, yaml.string(), common.robot_dir().string(), r.variant_name);
+    // A robot compiled into dynid needs its code regenerated; any other is compiled again from
+    // its folder by the next command that uses it.
+    if (compiled_robot(common))
+      fmt::print("added variant '{}' to {}; regenerate (symoroc generate {} -o generated) and rebuild, then "
+                 "dynid identify --model {}\n", r.variant_name, yaml.string(), common.robot_dir().string(), r.variant_name);
+    else
+      fmt::print("added variant '{}' to {}; dynid identify --model {} compiles it\n", r.variant_name, yaml.string(),
+                 r.variant_name);
   } catch (const diagnose::DiagnosisRequestError& e) {
     throw UsageError(e.what());
   }

@@ -29,6 +29,9 @@
 #include "symoro/identify/study.hpp"
 #include "symoro/identify/validation_io.hpp"
 #include "symoro/io/import.hpp"
+#include "../removed_at_exit.hpp"
+#include "symoro/diagnose/dataset_diagnosis.hpp"
+#include "symoro/io/text_file.hpp"
 #include "synthetic_log.hpp"
 #include "test_support.hpp"
 
@@ -252,6 +255,33 @@ TEST(DiagnoseVariant, EverySelectedWidthIsKept) {
   const std::string of_full = symoro::diagnose::variant_yaml(d, "diagnosed", "full");
   EXPECT_EQ(of_full.find("base:"), std::string::npos) << of_full;
   EXPECT_NE(of_full.find("    effects:\n"), std::string::npos) << of_full;
+}
+
+// --apply on a robot.yaml without a `variants:` section (what symoroc model writes for a URDF)
+// adds the section; on one whose last section is `variants:` it appends to it.
+TEST(DiagnoseVariant, ApplyAddsTheVariantsSectionARobotYamlLacks) {
+  namespace fs = std::filesystem;
+  const fs::path dir = symoro::test::removed_at_exit(fmt::format("symoro_apply_{}", ::getpid()));
+  fs::create_directories(dir);
+  const fs::path yaml = dir / "robot.yaml";
+  std::string original = symoro::io::read_text_file(std::string(SYMORO_ROBOTS_DIR) + "/stanford_rrp/robot.yaml");
+  original = original.substr(0, original.find("\nvariants:") + 1);  // the robot without its variants
+  { std::ofstream(yaml) << original; }
+  symoro::diagnose::Diagnosis d;
+  symoro::diagnose::SelectedEffect e;
+  e.candidate.kind = symoro::diagnose::EffectKind::Offset;
+  e.candidate.joint = 2;
+  d.selection.effects.push_back(e);
+  symoro::diagnose::add_variant_to_robot_yaml(yaml, "diagnosed", symoro::diagnose::variant_yaml(d, "diagnosed", "full"));
+  const std::string once = symoro::io::read_text_file(yaml);
+  EXPECT_EQ(once.substr(0, original.size()), original);
+  EXPECT_EQ(once.substr(original.size()), "variants:\n" + symoro::diagnose::variant_yaml(d, "diagnosed", "full"));
+  symoro::diagnose::add_variant_to_robot_yaml(yaml, "again", symoro::diagnose::variant_yaml(d, "again", "full"));
+  const std::string twice = symoro::io::read_text_file(yaml);
+  EXPECT_EQ(twice.find("\nvariants:"), twice.rfind("\nvariants:")) << "one section: " << twice;
+  EXPECT_EQ(twice.substr(once.size()), symoro::diagnose::variant_yaml(d, "again", "full"));
+  EXPECT_THROW(symoro::diagnose::add_variant_to_robot_yaml(yaml, "again", symoro::diagnose::variant_yaml(d, "again", "full")),
+               symoro::diagnose::DiagnosisRequestError);
 }
 
 }  // namespace

@@ -223,16 +223,20 @@ DatasetDiagnosis diagnose_dataset(const DiagnosisModel& model, const DatasetDiag
 
 void add_variant_to_robot_yaml(const std::filesystem::path& yaml, const std::string& name, const std::string& variant) {
   if (variant.empty()) throw DiagnosisRequestError("--apply: nothing to add (no effect found)");
-  // robot.yaml gains the variant at its end, which must be the `variants:` section; the file is
-  // replaced atomically, so an interrupted run leaves the old one.
+  // robot.yaml gains the variant at its end, which must be the `variants:` section, or a new
+  // section when it has none (symoroc model writes none); the file is replaced atomically, so an
+  // interrupted run leaves the old one.
   std::string s = io::read_text_file(yaml);
-  const auto at = s.rfind("\nvariants:");
-  if (at == std::string::npos) throw DiagnosisRequestError(yaml.string() + ": no top-level `variants:` section to add to");
-  for (auto p = s.find('\n', at + 1); p != std::string::npos && p + 1 < s.size(); p = s.find('\n', p + 1))
+  if (!s.empty() && s.back() != '\n') s += '\n';
+  const auto found = ("\n" + s).rfind("\nvariants:");  // where its line starts in s
+  if (found == std::string::npos) {
+    io::write_file_atomically(yaml, s + "variants:\n" + variant);
+    return;
+  }
+  for (auto p = s.find('\n', found); p != std::string::npos && p + 1 < s.size(); p = s.find('\n', p + 1))
     if (s[p + 1] != ' ' && s[p + 1] != '#' && s[p + 1] != '\n')
       throw DiagnosisRequestError(yaml.string() + ": `variants:` must be the last section to add to it");
   if (s.find("\n  " + name + ":") != std::string::npos) throw DiagnosisRequestError(yaml.string() + ": variant '" + name + "' exists");
-  if (!s.empty() && s.back() != '\n') s += '\n';
   io::write_file_atomically(yaml, s + variant);
 }
 
