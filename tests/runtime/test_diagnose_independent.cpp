@@ -202,13 +202,6 @@ TEST(DiagnoseIndependentCrane, StribeckBesideCoulombIsNamedWithIt) {
   const Selection s = select_effects(r.train, r.heldout);
   print(s);
   expect_effects(s, {{EffectKind::Coulomb, 2, 0.05}, {EffectKind::Stribeck, 2, 0.06}}, 0.25);
-  // The same Stribeck friction alone is named alone (a Coulomb term beside it would be the
-  // sharper edge standing in for it).
-  o.coulomb.setZero();
-  const CraneRuns alone = crane_runs(o, true);
-  const Selection a = select_effects(alone.train, alone.heldout);
-  print(a);
-  expect_effects(a, {{EffectKind::Stribeck, 2, 0.06}}, 0.25);
 }
 
 TEST(DiagnoseIndependentCrane, PlayOnTwoJointsIsNamedThere) {
