@@ -296,6 +296,28 @@ trajectory::SampledReference rx90_reference(const std::string& name, double seco
   return ref;
 }
 
+// A 40 s excitation fitted (seed 11) and another held out (seed 12), stacked at 10 ms and 5 Hz.
+struct Rx90Runs {
+  io::Log fit;
+  DesignStack train, heldout;
+};
+
+Rx90Runs rx90_runs(const TwinConfig& c, test::IndependentArmOptions o) {
+  StackOptions so;
+  so.interval = 0.01;
+  so.cutoff = 5;
+  Rx90Runs r;
+  auto stack = [&](const std::string& name, unsigned seed, io::Log* keep) {
+    o.seed = seed;
+    const io::Log log = test::run_independent_arm<Rx>(c, rx90_reference(name, 40, seed), o);
+    if (keep) *keep = log;
+    return stack_design<Rx, RxRigid>({{name, preprocess::preprocess(log, 0.001, light_preprocessing())}}, so);
+  };
+  r.train = stack("fit", 11, &r.fit);
+  r.heldout = stack("heldout", 12, nullptr);
+  return r;
+}
+
 TEST(DiagnoseIndependentRx90, PlayIsNamedOnlyWhereThereIsPlay) {
   const TwinConfig c = rx90_twin();
   const auto ref = rx90_reference("excite", 40, 5);
@@ -323,16 +345,10 @@ TEST(DiagnoseIndependentRx90, CoulombWithoutItsColumnsIsNamedAloneWithoutPlay) {
   o.coulomb = Eigen::VectorXd::Zero(Rx::nq);
   o.coulomb(1) = 2.0;
   o.coulomb(3) = 0.5;
-  StackOptions so;
-  so.interval = 0.01;
-  so.cutoff = 5;
-  auto stack = [&](const std::string& name, unsigned seed) {
-    o.seed = seed;
-    const io::Log log = test::run_independent_arm<Rx>(c, rx90_reference(name, 40, seed), o);
-    return std::make_pair(log, stack_design<Rx, RxRigid>({{name, preprocess::preprocess(log, 0.001, light_preprocessing())}}, so));
-  };
-  const auto [fit_log, train] = stack("fit", 11);
-  const auto heldout = stack("heldout", 12).second;
+  const Rx90Runs r = rx90_runs(c, o);
+  const DesignStack& train = r.train;
+  const DesignStack& heldout = r.heldout;
+  const io::Log& fit_log = r.fit;
   const Selection s = select_effects(train, heldout);
   print(s);
   expect_effects(s, {{EffectKind::Coulomb, 2, 2.0}, {EffectKind::Coulomb, 4, 0.5}});
@@ -354,16 +370,8 @@ TEST(DiagnoseIndependentRx90, StribeckOfAnotherLawIsNamedBesideCoulomb) {
   o.coulomb(3) = 0.5;
   o.stribeck_velocity = 0.08;
   o.stribeck_shape = 1.5;
-  StackOptions so;
-  so.interval = 0.01;
-  so.cutoff = 5;
-  auto stack = [&](const std::string& name, unsigned seed) {
-    o.seed = seed;
-    const io::Log log = test::run_independent_arm<Rx>(c, rx90_reference(name, 40, seed), o);
-    return stack_design<Rx, RxRigid>({{name, preprocess::preprocess(log, 0.001, light_preprocessing())}}, so);
-  };
-  const DesignStack train = stack("fit", 11), heldout = stack("heldout", 12);
-  const Selection s = select_effects(train, heldout);
+  const Rx90Runs r = rx90_runs(c, o);
+  const Selection s = select_effects(r.train, r.heldout);
   print(s);
   expect_effects(s, {{EffectKind::Coulomb, 2, 2.0}, {EffectKind::Stribeck, 2, 1.5}, {EffectKind::Coulomb, 4, 0.5}}, 0.25);
 }
