@@ -9,15 +9,19 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdlib>
+#include <functional>
 #include <limits>
 #include <mutex>
 #include <random>
+#include <sstream>
 #include <string>
 #include <utility>
 
 #include <fmt/format.h>
 
 #include "ipopt_lock.hpp"
+#include "symoro/parallel/farm.hpp"
 
 namespace symoro::identify {
 
@@ -381,6 +385,105 @@ std::vector<ExcitationSlack> check_excitation(const IdentificationModel& model, 
   return worst;
 }
 
+namespace {
+
+// One start's outcome: its record, and the point its solve ended at.
+struct StartOutcome {
+  ExcitationStart result;
+  Eigen::VectorXd x;
+};
+
+StartOutcome run_start(const IdentificationModel& model, const ExcitationCriterion& criterion,
+                       const ExcitationDesignOptions& options, const Eigen::VectorXd& x0) {
+  const auto ts = Clock::now();
+  const FourierBasis& basis = criterion.basis();
+  auto* problem = new DesignProblem(criterion, options, x0);
+  const Ipopt::SmartPtr<Ipopt::TNLP> owner = problem;
+  ExcitationStart result;
+  {
+    std::lock_guard<std::mutex> lock(detail::ipopt_mutex());
+    Ipopt::SmartPtr<Ipopt::IpoptApplication> app = new Ipopt::IpoptApplication(false);  // prints nothing
+    auto& ip = *app->Options();
+    ip.SetIntegerValue("print_level", 0);
+    ip.SetStringValue("sb", "yes");
+    ip.SetNumericValue("tol", options.tolerance);
+    ip.SetNumericValue("constr_viol_tol", 1e-9);
+    ip.SetIntegerValue("max_iter", options.max_iterations);
+    ip.SetStringValue("hessian_approximation", "limited-memory");
+    ip.SetStringValue("mu_strategy", "adaptive");
+    if (app->Initialize("") != Ipopt::Solve_Succeeded) throw std::runtime_error("design_excitation: Ipopt did not initialize");
+    const Ipopt::ApplicationReturnStatus status = app->OptimizeTNLP(owner);
+    result.status = status_name(status);
+    result.solved = solved(status);
+    if (const auto stats = app->Statistics(); Ipopt::IsValid(stats)) result.iterations = stats->IterationCount();
+  }
+  result.criterion = -std::numeric_limits<double>::infinity();
+  if (problem->solution().size() == basis.variables()) {
+    if (const auto f = criterion.value(problem->solution())) {
+      result.criterion = -*f;
+      const auto slack = check_excitation(model, basis.trajectory(problem->solution(), options.name), options);
+      result.worst = *std::min_element(slack.begin(), slack.end(),
+                                       [](const ExcitationSlack& a, const ExcitationSlack& b) { return a.slack < b.slack; });
+      // A start counts only when its solve ended normally and its point passes the dense check:
+      // a point Ipopt left after "invalid number" or "restoration failed" is no design, even
+      // inside the limits (a NaN torque limit gave one, written with rc 0).
+      result.passed = result.solved && result.worst.slack >= 0;
+    }
+  }
+  result.seconds = std::chrono::duration<double>(Clock::now() - ts).count();
+  return {result, problem->solution()};
+}
+
+// A start's outcome as text, from its process to the design: a line per field, numbers as
+// hexadecimal floats (exact).
+std::string outcome_text(const StartOutcome& o) {
+  const ExcitationStart& r = o.result;
+  std::string t = fmt::format("{}\n{} {} {} {:a} {:a}\n{}\n{}\n{:a} {:a}\n{}", r.status, int(r.solved), int(r.passed),
+                              r.iterations, r.criterion, r.seconds, r.worst.constraint, r.worst.where, r.worst.slack,
+                              r.worst.time, o.x.size());
+  for (Eigen::Index i = 0; i < o.x.size(); ++i) t += fmt::format(" {:a}", o.x(i));
+  return t + "\n";
+}
+
+StartOutcome outcome_from_text(const std::string& text) {
+  std::istringstream in(text);
+  StartOutcome o;
+  ExcitationStart& r = o.result;
+  std::string line;
+  auto number = [](std::istream& s) {
+    std::string w;
+    s >> w;
+    return std::strtod(w.c_str(), nullptr);  // hexadecimal floats, inf and nan
+  };
+  std::getline(in, r.status);
+  std::getline(in, line);
+  {
+    std::istringstream l(line);
+    int solved = 0, passed = 0;
+    l >> solved >> passed >> r.iterations;
+    r.solved = solved != 0;
+    r.passed = passed != 0;
+    r.criterion = number(l);
+    r.seconds = number(l);
+  }
+  std::getline(in, r.worst.constraint);
+  std::getline(in, r.worst.where);
+  std::getline(in, line);
+  {
+    std::istringstream l(line);
+    r.worst.slack = number(l);
+    r.worst.time = number(l);
+  }
+  Eigen::Index n = 0;
+  in >> n;
+  o.x.resize(n);
+  for (Eigen::Index i = 0; i < n; ++i) o.x(i) = number(in);
+  if (!in) throw std::runtime_error("design_excitation: a start's outcome came back unreadable");
+  return o;
+}
+
+}  // namespace
+
 ExcitationDesign design_excitation(const IdentificationModel& model, const ExcitationDesignOptions& options) {
   const auto t0 = Clock::now();
   refuse_unmeetable(model, options);
@@ -392,53 +495,47 @@ ExcitationDesign design_excitation(const IdentificationModel& model, const Excit
   ExcitationDesign out;
   Eigen::VectorXd best_x;
   double best = -std::numeric_limits<double>::infinity();
-  for (int s = 0; s < std::max(1, options.starts); ++s) {
-    const auto ts = Clock::now();
-    const Eigen::VectorXd x0 = random_start(basis, options, options.seed * 1000003ULL + static_cast<std::uint64_t>(s));
+  // The starts, each from the same process state in a forked process of its own when there are
+  // cores to spare (Ipopt's solver is not thread-safe, and keeps state between solves), else in
+  // turn; either way chosen below in their order.
+  const int count = std::max(1, options.starts);
+  std::vector<Eigen::VectorXd> x0(static_cast<std::size_t>(count));
+  for (int s = 0; s < count; ++s) {
+    x0[static_cast<std::size_t>(s)] = random_start(basis, options, options.seed * 1000003ULL + static_cast<std::uint64_t>(s));
     if (s == 0) {
-      criterion.scale_columns_at(x0);
+      criterion.scale_columns_at(x0[0]);
       out.scales = criterion.scales();
     }
-    auto* problem = new DesignProblem(criterion, options, x0);
-    const Ipopt::SmartPtr<Ipopt::TNLP> owner = problem;
-    ExcitationStart result;
-    {
-      std::lock_guard<std::mutex> lock(detail::ipopt_mutex());
-      Ipopt::SmartPtr<Ipopt::IpoptApplication> app = new Ipopt::IpoptApplication(false);  // prints nothing
-      auto& ip = *app->Options();
-      ip.SetIntegerValue("print_level", 0);
-      ip.SetStringValue("sb", "yes");
-      ip.SetNumericValue("tol", options.tolerance);
-      ip.SetNumericValue("constr_viol_tol", 1e-9);
-      ip.SetIntegerValue("max_iter", options.max_iterations);
-      ip.SetStringValue("hessian_approximation", "limited-memory");
-      ip.SetStringValue("mu_strategy", "adaptive");
-      if (app->Initialize("") != Ipopt::Solve_Succeeded) throw std::runtime_error("design_excitation: Ipopt did not initialize");
-      const Ipopt::ApplicationReturnStatus status = app->OptimizeTNLP(owner);
-      result.status = status_name(status);
-      result.solved = solved(status);
-      if (const auto stats = app->Statistics(); Ipopt::IsValid(stats)) result.iterations = stats->IterationCount();
-    }
-    result.criterion = -std::numeric_limits<double>::infinity();
-    if (problem->solution().size() == basis.variables()) {
-      if (const auto f = criterion.value(problem->solution())) {
-        result.criterion = -*f;
-        const auto slack = check_excitation(model, basis.trajectory(problem->solution(), options.name), options);
-        result.worst = *std::min_element(slack.begin(), slack.end(),
-                                         [](const ExcitationSlack& a, const ExcitationSlack& b) { return a.slack < b.slack; });
-        // A start counts only when its solve ended normally and its point passes the dense check:
-        // a point Ipopt left after "invalid number" or "restoration failed" is no design, even
-        // inside the limits (a NaN torque limit gave one, written with rc 0).
-        result.passed = result.solved && result.worst.slack >= 0;
-      }
-    }
-    result.seconds = std::chrono::duration<double>(Clock::now() - ts).count();
-    if (result.passed && result.criterion > best) {
-      best = result.criterion;
-      best_x = problem->solution();
+  }
+  std::vector<StartOutcome> outcomes(static_cast<std::size_t>(count));
+  if (count > 1 && options.workers != 1 && parallel::place().ranks == 1) {
+    std::vector<std::string> tasks;
+    for (int s = 0; s < count; ++s) tasks.push_back(std::to_string(s));
+    parallel::Farm farm;
+    farm.work = [&](const std::string& task, const std::function<void(const std::string&)>& emit) {
+      emit(outcome_text(run_start(model, criterion, options, x0[std::stoul(task)])));
+    };
+    farm.on_result = [&](std::size_t task, const std::string& text) { outcomes[task] = outcome_from_text(text); };
+    farm.on_end = [&](const parallel::TaskEnd& e) {
+      if (!e.failed) return;
+      outcomes[e.task] = StartOutcome{};
+      outcomes[e.task].result.status = "failed: " + e.failure;
+    };
+    parallel::FarmOptions fo;
+    fo.workers = options.workers;
+    fo.isolate = true;
+    parallel::run_farm(tasks, farm, fo);
+  } else {
+    for (int s = 0; s < count; ++s) outcomes[static_cast<std::size_t>(s)] = run_start(model, criterion, options, x0[static_cast<std::size_t>(s)]);
+  }
+  for (int s = 0; s < count; ++s) {
+    const StartOutcome& r = outcomes[static_cast<std::size_t>(s)];
+    if (r.result.passed && r.result.criterion > best) {
+      best = r.result.criterion;
+      best_x = r.x;
       out.chosen = s;
     }
-    out.starts.push_back(result);
+    out.starts.push_back(r.result);
   }
   if (out.chosen < 0 && std::none_of(out.starts.begin(), out.starts.end(), [](const ExcitationStart& r) { return r.solved; })) {
     std::string statuses;

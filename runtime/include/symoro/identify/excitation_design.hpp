@@ -48,6 +48,9 @@ struct ExcitationDesignOptions {
   std::vector<HalfSpace> workspace;
   double workspace_margin = 0.01;  // m inside the half-spaces at the design instants
   int starts = 4;
+  // Starts solved at once, each in a forked process of its own (0: the cores; 1: one after the
+  // other, in this process). The design is the same either way.
+  int workers = 0;
   std::uint64_t seed = 1;
   int max_iterations = 150;     // per start
   double tolerance = 1e-5;      // Ipopt's relative tolerance
