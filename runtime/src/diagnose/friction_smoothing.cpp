@@ -1,9 +1,10 @@
-// A joint's friction chosen as a whole, at one smoothing width (friction_smoothing.hpp).
+// A joint's friction chosen as a whole, at one velocity spread (friction_smoothing.hpp).
 #include "friction_smoothing.hpp"
 
 #include <cmath>
 #include <limits>
 #include <string>
+#include <vector>
 
 #include <boost/math/distributions/chi_squared.hpp>
 
@@ -59,12 +60,19 @@ void choose_friction_smoothing(const DesignStack& train, const DesignStack& held
     std::vector<Option> opts = options(friction);
     const Option* single = nullptr;
     const Option* pair = nullptr;
+    // Each candidate's columns once (a column serves its single option and every pair it is in).
+    std::vector<Eigen::VectorXd> train_column, heldout_column;
+    for (const auto& c : friction) {
+      train_column.push_back(effect_columns(c, train, nd.train_state).col(0));
+      heldout_column.push_back(effect_columns(c, heldout, nd.heldout_state).col(0));
+    }
     for (auto& op : opts) {
       Eigen::MatrixXd Ctr(train.rows(), static_cast<Eigen::Index>(op.terms.size()));
       Eigen::MatrixXd Ch(heldout.rows(), Ctr.cols());
       for (std::size_t k = 0; k < op.terms.size(); ++k) {
-        Ctr.col(static_cast<Eigen::Index>(k)) = effect_columns(*op.terms[k], train, nd.train_state);
-        Ch.col(static_cast<Eigen::Index>(k)) = effect_columns(*op.terms[k], heldout, nd.heldout_state);
+        const auto i = static_cast<std::size_t>(op.terms[k] - friction.data());
+        Ctr.col(static_cast<Eigen::Index>(k)) = train_column[i];
+        Ch.col(static_cast<Eigen::Index>(k)) = heldout_column[i];
       }
       const AddedColumns ac = add_columns(nd, Ctr, Ch);
       if (ac.absorbed || !(ac.theta.minCoeff() > 0)) continue;  // friction opposes motion
