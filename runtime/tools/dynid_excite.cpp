@@ -8,16 +8,19 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <limits>
 #include <sstream>
 
 #include <fmt/format.h>
 #include <yaml-cpp/yaml.h>
 
+#include "dynid_excite_choice.hpp"
 #include "dynid_identify.hpp"
 #include "dynid_robots.hpp"
 #include "dynid_numbers.hpp"
 #include "dynid_trajectories.hpp"
 #include "symoro/identify/excitation_design.hpp"
+#include "symoro/identify/excitation_quality.hpp"
 #include "symoro/io/atomic_file.hpp"
 #include "symoro/io/parameters_yaml.hpp"
 #include "symoro/io/text_file.hpp"
@@ -40,7 +43,10 @@ struct ExciteOptions {
   bool force = false;       // replace trajectories.yaml and quality.txt in -o
   int optimized = 3;
   int harmonics = 5;
-  double period = 0;  // s; 0: from the limits (auto_period)
+  bool harmonics_given = false;
+  double period = 0;  // s; 0: from the limits (auto_period), or chosen (excite_choice.hpp)
+  double kappa_target = 0;   // > 0: choose the period for a scaled kappa below it
+  double max_duration = 25;  // s, the longest optimized trajectory the choice may make
   int periods = 1;
   int starts = 4;
   std::uint64_t seed = 1;
@@ -114,14 +120,15 @@ double auto_period(const Eigen::VectorXd& lower, const Eigen::VectorXd& upper, c
 }
 
 // The design options of one series from rest at `posture`.
-identify::ExcitationDesignOptions design_options(const ExciteOptions& o, double period, const YAML::Node& design, const std::string& posture,
+identify::ExcitationDesignOptions design_options(const ExciteOptions& o, const PeriodRung& rung, const YAML::Node& design,
+                                                 const std::string& posture,
                                                  const Eigen::VectorXd& lower, const Eigen::VectorXd& upper,
                                                  const Eigen::VectorXd& velocity, const Eigen::VectorXd& acceleration,
                                                  const Eigen::VectorXd& nominal, const identify::ModelDescription& d) {
   const int n = d.nq;
   identify::ExcitationDesignOptions eo;
-  eo.period = period;
-  eo.harmonics = o.harmonics;
+  eo.period = rung.period;
+  eo.harmonics = rung.harmonics;
   eo.start.resize(n);
   for (int j = 0; j < n; ++j) eo.start(j) = design["postures"][posture][j].as<double>() * kDeg;
   eo.limits.lower = lower.cwiseMin(eo.start - Eigen::VectorXd::Constant(n, 1e-3));
@@ -159,6 +166,158 @@ void warn_crossings(const std::vector<trajectory::Trajectory>& all, const std::v
                  "limits, not the surroundings; edit their postures or amplitudes\n",
                  t.name, worst, where, when);
   }
+}
+
+// The optimized series of one run: the design of one series from the postures in turn, and its
+// measures as the quality table rates them.
+struct SeriesDesigner {
+  const ExciteOptions& o;
+  const identify::IdentificationModel& model;
+  const YAML::Node& design;
+  const std::string& text;  // the structured families' design
+  const TrajectoryOptions& to;
+  const Eigen::VectorXd &lower, &upper, &velocity, &acceleration, &nominal;
+  std::vector<std::string> postures;
+  std::size_t next = 0;  // the posture the next series starts from
+
+  struct Series {
+    identify::ExcitationDesign r;
+    identify::ExcitationDesignOptions eo;
+    std::string posture, refused, yaml;
+  };
+
+  // Series k at `rung`: a posture whose rest already breaks a limit (a table above the arm there,
+  // gravity beyond a drive) is skipped for the next one; no posture left: `posture` is empty.
+  Series series(int k, const PeriodRung& rung) {
+    Series out;
+    const identify::ModelDescription& d = model.description();
+    for (std::size_t tries = 0; tries < postures.size() && out.posture.empty(); ++tries, ++next) {
+      const std::string candidate = postures[next % postures.size()];
+      out.eo = design_options(o, rung, design, candidate, lower, upper, velocity, acceleration, nominal, d);
+      out.eo.name = fmt::format("OF{:02d}", k + 1);
+      out.eo.seed = o.seed + static_cast<std::uint64_t>(k);
+      try {
+        out.r = identify::design_excitation(model, out.eo);
+        out.posture = candidate;
+      } catch (const identify::ExcitationInfeasible& e) {
+        fmt::print("{} from {}: refused: {}\n", out.eo.name, candidate, e.what());
+        out.refused += fmt::format("{}{}: {}", out.refused.empty() ? "" : "; ", candidate, e.what());
+      }
+    }
+    if (out.posture.empty()) return out;
+    const auto& r = out.r;
+    std::string starts;
+    for (std::size_t s = 0; s < r.starts.size(); ++s)
+      starts += fmt::format("{}{}{:.2f} ({}, {} it, {:.1f} s{})", s ? "; " : "", static_cast<int>(s) == r.chosen ? "*" : "",
+                            r.starts[s].criterion, r.starts[s].status, r.starts[s].iterations, r.starts[s].seconds,
+                            r.starts[s].passed ? "" : !r.starts[s].solved ? ", no design" : ", fails " + r.starts[s].worst.constraint);
+    fmt::print("{} from {} (period {:.3g} s, {} harmonics): log det {:.2f} in {:.1f} s; starts: {}\n", out.eo.name, out.posture,
+               rung.period, rung.harmonics, r.criterion, r.seconds, starts);
+    std::string tight;
+    for (const auto& s : r.slack) tight += fmt::format("{}{} {:.3g} ({}, t = {:.2f} s)", tight.empty() ? "" : ", ", s.constraint, s.slack, s.where, s.time);
+    fmt::print("  tightest limits (dense check every 1 ms): {}\n", tight);
+    out.yaml = "\n" + trajectory::fourier_trajectory_yaml(out.eo.name, out.posture, r.trajectory, o.periods,
+                                                          fmt::format("Optimized (D-optimal) from rest at {}: log det {:.4g}, period "
+                                                                      "{:.3g} s, {} harmonics",
+                                                                      out.posture, r.criterion, rung.period, rung.harmonics));
+    return out;
+  }
+
+  // A designed series' measures as the quality table rates it (its holds included).
+  ReferenceMeasures measures(const Series& s) const {
+    const fs::path tmp = fs::path(o.out) / "trajectories.yaml.choice";
+    io::write_file_atomically(tmp, text + (text.empty() || text.back() == '\n' ? "" : "\n") + s.yaml);
+    Eigen::MatrixXd W;
+    try {
+      W = trajectory_regressor(model, trajectory::TrajectoryDesign::read(tmp, model.description().joints).build(s.eo.name), to);
+    } catch (...) {
+      fs::remove(tmp);
+      throw;
+    }
+    fs::remove(tmp);
+    return {s.eo.name, identify::excitation_quality(W, model.description().parameters, 0, false).kappa_scaled,
+            log_det_per_sample(W, model.description().nq)};
+  }
+};
+
+// The periods the series are designed at, and what they must reach: one period (--period or
+// from the limits) without targets; with --kappa-target, or --compare and neither --period nor
+// --harmonics, the ladder up to --max-duration and the targets (dynid_excite_choice.hpp).
+std::vector<PeriodRung> series_ladder(const SeriesDesigner& sd, double first_period, ExcitationTargets& targets) {
+  const ExciteOptions& o = sd.o;
+  const bool choose = o.kappa_target > 0 || (!o.compare.empty() && o.period == 0 && !o.harmonics_given);
+  if (!choose || o.optimized == 0) return {{first_period, o.harmonics}};
+  std::vector<ReferenceMeasures> references;
+  for (const auto& file : o.compare) {
+    double duration = 0;
+    const Eigen::MatrixXd W = reference_regressor(sd.model, file, sd.to, duration);
+    references.push_back({fs::path(file).stem().string(),
+                          identify::excitation_quality(W, sd.model.description().parameters, 0, false).kappa_scaled,
+                          log_det_per_sample(W, sd.model.description().nq)});
+  }
+  targets = excitation_targets(o.kappa_target, references);
+  const double holds = sd.design["timing"]["start_hold"].as<double>() + sd.design["timing"]["end_hold"].as<double>();
+  const double longest = (o.max_duration - holds) / o.periods;
+  if (longest < 0.5)
+    throw UsageError(fmt::format("--max-duration {:.3g} s leaves no period after the design's holds ({:.3g} s)", o.max_duration, holds));
+  return period_ladder(first_period, o.harmonics, longest);
+}
+
+// The optimized series' YAML. With targets, each series climbs the ladder from the period the
+// one before it was kept at until it meets them (or keeps its lowest scaled kappa). A series no
+// posture can start ends the run there: `failure` says why (thrown at the first).
+std::string optimized_series(const Common& common, SeriesDesigner& sd, const std::string& nominal_from, std::string& failure) {
+  const ExciteOptions& o = sd.o;
+  const identify::ModelDescription& d = sd.model.description();
+  ExcitationTargets targets;
+  const std::vector<PeriodRung> ladder =
+      series_ladder(sd, o.period > 0 ? o.period : auto_period(sd.lower, sd.upper, sd.velocity), targets);
+  if (o.optimized == 0) return "";
+  std::string periods;
+  for (const auto& r : ladder) periods += fmt::format("{}{:.3g} s ({} harmonics)", periods.empty() ? "" : ", ", r.period, r.harmonics);
+  fmt::print("optimized excitation of {} model {} ({} base parameters): period {}, {} starts each; limits: the box, the "
+             "structured families' fastest level, torque {:.0f} % of effort{}\n",
+             common.robot, d.variant.empty() ? "full" : d.variant, d.np,
+             targets.any() ? "chosen for " + targets.text + " among " + periods : periods, o.starts, 100 * o.torque_fraction,
+             nominal_from.empty() ? " (not enforced)" : " (" + nominal_from + ")");
+  std::string out;
+  std::size_t at = 0;  // the ladder's rung the last series was kept at
+  for (int k = 0; k < o.optimized; ++k) {
+    SeriesDesigner::Series kept;
+    ReferenceMeasures best{"", std::numeric_limits<double>::infinity(), 0};
+    const std::size_t from_posture = sd.next;
+    std::size_t kept_next = from_posture, kept_at = at;
+    for (std::size_t i = at; i < ladder.size(); ++i) {
+      sd.next = from_posture;
+      SeriesDesigner::Series tried = sd.series(k, ladder[i]);
+      if (tried.posture.empty()) {
+        kept.refused = tried.refused;
+        continue;
+      }
+      const ReferenceMeasures m = targets.any() ? sd.measures(tried) : best;
+      const std::string missed = targets.missed_by(m.kappa_scaled, m.per_sample);
+      if (targets.any())
+        fmt::print("  scaled kappa {:.4g}, logdet/N {:.4g}: {}\n", m.kappa_scaled, m.per_sample,
+                   missed.empty() ? "meets the targets" : missed);
+      if (kept.posture.empty() || m.kappa_scaled < best.kappa_scaled || missed.empty()) {
+        best = m, kept = std::move(tried), kept_next = sd.next, kept_at = i;
+      }
+      if (missed.empty() || !targets.any()) break;
+    }
+    if (kept.posture.empty()) {
+      // Nothing designed yet: nothing to keep. Else the series so far are written first.
+      failure = fmt::format("excite OF{:02d}: no posture can start it: {}", k + 1, kept.refused);
+      if (k == 0) throw UsageError(failure);
+      break;
+    }
+    sd.next = kept_next, at = kept_at;
+    if (targets.any() && !targets.met_by(best.kappa_scaled, best.per_sample))
+      fmt::print("{}: no period up to --max-duration {:.3g} s meets the targets; kept period {:.3g} s, the lowest scaled kappa "
+                 "(more --starts, a longer --max-duration or more --harmonics may reach them)\n",
+                 kept.eo.name, o.max_duration, ladder[at].period);
+    out += kept.yaml;
+  }
+  return out;
 }
 
 void run(const Common& common, const ExciteOptions& o) {
@@ -206,8 +365,6 @@ void run(const Common& common, const ExciteOptions& o) {
   Eigen::VectorXd lower, upper;
   trajectory::structured_box(so, lower, upper);
 
-  const double period = o.period > 0 ? o.period : auto_period(lower, upper, velocity);
-
   // 2. The nominal model for the torque limits.
   Eigen::VectorXd nominal;
   std::string nominal_from;
@@ -225,55 +382,13 @@ void run(const Common& common, const ExciteOptions& o) {
   }
 
   // 3. The optimized series, one per posture in turn, each from rest at its posture.
-  std::vector<std::string> postures;
-  for (const auto& p : design["postures"]) postures.push_back(p.first.as<std::string>());
-  std::string optimized_text;
-  if (o.optimized > 0)
-    fmt::print("optimized excitation of {} model {} ({} base parameters): {} harmonics, period {:.3g} s, {} starts each; "
-               "limits: the box, the structured families' fastest level, torque {:.0f} % of effort{}\n",
-               common.robot, d.variant.empty() ? "full" : d.variant, d.np, o.harmonics, period, o.starts, 100 * o.torque_fraction,
-               nominal_from.empty() ? " (not enforced)" : " (" + nominal_from + ")");
-  // A posture whose rest already breaks a limit (a table above the arm there, gravity beyond a
-  // drive) is skipped for the next one: the series designed so far are kept.
-  std::size_t next = 0;
+  TrajectoryOptions to;
+  to.interval_ms = o.interval_ms;
+  to.compare = o.compare;
+  SeriesDesigner designer{o, *model, design, text, to, lower, upper, velocity, acceleration, nominal};
+  for (const auto& p : design["postures"]) designer.postures.push_back(p.first.as<std::string>());
   std::string failure;
-  for (int k = 0; k < o.optimized; ++k) {
-    identify::ExcitationDesign r;
-    identify::ExcitationDesignOptions eo;
-    std::string posture, refused;
-    for (std::size_t tries = 0; tries < postures.size() && posture.empty(); ++tries, ++next) {
-      const std::string candidate = postures[next % postures.size()];
-      eo = design_options(o, period, design, candidate, lower, upper, velocity, acceleration, nominal, d);
-      eo.name = fmt::format("OF{:02d}", k + 1);
-      eo.seed = o.seed + static_cast<std::uint64_t>(k);
-      try {
-        r = identify::design_excitation(*model, eo);
-        posture = candidate;
-      } catch (const identify::ExcitationInfeasible& e) {
-        fmt::print("{} from {}: refused: {}\n", eo.name, candidate, e.what());
-        refused += fmt::format("{}{}: {}", refused.empty() ? "" : "; ", candidate, e.what());
-      }
-    }
-    if (posture.empty()) {
-      // Nothing designed yet: nothing to keep. Else the series so far are written first.
-      failure = fmt::format("excite {}: no posture can start it: {}", eo.name, refused);
-      if (k == 0) throw UsageError(failure);
-      break;
-    }
-    std::string starts;
-    for (std::size_t s = 0; s < r.starts.size(); ++s)
-      starts += fmt::format("{}{}{:.2f} ({}, {} it, {:.1f} s{})", s ? "; " : "", static_cast<int>(s) == r.chosen ? "*" : "",
-                            r.starts[s].criterion, r.starts[s].status, r.starts[s].iterations, r.starts[s].seconds,
-                            r.starts[s].passed ? "" : !r.starts[s].solved ? ", no design" : ", fails " + r.starts[s].worst.constraint);
-    fmt::print("{} from {}: log det {:.2f} in {:.1f} s; starts: {}\n", eo.name, posture, r.criterion, r.seconds, starts);
-    std::string tight;
-    for (const auto& s : r.slack) tight += fmt::format("{}{} {:.3g} ({}, t = {:.2f} s)", tight.empty() ? "" : ", ", s.constraint, s.slack, s.where, s.time);
-    fmt::print("  tightest limits (dense check every 1 ms): {}\n", tight);
-    optimized_text += "\n" + trajectory::fourier_trajectory_yaml(
-                                 eo.name, posture, r.trajectory, o.periods,
-                                 fmt::format("Optimized (D-optimal) from rest at {}: log det {:.4g}, {} harmonics", posture, r.criterion,
-                                             o.harmonics));
-  }
+  const std::string optimized_text = optimized_series(common, designer, nominal_from, failure);
   if (o.optimized > 0 && text.find("\ntrajectories:") == std::string::npos) throw UsageError("the design has no trajectories list");
   const std::string full = text + (text.empty() || text.back() == '\n' ? "" : "\n") + optimized_text;
   // Read back before it is kept: the file must build, every trajectory inside its limits.
@@ -292,9 +407,6 @@ void run(const Common& common, const ExciteOptions& o) {
   warn_crossings(all, half_spaces(o, d), d);
 
   // 4. The excitation quality of each, side by side.
-  TrajectoryOptions to;
-  to.interval_ms = o.interval_ms;
-  to.compare = o.compare;
   const std::string table = trajectory_quality_table(common, all, to, o.model);
   fmt::print("{}", table);
   io::write_file_atomically(fs::path(o.out) / "quality.txt", table);
@@ -318,9 +430,21 @@ void add_excite_commands(CLI::App& app, Common& common) {
   cmd->add_option("--optimized", o->optimized, "Optimized trajectories (OF01...), from the postures in turn")
       ->check(numbers::count(0, 99))
       ->capture_default_str();
-  cmd->add_option("--harmonics", o->harmonics, "Harmonics of each series")->check(numbers::count(2, 20))->capture_default_str();
-  cmd->add_option("--period", o->period, "Period of each series, s (default: from the joints' box and speed, 5-60 s)")
-      ->check(numbers::checked(0.5, 3600, false, false, "from 0.5 to 3600 s"));
+  auto* harmonics = cmd->add_option("--harmonics", o->harmonics, "Harmonics of each series (with a period chosen: of its first "
+                                                                   "period, 1.5 more per doubling)")
+                        ->check(numbers::count(2, 20))
+                        ->capture_default_str();
+  auto* period = cmd->add_option("--period", o->period, "Period of each series, s (default: from the joints' box and speed, 5-60 "
+                                                        "s; with --compare or --kappa-target, chosen to meet them)")
+                     ->check(numbers::checked(0.5, 3600, false, false, "from 0.5 to 3600 s"));
+  cmd->add_option("--kappa-target", o->kappa_target, "Choose the period and the harmonics for a first series whose column-scaled "
+                                                     "kappa is below this (and that beats every --compare reference on scaled "
+                                                     "kappa and log det per sample)")
+      ->check(numbers::checked(1, 1e6, false, false, "from 1 to 1e6"))
+      ->excludes(period);
+  cmd->add_option("--max-duration", o->max_duration, "Longest optimized trajectory, holds included, s, when the period is chosen")
+      ->check(numbers::checked(1, 3600, false, false, "from 1 to 3600 s"))
+      ->capture_default_str();
   cmd->add_option("--periods", o->periods, "Periods each optimized trajectory runs")->check(numbers::count(1, 100))->capture_default_str();
   cmd->add_option("--starts", o->starts, "Random starts of each optimization")->check(numbers::count(1, 100))->capture_default_str();
   cmd->add_option("--seed", o->seed, "Seed of the starts and of the validation waypoints")->capture_default_str()->check(numbers::seed());
@@ -336,7 +460,10 @@ void add_excite_commands(CLI::App& app, Common& common) {
       ->check(CLI::ExistingFile);
   cmd->add_flag("--force", o->force, "Replace trajectories.yaml and quality.txt when -o holds them");
   cmd->add_option("--interval", o->interval_ms, "Sampling interval of the quality table, ms")->check(numbers::interval_ms())->capture_default_str();
-  cmd->callback([&common, o] { run(common, *o); });
+  cmd->callback([&common, o, harmonics] {
+    o->harmonics_given = harmonics->count() > 0;
+    run(common, *o);
+  });
 }
 
 }  // namespace symoro::dynid

@@ -20,12 +20,39 @@
 
 namespace symoro::dynid {
 
+double log_det_per_sample(const Eigen::MatrixXd& W, int joints) {
+  // log det (W'W / N) = 2 sum log diag(L), L L' = W'W / N; -inf when W'W is singular.
+  const double samples = static_cast<double>(W.rows() / std::max(1, joints));
+  const Eigen::LLT<Eigen::MatrixXd> llt(Eigen::MatrixXd(W.transpose() * W) / samples);
+  return llt.info() == Eigen::Success && llt.matrixLLT().diagonal().minCoeff() > 0 ? 2 * llt.matrixLLT().diagonal().array().log().sum()
+                                                                                   : -std::numeric_limits<double>::infinity();
+}
+
+Eigen::MatrixXd reference_regressor(const identify::IdentificationModel& model, const std::string& file, const TrajectoryOptions& o,
+                                    double& duration) {
+  const identify::ModelDescription& d = model.description();
+  const double interval = o.interval_ms / 1000;
+  const io::Log log = io::read_log(file);
+  const auto joints = log.has_references() ? log.q_ref.cols() : log.joints();
+  if (joints != d.nq) throw UsageError(fmt::format("--compare {}: {} joints, the model {}", file, joints, d.nq));
+  duration = log.time(log.samples() - 1) - log.time(0);
+  if (log.has_references()) {
+    const auto period = log.meta.sample_time > 0 ? log.meta.sample_time : o.period;
+    return model.stack_regression(identify::reference_samples(trajectory::sampled_reference(log, period), interval)).W;
+  }
+  return model.stack_regression(preprocess::preprocess(log, interval, identify::StudyOptions{}.preprocess)).W;
+}
+
+Eigen::MatrixXd trajectory_regressor(const identify::IdentificationModel& model, const trajectory::Trajectory& t,
+                                     const TrajectoryOptions& o) {
+  return model.stack_regression(identify::reference_samples(trajectory::sample(t, o.period), o.interval_ms / 1000)).W;
+}
+
 std::string trajectory_quality_table(const Common& common, const std::vector<trajectory::Trajectory>& trajectories,
                                      const TrajectoryOptions& o, const std::string& model_name) {
   const auto model = identification_model(common, model_name);
   std::string out;
   const identify::ModelDescription& d = model->description();
-  const double interval = o.interval_ms / 1000;
   out += fmt::format("excitation of {} model {} ({} base parameters) at {:.0f} ms: kappa of W, kappa of W and log det of W'W with "
                      "unit columns (<= 0, 0 when the columns are orthogonal), log det of W'W / N per sample (the model's SI "
                      "units, N samples: larger is more information per sample), the weakest direction's largest components\n",
@@ -37,12 +64,7 @@ std::string trajectory_quality_table(const Common& common, const std::vector<tra
     std::string weakest;
     if (!q.unexcited.empty()) weakest = fmt::format("{} parameters not excited (e.g. {})", q.unexcited.size(), q.unexcited.front());
     for (const auto& [p, v] : q.weakest) weakest += fmt::format("{}{} {:+.2f}", weakest.empty() ? "" : ", ", p, v);
-    // log det (W'W / N) = 2 sum log diag(L), L L' = W'W / N; -inf when W'W is singular.
-    const double samples = static_cast<double>(W.rows() / std::max(1, d.nq));
-    const Eigen::LLT<Eigen::MatrixXd> llt(Eigen::MatrixXd(W.transpose() * W) / samples);
-    const double per_sample = llt.info() == Eigen::Success && llt.matrixLLT().diagonal().minCoeff() > 0
-                                  ? 2 * llt.matrixLLT().diagonal().array().log().sum()
-                                  : -std::numeric_limits<double>::infinity();
+    const double per_sample = log_det_per_sample(W, d.nq);
     out += fmt::format("{:<6} {:<4} {:>7.1f}s {:>11.4g} {:>11.4g} {:>10.3f} {:>10.2f}  {}\n", name, family, duration, q.kappa,
                        q.kappa_scaled, q.log_det_scaled, per_sample, weakest);
   };
@@ -50,26 +72,16 @@ std::string trajectory_quality_table(const Common& common, const std::vector<tra
   Eigen::Index rows = 0;
   double total = 0;
   for (const auto& t : trajectories) {
-    Ws.push_back(model->stack_regression(identify::reference_samples(trajectory::sample(t, o.period), interval)).W);
+    Ws.push_back(trajectory_regressor(*model, t, o));
     row(t.name, t.family, t.duration(), Ws.back());
     rows += Ws.back().rows();
     total += t.duration();
   }
   // The reference motions the user compares with (not in the stacked design below).
   for (const auto& file : o.compare) {
-    const io::Log log = io::read_log(file);
-    const auto joints = log.has_references() ? log.q_ref.cols() : log.joints();
-    if (joints != d.nq) throw UsageError(fmt::format("--compare {}: {} joints, the model {}", file, joints, d.nq));
-    const std::string name = std::filesystem::path(file).stem().string();
-    const double duration = log.time(log.samples() - 1) - log.time(0);
-    if (log.has_references()) {
-      const auto period = log.meta.sample_time > 0 ? log.meta.sample_time : o.period;
-      row(name, "ref", duration,
-          model->stack_regression(identify::reference_samples(trajectory::sampled_reference(log, period), interval)).W);
-    } else {
-      row(name, "ref", duration,
-          model->stack_regression(preprocess::preprocess(log, interval, identify::StudyOptions{}.preprocess)).W);
-    }
+    double duration = 0;
+    const Eigen::MatrixXd W = reference_regressor(*model, file, o, duration);
+    row(std::filesystem::path(file).stem().string(), "ref", duration, W);
   }
   // All of them stacked: the design as a whole.
   Eigen::MatrixXd all(rows, d.np);

@@ -5,7 +5,10 @@
 #include <string>
 #include <vector>
 
+#include <Eigen/Core>
+
 #include "dynid_common.hpp"
+#include "symoro/identify/identification_model.hpp"
 #include "symoro/trajectory/trajectory.hpp"
 
 namespace symoro::dynid {
@@ -26,6 +29,19 @@ struct TrajectoryOptions {
 // `model` ("" robot.yaml's identified), as a table (compiled once: dynid_trajectories.cpp).
 std::string trajectory_quality_table(const Common& common, const std::vector<trajectory::Trajectory>& trajectories,
                                      const TrajectoryOptions& o, const std::string& model = "");
+
+// log det(W'W / N), N the samples (rows / joints): information per sample in the model's SI
+// units; -inf when W'W is singular.
+double log_det_per_sample(const Eigen::MatrixXd& W, int joints);
+
+// The stacked regressor of a designed trajectory sampled at o's period, every o's interval.
+Eigen::MatrixXd trajectory_regressor(const identify::IdentificationModel& model, const trajectory::Trajectory& t,
+                                     const TrajectoryOptions& o);
+
+// The stacked regressor of a reference log (--compare) at o's interval, as the table rates it;
+// `duration` its length, s.
+Eigen::MatrixXd reference_regressor(const identify::IdentificationModel& model, const std::string& file, const TrajectoryOptions& o,
+                                    double& duration);
 
 void run_trajectories(const Common& common, const TrajectoryOptions& o);
 

@@ -188,7 +188,7 @@ expect("${out}" "run.meta.yaml: error: the log is of robot 'crane_x7', the model
 # that cannot be met are refused with the constraint and the joint.
 run(0 out excite --robot crane_x7 -o ${WORK}/excite --from-design ${SOURCE_ROBOTS}/crane_x7/trajectories.yaml --optimized 1
     --harmonics 3 --period 6 --starts 1)
-expect("${out}" "OF01 from A: log det")
+expect("${out}" "OF01 from A \\(period 6 s, 3 harmonics\\): log det")
 expect("${out}" "tightest limits \\(dense check every 1 ms\\): position [0-9]")
 expect("${out}" "OF01 +OF +9.0s")
 expect("${out}" "AG02 +AG")
@@ -209,6 +209,30 @@ expect("${out}" "excite OF01: no posture can start it: A: torque limit of joint 
 if(EXISTS ${WORK}/excite-bad/trajectories.yaml)
   message(FATAL_ERROR "a refused design wrote trajectories.yaml")
 endif()
+# The period chosen (issue 41): the first series climbs the ladder of periods from the limits
+# until its scaled kappa is below --kappa-target and it beats the reference motion of --compare (a
+# reference file of the generated design's V01) on scaled kappa and log det per sample; the
+# quality table, computed apart from the choice, holds it to that.
+run(0 out excite --robot rx90 -o ${WORK}/choose-design --optimized 0)
+run(0 out trajectories --robot rx90 --design ${WORK}/choose-design/trajectories.yaml --only V01 -o ${WORK}/choose-ref)
+run(0 out excite --robot rx90 -o ${WORK}/choose --optimized 1 --starts 2 --kappa-target 12 --compare ${WORK}/choose-ref/V01.csv)
+expect("${out}" "period chosen for scaled kappa below 12 \\(--kappa-target\\), logdet/N above [0-9.]+ \\(V01\\) among 5 s \\(5 harmonics\\), 10 s \\(7 harmonics\\), 20 s \\(8 harmonics\\)")
+expect("${out}" "OF01 from A \\(period 5 s, 5 harmonics\\)[^\n]*\n[^\n]*\n  scaled kappa [0-9.]+, logdet/N [0-9.]+: scaled kappa [0-9.]+ is not below 12\n")
+expect("${out}" "OF01 from A \\(period 10 s, 7 harmonics\\)[^\n]*\n[^\n]*\n  scaled kappa [0-9.]+, logdet/N [0-9.]+: meets the targets\n")
+run(0 out trajectories --robot rx90 --design ${WORK}/choose/trajectories.yaml --only OF01 --quality --compare ${WORK}/choose-ref/V01.csv)
+string(REGEX MATCH "OF01 +OF +13.0s +[0-9.e+]+ +([0-9.]+) +[-0-9.]+ +([-0-9.]+)" row "${out}")
+set(kappa ${CMAKE_MATCH_1})
+set(per_sample ${CMAKE_MATCH_2})
+string(REGEX MATCH "V01 +ref +[0-9.]+s +[0-9.e+]+ +([0-9.]+) +[-0-9.]+ +([-0-9.]+)" row "${out}")
+if(NOT row OR NOT kappa LESS 12 OR NOT kappa LESS CMAKE_MATCH_1 OR NOT per_sample GREATER CMAKE_MATCH_2)
+  message(FATAL_ERROR "the chosen OF01 (13 s, scaled kappa ${kappa}, logdet/N ${per_sample}) does not meet kappa < 12 and "
+                      "beat V01 (${CMAKE_MATCH_1}, ${CMAKE_MATCH_2}):\n${out}")
+endif()
+# Where no period up to --max-duration (15 s: periods 5 and 10 s after the 3 s of holds) meets
+# the target, the lowest scaled kappa is kept and the output says so.
+run(0 out excite --robot planar2r -o ${WORK}/choose-none --optimized 1 --starts 2 --kappa-target 2 --max-duration 15)
+expect("${out}" "among 5 s \\(5 harmonics\\), 10 s \\(7 harmonics\\), 2 starts each")
+expect("${out}" "OF01: no period up to --max-duration 15 s meets the targets; kept period (5|10) s, the lowest scaled kappa")
 # A half-space that is not a number is refused (a NaN one reached Ipopt, which said "invalid
 # number", and the design was written with rc 0); a folder that holds a design is not replaced
 # without --force.
