@@ -149,7 +149,7 @@ void bind_workflow(py::module_& m) {
                        const std::optional<std::filesystem::path>& design_arg,
                        const std::vector<std::string>& only, const std::vector<std::string>& validation,
                        const std::vector<double>& intervals_ms, std::optional<int> jobs, int trial, bool weighted, bool fresh,
-                       bool in_process, double torque_delay_ms, int clie_iterations, double clie_std_bound,
+                       bool in_process, double torque_delay_ms, bool logged_velocity, int clie_iterations, double clie_std_bound,
                        double clie_noise_floor, const std::string& projection_metric, const std::string& consistency,
                        bool physical_start, const std::string& rescue_metric, py::object rescue_prior,
                        double rescue_prior_weight, const std::vector<double>& rescue_prior_weights, double validation_ms,
@@ -173,6 +173,7 @@ void bind_workflow(py::module_& m) {
     q.intervals_ms = intervals_ms;
     q.weighted = weighted;
     q.torque_delay_ms = torque_delay_ms;
+    q.logged_velocity = logged_velocity;
     q.clie_iterations = clie_iterations;
     q.clie_std_bound = clie_std_bound;
     q.clie_noise_floor = clie_noise_floor;
@@ -280,7 +281,8 @@ void bind_workflow(py::module_& m) {
      py::arg("validation") = std::vector<std::string>{}, py::arg("intervals_ms") = std::vector<double>{},
      py::arg("jobs") = py::none(), py::arg("trial") = defaults.trial, py::arg("weighted") = defaults.weighted,
      py::arg("fresh") = defaults.fresh, py::arg("in_process") = defaults.in_process,
-     py::arg("torque_delay_ms") = defaults.torque_delay_ms, py::arg("clie_iterations") = defaults.clie_iterations,
+     py::arg("torque_delay_ms") = defaults.torque_delay_ms,
+     py::arg("logged_velocity") = defaults.logged_velocity, py::arg("clie_iterations") = defaults.clie_iterations,
      py::arg("clie_std_bound") = defaults.clie_std_bound, py::arg("clie_noise_floor") = defaults.clie_noise_floor,
      py::arg("projection_metric") = defaults.projection_metric, py::arg("consistency") = defaults.consistency,
      py::arg("physical_start") = defaults.physical_start, py::arg("rescue_metric") = defaults.rescue_metric,

@@ -149,6 +149,8 @@ void add_identify_commands(CLI::App& app, Common& common) {
   cmd->add_option("--torque-delay", o->torque_delay_ms, "ms the logged torque lags the links' (an actuation delay "
                                                         "dynid diagnose named): the torque is read that much later")
       ->check(numbers::checked(-1000, 1000, false, false, "from -1000 to 1000 ms"));
+  cmd->add_flag("--logged-velocity", o->logged_velocity, "Fit on the log's velocity column instead of q's zero-phase "
+                                                        "derivative (the log must have one; its lag is the controller's)");
   cmd->add_option("--clie-iterations", o->clie_iterations, "CLIE iteration limit")->check(numbers::count(0, 100000));
   cmd->add_option("--projection-metric", o->projection_metric,
                   "Metric of the SDP projection and the rescue: euclidean (the paper's) or information (the run's "

@@ -1,10 +1,12 @@
 // Writes a CSV as a robot's own controller could export it, for the command-line tests of the
 // any-robot workflow: `write_export <robot> <file> <seconds> <seed>` for rx90, stanford_rrp or
-// ur5 (from its URDF's inertials). The
+// ur5 (from its URDF's inertials); `[velocity Hz]`: the velocity columns through a first-order
+// low-pass at that corner, as a controller's own causal estimate (late by its filter). The
 // motion and torque come from the robot's generated model (synthetic_log.hpp) with Coulomb
 // friction (in the truth; a `rigid` model lacks it), an offset of -0.06 N m on the last joint,
 // noise and 5 % stale rows; columns stamp_ms, mode (text), <joint>_pos, _vel (deg, deg/s; m,
 // m/s for a prismatic joint), <joint>_eff (N m; N).
+#include <cmath>
 #include <cstdio>
 #include <fstream>
 #include <string>
@@ -22,12 +24,30 @@
 
 namespace {
 
+// A controller's causal velocity estimate: y += (1 - exp(-2 pi fc dt)) (qd - y), from rest. A
+// stale row (the logger repeated the row before) repeats the estimate too.
+void lag_velocity(symoro::io::Log& log, double corner_hz) {
+  if (!(corner_hz > 0)) return;
+  const Eigen::MatrixXd raw = log.qd;
+  Eigen::RowVectorXd y = log.qd.row(0);
+  for (Eigen::Index k = 1; k < log.qd.rows(); ++k) {
+    if (log.q.row(k) == log.q.row(k - 1) && raw.row(k) == raw.row(k - 1)) {
+      log.qd.row(k) = log.qd.row(k - 1);
+      continue;
+    }
+    const double a = 1 - std::exp(-2 * 3.14159265358979323846 * corner_hz * (log.time(k) - log.time(k - 1)));
+    y += a * (log.qd.row(k) - y);
+    log.qd.row(k) = y;
+  }
+}
+
 template <class Model>
-int write(const std::string& file, double seconds, unsigned seed) {
+int write(const std::string& file, double seconds, unsigned seed, double velocity_hz) {
   symoro::test::Random rng(23);
   const Eigen::Matrix<double, Model::np, 1> truth = Model::base_from_standard(symoro::test::random_standard_parameters<Model>(rng).s);
-  const symoro::io::Log log =
+  symoro::io::Log log =
       symoro::test::synthesize<Model>("export", truth, seconds, seed, 0.05, symoro::test::offset_on<Model>(Model::nq, -0.06));
+  lag_velocity(log, velocity_hz);
   symoro::test::write_export_csv<Model>(log, file);
   return 0;
 }
@@ -51,15 +71,16 @@ int write_from_nominal(const std::string& file, double seconds, unsigned seed, c
 }  // namespace
 
 int main(int argc, char** argv) {
-  if (argc != 5) {
-    std::fprintf(stderr, "usage: write_export rx90|stanford_rrp|ur5 <file.csv> <seconds> <seed>\n");
+  if (argc != 5 && argc != 6) {
+    std::fprintf(stderr, "usage: write_export rx90|stanford_rrp|ur5 <file.csv> <seconds> <seed> [velocity Hz]\n");
     return 2;
   }
   const std::string robot = argv[1];
   const double seconds = std::stod(argv[3]);
   const unsigned seed = static_cast<unsigned>(std::stoul(argv[4]));
-  if (robot == "rx90") return write<symoro::rx90::Model>(argv[2], seconds, seed);
-  if (robot == "stanford_rrp") return write<symoro::stanford_rrp::Model>(argv[2], seconds, seed);
+  const double velocity_hz = argc == 6 ? std::stod(argv[5]) : 0;
+  if (robot == "rx90") return write<symoro::rx90::Model>(argv[2], seconds, seed, velocity_hz);
+  if (robot == "stanford_rrp") return write<symoro::stanford_rrp::Model>(argv[2], seconds, seed, velocity_hz);
   if (robot == "ur5") return write_from_nominal<symoro::ur5::Model>(argv[2], seconds, seed, {1.5, 1.5, 1.0, 0.3, 0.3, 0.3});
   std::fprintf(stderr, "unknown robot %s\n", robot.c_str());
   return 2;

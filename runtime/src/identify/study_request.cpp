@@ -54,6 +54,7 @@ StudyOptions study_options(const StudyRequest& r, const ModelDescription& d, con
   }
   so.least_squares.weighted = r.weighted;
   so.preprocess.torque_delay = r.torque_delay_ms / 1000;
+  so.preprocess.use_logged_velocity = r.logged_velocity;
   so.clie.max_iterations = r.clie_iterations;
   so.clie.std_bound = r.clie_std_bound;
   so.clie.noise_floor = r.clie_noise_floor;

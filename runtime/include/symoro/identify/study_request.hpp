@@ -27,6 +27,9 @@ struct StudyRequest {
   double clie_noise_floor = StudyOptions{}.clie.noise_floor;
   double validation_ms = StudyOptions{}.validation_interval * 1000;  // 0: the selected run's interval
   double torque_delay_ms = StudyOptions{}.preprocess.torque_delay * 1000;
+  // Fit on the log's own velocity column instead of q's zero-phase derivative (a robot whose
+  // controller estimates qd better than its encoder's q differentiates, e.g. a Franka's dq).
+  bool logged_velocity = StudyOptions{}.preprocess.use_logged_velocity;
   double rank_timeout = StudyOptions{}.rank_timeout;
   std::string projection_metric = to_string(StudyOptions{}.projection_metric);
   std::string consistency = to_string(StudyOptions{}.consistency);
