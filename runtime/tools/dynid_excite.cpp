@@ -168,6 +168,11 @@ void warn_crossings(const std::vector<trajectory::Trajectory>& all, const std::v
   }
 }
 
+// A regressor's two measures the choice compares: column-scaled kappa, log det per sample.
+ReferenceMeasures measures_of(const std::string& name, const Eigen::MatrixXd& W, const identify::ModelDescription& d) {
+  return {name, identify::excitation_quality(W, d.parameters, 0, false).kappa_scaled, log_det_per_sample(W, d.nq)};
+}
+
 // The optimized series of one run: the design of one series from the postures in turn, and its
 // measures as the quality table rates them.
 struct SeriesDesigner {
@@ -235,8 +240,7 @@ struct SeriesDesigner {
       throw;
     }
     fs::remove(tmp);
-    return {s.eo.name, identify::excitation_quality(W, model.description().parameters, 0, false).kappa_scaled,
-            log_det_per_sample(W, model.description().nq)};
+    return measures_of(s.eo.name, W, model.description());
   }
 };
 
@@ -250,10 +254,8 @@ std::vector<PeriodRung> series_ladder(const SeriesDesigner& sd, double first_per
   std::vector<ReferenceMeasures> references;
   for (const auto& file : o.compare) {
     double duration = 0;
-    const Eigen::MatrixXd W = reference_regressor(sd.model, file, sd.to, duration);
-    references.push_back({fs::path(file).stem().string(),
-                          identify::excitation_quality(W, sd.model.description().parameters, 0, false).kappa_scaled,
-                          log_det_per_sample(W, sd.model.description().nq)});
+    references.push_back(measures_of(fs::path(file).stem().string(), reference_regressor(sd.model, file, sd.to, duration),
+                                     sd.model.description()));
   }
   targets = excitation_targets(o.kappa_target, references);
   const double holds = sd.design["timing"]["start_hold"].as<double>() + sd.design["timing"]["end_hold"].as<double>();
