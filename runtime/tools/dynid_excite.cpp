@@ -170,7 +170,8 @@ void warn_crossings(const std::vector<trajectory::Trajectory>& all, const std::v
 
 // A regressor's two measures the choice compares: column-scaled kappa, log det per sample.
 ReferenceMeasures measures_of(const std::string& name, const Eigen::MatrixXd& W, const identify::ModelDescription& d) {
-  return {name, identify::excitation_quality(W, d.parameters, 0, false).kappa_scaled, log_det_per_sample(W, d.nq)};
+  const RegressorFactor f = RegressorFactor::of(W);
+  return {name, identify::excitation_quality_of_factor(f.R, f.rows, d.parameters, 0).kappa_scaled, log_det_per_sample(f, d.nq)};
 }
 
 // The optimized series of one run: the design of one series from the postures in turn, and its

@@ -6,7 +6,7 @@
 #include <limits>
 
 #include <CLI/CLI.hpp>
-#include <Eigen/Cholesky>
+#include <Eigen/SVD>
 #include <fmt/format.h>
 
 #include "dynid_numbers.hpp"
@@ -20,12 +20,28 @@
 
 namespace symoro::dynid {
 
-double log_det_per_sample(const Eigen::MatrixXd& W, int joints) {
-  // log det (W'W / N) = 2 sum log diag(L), L L' = W'W / N; -inf when W'W is singular.
-  const double samples = static_cast<double>(W.rows() / std::max(1, joints));
-  const Eigen::LLT<Eigen::MatrixXd> llt(Eigen::MatrixXd(W.transpose() * W) / samples);
-  return llt.info() == Eigen::Success && llt.matrixLLT().diagonal().minCoeff() > 0 ? 2 * llt.matrixLLT().diagonal().array().log().sum()
-                                                                                   : -std::numeric_limits<double>::infinity();
+RegressorFactor RegressorFactor::of(const Eigen::MatrixXd& W) { return {identify::triangular_factor(W), W.rows()}; }
+
+RegressorFactor RegressorFactor::stacked(const std::vector<RegressorFactor>& parts) {
+  Eigen::Index rows = 0, factor_rows = 0;
+  for (const auto& f : parts) rows += f.rows, factor_rows += f.R.rows();
+  Eigen::MatrixXd Rs(factor_rows, parts.empty() ? 0 : parts.front().R.cols());
+  Eigen::Index at = 0;
+  for (const auto& f : parts) {
+    Rs.middleRows(at, f.R.rows()) = f.R;
+    at += f.R.rows();
+  }
+  return {identify::triangular_factor(Rs), rows};
+}
+
+double log_det_per_sample(const RegressorFactor& f, int joints) {
+  // log det (W'W / N) = 2 sum log sigma_i(R) - p log N; -inf when R is numerically singular.
+  const Eigen::Index p = f.R.cols();
+  const double samples = static_cast<double>(f.rows / std::max(1, joints));
+  if (f.R.rows() < p || p == 0) return -std::numeric_limits<double>::infinity();
+  const Eigen::VectorXd sigma = Eigen::JacobiSVD<Eigen::MatrixXd>(f.R).singularValues();
+  if (identify::numerically_singular(sigma)) return -std::numeric_limits<double>::infinity();
+  return 2 * sigma.array().log().sum() - static_cast<double>(p) * std::log(samples);
 }
 
 Eigen::MatrixXd reference_regressor(const identify::IdentificationModel& model, const std::string& file, const TrajectoryOptions& o,
@@ -59,38 +75,29 @@ std::string trajectory_quality_table(const Common& common, const std::vector<tra
              common.robot, d.variant.empty() ? "full" : d.variant, d.np, o.interval_ms);
   out += fmt::format("{:<6} {:<4} {:>8} {:>11} {:>11} {:>10} {:>10}  {}\n", "name", "fam", "duration", "kappa", "kappa_scl",
                      "logdet_scl", "logdet/N", "weakest");
-  auto row = [&](const std::string& name, const std::string& family, double duration, const Eigen::MatrixXd& W) {
-    const identify::ExcitationQuality q = identify::excitation_quality(W, d.parameters);
+  auto row = [&](const std::string& name, const std::string& family, double duration, const RegressorFactor& f) {
+    const identify::ExcitationQuality q = identify::excitation_quality_of_factor(f.R, f.rows, d.parameters);
     std::string weakest;
     if (!q.unexcited.empty()) weakest = fmt::format("{} parameters not excited (e.g. {})", q.unexcited.size(), q.unexcited.front());
     for (const auto& [p, v] : q.weakest) weakest += fmt::format("{}{} {:+.2f}", weakest.empty() ? "" : ", ", p, v);
-    const double per_sample = log_det_per_sample(W, d.nq);
     out += fmt::format("{:<6} {:<4} {:>7.1f}s {:>11.4g} {:>11.4g} {:>10.3f} {:>10.2f}  {}\n", name, family, duration, q.kappa,
-                       q.kappa_scaled, q.log_det_scaled, per_sample, weakest);
+                       q.kappa_scaled, q.log_det_scaled, log_det_per_sample(f, d.nq), weakest);
   };
-  std::vector<Eigen::MatrixXd> Ws;
-  Eigen::Index rows = 0;
+  std::vector<RegressorFactor> factors;
   double total = 0;
   for (const auto& t : trajectories) {
-    Ws.push_back(trajectory_regressor(*model, t, o));
-    row(t.name, t.family, t.duration(), Ws.back());
-    rows += Ws.back().rows();
+    factors.push_back(RegressorFactor::of(trajectory_regressor(*model, t, o)));
+    row(t.name, t.family, t.duration(), factors.back());
     total += t.duration();
   }
-  // The reference motions the user compares with (not in the stacked design below).
+  // The reference motions the user compares with (not in the design's whole below).
   for (const auto& file : o.compare) {
     double duration = 0;
-    const Eigen::MatrixXd W = reference_regressor(*model, file, o, duration);
-    row(std::filesystem::path(file).stem().string(), "ref", duration, W);
+    const RegressorFactor f = RegressorFactor::of(reference_regressor(*model, file, o, duration));
+    row(std::filesystem::path(file).stem().string(), "ref", duration, f);
   }
-  // All of them stacked: the design as a whole.
-  Eigen::MatrixXd all(rows, d.np);
-  Eigen::Index at = 0;
-  for (const auto& W : Ws) {
-    all.middleRows(at, W.rows()) = W;
-    at += W.rows();
-  }
-  if (trajectories.size() > 1) row("all", "", total, all);
+  // The design as a whole: all its trajectories stacked.
+  if (trajectories.size() > 1) row("all", "", total, RegressorFactor::stacked(factors));
   return out;
 }
 

@@ -30,9 +30,18 @@ struct TrajectoryOptions {
 std::string trajectory_quality_table(const Common& common, const std::vector<trajectory::Trajectory>& trajectories,
                                      const TrajectoryOptions& o, const std::string& model = "");
 
+// A stacked regressor W as the table rates it: its triangular factor (W'W = R'R,
+// identify::triangular_factor) and its row count; factors of several motions stack into their whole.
+struct RegressorFactor {
+  Eigen::MatrixXd R;
+  Eigen::Index rows = 0;
+  static RegressorFactor of(const Eigen::MatrixXd& W);
+  static RegressorFactor stacked(const std::vector<RegressorFactor>& parts);
+};
+
 // log det(W'W / N), N the samples (rows / joints): information per sample in the model's SI
 // units; -inf when W'W is singular.
-double log_det_per_sample(const Eigen::MatrixXd& W, int joints);
+double log_det_per_sample(const RegressorFactor& f, int joints);
 
 // The stacked regressor of a designed trajectory sampled at o's period, every o's interval.
 Eigen::MatrixXd trajectory_regressor(const identify::IdentificationModel& model, const trajectory::Trajectory& t,

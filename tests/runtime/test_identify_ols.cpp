@@ -182,11 +182,25 @@ TEST(ExcitationQuality, HandDerivedValues) {
   EXPECT_NEAR(q.weakest[0].second, -q.weakest[1].second, 1e-9);
   std::set<std::string> weak{q.weakest[0].first, q.weakest[1].first};
   EXPECT_EQ(weak, (std::set<std::string>{"P0", "P1"}));
+  // The same from W's triangular factor (dynid's quality table).
+  ExcitationQuality f = excitation_quality_of_factor(triangular_factor(W), W.rows(), p, 2);
+  EXPECT_NEAR(f.kappa_scaled, std::sqrt((1 + std::cos(theta)) / (1 - std::cos(theta))), 1e-6);
+  EXPECT_NEAR(f.log_det_scaled, std::log((1 + std::cos(theta)) * (1 - std::cos(theta))), 1e-8);
+  EXPECT_NEAR(std::abs(f.weakest[0].second), std::sqrt(0.5), 1e-9);
+  // Two columns equal up to scale: singular, whatever rounding leaves of its smallest singular
+  // value, and said so (kappa and scaled kappa infinite, log det -inf).
+  W.col(1) = 7 * Q.col(0);
+  f = excitation_quality_of_factor(triangular_factor(W), W.rows(), p);
+  EXPECT_TRUE(std::isinf(f.kappa));
+  EXPECT_TRUE(std::isinf(f.kappa_scaled));
+  EXPECT_TRUE(std::isinf(f.log_det_scaled) && f.log_det_scaled < 0);
   // A zero column is named, not hidden in a kappa.
   W.col(2).setZero();
   q = excitation_quality(W, p);
   EXPECT_EQ(q.unexcited, std::vector<std::string>{"P2"});
   EXPECT_TRUE(std::isinf(q.kappa_scaled));
+  f = excitation_quality_of_factor(triangular_factor(W), W.rows(), p);
+  EXPECT_EQ(f.unexcited, std::vector<std::string>{"P2"});
 }
 
 // On a designed or random motion: the interface's regression gives the numbers an SVD of the
@@ -229,6 +243,22 @@ void expect_quality_of_random_motion() {
   double norm2 = 0;
   for (const auto& [name, v] : q.weakest) norm2 += v * v;
   EXPECT_NEAR(norm2, 1, 1e-9);
+  // The triangular factor, by blocks of rows, rates W alike; and so does the factor of two
+  // halves' factors stacked (a design's whole from its trajectories).
+  const Eigen::MatrixXd R = triangular_factor(W);
+  ASSERT_EQ(R.rows(), Model::np);
+  const Eigen::Index half = W.rows() / 2;
+  Eigen::MatrixXd halves(2 * Model::np, Model::np);
+  halves << triangular_factor(W.topRows(half)), triangular_factor(W.bottomRows(W.rows() - half));
+  for (const Eigen::MatrixXd& factor : {R, Eigen::MatrixXd(triangular_factor(halves))}) {
+    const ExcitationQuality f = excitation_quality_of_factor(factor, W.rows(), identification_model<Model>()->description().parameters,
+                                                             static_cast<int>(Model::np));
+    EXPECT_EQ(f.rows, W.rows());
+    EXPECT_NEAR(f.kappa / (raw(0) / raw(raw.size() - 1)), 1, 1e-9);
+    EXPECT_NEAR(f.kappa_scaled / (s(0) / s(s.size() - 1)), 1, 1e-9);
+    EXPECT_NEAR(f.log_det_scaled, 2 * s.array().log().sum(), 1e-8);
+    EXPECT_NEAR((factor.transpose() * factor - W.transpose() * W).norm() / (W.transpose() * W).norm(), 0, 1e-13);
+  }
 }
 
 TEST(ExcitationQuality, MatchesTheGeneratedRegressorOnTwoRobots) {

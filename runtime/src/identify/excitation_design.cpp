@@ -122,13 +122,16 @@ class DesignProblem : public Ipopt::TNLP {
     return true;
   }
 
+  // The value alone where Ipopt asks for the value: its line search and restoration phase try
+  // many points whose gradient it never asks for, and the gradient costs a derivative of the
+  // inverse dynamics per instant and joint.
   bool eval_f(Ipopt::Index, const Ipopt::Number* x, bool, Ipopt::Number& f) override {
-    if (!objective(x)) return false;
+    if (!objective(x, false)) return false;
     f = f_;
     return true;
   }
   bool eval_grad_f(Ipopt::Index, const Ipopt::Number* x, bool, Ipopt::Number* grad) override {
-    if (!objective(x)) return false;
+    if (!objective(x, true)) return false;
     std::copy(grad_.data(), grad_.data() + V_, grad);
     return true;
   }
@@ -193,13 +196,17 @@ class DesignProblem : public Ipopt::TNLP {
     return cached.size() == V_ && std::equal(x, x + V_, cached.data());
   }
   // An exception must not unwind through Ipopt: a failed evaluation makes it cut the step.
-  bool objective(const Ipopt::Number* x) {
-    if (same(fx_, x)) return f_ok_;
+  // The value (and with `gradient` its gradient) at x, cached: the value is the same whether or
+  // not the gradient is asked for.
+  bool objective(const Ipopt::Number* x, bool gradient) {
+    if (same(fx_, x) && (grad_ok_ || !gradient || !f_ok_)) return f_ok_;
     fx_ = Eigen::Map<const Eigen::VectorXd>(x, V_);
+    grad_ok_ = false;
     try {
-      const auto f = c_.value(fx_, &grad_);
-      f_ok_ = f.has_value() && std::isfinite(*f) && grad_.allFinite();
+      const auto f = c_.value(fx_, gradient ? &grad_ : nullptr);
+      f_ok_ = f.has_value() && std::isfinite(*f) && (!gradient || grad_.allFinite());
       if (f_ok_) f_ = *f;
+      grad_ok_ = f_ok_ && gradient;
     } catch (...) {
       f_ok_ = false;
     }
@@ -253,7 +260,7 @@ class DesignProblem : public Ipopt::TNLP {
   bool torque_ = false;
   Eigen::VectorXd fx_, grad_, gx_;
   double f_ = 0;
-  bool f_ok_ = false, g_ok_ = false;
+  bool f_ok_ = false, grad_ok_ = false, g_ok_ = false;
   Eigen::VectorXd ks_;
   Eigen::MatrixXd Jks_;
 };

@@ -1,5 +1,7 @@
 #include "symoro/identify/least_squares.hpp"
 
+#include "singular_values.hpp"
+
 #include <cmath>
 #include <limits>
 #include <stdexcept>
@@ -10,15 +12,18 @@
 
 namespace symoro::identify {
 
-namespace {
+namespace detail {
 
-// Singular values of W through its QR factor: W = Q R has the singular values of R, and the
-// SVD of the small p x p R is cheap where the SVD of a 10^5 x p W is not.
-Eigen::VectorXd singular_values(const Eigen::MatrixXd& W) {
+Eigen::VectorXd tall_singular_values(const Eigen::MatrixXd& W) {
+  if (W.rows() < W.cols()) return Eigen::JacobiSVD<Eigen::MatrixXd>(W).singularValues();
   const Eigen::HouseholderQR<Eigen::MatrixXd> qr(W);
   const Eigen::MatrixXd R = qr.matrixQR().topRows(W.cols()).triangularView<Eigen::Upper>();
   return Eigen::JacobiSVD<Eigen::MatrixXd>(R).singularValues();
 }
+
+}  // namespace detail
+
+namespace {
 
 struct Solve {
   Eigen::VectorXd phi, std_dev;
@@ -52,9 +57,9 @@ double condition_number(const Eigen::MatrixXd& W, bool unit_columns) {
     Eigen::VectorXd norms = W.colwise().norm().transpose();
     for (Eigen::Index i = 0; i < norms.size(); ++i)
       if (norms(i) == 0) return std::numeric_limits<double>::infinity();
-    sv = singular_values(W * norms.cwiseInverse().asDiagonal());
+    sv = detail::tall_singular_values(W * norms.cwiseInverse().asDiagonal());
   } else {
-    sv = singular_values(W);
+    sv = detail::tall_singular_values(W);
   }
   return sv(sv.size() - 1) > 0 ? sv(0) / sv(sv.size() - 1) : std::numeric_limits<double>::infinity();
 }

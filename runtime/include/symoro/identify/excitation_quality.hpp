@@ -42,6 +42,23 @@ struct ExcitationQuality {
 ExcitationQuality excitation_quality(const Eigen::MatrixXd& W, const std::vector<ParameterInfo>& parameters, int top = 3,
                                      bool raw_kappa = true);
 
+// W's triangular factor: the p x p upper triangular R of W = Q R (fewer rows when W has fewer than
+// p), by Householder QR of blocks of rows in turn (R of [R; next block]: each block stays in
+// cache, where one QR of a 10^5-row W runs its panels through memory). R holds all the measures
+// need, W'W = R'R and the singular values of W, and factors stack: the R of [W1; W2] is the R of
+// [R1; R2], so a design's whole is rated from its trajectories' factors.
+Eigen::MatrixXd triangular_factor(const Eigen::MatrixXd& W);
+
+// Whether singular values (descending) are those of a numerically singular matrix: the smallest
+// at most p eps of the largest (the rank tolerance of a p x p factor), where its value is rounding.
+bool numerically_singular(const Eigen::VectorXd& sigma);
+
+// The measures of excitation_quality from W's triangular factor R and W's row count, the scaled
+// ones from the singular values of R with unit columns (not squared through a Gram matrix); a
+// numerically singular R (numerically_singular) has infinite kappas and log det -inf.
+ExcitationQuality excitation_quality_of_factor(const Eigen::MatrixXd& R, Eigen::Index rows,
+                                               const std::vector<ParameterInfo>& parameters, int top = 3);
+
 // A reference motion as identification samples every `interval` s: its own q, qd, qdd (no
 // preprocessing: they are exact), torque 0.
 preprocess::Samples reference_samples(const trajectory::SampledReference& reference, double interval);
