@@ -262,6 +262,8 @@ void bind_workflow(py::module_& m) {
       parameters[py::str(r.names[i])] = r.phi_rescue[static_cast<Eigen::Index>(i)];
     result["parameters"] = parameters;
     result["accepted"] = r.accepted;
+    result["not_accepted_because"] = identify::acceptance_verdict(r).reasons;  // empty when accepted
+    result["final_audit"] = r.final_audit;
     result["rescued"] = r.rescued;
     result["consistency"] = r.consistency;
     result["final_lambda_min"] = r.final_lambda_min;

@@ -13,6 +13,7 @@
 
 #include <CLI/CLI.hpp>
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include "dynid_identify.hpp"
 #include "dynid_robots.hpp"
@@ -92,7 +93,7 @@ void run_identify(const Common& common, const IdentifyOptions& o) {
                r.rescued ? (r.rescue_feasible ? (r.consistency == "physical" ? "rescued onto the consistent set" : "rescued (eps = 0)")
                                                            : "rescue FAILED: " + r.rescue_status)
                          : (r.consistency == "physical" ? "consistent, no rescue" : "PD without rescue"),
-               r.final_lambda_min, r.accepted ? "accepted" : "NOT accepted");
+               r.final_lambda_min, r.accepted ? "accepted" : fmt::format("NOT accepted: {}", fmt::join(identify::acceptance_verdict(r).reasons, "; ")));
     fmt::print("physical consistency of the accepted vector: {}\n",
                r.final_consistency_note.empty() ? "not checked" : r.final_consistency_note);
     for (const auto& v : r.validation)

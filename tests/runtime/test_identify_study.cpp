@@ -18,6 +18,7 @@
 #include "symoro/identify/detail/closed_loop_model.hpp"
 #include "symoro/io/dataset.hpp"
 #include "symoro/identify/validation.hpp"
+#include "symoro/identify/acceptance.hpp"
 #include "symoro/identify/study.hpp"
 #include "symoro/robot/compiled_model.hpp"
 #include "twin_dataset.hpp"
@@ -198,6 +199,93 @@ TEST(Study, EndToEndOnTwinData) {
     SCOPED_TRACE("rerun skips finished runs, redoes stale ones");
     rerun_skips_finished_runs_and_redoes_stale_ones();
   }
+}
+
+// The acceptance rule's steps on their own (acceptance.hpp).
+TEST(Acceptance, FinalAuditIsDenserAndOnOtherPoses) {
+  identify::AuditOptions pipeline;
+  pipeline.samples = 1000;
+  pipeline.starts = 5;
+  pipeline.seed = 3;
+  const identify::AuditOptions a = identify::final_audit_options(pipeline, identify::FinalAuditOptions{});
+  EXPECT_EQ(a.samples, 4000);
+  EXPECT_EQ(a.starts, 10);
+  EXPECT_EQ(a.seed, 3u + 7919u);
+  EXPECT_EQ(identify::describe(a), "4000 quasi-random poses, 10 local minimizations, seed 7922");
+  identify::FinalAuditOptions same;
+  same.sample_factor = 1, same.start_factor = 1, same.seed_offset = 0;
+  EXPECT_EQ(identify::final_audit_options(pipeline, same).samples, 1000);
+}
+
+TEST(Acceptance, PriorWeightBySmallestHeldOutErrorSmallerOnATie) {
+  // Each weight's "rescue" is a vector holding the weight; held-out errors by hand: 1e-4 is
+  // 0.05 % worse than 1e-2 (a tie: the smaller weight stays), 1 is best but infeasible.
+  const auto rescue = [](double w) {
+    identify::PhysicalProjection p;
+    p.phi = Eigen::VectorXd::Constant(1, w);
+    p.feasible = w < 0.5;
+    return p;
+  };
+  const auto rmse = [](const Eigen::VectorXd& phi) {
+    const double w = phi(0);
+    return w == 1e-6 ? 2.0 : w == 1e-4 ? 1.0005 : w == 1e-2 ? 1.0 : 0.5;
+  };
+  const identify::PriorWeightChoice c = identify::choose_prior_weight({1e-6, 1e-4, 1e-2, 1.0}, 1e-6, rescue, rmse);
+  EXPECT_EQ(c.weight, 1e-4);
+  EXPECT_EQ(c.projection.phi(0), 1e-4);
+  ASSERT_EQ(c.scores.size(), 4u);
+  EXPECT_EQ(c.scores[3].second, 0.5);
+  // None feasible: the default weight's rescue.
+  const auto never = [](double w) {
+    identify::PhysicalProjection p;
+    p.phi = Eigen::VectorXd::Constant(1, w);
+    return p;
+  };
+  const identify::PriorWeightChoice d = identify::choose_prior_weight({1e-4, 1e-2}, 1e-6, never, rmse);
+  EXPECT_EQ(d.weight, 1e-6);
+  EXPECT_EQ(d.projection.phi(0), 1e-6);
+}
+
+TEST(Acceptance, TheVerdictSaysWhyNot) {
+  identify::StudyResult r;
+  EXPECT_FALSE(identify::acceptance_verdict(r).accepted);
+  EXPECT_EQ(identify::acceptance_verdict(r).reasons.front(), "no representative run: no run produced a final vector");
+  r.selection.run = 0;
+  r.final_lambda_min = 1e-3;
+  r.consistency = "pd";
+  EXPECT_TRUE(identify::acceptance_verdict(r).accepted);
+  EXPECT_TRUE(identify::acceptance_verdict(r).reasons.empty());
+  // The PD path does not ask for a consistent set; the physical path does.
+  r.consistency = "physical";
+  r.final_consistent = false;
+  r.final_consistency_note = "link 3's pseudo-inertia is not positive definite";
+  identify::Verdict v = identify::acceptance_verdict(r);
+  EXPECT_FALSE(v.accepted);
+  ASSERT_EQ(v.reasons.size(), 1u);
+  EXPECT_EQ(v.reasons[0], "no physically consistent set maps onto it (link 3's pseudo-inertia is not positive definite)");
+  // A failed audit after a failed rescue: both said, the audit first.
+  r.final_consistent = true;
+  r.final_lambda_min = -2e-4;
+  r.rescued = true;
+  r.rescue_feasible = false;
+  r.rescue_status = "the SDP solver stopped";
+  v = identify::acceptance_verdict(r);
+  EXPECT_FALSE(v.accepted);
+  ASSERT_EQ(v.reasons.size(), 2u);
+  EXPECT_EQ(v.reasons[0], "the final audit found M(q) not positive definite (lambda_min -0.0002)");
+  EXPECT_EQ(v.reasons[1], "the rescue's projection failed (the SDP solver stopped)");
+}
+
+TEST(Acceptance, RepresentativeOfNoRunOneRunAndACloud) {
+  std::vector<identify::RunRecord> runs(1);
+  runs[0].failed = true;
+  EXPECT_FALSE(identify::select_representative(runs, 3, 0.9).has_value());
+  runs[0].failed = false;
+  runs[0].phi_clie = Eigen::VectorXd::Ones(4);
+  const auto one = identify::select_representative(runs, 3, 0.9);
+  ASSERT_TRUE(one.has_value());
+  EXPECT_EQ(one->selection.run, 0);
+  EXPECT_EQ(one->selection.rule, "the only run (no PCA cloud)");
 }
 
 }  // namespace

@@ -1,5 +1,7 @@
 #include "symoro/identify/report.hpp"
 
+#include "symoro/identify/acceptance.hpp"
+
 #include <algorithm>
 #include <cctype>
 #include <cmath>
@@ -199,18 +201,17 @@ std::string summary(const StudyResult& study) {
   std::string out = "## Summary\n\n";
   const RunRecord* sel = selected_run(study);
   if (sel) {
-    out += fmt::format("- **Accepted model**: {}, {}; final all-pose audit λ_min = {} at the worst pose {} deg: {}.\n",
+    out += fmt::format("- **Accepted model**: {}, {}; final all-pose audit{} λ_min = {} at the worst pose {} deg: {}.\n",
                        sel->id(),
                        study.rescued ? (study.rescue_feasible ? (study.consistency == "physical"
                                                                      ? fmt::format("rescued onto the physically consistent set (clearance {} of each link's size)", sig(study.rescue_eps, 3))
                                                                      : fmt::format("PD-rescued (ε = {})", sig(study.rescue_eps, 3)))
                                                               : "the rescue's projection FAILED (" + study.rescue_status + ")")
                                      : std::string("the run's final vector as is (no rescue needed)"),
-                       sig(study.final_lambda_min, 4), degrees(study.final_worst_pose),
+                       study.final_audit.empty() ? "" : " (" + study.final_audit + ")", sig(study.final_lambda_min, 4),
+                       degrees(study.final_worst_pose),
                        study.accepted ? "**accepted**"
-                                      : study.consistency == "physical" && !study.final_consistent
-                                            ? "**not accepted** (no physically consistent set maps onto it)"
-                                            : "**not accepted** (the final audit failed)");
+                                      : fmt::format("**not accepted** ({})", fmt::join(acceptance_verdict(study).reasons, "; ")));
     out += fmt::format("- **Physical consistency** of the accepted vector ({} path): {}.\n",
                        study.consistency == "physical" ? "the physical" : "the paper's PD",
                        study.final_consistency_note.empty() ? std::string("not checked")

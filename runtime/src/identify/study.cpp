@@ -18,6 +18,7 @@
 #include <fmt/ranges.h>
 
 #include "symoro/error.hpp"
+#include "symoro/identify/acceptance.hpp"
 #include "symoro/identify/clie.hpp"
 #include "symoro/io/dataset.hpp"
 #include "symoro/identify/least_squares.hpp"
@@ -354,101 +355,102 @@ class StudyRun {
     return information_metric(A / rows, o_.information_ridge);
   }
 
+  // The acceptance rule (acceptance.hpp): the representative, its rescue when its vector is not
+  // admissible on the study's path, the final audit, the verdict.
   void select_and_accept(const Dataset& data, StudyResult& out) const {
-    int usable = 0;
-    for (const RunRecord& r : out.runs) usable += !r.failed && r.phi_clie.size() > 0;
-    if (usable == 0) return;
-    if (out.runs.size() == 1) {  // one run (--only X --interval h): it is the candidate, no cloud
-      out.selection.run = 0;
-      out.selection.centrality = {0.0};
-      out.selection.rule = "the only run (no PCA cloud)";
-    } else {
-      out.pca = pca_clouds(out.runs, o_.pca_components);
-      out.selection = select_central(out.runs, out.pca, o_.variance_fraction);
-    }
+    std::optional<Representative> rep = select_representative(out.runs, o_.pca_components, o_.variance_fraction);
+    if (!rep) return;  // no run produced a final vector
+    out.pca = std::move(rep->pca);
+    out.selection = std::move(rep->selection);
     if (out.selection.run < 0) return;
     const RunRecord& sel = out.runs[out.selection.run];
     out.phi_rescue = sel.phi_clie;
     out.rescued = false;
-    if (o_.consistency == Consistency::physical) {
-      if (!sel.clie_consistent) {
-        // The rescue over standard parameters: the nearest base vector with a consistent set, in
-        // the selected run's predicted-torque metric.
-        const Eigen::MatrixXd metric = o_.rescue_metric_all_runs ? pooled_torque_metric(data, sel.interval)
-                                                                 : detail::torque_metric(refit(data, sel), o_.information_ridge);
-        auto rescue = [&](double weight) {
-          return model_.physical_projection(sel.phi_clie, metric, o_.physical_rescue_clearance, o_.rescue_prior, weight);
-        };
-        out.rescue_prior_weight = o_.rescue_prior_weight;
-        PhysicalProjection p;
-        if (o_.rescue_prior_weights.empty()) {
-          p = rescue(o_.rescue_prior_weight);
-        } else {
-          // Held out: the other identification runs at the representative's interval.
-          std::vector<preprocess::Samples> others;
-          for (const RunRecord& r : out.runs)
-            if (&r != &sel && !r.failed && std::abs(r.interval - sel.interval) < 1e-12) {
-              try {
-                others.push_back(preprocess::preprocess(load_log(data.find(r.trajectory, o_.trial)), r.interval, o_.preprocess));
-              } catch (const std::exception&) {
-              }
-            }
-          double best = std::numeric_limits<double>::infinity();
-          for (double w : o_.rescue_prior_weights) {
-            PhysicalProjection q = rescue(w);
-            double sq = 0, count = 0;
-            for (const auto& s : others) {
-              const Eigen::MatrixXd e = s.tau - model_.open_loop_torque(s, q.phi);
-              sq += e.squaredNorm();
-              count += static_cast<double>(e.size());
-            }
-            const double rmse = count > 0 ? std::sqrt(sq / count) : 0.0;
-            out.rescue_prior_scores.emplace_back(w, rmse);
-            if (q.feasible && (p.phi.size() == 0 || rmse < best * (1 - 1e-3))) {
-              best = rmse;
-              p = std::move(q);
-              out.rescue_prior_weight = w;
-            }
-          }
-          if (p.phi.size() == 0) p = rescue(o_.rescue_prior_weight);
-          std::string scores;
-          for (const auto& [w, e] : out.rescue_prior_scores) scores += fmt::format("{}{:g}: {:.6g}", scores.empty() ? "" : ", ", w, e);
-          out.stages.push_back(fmt::format("rescue prior weight: {:g}, by held-out open-loop RMSE on {} other runs (N m; {})",
-                                           out.rescue_prior_weight, others.size(), scores));
+    if (o_.consistency == Consistency::physical && !sel.clie_consistent) rescue_physical(data, sel, out);
+    if (o_.consistency == Consistency::pd && !sel.clie_pd) rescue_pd(data, sel, out);
+    final_audit(out);
+  }
+
+  // The rescue over standard parameters: the nearest base vector with a consistent set, in the
+  // predicted-torque metric, towards the prior (its weight chosen by held-out error when several).
+  void rescue_physical(const Dataset& data, const RunRecord& sel, StudyResult& out) const {
+    const Eigen::MatrixXd metric = o_.rescue_metric_all_runs ? pooled_torque_metric(data, sel.interval)
+                                                             : detail::torque_metric(refit(data, sel), o_.information_ridge);
+    auto rescue = [&](double weight) {
+      return model_.physical_projection(sel.phi_clie, metric, o_.physical_rescue_clearance, o_.rescue_prior, weight);
+    };
+    out.rescue_prior_weight = o_.rescue_prior_weight;
+    PhysicalProjection p;
+    if (o_.rescue_prior_weights.empty()) {
+      p = rescue(o_.rescue_prior_weight);
+    } else {
+      const std::vector<preprocess::Samples> others = other_runs_at_interval(data, sel, out);
+      const auto heldout_rmse = [&](const Eigen::VectorXd& phi) {
+        double sq = 0, count = 0;
+        for (const auto& s : others) {
+          const Eigen::MatrixXd e = s.tau - model_.open_loop_torque(s, phi);
+          sq += e.squaredNorm();
+          count += static_cast<double>(e.size());
         }
-        out.phi_rescue = p.phi;
-        out.rescued = true;
-        out.rescue_eps = o_.physical_rescue_clearance;
-        out.rescue_feasible = p.feasible;
-        out.rescue_status = p.status;
-      }
-    } else if (!sel.clie_pd) {
-      ProjectionOptions po = o_.projection;
-      po.eps = 0;  // the paper's rescue: a minimal feasibility correction
-      if (o_.projection_metric == ProjectionMetric::information)
-        po.metric = information_metric(refit(data, sel).information, o_.information_ridge);
-      const ProjectionResult p = project_pd(*inertia_, sel.phi_clie, domain_, po);
-      out.phi_rescue = p.phi;
-      out.rescued = true;
-      out.rescue_eps = 0;
-      out.rescue_feasible = p.feasible;
-      out.rescue_status = p.status;
+        return count > 0 ? std::sqrt(sq / count) : 0.0;
+      };
+      PriorWeightChoice choice = choose_prior_weight(o_.rescue_prior_weights, o_.rescue_prior_weight, rescue, heldout_rmse);
+      p = std::move(choice.projection);
+      out.rescue_prior_weight = choice.weight;
+      out.rescue_prior_scores = choice.scores;
+      std::string scores;
+      for (const auto& [w, e] : out.rescue_prior_scores) scores += fmt::format("{}{:g}: {:.6g}", scores.empty() ? "" : ", ", w, e);
+      out.stages.push_back(fmt::format("rescue prior weight: {:g}, by held-out open-loop RMSE on {} other runs (N m; {})",
+                                       out.rescue_prior_weight, others.size(), scores));
     }
-    // The final audit: denser and with another seed than the ones the pipeline used.
-    AuditOptions fa = o_.audit;
-    fa.samples *= 4;
-    fa.starts *= 2;
-    fa.seed += 7919;
+    out.phi_rescue = p.phi;
+    out.rescued = true;
+    out.rescue_eps = o_.physical_rescue_clearance;
+    out.rescue_feasible = p.feasible;
+    out.rescue_status = p.status;
+  }
+
+  // Held out for the prior's weight: the other identification runs at the representative's
+  // interval, preprocessed (a log that cannot be read is left out).
+  std::vector<preprocess::Samples> other_runs_at_interval(const Dataset& data, const RunRecord& sel, const StudyResult& out) const {
+    std::vector<preprocess::Samples> others;
+    for (const RunRecord& r : out.runs)
+      if (&r != &sel && !r.failed && std::abs(r.interval - sel.interval) < 1e-12) {
+        try {
+          others.push_back(preprocess::preprocess(load_log(data.find(r.trajectory, o_.trial)), r.interval, o_.preprocess));
+        } catch (const std::exception&) {
+        }
+      }
+    return others;
+  }
+
+  // The paper's rescue: a minimal feasibility correction onto the all-pose PD set (eps 0).
+  void rescue_pd(const Dataset& data, const RunRecord& sel, StudyResult& out) const {
+    ProjectionOptions po = o_.projection;
+    po.eps = 0;
+    if (o_.projection_metric == ProjectionMetric::information)
+      po.metric = information_metric(refit(data, sel).information, o_.information_ridge);
+    const ProjectionResult p = project_pd(*inertia_, sel.phi_clie, domain_, po);
+    out.phi_rescue = p.phi;
+    out.rescued = true;
+    out.rescue_eps = 0;
+    out.rescue_feasible = p.feasible;
+    out.rescue_status = p.status;
+  }
+
+  // The final audit (denser, poses the pipeline never saw), the accepted vector's physical
+  // consistency on both paths, and the verdict.
+  void final_audit(StudyResult& out) const {
+    const AuditOptions fa = final_audit_options(o_.audit, o_.final_audit);
+    out.final_audit = describe(fa);
     const AuditResult a = audit_pd(*inertia_, out.phi_rescue, domain_, fa);
     out.final_lambda_min = a.lambda_min;
     out.final_worst_pose = a.worst_pose;
-    out.accepted = a.positive_definite();
-    // Physical consistency of the accepted vector, on both paths (the physical one requires it).
     const ConsistencyResult k = model_.physical_check(out.phi_rescue);
     out.final_consistent = k.ok();
     out.final_consistency = k.feasibility;
     out.final_consistency_note = k.message;
-    if (o_.consistency == Consistency::physical) out.accepted = out.accepted && out.final_consistent;
+    out.accepted = acceptance_verdict(out).accepted;
   }
 
   void validate(const Dataset& data, const std::vector<std::string>& names, StudyResult& out) const {

@@ -8,6 +8,7 @@
 
 #include <Eigen/Core>
 
+#include "symoro/identify/acceptance.hpp"
 #include "symoro/identify/clie.hpp"
 #include "symoro/identify/least_squares.hpp"
 #include "symoro/identify/pd_audit.hpp"
@@ -53,6 +54,10 @@ struct StudyOptions {
   preprocess::Options preprocess;
   LeastSquaresOptions least_squares;
   AuditOptions audit;
+  // The acceptance's final audit, relative to `audit` (acceptance.hpp). Not in describe(): no run
+  // depends on it; the study applies it after the runs at every invocation and its result
+  // records the settings it used (StudyResult::final_audit).
+  FinalAuditOptions final_audit;
   // Its eps is set per margin. shortfall_raise 0.5: the exchange loop ends in about 2 rounds
   // instead of 6 for a distance larger by about 1e-4 (relative).
   ProjectionOptions projection = [] {

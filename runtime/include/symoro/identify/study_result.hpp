@@ -129,9 +129,12 @@ struct StudyResult {
   // candidate's open-loop RMSE on the other identification runs (N m).
   double rescue_prior_weight = 0;
   std::vector<std::pair<double, double>> rescue_prior_scores;
+  std::string final_audit;                // its settings (acceptance.hpp's describe)
   double final_lambda_min = 0;
   Eigen::VectorXd final_worst_pose;
-  bool accepted = false;                  // final audit passed (physical: and a consistent set exists)
+  // Final audit passed (physical: and a consistent set exists); acceptance_verdict
+  // (acceptance.hpp) says why not.
+  bool accepted = false;
   std::string consistency = "pd";         // the path: pd (the paper's) or physical
   // The accepted vector's physical consistency, checked on both paths where the model allows
   // (physical_projection.hpp): a consistent standard set maps onto it, phase 1's margin (NaN: not
