@@ -3,7 +3,11 @@
 #      (runtime/include/symoro/*.hpp, detail/) and those of the areas runtime/CMakeLists.txt says
 #      it depends on, directly or not: the declared dependencies are the real ones;
 #   2. docs/architecture.md's dependency block lists every area with exactly its declared
-#      direct dependencies.
+#      direct dependencies, and its table of areas lists every area once (issue 43);
+#   3. the naming rule: in the public headers (runtime/include/symoro/), namespace detail only
+#      under a detail/ folder or in a <name>-inl.hpp template body;
+#   4. every file docs/architecture.md names (a path, or a file name found somewhere in the
+#      project) exists.
 cmake_minimum_required(VERSION 3.16)
 # Run: cmake -DSOURCE=<project dir> -P area_dependencies.cmake
 file(READ ${SOURCE}/runtime/CMakeLists.txt cm)
@@ -82,8 +86,76 @@ foreach(a IN LISTS areas)
   endif()
 endforeach()
 
+# The table of areas: rows "| <area> | ..." after "| area | owns |".
+string(REGEX MATCH "\\| area \\| owns \\|\n\\|[-|]+\\|\n((\\|[^\n]*\n)+)" _ "${doc}")
+string(REGEX MATCHALL "\n?\\| ([a-z_]+) \\|" rows "${CMAKE_MATCH_1}")
+set(tabled "")
+foreach(row IN LISTS rows)
+  string(REGEX MATCH "\\| ([a-z_]+) \\|" _ "${row}")
+  list(APPEND tabled ${CMAKE_MATCH_1})
+endforeach()
+foreach(a IN LISTS areas)
+  set(n 0)
+  foreach(t IN LISTS tabled)
+    if(t STREQUAL a)
+      math(EXPR n "${n} + 1")
+    endif()
+  endforeach()
+  if(NOT n EQUAL 1)
+    string(APPEND problems "\n  docs/architecture.md: area ${a} is in the table of areas ${n} times")
+  endif()
+endforeach()
+foreach(t IN LISTS tabled)
+  if(NOT t IN_LIST areas)
+    string(APPEND problems "\n  docs/architecture.md: the table of areas has '${t}', not an area")
+  endif()
+endforeach()
+
+# The naming rule.
+file(GLOB_RECURSE public ${SOURCE}/runtime/include/symoro/*.hpp)
+foreach(f IN LISTS public)
+  if(f MATCHES "/detail/" OR f MATCHES "-inl\\.hpp$")
+    continue()
+  endif()
+  file(STRINGS ${f} hits REGEX "^namespace ([a-z_]+::)*detail( |$)")
+  if(hits)
+    file(RELATIVE_PATH rel ${SOURCE} ${f})
+    string(APPEND problems "\n  ${rel}: namespace detail in a public header outside detail/ (move it to <area>/detail/)")
+  endif()
+endforeach()
+
+# The files the map names. Words with a pattern in them (<name>, *, {a,b}) are not names.
+string(REGEX REPLACE "[^ `()\n]*[*<>{}][^ `()\n]*" " " names_text "${doc}")
+string(REGEX MATCHALL "[A-Za-z0-9_][A-Za-z0-9_./-]*\\.(hpp|cpp|h|md|cmake|in|py|sh)" named "${names_text}")
+list(REMOVE_DUPLICATES named)
+file(GLOB_RECURSE project_files ${SOURCE}/runtime/* ${SOURCE}/codegen/* ${SOURCE}/grammar/* ${SOURCE}/python/*
+     ${SOURCE}/cmake/* ${SOURCE}/docs/* ${SOURCE}/tools/* ${SOURCE}/tests/*)
+foreach(name IN LISTS named)
+  set(found FALSE)
+  if(name MATCHES "/")
+    foreach(root "" "runtime/include/" "runtime/include/symoro/" "runtime/src/" "runtime/tools/" "codegen/include/"
+                 "codegen/include/symoro/" "python/src/" "docs/")
+      if(EXISTS ${SOURCE}/${root}${name})
+        set(found TRUE)
+      endif()
+    endforeach()
+  else()
+    foreach(f IN LISTS project_files)
+      if(f MATCHES "/${name}(\\.in)?$")  # or the template CMake configures it from
+        set(found TRUE)
+        break()
+      endif()
+    endforeach()
+  endif()
+  if(NOT found)
+    string(APPEND problems "\n  docs/architecture.md names ${name}: no such file")
+  endif()
+endforeach()
+
 if(problems)
   message(FATAL_ERROR "the runtime's layering:${problems}")
 endif()
 list(LENGTH areas count)
-message(STATUS "${count} areas; every include follows the declared dependencies; docs/architecture.md agrees")
+list(LENGTH named files_named)
+message(STATUS "${count} areas; every include follows the declared dependencies; docs/architecture.md agrees, "
+               "and the ${files_named} files it names exist; the public headers keep the naming rule")

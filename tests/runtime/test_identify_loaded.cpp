@@ -22,6 +22,7 @@
 #include "symoro/identify/study_options.hpp"
 #include "symoro/io/dataset.hpp"
 #include "symoro/identify/loaded_closed_loop.hpp"
+#include "symoro/identify/detail/loaded_closed_loop_sizes.hpp"
 #include "symoro/identify/loaded_model.hpp"
 #include "symoro/robot/compiled_model.hpp"
 #include "symoro/robot/load_robot.hpp"

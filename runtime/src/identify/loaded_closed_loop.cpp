@@ -6,6 +6,7 @@
 // simulator's do, 20 % faster than with run-time sizes), a run-time one otherwise; the parameter
 // count always a run-time one. The arithmetic is the same either way.
 #include "symoro/identify/loaded_closed_loop.hpp"
+#include "symoro/identify/detail/loaded_closed_loop_sizes.hpp"
 
 #include <algorithm>
 #include <cmath>

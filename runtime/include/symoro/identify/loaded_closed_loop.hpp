@@ -14,11 +14,4 @@ namespace symoro::identify {
 std::unique_ptr<ClosedLoop> closed_loop(const robot::ModelHandle& model, const ClosedLoopSetup& setup,
                                         const trajectory::SampledReference& reference);
 
-namespace detail {
-// The same at run-time sizes whatever the joint count: what a robot of 1 or more than 8 joints
-// runs, for the tests to check on the shipped robots.
-std::unique_ptr<ClosedLoop> closed_loop_run_time_sizes(const robot::ModelHandle& model, const ClosedLoopSetup& setup,
-                                                       const trajectory::SampledReference& reference);
-}  // namespace detail
-
 }  // namespace symoro::identify

@@ -5,10 +5,8 @@
 // symoro::<robot>_identification (cmake/SymoroRobots.cmake), which holds both.
 #pragma once
 
-#include <cstddef>
 #include <tuple>
 #include <type_traits>
-#include <utility>
 #include <vector>
 
 #include "symoro/robot/model_handle.hpp"
@@ -29,19 +27,24 @@ struct LinkedRobot {
   int identified = 0;
 };
 
-namespace detail {
-template <class Models, class Identified, std::size_t... I>
-LinkedRobot linked_robot(std::index_sequence<I...>) {
-  LinkedRobot r;
-  r.models = {&compiled_model<std::tuple_element_t<I, Models>>()...};
-  ((r.identified = std::is_same_v<std::tuple_element_t<I, Models>, Identified> ? static_cast<int>(I) : r.identified), ...);
-  return r;
-}
-}  // namespace detail
+// A robot's Models (a std::tuple of its generated model types) as linked handles.
+template <class Models>
+struct LinkedModels;
+template <class... Model>
+struct LinkedModels<std::tuple<Model...>> {
+  template <class Identified>
+  static LinkedRobot robot() {
+    LinkedRobot r;
+    r.models = {&compiled_model<Model>()...};
+    int index = 0;
+    ((r.identified = std::is_same_v<Model, Identified> ? index : r.identified, ++index), ...);
+    return r;
+  }
+};
 
 template <class Models, class Identified>
 LinkedRobot linked_robot() {
-  return detail::linked_robot<Models, Identified>(std::make_index_sequence<std::tuple_size_v<Models>>{});
+  return LinkedModels<Models>::template robot<Identified>();
 }
 
 }  // namespace symoro::robot
