@@ -119,8 +119,8 @@ void bind_diagnose(py::module_& m) {
     o.cutoff = cutoff;
     o.only = only;
     o.alpha = alpha;
-    o.min_gain = min_gain;
-    o.min_torque = min_torque;
+    o.min_heldout_gain = min_gain;
+    o.min_effect_torque = min_torque;
     o.backlash = backlash;
     o.params = params.value_or("");
     o.variant = variant;
@@ -160,8 +160,8 @@ void bind_diagnose(py::module_& m) {
   }, py::arg("model"), py::arg("data"), py::arg("out"), py::kw_only(), py::arg("robot_dir") = py::none(),
      py::arg("train") = std::vector<std::string>{}, py::arg("heldout") = std::vector<std::string>{},
      py::arg("trial") = defaults.trial, py::arg("interval_ms") = defaults.interval * 1000, py::arg("cutoff") = defaults.cutoff,
-     py::arg("only") = std::vector<std::string>{}, py::arg("alpha") = defaults.alpha, py::arg("min_gain") = defaults.min_gain,
-     py::arg("min_torque") = defaults.min_torque, py::arg("backlash") = defaults.backlash, py::arg("params") = py::none(),
+     py::arg("only") = std::vector<std::string>{}, py::arg("alpha") = defaults.alpha, py::arg("min_gain") = defaults.min_heldout_gain,
+     py::arg("min_torque") = defaults.min_effect_torque, py::arg("backlash") = defaults.backlash, py::arg("params") = py::none(),
      py::arg("variant") = "", py::arg("apply") = false, py::arg("progress") = py::none());
 }
 

@@ -28,8 +28,8 @@ diagnose::DatasetDiagnosisOptions library_options(const Common& common, const Di
   d.cutoff = o.cutoff;
   d.only = o.only;
   d.alpha = o.alpha;
-  d.min_gain = o.min_gain;
-  d.min_torque = o.min_torque;
+  d.min_heldout_gain = o.min_gain;
+  d.min_effect_torque = o.min_torque;
   d.backlash = !o.no_backlash;
   d.params = o.params;
   d.variant = o.variant;
@@ -61,6 +61,15 @@ void run_diagnose(const Common& common, const DiagnoseOptions& o, const diagnose
 
 void add_diagnose_commands(CLI::App& app, Common& common) {
   auto o = std::make_shared<DiagnoseOptions>();
+  {  // the defaults are the library's, not written again here
+    const diagnose::DatasetDiagnosisOptions d;
+    o->trial = d.trial;
+    o->interval_ms = d.interval * 1000;
+    o->cutoff = d.cutoff;
+    o->alpha = d.alpha;
+    o->min_gain = d.min_heldout_gain;
+    o->min_torque = d.min_effect_torque;
+  }
   auto* cmd = app.add_subcommand("diagnose", "Model-gap diagnosis: which effects the identified model misses, how large, "
                                              "where the residual is; before/after report");
   add_robot_options(cmd, common);

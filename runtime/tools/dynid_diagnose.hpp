@@ -17,8 +17,9 @@ struct DiagnoseOptions {
   std::string data, out, model, variant, apply, params;
   bool no_backlash = false;
   std::vector<std::string> train, heldout, only;  // empty: from the dataset's families
-  int trial = 1;
-  double interval_ms = 10, cutoff = 5, alpha = 1e-3, min_gain = 0.02, min_torque = 0.003;
+  // Defaults: diagnose::DatasetDiagnosisOptions' (set where the command is added).
+  int trial = 0;
+  double interval_ms = 0, cutoff = 0, alpha = 0, min_gain = 0, min_torque = 0;
 };
 
 // The command on one model (dynid_diagnose.cpp).

@@ -30,8 +30,8 @@ void check_request(const DatasetDiagnosisOptions& o) {
   range("--interval", o.interval * 1000, 1, 10000, false, "from 1 to 10000 ms");
   range("--cutoff", o.cutoff, 0, 1e5, true, "> 0 and <= 1e5 Hz");
   range("--alpha", o.alpha, 0, 0.5, true, "> 0 and <= 0.5");
-  range("--min-gain", o.min_gain, 0, 1, false, ">= 0 and <= 1");
-  range("--min-torque", o.min_torque, 0, 1e6, false, ">= 0 and <= 1e6 N m");
+  range("--min-gain", o.min_heldout_gain, 0, 1, false, ">= 0 and <= 1");
+  range("--min-torque", o.min_effect_torque, 0, 1e6, false, ">= 0 and <= 1e6 N m");
   static const std::regex lower_id("^[a-z][a-z0-9_]*$");
   if (!o.variant.empty() && (!std::regex_match(o.variant, lower_id) || o.variant == "full" || o.variant == "param"))
     throw DiagnosisRequestError("--variant '" + o.variant + "' must be a lower-case identifier other than 'full' and 'param' "
@@ -46,11 +46,12 @@ void check_request(const DatasetDiagnosisOptions& o) {
 
 std::pair<std::vector<std::string>, std::vector<std::string>> diagnosis_runs(const io::Dataset& data,
                                                                               const DatasetDiagnosisOptions& o) {
-  // Held out: family V, as a split at import records it; fitting: every other run of the trial.
+  // Held out: the held-out family (V, as a split at import records it); fitting: every other run
+  // of the trial.
   auto pick = [&](bool heldout) {
     std::vector<std::string> v;
     for (const auto& r : data.runs)
-      if (r.trial == o.trial && (r.family == "V") == heldout && std::find(v.begin(), v.end(), r.trajectory) == v.end())
+      if (r.trial == o.trial && (r.family == o.heldout_family) == heldout && std::find(v.begin(), v.end(), r.trajectory) == v.end())
         v.push_back(r.trajectory);
     return v;
   };
@@ -61,8 +62,9 @@ std::pair<std::vector<std::string>, std::vector<std::string>> diagnosis_runs(con
   if (train.empty())
     throw DiagnosisRequestError(fmt::format("{}: no fitting run for trial {} (runs: {}); name them with --train", manifest, o.trial, all));
   if (heldout.empty())
-    throw DiagnosisRequestError(fmt::format("{}: no held-out run (family V) for trial {} (runs: {}); name them with --heldout, "
-                                            "or split a long run at import (dynid import --split 0.7)", manifest, o.trial, all));
+    throw DiagnosisRequestError(fmt::format("{}: no held-out run (family {}) for trial {} (runs: {}); name them with --heldout, "
+                                            "or split a long run at import (dynid import --split 0.7)",
+                                            manifest, o.heldout_family, o.trial, all));
   for (const auto* list : {&train, &heldout})
     for (const auto& name : *list) {
       bool found = false;
@@ -91,8 +93,8 @@ void score_raw_torque(const DiagnosisModel& model, const DesignStack& train, con
   if (held.size()) raw.hold(held);
   std::vector<Candidate> effects;
   for (const auto& e : d.selection.effects) effects.push_back(e.candidate);
-  const Fit b = fit_with_effects(train, raw, {}, d.selection.weights);
-  const Fit a = fit_with_effects(train, raw, effects, d.selection.weights);
+  const Fit b = fit_with_effects(train, raw, {}, d.selection.weights, d.options.max_lag);
+  const Fit a = fit_with_effects(train, raw, effects, d.selection.weights, d.options.max_lag);
   d.raw_before = b.heldout_rmse;
   d.raw_after = a.heldout_rmse;
   d.raw_total_before = b.heldout_total;
@@ -146,8 +148,8 @@ DatasetDiagnosis diagnose_dataset(const DiagnosisModel& model, const DatasetDiag
   }
   DiagnosisOptions dopt;
   dopt.selection.alpha = o.alpha;
-  dopt.selection.min_heldout_gain = o.min_gain;
-  dopt.selection.min_effect_torque = o.min_torque;
+  dopt.selection.min_heldout_gain = o.min_heldout_gain;
+  dopt.selection.min_effect_torque = o.min_effect_torque;
   dopt.selection.candidates = so.candidates;
   // A delay the controller description already models is not a missing effect.
   const auto controller_path = o.robot_dir / control::controller_file_name();

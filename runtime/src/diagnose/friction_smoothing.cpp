@@ -54,7 +54,7 @@ void choose_friction_smoothing(const DesignStack& train, const DesignStack& held
     }
     if (named.empty()) continue;
     // The other effects, refitted without the joint's friction; each option is added to them.
-    const Fit without = fit_with_effects(train, heldout, others, weights);
+    const Fit without = fit_with_effects(train, heldout, others, weights, o.max_lag);
     const NestedDesign nd = nested_design(train, heldout, others, without, weights);
     const std::vector<Candidate> friction = friction_options(train, o.candidates, j);
     std::vector<Option> opts = options(friction);
@@ -103,7 +103,7 @@ void choose_friction_smoothing(const DesignStack& train, const DesignStack& held
           recorded = true;
         }
       if (!recorded) {
-        if (sds.empty()) f = fit_with_effects(train, heldout, refit, weights, &sds);
+        if (sds.empty()) f = fit_with_effects(train, heldout, refit, weights, o.max_lag, &sds);
         const std::size_t i = at + k;
         const double z = sds[i](0) > 0 ? f.theta[i](0) / sds[i](0) : 0.0;
         e.f = z * z;

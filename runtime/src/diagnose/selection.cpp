@@ -118,7 +118,7 @@ void backward_check(const DesignStack& train, const DesignStack& heldout, const 
   while (!chosen.empty()) {
     std::vector<Eigen::VectorXd> sds;
     std::vector<Eigen::MatrixXd> covs;
-    const Fit full = fit_with_effects(train, heldout, chosen, weights, &sds, &covs);
+    const Fit full = fit_with_effects(train, heldout, chosen, weights, o.max_lag, &sds, &covs);
     int worst = -1;
     double worst_weakness = 0;
     DroppedEffect drop;
@@ -141,7 +141,7 @@ void backward_check(const DesignStack& train, const DesignStack& heldout, const 
         if (effect_info(c.kind).per_joint) on.push_back(c.joint);
         std::vector<Candidate> others = chosen;
         others.erase(others.begin() + static_cast<std::ptrdiff_t>(i));
-        const Fit without = fit_with_effects(train, heldout, others, weights);
+        const Fit without = fit_with_effects(train, heldout, others, weights, o.max_lag);
         const double s0 = heldout_sse(without, weights, on, heldout.samples()), s1 = heldout_sse(full, weights, on, heldout.samples());
         return s0 > 0 ? 1 - s1 / s0 : 0.0;
       };
@@ -202,7 +202,7 @@ Eigen::VectorXd autocorrelation_time(const DesignStack& d, const Eigen::MatrixXd
 }
 
 Fit fit_with_effects(const DesignStack& train, const DesignStack& heldout, const std::vector<Candidate>& effects,
-                     const Eigen::VectorXd& weights, std::vector<Eigen::VectorXd>* theta_sd,
+                     const Eigen::VectorXd& weights, int max_lag, std::vector<Eigen::VectorXd>* theta_sd,
                      std::vector<Eigen::MatrixXd>* theta_cov) {
   if (heldout.held() != train.held()) throw std::invalid_argument("fit_with_effects: parameters held in one stack only");
   const Eigen::Index np = free_parameters(train);
@@ -224,7 +224,7 @@ Fit fit_with_effects(const DesignStack& train, const DesignStack& heldout, const
   // Standard deviations with the residual's autocorrelation time.
   const Eigen::VectorXd r = A.cols() ? Eigen::VectorXd(y - A * s.beta) : y;
   const Eigen::MatrixXd rs = per_sample(train, rw.cwiseProduct(r));
-  const double tau_int = pooled_time(autocorrelation_time(train, rs, 400));
+  const double tau_int = pooled_time(autocorrelation_time(train, rs, max_lag));
   const Solve sd = weighted_ls(A, y, rw, tau_int);
   Fit f;
   f.phi = train.held() ? train.held_phi : Eigen::VectorXd(s.beta.head(np));
@@ -254,10 +254,10 @@ Selection select_effects(const DesignStack& train, const DesignStack& heldout, c
   const Eigen::Index np = free_parameters(train);
   // Weights from the base model's unweighted residual: 1 / std per joint.
   {
-    const Fit plain = fit_with_effects(train, heldout, {}, Eigen::VectorXd::Ones(n));
+    const Fit plain = fit_with_effects(train, heldout, {}, Eigen::VectorXd::Ones(n), o.max_lag);
     sel.weights = plain.train_rmse.cwiseMax(1e-9).cwiseInverse();
   }
-  sel.before = fit_with_effects(train, heldout, {}, sel.weights);
+  sel.before = fit_with_effects(train, heldout, {}, sel.weights, o.max_lag);
   const std::vector<Candidate> all = candidates(train, o.candidates);
   std::vector<Candidate> chosen;
   std::set<std::string> taken;  // "<effect>:<joint>": one Stribeck velocity per joint, once
@@ -406,13 +406,13 @@ Selection select_effects(const DesignStack& train, const DesignStack& heldout, c
     sel.steps.push_back(step);
     chosen.push_back(c);
     taken.insert(slot(c));
-    current = fit_with_effects(train, heldout, chosen, sel.weights);
+    current = fit_with_effects(train, heldout, chosen, sel.weights, o.max_lag);
   }
   if (sel.stop_reason.empty()) sel.stop_reason = "the maximum number of effects was reached";
   detail::choose_friction_smoothing(train, heldout, o, sel.weights, chosen, sel.effects);
   backward_check(train, heldout, o, sel.weights, chosen, sel);
   std::vector<Eigen::VectorXd> sds;
-  sel.after = fit_with_effects(train, heldout, chosen, sel.weights, &sds);
+  sel.after = fit_with_effects(train, heldout, chosen, sel.weights, o.max_lag, &sds);
   for (std::size_t i = 0; i < sel.effects.size(); ++i) {
     sel.effects[i].theta = sel.after.theta[i];
     sel.effects[i].std_dev = sds[i];

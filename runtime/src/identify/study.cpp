@@ -7,9 +7,7 @@
 #include <algorithm>
 #include <chrono>
 #include <filesystem>
-#include <fstream>
 #include <functional>
-#include <iterator>
 #include <limits>
 #include <sstream>
 #include <vector>
@@ -31,6 +29,7 @@
 #include "symoro/identify/validation.hpp"
 #include "symoro/io/digest.hpp"
 #include "symoro/io/log.hpp"
+#include "symoro/io/text_file.hpp"
 #include "symoro/parallel/farm.hpp"
 #include "symoro/preprocess/preprocess.hpp"
 #include "symoro/trajectory/sampled_reference.hpp"
@@ -309,10 +308,9 @@ class StudyRun {
       in.loop = fmt::format("{} {} {} {} {} | {} {} {} {}", c.gains.period, c.gains.pseudo_derivative_time, c.delay, c.pre_roll,
                             c.substeps, fmt::join(c.gains.inertia, " "), fmt::join(c.gains.damping, " "),
                             fmt::join(c.gains.kp, " "), fmt::join(c.gains.kv, " "));
-      if (loop_.design) {
-        std::ifstream file(loop_.design->path(), std::ios::binary);
-        in.loop += " | " + fingerprint_of(std::string(std::istreambuf_iterator<char>(file), std::istreambuf_iterator<char>()));
-      }
+      // The design's bytes (an unreadable design is an error, not an empty fingerprint).
+      if (loop_.design)
+        in.loop += " | " + fingerprint_of(io::read_text_file(loop_.design->path(), "cannot read the trajectory design"));
     }
     return in;
   }

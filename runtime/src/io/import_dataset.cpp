@@ -56,7 +56,7 @@ DatasetImportResult import_dataset(const std::filesystem::path& out, const Datas
         throw DataError(in.file.string(), 0, fmt::format("run name '{}' is used twice (name the inputs apart)", run));
     const Log& log = imported.log;
     if (!split) {
-      result.runs.push_back({name, in.heldout ? "V" : "F", csv, -std::numeric_limits<double>::infinity(),
+      result.runs.push_back({name, in.heldout ? kHeldOutFamily : "F", csv, -std::numeric_limits<double>::infinity(),
                              std::numeric_limits<double>::infinity()});
     } else {
       // By time: the first `split` of the run's span fits, the rest is held out.
@@ -71,7 +71,7 @@ DatasetImportResult import_dataset(const std::filesystem::path& out, const Datas
                                     "least {}", import.split, number_text(cut), std::min(fitting, heldout),
                                     log.samples(), fitting < min_part ? "fitting" : "held-out", min_part));
       result.runs.push_back({name, "F", csv, t0, cut});
-      result.runs.push_back({name + "_heldout", "V", csv, cut, std::numeric_limits<double>::infinity()});
+      result.runs.push_back({name + "_heldout", kHeldOutFamily, csv, cut, std::numeric_limits<double>::infinity()});
     }
     result.logs.push_back(std::move(imported));
   }

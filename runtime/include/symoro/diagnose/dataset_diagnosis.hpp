@@ -22,12 +22,16 @@ struct DatasetDiagnosisOptions {
   std::filesystem::path data;       // the dataset folder (dataset.yaml and logs)
   std::filesystem::path out;        // the report folder
   std::filesystem::path robot_dir;  // twin.yaml, controller.yaml; empty: none (no backlash stage)
-  std::vector<std::string> train, heldout;  // empty: the dataset's (held out: family V)
+  std::vector<std::string> train, heldout;  // empty: the dataset's (held out: heldout_family)
+  std::string heldout_family = io::kHeldOutFamily;
   int trial = 1;
   double interval = 0.01;  // s, the diagnosis grid
   double cutoff = 5;       // Hz, the low-pass on every column and the torque
   std::vector<std::string> only;  // effect names (effects.hpp); empty: every candidate
-  double alpha = 1e-3, min_gain = 0.02, min_torque = 0.003;  // SelectionOptions'
+  // The selection's thresholds, with SelectionOptions' defaults (selection.hpp says what each is).
+  double alpha = SelectionOptions{}.alpha;
+  double min_heldout_gain = SelectionOptions{}.min_heldout_gain;
+  double min_effect_torque = SelectionOptions{}.min_effect_torque;
   bool backlash = true;           // the closed-loop high-band stage
   std::filesystem::path params;   // an earlier identification's parameters, held (empty: refit)
   std::string variant;            // the variant's name (empty: <model>_diagnosed, or diagnosed)

@@ -120,9 +120,10 @@ Selection select_effects(const DesignStack& train, const DesignStack& heldout, c
 
 // Weighted least squares of y on [W | effect columns] (no selection): what `Selection::after`
 // holds, exposed for reports and tests that fix the effects.
-// theta_cov: each effect's parameter covariance (the residual's autocorrelation counted).
+// theta_cov: each effect's parameter covariance (the residual's autocorrelation counted, over
+// at most max_lag samples: SelectionOptions::max_lag).
 Fit fit_with_effects(const DesignStack& train, const DesignStack& heldout, const std::vector<Candidate>& effects,
-                     const Eigen::VectorXd& weights, std::vector<Eigen::VectorXd>* theta_sd = nullptr,
+                     const Eigen::VectorXd& weights, int max_lag, std::vector<Eigen::VectorXd>* theta_sd = nullptr,
                      std::vector<Eigen::MatrixXd>* theta_cov = nullptr);
 
 // Integrated autocorrelation time of the columns of a samples x joints residual along the

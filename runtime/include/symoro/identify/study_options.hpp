@@ -14,6 +14,7 @@
 #include "symoro/identify/pd_audit.hpp"
 #include "symoro/identify/sdp_projection.hpp"
 #include "symoro/identify/study_result.hpp"
+#include "symoro/io/dataset.hpp"
 #include "symoro/preprocess/preprocess.hpp"
 
 namespace symoro::identify {
@@ -42,7 +43,7 @@ struct StudyOptions {
   int trial = 1;                // which repetition of each trajectory
   std::vector<std::string> trajectories;  // identification set (empty: every family but V)
   std::vector<std::string> validation;    // held-out set (empty: family V)
-  std::string validation_family = "V";
+  std::string validation_family = io::kHeldOutFamily;
   std::vector<double> intervals = preprocess::paper_intervals();
   int threads = 0;              // 0: every core
   bool fresh = false;           // redo every run, even those finished (benchmarks)

@@ -15,6 +15,10 @@
 
 namespace symoro::io {
 
+// The family of the held-out runs (a split's held-out part, the twin's V01-V03): identify's and
+// the diagnosis's default held-out set.
+inline constexpr const char* kHeldOutFamily = "V";
+
 struct DatasetRun {
   std::string trajectory, family;
   int trial = 1;
