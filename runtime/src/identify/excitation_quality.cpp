@@ -56,7 +56,7 @@ ExcitationQuality excitation_quality(const Eigen::MatrixXd& W, const std::vector
   q.unexcited = unexcited_columns(norms, parameters);
   if (raw_kappa) {
     const Eigen::VectorXd sigma = detail::tall_singular_values(W);
-    if (sigma(sigma.size() - 1) > 0) q.kappa = sigma(0) / sigma(sigma.size() - 1);
+    if (!numerically_singular(sigma)) q.kappa = sigma(0) / sigma(sigma.size() - 1);  // as the factor path judges it
   }
   if (!q.unexcited.empty()) return q;
   // The scaled quantities from the Gram matrix of the unit columns (parameters x parameters:
