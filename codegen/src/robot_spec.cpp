@@ -237,7 +237,9 @@ bool glob_match(const std::string& pattern, const std::string& name) {
   return p == pattern.size();
 }
 
-RobotSpec read_robot_spec(const std::string& path) {
+namespace {
+
+RobotSpec read_robot_spec_checked(const std::string& path) {
   const YAML::Node root = load_yaml_file(path);
   Reader r{path};
   if (!root.IsMap()) throw InputError(path, 1, 1, "robot.yaml must be a mapping of keys");
@@ -291,6 +293,7 @@ RobotSpec read_robot_spec(const std::string& path) {
   spec.units = kDefaultUnits;
   spec.prismatic_units = kDefaultPrismaticUnits;
   if (const auto u = root["parameter_units"]) {
+    if (!u.IsMap()) r.fail(u, "parameter_units must be a mapping (revolute, prismatic)");
     r.only_keys(u, {"revolute", "prismatic"}, "parameter_units");
     auto read = [&](const YAML::Node& m, std::map<std::string, std::string>& into) {
       if (!m) return;
@@ -324,6 +327,8 @@ RobotSpec read_robot_spec(const std::string& path) {
                              "' must be a lower-case identifier other than 'full' and 'param'");
       for (const auto& other : raw)
         if (other.spec.name == vs.name) r.fail(kv.first, "duplicate variant name '" + vs.name + "'");
+      if (!kv.second.IsMap())
+        r.fail(kv.second, "variant " + vs.name + " must be a mapping (description, base, fixed, effects)");
       r.only_keys(kv.second, {"description", "base", "fixed", "effects"}, "variant " + vs.name);
       if (kv.second["description"]) vs.description = r.string(kv.second["description"], "description");
       if (const auto b = kv.second["base"]) {
@@ -368,6 +373,20 @@ RobotSpec read_robot_spec(const std::string& path) {
     if (!known) r.fail(id, "identified: '" + spec.identified + "' is neither 'full' nor a variant");
   }
   return spec;
+}
+
+}  // namespace
+
+RobotSpec read_robot_spec(const std::string& path) {
+  // The checks above name each shape they expect; a shape they miss must still be an error at its
+  // place in the file, never an escaping yaml-cpp exception (found by fuzz_yaml: a variant given as
+  // a scalar).
+  try {
+    return read_robot_spec_checked(path);
+  } catch (const YAML::Exception& e) {
+    const int line = e.mark.is_null() ? 1 : e.mark.line + 1, column = e.mark.is_null() ? 1 : e.mark.column + 1;
+    throw InputError(path, line, column, "robot.yaml: unexpected shape (" + e.msg + ")");
+  }
 }
 
 }  // namespace symoro::codegen

@@ -145,6 +145,17 @@ TEST_F(BrokenRobot, ACycleOfAliasesOrASecondDocumentIsRefusedAtItsLine) {
   expect_error(R"(robot\.yaml:\d+:\d+: error: a second YAML document)");
 }
 
+// A map given where robot.yaml wants a map is an error at its line, not a yaml-cpp exception
+// (fuzz_yaml found the variant case).
+TEST_F(BrokenRobot, AScalarWhereAMapBelongsIsRefusedAtItsLine) {
+  add_variants("  light: frictionless\n");
+  expect_error("robot\\.yaml:" + std::to_string(kFirstAddedLine) +
+               R"(:10: error: variant light must be a mapping \(description, base, fixed, effects\))");
+  start_from("rx90");
+  replace("robot.yaml", "parameter_units:\n  revolute:", "parameter_units: SI\nnominal:\n  revolute:");
+  expect_error(R"(robot\.yaml:17:18: error: parameter_units must be a mapping \(revolute, prismatic\))");
+}
+
 TEST_F(BrokenRobot, VariantPatternThatMatchesNothing) {
   add_variants("  light:\n    fixed: {\"XY*\": 0}\n");
   expect_error(R"(robot\.yaml:\d+:1: error: variant light: 'XY\*' matches no base parameter)");
