@@ -1,31 +1,47 @@
 #include "symoro/codegen/effects.hpp"
 
 #include <algorithm>
+#include <array>
 #include <stdexcept>
 #include <tuple>
 
 #include "symoro/codegen/emitter.hpp"
+#include "symoro/effect_table.hpp"
 
 namespace symoro::codegen {
 
 namespace {
 
+// The variant effects in canonical order (EffectKind's, which orders the parameters they add),
+// each a row of the effect table by its variant name.
+constexpr std::array<std::string_view, 7> kVariantOrder{"coulomb",           "inertia_products",   "offset",
+                                                        "stribeck",          "viscous_asymmetry",  "position_harmonics",
+                                                        "smooth_coulomb"};
+static_assert(kVariantOrder.size() == static_cast<std::size_t>(EffectKind::SmoothCoulomb) + 1);
+
+constexpr bool every_variant_has_a_row() {
+  for (std::string_view name : kVariantOrder)
+    if (!find_effect(&EffectRow::variant, name)) return false;
+  return true;
+}
+static_assert(every_variant_has_a_row(), "a variant effect without its row in symoro/effect_table.hpp");
+
 struct Entry {
   EffectKind kind;
+  const EffectRow* row;
   std::string name;
   std::vector<std::string> unfixes;
 };
 
 const std::vector<Entry>& catalogue() {
-  static const std::vector<Entry> entries = {
-      {EffectKind::Coulomb, "coulomb", {"FS"}},
-      {EffectKind::InertiaProducts, "inertia_products", {"XY", "XZ", "YZ"}},
-      {EffectKind::Offset, "offset", {}},
-      {EffectKind::Stribeck, "stribeck", {}},
-      {EffectKind::ViscousAsymmetry, "viscous_asymmetry", {}},
-      {EffectKind::PositionHarmonics, "position_harmonics", {}},
-      {EffectKind::SmoothCoulomb, "smooth_coulomb", {}},
-  };
+  static const std::vector<Entry> entries = [] {
+    std::vector<Entry> out;
+    for (std::size_t k = 0; k < kVariantOrder.size(); ++k) {
+      const EffectRow* row = find_effect(&EffectRow::variant, kVariantOrder[k]);
+      out.push_back({static_cast<EffectKind>(k), row, std::string(row->variant), effect_words(row->unfixes)});
+    }
+    return out;
+  }();
   return entries;
 }
 
@@ -47,9 +63,9 @@ std::string effect_names() {
   return out;
 }
 
-bool effect_on_links(EffectKind kind) { return kind == EffectKind::InertiaProducts; }
+bool effect_on_links(EffectKind kind) { return entry(kind).row->scope == EffectScope::Link; }
 
-bool effect_has_velocity(EffectKind kind) { return kind == EffectKind::Stribeck || kind == EffectKind::SmoothCoulomb; }
+bool effect_has_velocity(EffectKind kind) { return entry(kind).row->velocity_scale; }
 
 const std::vector<std::string>& unfixed_families(EffectKind kind) { return entry(kind).unfixes; }
 
@@ -63,26 +79,19 @@ std::vector<EffectParameter> effect_parameters(
   });
   std::vector<EffectParameter> out;
   for (const EffectSpec* e : sorted) {
+    const EffectRow& row = *entry(e->kind).row;
     const int j = e->index;
-    const std::string js = std::to_string(j);
-    switch (e->kind) {
-      case EffectKind::Offset: out.push_back({"OFF" + js, "OFF", j, unit("FS", j), 0, 0.0}); break;
-      case EffectKind::Stribeck: out.push_back({"FST" + js, "FST", j, unit("FS", j), 0, e->velocity}); break;
-      case EffectKind::ViscousAsymmetry: out.push_back({"FVA" + js, "FVA", j, unit("FV", j), 0, 0.0}); break;
-      case EffectKind::SmoothCoulomb: out.push_back({"FC" + js, "FC", j, unit("FS", j), 0, e->velocity}); break;
-      case EffectKind::PositionHarmonics: {
-        std::vector<int> orders = e->orders;
-        std::sort(orders.begin(), orders.end());
-        for (int k : orders) {
-          const std::string suffix = js + "_" + std::to_string(k);
-          out.push_back({"HS" + suffix, "HS", j, unit("FS", j), k, 0.0});
-          out.push_back({"HC" + suffix, "HC", j, unit("FS", j), k, 0.0});
-        }
-        break;
-      }
-      case EffectKind::Coulomb:
-      case EffectKind::InertiaProducts: break;
-    }
+    // The unit of the base family the row's parameters share (prismatic joints have their own).
+    const std::string u = row.unit_like == EffectUnit::LikeFV   ? unit("FV", j)
+                          : row.unit_like == EffectUnit::LikeFS ? unit("FS", j)
+                                                                : std::string(row.unit);
+    const double velocity = row.velocity_scale ? e->velocity : 0.0;
+    std::vector<int> orders = e->orders;
+    std::sort(orders.begin(), orders.end());
+    if (orders.empty()) orders = {0};  // one parameter per family: no order
+    for (int k : orders)
+      for (const std::string& family : effect_words(row.families))
+        out.push_back({effect_parameter_name(family, j, k), family, j, u, k, velocity});
   }
   return out;
 }

@@ -377,3 +377,117 @@ TEST(DiagnoseEffects, TermsMatchTheCompiledVariant) {
 }
 
 }  // namespace
+
+
+#include "symoro/codegen/effects.hpp"
+#include "symoro/codegen/graph_evaluator.hpp"
+#include "symoro/effect_table.hpp"
+#include "symoro/twin/plant.hpp"
+#include "symoro/twin/truth.hpp"
+
+namespace {
+
+// The compiled term of one of a variant effect's parameters, evaluated at (q, qd).
+double compiled_term(const symoro::codegen::EffectParameter& p, double q, double qd) {
+  symoro::codegen::ExprGraph g;
+  const auto root = symoro::codegen::effect_term(g, p, g.symbol("q"), g.symbol("qd"));
+  symoro::codegen::Evaluator eval(g, {root});
+  return eval({{"q", q}, {"qd", qd}})[0];
+}
+
+// Every row of the effect table, read by the three that use it: the diagnosis knows it by its
+// diagnosis name, the compiler by its variant name (with the families it un-fixes), the twin by
+// its twin name; where a row has a diagnosis and a compiled term, the two name the same
+// parameters in the same units and evaluate the same law (the diagnosis's averaged over a
+// vanishing velocity spread); where the twin simulates a friction row, its plant's torque is the
+// compiled term with the twin's level and velocity.
+TEST(EffectTable, TheDiagnosisTheCompilerAndTheTwinAgreeOnEveryRow) {
+  namespace cg = symoro::codegen;
+  const auto unit = [](const std::string& family, int) { return family == "FV" ? "N*m*s/rad" : "N*m"; };
+  int compared = 0;
+  for (const symoro::EffectRow& row : symoro::kEffectTable) {
+    SCOPED_TRACE(std::string(row.title));
+    EXPECT_FALSE(row.diagnosis.empty() && row.variant.empty() && row.twin.empty()) << "a row nobody reads";
+    if (!row.diagnosis.empty()) EXPECT_EQ(effect_info(effect_kind(std::string(row.diagnosis))).row, &row);
+    std::optional<cg::EffectKind> compiled;
+    if (!row.variant.empty()) {
+      compiled = cg::effect_kind(std::string(row.variant));
+      ASSERT_TRUE(compiled.has_value()) << row.variant;
+      EXPECT_EQ(cg::unfixed_families(*compiled), symoro::effect_words(row.unfixes));
+      EXPECT_EQ(cg::effect_has_velocity(*compiled), row.velocity_scale);
+      EXPECT_EQ(cg::effect_on_links(*compiled), row.scope == symoro::EffectScope::Link);
+    }
+    if (!row.twin.empty()) {
+      symoro::twin::Effects e;
+      e.disable_all();
+      e.set(std::string(row.twin), true);
+      EXPECT_EQ(e.enabled(), std::vector<std::string>{std::string(row.twin)});
+    }
+    if (row.diagnosis.empty() || !compiled || !row.unfixes.empty()) continue;
+    // The same candidate as the diagnosis makes it and as a variant compiles it, on joint 2.
+    Candidate c;
+    c.kind = effect_kind(std::string(row.diagnosis));
+    c.joint = 2;
+    c.coulomb_velocity = 1e-7;  // the spread's effect on Stribeck's law: (spread / vs)^2 relative
+    c.stribeck_velocity = 0.05;
+    if (c.kind == EffectKind::PositionHarmonics) c.orders = {1, 3};
+    cg::EffectSpec spec;
+    spec.kind = *compiled;
+    spec.index = 2;
+    spec.velocity = variant_velocity(c);
+    spec.orders = c.orders;
+    const std::vector<cg::EffectParameter> params = cg::effect_parameters({spec}, unit);
+    std::vector<std::string> names, units;
+    for (const auto& p : params) names.push_back(p.name), units.push_back(p.unit);
+    EXPECT_EQ(names.size(), c.orders.empty() ? symoro::effect_words(row.families).size()
+                                             : symoro::effect_words(row.families).size() * c.orders.size());
+    const Candidate made = joint_candidate(c.kind, 2, c.orders);  // as candidates() makes it
+    EXPECT_EQ(made.parameters, names);
+    EXPECT_EQ(made.units, units);
+    std::vector<double> v(params.size());
+    for (double q : {-2.0, 0.3, 1.7})
+      for (double qd : {-0.4, -0.05, -0.01, 0.01, 0.03, 0.2}) {
+        effect_terms(c, q, qd, v.data());
+        for (std::size_t i = 0; i < params.size(); ++i)
+          EXPECT_NEAR(compiled_term(params[i], q, qd), v[i], 1e-9) << names[i] << " at q " << q << ", qd " << qd;
+      }
+    ++compared;
+  }
+  EXPECT_EQ(compared, 5);  // coulomb, stribeck, offset, viscous_asymmetry, position_harmonics
+
+  // The twin's friction rows: its plant's torque beyond viscous friction is the compiled term
+  // times the twin's level (coulomb: smooth_coulomb at the twin's smoothing velocity; stribeck:
+  // the law, where the twin's tanh-smoothed sign is 1), and its torque offset t is the offset
+  // term with OFF = -t (the plant adds t to the drive).
+  TwinConfig config = base_config();
+  config.effects.disable_all();
+  config.effects.coulomb = config.effects.stribeck = config.effects.torque_offset = true;
+  config.effects.coulomb_torque = Eigen::VectorXd::LinSpaced(n, 0.1, 0.4);
+  config.effects.stribeck_torque = Eigen::VectorXd::LinSpaced(n, 0.05, 0.2);
+  config.effects.offset_torque = Eigen::VectorXd::LinSpaced(n, -0.3, 0.2);
+  const auto model = symoro::robot::compiled_model<Full>();
+  const symoro::twin::Truth truth = symoro::twin::make_truth(model, config);
+  const Eigen::VectorXd q0 = Eigen::VectorXd::LinSpaced(n, -0.5, 0.5);
+  const symoro::twin::Plant plant(model, truth, config, q0);
+  const auto& fx = config.effects;
+  const cg::EffectParameter fc{"FC1", "FC", 1, "N*m", 0, fx.coulomb_smoothing_velocity};
+  const cg::EffectParameter fst{"FST1", "FST", 1, "N*m", 0, fx.stribeck_velocity};
+  for (int j = 0; j < n; ++j)
+    for (double qd : {-0.3, -0.12, 0.15, 0.25}) {  // |qd| >= 12 smoothing widths: tanh is the sign to 1e-10
+      const double expected = fx.coulomb_torque(j) * compiled_term(fc, 0, qd) + fx.stribeck_torque(j) * compiled_term(fst, 0, qd);
+      EXPECT_NEAR(plant.extra_friction(j, qd), expected, 1e-9) << "joint " << j + 1 << ", qd " << qd;
+    }
+  // Offset: the plant with it under torques tau moves as the plant without it under tau + t.
+  TwinConfig rigid = config;
+  rigid.effects.disable_all();
+  const symoro::twin::Plant without(model, symoro::twin::make_truth(model, rigid), rigid, q0);
+  Eigen::VectorXd x = plant.state(), dx_with(x.size()), dx_without(x.size());
+  x.segment(n, n).setZero();  // at rest: no friction either way
+  const Eigen::VectorXd tau = Eigen::VectorXd::LinSpaced(n, 1.0, -1.0);
+  plant.derivative(x, tau, dx_with);
+  without.derivative(x, tau + fx.offset_torque, dx_without);
+  EXPECT_LT((dx_with - dx_without).norm(), 1e-9 * dx_with.norm());
+  EXPECT_GT((dx_with - [&] { Eigen::VectorXd d(x.size()); without.derivative(x, tau, d); return d; }()).norm(), 1e-3);
+}
+
+}  // namespace

@@ -228,6 +228,13 @@ std::vector<std::filesystem::path> write_diagnosis_report(const Diagnosis& d, co
   return written;
 }
 
+namespace {
+
+// The robot.yaml variant effect a selected effect compiles to (the effect table's).
+std::string variant_of(const Candidate& c) { return std::string(effect_info(c.kind).row->variant); }
+
+}  // namespace
+
 std::string variant_yaml(const Diagnosis& d, const std::string& name, const std::string& base) {
   std::map<std::string, std::vector<int>> joints;
   // Effects written {joints: [...], <parameter>}: joints grouped by (effect, parameter text).
@@ -242,16 +249,16 @@ std::string variant_yaml(const Diagnosis& d, const std::string& name, const std:
       // Coulomb friction smoothed as the diagnosis found the logs' velocity spread: the files'
       // sign(qd) column is biased towards 0 by it at slow motion. The variant's tanh(qd / width)
       // has the slope at rest of the diagnosis's erf (width = spread sqrt(pi / 2)).
-      case EffectKind::Coulomb: scaled["smooth_coulomb"][c.joint] = c.coulomb_velocity * std::sqrt(std::acos(-1.0) / 2); break;
-      case EffectKind::Offset: joints["offset"].push_back(c.joint); break;
-      case EffectKind::ViscousAsymmetry: joints["viscous_asymmetry"].push_back(c.joint); break;
-      case EffectKind::InertiaProducts: joints["inertia_products"].push_back(c.joint); break;
+      case EffectKind::Coulomb: scaled[variant_of(c)][c.joint] = variant_velocity(c); break;
+      case EffectKind::Offset:
+      case EffectKind::ViscousAsymmetry:
+      case EffectKind::InertiaProducts: joints[variant_of(c)].push_back(c.joint); break;
       // The law itself, sign(qd) exp(-(qd / vs)^2): its level is the law's (effects.hpp).
-      case EffectKind::Stribeck: scaled["stribeck"][c.joint] = c.stribeck_velocity; break;
+      case EffectKind::Stribeck: scaled[variant_of(c)][c.joint] = variant_velocity(c); break;
       case EffectKind::PositionHarmonics: {
         std::string orders;
         for (int k : c.orders) orders += (orders.empty() ? "" : ", ") + std::to_string(k);
-        shaped["position_harmonics"]["orders: [" + orders + "]"].push_back(c.joint);
+        shaped[variant_of(c)]["orders: [" + orders + "]"].push_back(c.joint);
         break;
       }
       case EffectKind::ActuationDelay:

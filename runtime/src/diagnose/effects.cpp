@@ -1,5 +1,7 @@
 #include "symoro/diagnose/effects.hpp"
 
+#include <algorithm>
+#include <array>
 #include <cmath>
 #include <stdexcept>
 
@@ -24,19 +26,32 @@ bool has_parameter(const DesignStack& d, const std::string& name) {
 
 }  // namespace
 
+namespace {
+
+// The diagnosis's effects in EffectKind's order, each a row of the effect table by its name.
+constexpr std::array<std::string_view, 10> kDiagnosisOrder{
+    "coulomb",         "stribeck",        "offset",   "viscous_asymmetry", "position_harmonics",
+    "inertia_products", "torque_constant", "actuation_delay", "backlash",   "payload"};
+static_assert(kDiagnosisOrder.size() == static_cast<std::size_t>(EffectKind::Payload) + 1);
+
+constexpr bool every_effect_has_a_row() {
+  for (std::string_view name : kDiagnosisOrder)
+    if (!find_effect(&EffectRow::diagnosis, name)) return false;
+  return true;
+}
+static_assert(every_effect_has_a_row(), "a diagnosis effect without its row in symoro/effect_table.hpp");
+
+}  // namespace
+
 const std::vector<EffectInfo>& effect_catalogue() {
-  static const std::vector<EffectInfo> v{
-      {EffectKind::Coulomb, "coulomb", "Coulomb friction", "N m", true, true},
-      {EffectKind::Stribeck, "stribeck", "Stribeck friction", "N m", true, true},
-      {EffectKind::Offset, "offset", "constant torque offset", "N m", true, true},
-      {EffectKind::ViscousAsymmetry, "viscous_asymmetry", "direction-dependent viscous friction", "N m s/rad", true, true},
-      {EffectKind::PositionHarmonics, "position_harmonics", "position-dependent torque", "N m", true, true},
-      {EffectKind::InertiaProducts, "inertia_products", "products of inertia", "kg m^2", false, true},
-      {EffectKind::TorqueConstant, "torque_constant", "torque-constant error", "%", true, false},
-      {EffectKind::ActuationDelay, "actuation_delay", "actuation delay", "ms", false, false},
-      {EffectKind::Backlash, "backlash", "backlash", "deg", true, false},
-      {EffectKind::Payload, "payload", "payload on the last link", "kg", false, false},
-  };
+  static const std::vector<EffectInfo> v = [] {
+    std::vector<EffectInfo> out;
+    for (std::size_t k = 0; k < kDiagnosisOrder.size(); ++k) {
+      const EffectRow* row = find_effect(&EffectRow::diagnosis, kDiagnosisOrder[k]);
+      out.push_back({static_cast<EffectKind>(k), row, row->diagnosis.data(), row->title.data()});
+    }
+    return out;
+  }();
   return v;
 }
 
@@ -72,40 +87,47 @@ std::string Candidate::label() const {
   return s + fmt::format(", joint {}", joint);
 }
 
+Candidate joint_candidate(EffectKind kind, int j, const std::vector<int>& orders) {
+  const EffectRow& row = *effect_info(kind).row;
+  Candidate c;
+  c.kind = kind;
+  c.joint = j;
+  c.orders = orders;
+  for (int k : orders.empty() ? std::vector<int>{0} : orders)
+    for (const std::string& family : effect_words(row.families)) {
+      c.parameters.push_back(effect_parameter_name(family, j, k));
+      c.units.emplace_back(row.unit);
+    }
+  return c;
+}
+
 namespace {
 
-bool wanted(const CandidateOptions& o, EffectKind k) {
-  if (o.only.empty()) return true;
-  for (const auto& n : o.only)
+bool wanted(const CandidateOptions& options, EffectKind k) {
+  if (options.only.empty()) return true;
+  for (const auto& n : options.only)
     if (n == effect_info(k).name) return true;
   return false;
 }
 
 // Joint j's Coulomb candidates, one per spread, and Stribeck candidates, one per velocity and
 // spread of at most half of it.
-void add_friction(const DesignStack& d, const CandidateOptions& o, int j, const std::vector<double>& spreads,
+void add_friction(const DesignStack& d, const CandidateOptions& options, int j, const std::vector<double>& spreads,
                   const std::vector<double>& velocities, std::vector<Candidate>& out) {
-  auto make = [&](EffectKind k, const std::string& parameter) {
-    Candidate c;
-    c.kind = k;
-    c.joint = j;
-    c.parameters = {parameter};
-    c.units = {"N*m"};
-    return c;
-  };
   // Named as the variant compiles it (smooth_coulomb: FC<j>); not a candidate where the model
   // already has Coulomb friction on the joint (OpenSYMORO's FS<j>, or a compiled FC<j>).
-  const std::string fc = fmt::format("FC{}", j), fst = fmt::format("FST{}", j);
-  if (wanted(o, EffectKind::Coulomb) && !has_parameter(d, fmt::format("FS{}", j)) && !has_parameter(d, fc))
+  const std::string fc = joint_candidate(EffectKind::Coulomb, j).parameters[0];
+  const std::string fst = joint_candidate(EffectKind::Stribeck, j).parameters[0];
+  if (wanted(options, EffectKind::Coulomb) && !has_parameter(d, fmt::format("FS{}", j)) && !has_parameter(d, fc))
     for (double spread : spreads) {
-      out.push_back(make(EffectKind::Coulomb, fc));
+      out.push_back(joint_candidate(EffectKind::Coulomb, j));
       out.back().coulomb_velocity = spread;
     }
-  if (wanted(o, EffectKind::Stribeck) && !has_parameter(d, fst))
+  if (wanted(options, EffectKind::Stribeck) && !has_parameter(d, fst))
     for (double vs : velocities)
       for (double spread : spreads)
         if (2 * spread <= vs) {
-          out.push_back(make(EffectKind::Stribeck, fst));
+          out.push_back(joint_candidate(EffectKind::Stribeck, j));
           out.back().stribeck_velocity = vs;
           out.back().coulomb_velocity = spread;
         }
@@ -113,53 +135,44 @@ void add_friction(const DesignStack& d, const CandidateOptions& o, int j, const 
 
 }  // namespace
 
-std::vector<Candidate> friction_options(const DesignStack& d, const CandidateOptions& o, int joint) {
+std::vector<Candidate> friction_options(const DesignStack& d, const CandidateOptions& options, int joint) {
   std::vector<Candidate> out;
-  add_friction(d, o, joint, o.refined_spreads, o.refined_stribeck_velocities, out);
+  add_friction(d, options, joint, options.refined_spreads, options.refined_stribeck_velocities, out);
   return out;
 }
 
-std::vector<Candidate> candidates(const DesignStack& d, const CandidateOptions& o) {
+std::vector<Candidate> candidates(const DesignStack& d, const CandidateOptions& options) {
   std::vector<Candidate> out;
   const int n = d.joints;
   for (int j = 1; j <= n; ++j) {
-    auto add = [&](EffectKind k, std::vector<std::string> params, std::vector<std::string> units) {
-      if (!wanted(o, k)) return static_cast<Candidate*>(nullptr);
-      for (const auto& p : params)
-        if (has_parameter(d, p)) return static_cast<Candidate*>(nullptr);
-      Candidate c;
-      c.kind = k;
-      c.joint = j;
-      c.parameters = std::move(params);
-      c.units = std::move(units);
-      out.push_back(c);
-      return &out.back();
+    // A joint's effect, unless the model already has one of its parameters.
+    auto add = [&](EffectKind k, const std::vector<int>& orders = {}) {
+      if (!wanted(options, k)) return;
+      Candidate c = joint_candidate(k, j, orders);
+      for (const auto& p : c.parameters)
+        if (has_parameter(d, p)) return;
+      out.push_back(std::move(c));
     };
-    add_friction(d, o, j, o.coulomb_velocities, o.stribeck_velocities, out);
-    add(EffectKind::Offset, {fmt::format("OFF{}", j)}, {"N*m"});
-    add(EffectKind::ViscousAsymmetry, {fmt::format("FVA{}", j)}, {"N*m*s/rad"});
-    std::vector<std::string> hp, hu;
-    for (int k : o.harmonic_orders) {
-      hp.push_back(fmt::format("HS{}_{}", j, k));
-      hp.push_back(fmt::format("HC{}_{}", j, k));
-      hu.insert(hu.end(), 2, "N*m");
-    }
-    if (!hp.empty())
-      if (Candidate* c = add(EffectKind::PositionHarmonics, hp, hu)) c->orders = o.harmonic_orders;
+    add_friction(d, options, j, options.coulomb_velocities, options.stribeck_velocities, out);
+    add(EffectKind::Offset);
+    add(EffectKind::ViscousAsymmetry);
+    if (!options.harmonic_orders.empty()) add(EffectKind::PositionHarmonics, options.harmonic_orders);
     const bool drive = d.rotor_inertia_index(j - 1) >= 0 && d.viscous_index(j - 1) >= 0;
-    add(EffectKind::TorqueConstant, {fmt::format("KTE{}", j)}, {"1"});
-    if (drive) add(EffectKind::Backlash, {fmt::format("BL{}", j)}, {"rad"});
+    add(EffectKind::TorqueConstant);
+    if (drive) add(EffectKind::Backlash);
     // Products of inertia of link j from the full model.
-    if (wanted(o, EffectKind::InertiaProducts)) {
+    if (wanted(options, EffectKind::InertiaProducts)) {
+      const EffectRow& row = *effect_info(EffectKind::InertiaProducts).row;
+      const std::vector<std::string> families = effect_words(row.families);
       Candidate c;
       c.kind = EffectKind::InertiaProducts;
       c.joint = j;
       for (std::size_t i = 0; i < d.full_extra_names.size(); ++i) {
         const std::string& f = d.full_extra_families[i];
-        if (d.full_extra_joints[i] == j && (f == "XY" || f == "XZ" || f == "YZ")) {
+        if (d.full_extra_joints[i] == j && std::find(families.begin(), families.end(), f) != families.end()) {
           c.full_columns.push_back(static_cast<int>(i));
           c.parameters.push_back(d.full_extra_names[i]);
-          c.units.push_back("kg*m^2");
+          c.units.emplace_back(row.unit);
         }
       }
       if (!c.full_columns.empty()) out.push_back(c);
@@ -167,7 +180,7 @@ std::vector<Candidate> candidates(const DesignStack& d, const CandidateOptions& 
   }
   // A payload changes the last link's inertial parameters, which a refit absorbs: it is a
   // candidate only when the identified parameters are held.
-  if (wanted(o, EffectKind::Payload) && d.held() && d.payload_link > 0 && d.payload_map.cols() == 4) {
+  if (wanted(options, EffectKind::Payload) && d.held() && d.payload_link > 0 && d.payload_map.cols() == 4) {
     Candidate c;
     c.kind = EffectKind::Payload;
     c.joint = d.payload_link;
@@ -175,7 +188,7 @@ std::vector<Candidate> candidates(const DesignStack& d, const CandidateOptions& 
     c.units = {"kg", "kg*m", "kg*m", "kg*m"};
     out.push_back(c);
   }
-  if (wanted(o, EffectKind::ActuationDelay)) {
+  if (wanted(options, EffectKind::ActuationDelay)) {
     Candidate c;
     c.kind = EffectKind::ActuationDelay;
     c.parameters = {"DELAY"};
@@ -280,20 +293,16 @@ void effect_terms(const Candidate& c, double q, double qd, double* out) {
   }
 }
 
-bool physical(const Candidate& c, const Eigen::VectorXd& theta) {
-  switch (c.kind) {
-    case EffectKind::Coulomb:
-    case EffectKind::Stribeck:
-    case EffectKind::Backlash:
-    case EffectKind::Payload:
-    // A torque cannot answer its command before it is sent: a negative delay is another
-    // misfit's shape (seen against a study's accepted parameters: -3.39 ms), not a delay.
-    case EffectKind::ActuationDelay:
-      return theta(0) > 0;
-    default:
-      return true;
-  }
+double variant_velocity(const Candidate& c) {
+  if (c.kind == EffectKind::Coulomb) return c.coulomb_velocity * std::sqrt(std::acos(-1.0) / 2);
+  if (c.kind == EffectKind::Stribeck) return c.stribeck_velocity;
+  return 0;
 }
+
+// The effect table's check: a level, a play, a mass or a delay must be positive. (A torque cannot
+// answer its command before it is sent: a negative delay is another misfit's shape, seen against
+// a study's accepted parameters: -3.39 ms, not a delay.)
+bool physical(const Candidate& c, const Eigen::VectorXd& theta) { return !effect_info(c.kind).row->positive || theta(0) > 0; }
 
 Magnitude magnitude(const Candidate& c, const Eigen::VectorXd& theta, const Eigen::VectorXd& sd) {
   Magnitude m;
@@ -304,15 +313,14 @@ Magnitude magnitude(const Candidate& c, const Eigen::VectorXd& theta, const Eige
     case EffectKind::Coulomb:
     case EffectKind::Stribeck:
     case EffectKind::Offset:
+    case EffectKind::ViscousAsymmetry: {  // one parameter, in the table's unit ("N*m" read "N m")
+      std::string unit(effect_info(c.kind).row->unit);
+      std::replace(unit.begin(), unit.end(), '*', ' ');
       m.values = {theta(0)};
       m.names = {c.parameters[0]};
-      m.text = pm(theta(0), sd(0), "N m", 1, 4);
+      m.text = pm(theta(0), sd(0), unit.c_str(), 1, 4);
       break;
-    case EffectKind::ViscousAsymmetry:
-      m.values = {theta(0)};
-      m.names = {c.parameters[0]};
-      m.text = pm(theta(0), sd(0), "N m s/rad", 1, 4);
-      break;
+    }
     case EffectKind::PositionHarmonics:
       for (std::size_t i = 0; i < c.orders.size(); ++i) {
         const double a = std::hypot(theta(2 * i), theta(2 * i + 1));

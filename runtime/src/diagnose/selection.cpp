@@ -138,7 +138,7 @@ void backward_check(const DesignStack& train, const DesignStack& heldout, const 
       // its own region already fails (the weakest by size).
       auto heldout_gain = [&] {
         std::vector<int> on;
-        if (effect_info(c.kind).per_joint) on.push_back(c.joint);
+        if (effect_info(c.kind).row->scope == EffectScope::Joint) on.push_back(c.joint);
         std::vector<Candidate> others = chosen;
         others.erase(others.begin() + static_cast<std::ptrdiff_t>(i));
         const Fit without = fit_with_effects(train, heldout, others, weights, o.max_lag);

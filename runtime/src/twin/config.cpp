@@ -11,6 +11,7 @@
 #include <fmt/format.h>
 #include <yaml-cpp/yaml.h>
 
+#include "symoro/effect_table.hpp"
 #include "symoro/error.hpp"
 #include "symoro/io/yaml_keys.hpp"
 
@@ -209,9 +210,7 @@ class Reader {
   }
 
   void effects(const YAML::Node& node, Effects& e) const {
-    check_keys(node, "effects", {"coulomb", "stribeck", "torque_offset", "backlash", "payload",
-                                 "torque_constant_error", "actuation_delay", "sensor_noise", "timestamp_jitter",
-                                 "dropped_samples"});
+    check_keys(node, "effects", Effects::names());
     auto section = [&](const char* name, const std::vector<std::string>& keys, bool& enabled, auto&& body) {
       const YAML::Node s = node[name];
       if (!s.IsDefined()) {
@@ -313,10 +312,15 @@ YAML::Node load(const std::filesystem::path& path) {
 
 }  // namespace
 
+// The twin's effects are the effect table's rows with a twin name, in the table's order; the
+// flags of set() and enabled() follow that order.
 const std::vector<std::string>& Effects::names() {
-  static const std::vector<std::string> v{"coulomb", "stribeck", "torque_offset", "backlash", "payload",
-                                          "torque_constant_error", "actuation_delay", "sensor_noise", "timestamp_jitter",
-                                          "dropped_samples"};
+  static const std::vector<std::string> v = [] {
+    std::vector<std::string> out;
+    for (const EffectRow& row : kEffectTable)
+      if (!row.twin.empty()) out.emplace_back(row.twin);
+    return out;
+  }();
   return v;
 }
 
@@ -324,6 +328,7 @@ void Effects::set(const std::string& name, bool on) {
   bool* flags[] = {&coulomb, &stribeck, &torque_offset, &backlash, &payload,
                    &torque_constant_error, &actuation_delay, &sensor_noise, &timestamp_jitter, &dropped_samples};
   const auto& n = names();
+  if (n.size() != std::size(flags)) throw std::logic_error("the twin's effect flags and the effect table's twin names differ");
   for (size_t i = 0; i < n.size(); ++i)
     if (n[i] == name) {
       *flags[i] = on;
@@ -342,7 +347,7 @@ std::vector<std::string> Effects::enabled() const {
   const bool flags[] = {coulomb, stribeck, torque_offset, backlash, payload,
                         torque_constant_error, actuation_delay, sensor_noise, timestamp_jitter, dropped_samples};
   std::vector<std::string> out;
-  for (size_t i = 0; i < names().size(); ++i)
+  for (size_t i = 0; i < std::size(flags) && i < names().size(); ++i)
     if (flags[i]) out.push_back(names()[i]);
   return out;
 }

@@ -4,6 +4,7 @@
 
 #include <fmt/format.h>
 
+#include "symoro/effect_table.hpp"
 #include "symoro/twin/kinematics.hpp"
 
 namespace symoro::twin {
@@ -106,8 +107,7 @@ Eigen::VectorXd standard_vector(const std::vector<StandardParameterInfo>& names,
     if (family == "FS") return coulomb(j - 1);
     // A variant's model-gap effect parameters (robot.yaml `effects`): like Coulomb friction, the
     // twin applies its own effects, so they are 0 in the truth.
-    if (family == "OFF" || family == "FST" || family == "FVA" || family == "HS" || family == "HC" || family == "FC")
-      return 0.0;
+    if (variant_adds_family(family)) return 0.0;
     const LinkInertial& L = links.at(j - 1);
     if (family == "XX") return L.J(0, 0);
     if (family == "XY") return L.J(0, 1);

@@ -1,7 +1,7 @@
-// Model-gap effects of robot.yaml variants (`effects:`), the catalogue in one place: effect
-// names, the base parameters an effect un-fixes, the parameters it adds (names, families,
-// units, canonical order) and their torque terms. See docs/generated-api.md, "Effects in
-// variants".
+// Model-gap effects of robot.yaml variants (`effects:`): their kinds in canonical order, the
+// parameters they add and their torque terms. Names, the families an effect un-fixes or adds
+// and their units are the effect table's (runtime/include/symoro/effect_table.hpp, which the
+// diagnosis and the twin read too). See docs/generated-api.md, "Effects in variants".
 //
 //   coulomb             un-fixes FS<j> (the files already have FSj*sign(QPj))
 //   inertia_products    un-fixes the XY, XZ, YZ base parameters of link j

@@ -24,8 +24,9 @@
 //                                                       s made at the logs' rate and low-passed as
 //                                                       the data were (DesignStack::filtered)
 // The last three are linearizations about the current fit (their columns use its torque), so
-// the selection re-evaluates them after every step. The names of the first five match the
-// compiler's variant effects (robot.yaml `effects:`), so a selected effect can be compiled in.
+// the selection re-evaluates them after every step. Names, families, units, the physical check
+// and the variant effect each compiles to (coulomb -> smooth_coulomb) are the effect table's
+// (symoro/effect_table.hpp); what is here is each effect's term.
 #pragma once
 
 #include <string>
@@ -34,6 +35,7 @@
 #include <Eigen/Core>
 
 #include "symoro/diagnose/design_stack.hpp"
+#include "symoro/effect_table.hpp"
 
 namespace symoro::diagnose {
 
@@ -50,13 +52,13 @@ enum class EffectKind {
   Payload,
 };
 
+// A diagnosis effect: its kind and its row of the effect table (symoro/effect_table.hpp: name,
+// title, parameter families and units, the physical check, the variant effect it compiles to).
 struct EffectInfo {
   EffectKind kind;
-  const char* name;         // robot.yaml / report key, e.g. "coulomb"
-  const char* title;        // "Coulomb friction"
-  const char* unit;         // of its magnitude
-  bool per_joint;           // else per link (inertia_products) or whole robot (actuation_delay)
-  bool compilable;          // the compiler can add it to a variant
+  const EffectRow* row;
+  const char* name;  // row->diagnosis, e.g. "coulomb"
+  const char* title;  // row->title, "Coulomb friction"
 };
 
 const std::vector<EffectInfo>& effect_catalogue();
@@ -94,6 +96,10 @@ struct CandidateOptions {
   std::vector<std::string> only;  // effect names to consider (empty: all)
 };
 
+// A joint's candidate with its parameters named and united as the effect table says (one per
+// family, and per order for position harmonics; revolute units), at the default velocities.
+Candidate joint_candidate(EffectKind kind, int joint, const std::vector<int>& orders = {});
+
 // Every candidate the data and the identified model allow: not one the model already has
 // (a parameter of the same name), inertia products only for links whose full-model columns
 // exist in the stack, torque-constant and backlash only where IA and FV are identified.
@@ -117,6 +123,11 @@ void effect_terms(const Candidate& c, double q, double qd, double* out);
 // The candidate's columns, (samples * joints) x parameters: the precomputed terms of the
 // stack when it has them, else evaluated on the stack's samples.
 Eigen::MatrixXd effect_columns(const Candidate& c, const DesignStack& d, const FitState& fit);
+
+// The velocity scale of the variant effect the candidate compiles to (robot.yaml's {joints,
+// velocity}): Stribeck's own velocity; for Coulomb friction the tanh width whose slope at rest is
+// the erf's, spread sqrt(pi / 2); 0 for an effect without one.
+double variant_velocity(const Candidate& c);
 
 // False when fitted parameters contradict the effect's physics (negative Coulomb or Stribeck
 // level, negative play, a negative payload mass or actuation delay): such a fit is absorbing
