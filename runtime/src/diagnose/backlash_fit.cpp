@@ -45,16 +45,16 @@ twin::TwinConfig with_selected_effects(twin::TwinConfig c, const Selection& s) {
 }
 
 BacklashFit fit_backlash(const robot::ModelHandle& full, const io::Log& measured, const trajectory::SampledReference& reference,
-                         twin::TwinConfig nominal, const BacklashFitOptions& o) {
+                         twin::TwinConfig nominal, const BacklashFitOptions& options) {
   const int n = full.nq();
   BacklashFit fit;
-  fit.measured = high_band_rms(measured, o);
+  fit.measured = high_band_rms(measured, options);
   // No play anywhere to start with (a description may carry widths with backlash switched off).
   nominal.effects.backlash = false;
   nominal.effects.backlash_width = Eigen::VectorXd::Zero(n);
   // The null: the log's encoder noise in the loop, its unexplained torque added to the result
   // (the twin's own current noise off: the log's is that).
-  fit.floor = loop_floor(measured, nominal, o);
+  fit.floor = loop_floor(measured, nominal, options);
   nominal.effects.sensor_noise = true;
   nominal.effects.encoder_noise = fit.floor.encoder_noise;
   nominal.effects.encoder_noise_per_joint = fit.floor.encoder_noise_per_joint;
@@ -64,29 +64,29 @@ BacklashFit fit_backlash(const robot::ModelHandle& full, const io::Log& measured
     ro.robot = full.robot();
     ro.seed = seed;
     ++fit.simulations;
-    const Eigen::VectorXd loop = high_band_rms(twin::ClosedLoopTwin(full, c).run(reference, ro), o);
+    const Eigen::VectorXd loop = high_band_rms(twin::ClosedLoopTwin(full, c).run(reference, ro), options);
     return Eigen::VectorXd((loop.cwiseAbs2() + fit.floor.rms.cwiseAbs2()).cwiseSqrt());
   };
   auto judge = [&](const twin::TwinConfig& c) {
-    Eigen::MatrixXd runs(n, o.seeds);
-    for (int k = 0; k < o.seeds; ++k) runs.col(k) = simulate(c, o.seed + static_cast<std::uint64_t>(k));
+    Eigen::MatrixXd runs(n, options.seeds);
+    for (int k = 0; k < options.seeds; ++k) runs.col(k) = simulate(c, options.seed + static_cast<std::uint64_t>(k));
     fit.simulated = runs.rowwise().mean();
-    fit.spread = ((runs.colwise() - fit.simulated).array().square().rowwise().sum() / std::max(1, o.seeds - 1)).sqrt();
+    fit.spread = ((runs.colwise() - fit.simulated).array().square().rowwise().sum() / std::max(1, options.seeds - 1)).sqrt();
   };
   twin::TwinConfig c = nominal;
   if (c.effects.actuation_delay && c.effects.actuation_delay_time > 0) {
     auto mismatch = [&](double d) {
       twin::TwinConfig t = c;
       t.effects.actuation_delay_time = d;
-      const Eigen::VectorXd h = simulate(t, o.seed);
+      const Eigen::VectorXd h = simulate(t, options.seed);
       double sum = 0;
       for (int j = 0; j < n; ++j) sum += std::pow(std::log(fit.measured(j) / h(j)), 2);
       return sum;
     };
     const double g = 0.5 * (std::sqrt(5.0) - 1);
-    double a = c.effects.actuation_delay_time * (1 - o.delay_range), b = c.effects.actuation_delay_time * (1 + o.delay_range);
+    double a = c.effects.actuation_delay_time * (1 - options.delay_range), b = c.effects.actuation_delay_time * (1 + options.delay_range);
     double x1 = b - g * (b - a), x2 = a + g * (b - a), f1 = mismatch(x1), f2 = mismatch(x2);
-    for (int k = 0; k < o.delay_steps; ++k) {
+    for (int k = 0; k < options.delay_steps; ++k) {
       if (f1 < f2) {
         b = x2, x2 = x1, f2 = f1, x1 = b - g * (b - a), f1 = mismatch(x1);
       } else {
@@ -106,7 +106,7 @@ BacklashFit fit_backlash(const robot::ModelHandle& full, const io::Log& measured
     for (int j = 0; j < n; ++j) {
       if (!(c.rotor_inertia(j) > 0) || c.effects.backlash_width(j) > 0 || refused[j]) continue;
       const double excess = fit.measured(j) - fit.simulated(j);
-      if (excess > o.sigmas * fit.spread(j) && excess > o.relative * fit.simulated(j) &&
+      if (excess > options.sigmas * fit.spread(j) && excess > options.relative * fit.simulated(j) &&
           excess / fit.simulated(j) > best_ratio) {
         best = j;
         best_ratio = excess / fit.simulated(j);
@@ -121,12 +121,12 @@ BacklashFit fit_backlash(const robot::ModelHandle& full, const io::Log& measured
     // Bisection on the width: the simulated high-band rms of this joint against the measured.
     twin::TwinConfig trial = c;
     trial.effects.backlash = true;
-    double lo = 0, hi = o.max_width;
+    double lo = 0, hi = options.max_width;
     try {
-      for (int k = 0; k < o.bisection_steps; ++k) {
+      for (int k = 0; k < options.bisection_steps; ++k) {
         const double mid = 0.5 * (lo + hi);
         trial.effects.backlash_width(best) = mid;
-        (simulate(trial, o.seed)(best) < f.measured ? lo : hi) = mid;
+        (simulate(trial, options.seed)(best) < f.measured ? lo : hi) = mid;
       }
     } catch (const DataError& e) {  // e.g. a joint whose link side has no inertia in the twin
       refused[best] = true;
@@ -137,7 +137,7 @@ BacklashFit fit_backlash(const robot::ModelHandle& full, const io::Log& measured
     }
     f.width = 0.5 * (lo + hi);
     // A width at the bisection's floor: any play at all overshoots, so play does not explain it.
-    if (f.width < 2 * o.max_width / std::pow(2.0, o.bisection_steps)) break;
+    if (f.width < 2 * options.max_width / std::pow(2.0, options.bisection_steps)) break;
     trial.effects.backlash_width(best) = f.width;
     c = trial;
     judge(c);

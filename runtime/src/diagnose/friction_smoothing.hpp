@@ -25,7 +25,7 @@
 namespace symoro::diagnose::detail {
 
 // `chosen` and `effects` (the same effects, in order) are rewritten joint by joint.
-void choose_friction_smoothing(const DesignStack& train, const DesignStack& heldout, const SelectionOptions& o,
+void choose_friction_smoothing(const DesignStack& train, const DesignStack& heldout, const SelectionOptions& options,
                                const Eigen::VectorXd& weights, std::vector<Candidate>& chosen,
                                std::vector<SelectedEffect>& effects);
 

@@ -66,15 +66,15 @@ svg::Series line(const Eigen::VectorXd& t, const Eigen::MatrixXd& m, int j, cons
   return s;
 }
 
-std::string joint_bars(const GapComparison& c, const GapReportOptions& o) {
+std::string joint_bars(const GapComparison& c, const GapReportOptions& options) {
   svg::Figure f;
   f.title = "Held-out torque error per joint (rms over the compared trajectories)";
   svg::Panel p;
   p.y_label = "rms(τ measured − τ simulated) [N m]";
   svg::Series b, a;
-  b.name = o.before_label + " (" + c.before_model + ")";
+  b.name = options.before_label + " (" + c.before_model + ")";
   b.style.colour = "#999999";
-  a.name = o.after_label + " (" + c.after_model + ")";
+  a.name = options.after_label + " (" + c.after_model + ")";
   a.style.colour = "#d62728";
   for (Eigen::Index j = 0; j < c.joint_before.size(); ++j) {
     p.categories.push_back(fmt::format("J{}", j + 1));
@@ -88,7 +88,7 @@ std::string joint_bars(const GapComparison& c, const GapReportOptions& o) {
 }
 
 std::string torque_figure(const ValidationRecord& before, const ValidationRecord& after, const std::vector<int>& joints,
-                          const GapComparison& c, const GapReportOptions& o) {
+                          const GapComparison& c, const GapReportOptions& options) {
   svg::Figure f;
   f.title = before.trajectory + ": measured torque and the closed-loop simulation of each model";
   f.columns = 2;
@@ -101,17 +101,17 @@ std::string torque_figure(const ValidationRecord& before, const ValidationRecord
     p.x_label = "t [s]";
     p.y_label = "τ [N m]";
     p.lines.push_back(line(before.time, before.tau_measured, j, "measured", "#000000", 1.6, ""));
-    p.lines.push_back(line(before.time, before.tau_rescue, j, o.before_label + " (" + c.before_model + ")", "#999999",
+    p.lines.push_back(line(before.time, before.tau_rescue, j, options.before_label + " (" + c.before_model + ")", "#999999",
                            1.2, "6 3"));
-    p.lines.push_back(line(after.time, after.tau_rescue, j, o.after_label + " (" + c.after_model + ")", "#d62728", 1.1, ""));
+    p.lines.push_back(line(after.time, after.tau_rescue, j, options.after_label + " (" + c.after_model + ")", "#d62728", 1.1, ""));
     f.panels.push_back(p);
     svg::Panel r;
     r.title = fmt::format("J{}: error (measured − simulated)", j + 1);
     r.x_label = "t [s]";
     r.y_label = "[N m]";
     const Eigen::MatrixXd eb = before.tau_measured - before.tau_rescue, ea = after.tau_measured - after.tau_rescue;
-    r.lines.push_back(line(before.time, eb, j, o.before_label + " (" + c.before_model + ")", "#999999", 1.2, ""));
-    r.lines.push_back(line(after.time, ea, j, o.after_label + " (" + c.after_model + ")", "#d62728", 1.1, ""));
+    r.lines.push_back(line(before.time, eb, j, options.before_label + " (" + c.before_model + ")", "#999999", 1.2, ""));
+    r.lines.push_back(line(after.time, ea, j, options.after_label + " (" + c.after_model + ")", "#d62728", 1.1, ""));
     f.panels.push_back(r);
   }
   return svg::render(f);
@@ -245,10 +245,10 @@ GapReportOptions gap_report_options(const std::filesystem::path& before_dir, con
 
 std::vector<std::filesystem::path> write_gap_report(const StudyValidation& before, const StudyValidation& after,
                                                     const GapComparison& c, const std::filesystem::path& dir,
-                                                    const GapReportOptions& o) {
+                                                    const GapReportOptions& options) {
   std::vector<std::filesystem::path> files;
   std::filesystem::create_directories(dir / "figures");
-  const std::string bl = o.before_label + " (" + c.before_model + ")", al = o.after_label + " (" + c.after_model + ")";
+  const std::string bl = options.before_label + " (" + c.before_model + ")", al = options.after_label + " (" + c.after_model + ")";
 
   std::string md = fmt::format("# Model gap on held-out trajectories: {} → {}\n\n", c.before_model, c.after_model);
   md += fmt::format(
@@ -259,7 +259,7 @@ std::vector<std::filesystem::path> write_gap_report(const StudyValidation& befor
       c.robot);
   md += "| | model | parameters | selected run | final audit |\n|---|---|---|---|---|\n";
   for (const auto* s : {&before, &after})
-    md += fmt::format("| {} | {} | {} | {} | {}{} |\n", s == &before ? o.before_label : o.after_label,
+    md += fmt::format("| {} | {} | {} | {} | {}{} |\n", s == &before ? options.before_label : options.after_label,
                       model_name(s->model), s->names.size(), s->selected_run, s->accepted ? "PD" : "NOT PD",
                       s->rescued ? " (rescued)" : "");
   md += fmt::format("\n**Held-out rms torque error: {:.4f} → {:.4f} N m ({})** over {}.\n\n", c.rmse_before, c.rmse_after,
@@ -301,7 +301,7 @@ std::vector<std::filesystem::path> write_gap_report(const StudyValidation& befor
     md += fmt::format("| J{} | {:.4f} | {:.4f} | {} |\n", j + 1, c.joint_before(j), c.joint_after(j),
                       pct(c.joint_before(j), c.joint_after(j)));
   const std::string bars = "figures/gap_joints.svg";
-  io::write_file_atomically(dir / bars, joint_bars(c, o));
+  io::write_file_atomically(dir / bars, joint_bars(c, options));
   files.push_back(dir / bars);
   md += fmt::format("\n![rms error per joint, before and after]({})\n\n", bars);
 
@@ -320,12 +320,12 @@ std::vector<std::filesystem::path> write_gap_report(const StudyValidation& befor
 
   // Torque figure: the requested trajectory, else the last compared; the joints whose error
   // changed most unless given.
-  std::string traj = o.figure_trajectory.empty() ? c.trajectories.back().trajectory : o.figure_trajectory;
+  std::string traj = options.figure_trajectory.empty() ? c.trajectories.back().trajectory : options.figure_trajectory;
   const ValidationRecord* vb = find(before, traj);
   const ValidationRecord* va = find(after, traj);
   if (!vb || !va)
     throw std::invalid_argument("figure trajectory " + traj + " is not validated by both studies");
-  std::vector<int> joints = o.figure_joints;
+  std::vector<int> joints = options.figure_joints;
   if (joints.empty()) {
     std::vector<int> order(static_cast<std::size_t>(c.joint_before.size()));
     std::iota(order.begin(), order.end(), 0);
@@ -337,7 +337,7 @@ std::vector<std::filesystem::path> write_gap_report(const StudyValidation& befor
     joints = order;
   }
   const std::string torque = "figures/gap_torque_" + traj + ".svg";
-  io::write_file_atomically(dir / torque, torque_figure(*vb, *va, joints, c, o));
+  io::write_file_atomically(dir / torque, torque_figure(*vb, *va, joints, c, options));
   files.push_back(dir / torque);
   md += fmt::format("## {}: torques and errors\n\nMeasured (black), {} (grey, dashed) and {} (red).\n\n![{}]({})\n",
                     traj, bl, al, traj, torque);

@@ -13,12 +13,12 @@
 
 namespace symoro::diagnose {
 
-Eigen::VectorXd high_band_rms(const io::Log& log, const BacklashFitOptions& o) {
+Eigen::VectorXd high_band_rms(const io::Log& log, const BacklashFitOptions& options) {
   preprocess::Options po;
-  po.derivative_cutoff = o.light_hz;
+  po.derivative_cutoff = options.light_hz;
   const double base = log.meta.sample_time > 0 ? log.meta.sample_time : 0.001;
   const preprocess::Samples s = preprocess::preprocess(log, base, po);
-  const auto sections = preprocess::butterworth_lowpass(4, o.band_hz, 1.0 / base);
+  const auto sections = preprocess::butterworth_lowpass(4, options.band_hz, 1.0 / base);
   const int padding = preprocess::zero_phase_padding(sections);
   const Eigen::Index n = s.tau.cols();
   Eigen::VectorXd sum = Eigen::VectorXd::Zero(n);
@@ -46,7 +46,7 @@ bool consecutive(const io::Log& log, Eigen::Index k, int lag, double period) {
 
 }  // namespace
 
-LoopFloor loop_floor(const io::Log& log, const twin::TwinConfig& c, const BacklashFitOptions& o) {
+LoopFloor loop_floor(const io::Log& log, const twin::TwinConfig& c, const BacklashFitOptions& options) {
   const Eigen::Index n = log.joints(), rows = log.samples();
   const std::string name = log.meta.trajectory.empty() ? "log" : log.meta.trajectory;
   if (!log.has_references()) throw DataError(name, 0, "the loop's floor needs the log's reference columns");
@@ -81,7 +81,7 @@ LoopFloor loop_floor(const io::Log& log, const twin::TwinConfig& c, const Backla
   io::Log residual = log;
   residual.tau = residual_at(f.lag);
   f.law_rms = (residual.tau.colwise().squaredNorm() / std::max<double>(1.0, static_cast<double>(rows))).cwiseSqrt().transpose();
-  f.rms = high_band_rms(residual, o);
+  f.rms = high_band_rms(residual, options);
   // Encoder noise: the position's second difference in counts on 50 ms blocks, its median over
   // blocks (a play's chatter or a fast move raises a few), against the same of the logged
   // position smoothed (20 Hz, zero phase: the motion) and quantized again with a trial noise:

@@ -104,21 +104,21 @@ double log_period(const DesignStack& d) { return d.base_interval > 0 ? d.base_in
 // Whether an effect is large enough to act on, in its own terms: a delay against the logs'
 // period (a shift below one sample is not a remedy one can apply, and the logs' own sample and
 // hold sits there), every other effect against the torque resolution on its largest joint.
-bool matters(const Candidate& c, const CandidateTest& t, const DesignStack& d, const SelectionOptions& o) {
+bool matters(const Candidate& c, const CandidateTest& t, const DesignStack& d, const SelectionOptions& options) {
   if (c.kind == EffectKind::ActuationDelay) {
-    return !t.magnitude.empty() && std::abs(t.magnitude[0]) >= o.min_delay_periods * log_period(d);
+    return !t.magnitude.empty() && std::abs(t.magnitude[0]) >= options.min_delay_periods * log_period(d);
   }
-  return t.effect_rms >= o.min_effect_torque;
+  return t.effect_rms >= options.min_effect_torque;
 }
 
 // The backward check (selection.hpp): every chosen effect refitted with all the others; the
 // weakest of those that no longer stand is dropped, and the rest refitted, until all stand.
-void backward_check(const DesignStack& train, const DesignStack& heldout, const SelectionOptions& o,
+void backward_check(const DesignStack& train, const DesignStack& heldout, const SelectionOptions& options,
                     const Eigen::VectorXd& weights, std::vector<Candidate>& chosen, Selection& sel) {
   while (!chosen.empty()) {
     std::vector<Eigen::VectorXd> sds;
     std::vector<Eigen::MatrixXd> covs;
-    const Fit full = fit_with_effects(train, heldout, chosen, weights, o.max_lag, &sds, &covs);
+    const Fit full = fit_with_effects(train, heldout, chosen, weights, options.max_lag, &sds, &covs);
     int worst = -1;
     double worst_weakness = 0;
     DroppedEffect drop;
@@ -132,7 +132,7 @@ void backward_check(const DesignStack& train, const DesignStack& heldout, const 
       const Eigen::LDLT<Eigen::MatrixXd> cf(covs[i]);
       const double wald = cf.info() == Eigen::Success ? theta.dot(cf.solve(theta)) : 0.0;
       const boost::math::chi_squared_distribution<double> chi2(static_cast<double>(m));
-      const double bound = boost::math::quantile(chi2, 0.95) / std::pow(1 - o.smallest_fraction, 2);
+      const double bound = boost::math::quantile(chi2, 0.95) / std::pow(1 - options.smallest_fraction, 2);
       const double size = wald / bound;
       // What dropping it costs its joints held out (a refit without it): not needed for an effect
       // its own region already fails (the weakest by size).
@@ -141,7 +141,7 @@ void backward_check(const DesignStack& train, const DesignStack& heldout, const 
         if (effect_info(c.kind).row->scope == EffectScope::Joint) on.push_back(c.joint);
         std::vector<Candidate> others = chosen;
         others.erase(others.begin() + static_cast<std::ptrdiff_t>(i));
-        const Fit without = fit_with_effects(train, heldout, others, weights, o.max_lag);
+        const Fit without = fit_with_effects(train, heldout, others, weights, options.max_lag);
         const double s0 = heldout_sse(without, weights, on, heldout.samples()), s1 = heldout_sse(full, weights, on, heldout.samples());
         return s0 > 0 ? 1 - s1 / s0 : 0.0;
       };
@@ -149,17 +149,17 @@ void backward_check(const DesignStack& train, const DesignStack& heldout, const 
       std::string reason;
       if (!physical(c, theta))
         reason = "refitted with the others, its parameters contradict its physics";
-      else if (c.kind == EffectKind::ActuationDelay && o.modeled_delay >= 0 &&
-               std::abs(theta(0) - o.modeled_delay) <=
-                   std::max(1.96 * std::sqrt(std::max(0.0, covs[i](0, 0))), o.min_delay_periods * log_period(train)))
+      else if (c.kind == EffectKind::ActuationDelay && options.modeled_delay >= 0 &&
+               std::abs(theta(0) - options.modeled_delay) <=
+                   std::max(1.96 * std::sqrt(std::max(0.0, covs[i](0, 0))), options.min_delay_periods * log_period(train)))
         reason = fmt::format("refitted with the others, it is the {:.2f} ms the controller description already models",
-                             1e3 * o.modeled_delay);
+                             1e3 * options.modeled_delay);
       else if (size < 1)
         reason = fmt::format("refitted with the others, its 95 % region reaches {:.0f} % of its size or less",
-                             100 * o.smallest_fraction);
-      else if (gain < o.min_heldout_gain)
+                             100 * options.smallest_fraction);
+      else if (gain < options.min_heldout_gain)
         reason = fmt::format("refitted with the others, it lowers its joints' held-out residual by {:.1f} % (under {:.0f} %)",
-                             100 * gain, 100 * o.min_heldout_gain);
+                             100 * gain, 100 * options.min_heldout_gain);
       if (reason.empty()) continue;
       // The weakest: the smallest size, held-out gain breaking ties among determined ones.
       const double weakness = size < 1 ? size : 1 + std::max(0.0, gain);
@@ -248,23 +248,23 @@ Fit fit_with_effects(const DesignStack& train, const DesignStack& heldout, const
   return f;
 }
 
-Selection select_effects(const DesignStack& train, const DesignStack& heldout, const SelectionOptions& o) {
+Selection select_effects(const DesignStack& train, const DesignStack& heldout, const SelectionOptions& options) {
   Selection sel;
   const int n = train.joints;
   const Eigen::Index np = free_parameters(train);
   // Weights from the base model's unweighted residual: 1 / std per joint.
   {
-    const Fit plain = fit_with_effects(train, heldout, {}, Eigen::VectorXd::Ones(n), o.max_lag);
+    const Fit plain = fit_with_effects(train, heldout, {}, Eigen::VectorXd::Ones(n), options.max_lag);
     sel.weights = plain.train_rmse.cwiseMax(1e-9).cwiseInverse();
   }
-  sel.before = fit_with_effects(train, heldout, {}, sel.weights, o.max_lag);
-  const std::vector<Candidate> all = candidates(train, o.candidates);
+  sel.before = fit_with_effects(train, heldout, {}, sel.weights, options.max_lag);
+  const std::vector<Candidate> all = candidates(train, options.candidates);
   std::vector<Candidate> chosen;
   std::set<std::string> taken;  // "<effect>:<joint>": one Stribeck velocity per joint, once
   auto slot = [](const Candidate& c) { return std::string(effect_info(c.kind).name) + ":" + std::to_string(c.joint); };
 
   Fit current = sel.before;
-  while (static_cast<int>(chosen.size()) < o.max_effects) {
+  while (static_cast<int>(chosen.size()) < options.max_effects) {
     const detail::NestedDesign nd = detail::nested_design(train, heldout, chosen, current, sel.weights);
     const Eigen::MatrixXd& As = nd.As;
     const Eigen::VectorXd& r = nd.r;
@@ -272,7 +272,7 @@ Selection select_effects(const DesignStack& train, const DesignStack& heldout, c
     const Eigen::Index N = nd.A.rows(), p = nd.A.cols();
 
     SelectionStep step;
-    step.autocorrelation_time = pooled_time(autocorrelation_time(train, per_sample(train, r), o.max_lag));
+    step.autocorrelation_time = pooled_time(autocorrelation_time(train, per_sample(train, r), options.max_lag));
     const double dof = static_cast<double>(N) / static_cast<double>(std::max<Eigen::Index>(1, N - p));
     std::vector<const Candidate*> pool;
     for (const auto& c : all)
@@ -281,7 +281,7 @@ Selection select_effects(const DesignStack& train, const DesignStack& heldout, c
       sel.stop_reason = "every candidate is in the model";
       break;
     }
-    step.level = o.alpha / static_cast<double>(pool.size());
+    step.level = options.alpha / static_cast<double>(pool.size());
     int best = -1;
     double best_reduction = 0;
     for (const Candidate* c : pool) {
@@ -312,8 +312,8 @@ Selection select_effects(const DesignStack& train, const DesignStack& heldout, c
       // offset that removed 99 % of the held-out error).
       const Eigen::MatrixXd Z = C - As * ac.K;
       const Eigen::MatrixXd r1 = per_sample(train, Eigen::VectorXd(r - Z * theta_s));
-      const Eigen::MatrixXd V = dof * score_covariance(train, Z, autocovariance(train, r1, o.max_lag));
-      const double df2 = static_cast<double>(N) / pooled_time(autocorrelation_time(train, r1, o.max_lag)) - static_cast<double>(p + m);
+      const Eigen::MatrixXd V = dof * score_covariance(train, Z, autocovariance(train, r1, options.max_lag));
+      const double df2 = static_cast<double>(N) / pooled_time(autocorrelation_time(train, r1, options.max_lag)) - static_cast<double>(p + m);
       t.df2 = df2;
       const Eigen::LDLT<Eigen::MatrixXd> Vf(V);
       const double stat = Vf.info() == Eigen::Success ? Cr.dot(Vf.solve(Cr)) : 0.0;
@@ -355,8 +355,8 @@ Selection select_effects(const DesignStack& train, const DesignStack& heldout, c
       }
       t.physical = physical(*c, theta);
       t.magnitude = magnitude(*c, theta, Eigen::VectorXd::Zero(theta.size())).values;
-      t.matters = matters(*c, t, train, o);
-      t.generalizes = t.heldout_gain >= o.min_heldout_gain && t.matters && t.physical;
+      t.matters = matters(*c, t, train, options);
+      t.generalizes = t.heldout_gain >= options.min_heldout_gain && t.matters && t.physical;
       step.tests.push_back(t);
       // Of the admissible candidates, the one that removes most of the held-out residual (all
       // joints, weighted): the out-of-sample form of forward selection's largest RSS drop. A
@@ -367,7 +367,7 @@ Selection select_effects(const DesignStack& train, const DesignStack& heldout, c
       }
     }
     // Parsimony: a candidate with fewer parameters that removes nearly as much (within
-    // o.parsimony of the best) is taken instead. Position harmonics of a joint whose range is
+    // options.parsimony of the best) is taken instead. Position harmonics of a joint whose range is
     // limited mimic a constant offset with four columns for one, and won by 1 % of the
     // held-out residual over the offset that was there (RX-90 joint 3).
     if (best >= 0) {
@@ -377,7 +377,7 @@ Selection select_effects(const DesignStack& train, const DesignStack& heldout, c
         if (pool[i] == &all[static_cast<std::size_t>(best)]) fewest_columns = step.tests[i].columns;
       for (std::size_t i = 0; i < pool.size(); ++i) {
         const CandidateTest& t = step.tests[i];
-        if (t.significant && t.generalizes && t.heldout_reduction >= (1 - o.parsimony) * best_reduction &&
+        if (t.significant && t.generalizes && t.heldout_reduction >= (1 - options.parsimony) * best_reduction &&
             t.columns < fewest_columns) {
           fewest = static_cast<int>(pool[i] - all.data());
           fewest_columns = t.columns;
@@ -406,13 +406,13 @@ Selection select_effects(const DesignStack& train, const DesignStack& heldout, c
     sel.steps.push_back(step);
     chosen.push_back(c);
     taken.insert(slot(c));
-    current = fit_with_effects(train, heldout, chosen, sel.weights, o.max_lag);
+    current = fit_with_effects(train, heldout, chosen, sel.weights, options.max_lag);
   }
   if (sel.stop_reason.empty()) sel.stop_reason = "the maximum number of effects was reached";
-  detail::choose_friction_smoothing(train, heldout, o, sel.weights, chosen, sel.effects);
-  backward_check(train, heldout, o, sel.weights, chosen, sel);
+  detail::choose_friction_smoothing(train, heldout, options, sel.weights, chosen, sel.effects);
+  backward_check(train, heldout, options, sel.weights, chosen, sel);
   std::vector<Eigen::VectorXd> sds;
-  sel.after = fit_with_effects(train, heldout, chosen, sel.weights, o.max_lag, &sds);
+  sel.after = fit_with_effects(train, heldout, chosen, sel.weights, options.max_lag, &sds);
   for (std::size_t i = 0; i < sel.effects.size(); ++i) {
     sel.effects[i].theta = sel.after.theta[i];
     sel.effects[i].std_dev = sds[i];

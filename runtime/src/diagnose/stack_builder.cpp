@@ -15,13 +15,13 @@
 
 namespace symoro::diagnose {
 
-DesignStack stack_design(const StackModel& m, const std::vector<NamedSamples>& runs, const StackOptions& o) {
+DesignStack stack_design(const StackModel& m, const std::vector<NamedSamples>& runs, const StackOptions& options) {
   const int n = m.nq, p = m.np, pf = static_cast<int>(m.full_parameters.size());
   DesignStack d;
   d.joints = n;
-  d.interval = o.interval;
-  d.cutoff = o.cutoff;
-  d.filter_order = o.order;
+  d.interval = options.interval;
+  d.cutoff = options.cutoff;
+  d.filter_order = options.order;
   for (const auto& j : m.joints) d.joint_names.push_back(j.name);
   for (const auto& par : m.parameters) d.parameters.push_back(par.name);
   d.rotor_inertia_index = Eigen::VectorXd::Constant(n, -1);
@@ -67,9 +67,9 @@ DesignStack stack_design(const StackModel& m, const std::vector<NamedSamples>& r
   auto keep = [&](const Candidate& c) {
     if (sample_local(c.kind) && keys.insert(c.key()).second) local.push_back(c);
   };
-  for (const auto& c : candidates(d, o.candidates)) keep(c);
+  for (const auto& c : candidates(d, options.candidates)) keep(c);
   for (int j = 1; j <= n; ++j)
-    for (const auto& c : friction_options(d, o.candidates, j)) keep(c);
+    for (const auto& c : friction_options(d, options.candidates, j)) keep(c);
 
   // The pieces and the samples each keeps (multiples of the interval on the log's clock).
   struct Piece {
@@ -82,21 +82,21 @@ DesignStack stack_design(const StackModel& m, const std::vector<NamedSamples>& r
   double base = runs.empty() ? 0.0 : runs.front().samples.interval;
   if (!(base > 0)) throw std::invalid_argument("stack_design: no samples");
   d.base_interval = base;
-  const auto sections = preprocess::butterworth_lowpass(o.order, o.cutoff, 1.0 / base);
+  const auto sections = preprocess::butterworth_lowpass(options.order, options.cutoff, 1.0 / base);
   const int padding = preprocess::zero_phase_padding(sections);
   std::vector<preprocess::Biquad> slow;
   int slow_padding = 0;
-  if (o.effect_velocity_cutoff > 0 && o.effect_velocity_cutoff < 0.5 / base) {
-    slow = preprocess::butterworth_lowpass(o.order, o.effect_velocity_cutoff, 1.0 / base);
+  if (options.effect_velocity_cutoff > 0 && options.effect_velocity_cutoff < 0.5 / base) {
+    slow = preprocess::butterworth_lowpass(options.order, options.effect_velocity_cutoff, 1.0 / base);
     slow_padding = preprocess::zero_phase_padding(slow);
   }
   const Eigen::Index edge =
-      static_cast<Eigen::Index>(std::ceil(o.edge_time_constants * preprocess::slowest_time_constant(sections)));
+      static_cast<Eigen::Index>(std::ceil(options.edge_time_constants * preprocess::slowest_time_constant(sections)));
   for (const auto& r : runs) {
     const auto& s = r.samples;
     if (std::abs(s.interval - base) > 1e-12) throw std::invalid_argument("stack_design: runs at different base periods");
-    const long step = std::lround(o.interval / base);
-    if (step < 1 || std::abs(step * base - o.interval) > 1e-9)
+    const long step = std::lround(options.interval / base);
+    if (step < 1 || std::abs(step * base - options.interval) > 1e-9)
       throw std::invalid_argument("stack_design: the interval must be a multiple of the base period");
     for (Eigen::Index a = 0; a < s.q.rows();) {
       Eigen::Index b = a + 1;

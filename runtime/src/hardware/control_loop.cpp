@@ -67,14 +67,14 @@ class RealtimeScope {
 std::string Loop::joint_name(int j) const { return fmt::format("servo ID {} (joint {} {})", int(ids_[j]), j + 1, joints_[j].name); }
 
 Loop::Loop(Bus& bus, const HardwareConfig& hw, const std::vector<JointInfo>& joints, const control::FfpdGains& gains,
-     const trajectory::Trajectory& traj, const ControlOptions& o)
-    : bus_(bus), hw_(hw), joints_(joints), gains_(gains), traj_(traj), o_(o), clock_(o.clock ? *o.clock : steady_loop_clock()), n_(static_cast<int>(joints.size())), ids_(hw.ids()) {
+     const trajectory::Trajectory& traj, const ControlOptions& options)
+    : bus_(bus), hw_(hw), joints_(joints), gains_(gains), traj_(traj), o_(options), clock_(options.clock ? *options.clock : steady_loop_clock()), n_(static_cast<int>(joints.size())), ids_(hw.ids()) {
   if (static_cast<int>(hw.joints.size()) != n_) throw std::invalid_argument("run_control: hardware.yaml and the robot differ in joints");
   if (traj.joints() != n_) throw DataError(traj.name, 0, fmt::format("the trajectory has {} joints, the robot {}", traj.joints(), n_));
   if (gains.inertia.size() != n_) throw std::invalid_argument("run_control: FF+PD gains for another joint count");
-  stop_ = o.stop ? o.stop : &stop_flag();
+  stop_ = options.stop ? options.stop : &stop_flag();
   stops_seen_ = stop_->load();
-  watchdog_ = o.watchdog_cycles > 0 ? o.watchdog_cycles : hw.safety.watchdog_cycles;
+  watchdog_ = options.watchdog_cycles > 0 ? options.watchdog_cycles : hw.safety.watchdog_cycles;
   T_ = hw.period;
   for (Eigen::VectorXd* v : {&q_, &qd_servo_, &current_, &tau_, &qr_, &qdr_, &qddr_, &ff_, &q0_, &qr0_, &kt_, &limit_, &unit_,
                              &max_error_})

@@ -49,7 +49,7 @@ struct StopNow {
 class Loop {
  public:
   Loop(dynamixel::Bus& bus, const HardwareConfig& hw, const std::vector<JointInfo>& joints, const control::FfpdGains& gains,
-       const trajectory::Trajectory& traj, const ControlOptions& o);
+       const trajectory::Trajectory& traj, const ControlOptions& options);
   ControlResult run(const std::string& csv);
 
  private:

@@ -8,18 +8,18 @@
 
 namespace symoro::identify {
 
-ModelExport export_model(const IdentificationModel& model, const Eigen::VectorXd& phi, const ModelExportOptions& o) {
+ModelExport export_model(const IdentificationModel& model, const Eigen::VectorXd& phi, const ModelExportOptions& options) {
   const ModelDescription& md = model.description();
   ConsistencyOptions co;
-  co.margin = o.margin;
-  co.base_metric_root = o.base_metric_root;
+  co.margin = options.margin;
+  co.base_metric_root = options.base_metric_root;
   ModelExport e;
-  e.consistency = model.consistent_standard_parameters(phi, o.prior, co);
+  e.consistency = model.consistent_standard_parameters(phi, options.prior, co);
   const ConsistencyResult& r = e.consistency;
-  e.nearest = r.status == ConsistencyStatus::NoConsistentSet && o.nearest;
+  e.nearest = r.status == ConsistencyStatus::NoConsistentSet && options.nearest;
   // Checked here, independently of the solver's own report.
   const Eigen::VectorXd target = model.consistency_target(phi);
-  if (r.status == ConsistencyStatus::NoConsistentSet && o.cost) e.cost = o.cost(target, r.phi_consistent);
+  if (r.status == ConsistencyStatus::NoConsistentSet && options.cost) e.cost = options.cost(target, r.phi_consistent);
   if (!r.ok() && !e.nearest) {
     std::string why = fmt::format("no URDF written: {} ({})", r.message, to_string(r.status));
     if (r.status == ConsistencyStatus::NoConsistentSet)
@@ -38,8 +38,8 @@ ModelExport export_model(const IdentificationModel& model, const Eigen::VectorXd
   d.s = r.s;
   const std::string label = md.variant.empty() ? "full" : md.variant;
   d.notes.push_back(fmt::format("Model: {} ({}), {} base parameters. Study: {}{}.", md.robot, label, md.np,
-                                std::filesystem::absolute(o.study).lexically_normal().string(),
-                                o.accepted ? "" : " (NOT accepted by its final audit)"));
+                                std::filesystem::absolute(options.study).lexically_normal().string(),
+                                options.accepted ? "" : " (NOT accepted by its final audit)"));
   if (e.nearest)
     d.notes.push_back(fmt::format("WARNING: no consistent set reproduces the accepted base parameters ({}); these "
                                   "inertials reproduce the nearest base vector that has one, {:.4g} away (weighted): "
@@ -48,12 +48,12 @@ ModelExport export_model(const IdentificationModel& model, const Eigen::VectorXd
   d.notes.push_back(fmt::format("Inertials: the physically consistent standard parameters (pseudo-inertia >= {} I per "
                                 "link) nearest the prior {} that reproduce {}: max |B s - phi| = {:.3g} (phi the "
                                 "accepted vector), smallest pseudo-inertia eigenvalue {:.6g}.",
-                                o.margin, o.prior_what,
+                                options.margin, options.prior_what,
                                 e.nearest ? "the nearest consistent base vector" : "the accepted base parameters",
                                 e.residual, r.lambda_min));
   e.header = fmt::format("robot: \"{}\"\nmodel: \"{}\"\nstudy: \"{}\"\nprior: \"{}\"\naccepted: {}\nnearest_consistent_base: {}\n"
                          "margin: {}\nlambda_min: {}\nbase_residual: {}\n",
-                         md.robot, label, o.study, o.prior_what, o.accepted, e.nearest, o.margin, r.lambda_min, e.residual);
+                         md.robot, label, options.study, options.prior_what, options.accepted, e.nearest, options.margin, r.lambda_min, e.residual);
   return e;
 }
 

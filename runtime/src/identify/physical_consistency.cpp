@@ -57,14 +57,14 @@ struct Setup {
   double margin = 0;
 
   Setup(const ConsistencyStructure& s, const Eigen::VectorXd& phi_, const Eigen::VectorXd& prior,
-        const ConsistencyOptions& o)
-      : st(s), phi(phi_), s0(prior), margin(o.margin) {
+        const ConsistencyOptions& options)
+      : st(s), phi(phi_), s0(prior), margin(options.margin) {
     const Eigen::Index ns = s.B.cols();
-    w = o.weights.size() ? o.weights : default_consistency_weights(s, prior, phi_);
+    w = options.weights.size() ? options.weights : default_consistency_weights(s, prior, phi_);
     scale = w.cwiseInverse();
-    lower = o.lower.size() ? o.lower : Eigen::VectorXd::Constant(ns, -kInf);
-    upper = o.upper.size() ? o.upper : Eigen::VectorXd::Constant(ns, kInf);
-    if (!o.lower.size())
+    lower = options.lower.size() ? options.lower : Eigen::VectorXd::Constant(ns, -kInf);
+    upper = options.upper.size() ? options.upper : Eigen::VectorXd::Constant(ns, kInf);
+    if (!options.lower.size())
       for (int k : s.nonnegative) lower(k) = 0;
     Bt = s.B * scale.asDiagonal();
 
@@ -217,12 +217,12 @@ std::vector<double> targets(const Setup& S, double relative) {
 // Phase 3: no consistent set maps onto phi. The nearest base vector that has one,
 //   min |W_b (B s - phi)|^2 + mu |W (s - s0)|^2  s.t.  s consistent (clearing the margin a little),
 // in u = W (s - s0) = sigma v, sigma the size of the prior's gap so that v is O(1).
-void nearest_consistent(const Setup& S, const ConsistencyOptions& o, ConsistencyResult& r) {
+void nearest_consistent(const Setup& S, const ConsistencyOptions& options, ConsistencyResult& r) {
   const Eigen::Index ns = S.s0.size(), np = S.phi.size();
   // W_b: the full base metric's root when given, else the diagonal weights.
-  Eigen::MatrixXd Wb = o.base_metric_root;
+  Eigen::MatrixXd Wb = options.base_metric_root;
   if (!Wb.size()) {
-    Eigen::VectorXd wb = o.base_weights;
+    Eigen::VectorXd wb = options.base_weights;
     if (!wb.size()) {
       wb.resize(np);
       for (Eigen::Index i = 0; i < np; ++i) {
@@ -238,13 +238,13 @@ void nearest_consistent(const Setup& S, const ConsistencyOptions& o, Consistency
   // orthonormal basis of what leaves them unchanged (everything when none are held).
   Eigen::VectorXd uh = Eigen::VectorXd::Zero(ns);
   Eigen::MatrixXd Nh = Eigen::MatrixXd::Identity(ns, ns);
-  if (!o.held_rows.empty()) {
-    const auto nh = static_cast<Eigen::Index>(o.held_rows.size());
+  if (!options.held_rows.empty()) {
+    const auto nh = static_cast<Eigen::Index>(options.held_rows.size());
     Eigen::MatrixXd Bh(nh, ns);
     Eigen::VectorXd rh(nh);
     const Eigen::VectorXd Bs0 = S.st.B * S.s0;
     for (Eigen::Index i = 0; i < nh; ++i) {
-      const int row = o.held_rows[static_cast<std::size_t>(i)];
+      const int row = options.held_rows[static_cast<std::size_t>(i)];
       Bh.row(i) = S.Bt.row(row);
       rh(i) = S.phi(row) - Bs0(row);
     }
@@ -281,10 +281,10 @@ void nearest_consistent(const Setup& S, const ConsistencyOptions& o, Consistency
   }
   add_norm_block(lmi, 0, nv, t2);  // tau2 >= |v|^2
   const Eigen::MatrixXd G = sigma * S.scale.asDiagonal() * Nh;
-  std::vector<double> target = targets(S, o.infeasible_clearance);
+  std::vector<double> target = targets(S, options.infeasible_clearance);
   Eigen::VectorXd b = Eigen::VectorXd::Zero(nv + 2);
   b(t1) = 1;
-  b(t2) = o.prior_regularization;
+  b(t2) = options.prior_regularization;
   lmi.set_objective(b);
   add_constraints(lmi, S, S.standard(uh), G, target, -1);
   const detail::LmiSolution sol = solve(lmi, r.solves);
@@ -355,7 +355,7 @@ Eigen::VectorXd default_consistency_weights(const ConsistencyStructure& st, cons
 }
 
 ConsistencyResult consistent_standard_parameters(const ConsistencyStructure& st, const Eigen::VectorXd& phi,
-                                                 const Eigen::VectorXd& prior, const ConsistencyOptions& o) {
+                                                 const Eigen::VectorXd& prior, const ConsistencyOptions& options) {
   const auto t0 = Clock::now();
   const Eigen::Index np = st.B.rows(), ns = st.B.cols();
   auto require = [](bool ok, const char* what) {
@@ -368,19 +368,19 @@ ConsistencyResult consistent_standard_parameters(const ConsistencyStructure& st,
           "names and groups must have one entry per column of B");
   for (const auto& l : st.links)
     for (int k : l.index) require(k >= -1 && k < ns, "a link index is out of range");
-  require(!o.weights.size() || (o.weights.size() == ns && (o.weights.array() > 0).all() && o.weights.allFinite()),
+  require(!options.weights.size() || (options.weights.size() == ns && (options.weights.array() > 0).all() && options.weights.allFinite()),
           "weights must be positive and finite, one per standard parameter");
-  require(!o.lower.size() || o.lower.size() == ns, "lower must have one entry per standard parameter");
-  require(!o.upper.size() || o.upper.size() == ns, "upper must have one entry per standard parameter");
-  require(!o.base_weights.size() || (o.base_weights.size() == np && (o.base_weights.array() > 0).all()),
+  require(!options.lower.size() || options.lower.size() == ns, "lower must have one entry per standard parameter");
+  require(!options.upper.size() || options.upper.size() == ns, "upper must have one entry per standard parameter");
+  require(!options.base_weights.size() || (options.base_weights.size() == np && (options.base_weights.array() > 0).all()),
           "base_weights must be positive, one per base parameter");
-  require(!o.base_metric_root.size() || (o.base_metric_root.cols() == np && o.base_metric_root.allFinite() &&
-                                         o.base_metric_root.rows() > 0),
+  require(!options.base_metric_root.size() || (options.base_metric_root.cols() == np && options.base_metric_root.allFinite() &&
+                                         options.base_metric_root.rows() > 0),
           "base_metric_root must have one column per base parameter and finite entries");
-  for (int row : o.held_rows) require(row >= 0 && row < np, "a held row is out of range");
-  require(std::isfinite(o.margin) && o.margin >= 0, "the margin must be >= 0");
+  for (int row : options.held_rows) require(row >= 0 && row < np, "a held row is out of range");
+  require(std::isfinite(options.margin) && options.margin >= 0, "the margin must be >= 0");
 
-  const Setup S(st, phi, prior, o);
+  const Setup S(st, phi, prior, options);
   require(!(S.lower.array() > S.upper.array()).any() && !S.lower.hasNaN() && !S.upper.hasNaN(),
           "lower must not exceed upper");
   ConsistencyResult r;
@@ -410,7 +410,7 @@ ConsistencyResult consistent_standard_parameters(const ConsistencyStructure& st,
   }
 
   // Phase 1: max t s.t. every constraint holds with t to spare, |z| <= R, t <= 1.
-  const double R = o.trust_radius * (1 + S.up.norm());
+  const double R = options.trust_radius * (1 + S.up.norm());
   const Eigen::MatrixXd G = S.scale.asDiagonal() * S.N;  // ds / dz
   double t_star = -kInf;
   Eigen::VectorXd z1 = Eigen::VectorXd::Zero(nz);
@@ -437,23 +437,23 @@ ConsistencyResult consistent_standard_parameters(const ConsistencyStructure& st,
   // Constraints the base vector fixes count when they are violated; one met exactly (FS fixed
   // at its bound 0 by a variant, -1.6e-22 after the pseudo-inverse's rounding) would otherwise
   // pin the margin at 0 whatever the links'.
-  r.feasibility = fixed.constant_min < -o.feasibility_tolerance ? std::min(t_star, fixed.constant_min) : t_star;
-  if (r.feasibility < -o.feasibility_tolerance) {
+  r.feasibility = fixed.constant_min < -options.feasibility_tolerance ? std::min(t_star, fixed.constant_min) : t_star;
+  if (r.feasibility < -options.feasibility_tolerance) {
     r.status = ConsistencyStatus::NoConsistentSet;
-    if (fixed.constant_min < -o.feasibility_tolerance) r.feasibility = fixed.constant_min;
-    if (o.feasibility_only) {
+    if (fixed.constant_min < -options.feasibility_tolerance) r.feasibility = fixed.constant_min;
+    if (options.feasibility_only) {
       evaluate(S, S.refine(S.standard(S.up + S.N * z1)), phi, r);
       r.message = fmt::format("no consistent standard set maps onto phi (phase 1: the best smallest-eigenvalue margin is "
                               "{:.3g} of the links' size)", r.feasibility);
     } else {
-      nearest_consistent(S, o, r);
+      nearest_consistent(S, options, r);
     }
-    if (fixed.constant_min < -o.feasibility_tolerance)
+    if (fixed.constant_min < -options.feasibility_tolerance)
       r.message += fmt::format(" (violated whatever the other parameters: {})", fixed.constant_what);
     return finish();
   }
 
-  if (o.feasibility_only) {
+  if (options.feasibility_only) {
     evaluate(S, S.refine(S.standard(S.up + S.N * z1)), phi, r);
     r.status = ConsistencyStatus::Consistent;
     r.message = fmt::format("consistent (phase 1 margin {:.3g} of the links' size)", r.feasibility);

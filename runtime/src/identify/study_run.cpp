@@ -16,12 +16,12 @@ namespace symoro::identify::detail {
 
 // The paper's pre-CLIE step (Algorithm 1, lines 4-15): the all-pose audit of the OLS estimate
 // and, when it is not PD, the conditional SDP projection. Fills the record's audit and route.
-ClieStart pd_start(const LeastSquaresResult& ls, const StudyOptions& o, const InertiaFunction& inertia,
+ClieStart pd_start(const LeastSquaresResult& ls, const StudyOptions& options, const InertiaFunction& inertia,
                           const AuditDomain& domain, RunRecord& r) {
   const auto t = std::chrono::steady_clock::now();
-  ProjectionOptions po = o.projection;
-  if (o.projection_metric == ProjectionMetric::information) po.metric = information_metric(ls.information, o.information_ridge);
-  const ConditionalProjection cp = conditional_projection(inertia, ls.phi, domain, o.margins, po);
+  ProjectionOptions po = options.projection;
+  if (options.projection_metric == ProjectionMetric::information) po.metric = information_metric(ls.information, options.information_ridge);
+  const ConditionalProjection cp = conditional_projection(inertia, ls.phi, domain, options.margins, po);
   const double conditional_wall = seconds_since(t);
   r.ols_lambda_min = cp.audit.lambda_min;
   r.ols_worst_pose = cp.audit.worst_pose;
@@ -46,19 +46,19 @@ ClieStart pd_start(const LeastSquaresResult& ls, const StudyOptions& o, const In
 // The physical path's pre-CLIE step when asked (StudyOptions::physical_start): the all-pose audit
 // (for the record) and, when the OLS estimate has no consistent standard set, the nearest base
 // vector that has one in the run's predicted-torque metric (physical_projection.hpp).
-ClieStart physical_start(const IdentificationModel& model, const LeastSquaresResult& ls, const StudyOptions& o,
+ClieStart physical_start(const IdentificationModel& model, const LeastSquaresResult& ls, const StudyOptions& options,
                          const InertiaFunction& inertia, const AuditDomain& domain, RunRecord& r) {
-  const AuditResult a = audit_pd(inertia, ls.phi, domain, o.audit);
+  const AuditResult a = audit_pd(inertia, ls.phi, domain, options.audit);
   r.ols_lambda_min = a.lambda_min;
   r.ols_worst_pose = a.worst_pose;
   r.ols_pd = a.positive_definite();
   r.t_audit = a.wall;
-  const PhysicalProjection p = model.physical_projection(ls.phi, torque_metric(ls, o.information_ridge), o.physical_clearance);
+  const PhysicalProjection p = model.physical_projection(ls.phi, torque_metric(ls, options.information_ridge), options.physical_clearance);
   r.physical = true;
   r.ols_consistent = p.consistent;
   r.ols_consistency = p.check.feasibility;
   r.route = p.projected ? "O-S-C" : "O-C";
-  r.eps = p.projected ? o.physical_clearance : 0.0;
+  r.eps = p.projected ? options.physical_clearance : 0.0;
   r.sdp_feasible = p.feasible;
   r.t_sdp = p.wall;
   if (!p.feasible) {
@@ -68,7 +68,7 @@ ClieStart physical_start(const IdentificationModel& model, const LeastSquaresRes
   }
   ClieStart start{p.phi, r.ols_lambda_min};
   if (p.projected) {  // the start's PD margin (no CLIE: the run's final one)
-    const AuditResult b = audit_pd(inertia, p.phi, domain, o.audit);
+    const AuditResult b = audit_pd(inertia, p.phi, domain, options.audit);
     start.lambda_min = b.lambda_min;
     r.t_audit += b.wall;
   }
@@ -78,19 +78,19 @@ ClieStart physical_start(const IdentificationModel& model, const LeastSquaresRes
 // One trajectory at one interval, from its log.
 // sim: the run's closed loop, or nullptr (CLIE is skipped; `no_clie` says why).
 RunRecord identify_run(const IdentificationModel& model, const io::Log& log, const ClosedLoop* sim,
-                       const std::string& no_clie, double interval, const StudyOptions& o,
+                       const std::string& no_clie, double interval, const StudyOptions& options,
                        const InertiaFunction& inertia, const AuditDomain& domain) {
   RunRecord r;
   r.trajectory = log.meta.trajectory;
   r.interval = interval;
   auto t = std::chrono::steady_clock::now();
-  const preprocess::Samples s = preprocess::preprocess(log, interval, o.preprocess);
+  const preprocess::Samples s = preprocess::preprocess(log, interval, options.preprocess);
   r.samples = static_cast<int>(s.time.size());
   r.edge_samples = s.report.edge_samples;
   const Regression reg = model.stack_regression(s);
   LeastSquaresResult ls;
   try {
-    ls = least_squares(reg, o.least_squares);
+    ls = least_squares(reg, options.least_squares);
   } catch (const std::invalid_argument& e) {
     throw DataError(log.meta.trajectory, 0, fmt::format("at {} ms: {}", interval * 1e3, e.what()));
   }
@@ -105,9 +105,9 @@ RunRecord identify_run(const IdentificationModel& model, const io::Log& log, con
   r.weighted = ls.weighted;
   r.t_ols = seconds_since(t);
 
-  const bool physical = o.consistency == Consistency::physical;
-  const ClieStart start = physical && o.physical_start ? physical_start(model, ls, o, inertia, domain, r)
-                                                       : pd_start(ls, o, inertia, domain, r);
+  const bool physical = options.consistency == Consistency::physical;
+  const ClieStart start = physical && options.physical_start ? physical_start(model, ls, options, inertia, domain, r)
+                                                       : pd_start(ls, options, inertia, domain, r);
   // Whether a vector has a consistent set (the physical path; its time counts as the SDP's).
   auto check = [&](const Eigen::VectorXd& phi, bool& consistent, double& margin) {
     const auto tc = std::chrono::steady_clock::now();
@@ -116,7 +116,7 @@ RunRecord identify_run(const IdentificationModel& model, const io::Log& log, con
     margin = k.feasibility;
     r.t_sdp += seconds_since(tc);
   };
-  if (physical && !o.physical_start) {  // physical_start has checked the OLS vector already
+  if (physical && !options.physical_start) {  // physical_start has checked the OLS vector already
     r.physical = true;
     check(ls.phi, r.ols_consistent, r.ols_consistency);
   }
@@ -137,8 +137,8 @@ RunRecord identify_run(const IdentificationModel& model, const io::Log& log, con
     return r;
   }
   t = std::chrono::steady_clock::now();
-  ClieOptions co = o.clie;
-  co.preprocess = o.preprocess;
+  ClieOptions co = options.clie;
+  co.preprocess = options.preprocess;
   if (co.std_bound > 0) co.scale = ls.std_dev;
   const ClieResult c = clie(*sim, s, start.phi, co);
   r.t_clie = seconds_since(t);
@@ -150,7 +150,7 @@ RunRecord identify_run(const IdentificationModel& model, const io::Log& log, con
   r.clie_rms = c.rms_final;
   if (c.success) {
     r.phi_clie = c.phi;
-    const AuditResult a = audit_pd(inertia, c.phi, domain, o.audit);
+    const AuditResult a = audit_pd(inertia, c.phi, domain, options.audit);
     r.clie_lambda_min = a.lambda_min;
     r.clie_pd = a.positive_definite();
     r.t_audit += a.wall;

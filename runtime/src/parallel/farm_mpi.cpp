@@ -125,11 +125,11 @@ std::string end_message(const TaskEnd& e) {
   return b + e.failure;
 }
 
-FarmSummary coordinate(const std::vector<std::string>& tasks, const Farm& farm, const FarmOptions& o) {
+FarmSummary coordinate(const std::vector<std::string>& tasks, const Farm& farm, const FarmOptions& options) {
   const Session& s = session();
   FarmSummary summary;
   summary.ranks = s.place.ranks;
-  summary.workers = detail::worker_count(o, s.ranks_on_node);
+  summary.workers = detail::worker_count(options, s.ranks_on_node);
   summary.tasks.resize(tasks.size());
   std::mutex m;  // the list and the callbacks
   std::size_t next = 0;
@@ -147,7 +147,7 @@ FarmSummary coordinate(const std::vector<std::string>& tasks, const Farm& farm, 
   };
   auto worker = [&] {
     for (std::int64_t i; (i = take_next()) >= 0;) {
-      TaskEnd e = detail::run_task(farm, tasks[i], o.isolate, [&](const std::string& r) {
+      TaskEnd e = detail::run_task(farm, tasks[i], options.isolate, [&](const std::string& r) {
         std::lock_guard<std::mutex> lock(m);
         if (farm.on_result) farm.on_result(static_cast<std::size_t>(i), r);
       });
@@ -169,7 +169,7 @@ FarmSummary coordinate(const std::vector<std::string>& tasks, const Farm& farm, 
   std::vector<bool> spoke(s.place.ranks, false);
   std::vector<bool> done(s.place.ranks, false), lost(s.place.ranks, false);  // done: said bye, or lost
   std::vector<std::pair<std::int64_t, int>> running;  // (task, rank) handed to other ranks
-  const auto timeout = std::chrono::duration<double>(o.rank_timeout);
+  const auto timeout = std::chrono::duration<double>(options.rank_timeout);
   std::string b;
   MPI_Status st;
   while (byes < s.place.ranks - 1) {
@@ -190,7 +190,7 @@ FarmSummary coordinate(const std::vector<std::string>& tasks, const Farm& farm, 
           e.rank = r;
           e.failed = true;
           e.failure = fmt::format("rank {} stopped answering for {:g} s while running this task (its process or node was lost)",
-                                  r, o.rank_timeout);
+                                  r, options.rank_timeout);
           ended(e);
           t = running.erase(t);
         }
@@ -246,7 +246,7 @@ FarmSummary coordinate(const std::vector<std::string>& tasks, const Farm& farm, 
   return summary;
 }
 
-void serve(const Farm& farm, const FarmOptions& o) {
+void serve(const Farm& farm, const FarmOptions& options) {
   const Session& s = session();
   std::mutex mpi;  // MPI_THREAD_SERIALIZED
   auto worker = [&](std::int32_t slot) {
@@ -269,7 +269,7 @@ void serve(const Farm& farm, const FarmOptions& o) {
       std::size_t at = 0;
       const auto i = take<std::int64_t>(b, at);
       if (i < 0) return;
-      TaskEnd e = detail::run_task(farm, b.substr(at), o.isolate, [&](const std::string& r) {
+      TaskEnd e = detail::run_task(farm, b.substr(at), options.isolate, [&](const std::string& r) {
         std::string msg(1, 'R');
         put<std::uint64_t>(msg, static_cast<std::uint64_t>(i));
         msg += r;
@@ -282,7 +282,7 @@ void serve(const Farm& farm, const FarmOptions& o) {
     }
   };
   std::vector<std::thread> pool;
-  const int workers = detail::worker_count(o, s.ranks_on_node);
+  const int workers = detail::worker_count(options, s.ranks_on_node);
   std::atomic<int> finished{0};
   for (int w = 0; w < workers; ++w)
     pool.emplace_back([&, w] {
@@ -314,12 +314,12 @@ void abort_job(int code) {
 }
 
 namespace detail {
-FarmSummary run_farm_mpi(const std::vector<std::string>& tasks, const Farm& farm, const FarmOptions& o) {
-  if (session().place.rank == 0) return coordinate(tasks, farm, o);
-  serve(farm, o);
+FarmSummary run_farm_mpi(const std::vector<std::string>& tasks, const Farm& farm, const FarmOptions& options) {
+  if (session().place.rank == 0) return coordinate(tasks, farm, options);
+  serve(farm, options);
   FarmSummary summary;
   summary.ranks = session().place.ranks;
-  summary.workers = detail::worker_count(o, session().ranks_on_node);
+  summary.workers = detail::worker_count(options, session().ranks_on_node);
   return summary;
 }
 }  // namespace detail

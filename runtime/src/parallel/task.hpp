@@ -18,8 +18,8 @@ TaskEnd run_task(const Farm& farm, const std::string& task, bool isolate, const 
 
 // Worker threads per rank: the option, else the cores this process may run on (its affinity), or
 // this machine's cores shared among the ranks on it when it is not bound.
-int worker_count(const FarmOptions& o, int ranks_on_this_machine);
+int worker_count(const FarmOptions& options, int ranks_on_this_machine);
 
-FarmSummary run_farm_mpi(const std::vector<std::string>& tasks, const Farm& farm, const FarmOptions& o);
+FarmSummary run_farm_mpi(const std::vector<std::string>& tasks, const Farm& farm, const FarmOptions& options);
 
 }  // namespace symoro::parallel::detail

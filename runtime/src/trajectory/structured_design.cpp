@@ -40,37 +40,37 @@ std::string join(const std::vector<std::string>& items) {
 
 }  // namespace
 
-void structured_box(const StructuredDesignOptions& o, Eigen::VectorXd& lower, Eigen::VectorXd& upper) {
-  const int n = static_cast<int>(o.joints.size());
+void structured_box(const StructuredDesignOptions& options, Eigen::VectorXd& lower, Eigen::VectorXd& upper) {
+  const int n = static_cast<int>(options.joints.size());
   lower.resize(n);
   upper.resize(n);
   for (int j = 0; j < n; ++j) {
-    const JointInfo& J = o.joints[static_cast<std::size_t>(j)];
-    double lo = std::max(J.lower + o.position_margin, J.audit_lower), hi = std::min(J.upper - o.position_margin, J.audit_upper);
-    if (!(hi > lo)) lo = J.lower + o.position_margin, hi = J.upper - o.position_margin;  // an audit box beside the range
+    const JointInfo& J = options.joints[static_cast<std::size_t>(j)];
+    double lo = std::max(J.lower + options.position_margin, J.audit_lower), hi = std::min(J.upper - options.position_margin, J.audit_upper);
+    if (!(hi > lo)) lo = J.lower + options.position_margin, hi = J.upper - options.position_margin;  // an audit box beside the range
     const double mid = (lo + hi) / 2;
     lower(j) = std::max(lo, mid - kMaxHalfBox);
     upper(j) = std::min(hi, mid + kMaxHalfBox);
   }
 }
 
-std::string structured_design_yaml(const StructuredDesignOptions& o) {
-  const int n = static_cast<int>(o.joints.size());
-  for (const JointInfo& j : o.joints)
+std::string structured_design_yaml(const StructuredDesignOptions& options) {
+  const int n = static_cast<int>(options.joints.size());
+  for (const JointInfo& j : options.joints)
     if (j.type != JointType::Revolute)
       throw std::invalid_argument(std::string("structured design: joint ") + j.name + " is prismatic; the design format covers revolute joints");
   auto sized = [n](const Eigen::VectorXd& v) { return v.size() == 0 || v.size() == n; };
-  if (!sized(o.velocity) || !sized(o.acceleration) || (!o.joint_class.empty() && static_cast<int>(o.joint_class.size()) != n))
+  if (!sized(options.velocity) || !sized(options.acceleration) || (!options.joint_class.empty() && static_cast<int>(options.joint_class.size()) != n))
     throw std::invalid_argument(fmt::format("structured design: limits and classes need {} joints", n));
   Eigen::VectorXd lo, hi;
-  structured_box(o, lo, hi);
+  structured_box(options, lo, hi);
   for (int j = 0; j < n; ++j)
     if (!(hi(j) > lo(j)))
       throw std::invalid_argument(fmt::format("structured design: joint {} ({}) has no room inside its limits less the margin", j + 1,
-                                              o.joints[static_cast<std::size_t>(j)].name));
+                                              options.joints[static_cast<std::size_t>(j)].name));
   const Eigen::VectorXd width = hi - lo, mid = (lo + hi) / 2;
 
-  std::map<std::string, Eigen::VectorXd> postures = o.postures;
+  std::map<std::string, Eigen::VectorXd> postures = options.postures;
   if (postures.empty()) {
     postures["A"] = mid;
     postures["B"] = mid;
@@ -83,29 +83,29 @@ std::string structured_design_yaml(const StructuredDesignOptions& o) {
   }
   for (const auto& [name, q] : postures)
     if (q.size() != n) throw std::invalid_argument(fmt::format("structured design: posture {} needs {} joints", name, n));
-  Eigen::VectorXd velocity = o.velocity, acceleration = o.acceleration;
+  Eigen::VectorXd velocity = options.velocity, acceleration = options.acceleration;
   if (velocity.size() == 0) {
     velocity.resize(n);
-    for (int j = 0; j < n; ++j) velocity(j) = 0.6 * o.joints[static_cast<std::size_t>(j)].velocity;
+    for (int j = 0; j < n; ++j) velocity(j) = 0.6 * options.joints[static_cast<std::size_t>(j)].velocity;
   }
   if (acceleration.size() == 0) acceleration = 5.0 * velocity;
-  std::vector<std::string> classes = o.joint_class;
+  std::vector<std::string> classes = options.joint_class;
   if (classes.empty())
     for (int j = 0; j < n; ++j) classes.push_back(j < 2 ? "proximal" : "normal");
 
   std::string y;
-  y += fmt::format("# {} identification and validation trajectories: the paper's structured families (single-joint\n", o.robot);
+  y += fmt::format("# {} identification and validation trajectories: the paper's structured families (single-joint\n", options.robot);
   y += "# and adjacent-pair primitives on a posture x pattern x speed grid), written by `dynid excite`\n";
   y += "# (symoro/trajectory/structured_design.hpp). Units: deg, rad/s and rad/s^2 at speed factor 1, s.\n";
   y += "# Review the postures and amplitudes: they are derived from the joint limits, not from the arm's\n";
   y += "# surroundings.\n\n";
-  y += fmt::format("robot: {}\njoints: [", o.robot);
-  for (int j = 0; j < n; ++j) y += (j ? ", " : "") + std::string(o.joints[static_cast<std::size_t>(j)].name);
+  y += fmt::format("robot: {}\njoints: [", options.robot);
+  for (int j = 0; j < n; ++j) y += (j ? ", " : "") + std::string(options.joints[static_cast<std::size_t>(j)].name);
   y += "]\n\nlimits:\n";
-  y += fmt::format("  position_margin: {:.6g}\n", o.position_margin / kDeg);
+  y += fmt::format("  position_margin: {:.6g}\n", options.position_margin / kDeg);
   y += fmt::format("  velocity: {}\n  acceleration: {}\n\n", list(velocity, 1), list(acceleration, 1));
   y += "speed_factors:\n";
-  for (const auto& [c, f] : o.speed_factors) {
+  for (const auto& [c, f] : options.speed_factors) {
     y += fmt::format("  {}: [", c);
     for (std::size_t k = 0; k < f.size(); ++k) y += fmt::format("{}{:.6g}", k ? ", " : "", f[k]);
     y += "]\n";
@@ -114,13 +114,13 @@ std::string structured_design_yaml(const StructuredDesignOptions& o) {
   for (int j = 0; j < n; ++j) y += (j ? ", " : "") + classes[static_cast<std::size_t>(j)];
   y += "]\n\n";
   y += fmt::format("timing:\n  start_hold: {:.6g}\n  end_hold: {:.6g}\n  waypoint_dwell: {:.6g}\n  primitive_dwell: {:.6g}\n\n",
-                   o.start_hold, o.end_hold, o.waypoint_dwell, o.primitive_dwell);
+                   options.start_hold, options.end_hold, options.waypoint_dwell, options.primitive_dwell);
   y += "postures:\n";
   for (const auto& [name, q] : postures) y += fmt::format("  {}: {}\n", name, list(q, kDeg));
   y += "\n# Amplitude a_j and center offset c_j per posture: qbar +- a_j stays inside the box.\nprimitives:\n";
   for (const auto& [name, q] : postures) {
     PrimitiveRanges r;
-    if (const auto given = o.primitives.find(name); given != o.primitives.end()) {
+    if (const auto given = options.primitives.find(name); given != options.primitives.end()) {
       r = given->second;
     } else {
       r.center = Eigen::VectorXd::Zero(n);
@@ -176,10 +176,10 @@ std::string structured_design_yaml(const StructuredDesignOptions& o) {
     y += "\n";
   }
   // Held-out validation: six multi-axis waypoints each, drawn inside the middle 70 % of the box.
-  std::mt19937_64 rng(o.seed);
+  std::mt19937_64 rng(options.seed);
   std::uniform_real_distribution<double> u(-0.35, 0.35);
   const std::string first = postures.begin()->first;
-  for (int v = 1; v <= o.validation; ++v) {
+  for (int v = 1; v <= options.validation; ++v) {
     y += fmt::format("  - name: V{:02d}\n    posture: {}\n    speed: 2\n    sequence:\n      - waypoints: [", v, first);
     for (int w = 0; w < 6; ++w) {
       Eigen::VectorXd q(n);

@@ -38,30 +38,30 @@ std::string describe_run(const RunStats& s) {
 }
 
 TwinDatasetSummary make_twin_dataset(const ClosedLoopTwin& twin, const std::vector<trajectory::Trajectory>& trajectories,
-                                     const TwinDatasetOptions& o) {
+                                     const TwinDatasetOptions& options) {
   return make_twin_dataset([&twin](const trajectory::Trajectory& t, const RunOptions& ro, RunStats* st) { return twin.run(t, ro, st); },
-                           twin.notes(), twin.config(), trajectories, o);
+                           twin.notes(), twin.config(), trajectories, options);
 }
 
 TwinDatasetSummary make_twin_dataset(const RunTwin& run, const std::string& notes, const TwinConfig& config,
-                                     const std::vector<trajectory::Trajectory>& trajs, const TwinDatasetOptions& o) {
-  std::filesystem::create_directories(o.out);
+                                     const std::vector<trajectory::Trajectory>& trajs, const TwinDatasetOptions& options) {
+  std::filesystem::create_directories(options.out);
   TwinDatasetSummary summary;
-  summary.runs = static_cast<int>(trajs.size()) * o.trials;
+  summary.runs = static_cast<int>(trajs.size()) * options.trials;
 
   struct Job { int traj, trial; };
   std::vector<Job> jobs;
   for (int t = 0; t < static_cast<int>(trajs.size()); ++t)
-    for (int k = 1; k <= o.trials; ++k) {
-      const auto file = o.out / run_file_name(trajs[t].name, k);
-      if (finished(file, run_seed(o.seed, trajs[t].name, k), k, notes)) ++summary.skipped;
+    for (int k = 1; k <= options.trials; ++k) {
+      const auto file = options.out / run_file_name(trajs[t].name, k);
+      if (finished(file, run_seed(options.seed, trajs[t].name, k), k, notes)) ++summary.skipped;
       else jobs.push_back({t, k});
     }
   summary.made = static_cast<int>(jobs.size());
   // Longest runs first: better load balance across workers.
   std::stable_sort(jobs.begin(), jobs.end(), [&](const Job& a, const Job& b) { return trajs[a.traj].duration() > trajs[b.traj].duration(); });
   summary.coordinator = parallel::place().coordinator();
-  if (summary.coordinator && o.on_start) o.on_start(summary.made, summary.skipped);
+  if (summary.coordinator && options.on_start) options.on_start(summary.made, summary.skipped);
   auto name_of = [&](const Job& j) { return fmt::format("{} t{}", trajs[j.traj].name, j.trial); };
 
   // Each worker writes its run's log (atomically, a file of its own) and sends rank 0 what it
@@ -75,12 +75,12 @@ TwinDatasetSummary make_twin_dataset(const RunTwin& run, const std::string& note
     Job j{};
     in >> j.traj >> j.trial;
     RunOptions ro;
-    ro.robot = o.robot;
+    ro.robot = options.robot;
     ro.trial = j.trial;
-    ro.seed = run_seed(o.seed, trajs[j.traj].name, j.trial);
+    ro.seed = run_seed(options.seed, trajs[j.traj].name, j.trial);
     RunStats st;
     const io::Log log = run(trajs[j.traj], ro, &st);
-    io::write_log(o.out / run_file_name(trajs[j.traj].name, j.trial), log);
+    io::write_log(options.out / run_file_name(trajs[j.traj].name, j.trial), log);
     emit(fmt::format("{:.17g} {}", st.simulated, describe_run(st)));
   };
   farm.on_result = [&](std::size_t i, const std::string& text) {
@@ -90,13 +90,13 @@ TwinDatasetSummary make_twin_dataset(const RunTwin& run, const std::string& note
     summary.simulated += s;
     std::string rest;
     std::getline(in, rest);
-    if (o.on_run) o.on_run(name_of(jobs[i]), rest.empty() ? rest : rest.substr(1));
+    if (options.on_run) options.on_run(name_of(jobs[i]), rest.empty() ? rest : rest.substr(1));
   };
   farm.on_end = [&](const parallel::TaskEnd& e) {
     if (e.failed) errors += fmt::format("{}{}: {}", errors.empty() ? "" : "; ", name_of(jobs[e.task]), e.failure);
   };
   parallel::FarmOptions fo;
-  fo.workers = o.workers;
+  fo.workers = options.workers;
   const auto t0 = std::chrono::steady_clock::now();
   const parallel::FarmSummary farmed = parallel::run_farm(tasks, farm, fo);
   summary.ranks = farmed.ranks;
@@ -106,16 +106,16 @@ TwinDatasetSummary make_twin_dataset(const RunTwin& run, const std::string& note
   summary.wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 
   io::Dataset d;
-  d.dir = o.out;
-  d.robot = o.robot;
+  d.dir = options.out;
+  d.robot = options.robot;
   d.twin = config.path;
-  if (!o.overrides.empty()) {
+  if (!options.overrides.empty()) {
     d.twin_overrides = "twin_overrides.yaml";  // relative to the folder
-    io::write_file_atomically(o.out / d.twin_overrides, io::read_text_file(o.overrides));
+    io::write_file_atomically(options.out / d.twin_overrides, io::read_text_file(options.overrides));
   }
-  d.twin_record = io::TwinDatasetRecord{o.seed, o.trials, config.effects.enabled()};
+  d.twin_record = io::TwinDatasetRecord{options.seed, options.trials, config.effects.enabled()};
   for (const trajectory::Trajectory& t : trajs)
-    for (int k = 1; k <= o.trials; ++k) d.runs.push_back({t.name, t.family, k, run_file_name(t.name, k)});
+    for (int k = 1; k <= options.trials; ++k) d.runs.push_back({t.name, t.family, k, run_file_name(t.name, k)});
   io::write_dataset(d);
   return summary;
 }

@@ -60,6 +60,6 @@ twin::TwinConfig with_selected_effects(twin::TwinConfig c, const Selection& s);
 // `measured` the fitting run and `reference` its reference at every cycle (the log's own
 // references: the motion that was logged).
 BacklashFit fit_backlash(const robot::ModelHandle& full, const io::Log& measured, const trajectory::SampledReference& reference,
-                         twin::TwinConfig nominal, const BacklashFitOptions& o = {});
+                         twin::TwinConfig nominal, const BacklashFitOptions& options = {});
 
 }  // namespace symoro::diagnose

@@ -41,7 +41,7 @@ struct BacklashFitOptions {
 
 // A log's torque above band_hz, rms per joint (N m): the log preprocessed at its own rate (a
 // light_hz low-pass), less its zero-phase band_hz low-pass, over every piece.
-Eigen::VectorXd high_band_rms(const io::Log& log, const BacklashFitOptions& o = {});
+Eigen::VectorXd high_band_rms(const io::Log& log, const BacklashFitOptions& options = {});
 
 struct LoopFloor {
   Eigen::VectorXd rms;         // N m per joint: the high band of what the law does not explain
@@ -54,6 +54,6 @@ struct LoopFloor {
 // The floor of a log (its reference columns needed) under the controller and servos of `c`.
 // The lag (0, 1 or 2 rows) is the one whose residual is smallest. Throws DataError naming the
 // log when it has no references or differs from the description in joints.
-LoopFloor loop_floor(const io::Log& log, const twin::TwinConfig& c, const BacklashFitOptions& o = {});
+LoopFloor loop_floor(const io::Log& log, const twin::TwinConfig& c, const BacklashFitOptions& options = {});
 
 }  // namespace symoro::diagnose

@@ -50,9 +50,9 @@ struct StackOptions {
 // The derivative noise it lets in is averaged by the low-pass where it enters linearly; its
 // square biases the velocity-squared terms by well under a mN m at 4096 counts/rev.
 inline preprocess::Options light_preprocessing(double cutoff_hz = 150.0) {
-  preprocess::Options o;
-  o.derivative_cutoff = cutoff_hz;
-  return o;
+  preprocess::Options options;
+  options.derivative_cutoff = cutoff_hz;
+  return options;
 }
 
 // What the design stack needs of the diagnosed model and of its robot's full model: their
@@ -70,7 +70,7 @@ struct StackModel {
 };
 
 // The design stack of `runs` (stack_builder.cpp, compiled once for every robot).
-DesignStack stack_design(const StackModel& model, const std::vector<NamedSamples>& runs, const StackOptions& o = {});
+DesignStack stack_design(const StackModel& model, const std::vector<NamedSamples>& runs, const StackOptions& options = {});
 
 // A generated model and its full model as a StackModel.
 template <class Full, class Identified>
@@ -106,8 +106,8 @@ StackModel stack_model() {
 }
 
 template <class Full, class Identified>
-DesignStack stack_design(const std::vector<NamedSamples>& runs, const StackOptions& o = {}) {
-  return stack_design(stack_model<Full, Identified>(), runs, o);
+DesignStack stack_design(const std::vector<NamedSamples>& runs, const StackOptions& options = {}) {
+  return stack_design(stack_model<Full, Identified>(), runs, options);
 }
 
 }  // namespace symoro::diagnose

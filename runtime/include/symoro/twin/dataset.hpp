@@ -44,11 +44,11 @@ using RunTwin = std::function<io::Log(const trajectory::Trajectory&, const RunOp
 // ::config). Throws std::runtime_error naming the failed runs, after the others are written (a
 // rerun does only the failed ones); the manifest is then not written.
 TwinDatasetSummary make_twin_dataset(const RunTwin& run, const std::string& notes, const TwinConfig& config,
-                                     const std::vector<trajectory::Trajectory>& trajectories, const TwinDatasetOptions& o);
+                                     const std::vector<trajectory::Trajectory>& trajectories, const TwinDatasetOptions& options);
 
 // The same with the twin's own runs.
 TwinDatasetSummary make_twin_dataset(const ClosedLoopTwin& twin, const std::vector<trajectory::Trajectory>& trajectories,
-                                     const TwinDatasetOptions& o);
+                                     const TwinDatasetOptions& options);
 
 // A run's log file in a dataset: <trajectory>_t<trial>.csv.
 std::string run_file_name(const std::string& trajectory, int trial);

@@ -42,19 +42,19 @@ struct ClieStart {
 
 // The paper's pre-CLIE step (Algorithm 1, lines 4-15): the all-pose audit of the OLS estimate
 // and, when it is not PD, the conditional SDP projection. Fills the record's audit and route.
-ClieStart pd_start(const LeastSquaresResult& ls, const StudyOptions& o, const InertiaFunction& inertia,
+ClieStart pd_start(const LeastSquaresResult& ls, const StudyOptions& options, const InertiaFunction& inertia,
                    const AuditDomain& domain, RunRecord& r);
 
 // The physical path's pre-CLIE step when asked (StudyOptions::physical_start): the all-pose audit
 // (for the record) and, when the OLS estimate has no consistent standard set, the nearest base
 // vector that has one in the run's predicted-torque metric (physical_projection.hpp).
-ClieStart physical_start(const IdentificationModel& model, const LeastSquaresResult& ls, const StudyOptions& o,
+ClieStart physical_start(const IdentificationModel& model, const LeastSquaresResult& ls, const StudyOptions& options,
                          const InertiaFunction& inertia, const AuditDomain& domain, RunRecord& r);
 
 // One trajectory at one interval, from its log.
 // sim: the run's closed loop, or nullptr (CLIE is skipped; `no_clie` says why).
 RunRecord identify_run(const IdentificationModel& model, const io::Log& log, const ClosedLoop* sim,
-                       const std::string& no_clie, double interval, const StudyOptions& o,
+                       const std::string& no_clie, double interval, const StudyOptions& options,
                        const InertiaFunction& inertia, const AuditDomain& domain);
 
 }  // namespace detail
