@@ -19,12 +19,7 @@ constexpr std::array<std::string_view, 7> kVariantOrder{"coulomb",           "in
                                                         "smooth_coulomb"};
 static_assert(kVariantOrder.size() == static_cast<std::size_t>(EffectKind::SmoothCoulomb) + 1);
 
-constexpr bool every_variant_has_a_row() {
-  for (std::string_view name : kVariantOrder)
-    if (!find_effect(&EffectRow::variant, name)) return false;
-  return true;
-}
-static_assert(every_variant_has_a_row(), "a variant effect without its row in symoro/effect_table.hpp");
+static_assert(every_name_has_a_row(&EffectRow::variant, kVariantOrder), "a variant effect without its row in symoro/effect_table.hpp");
 
 struct Entry {
   EffectKind kind;

@@ -85,6 +85,15 @@ constexpr const EffectRow* find_effect(std::string_view EffectRow::*column, std:
   return nullptr;
 }
 
+// Whether every name of a list has its row in a column: what the diagnosis's and the compiler's
+// own orders of their effects static_assert.
+template <std::size_t N>
+constexpr bool every_name_has_a_row(std::string_view EffectRow::*column, const std::array<std::string_view, N>& names) {
+  for (std::string_view name : names)
+    if (!find_effect(column, name)) return false;
+  return true;
+}
+
 // The words of a space-separated column (families, unfixes).
 inline std::vector<std::string> effect_words(std::string_view text) {
   std::vector<std::string> words;

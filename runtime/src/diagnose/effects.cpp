@@ -34,12 +34,7 @@ constexpr std::array<std::string_view, 10> kDiagnosisOrder{
     "inertia_products", "torque_constant", "actuation_delay", "backlash",   "payload"};
 static_assert(kDiagnosisOrder.size() == static_cast<std::size_t>(EffectKind::Payload) + 1);
 
-constexpr bool every_effect_has_a_row() {
-  for (std::string_view name : kDiagnosisOrder)
-    if (!find_effect(&EffectRow::diagnosis, name)) return false;
-  return true;
-}
-static_assert(every_effect_has_a_row(), "a diagnosis effect without its row in symoro/effect_table.hpp");
+static_assert(every_name_has_a_row(&EffectRow::diagnosis, kDiagnosisOrder), "a diagnosis effect without its row in symoro/effect_table.hpp");
 
 }  // namespace
 
