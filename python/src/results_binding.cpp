@@ -222,7 +222,8 @@ void bind_export(py::module_& m) {
     r["message"] = e.consistency.message;
     return r;
   }, py::arg("model"), py::arg("study"), py::arg("urdf"), py::kw_only(), py::arg("prior") = py::none(),
-     py::arg("robot_dir") = py::none(), py::arg("margin") = 1e-9, py::arg("nearest") = false, py::arg("not_accepted") = false,
+     py::arg("robot_dir") = py::none(), py::arg("margin") = identify::ModelExportOptions{}.margin,
+     py::arg("nearest") = identify::ModelExportOptions{}.nearest, py::arg("not_accepted") = false,
      "The study's accepted parameters as a URDF (dynid export): the physically consistent standard parameters nearest the "
      "prior that reproduce them, written to urdf and <stem>.standard.yaml/.csv");
 }

@@ -42,14 +42,14 @@ struct ExciteOptions {
   std::string params;       // nominal phi; "" robot.yaml's nominal
   bool force = false;       // replace trajectories.yaml and quality.txt in -o
   int optimized = 3;
-  int harmonics = 5;
+  int harmonics = identify::ExcitationDesignOptions{}.harmonics;
   bool harmonics_given = false;
   double period = 0;  // s; 0: from the limits (auto_period), or chosen (excite_choice.hpp)
   double kappa_target = 0;   // > 0: choose the period for a scaled kappa below it
   double max_duration = 25;  // s, the longest optimized trajectory the choice may make
   int periods = 1;
-  int starts = 4;
-  std::uint64_t seed = 1;
+  int starts = identify::ExcitationDesignOptions{}.starts;
+  std::uint64_t seed = identify::ExcitationDesignOptions{}.seed;
   double torque_fraction = 0.8;
   double table = -1;                    // m below frame 0; < 0: none
   std::vector<std::string> half_spaces;  // "frame:nx,ny,nz:offset"

@@ -4,6 +4,7 @@
 #include <string>
 
 #include "dynid_common.hpp"
+#include "symoro/identify/model_export.hpp"
 
 namespace symoro::dynid {
 
@@ -11,10 +12,10 @@ struct ExportOptions {
   std::string study, urdf, model, prior, data;
   std::string into;  // the user's URDF to write the inertials into (dynid_urdf_into.hpp)
   // Strictly inside the consistent set, above rounding: a singular pseudo-inertia (lambda_min
-  // -2e-17 measured with 0) is a body some simulators reject.
-  double margin = 1e-9;
+  // -2e-17 measured with 0) is a body some simulators reject. The library's defaults.
+  double margin = identify::ModelExportOptions{}.margin;
   int trial = 1;
-  bool not_accepted = false, nearest = false;
+  bool not_accepted = false, nearest = identify::ModelExportOptions{}.nearest;
   bool force = false;  // overwrite the URDF and its .standard files
 };
 
