@@ -239,27 +239,9 @@ bool glob_match(const std::string& pattern, const std::string& name) {
 
 namespace {
 
-RobotSpec read_robot_spec_checked(const std::string& path) {
-  const YAML::Node root = load_yaml_file(path);
-  Reader r{path};
-  if (!root.IsMap()) throw InputError(path, 1, 1, "robot.yaml must be a mapping of keys");
-  r.only_keys(root, {"name", "description", "constants", "joints", "parameter_units",
-                     "identified", "variants", "nominal", "urdf"},
-              "robot.yaml");
-
-  RobotSpec spec;
-  spec.path = path;
-  if (root["description"]) spec.description = r.string(root["description"], "description");
-
-  if (const auto c = root["constants"]) {
-    if (!c.IsMap()) r.fail(c, "constants must map names to numbers");
-    for (const auto& kv : c) {
-      const std::string name = kv.first.Scalar();
-      if (!is_identifier(name)) r.fail(kv.first, "'" + name + "' is not a symbol name");
-      spec.constants[name] = r.number(kv.second, "constant " + name);
-    }
-  }
-
+// robot.yaml's `joints`: one entry per joint, named, with its limits (and its audit box).
+void read_joints(const Reader& r, const YAML::Node& root, RobotSpec& spec) {
+  const std::string& path = r.path;
   const auto joints = root["joints"];
   if (!joints || !joints.IsSequence() || joints.size() == 0)
     throw InputError(path, 1, 1, "missing 'joints': a list with one entry per joint");
@@ -290,6 +272,10 @@ RobotSpec read_robot_spec_checked(const std::string& path) {
     spec.joints.push_back(js);
   }
 
+}
+
+// robot.yaml's `parameter_units` over the defaults, per family, for revolute and prismatic joints.
+void read_units(const Reader& r, const YAML::Node& root, RobotSpec& spec) {
   spec.units = kDefaultUnits;
   spec.prismatic_units = kDefaultPrismaticUnits;
   if (const auto u = root["parameter_units"]) {
@@ -313,6 +299,11 @@ RobotSpec read_robot_spec_checked(const std::string& path) {
     read(u["prismatic"], spec.prismatic_units);
   }
 
+}
+
+// robot.yaml's `variants`: each with its description, base, fixed patterns and effects, bases
+// resolved.
+void read_variants(const Reader& r, const YAML::Node& root, RobotSpec& spec) {
   if (const auto v = root["variants"]) {
     if (!v.IsMap()) r.fail(v, "variants must map variant names to {description, base, fixed, effects}");
     std::vector<RawVariant> raw;
@@ -349,10 +340,10 @@ RobotSpec read_robot_spec_checked(const std::string& path) {
     resolve_bases(r, raw);
     for (const auto& rv : raw) spec.variants.push_back(rv.spec);
   }
-  if (const auto nom = root["nominal"]) {
-    if (!nom.IsMap()) r.fail(nom, "nominal must map standard parameter names to numbers");
-    for (const auto& kv : nom) spec.nominal[kv.first.Scalar()] = r.number(kv.second, "nominal " + kv.first.Scalar());
-  }
+}
+
+// robot.yaml's `urdf`: the description the robot was modelled from (symoroc model).
+void read_urdf_section(const Reader& r, const YAML::Node& root, RobotSpec& spec) {
   if (const auto u = root["urdf"]) {
     if (!u.IsMap()) r.fail(u, "urdf must be a mapping (file, base_link, tip_link, ...)");
     r.only_keys(u, {"file", "base_link", "tip_link", "frame0_in_base", "tip_in_last_frame", "joints", "links", "locked"}, "urdf");
@@ -366,6 +357,37 @@ RobotSpec read_robot_spec_checked(const std::string& path) {
       for (const auto& name : j) spec.urdf.joints.push_back(r.string(name, "urdf joint name"));
     }
   }
+}
+
+RobotSpec read_robot_spec_checked(const std::string& path) {
+  const YAML::Node root = load_yaml_file(path);
+  Reader r{path};
+  if (!root.IsMap()) throw InputError(path, 1, 1, "robot.yaml must be a mapping of keys");
+  r.only_keys(root, {"name", "description", "constants", "joints", "parameter_units",
+                     "identified", "variants", "nominal", "urdf"},
+              "robot.yaml");
+
+  RobotSpec spec;
+  spec.path = path;
+  if (root["description"]) spec.description = r.string(root["description"], "description");
+
+  if (const auto c = root["constants"]) {
+    if (!c.IsMap()) r.fail(c, "constants must map names to numbers");
+    for (const auto& kv : c) {
+      const std::string name = kv.first.Scalar();
+      if (!is_identifier(name)) r.fail(kv.first, "'" + name + "' is not a symbol name");
+      spec.constants[name] = r.number(kv.second, "constant " + name);
+    }
+  }
+
+  read_joints(r, root, spec);
+  read_units(r, root, spec);
+  read_variants(r, root, spec);
+  if (const auto nom = root["nominal"]) {
+    if (!nom.IsMap()) r.fail(nom, "nominal must map standard parameter names to numbers");
+    for (const auto& kv : nom) spec.nominal[kv.first.Scalar()] = r.number(kv.second, "nominal " + kv.first.Scalar());
+  }
+  read_urdf_section(r, root, spec);
   if (const auto id = root["identified"]) {
     spec.identified = r.string(id, "identified");
     bool known = spec.identified == "full";

@@ -1,6 +1,7 @@
 #include "symoro/codegen/modeling.hpp"
 
 #include <algorithm>
+#include <functional>
 
 #include "base_parameters.hpp"
 #include "description.hpp"
@@ -131,6 +132,58 @@ std::string base_par(const ExprGraph& g, const Description& d, const std::vector
 }  // namespace
 
 namespace {
+// The solution x of A x = b, A symmetric positive definite as symbols, by LDL^T: one division
+// per pivot. b(i) makes the right-hand side's row i when the forward substitution reaches it (the
+// graph's nodes are made in the order the emitted text depends on).
+std::vector<NodeId> ldlt_solve(ExprGraph& g, const std::vector<std::vector<NodeId>>& A, const std::function<NodeId(int)>& b) {
+  const int n = static_cast<int>(A.size());
+  std::vector<std::vector<NodeId>> L(n, std::vector<NodeId>(n, g.zero()));
+  std::vector<NodeId> D(n), inv_D(n), x(n);
+  for (int j = 0; j < n; ++j) {
+    NodeId dj = A[j][j];
+    for (int k = 0; k < j; ++k) dj = g.sub(dj, g.mul(g.pow(L[j][k], 2.0), D[k]));
+    D[j] = dj;
+    inv_D[j] = g.div(g.one(), dj);
+    for (int i = j + 1; i < n; ++i) {
+      NodeId v = A[i][j];
+      for (int k = 0; k < j; ++k) v = g.sub(v, g.mul(g.mul(L[i][k], L[j][k]), D[k]));
+      L[i][j] = g.mul(v, inv_D[j]);
+    }
+  }
+  for (int i = 0; i < n; ++i) {
+    NodeId y = b(i);
+    for (int k = 0; k < i; ++k) y = g.sub(y, g.mul(L[i][k], x[k]));
+    x[i] = y;
+  }
+  for (int i = 0; i < n; ++i) x[i] = g.mul(x[i], inv_D[i]);
+  for (int i = n - 1; i >= 0; --i)
+    for (int k = i + 1; k < n; ++k) x[i] = g.sub(x[i], g.mul(L[k][i], x[k]));
+  return x;
+}
+
+// fgm.txt and jac.txt: the pose and the Jacobian of `frame`.
+void add_geometric_files(ExprGraph& g, const Description& d, Tables& t, int frame, const std::vector<std::string>& q,
+                         Modeling& out) {
+  const int n = d.n;
+  {
+    const auto T = frame_pose(g, d, frame);
+    std::vector<std::pair<std::string, NodeId>> o;
+    for (int c = 0; c < 4; ++c)
+      for (int r = 0; r < 3; ++r)
+        o.emplace_back("T0T" + std::to_string(frame) + std::to_string(r + 1) + std::to_string(c + 1), T[r][c]);
+    out.files.push_back({"fgm.txt", model_file({"Direct Geometric model (symoroc model)"}, t.geometric(), equations_text(g, o, q, "T"))});
+  }
+  {
+    const auto J = frame_jacobian(g, d, frame);
+    std::vector<std::pair<std::string, NodeId>> o;
+    for (int c = 0; c < n; ++c)
+      for (int r = 0; r < 6; ++r) o.emplace_back("J" + std::to_string(r + 1) + std::to_string(c + 1), J[r][c]);
+    out.files.push_back({"jac.txt", model_file({"Jacobian matrix for frame " + std::to_string(frame) + " (symoroc model)",
+                                                "Projection frame 0, intermediate frame " + std::to_string(frame)},
+                                               t.geometric(), equations_text(g, o, q, "T"))});
+  }
+}
+
 Modeling model_from_par_file(const grammar::ParFile& par, const ModelingOptions& options);
 }  // namespace
 
@@ -229,27 +282,7 @@ Modeling model_from_par_file(const grammar::ParFile& par, const ModelingOptions&
 
   // The direct dynamics: M qdd = tau - h by an LDL^T factorization of M.
   {
-    std::vector<std::vector<NodeId>> L(n, std::vector<NodeId>(n, g.zero()));
-    std::vector<NodeId> D(n), inv_D(n), x(n);  // one division per pivot
-    for (int j = 0; j < n; ++j) {
-      NodeId dj = A[j][j];
-      for (int k = 0; k < j; ++k) dj = g.sub(dj, g.mul(g.pow(L[j][k], 2.0), D[k]));
-      D[j] = dj;
-      inv_D[j] = g.div(g.one(), dj);
-      for (int i = j + 1; i < n; ++i) {
-        NodeId v = A[i][j];
-        for (int k = 0; k < j; ++k) v = g.sub(v, g.mul(g.mul(L[i][k], L[j][k]), D[k]));
-        L[i][j] = g.mul(v, inv_D[j]);
-      }
-    }
-    for (int i = 0; i < n; ++i) {
-      NodeId y = g.sub(g.symbol(d.joints[i].tau), h[i]);
-      for (int k = 0; k < i; ++k) y = g.sub(y, g.mul(L[i][k], x[k]));
-      x[i] = y;
-    }
-    for (int i = 0; i < n; ++i) x[i] = g.mul(x[i], inv_D[i]);
-    for (int i = n - 1; i >= 0; --i)
-      for (int k = i + 1; k < n; ++k) x[i] = g.sub(x[i], g.mul(L[k][i], x[k]));
+    const std::vector<NodeId> x = ldlt_solve(g, A, [&](int i) { return g.sub(g.symbol(d.joints[i].tau), h[i]); });
     std::vector<std::pair<std::string, NodeId>> o;
     for (int j = 0; j < n; ++j) o.emplace_back(d.joints[j].qdd, x[j]);
     out.files.push_back({"ddm.txt", model_file({"Direct Dynamic Model (LDL^T solve of the Newton-Euler model, symoroc model)",
@@ -257,23 +290,7 @@ Modeling model_from_par_file(const grammar::ParFile& par, const ModelingOptions&
                                                tables, equations_text(g, o, q, "T"))});
   }
 
-  {
-    const auto T = frame_pose(g, d, frame);
-    std::vector<std::pair<std::string, NodeId>> o;
-    for (int c = 0; c < 4; ++c)
-      for (int r = 0; r < 3; ++r)
-        o.emplace_back("T0T" + std::to_string(frame) + std::to_string(r + 1) + std::to_string(c + 1), T[r][c]);
-    out.files.push_back({"fgm.txt", model_file({"Direct Geometric model (symoroc model)"}, t.geometric(), equations_text(g, o, q, "T"))});
-  }
-  {
-    const auto J = frame_jacobian(g, d, frame);
-    std::vector<std::pair<std::string, NodeId>> o;
-    for (int c = 0; c < n; ++c)
-      for (int r = 0; r < 6; ++r) o.emplace_back("J" + std::to_string(r + 1) + std::to_string(c + 1), J[r][c]);
-    out.files.push_back({"jac.txt", model_file({"Jacobian matrix for frame " + std::to_string(frame) + " (symoroc model)",
-                                                "Projection frame 0, intermediate frame " + std::to_string(frame)},
-                                               t.geometric(), equations_text(g, o, q, "T"))});
-  }
+  add_geometric_files(g, d, t, frame, q, out);
   return out;
 }
 

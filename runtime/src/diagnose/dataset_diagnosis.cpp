@@ -104,6 +104,55 @@ void score_raw_torque(const DiagnosisModel& model, const DesignStack& train, con
 
 }  // namespace
 
+namespace {
+
+// Backlash from the closed loop's high band: the robot's digital twin replays the fitting run's
+// own references. A stage that cannot run, or fails, is said in the report (d.backlash_note).
+void backlash_stage(const DiagnosisModel& model, const DatasetDiagnosisOptions& o, const std::string& robot,
+                    const io::Log& first_train, const std::string& first_train_name, const std::function<void()>& check_stop,
+                    Diagnosis& d) {
+  const identify::ModelDescription& md = model.description();
+  const auto twin_path = o.robot_dir / "twin.yaml";
+  if (!o.backlash) {
+    d.backlash_note = "Not run (--no-backlash).";
+  } else if (o.robot_dir.empty()) {
+    d.backlash_note = "Not run: the stage simulates the robot's digital twin, and no robot folder was given.";
+  } else if (!std::filesystem::exists(twin_path)) {
+    d.backlash_note = fmt::format("Not run: the stage simulates the robot's digital twin, and {} has none ({} not found).",
+                                  robot, twin_path.string());
+  } else if (!first_train.has_references()) {
+    d.backlash_note = fmt::format("Not run: the log of {} has no reference columns (q_ref, qd_ref, qdd_ref) for the twin to "
+                                  "replay.", first_train_name);
+  } else {
+    check_stop();
+    try {
+      const twin::TwinConfig nominal = with_selected_effects(twin::read_twin_config(twin_path, md.nq), d.selection);
+      const auto reference = trajectory::sampled_reference(first_train, nominal.controller.period);
+      d.backlash = model.fit_backlash(first_train, reference, nominal, BacklashFitOptions{});
+      d.backlash_judged = true;
+    } catch (const std::exception& e) {
+      d.backlash_note = fmt::format("Failed after the selection, so no play is named: {}", e.what());
+    }
+  }
+}
+
+// What the diagnosis named (and dropped), said line by line.
+void say_findings(const Diagnosis& d, const std::function<void(const std::string&)>& say) {
+  for (const auto& e : d.selection.dropped) say(fmt::format("dropped: {}: {} ({})", e.candidate.label(), e.magnitude, e.reason));
+  for (const auto& e : d.selection.effects)
+    say(fmt::format("effect: {}: {} (F {:.1f}, held-out gain {:.1f} %)", e.candidate.label(), e.magnitude.text, e.f,
+                    100 * e.heldout_gain));
+  for (const auto& f : d.backlash.findings)
+    say(fmt::format("effect: backlash, joint {}: {:.3f} deg of play (high-band torque {:.3f} N m measured, {:.3f} simulated "
+                    "without it, {:.3f} with it)",
+                    f.joint, f.width * 180 / 3.14159265358979323846, f.measured, f.simulated_before, f.simulated_after));
+  if (d.backlash.delay > 0) say(fmt::format("actuation delay refined on the high band: {:.2f} ms", d.backlash.delay * 1e3));
+  if (d.selection.effects.empty() && d.backlash.findings.empty())
+    say(fmt::format("no missing effect found ({})", d.selection.stop_reason));
+}
+
+}  // namespace
+
 DatasetDiagnosis diagnose_dataset(const DiagnosisModel& model, const DatasetDiagnosisOptions& o) {
   check_request(o);
   const identify::ModelDescription& md = model.description();
@@ -166,47 +215,15 @@ DatasetDiagnosis diagnose_dataset(const DiagnosisModel& model, const DatasetDiag
   } catch (const std::exception& e) {
     d.raw_note = e.what();
   }
-  // Backlash from the closed loop's high band: the robot's digital twin replays the fitting
-  // run's own references. A stage that cannot run, or fails, is said in the report.
+  // Backlash from the closed loop's high band (a stage that cannot run is said in the report).
   const std::string robot = o.robot_dir.empty() ? md.robot : o.robot_dir.filename().string();
-  const auto twin_path = o.robot_dir / "twin.yaml";
-  if (!o.backlash) {
-    d.backlash_note = "Not run (--no-backlash).";
-  } else if (o.robot_dir.empty()) {
-    d.backlash_note = "Not run: the stage simulates the robot's digital twin, and no robot folder was given.";
-  } else if (!std::filesystem::exists(twin_path)) {
-    d.backlash_note = fmt::format("Not run: the stage simulates the robot's digital twin, and {} has none ({} not found).",
-                                  robot, twin_path.string());
-  } else if (!first_train.has_references()) {
-    d.backlash_note = fmt::format("Not run: the log of {} has no reference columns (q_ref, qd_ref, qdd_ref) for the twin to "
-                                  "replay.", train_names.front());
-  } else {
-    check_stop();
-    try {
-      const twin::TwinConfig nominal = with_selected_effects(twin::read_twin_config(twin_path, md.nq), d.selection);
-      const auto reference = trajectory::sampled_reference(first_train, nominal.controller.period);
-      d.backlash = model.fit_backlash(first_train, reference, nominal, BacklashFitOptions{});
-      d.backlash_judged = true;
-    } catch (const std::exception& e) {
-      d.backlash_note = fmt::format("Failed after the selection, so no play is named: {}", e.what());
-    }
-  }
+  backlash_stage(model, o, robot, first_train, train_names.front(), check_stop, d);
   if (!d.backlash_note.empty()) say(fmt::format("backlash stage: {}", d.backlash_note));
   d.robot = robot;
   d.model = md.robot + (md.variant.empty() ? "" : "::" + md.variant);
   d.cutoff = o.cutoff;
   d.held_parameters = o.params.string();
-  for (const auto& e : d.selection.dropped) say(fmt::format("dropped: {}: {} ({})", e.candidate.label(), e.magnitude, e.reason));
-  for (const auto& e : d.selection.effects)
-    say(fmt::format("effect: {}: {} (F {:.1f}, held-out gain {:.1f} %)", e.candidate.label(), e.magnitude.text, e.f,
-                    100 * e.heldout_gain));
-  for (const auto& f : d.backlash.findings)
-    say(fmt::format("effect: backlash, joint {}: {:.3f} deg of play (high-band torque {:.3f} N m measured, {:.3f} simulated "
-                    "without it, {:.3f} with it)",
-                    f.joint, f.width * 180 / 3.14159265358979323846, f.measured, f.simulated_before, f.simulated_after));
-  if (d.backlash.delay > 0) say(fmt::format("actuation delay refined on the high band: {:.2f} ms", d.backlash.delay * 1e3));
-  if (d.selection.effects.empty() && d.backlash.findings.empty())
-    say(fmt::format("no missing effect found ({})", d.selection.stop_reason));
+  say_findings(d, say);
   say(fmt::format("held-out rms residual: {:.4f} -> {:.4f} N m", d.selection.before.heldout_total, d.selection.after.heldout_total));
   check_stop();  // the last chance: from here the report is written whole
   result.files = write_diagnosis_report(d, o.out);

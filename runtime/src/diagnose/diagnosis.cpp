@@ -85,22 +85,18 @@ std::string flags(const CandidateTest& t) {
 
 }  // namespace
 
-std::vector<std::filesystem::path> write_diagnosis_report(const Diagnosis& d, const std::filesystem::path& dir) {
-  std::filesystem::create_directories(dir / "figures");
-  std::vector<std::filesystem::path> written;
+namespace {
+
+std::string joined(const std::vector<std::string>& v) {
+  std::string out;
+  for (const auto& x : v) out += (out.empty() ? "" : ", ") + x;
+  return out;
+}
+
+// The effects selected (with the note on an actuation delay), and those the backward check dropped.
+std::string effects_markdown(const Diagnosis& d) {
   const Selection& s = d.selection;
-  std::string m = "# Model-gap diagnosis\n\n";
-  auto join = [](const std::vector<std::string>& v) {
-    std::string out;
-    for (const auto& x : v) out += (out.empty() ? "" : ", ") + x;
-    return out;
-  };
-  m += fmt::format("Robot `{}`, model `{}`. Fitted on {}; judged on the held-out {}. Grid {:g} ms, every column and "
-                   "the torque through the same {:g} Hz zero-phase low-pass (parallel filtering).\n\n",
-                   d.robot, d.model, join(d.train), join(d.heldout), d.interval * 1000, d.cutoff);
-  if (!d.held_parameters.empty())
-    m += "The identified parameters are held at `" + d.held_parameters +
-         "` (an earlier identification): only the effects are fitted, so what changed since (a payload) shows.\n\n";
+  std::string m;
   m += "## Effects found\n\n";
   if (s.effects.empty()) {
     m += "None: no candidate effect is significant and improves the held-out trajectories (" + s.stop_reason + ").\n\n";
@@ -109,7 +105,7 @@ std::vector<std::filesystem::path> write_diagnosis_report(const Diagnosis& d, co
     for (std::size_t i = 0; i < s.effects.size(); ++i) {
       const auto& e = s.effects[i];
       m += fmt::format("| {} | {} | {} | {} | {:.1f} | {:.1e} | {:.1f} % |\n", i + 1, e.candidate.label(),
-                       join(e.candidate.parameters), e.magnitude.text, e.f, e.p_value, 100 * e.heldout_gain);
+                       joined(e.candidate.parameters), e.magnitude.text, e.f, e.p_value, 100 * e.heldout_gain);
     }
     m += "\nStopped: " + s.stop_reason + ".\n\n";
     for (const auto& e : s.effects)
@@ -130,6 +126,12 @@ std::vector<std::filesystem::path> write_diagnosis_report(const Diagnosis& d, co
       m += fmt::format("- {}: {}; {}.\n", e.candidate.label(), e.magnitude, e.reason);
     m += "\n";
   }
+  return m;
+}
+
+// The backlash stage: the closed loop's high band against the twin's null, joint by joint.
+std::string backlash_markdown(const Diagnosis& d) {
+  std::string m;
   if (d.backlash_judged) {
     const BacklashFit& b = d.backlash;
     m += "## Backlash: the closed loop's high band\n\n";
@@ -157,6 +159,13 @@ std::vector<std::filesystem::path> write_diagnosis_report(const Diagnosis& d, co
     if (!b.notes.empty()) m += "\n";
   }
   if (!d.backlash_note.empty()) m += "## Backlash: the closed loop's high band\n\n" + d.backlash_note + "\n\n";
+  return m;
+}
+
+// The held-out gap before and after, on the stack's grid and against the raw torque.
+std::string gap_markdown(const Diagnosis& d) {
+  const Selection& s = d.selection;
+  std::string m;
   m += "## The gap before and after (held-out trajectories)\n\n";
   m += "| joint | rms before (N m) | rms after (N m) | change |\n|---|---|---|---|\n";
   for (Eigen::Index j = 0; j < s.before.heldout_rmse.size(); ++j) {
@@ -178,9 +187,13 @@ std::vector<std::filesystem::path> write_diagnosis_report(const Diagnosis& d, co
   } else if (!d.raw_note.empty()) {
     m += "Against the raw measured torque: not scored (" + d.raw_note + ").\n\n";
   }
-  io::write_file_atomically(dir / "figures" / "heldout_rmse.svg", rmse_figure(d, {}));
-  written.push_back(dir / "figures" / "heldout_rmse.svg");
-  m += "![held-out rms per joint](figures/heldout_rmse.svg)\n\n";
+  return m;
+}
+
+// The stepwise selection: the weights and the rule, then each step's best candidates.
+std::string stepwise_markdown(const Diagnosis& d) {
+  const Selection& s = d.selection;
+  std::string m;
   m += "## Stepwise selection\n\n";
   m += fmt::format("Weights per joint (1/N m): {}. Each step refits the model with each candidate; F is a score test with the "
                    "residual's autocorrelation (effective sample size per candidate), the level ({:g} per step) is Bonferroni-corrected, "
@@ -214,6 +227,29 @@ std::vector<std::filesystem::path> write_diagnosis_report(const Diagnosis& d, co
            "can already represent it, and it cannot be judged apart): " + absorbed + ".\n";
     m += "\n";
   }
+  return m;
+}
+
+}  // namespace
+
+std::vector<std::filesystem::path> write_diagnosis_report(const Diagnosis& d, const std::filesystem::path& dir) {
+  std::filesystem::create_directories(dir / "figures");
+  std::vector<std::filesystem::path> written;
+  const Selection& s = d.selection;
+  std::string m = "# Model-gap diagnosis\n\n";
+  m += fmt::format("Robot `{}`, model `{}`. Fitted on {}; judged on the held-out {}. Grid {:g} ms, every column and "
+                   "the torque through the same {:g} Hz zero-phase low-pass (parallel filtering).\n\n",
+                   d.robot, d.model, joined(d.train), joined(d.heldout), d.interval * 1000, d.cutoff);
+  if (!d.held_parameters.empty())
+    m += "The identified parameters are held at `" + d.held_parameters +
+         "` (an earlier identification): only the effects are fitted, so what changed since (a payload) shows.\n\n";
+  m += effects_markdown(d);
+  m += backlash_markdown(d);
+  m += gap_markdown(d);
+  io::write_file_atomically(dir / "figures" / "heldout_rmse.svg", rmse_figure(d, {}));
+  written.push_back(dir / "figures" / "heldout_rmse.svg");
+  m += "![held-out rms per joint](figures/heldout_rmse.svg)\n\n";
+  m += stepwise_markdown(d);
   const auto before_figs = write_localization_figures(d.before_series, d.before, dir / "figures", "before");
   std::vector<std::string> before_links, after_links;
   for (const auto& f : before_figs) before_links.push_back("figures/" + f), written.push_back(dir / "figures" / f);

@@ -248,10 +248,121 @@ Fit fit_with_effects(const DesignStack& train, const DesignStack& heldout, const
   return f;
 }
 
+namespace {
+
+// One candidate's test at a step of the forward selection, against the nested design of the
+// effects chosen so far: its columns added (or found absorbed by the model's), the score test
+// with the residual's autocorrelation at the step's level, then the refit's held-out gain on
+// the joints it acts on, its size there, and whether it is physical and matters.
+CandidateTest test_candidate(const Candidate& c, const detail::NestedDesign& nd, const DesignStack& train,
+                             const DesignStack& heldout, const SelectionOptions& options, double level) {
+  const int n = train.joints;
+  const Eigen::MatrixXd& As = nd.As;
+  const Eigen::VectorXd& r = nd.r;
+  const double rss0 = r.squaredNorm();
+  const Eigen::Index N = nd.A.rows(), p = nd.A.cols();
+  const double dof = static_cast<double>(N) / static_cast<double>(std::max<Eigen::Index>(1, N - p));
+  CandidateTest t;
+  t.key = c.key();
+  t.label = c.label();
+  const Eigen::MatrixXd Ctr = effect_columns(c, train, nd.train_state);
+  const Eigen::MatrixXd Ch = effect_columns(c, heldout, nd.heldout_state);
+  const detail::AddedColumns ac = detail::add_columns(nd, Ctr, Ch);
+  t.columns = static_cast<int>(Ctr.cols());
+  if (ac.absorbed) {
+    t.absorbed = true;
+    return t;
+  }
+  const Eigen::Index m = Ctr.cols();
+  const Eigen::MatrixXd& C = ac.C;
+  const Eigen::VectorXd& Cr = ac.Cr;
+  const Eigen::VectorXd& theta_s = ac.theta_s;
+  const double reduction = ac.reduction;
+  // Test with the long-run (autocorrelation-consistent) variance of the score, the
+  // candidate's own columns against the autocorrelation of the residual the candidate
+  // leaves (the alternative's): an offset is judged against the residual's slow drift, a
+  // fast column against the faster part. Not the residual before it: where the candidate
+  // is the dominant misfit (a constant offset a joint's gravity columns cannot absorb),
+  // that residual is the effect itself, its uncentred autocovariance stays at the
+  // effect's square over every lag, and the effect capped its own F (F 9-13 for an
+  // offset that removed 99 % of the held-out error).
+  const Eigen::MatrixXd Z = C - As * ac.K;
+  const Eigen::MatrixXd r1 = per_sample(train, Eigen::VectorXd(r - Z * theta_s));
+  const Eigen::MatrixXd V = dof * score_covariance(train, Z, autocovariance(train, r1, options.max_lag));
+  const double df2 = static_cast<double>(N) / pooled_time(autocorrelation_time(train, r1, options.max_lag)) - static_cast<double>(p + m);
+  t.df2 = df2;
+  const Eigen::LDLT<Eigen::MatrixXd> Vf(V);
+  const double stat = Vf.info() == Eigen::Success ? Cr.dot(Vf.solve(Cr)) : 0.0;
+  t.effective_time = stat > 0 ? (reduction / (rss0 / static_cast<double>(N - p))) / stat : 1.0;
+  if (df2 > 1 && stat > 0) {
+    t.f = stat / static_cast<double>(m);
+    const boost::math::fisher_f_distribution<double> dist(static_cast<double>(m), df2);
+    t.p_value = boost::math::cdf(boost::math::complement(dist, t.f));
+  }
+  t.significant = t.p_value < level;
+  // Held out: the refit with the candidate, on the joints it acts on.
+  const Eigen::VectorXd& theta = ac.theta;
+  const Eigen::VectorXd& rh = nd.rh;
+  const Eigen::VectorXd& rh1 = ac.rh1;
+  double sse0 = 0, sse1 = 0, total0 = 0, total1 = 0;
+  std::vector<bool> acts_on(n, false);
+  for (int j = 0; j < n; ++j) {
+    double acts = 0;
+    for (int s = 0; s < train.samples(); ++s) acts += Ctr.row(static_cast<Eigen::Index>(s) * n + j).squaredNorm();
+    acts_on[j] = acts > 0;
+    for (int s = 0; s < heldout.samples(); ++s) {
+      const Eigen::Index i = static_cast<Eigen::Index>(s) * n + j;
+      total0 += rh(i) * rh(i);
+      total1 += rh1(i) * rh1(i);
+      if (!acts_on[j]) continue;
+      sse0 += rh(i) * rh(i);
+      sse1 += rh1(i) * rh1(i);
+    }
+  }
+  t.heldout_gain = sse0 > 0 ? 1 - sse1 / sse0 : 0;
+  t.heldout_reduction = total0 > 0 ? 1 - total1 / total0 : 0;
+  const Eigen::VectorXd effect_h = Ch * theta;
+  t.effect_rms = 0;
+  for (int j = 0; j < n && heldout.samples() > 0; ++j) {
+    if (!(acts_on[j])) continue;
+    double ss = 0;
+    for (int s = 0; s < heldout.samples(); ++s) ss += std::pow(effect_h(static_cast<Eigen::Index>(s) * n + j), 2);
+    t.effect_rms = std::max(t.effect_rms, std::sqrt(ss / heldout.samples()));
+  }
+  t.physical = physical(c, theta);
+  t.magnitude = magnitude(c, theta, Eigen::VectorXd::Zero(theta.size())).values;
+  t.matters = matters(c, t, train, options);
+  t.generalizes = t.heldout_gain >= options.min_heldout_gain && t.matters && t.physical;
+  return t;
+}
+
+// Parsimony: a candidate with fewer parameters that removes nearly as much (within
+// options.parsimony of the best) is taken instead. Position harmonics of a joint whose range is
+// limited mimic a constant offset with four columns for one, and won by 1 % of the held-out
+// residual over the offset that was there (RX-90 joint 3). tests[i] is pool[i]'s; the indices
+// are into `all`.
+int parsimonious(int best, double best_reduction, const std::vector<const Candidate*>& pool,
+                 const std::vector<Candidate>& all, const std::vector<CandidateTest>& tests,
+                 const SelectionOptions& options) {
+  int fewest = best, fewest_columns = 0;
+  for (std::size_t i = 0; i < pool.size(); ++i)
+    if (pool[i] == &all[static_cast<std::size_t>(best)]) fewest_columns = tests[i].columns;
+  for (std::size_t i = 0; i < pool.size(); ++i) {
+    const CandidateTest& t = tests[i];
+    if (t.significant && t.generalizes && t.heldout_reduction >= (1 - options.parsimony) * best_reduction &&
+        t.columns < fewest_columns) {
+      fewest = static_cast<int>(pool[i] - all.data());
+      fewest_columns = t.columns;
+    }
+  }
+  return fewest;
+}
+
+}  // namespace
+
 Selection select_effects(const DesignStack& train, const DesignStack& heldout, const SelectionOptions& options) {
   Selection sel;
   const int n = train.joints;
-  const Eigen::Index np = free_parameters(train);
   // Weights from the base model's unweighted residual: 1 / std per joint.
   {
     const Fit plain = fit_with_effects(train, heldout, {}, Eigen::VectorXd::Ones(n), options.max_lag);
@@ -266,14 +377,8 @@ Selection select_effects(const DesignStack& train, const DesignStack& heldout, c
   Fit current = sel.before;
   while (static_cast<int>(chosen.size()) < options.max_effects) {
     const detail::NestedDesign nd = detail::nested_design(train, heldout, chosen, current, sel.weights);
-    const Eigen::MatrixXd& As = nd.As;
-    const Eigen::VectorXd& r = nd.r;
-    const double rss0 = r.squaredNorm();
-    const Eigen::Index N = nd.A.rows(), p = nd.A.cols();
-
     SelectionStep step;
-    step.autocorrelation_time = pooled_time(autocorrelation_time(train, per_sample(train, r), options.max_lag));
-    const double dof = static_cast<double>(N) / static_cast<double>(std::max<Eigen::Index>(1, N - p));
+    step.autocorrelation_time = pooled_time(autocorrelation_time(train, per_sample(train, nd.r), options.max_lag));
     std::vector<const Candidate*> pool;
     for (const auto& c : all)
       if (!taken.count(slot(c))) pool.push_back(&c);
@@ -285,78 +390,7 @@ Selection select_effects(const DesignStack& train, const DesignStack& heldout, c
     int best = -1;
     double best_reduction = 0;
     for (const Candidate* c : pool) {
-      CandidateTest t;
-      t.key = c->key();
-      t.label = c->label();
-      const Eigen::MatrixXd Ctr = effect_columns(*c, train, nd.train_state);
-      const Eigen::MatrixXd Ch = effect_columns(*c, heldout, nd.heldout_state);
-      const detail::AddedColumns ac = detail::add_columns(nd, Ctr, Ch);
-      t.columns = static_cast<int>(Ctr.cols());
-      if (ac.absorbed) {
-        t.absorbed = true;
-        step.tests.push_back(t);
-        continue;
-      }
-      const Eigen::Index m = Ctr.cols();
-      const Eigen::MatrixXd& C = ac.C;
-      const Eigen::VectorXd& Cr = ac.Cr;
-      const Eigen::VectorXd& theta_s = ac.theta_s;
-      const double reduction = ac.reduction;
-      // Test with the long-run (autocorrelation-consistent) variance of the score, the
-      // candidate's own columns against the autocorrelation of the residual the candidate
-      // leaves (the alternative's): an offset is judged against the residual's slow drift, a
-      // fast column against the faster part. Not the residual before it: where the candidate
-      // is the dominant misfit (a constant offset a joint's gravity columns cannot absorb),
-      // that residual is the effect itself, its uncentred autocovariance stays at the
-      // effect's square over every lag, and the effect capped its own F (F 9-13 for an
-      // offset that removed 99 % of the held-out error).
-      const Eigen::MatrixXd Z = C - As * ac.K;
-      const Eigen::MatrixXd r1 = per_sample(train, Eigen::VectorXd(r - Z * theta_s));
-      const Eigen::MatrixXd V = dof * score_covariance(train, Z, autocovariance(train, r1, options.max_lag));
-      const double df2 = static_cast<double>(N) / pooled_time(autocorrelation_time(train, r1, options.max_lag)) - static_cast<double>(p + m);
-      t.df2 = df2;
-      const Eigen::LDLT<Eigen::MatrixXd> Vf(V);
-      const double stat = Vf.info() == Eigen::Success ? Cr.dot(Vf.solve(Cr)) : 0.0;
-      t.effective_time = stat > 0 ? (reduction / (rss0 / static_cast<double>(N - p))) / stat : 1.0;
-      if (df2 > 1 && stat > 0) {
-        t.f = stat / static_cast<double>(m);
-        const boost::math::fisher_f_distribution<double> dist(static_cast<double>(m), df2);
-        t.p_value = boost::math::cdf(boost::math::complement(dist, t.f));
-      }
-      t.significant = t.p_value < step.level;
-      // Held out: the refit with the candidate, on the joints it acts on.
-      const Eigen::VectorXd& theta = ac.theta;
-      const Eigen::VectorXd& rh = nd.rh;
-      const Eigen::VectorXd& rh1 = ac.rh1;
-      double sse0 = 0, sse1 = 0, total0 = 0, total1 = 0;
-      std::vector<bool> acts_on(n, false);
-      for (int j = 0; j < n; ++j) {
-        double acts = 0;
-        for (int s = 0; s < train.samples(); ++s) acts += Ctr.row(static_cast<Eigen::Index>(s) * n + j).squaredNorm();
-        acts_on[j] = acts > 0;
-        for (int s = 0; s < heldout.samples(); ++s) {
-          const Eigen::Index i = static_cast<Eigen::Index>(s) * n + j;
-          total0 += rh(i) * rh(i);
-          total1 += rh1(i) * rh1(i);
-          if (!acts_on[j]) continue;
-          sse0 += rh(i) * rh(i);
-          sse1 += rh1(i) * rh1(i);
-        }
-      }
-      t.heldout_gain = sse0 > 0 ? 1 - sse1 / sse0 : 0;
-      t.heldout_reduction = total0 > 0 ? 1 - total1 / total0 : 0;
-      const Eigen::VectorXd effect_h = Ch * theta;
-      t.effect_rms = 0;
-      for (int j = 0; j < n && heldout.samples() > 0; ++j) {
-        if (!(acts_on[j])) continue;
-        double ss = 0;
-        for (int s = 0; s < heldout.samples(); ++s) ss += std::pow(effect_h(static_cast<Eigen::Index>(s) * n + j), 2);
-        t.effect_rms = std::max(t.effect_rms, std::sqrt(ss / heldout.samples()));
-      }
-      t.physical = physical(*c, theta);
-      t.magnitude = magnitude(*c, theta, Eigen::VectorXd::Zero(theta.size())).values;
-      t.matters = matters(*c, t, train, options);
-      t.generalizes = t.heldout_gain >= options.min_heldout_gain && t.matters && t.physical;
+      const CandidateTest t = test_candidate(*c, nd, train, heldout, options, step.level);
       step.tests.push_back(t);
       // Of the admissible candidates, the one that removes most of the held-out residual (all
       // joints, weighted): the out-of-sample form of forward selection's largest RSS drop. A
@@ -366,25 +400,7 @@ Selection select_effects(const DesignStack& train, const DesignStack& heldout, c
         best = static_cast<int>(c - all.data());
       }
     }
-    // Parsimony: a candidate with fewer parameters that removes nearly as much (within
-    // options.parsimony of the best) is taken instead. Position harmonics of a joint whose range is
-    // limited mimic a constant offset with four columns for one, and won by 1 % of the
-    // held-out residual over the offset that was there (RX-90 joint 3).
-    if (best >= 0) {
-      // step.tests[i] is pool[i]'s (the sort below comes after).
-      int fewest = best, fewest_columns = 0;
-      for (std::size_t i = 0; i < pool.size(); ++i)
-        if (pool[i] == &all[static_cast<std::size_t>(best)]) fewest_columns = step.tests[i].columns;
-      for (std::size_t i = 0; i < pool.size(); ++i) {
-        const CandidateTest& t = step.tests[i];
-        if (t.significant && t.generalizes && t.heldout_reduction >= (1 - options.parsimony) * best_reduction &&
-            t.columns < fewest_columns) {
-          fewest = static_cast<int>(pool[i] - all.data());
-          fewest_columns = t.columns;
-        }
-      }
-      best = fewest;
-    }
+    if (best >= 0) best = parsimonious(best, best_reduction, pool, all, step.tests, options);
     std::sort(step.tests.begin(), step.tests.end(),
               [](const CandidateTest& a, const CandidateTest& b) { return a.heldout_reduction > b.heldout_reduction; });
     if (best < 0) {

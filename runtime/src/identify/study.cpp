@@ -54,6 +54,42 @@ class StudyRun {
                                               "inertial parameters); identify it with the PD path", d_.variant));
     const Dataset data = io::read_dataset(o_.data);
     io::check_dataset_robot(data, d_.robot);
+    StudyResult out = described(data);
+    const std::vector<std::string> ident = identification_names(data), valid = validation_names(data);
+
+    std::vector<Slot> slots = planned_runs(data, ident);
+    const parallel::FarmSummary farmed = farm_runs(data, ident, slots, out);
+    out.threads = farmed.workers;
+    out.ranks = farmed.ranks;
+    if (!parallel::place().coordinator()) return out;  // rank 0 gathers the records and goes on
+
+    for (Slot& s : slots) out.runs.push_back(std::move(*s.record));
+    int failures = 0;
+    for (const RunRecord& r : out.runs) {
+      out.wall_runs += r.t_ols + r.t_audit + r.t_sdp + r.t_clie;
+      failures += r.failed;
+    }
+    describe_stages(out, failures);
+
+    select_and_accept(data, out);
+    if (out.selection.run >= 0) validate(data, valid, out);
+    out.wall = detail::seconds_since(t0);
+    return out;
+  }
+
+ private:
+  // A run of the study: a trajectory at an interval, its record file and fingerprint, and its
+  // record once finished (loaded when a finished run's fingerprint matches).
+  struct Slot {
+    std::string trajectory;
+    double interval;
+    std::filesystem::path file;
+    std::string fingerprint;
+    std::optional<RunRecord> record;
+  };
+
+  // The result's description of the study: robot, model, parameters, the data's source.
+  StudyResult described(const Dataset& data) const {
     StudyResult out;
     out.robot = d_.robot;
     out.model = d_.variant;
@@ -66,17 +102,12 @@ class StudyRun {
     out.data_twin_overrides = data.twin_overrides;
     out.data_source = data.twin.empty() ? "measured (" + data.dir.string() + ")"
                                         : "digital twin (" + data.twin + "), " + data.dir.string();
-    const std::vector<std::string> ident = identification_names(data), valid = validation_names(data);
+    return out;
+  }
 
-    // Every run's fingerprint; finished runs are loaded, the others form the tasks.
+  // Every run's fingerprint; finished runs are loaded, the others are left to do.
+  std::vector<Slot> planned_runs(const Dataset& data, const std::vector<std::string>& ident) {
     std::filesystem::create_directories(o_.out / "runs");
-    struct Slot {
-      std::string trajectory;
-      double interval;
-      std::filesystem::path file;
-      std::string fingerprint;
-      std::optional<RunRecord> record;
-    };
     std::vector<Slot> slots;
     const StudyInputs inputs = study_inputs();  // once: the design file is read for its hash
     for (const auto& name : ident) {
@@ -90,6 +121,14 @@ class StudyRun {
         slots.push_back(std::move(s));
       }
     }
+    return slots;
+  }
+
+  // The runs left to do, one task per trajectory (its log read once, its missing intervals in
+  // order), on the farm: this machine's threads, or MPI ranks when started by mpirun. Each
+  // record is saved as it comes; a stopped study throws StudyStopped with what is saved.
+  parallel::FarmSummary farm_runs(const Dataset& data, const std::vector<std::string>& ident, std::vector<Slot>& slots,
+                                  StudyResult& out) {
     std::vector<std::string> todo;
     for (const auto& name : ident)
       for (const Slot& s : slots)
@@ -171,25 +210,9 @@ class StudyRun {
       throw StudyStopped(fmt::format("the study was stopped: {} of {} runs are saved in {}; run it again to resume", saved,
                                      slots.size(), (o_.out / "runs").string()));
     }
-    out.threads = farmed.workers;
-    out.ranks = farmed.ranks;
-    if (!parallel::place().coordinator()) return out;  // rank 0 gathers the records and goes on
-
-    for (Slot& s : slots) out.runs.push_back(std::move(*s.record));
-    int failures = 0;
-    for (const RunRecord& r : out.runs) {
-      out.wall_runs += r.t_ols + r.t_audit + r.t_sdp + r.t_clie;
-      failures += r.failed;
-    }
-    describe_stages(out, failures);
-
-    select_and_accept(data, out);
-    if (out.selection.run >= 0) validate(data, valid, out);
-    out.wall = detail::seconds_since(t0);
-    return out;
+    return farmed;
   }
 
- private:
   // Names in order, each once: a repeated name would give one run to two threads.
   static std::vector<std::string> unique(const std::vector<std::string>& names) {
     std::vector<std::string> v;

@@ -88,18 +88,24 @@ Eigen::MatrixXd differentiate_positions(const Eigen::VectorXd& time, const Eigen
   return qd;
 }
 
-ImportedLog import_log(const std::filesystem::path& input, const ImportMapping& mapping, const ImportTarget& target) {
-  check_mapping(mapping);
-  const int n = static_cast<int>(target.joints.size());
-  if (n == 0) throw DataError(input.string(), 0, "the robot has no joints");
-  if (!target.prismatic.empty() && static_cast<int>(target.prismatic.size()) != n)
-    throw DataError(input.string(), 0, "the prismatic flags do not match the joint list");
-  const detail::TextTable table(input, mapping.delimiter, mapping.header);
-  const std::string& file = table.file();
+namespace {
 
-  // Every mapped column once, in group order: time, q, [qd], tau, [q_ref, qd_ref, qdd_ref].
+// Every mapped column once, in group order: time, q, [qd], tau, [q_ref, qd_ref, qdd_ref]; a
+// column two groups select is an error at the header.
+struct Columns {
   std::vector<Group> groups;
-  std::vector<int> columns;
+  std::vector<int> columns;  // the table's columns, group after group
+  const Group* group(const std::string& key) const {
+    for (const Group& g : groups)
+      if (g.key == key) return &g;
+    return nullptr;
+  }
+};
+
+Columns select_columns(const detail::TextTable& table, const ImportMapping& mapping, const ImportTarget& target, int n) {
+  Columns out;
+  std::vector<Group>& groups = out.groups;
+  std::vector<int>& columns = out.columns;
   for (const auto& [key, selector] : std::vector<std::pair<std::string, std::string>>{
            {"time", mapping.time}, {"q", mapping.q}, {"qd", mapping.qd}, {"tau", mapping.tau},
            {"q_ref", mapping.q_ref}, {"qd_ref", mapping.qd_ref}, {"qdd_ref", mapping.qdd_ref}}) {
@@ -112,7 +118,7 @@ ImportedLog import_log(const std::filesystem::path& input, const ImportMapping& 
           return static_cast<std::size_t>(used - columns.begin()) >= o.offset &&
                  static_cast<std::size_t>(used - columns.begin()) < o.offset + o.columns.size();
         });
-        throw DataError(file, table.has_header() ? table.header_line() : table.first_line(),
+        throw DataError(table.file(), table.has_header() ? table.header_line() : table.first_line(),
                         fmt::format("{} and {} both select {} (mapping: {})", owner.key, key, table.column_label(c),
                                     mapping.origin));
       }
@@ -120,27 +126,25 @@ ImportedLog import_log(const std::filesystem::path& input, const ImportMapping& 
     }
     groups.push_back(std::move(g));
   }
-  const auto group = [&](const std::string& key) -> const Group* {
-    for (const Group& g : groups)
-      if (g.key == key) return &g;
-    return nullptr;
-  };
-  const bool has_qd = group("qd") != nullptr;
-  const bool has_refs = group("q_ref") != nullptr;
-  // Measured values end where the references begin: they decide a stale row.
-  const std::size_t width = columns.size();
-  const std::size_t measured_end = has_refs ? group("q_ref")->offset : width;
+  return out;
+}
 
-  std::vector<double> values;
-  std::vector<int> lines;
-  table.read(columns, values, lines);
-
-  ImportedLog out;
-  out.input = input;
-  out.rows = static_cast<int>(lines.size());
-  const double divisor = detail::time_divisor(mapping.time_unit);
-  std::vector<std::size_t> kept;  // parsed rows written
+// The parsed rows kept, in order, and whether each is stale: a row with the previous kept row's
+// time and values is a duplicate (dropped, its line noted), with its time but other values an
+// error; a later row whose measured values (those before measured_end) repeat the previous
+// row's is stale (kept, noted). Time going backwards is an error.
+struct KeptRows {
+  std::vector<std::size_t> rows;
   std::vector<bool> stale;
+};
+
+KeptRows keep_rows(const detail::TextTable& table, const std::vector<int>& columns, const std::vector<double>& values,
+                   const std::vector<int>& lines, std::size_t measured_end, double divisor, ImportedLog& out) {
+  const std::string& file = table.file();
+  const std::size_t width = columns.size();
+  KeptRows k;
+  std::vector<std::size_t>& kept = k.rows;
+  std::vector<bool>& stale = k.stale;
   for (std::size_t r = 0; r < lines.size(); ++r) {
     const double* row = values.data() + r * width;
     if (kept.empty()) {
@@ -171,10 +175,67 @@ ImportedLog import_log(const std::filesystem::path& input, const ImportMapping& 
     kept.push_back(r);
     stale.push_back(repeated);
   }
+  return k;
+}
+
+// The kept rows' times in s. Stamps far from 0 (1e15 ms since an epoch) hold no 1 ms step in
+// double precision once in s (read as 0.977 ms): then the times count from the first stamp, the
+// difference taken in the file's unit, where it is exact. Returns whether they were rebased.
+bool fill_times(const std::vector<double>& values, std::size_t width, const std::vector<std::size_t>& kept, double divisor,
+                Eigen::VectorXd& time) {
+  const Eigen::Index rows = static_cast<Eigen::Index>(kept.size());
+  time.resize(rows);
+  for (Eigen::Index k = 0; k < rows; ++k) time[k] = values[kept[static_cast<std::size_t>(k)] * width] / divisor;
+  bool rebased = false;
+  if (rows >= 2) {
+    std::vector<double> steps;
+    for (std::size_t i = 1; i < kept.size(); ++i) steps.push_back(values[kept[i] * width] - values[kept[i - 1] * width]);
+    std::nth_element(steps.begin(), steps.begin() + static_cast<std::ptrdiff_t>(steps.size() / 2), steps.end());
+    const double step = steps[steps.size() / 2] / divisor;
+    const double t_max = std::max(std::abs(time[0]), std::abs(time[rows - 1]));
+    rebased = std::nextafter(t_max, INFINITY) - t_max > 1e-4 * step;
+  }
+  if (rebased) {
+    const double first = values[kept[0] * width];
+    for (Eigen::Index k = 0; k < rows; ++k) time[k] = (values[kept[static_cast<std::size_t>(k)] * width] - first) / divisor;
+  }
+  return rebased;
+}
+
+}  // namespace
+
+ImportedLog import_log(const std::filesystem::path& input, const ImportMapping& mapping, const ImportTarget& target) {
+  check_mapping(mapping);
+  const int n = static_cast<int>(target.joints.size());
+  if (n == 0) throw DataError(input.string(), 0, "the robot has no joints");
+  if (!target.prismatic.empty() && static_cast<int>(target.prismatic.size()) != n)
+    throw DataError(input.string(), 0, "the prismatic flags do not match the joint list");
+  const detail::TextTable table(input, mapping.delimiter, mapping.header);
+  const std::string& file = table.file();
+
+  const Columns selected = select_columns(table, mapping, target, n);
+  const std::vector<int>& columns = selected.columns;
+  const auto group = [&](const std::string& key) { return selected.group(key); };
+  const bool has_qd = group("qd") != nullptr;
+  const bool has_refs = group("q_ref") != nullptr;
+  // Measured values end where the references begin: they decide a stale row.
+  const std::size_t width = columns.size();
+  const std::size_t measured_end = has_refs ? group("q_ref")->offset : width;
+
+  std::vector<double> values;
+  std::vector<int> lines;
+  table.read(columns, values, lines);
+
+  ImportedLog out;
+  out.input = input;
+  out.rows = static_cast<int>(lines.size());
+  const double divisor = detail::time_divisor(mapping.time_unit);
+  const KeptRows kept_rows = keep_rows(table, columns, values, lines, measured_end, divisor, out);
+  const std::vector<std::size_t>& kept = kept_rows.rows;
+  const std::vector<bool>& stale = kept_rows.stale;
 
   Log& log = out.log;
   const Eigen::Index rows = static_cast<Eigen::Index>(kept.size());
-  log.time.resize(rows);
   const auto fill = [&](const Group* g, Eigen::MatrixXd& m, bool torque) {
     m.resize(rows, g ? n : 0);
     if (!g) return;
@@ -189,23 +250,7 @@ ImportedLog import_log(const std::filesystem::path& input, const ImportMapping& 
       }
     }
   };
-  for (Eigen::Index k = 0; k < rows; ++k) log.time[k] = values[kept[static_cast<std::size_t>(k)] * width] / divisor;
-  // Stamps far from 0 (1e15 ms since an epoch) hold no 1 ms step in double precision once in s
-  // (read as 0.977 ms): then the times count from the first stamp, the difference taken in the
-  // file's unit, where it is exact.
-  bool rebased = false;
-  if (rows >= 2) {
-    std::vector<double> steps;
-    for (std::size_t i = 1; i < kept.size(); ++i) steps.push_back(values[kept[i] * width] - values[kept[i - 1] * width]);
-    std::nth_element(steps.begin(), steps.begin() + static_cast<std::ptrdiff_t>(steps.size() / 2), steps.end());
-    const double step = steps[steps.size() / 2] / divisor;
-    const double t_max = std::max(std::abs(log.time[0]), std::abs(log.time[rows - 1]));
-    rebased = std::nextafter(t_max, INFINITY) - t_max > 1e-4 * step;
-  }
-  if (rebased) {
-    const double first = values[kept[0] * width];
-    for (Eigen::Index k = 0; k < rows; ++k) log.time[k] = (values[kept[static_cast<std::size_t>(k)] * width] - first) / divisor;
-  }
+  const bool rebased = fill_times(values, width, kept, divisor, log.time);
   for (std::size_t r : kept) out.lines.push_back(lines[r]);
   fill(group("q"), log.q, false);
   fill(group("tau"), log.tau, true);
@@ -238,7 +283,7 @@ ImportedLog import_log(const std::filesystem::path& input, const ImportMapping& 
                                       "time in double precision)",
                                       number_text(values[kept[0] * width]), detail::time_unit_name(mapping.time_unit))
                         : std::string());
-  for (const Group& g : groups)
+  for (const Group& g : selected.groups)
     for (std::size_t j = 0; j < g.columns.size(); ++j)
       out.columns[g.key == "time" ? "time" : g.key + std::to_string(j + 1)] = table.column_label(g.columns[j]);
   return out;

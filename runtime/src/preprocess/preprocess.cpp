@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <optional>
 #include <stdexcept>
 #include <utility>
 
@@ -121,6 +122,98 @@ double base_period(const io::Log& log, const Options& options) {
 
 namespace {
 
+// What every piece of a log is filtered with, and how its samples are chosen.
+struct PieceFilter {
+  const Options& options;
+  std::vector<Biquad> sections;  // the one low-pass of q and tau
+  int padding = 0, settle = 0, stride = 1;
+  double interval = 0, period = 0;
+  Eigen::ArrayXd quantum;  // q's smallest steps per joint (trim_settling)
+};
+
+// Piece k of the log on the target grid: q and tau interpolated onto the base grid and filtered
+// alike, the torque delayed, the target rows within the settling time of an end where the arm
+// moves left out (their times to edge_times), the derivatives of q (or the logged velocity's);
+// none when no row is left.
+std::optional<PieceSamples> filter_piece(const io::Log& log, const StampAnalysis& stamps, std::size_t k,
+                                         const PieceFilter& f, Report& report, std::vector<double>& edge_times) {
+  const StampPiece& piece = stamps.pieces[k];
+  const Eigen::Index joints = log.joints();
+  // q and tau through the same interpolation and the same filter.
+  const GridInterpolation interpolation = grid_interpolation(log.time, stamps, piece);
+  Channels q = interpolation.apply(log.q);
+  Channels tau = interpolation.apply(log.tau);
+  // Whether the arm moves at each end, judged on q before the filter (edges.hpp).
+  const int reach = std::min(f.settle, piece.grid_samples());
+  const bool start_moves = f.options.trim_settling && moving_at_end(q, reach, true, f.quantum);
+  const bool end_moves = f.options.trim_settling && moving_at_end(q, reach, false, f.quantum);
+  report.moving_ends += int(start_moves) + int(end_moves);
+  filtfilt(f.sections, f.padding, q);
+  if (f.options.filter_torque) filtfilt(f.sections, f.padding, tau);
+  if (f.options.torque_delay != 0) shift_later(tau, f.options.torque_delay / f.period);
+
+  std::vector<int> rows = target_rows(piece.first_index, piece.grid_samples(), f.stride);
+  if (start_moves || end_moves) {
+    std::vector<int> kept_rows;
+    const int last = piece.grid_samples() - 1;
+    for (int r : rows) {
+      if ((start_moves && r < f.settle) || (end_moves && r > last - f.settle))
+        edge_times.push_back(stamps.t0 + static_cast<double>((piece.first_index + r) / f.stride) * f.interval);
+      else
+        kept_rows.push_back(r);
+    }
+    rows = std::move(kept_rows);
+  }
+  if (rows.empty()) return std::nullopt;  // all of it within the settling time of a moving end
+  Derivatives d = finite_differences(q, f.period, rows);
+  if (f.options.use_logged_velocity) {
+    // The logged velocity through the filter q had; its difference is the acceleration.
+    Channels qd = interpolation.apply(log.qd);
+    filtfilt(f.sections, f.padding, qd);
+    Derivatives v = finite_differences(qd, f.period, rows);
+    for (std::size_t i = 0; i < rows.size(); ++i) d.first.row(static_cast<Eigen::Index>(i)) = qd.row(rows[i]);
+    d.second = std::move(v.first);
+  }
+  PieceSamples p;
+  p.piece = static_cast<int>(k);
+  p.q.resize(rows.size(), joints);
+  p.tau.resize(rows.size(), joints);
+  for (std::size_t i = 0; i < rows.size(); ++i) {
+    p.target_index.push_back(piece.first_index + rows[i]);
+    p.q.row(i) = q.row(rows[i]);
+    p.tau.row(i) = tau.row(rows[i]);
+  }
+  p.qd = std::move(d.first);
+  p.qdd = std::move(d.second);
+  return p;
+}
+
+// The kept pieces' samples one after another into out, at their target times; their count.
+Eigen::Index gather(const std::vector<PieceSamples>& kept, double t0, int stride, double interval, Eigen::Index joints,
+                    Samples& out) {
+  Eigen::Index total = 0;
+  for (const PieceSamples& p : kept) total += p.q.rows();
+  out.time.resize(total);
+  out.q.resize(total, joints);
+  out.qd.resize(total, joints);
+  out.qdd.resize(total, joints);
+  out.tau.resize(total, joints);
+  out.piece.reserve(total);
+  Eigen::Index row = 0;
+  for (const PieceSamples& p : kept) {
+    const Eigen::Index n = p.q.rows();
+    for (Eigen::Index i = 0; i < n; ++i)
+      out.time[row + i] = t0 + static_cast<double>(p.target_index[i] / stride) * interval;
+    out.q.middleRows(row, n) = p.q;
+    out.qd.middleRows(row, n) = p.qd;
+    out.qdd.middleRows(row, n) = p.qdd;
+    out.tau.middleRows(row, n) = p.tau;
+    out.piece.insert(out.piece.end(), n, p.piece);
+    row += n;
+  }
+  return total;
+}
+
 // preprocess() of a whole log; the times of the target samples left out in the settling time at
 // a moving end go to edge_times.
 Samples preprocess_whole(const io::Log& raw, double interval, const Options& options, std::vector<double>& edge_times) {
@@ -168,6 +261,7 @@ Samples preprocess_whole(const io::Log& raw, double interval, const Options& opt
   const int settle = settling_samples(sections);
   report.settling_seconds = settle * period;
   const Eigen::ArrayXd quantum = options.trim_settling ? smallest_steps(log.q) : Eigen::ArrayXd();
+  const PieceFilter f{options, sections, padding, settle, stride, interval, period, quantum};
 
   const Eigen::Index joints = log.joints();
   std::vector<PieceSamples> kept;
@@ -180,53 +274,9 @@ Samples preprocess_whole(const io::Log& raw, double interval, const Options& opt
       report.dropped_samples += piece.raw_samples();
       continue;
     }
-    // q and tau through the same interpolation and the same filter.
-    const GridInterpolation interpolation = grid_interpolation(log.time, stamps, piece);
-    Channels q = interpolation.apply(log.q);
-    Channels tau = interpolation.apply(log.tau);
-    // Whether the arm moves at each end, judged on q before the filter (edges.hpp).
-    const int reach = std::min(settle, piece.grid_samples());
-    const bool start_moves = options.trim_settling && moving_at_end(q, reach, true, quantum);
-    const bool end_moves = options.trim_settling && moving_at_end(q, reach, false, quantum);
-    report.moving_ends += int(start_moves) + int(end_moves);
-    filtfilt(sections, padding, q);
-    if (options.filter_torque) filtfilt(sections, padding, tau);
-    if (options.torque_delay != 0) shift_later(tau, options.torque_delay / period);
-
-    std::vector<int> rows = target_rows(piece.first_index, piece.grid_samples(), stride);
-    if (start_moves || end_moves) {
-      std::vector<int> kept_rows;
-      const int last = piece.grid_samples() - 1;
-      for (int r : rows) {
-        if ((start_moves && r < settle) || (end_moves && r > last - settle))
-          edge_times.push_back(stamps.t0 + static_cast<double>((piece.first_index + r) / stride) * interval);
-        else
-          kept_rows.push_back(r);
-      }
-      rows = std::move(kept_rows);
-    }
-    if (rows.empty()) continue;  // all of it within the settling time of a moving end
-    Derivatives d = finite_differences(q, period, rows);
-    if (options.use_logged_velocity) {
-      // The logged velocity through the filter q had; its difference is the acceleration.
-      Channels qd = interpolation.apply(log.qd);
-      filtfilt(sections, padding, qd);
-      Derivatives v = finite_differences(qd, period, rows);
-      for (std::size_t i = 0; i < rows.size(); ++i) d.first.row(static_cast<Eigen::Index>(i)) = qd.row(rows[i]);
-      d.second = std::move(v.first);
-    }
-    PieceSamples p;
-    p.piece = static_cast<int>(k);
-    p.q.resize(rows.size(), joints);
-    p.tau.resize(rows.size(), joints);
-    for (std::size_t i = 0; i < rows.size(); ++i) {
-      p.target_index.push_back(piece.first_index + rows[i]);
-      p.q.row(i) = q.row(rows[i]);
-      p.tau.row(i) = tau.row(rows[i]);
-    }
-    p.qd = std::move(d.first);
-    p.qdd = std::move(d.second);
-    kept.push_back(std::move(p));
+    std::optional<PieceSamples> p = filter_piece(log, stamps, k, f, report, edge_times);
+    if (!p) continue;  // all of it within the settling time of a moving end
+    kept.push_back(std::move(*p));
   }
   if (kept.empty() && !edge_times.empty())
     throw DataError(source, 0,
@@ -240,26 +290,7 @@ Samples preprocess_whole(const io::Log& raw, double interval, const Options& opt
                                 longest, period, report.cutoff, options.filter_order,
                                 min_samples));
 
-  Eigen::Index total = 0;
-  for (const PieceSamples& p : kept) total += p.q.rows();
-  out.time.resize(total);
-  out.q.resize(total, joints);
-  out.qd.resize(total, joints);
-  out.qdd.resize(total, joints);
-  out.tau.resize(total, joints);
-  out.piece.reserve(total);
-  Eigen::Index row = 0;
-  for (const PieceSamples& p : kept) {
-    const Eigen::Index n = p.q.rows();
-    for (Eigen::Index i = 0; i < n; ++i)
-      out.time[row + i] = stamps.t0 + static_cast<double>(p.target_index[i] / stride) * interval;
-    out.q.middleRows(row, n) = p.q;
-    out.qd.middleRows(row, n) = p.qd;
-    out.qdd.middleRows(row, n) = p.qdd;
-    out.tau.middleRows(row, n) = p.tau;
-    out.piece.insert(out.piece.end(), n, p.piece);
-    row += n;
-  }
+  const Eigen::Index total = gather(kept, stamps.t0, stride, interval, joints, out);
   report.kept_samples = static_cast<int>(total);
   report.edge_samples = static_cast<int>(edge_times.size());
   return out;

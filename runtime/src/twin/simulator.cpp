@@ -35,40 +35,35 @@ io::Log ClosedLoopTwin::run(const trajectory::Trajectory& traj, const RunOptions
   return run(trajectory::sample(traj, c_.controller.period), opt, stats);
 }
 
-io::Log ClosedLoopTwin::run(const trajectory::SampledReference& ref, const RunOptions& opt, RunStats* stats) const {
-  using Vec = Eigen::VectorXd;
-  const auto wall0 = std::chrono::steady_clock::now();
-  const int n = joints();
-  if (ref.joints() != n)
-    throw DataError(ref.name, 0, "the reference has " + std::to_string(ref.joints()) + " joints, the robot " + std::to_string(n));
-  if (!(std::abs(ref.period - c_.controller.period) <= 1e-9 * c_.controller.period) || ref.cycles() < 1)
-    throw DataError(ref.name, 0, "the reference is sampled every " + std::to_string(ref.period) + " s, the controller runs every " +
-                                     std::to_string(c_.controller.period) + " s");
-  const Effects& e = c_.effects;
-  const double T = c_.controller.period, d = c_.controller.communication_delay;
-  const int K = ref.cycles() - 1;
-  Random rng(opt.seed);
+namespace {
 
-  // Servo constants.
-  Vec kt(n), kt_true(n), unit(n), limit(n), lsb(n);
-  for (int j = 0; j < n; ++j) {
-    const Servo& s = c_.servos[j];
-    kt(j) = s.torque_constant;
-    kt_true(j) = s.torque_constant * (e.torque_constant_error ? e.torque_constant_scale(j) : 1.0);
-    unit(j) = s.current_unit;
-    limit(j) = std::floor(s.current_limit / s.current_unit) * s.current_unit;
-    lsb(j) = 2 * 3.14159265358979323846 / s.encoder_counts;
+using Vec = Eigen::VectorXd;
+
+// The servos as the controller sees them: encoders that quantize q (with noise when enabled),
+// current commands in the servo's units, saturated at its limit, and the torque constant the
+// controller assumes beside the true one (a torque-constant error).
+struct Servos {
+  Servos(const TwinConfig& c, int n, Random& rng) : e(c.effects), n(n), rng(rng) {
+    kt.resize(n), kt_true.resize(n), unit.resize(n), limit.resize(n), lsb.resize(n);
+    for (int j = 0; j < n; ++j) {
+      const Servo& s = c.servos[j];
+      kt(j) = s.torque_constant;
+      kt_true(j) = s.torque_constant * (e.torque_constant_error ? e.torque_constant_scale(j) : 1.0);
+      unit(j) = s.current_unit;
+      limit(j) = std::floor(s.current_limit / s.current_unit) * s.current_unit;
+      lsb(j) = 2 * 3.14159265358979323846 / s.encoder_counts;
+    }
   }
-  // The encoders' reading of q (quantized, with noise when enabled).
-  auto encoder = [&](const Eigen::Ref<const Vec>& q, Vec& m) {
+  // The encoders' reading of q.
+  void encoder(const Eigen::Ref<const Vec>& q, Vec& m) const {
     for (int j = 0; j < n; ++j) {
       const double sd = e.encoder_noise_per_joint.size() == n ? e.encoder_noise_per_joint(j) : e.encoder_noise;
       const double noise = e.sensor_noise ? sd * rng.normal() : 0.0;
       m(j) = std::round(q(j) / lsb(j) + noise) * lsb(j);
     }
-  };
-  // The current commands for the controller's torques (in current units, saturated).
-  auto current_command = [&](const Vec& u, Vec& i, bool& saturated) {
+  }
+  // The current commands for the controller's torques u.
+  void current_command(const Vec& u, Vec& i, bool& saturated) const {
     for (int j = 0; j < n; ++j) {
       i(j) = std::round(u(j) / kt(j) / unit(j)) * unit(j);
       if (std::abs(i(j)) >= limit(j)) {
@@ -76,24 +71,30 @@ io::Log ClosedLoopTwin::run(const trajectory::SampledReference& ref, const RunOp
         saturated = true;
       }
     }
-  };
+  }
+  // The torque the servos log for the current they report (with current noise when enabled).
+  void logged_torque(const Vec& current, Vec& tau) const {
+    for (int j = 0; j < n; ++j) {
+      const double noise = e.sensor_noise ? e.current_noise * rng.normal() : 0.0;
+      tau(j) = kt(j) * std::round((current(j) + noise) / unit(j)) * unit(j);
+    }
+  }
 
-  // References per cycle (the controller steps through them by cycle count).
-  Vec qr = ref.q.col(0), qdr = ref.qd.col(0), qddr = ref.qdd.col(0);
-  Plant plant(model_, truth_, c_, qr);
-  control::FfpdController ctrl(controller_gains(c_));
-  Vec q_meas(n), q_true(n), u_cmd(n), torque(n);
-  encoder(plant.q(), q_meas);
-  ctrl.reset(q_meas);
-  Vec current = Vec::Zero(n);  // what the servos report (and the controller commanded)
-  bool sat = false;
-  // The current that makes torque: `current` itself, or with the actuation delay, the
-  // commands in the order they went out, each taking effect `lag` after it.
-  const double lag = e.actuation_delay ? e.actuation_delay_time : 0.0;
-  Vec applied = Vec::Zero(n);
-  std::deque<std::pair<double, Vec>> pending;
-  double clock = -static_cast<double>(std::llround(opt.pre_roll / T)) * T;  // the pre-roll starts there
-  auto drive = [&](double dt) {
+  const Effects& e;
+  int n;
+  Random& rng;
+  Vec kt, kt_true, unit, limit, lsb;
+};
+
+// The plant driven by the commanded currents: `current` is what the servos report (and the
+// controller commanded); the current that makes torque is that one, or with the actuation
+// delay, the commands in the order they went out, each taking effect `lag` after it.
+struct Actuation {
+  Actuation(Plant& plant, const Vec& kt_true, double lag, double clock)
+      : plant(plant), kt_true(kt_true), lag(lag), clock(clock), current(Vec::Zero(kt_true.size())),
+        applied(Vec::Zero(kt_true.size())), torque(kt_true.size()) {}
+  // Advances the plant by dt, applying each pending command when it takes effect.
+  void drive(double dt) {
     const double end = clock + dt;
     while (!pending.empty() && pending.front().first < end) {
       if (pending.front().first > clock) {
@@ -109,35 +110,75 @@ io::Log ClosedLoopTwin::run(const trajectory::SampledReference& ref, const RunOp
       plant.advance(end - clock, torque);
     }
     clock = end;
-  };
-  auto command = [&](const Vec& c) {
+  }
+  void command(const Vec& c) {
     current = c;
     pending.emplace_back(clock + lag, c);
-  };
-
-  // Pre-roll: hold the first reference so the run starts from the held posture.
-  const int pre = static_cast<int>(std::llround(opt.pre_roll / T));
-  for (int k = 0; k < pre; ++k) {
-    encoder(plant.q(), q_meas);
-    current_command(ctrl.update(q_meas, qr, qdr, qddr), u_cmd, sat);
-    drive(d);
-    command(u_cmd);
-    drive(T - d);
   }
 
+  Plant& plant;
+  const Vec& kt_true;
+  double lag, clock;
+  Vec current, applied, torque;
+  std::deque<std::pair<double, Vec>> pending;
+};
+
+// A log of up to `rows` cycles of the twin, described as the run's.
+io::Log empty_log(const trajectory::SampledReference& ref, const RunOptions& opt, const std::vector<std::string>& joints,
+                  const std::string& notes, double sample_time, int rows) {
   io::Log log;
   log.meta.robot = opt.robot;
   log.meta.trajectory = ref.name;
   log.meta.trial = opt.trial;
   log.meta.seed = opt.seed;
   log.meta.source = "twin";
-  log.meta.sample_time = T;
-  log.meta.joints = names_;
-  log.meta.notes = notes();
-  const int rows_max = K + 1;
-  log.time.resize(rows_max);
-  for (Eigen::MatrixXd* m : {&log.q, &log.qd, &log.tau, &log.q_ref, &log.qd_ref, &log.qdd_ref}) m->resize(rows_max, n);
+  log.meta.sample_time = sample_time;
+  log.meta.joints = joints;
+  log.meta.notes = notes;
+  log.time.resize(rows);
+  for (Eigen::MatrixXd* m : {&log.q, &log.qd, &log.tau, &log.q_ref, &log.qd_ref, &log.qdd_ref})
+    m->resize(rows, static_cast<Eigen::Index>(joints.size()));
+  return log;
+}
 
+}  // namespace
+
+io::Log ClosedLoopTwin::run(const trajectory::SampledReference& ref, const RunOptions& opt, RunStats* stats) const {
+  const auto wall0 = std::chrono::steady_clock::now();
+  const int n = joints();
+  if (ref.joints() != n)
+    throw DataError(ref.name, 0, "the reference has " + std::to_string(ref.joints()) + " joints, the robot " + std::to_string(n));
+  if (!(std::abs(ref.period - c_.controller.period) <= 1e-9 * c_.controller.period) || ref.cycles() < 1)
+    throw DataError(ref.name, 0, "the reference is sampled every " + std::to_string(ref.period) + " s, the controller runs every " +
+                                     std::to_string(c_.controller.period) + " s");
+  const Effects& e = c_.effects;
+  const double T = c_.controller.period, d = c_.controller.communication_delay;
+  const int K = ref.cycles() - 1;
+  Random rng(opt.seed);
+  const Servos servos(c_, n, rng);
+
+  // References per cycle (the controller steps through them by cycle count).
+  Vec qr = ref.q.col(0), qdr = ref.qd.col(0), qddr = ref.qdd.col(0);
+  Plant plant(model_, truth_, c_, qr);
+  control::FfpdController ctrl(controller_gains(c_));
+  Vec q_meas(n), q_true(n), u_cmd(n);
+  servos.encoder(plant.q(), q_meas);
+  ctrl.reset(q_meas);
+  bool sat = false;
+  const int pre = static_cast<int>(std::llround(opt.pre_roll / T));
+  Actuation act(plant, servos.kt_true, e.actuation_delay ? e.actuation_delay_time : 0.0,
+                -static_cast<double>(pre) * T);  // the pre-roll starts there
+
+  // Pre-roll: hold the first reference so the run starts from the held posture.
+  for (int k = 0; k < pre; ++k) {
+    servos.encoder(plant.q(), q_meas);
+    servos.current_command(ctrl.update(q_meas, qr, qdr, qddr), u_cmd, sat);
+    act.drive(d);
+    act.command(u_cmd);
+    act.drive(T - d);
+  }
+
+  io::Log log = empty_log(ref, opt, names_, notes(), T, K + 1);
   RunStats st;
   st.max_error = Vec::Zero(n);
   st.rms_error = Vec::Zero(n);
@@ -150,7 +191,7 @@ io::Log ClosedLoopTwin::run(const trajectory::SampledReference& ref, const RunOp
     double t_k = k * T;
     if (e.timestamp_jitter && k > 0) t_k += std::clamp(e.jitter_std * rng.normal(), -e.jitter_max, e.jitter_max);
     t_k = std::max(t_k, t_start_next);
-    drive(t_k - t_now);
+    act.drive(t_k - t_now);
     t_now = t_k;
 
     qr = ref.q.col(k), qdr = ref.qd.col(k), qddr = ref.qdd.col(k);
@@ -158,7 +199,7 @@ io::Log ClosedLoopTwin::run(const trajectory::SampledReference& ref, const RunOp
     err = qr - q_true;
     st.max_error = st.max_error.cwiseMax(err.cwiseAbs());
     st.rms_error += err.cwiseAbs2();
-    st.max_torque = st.max_torque.cwiseMax(kt_true.cwiseProduct(applied).cwiseAbs());
+    st.max_torque = st.max_torque.cwiseMax(servos.kt_true.cwiseProduct(act.applied).cwiseAbs());
 
     bool dropped = false;
     if (e.dropped_samples && k > 0 && k < K) {
@@ -169,16 +210,13 @@ io::Log ClosedLoopTwin::run(const trajectory::SampledReference& ref, const RunOp
       }
     }
     if (!dropped) {
-      encoder(q_true, q_meas);
-      for (int j = 0; j < n; ++j) {
-        const double noise = e.sensor_noise ? e.current_noise * rng.normal() : 0.0;
-        tau_logged(j) = kt(j) * std::round((current(j) + noise) / unit(j)) * unit(j);
-      }
+      servos.encoder(q_true, q_meas);
+      servos.logged_torque(act.current, tau_logged);
     } else {
       ++st.dropped;
     }
     bool cycle_sat = false;
-    current_command(ctrl.update(q_meas, qr, qdr, qddr), cmd, cycle_sat);
+    servos.current_command(ctrl.update(q_meas, qr, qdr, qddr), cmd, cycle_sat);
     st.saturated += cycle_sat;
     if (!dropped) {
       log.time(rows) = t_k;
@@ -190,9 +228,9 @@ io::Log ClosedLoopTwin::run(const trajectory::SampledReference& ref, const RunOp
       log.qdd_ref.row(rows) = qddr.transpose();
       ++rows;
     }
-    drive(d);
+    act.drive(d);
     t_now = t_k + d;
-    command(cmd);
+    act.command(cmd);
     t_start_next = t_now + 1e-6;
   }
   log.time.conservativeResize(rows);
