@@ -105,29 +105,19 @@ std::vector<Piece> cut_pieces(const std::vector<NamedSamples>& runs, double base
   return pieces;
 }
 
-// The stack's matrices for `rows` samples (shrink: conservatively, keeping what is there).
-void size_stack(DesignStack& d, Eigen::Index rows, Eigen::Index p, Eigen::Index pe, bool shrink) {
+// The stack's matrices (and the effects' terms) sized for `rows` samples, keeping the rows they
+// have: the allocation before the pieces, and the shrink when pieces were left out.
+void size_stack(DesignStack& d, Eigen::Index rows, Eigen::Index p, Eigen::Index pe) {
   const Eigen::Index n = d.joints;
-  if (shrink) {
-    d.q.conservativeResize(rows, n);
-    d.qd.conservativeResize(rows, n);
-    d.qdd.conservativeResize(rows, n);
-    d.tau.conservativeResize(rows, n);
-    d.time.conservativeResize(rows);
-    d.W.conservativeResize(rows * n, p);
-    d.tau0.conservativeResize(rows * n);
-    d.full_extra.conservativeResize(rows * n, pe);
-    for (auto& [key, m] : d.effect_terms) m.conservativeResize(rows, m.cols());
-    return;
-  }
-  d.q.resize(rows, n);
-  d.qd.resize(rows, n);
-  d.qdd.resize(rows, n);
-  d.tau.resize(rows, n);
-  d.time.resize(rows);
-  d.W.resize(rows * n, p);
-  d.tau0.resize(rows * n);
-  d.full_extra.resize(rows * n, pe);
+  d.q.conservativeResize(rows, n);
+  d.qd.conservativeResize(rows, n);
+  d.qdd.conservativeResize(rows, n);
+  d.tau.conservativeResize(rows, n);
+  d.time.conservativeResize(rows);
+  d.W.conservativeResize(rows * n, p);
+  d.tau0.conservativeResize(rows * n);
+  d.full_extra.conservativeResize(rows * n, pe);
+  for (auto& [key, m] : d.effect_terms) m.conservativeResize(rows, m.cols());
 }
 
 // What every piece is filtered with.
@@ -243,7 +233,7 @@ DesignStack stack_design(const StackModel& m, const std::vector<NamedSamples>& r
   Eigen::Index total = 0;
   for (const auto& pc : pieces) total += static_cast<Eigen::Index>(pc.keep.size());
 
-  size_stack(d, total, p, pe, false);
+  size_stack(d, total, p, pe);
   for (const auto& c : local) d.effect_terms[c.key()] = Eigen::MatrixXd(total, static_cast<Eigen::Index>(c.parameters.size()));
   Eigen::Index out = 0;
   for (const auto& pc : pieces) {
@@ -252,7 +242,7 @@ DesignStack stack_design(const StackModel& m, const std::vector<NamedSamples>& r
     stack_piece(m, pc, extra, local, f, out, d);
     out += K;
   }
-  if (out < total) size_stack(d, out, p, pe, true);  // pieces left out shrink the stack
+  if (out < total) size_stack(d, out, p, pe);  // pieces left out shrink the stack
   return d;
 }
 
