@@ -83,10 +83,8 @@ std::vector<EffectParameter> effect_parameters(
     const double velocity = row.velocity_scale ? e->velocity : 0.0;
     std::vector<int> orders = e->orders;
     std::sort(orders.begin(), orders.end());
-    if (orders.empty()) orders = {0};  // one parameter per family: no order
-    for (int k : orders)
-      for (const std::string& family : effect_words(row.families))
-        out.push_back({effect_parameter_name(family, j, k), family, j, u, k, velocity});
+    for (const EffectParameterName& p : effect_parameter_names(row, j, orders))
+      out.push_back({p.name, p.family, j, u, p.order, velocity});
   }
   return out;
 }

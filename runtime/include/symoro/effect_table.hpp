@@ -123,4 +123,17 @@ inline std::string effect_parameter_name(std::string_view family, int joint, int
   return name;
 }
 
+// The parameters a row adds on a joint, in their canonical order: per order (position
+// harmonics; none: one of each family), each family of the row.
+struct EffectParameterName {
+  std::string name, family;
+  int order = 0;
+};
+inline std::vector<EffectParameterName> effect_parameter_names(const EffectRow& row, int joint, const std::vector<int>& orders) {
+  std::vector<EffectParameterName> out;
+  for (int k : orders.empty() ? std::vector<int>{0} : orders)
+    for (const std::string& family : effect_words(row.families)) out.push_back({effect_parameter_name(family, joint, k), family, k});
+  return out;
+}
+
 }  // namespace symoro

@@ -88,11 +88,10 @@ Candidate joint_candidate(EffectKind kind, int j, const std::vector<int>& orders
   c.kind = kind;
   c.joint = j;
   c.orders = orders;
-  for (int k : orders.empty() ? std::vector<int>{0} : orders)
-    for (const std::string& family : effect_words(row.families)) {
-      c.parameters.push_back(effect_parameter_name(family, j, k));
-      c.units.emplace_back(row.unit);
-    }
+  for (const EffectParameterName& p : effect_parameter_names(row, j, orders)) {
+    c.parameters.push_back(p.name);
+    c.units.emplace_back(row.unit);
+  }
   return c;
 }
 

@@ -125,10 +125,10 @@ namespace {
 // What every piece of a log is filtered with, and how its samples are chosen.
 struct PieceFilter {
   const Options& options;
-  std::vector<Biquad> sections;  // the one low-pass of q and tau
+  const std::vector<Biquad>& sections;  // the one low-pass of q and tau
   int padding = 0, settle = 0, stride = 1;
   double interval = 0, period = 0;
-  Eigen::ArrayXd quantum;  // q's smallest steps per joint (trim_settling)
+  const Eigen::ArrayXd& quantum;  // q's smallest steps per joint (trim_settling)
 };
 
 // Piece k of the log on the target grid: q and tau interpolated onto the base grid and filtered

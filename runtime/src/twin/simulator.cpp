@@ -55,7 +55,7 @@ struct Servos {
     }
   }
   // The encoders' reading of q.
-  void encoder(const Eigen::Ref<const Vec>& q, Vec& m) const {
+  void encoder(const Eigen::Ref<const Vec>& q, Vec& m) {
     for (int j = 0; j < n; ++j) {
       const double sd = e.encoder_noise_per_joint.size() == n ? e.encoder_noise_per_joint(j) : e.encoder_noise;
       const double noise = e.sensor_noise ? sd * rng.normal() : 0.0;
@@ -73,7 +73,7 @@ struct Servos {
     }
   }
   // The torque the servos log for the current they report (with current noise when enabled).
-  void logged_torque(const Vec& current, Vec& tau) const {
+  void logged_torque(const Vec& current, Vec& tau) {
     for (int j = 0; j < n; ++j) {
       const double noise = e.sensor_noise ? e.current_noise * rng.normal() : 0.0;
       tau(j) = kt(j) * std::round((current(j) + noise) / unit(j)) * unit(j);
@@ -155,7 +155,7 @@ io::Log ClosedLoopTwin::run(const trajectory::SampledReference& ref, const RunOp
   const double T = c_.controller.period, d = c_.controller.communication_delay;
   const int K = ref.cycles() - 1;
   Random rng(opt.seed);
-  const Servos servos(c_, n, rng);
+  Servos servos(c_, n, rng);  // draws the sensors' noise from rng
 
   // References per cycle (the controller steps through them by cycle count).
   Vec qr = ref.q.col(0), qdr = ref.qd.col(0), qddr = ref.qdd.col(0);
