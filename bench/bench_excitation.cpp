@@ -1,4 +1,4 @@
-// An optimized excitation design (identify/excitation_design.hpp) of CRANE-X7's full model (8
+// An optimized excitation design (excitation/design.hpp) of CRANE-X7's full model (8
 // joints, 65 base parameters): 5 harmonics, 10 s period, 4 random starts, position, velocity,
 // acceleration and CAD-torque limits (issue 29's target: a 7-DoF design in under 60 s on 2
 // cores); and one evaluation of the criterion with its exact gradient.
@@ -8,7 +8,7 @@
 
 #include <symoro/crane_x7.hpp>
 
-#include "symoro/identify/excitation_design.hpp"
+#include "symoro/excitation/design.hpp"
 #include "symoro/identify/identification_model.hpp"
 #include "symoro/robot/compiled_model.hpp"
 #include "symoro/twin/config.hpp"
@@ -18,6 +18,7 @@ namespace {
 
 using Model = symoro::crane_x7::Model;
 using namespace symoro::identify;
+using namespace symoro::excitation;
 
 ExcitationDesignOptions crane_options(int starts) {
   const auto& joints = Model::joints;

@@ -12,7 +12,7 @@
 
 #include <symoro/crane_x7.hpp>
 
-#include "symoro/identify/study.hpp"
+#include "symoro/study/study.hpp"
 #include "symoro/io/import.hpp"
 #include "symoro/robot/compiled_model.hpp"
 #include "symoro/twin/config.hpp"
@@ -69,11 +69,11 @@ void BM_ImportAndIdentify(benchmark::State& state) {
     std::filesystem::remove_all(kDir / "data");
     std::filesystem::remove_all(kDir / "study");
     symoro::io::import_dataset(kDir / "data", im);
-    symoro::identify::StudyOptions o;
+    symoro::study::StudyOptions o;
     o.data = kDir / "data";
     o.out = kDir / "study";
     o.intervals = {0.010};
-    symoro::identify::Study study(symoro::identify::identification_model<Model>(), o, symoro::identify::ClosedLoopSource{});
+    symoro::study::Study study(symoro::identify::identification_model<Model>(), o, symoro::study::ClosedLoopSource{});
     const auto r = study.run();
     state.counters["accepted"] = r.accepted;
   }

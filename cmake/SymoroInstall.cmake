@@ -2,8 +2,9 @@
 # symoro::<robot> target per generated robot (header-only over Eigen), and the runtime's stages
 # as static libraries: symoro::io (logs, import), symoro::trajectory, symoro::preprocess,
 # symoro::control, symoro::parallel (the task farm, MPI or threads), symoro::twin, symoro::report
-# (SVG figures, Markdown tables), symoro::identify (OLS, audit, SDP, CLIE, the study),
-# symoro::diagnose, symoro::dynamixel, symoro::hardware, symoro::twin_bus (the twin behind the
+# (SVG figures, Markdown tables), symoro::identify (the identification model; OLS, audit, SDP,
+# CLIE), symoro::excitation, symoro::study (the study, its acceptance, validation and report),
+# symoro::model_export (URDF), symoro::diagnose, symoro::dynamixel, symoro::hardware, symoro::twin_bus (the twin behind the
 # virtual bus), and symoro::runtime (all of them). docs/architecture.md draws them.
 include(CMakePackageConfigHelpers)
 

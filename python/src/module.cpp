@@ -3,7 +3,7 @@
 #include <pybind11/pybind11.h>
 
 #include "symoro/error.hpp"
-#include "symoro/identify/study.hpp"
+#include "symoro/study/study.hpp"
 
 namespace symoro::python {
 
@@ -22,7 +22,7 @@ PYBIND11_MODULE(_symoro, m) {
   m.doc() = "symoro's compiled core: robot models and the identification workflow";
   // A file's problem (file:line: error: message): a ValueError, with .file and .line.
   static py::exception<symoro::DataError> data_error(m, "DataError", PyExc_ValueError);
-  static py::exception<symoro::identify::StudyStopped> stopped(m, "StudyStopped", PyExc_RuntimeError);
+  static py::exception<symoro::study::StudyStopped> stopped(m, "StudyStopped", PyExc_RuntimeError);
   py::register_exception_translator([](std::exception_ptr p) {
     try {
       if (p) std::rethrow_exception(p);
@@ -31,7 +31,7 @@ PYBIND11_MODULE(_symoro, m) {
       err.attr("file") = e.file();
       err.attr("line") = e.line();
       PyErr_SetObject(data_error.ptr(), err.ptr());
-    } catch (const symoro::identify::StudyStopped& e) {
+    } catch (const symoro::study::StudyStopped& e) {
       stopped(e.what());
     }
   });

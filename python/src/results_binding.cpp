@@ -12,10 +12,10 @@
 
 #include "arrays.hpp"
 #include "symoro/diagnose/gap_report.hpp"
-#include "symoro/identify/model_export.hpp"
-#include "symoro/identify/prediction.hpp"
-#include "symoro/identify/robot_folder.hpp"
-#include "symoro/identify/validation_io.hpp"
+#include "symoro/model_export/model_export.hpp"
+#include "symoro/study/prediction.hpp"
+#include "symoro/study/robot_folder.hpp"
+#include "symoro/study/validation_io.hpp"
 #include "symoro/io/dataset.hpp"
 #include "symoro/io/parameters_yaml.hpp"
 
@@ -34,7 +34,7 @@ Eigen::VectorXd parameters_of(const identify::IdentificationModel& model, py::ha
   const identify::ModelDescription& d = model.description();
   if (py::isinstance<py::str>(params) && params.cast<std::string>() == "nominal") {
     std::vector<double> s;
-    if (!robot_dir || !identify::nominal_standard_parameters(*robot_dir, d.standard, s))
+    if (!robot_dir || !study::nominal_standard_parameters(*robot_dir, d.standard, s))
       throw py::value_error("params='nominal': " + (robot_dir ? (*robot_dir / "robot.yaml").string() +
                                                                     " has no nominal parameters (symoroc model writes them from a URDF)"
                                                               : std::string("no robot_dir given")));
@@ -50,7 +50,7 @@ Eigen::VectorXd parameters_of(const identify::IdentificationModel& model, py::ha
   return Eigen::Map<const Eigen::VectorXd>(phi.data(), d.np);
 }
 
-py::dict prediction_dict(const std::string& name, const identify::Prediction& p) {
+py::dict prediction_dict(const std::string& name, const study::Prediction& p) {
   py::dict x;
   x["name"] = name;
   x["time"] = p.samples.time;
@@ -99,24 +99,24 @@ void bind_results(py::module_& m) {
       io::check_log_robot(log, input, d.robot, d.nq);
       logs.emplace_back(input.stem().string(), std::move(log));
     }
-    std::vector<identify::Prediction> out(logs.size());
+    std::vector<study::Prediction> out(logs.size());
     {
       py::gil_scoped_release release;
       for (std::size_t i = 0; i < logs.size(); ++i)
-        out[i] = identify::predict(logs[i].second, *id, phi, interval_ms / 1000, torque_delay_ms / 1000);
+        out[i] = study::predict(logs[i].second, *id, phi, {interval_ms / 1000, torque_delay_ms / 1000});
     }
     py::list result;
     for (std::size_t i = 0; i < logs.size(); ++i) result.append(prediction_dict(logs[i].first, out[i]));
     return result;
-  }, py::arg("model"), py::arg("params"), py::arg("input"), py::kw_only(), py::arg("interval_ms") = 10.0,
-     py::arg("torque_delay_ms") = 0.0, py::arg("trial") = 1, py::arg("robot_dir") = py::none(),
+  }, py::arg("model"), py::arg("params"), py::arg("input"), py::kw_only(), py::arg("interval_ms") = study::PredictionOptions{}.interval * 1000,
+     py::arg("torque_delay_ms") = study::PredictionOptions{}.torque_delay * 1000, py::arg("trial") = 1, py::arg("robot_dir") = py::none(),
      "The model's torque on a log or a dataset's runs: a list of {'name', 'time', 'q', 'qd', 'qdd', 'tau', 'tau_model', "
      "'rmse', 'rms', 'raw_rmse', 'raw_rmse_overall', 'raw_samples', 'edge_samples', 'context_rows', 'preprocessing'}; params: an array, a parameters file or 'nominal' (with robot_dir)");
 
   m.def("compare", [](const std::filesystem::path& before_dir, const std::filesystem::path& after_dir,
                       const std::filesystem::path& out, const std::string& trajectory, const std::vector<int>& joints) {
-    const identify::StudyValidation before = identify::read_validation(before_dir);
-    const identify::StudyValidation after = identify::read_validation(after_dir);
+    const study::StudyValidation before = study::read_validation(before_dir);
+    const study::StudyValidation after = study::read_validation(after_dir);
     const diagnose::GapComparison c = diagnose::compare_studies(before, after);
     diagnose::GapReportOptions ro;
     try {
@@ -175,7 +175,7 @@ void bind_export(py::module_& m) {
     if (!accepted && !not_accepted)
       throw py::value_error(params.string() + ": the study's final audit did not accept these parameters (accepted: false); "
                                               "not_accepted=True exports them anyway");
-    identify::ModelExportOptions eo;
+    model_export::ModelExportOptions eo;
     std::vector<std::string> standard;
     for (const auto& p : d.standard) standard.push_back(p.name);
     const std::string prior_name = py::isinstance<py::str>(prior) ? prior.cast<std::string>() : "";
@@ -184,7 +184,7 @@ void bind_export(py::module_& m) {
       eo.prior_what = "zero (the consistent set nearest 0)";
     } else if (prior.is_none() || prior_name == "nominal") {
       std::vector<double> s;
-      if (!robot_dir || !identify::nominal_standard_parameters(*robot_dir, d.standard, s))
+      if (!robot_dir || !study::nominal_standard_parameters(*robot_dir, d.standard, s))
         throw py::value_error("prior: robot.yaml's nominal parameters are needed (robot_dir=, a folder symoroc model wrote "
                               "from a URDF), else give prior='zero', a standard-parameter file or an array");
       eo.prior = Eigen::Map<const Eigen::VectorXd>(s.data(), static_cast<Eigen::Index>(s.size()));
@@ -203,12 +203,12 @@ void bind_export(py::module_& m) {
     eo.accepted = accepted;
     eo.margin = margin;
     eo.nearest = nearest;
-    identify::ModelExport e;
-    identify::ModelExportFiles files;
+    model_export::ModelExport e;
+    model_export::ModelExportFiles files;
     {
       py::gil_scoped_release release;
-      e = identify::export_model(*id, phi, eo);
-      files = identify::write_model_export(e, urdf, identify::urdf_text(e.description));
+      e = model_export::export_model(*id, phi, eo);
+      files = model_export::write_model_export(e, urdf, model_export::urdf_text(e.description));
     }
     py::dict r;
     r["urdf"] = files.urdf;
@@ -222,8 +222,8 @@ void bind_export(py::module_& m) {
     r["message"] = e.consistency.message;
     return r;
   }, py::arg("model"), py::arg("study"), py::arg("urdf"), py::kw_only(), py::arg("prior") = py::none(),
-     py::arg("robot_dir") = py::none(), py::arg("margin") = identify::ModelExportOptions{}.margin,
-     py::arg("nearest") = identify::ModelExportOptions{}.nearest, py::arg("not_accepted") = false,
+     py::arg("robot_dir") = py::none(), py::arg("margin") = model_export::ModelExportOptions{}.margin,
+     py::arg("nearest") = model_export::ModelExportOptions{}.nearest, py::arg("not_accepted") = false,
      "The study's accepted parameters as a URDF (dynid export): the physically consistent standard parameters nearest the "
      "prior that reproduce them, written to urdf and <stem>.standard.yaml/.csv");
 }

@@ -15,11 +15,11 @@
 
 #include "arrays.hpp"
 #include "interruptible.hpp"
-#include "symoro/identify/report.hpp"
-#include "symoro/identify/robot_folder.hpp"
-#include "symoro/identify/study.hpp"
-#include "symoro/identify/study_request.hpp"
-#include "symoro/identify/validation_io.hpp"
+#include "symoro/study/report.hpp"
+#include "symoro/study/robot_folder.hpp"
+#include "symoro/study/study.hpp"
+#include "symoro/study/request.hpp"
+#include "symoro/study/validation_io.hpp"
 #include "symoro/io/folder_lock.hpp"
 #include "symoro/io/import.hpp"
 #include "symoro/parallel/farm.hpp"
@@ -32,7 +32,7 @@ std::optional<std::filesystem::path> robot_dir_of(py::handle model, const std::o
 
 namespace {
 
-py::dict run_record(const identify::RunRecord& r) {
+py::dict run_record(const study::RunRecord& r) {
   py::dict d;
   d["id"] = r.id();
   d["trajectory"] = r.trajectory;
@@ -57,7 +57,7 @@ py::dict run_record(const identify::RunRecord& r) {
   return d;
 }
 
-py::dict validation_record(const identify::ValidationRecord& v) {
+py::dict validation_record(const study::ValidationRecord& v) {
   py::dict d;
   d["trajectory"] = v.trajectory;
   d["kind"] = v.kind;
@@ -143,7 +143,7 @@ void bind_workflow(py::module_& m) {
      py::arg("heldout") = std::vector<std::filesystem::path>{}, py::arg("split") = 0.0, py::arg("allow_implausible") = false);
 
   // dynid identify's defaults are the request's (StudyOptions' own): taken from it.
-  const identify::StudyRequest defaults;
+  const study::StudyRequest defaults;
   m.def("identify", [](py::handle model, const std::filesystem::path& data, const std::filesystem::path& out,
                        const std::optional<std::filesystem::path>& robot_dir_arg,
                        const std::optional<std::filesystem::path>& design_arg,
@@ -158,8 +158,8 @@ void bind_workflow(py::module_& m) {
     const identify::ModelDescription& d = id->description();
     const std::filesystem::path robot_dir = robot_dir_of(model, robot_dir_arg).value_or(""),
                                 design = design_arg.value_or("");
-    // As dynid identify: the same request, the same translation (identify/study_request.hpp).
-    identify::StudyRequest q;
+    // As dynid identify: the same request, the same translation (study/request.hpp).
+    study::StudyRequest q;
     q.data = data.string();
     q.out = out.string();
     q.trial = trial;
@@ -189,14 +189,14 @@ void bind_workflow(py::module_& m) {
                              !py::hasattr(rescue_prior, "__fspath__");
     if (!rescue_prior.is_none() && !array_prior) q.rescue_prior = py::str(rescue_prior).cast<std::string>();
     if (array_prior) q.rescue_prior = "zero";  // replaced below
-    identify::StudyOptions so = identify::study_options(q, d, robot_dir);
+    study::StudyOptions so = study::study_options(q, d, robot_dir);
     if (array_prior) {
       const StateArg s = state_arg(rescue_prior, "rescue_prior", static_cast<int>(d.standard.size()));
       so.rescue_prior = Eigen::Map<const Eigen::VectorXd>(s.data(), static_cast<Eigen::Index>(d.standard.size()));
       so.rescue_prior_source = "an array given from Python";
     }
-    identify::ClosedLoopSource loop;
-    if (!robot_dir.empty()) loop = identify::closed_loop_source(robot_dir, d, design);
+    study::ClosedLoopSource loop;
+    if (!robot_dir.empty()) loop = study::closed_loop_source(robot_dir, d, design);
     else loop.why = "no robot folder given (robot_dir): no controller description";
 
     std::atomic<bool> stop{false};
@@ -209,7 +209,7 @@ void bind_workflow(py::module_& m) {
         *total = t;
         *count = skipped;
       };
-      so.on_run = [&, total, count](const identify::RunRecord& r) {
+      so.on_run = [&, total, count](const study::RunRecord& r) {
         py::gil_scoped_acquire gil;
         try {
           progress(++*count, *total, run_record(r));
@@ -220,7 +220,7 @@ void bind_workflow(py::module_& m) {
         }
       };
     }
-    identify::StudyResult r;
+    study::StudyResult r;
     std::optional<io::FolderLock> lock;
     // Under mpirun (docs/scaling.md) every rank calls this; rank 0 holds the folder, gathers the
     // records and reports, the others run their share of the runs and return None.
@@ -228,19 +228,19 @@ void bind_workflow(py::module_& m) {
     if (coordinator) lock.emplace(out, "symoro.identify");  // one study per folder at a time
     try {
       run_interruptible(stop, [&] {
-        r = identify::Study(id, so, std::move(loop)).run();
+        r = study::Study(id, so, std::move(loop)).run();
         if (!coordinator) return;
-        identify::write_validation(r, out);
-        if (report) identify::write_report(r, out / "report");
+        study::write_validation(r, out);
+        if (report) study::write_report(r, out / "report");
       });
-    } catch (const identify::StudyStopped&) {
+    } catch (const study::StudyStopped&) {
       if (callback_error) std::rethrow_exception(callback_error);  // the callback's own exception stopped it
       throw;
     }
     if (callback_error) std::rethrow_exception(callback_error);
     if (!coordinator) return py::object(py::none());
     // As dynid identify: a study without a model fails, after its records and report are written.
-    identify::require_identified(r);
+    study::require_identified(r);
 
     py::dict result;
     result["robot"] = r.robot;
@@ -262,7 +262,7 @@ void bind_workflow(py::module_& m) {
       parameters[py::str(r.names[i])] = r.phi_rescue[static_cast<Eigen::Index>(i)];
     result["parameters"] = parameters;
     result["accepted"] = r.accepted;
-    result["not_accepted_because"] = identify::acceptance_verdict(r).reasons;  // empty when accepted
+    result["not_accepted_because"] = study::acceptance_verdict(r).reasons;  // empty when accepted
     result["final_audit"] = r.final_audit;
     result["rescued"] = r.rescued;
     result["consistency"] = r.consistency;

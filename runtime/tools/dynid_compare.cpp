@@ -9,7 +9,7 @@
 #include "dynid_common.hpp"
 #include "dynid_numbers.hpp"
 #include "symoro/diagnose/gap_report.hpp"
-#include "symoro/identify/validation_io.hpp"
+#include "symoro/study/validation_io.hpp"
 
 namespace symoro::dynid {
 
@@ -21,8 +21,8 @@ struct CompareOptions {
 };
 
 void run(const Common& common, const CompareOptions& o) {
-  const identify::StudyValidation before = identify::read_validation(o.before);
-  const identify::StudyValidation after = identify::read_validation(o.after);
+  const study::StudyValidation before = study::read_validation(o.before);
+  const study::StudyValidation after = study::read_validation(o.after);
   if (!common.robot.empty() && before.robot != common.robot)
     throw UsageError(fmt::format("--robot {}, but {} is a study of '{}'", common.robot, o.before, before.robot));
   diagnose::GapComparison c;

@@ -1,6 +1,6 @@
 // dynid excite: identification trajectories for any robot from its robots/ folder alone: the
 // paper's structured families (trajectory/structured_design.hpp) or a given design file, and
-// optimized Fourier series (identify/excitation_design.hpp) under the same speed limits, in one
+// optimized Fourier series (excitation/design.hpp) under the same speed limits, in one
 // design file that dynid twin, control, trajectories and identify read (--design), with the
 // excitation quality of every trajectory side by side.
 #include <CLI/CLI.hpp>
@@ -19,8 +19,8 @@
 #include "dynid_robots.hpp"
 #include "dynid_numbers.hpp"
 #include "dynid_trajectories.hpp"
-#include "symoro/identify/excitation_design.hpp"
-#include "symoro/identify/excitation_quality.hpp"
+#include "symoro/excitation/design.hpp"
+#include "symoro/excitation/quality.hpp"
 #include "symoro/io/atomic_file.hpp"
 #include "symoro/io/parameters_yaml.hpp"
 #include "symoro/io/text_file.hpp"
@@ -42,14 +42,14 @@ struct ExciteOptions {
   std::string params;       // nominal phi; "" robot.yaml's nominal
   bool force = false;       // replace trajectories.yaml and quality.txt in -o
   int optimized = 3;
-  int harmonics = identify::ExcitationDesignOptions{}.harmonics;
+  int harmonics = excitation::ExcitationDesignOptions{}.harmonics;
   bool harmonics_given = false;
   double period = 0;  // s; 0: from the limits (auto_period), or chosen (excite_choice.hpp)
   double kappa_target = 0;   // > 0: choose the period for a scaled kappa below it
   double max_duration = 25;  // s, the longest optimized trajectory the choice may make
   int periods = 1;
-  int starts = identify::ExcitationDesignOptions{}.starts;
-  std::uint64_t seed = identify::ExcitationDesignOptions{}.seed;
+  int starts = excitation::ExcitationDesignOptions{}.starts;
+  std::uint64_t seed = excitation::ExcitationDesignOptions{}.seed;
   double torque_fraction = 0.8;
   double table = -1;                    // m below frame 0; < 0: none
   std::vector<std::string> half_spaces;  // "frame:nx,ny,nz:offset"
@@ -73,9 +73,9 @@ std::vector<double> numbers_of(const std::string& text, char sep, const std::str
   return out;
 }
 
-std::vector<identify::HalfSpace> half_spaces(const ExciteOptions& o, const identify::ModelDescription& d) {
+std::vector<excitation::HalfSpace> half_spaces(const ExciteOptions& o, const identify::ModelDescription& d) {
   const int frames = static_cast<int>(d.frames.size());
-  std::vector<identify::HalfSpace> out;
+  std::vector<excitation::HalfSpace> out;
   if (o.table >= 0) {  // every frame origin past the first two above the table, "down" along gravity
     if (!(d.gravity.norm() > 0)) throw UsageError("--table: the model has no gravity to tell down from up; use --half-space");
     for (int f = 3; f <= frames; ++f) out.push_back({fmt::format("table@{}", f), f, d.gravity.normalized(), o.table});
@@ -120,13 +120,13 @@ double auto_period(const Eigen::VectorXd& lower, const Eigen::VectorXd& upper, c
 }
 
 // The design options of one series from rest at `posture`.
-identify::ExcitationDesignOptions design_options(const ExciteOptions& o, const PeriodRung& rung, const YAML::Node& design,
+excitation::ExcitationDesignOptions design_options(const ExciteOptions& o, const PeriodRung& rung, const YAML::Node& design,
                                                  const std::string& posture,
                                                  const Eigen::VectorXd& lower, const Eigen::VectorXd& upper,
                                                  const Eigen::VectorXd& velocity, const Eigen::VectorXd& acceleration,
                                                  const Eigen::VectorXd& nominal, const identify::ModelDescription& d) {
   const int n = d.nq;
-  identify::ExcitationDesignOptions eo;
+  excitation::ExcitationDesignOptions eo;
   eo.period = rung.period;
   eo.harmonics = rung.harmonics;
   eo.start.resize(n);
@@ -147,7 +147,7 @@ identify::ExcitationDesignOptions design_options(const ExciteOptions& o, const P
 
 // Where the structured families cross a half-space (they know the joint limits only), every
 // 10 ms: one line per trajectory, its worst crossing.
-void warn_crossings(const std::vector<trajectory::Trajectory>& all, const std::vector<identify::HalfSpace>& spaces,
+void warn_crossings(const std::vector<trajectory::Trajectory>& all, const std::vector<excitation::HalfSpace>& spaces,
                     const identify::ModelDescription& d) {
   if (spaces.empty()) return;
   for (const auto& t : all) {
@@ -157,7 +157,7 @@ void warn_crossings(const std::vector<trajectory::Trajectory>& all, const std::v
     std::string where;
     for (double time = 0; time <= t.duration(); time += 0.01) {
       t.evaluate(time, q, qd, qdd);
-      const Eigen::VectorXd v = identify::half_space_values(d.frames, q, spaces);
+      const Eigen::VectorXd v = excitation::half_space_values(d.frames, q, spaces);
       Eigen::Index h = 0;
       if (v.maxCoeff(&h) > worst) worst = v(h), when = time, where = spaces[static_cast<std::size_t>(h)].name;
     }
@@ -171,7 +171,7 @@ void warn_crossings(const std::vector<trajectory::Trajectory>& all, const std::v
 // A regressor's two measures the choice compares: column-scaled kappa, log det per sample.
 ReferenceMeasures measures_of(const std::string& name, const Eigen::MatrixXd& W, const identify::ModelDescription& d) {
   const RegressorFactor f = RegressorFactor::of(W);
-  return {name, identify::excitation_quality_of_factor(f.R, f.rows, d.parameters, 0).kappa_scaled, log_det_per_sample(f, d.nq)};
+  return {name, excitation::excitation_quality_of_factor(f.R, f.rows, d.parameters, 0).kappa_scaled, log_det_per_sample(f, d.nq)};
 }
 
 // The optimized series of one run: the design of one series from the postures in turn, and its
@@ -187,8 +187,8 @@ struct SeriesDesigner {
   std::size_t next = 0;  // the posture the next series starts from
 
   struct Series {
-    identify::ExcitationDesign r;
-    identify::ExcitationDesignOptions eo;
+    excitation::ExcitationDesign r;
+    excitation::ExcitationDesignOptions eo;
     PeriodRung rung;
     std::string posture, refused, yaml;
     ReferenceMeasures measures;  // with targets
@@ -223,9 +223,9 @@ struct SeriesDesigner {
       out.eo.name = fmt::format("OF{:02d}", k + 1);
       out.eo.seed = o.seed + static_cast<std::uint64_t>(k);
       try {
-        out.r = identify::design_excitation(model, out.eo);
+        out.r = excitation::design_excitation(model, out.eo);
         out.posture = candidate;
-      } catch (const identify::ExcitationInfeasible& e) {
+      } catch (const excitation::ExcitationInfeasible& e) {
         fmt::print("{} from {}: refused: {}\n", out.eo.name, candidate, e.what());
         out.refused += fmt::format("{}{}: {}", out.refused.empty() ? "" : "; ", candidate, e.what());
       }
@@ -256,7 +256,7 @@ struct SeriesDesigner {
       other.yaml = yaml_of(other);
       other.measures = measures(other);
       if (!targets.met_by(other.measures.kappa_scaled, other.measures.per_sample)) continue;
-      other.r.slack = identify::check_excitation(model, other.r.trajectory, other.eo);
+      other.r.slack = excitation::check_excitation(model, other.r.trajectory, other.eo);
       other.best_start = false;
       s = std::move(other);
       return;

@@ -1,5 +1,5 @@
 // dynid export --urdf: a study's accepted base parameters as a URDF of the robot with
-// physically consistent inertials (identify/physical_consistency.hpp, identify/urdf_export.hpp),
+// physically consistent inertials (identify/physical_consistency.hpp, model_export/urdf_export.hpp),
 // and the standard parameters beside it (<name>.standard.yaml, <name>.standard.csv).
 #include <algorithm>
 #include <cmath>
@@ -17,9 +17,9 @@
 #include "dynid_robots.hpp"
 #include "dynid_numbers.hpp"
 #include "dynid_urdf_into.hpp"
-#include "symoro/identify/model_export.hpp"
+#include "symoro/model_export/model_export.hpp"
 #include "symoro/identify/regression.hpp"
-#include "symoro/identify/urdf_export.hpp"
+#include "symoro/model_export/urdf_export.hpp"
 #include "symoro/io/folder_lock.hpp"
 #include "symoro/io/atomic_file.hpp"
 #include "symoro/io/dataset.hpp"
@@ -168,7 +168,7 @@ void run_export(const Common& common, const ExportOptions& o, const std::string&
                                    common.robot));
     }
 
-    identify::ModelExportOptions eo;
+    model_export::ModelExportOptions eo;
     eo.prior = prior;
     eo.prior_what = prior_what;
     eo.study = o.study;
@@ -185,20 +185,20 @@ void run_export(const Common& common, const ExportOptions& o, const std::string&
                      : std::string("--data <the study's dataset> measures the torque it costs on the fitting data (and takes "
                                    "the nearest vector in that metric)");
     };
-    const identify::ModelExport e = identify::export_model(*model, phi, eo);
+    const model_export::ModelExport e = model_export::export_model(*model, phi, eo);
     const identify::ConsistencyResult& r = e.consistency;
     const bool nearest = e.nearest;
     const std::string& cost = e.cost;
     const double residual = e.residual;
     std::string urdf_text;
     if (o.into.empty()) {
-      urdf_text = identify::urdf_text(e.description);
+      urdf_text = model_export::urdf_text(e.description);
     } else {
       std::vector<std::string> notes;
       urdf_text = urdf_into(e.description, (common.robot_dir() / "robot.yaml").string(), o.into, notes);
       for (const auto& note : notes) fmt::print("{}\n", note);
     }
-    const identify::ModelExportFiles files = identify::write_model_export(e, o.urdf, urdf_text);
+    const model_export::ModelExportFiles files = model_export::write_model_export(e, o.urdf, urdf_text);
     if (nearest)
       fmt::print("WARNING: {}; exported the nearest base vector with a consistent set ({:.4g} away); {}\n", r.message,
                  r.base_distance, cost);

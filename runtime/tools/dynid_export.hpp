@@ -4,7 +4,7 @@
 #include <string>
 
 #include "dynid_common.hpp"
-#include "symoro/identify/model_export.hpp"
+#include "symoro/model_export/model_export.hpp"
 
 namespace symoro::dynid {
 
@@ -13,9 +13,9 @@ struct ExportOptions {
   std::string into;  // the user's URDF to write the inertials into (dynid_urdf_into.hpp)
   // Strictly inside the consistent set, above rounding: a singular pseudo-inertia (lambda_min
   // -2e-17 measured with 0) is a body some simulators reject. The library's defaults.
-  double margin = identify::ModelExportOptions{}.margin;
+  double margin = model_export::ModelExportOptions{}.margin;
   int trial = 1;
-  bool not_accepted = false, nearest = identify::ModelExportOptions{}.nearest;
+  bool not_accepted = false, nearest = model_export::ModelExportOptions{}.nearest;
   bool force = false;  // overwrite the URDF and its .standard files
 };
 

@@ -19,10 +19,10 @@
 #include "dynid_robots.hpp"
 #include "dynid_numbers.hpp"
 #include "symoro/identify/loaded_model.hpp"
-#include "symoro/identify/report.hpp"
-#include "symoro/identify/robot_folder.hpp"
-#include "symoro/identify/study.hpp"
-#include "symoro/identify/validation_io.hpp"
+#include "symoro/study/report.hpp"
+#include "symoro/study/robot_folder.hpp"
+#include "symoro/study/study.hpp"
+#include "symoro/study/validation_io.hpp"
 #include "symoro/io/folder_lock.hpp"
 #include "symoro/io/parameters_yaml.hpp"
 #include "symoro/parallel/farm.hpp"
@@ -33,13 +33,13 @@ namespace symoro::dynid {
 
 namespace identify_detail {
 
-identify::StudyResult study(const Common& common, const IdentifyOptions& o, const robot::ModelHandle& handle,
+study::StudyResult study(const Common& common, const IdentifyOptions& o, const robot::ModelHandle& handle,
                             const std::shared_ptr<const identify::IdentificationModel>& model, bool quiet) {
   const identify::ModelDescription& d = model->description();
-  identify::StudyOptions so;
+  study::StudyOptions so;
   try {
-    so = identify::study_options(o, d, common.robot_dir());
-  } catch (const identify::StudyRequestError& e) {
+    so = study::study_options(o, d, common.robot_dir());
+  } catch (const study::StudyRequestError& e) {
     throw UsageError(e.what());
   }
   auto progress = std::make_shared<std::unique_ptr<Progress>>();
@@ -47,7 +47,7 @@ identify::StudyResult study(const Common& common, const IdentifyOptions& o, cons
     if (skipped > 0) fmt::print(stderr, "{} of {} runs already finished (same inputs): skipped\n", skipped, total);
     if (!quiet) *progress = std::make_unique<Progress>(total - skipped, "run");
   };
-  so.on_run = [progress](const identify::RunRecord& r) {
+  so.on_run = [progress](const study::RunRecord& r) {
     if (*progress)
       (*progress)->done(r.id(), r.failed ? "FAILED: " + r.failure
                                 : r.clie_ran ? fmt::format("kappa {:.1f} {} lambda_min(CLIE) {:+.2e} CLIE {:.1f} s", r.kappa, r.route,
@@ -57,9 +57,9 @@ identify::StudyResult study(const Common& common, const IdentifyOptions& o, cons
   };
   // What switches on the closed-loop stages: the robot's controller description (CLIE and
   // closed-loop validation) and its trajectory design (references for logs without them).
-  identify::ClosedLoopSource loop = identify::closed_loop_source(common.robot_dir(), d, common.design_path());
-  identify::Study s(model, so, std::move(loop));
-  identify::StudyResult result = s.run();
+  study::ClosedLoopSource loop = study::closed_loop_source(common.robot_dir(), d, common.design_path());
+  study::Study s(model, so, std::move(loop));
+  study::StudyResult result = s.run();
   // On twin data the truth is known: the twin's standard parameters mapped to the identified
   // model's base parameters (products of inertia dropped for a reduced variant), with the hidden
   // Coulomb friction and offsets where the variant has parameters for them.
@@ -75,7 +75,7 @@ identify::StudyResult study(const Common& common, const IdentifyOptions& o, cons
 void run_identify(const Common& common, const IdentifyOptions& o) {
   if (o.out.empty()) throw UsageError("--out is required");
   const robot::ModelHandle handle = robot_model(common, o.model);
-  const identify::StudyResult r =
+  const study::StudyResult r =
       identify_detail::study(common, o, handle, identify::identification_model(handle, full_model(common)), false);
   if (!parallel::place().coordinator()) return;  // rank 0 reports
   rusage usage{};
@@ -93,7 +93,7 @@ void run_identify(const Common& common, const IdentifyOptions& o) {
                r.rescued ? (r.rescue_feasible ? (r.consistency == "physical" ? "rescued onto the consistent set" : "rescued (eps = 0)")
                                                            : "rescue FAILED: " + r.rescue_status)
                          : (r.consistency == "physical" ? "consistent, no rescue" : "PD without rescue"),
-               r.final_lambda_min, r.accepted ? "accepted" : fmt::format("NOT accepted: {}", fmt::join(identify::acceptance_verdict(r).reasons, "; ")));
+               r.final_lambda_min, r.accepted ? "accepted" : fmt::format("NOT accepted: {}", fmt::join(study::acceptance_verdict(r).reasons, "; ")));
     fmt::print("physical consistency of the accepted vector: {}\n",
                r.final_consistency_note.empty() ? "not checked" : r.final_consistency_note);
     for (const auto& v : r.validation)
@@ -109,15 +109,15 @@ void run_identify(const Common& common, const IdentifyOptions& o) {
     }
   }
   // The held-out series on disk: dynid compare reads them to set two model variants side by side.
-  if (!identify::write_validation(r, o.out).empty())
+  if (!study::write_validation(r, o.out).empty())
     fmt::print("validation: {}\n", (std::filesystem::path(o.out) / "validation.yaml").string());
   if (!o.no_report) {
-    const auto files = identify::write_report(r, std::filesystem::path(o.out) / "report");
+    const auto files = study::write_report(r, std::filesystem::path(o.out) / "report");
     fmt::print("report: {} ({} files)\n", (std::filesystem::path(o.out) / "report" / "report.md").string(), files.size());
   }
   // A study without a model fails, after its records and report are written: `identify &&
   // export` must not carry on as if there were parameters.
-  identify::require_identified(r);
+  study::require_identified(r);
 }
 
 

@@ -6,13 +6,13 @@
 #include <vector>
 
 #include "dynid_common.hpp"
-#include "symoro/identify/study_request.hpp"
+#include "symoro/study/request.hpp"
 
 namespace symoro::dynid {
 
 // The study's options are the library's request (symoro.identify takes the same), and the
 // command's own.
-struct IdentifyOptions : identify::StudyRequest {
+struct IdentifyOptions : study::StudyRequest {
   std::string model;
   bool no_report = false;
 };

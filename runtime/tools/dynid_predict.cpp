@@ -17,8 +17,8 @@
 #include "dynid_robots.hpp"
 #include "dynid_numbers.hpp"
 #include "symoro/io/dataset.hpp"
-#include "symoro/identify/prediction.hpp"
-#include "symoro/identify/study_options.hpp"
+#include "symoro/study/prediction.hpp"
+#include "symoro/study/options.hpp"
 #include "symoro/io/atomic_file.hpp"
 #include "symoro/io/log.hpp"
 #include "symoro/io/number_text.hpp"
@@ -33,7 +33,8 @@ namespace fs = std::filesystem;
 
 struct PredictOptions {
   std::string params = "nominal", model, input, out;
-  double interval_ms = 10, torque_delay_ms = 0;
+  double interval_ms = study::PredictionOptions{}.interval * 1000;
+  double torque_delay_ms = study::PredictionOptions{}.torque_delay * 1000;
   int trial = 1;
   bool force = false;
 };
@@ -63,9 +64,9 @@ Eigen::VectorXd nominal_phi(const Common& common, const identify::Identification
 }
 
 // The prediction of one log, its samples written to `csv`.
-identify::Prediction predict_log(const io::Log& log, const identify::IdentificationModel& model, const Eigen::VectorXd& phi,
+study::Prediction predict_log(const io::Log& log, const identify::IdentificationModel& model, const Eigen::VectorXd& phi,
                                  const PredictOptions& o, const fs::path& csv) {
-  identify::Prediction p = identify::predict(log, model, phi, o.interval_ms / 1000, o.torque_delay_ms / 1000);
+  study::Prediction p = study::predict(log, model, phi, {o.interval_ms / 1000, o.torque_delay_ms / 1000});
   const preprocess::Samples& s = p.samples;
   const int n = static_cast<int>(s.tau.cols());
   const auto& joints = model.description().joints;
@@ -132,7 +133,7 @@ void run(const Common& common, const PredictOptions& o) {
   int total = 0;
   std::string raw_filter;
   for (std::size_t i = 0; i < logs.size(); ++i) {
-    const identify::Prediction p = predict_log(logs[i].second, *model, phi, o, files[i]);
+    const study::Prediction p = predict_log(logs[i].second, *model, phi, o, files[i]);
     const int samples = static_cast<int>(p.samples.tau.rows());
     std::string line = fmt::format("  {:<10} {:>6} samples:", logs[i].first, samples);
     for (int j = 0; j < d.nq; ++j) line += fmt::format(" {:.4f} ({:.3f})", p.rmse(j), p.rms(j));

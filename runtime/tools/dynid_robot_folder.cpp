@@ -7,7 +7,7 @@
 
 #include "dynid_robots.hpp"
 #include "symoro/error.hpp"
-#include "symoro/identify/robot_folder.hpp"
+#include "symoro/study/robot_folder.hpp"
 #include "symoro/io/digest.hpp"
 
 namespace symoro::dynid {
@@ -32,7 +32,7 @@ void check_robot_folder(const Common& common) {
 
 bool nominal_standard_parameters(const Common& common, const std::vector<StandardParameterInfo>& standard,
                                  std::vector<double>& values) {
-  return identify::nominal_standard_parameters(common.robot_dir(), standard, values);
+  return study::nominal_standard_parameters(common.robot_dir(), standard, values);
 }
 
 }  // namespace symoro::dynid

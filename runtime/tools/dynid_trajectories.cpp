@@ -12,15 +12,15 @@
 #include "dynid_numbers.hpp"
 #include "dynid_robots.hpp"
 #include "dynid_trajectories.hpp"
-#include "symoro/identify/excitation_quality.hpp"
-#include "symoro/identify/study_options.hpp"
+#include "symoro/excitation/quality.hpp"
+#include "symoro/study/options.hpp"
 #include "symoro/io/log.hpp"
 #include "symoro/preprocess/preprocess.hpp"
 #include "symoro/trajectory/design.hpp"
 
 namespace symoro::dynid {
 
-RegressorFactor RegressorFactor::of(const Eigen::MatrixXd& W) { return {identify::triangular_factor(W), W.rows()}; }
+RegressorFactor RegressorFactor::of(const Eigen::MatrixXd& W) { return {excitation::triangular_factor(W), W.rows()}; }
 
 RegressorFactor RegressorFactor::stacked(const std::vector<RegressorFactor>& parts) {
   Eigen::Index rows = 0, factor_rows = 0;
@@ -31,7 +31,7 @@ RegressorFactor RegressorFactor::stacked(const std::vector<RegressorFactor>& par
     Rs.middleRows(at, f.R.rows()) = f.R;
     at += f.R.rows();
   }
-  return {identify::triangular_factor(Rs), rows};
+  return {excitation::triangular_factor(Rs), rows};
 }
 
 double log_det_per_sample(const RegressorFactor& f, int joints) {
@@ -40,7 +40,7 @@ double log_det_per_sample(const RegressorFactor& f, int joints) {
   const double samples = static_cast<double>(f.rows / std::max(1, joints));
   if (f.R.rows() < p || p == 0) return -std::numeric_limits<double>::infinity();
   const Eigen::VectorXd sigma = Eigen::JacobiSVD<Eigen::MatrixXd>(f.R).singularValues();
-  if (identify::numerically_singular(sigma)) return -std::numeric_limits<double>::infinity();
+  if (excitation::numerically_singular(sigma)) return -std::numeric_limits<double>::infinity();
   return 2 * sigma.array().log().sum() - static_cast<double>(p) * std::log(samples);
 }
 
@@ -54,14 +54,14 @@ Eigen::MatrixXd reference_regressor(const identify::IdentificationModel& model, 
   duration = log.time(log.samples() - 1) - log.time(0);
   if (log.has_references()) {
     const auto period = log.meta.sample_time > 0 ? log.meta.sample_time : o.period;
-    return model.stack_regression(identify::reference_samples(trajectory::sampled_reference(log, period), interval)).W;
+    return model.stack_regression(excitation::reference_samples(trajectory::sampled_reference(log, period), interval)).W;
   }
-  return model.stack_regression(preprocess::preprocess(log, interval, identify::StudyOptions{}.preprocess)).W;
+  return model.stack_regression(preprocess::preprocess(log, interval, study::StudyOptions{}.preprocess)).W;
 }
 
 Eigen::MatrixXd trajectory_regressor(const identify::IdentificationModel& model, const trajectory::Trajectory& t,
                                      const TrajectoryOptions& o) {
-  return model.stack_regression(identify::reference_samples(trajectory::sample(t, o.period), o.interval_ms / 1000)).W;
+  return model.stack_regression(excitation::reference_samples(trajectory::sample(t, o.period), o.interval_ms / 1000)).W;
 }
 
 std::string trajectory_quality_table(const Common& common, const std::vector<trajectory::Trajectory>& trajectories,
@@ -76,7 +76,7 @@ std::string trajectory_quality_table(const Common& common, const std::vector<tra
   out += fmt::format("{:<6} {:<4} {:>8} {:>11} {:>11} {:>10} {:>10}  {}\n", "name", "fam", "duration", "kappa", "kappa_scl",
                      "logdet_scl", "logdet/N", "weakest");
   auto row = [&](const std::string& name, const std::string& family, double duration, const RegressorFactor& f) {
-    const identify::ExcitationQuality q = identify::excitation_quality_of_factor(f.R, f.rows, d.parameters);
+    const excitation::ExcitationQuality q = excitation::excitation_quality_of_factor(f.R, f.rows, d.parameters);
     std::string weakest;
     if (!q.unexcited.empty()) weakest = fmt::format("{} parameters not excited (e.g. {})", q.unexcited.size(), q.unexcited.front());
     for (const auto& [p, v] : q.weakest) weakest += fmt::format("{}{} {:+.2f}", weakest.empty() ? "" : ", ", p, v);

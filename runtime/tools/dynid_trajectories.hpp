@@ -17,7 +17,7 @@ struct TrajectoryOptions {
   std::string out;
   std::vector<std::string> only;
   double period = 0.001;
-  bool quality = false;      // print each trajectory's excitation quality (identify/excitation_quality.hpp)
+  bool quality = false;      // print each trajectory's excitation quality (excitation/quality.hpp)
   double interval_ms = 10;   // ... at this sampling interval
   // Logs (symoro-log CSV, e.g. dynid import's) of reference motions rated beside the designed
   // ones: their reference columns when they have them, else their measured motion as the study
@@ -31,7 +31,7 @@ std::string trajectory_quality_table(const Common& common, const std::vector<tra
                                      const TrajectoryOptions& o, const std::string& model = "");
 
 // A stacked regressor W as the table rates it: its triangular factor (W'W = R'R,
-// identify::triangular_factor) and its row count; factors of several motions stack into their whole.
+// excitation::triangular_factor) and its row count; factors of several motions stack into their whole.
 struct RegressorFactor {
   Eigen::MatrixXd R;
   Eigen::Index rows = 0;

@@ -181,7 +181,7 @@ std::string inertial_xml(const ComForm& f, const std::string& indent) {
 
 }  // namespace
 
-std::string urdf_into(const identify::UrdfDescription& d, const std::string& robot_yaml, const std::string& user_urdf,
+std::string urdf_into(const model_export::UrdfDescription& d, const std::string& robot_yaml, const std::string& user_urdf,
                       std::vector<std::string>& notes) {
   const Origin origin = read_origin(robot_yaml);
   std::ifstream in(user_urdf, std::ios::binary);
@@ -247,9 +247,9 @@ std::string urdf_into(const identify::UrdfDescription& d, const std::string& rob
                                      user_urdf, joint->name, k, angle * 180 / M_PI, off * 1e3, robot_yaml));
     }
     // The identified body of model link k, about frame k's origin.
-    identify::UrdfInertial id = identify::link_inertial(d, k);
+    model_export::UrdfInertial id = model_export::link_inertial(d, k);
     Body identified;
-    if (id.present) identify::inertial_about_origin(id, identified.J, identified.h, identified.m);
+    if (id.present) model_export::inertial_about_origin(id, identified.J, identified.h, identified.m);
     // Minus the merged links' own inertials.
     Body rest = identified;
     std::vector<std::string> merged;

@@ -443,7 +443,7 @@ void expect_written_into(double extra_mass, bool expect_whole) {
 
   // "Identified": each model link's nominal body plus a random consistent one (or, for the last
   // link, minus mass when extra_mass < 0: less than the merged hand and fingers weigh).
-  identify::UrdfDescription d;
+  model_export::UrdfDescription d;
   d.robot = r.name;
   for (const auto& f : r.frames) d.frames.push_back({f.ant, f.sigma, f.mu, f.gamma, f.b, f.alpha, f.d, f.theta, f.r});
   for (int j = 0; j < r.n; ++j) {

@@ -21,8 +21,8 @@
 #include <gtest/gtest.h>
 
 #include "robot_folders.hpp"
-#include "symoro/identify/excitation_design.hpp"
-#include "symoro/identify/excitation_quality.hpp"
+#include "symoro/excitation/design.hpp"
+#include "symoro/excitation/quality.hpp"
 #include "symoro/identify/loaded_model.hpp"
 #include "symoro/trajectory/design.hpp"
 #include "symoro/trajectory/structured_design.hpp"
@@ -97,7 +97,7 @@ TEST_P(Excite, StructuredFamiliesBuildInsideTheLimits) {
 TEST_P(Excite, OptimizedDesignMeetsEveryLimitAndExcitesEveryParameter) {
   const auto identification = identify::identification_model(model(), full());
   const int n = model().nq();
-  identify::ExcitationDesignOptions o;
+  excitation::ExcitationDesignOptions o;
   trajectory::StructuredDesignOptions so = structured_options();
   Eigen::VectorXd lo(n), hi(n);
   if (revolute_only()) {
@@ -119,10 +119,10 @@ TEST_P(Excite, OptimizedDesignMeetsEveryLimitAndExcitesEveryParameter) {
   o.harmonics = 4;
   o.period = 12;
   o.starts = 2;
-  identify::ExcitationDesign d;
+  excitation::ExcitationDesign d;
   try {
-    d = identify::design_excitation(*identification, o);
-  } catch (const identify::ExcitationInfeasible& e) {
+    d = excitation::design_excitation(*identification, o);
+  } catch (const excitation::ExcitationInfeasible& e) {
     FAIL() << "the design from the middle of the box was refused: " << e.what();
   }
   const auto& t = d.trajectory;
@@ -131,9 +131,9 @@ TEST_P(Excite, OptimizedDesignMeetsEveryLimitAndExcitesEveryParameter) {
   // solved one after the other in this process, bit for bit (two robots: it costs a design).
   const std::string robot = fs::path(GetParam()).filename().string();
   if (robot == "planar2r" || robot == "ur5") {
-    identify::ExcitationDesignOptions one = o;
+    excitation::ExcitationDesignOptions one = o;
     one.workers = 1;
-    const identify::ExcitationDesign serial = identify::design_excitation(*identification, one);
+    const excitation::ExcitationDesign serial = excitation::design_excitation(*identification, one);
     ASSERT_EQ(serial.starts.size(), d.starts.size());
     EXPECT_EQ(serial.chosen, d.chosen);
     for (std::size_t s = 0; s < d.starts.size(); ++s) {
@@ -160,7 +160,7 @@ TEST_P(Excite, OptimizedDesignMeetsEveryLimitAndExcitesEveryParameter) {
   EXPECT_GE(worst, 0);
   t.evaluate(0, q, qd, qdd);
   EXPECT_LT((q - o.start).norm() + qd.norm() + qdd.norm(), 1e-12);
-  const auto optimized = identify::excitation_quality(*identification, t.sample(0.001), 0.01);
+  const auto optimized = excitation::excitation_quality(*identification, t.sample(0.001), 0.01);
   EXPECT_TRUE(optimized.unexcited.empty());
   EXPECT_TRUE(std::isfinite(optimized.kappa_scaled));
   if (!revolute_only()) return;
@@ -175,7 +175,7 @@ TEST_P(Excite, OptimizedDesignMeetsEveryLimitAndExcitesEveryParameter) {
   singles.q.conservativeResize(Eigen::NoChange, cycles);
   singles.qd.conservativeResize(Eigen::NoChange, cycles);
   singles.qdd.conservativeResize(Eigen::NoChange, cycles);
-  const auto structured = identify::excitation_quality(*identification, singles, 0.01);
+  const auto structured = excitation::excitation_quality(*identification, singles, 0.01);
   EXPECT_GT(optimized.log_det_scaled, structured.log_det_scaled);
   // D-optimality is not kappa: where the singles are already well conditioned (the planar 2R
   // arm: 4.5) the optimum may trade a little kappa for information; where they are poorly

@@ -14,7 +14,7 @@
 #include "symoro/identify/identification_model.hpp"
 #include "symoro/identify/physical_projection.hpp"
 #include "symoro/identify/regression.hpp"
-#include "symoro/identify/validation.hpp"
+#include "symoro/study/validation.hpp"
 
 namespace symoro::identify {
 namespace detail {
@@ -46,7 +46,7 @@ class GeneratedIdentificationModel final : public IdentificationModel {
     return Model::base_from_standard(Eigen::Matrix<double, Model::ns, 1>(s));
   }
   Eigen::MatrixXd open_loop_torque(const preprocess::Samples& samples, const Eigen::VectorXd& phi) const override {
-    return identify::open_loop_torque<Model>(samples, phi);
+    return study::open_loop_torque<Model>(samples, phi);
   }
   void state_derivatives(const Eigen::VectorXd& q, const Eigen::VectorXd& qd, const Eigen::VectorXd& qdd,
                          const Eigen::VectorXd& phi, bool with_fixed, StateDerivatives& out) const override {

@@ -21,14 +21,14 @@
 #include <gtest/gtest.h>
 #include <yaml-cpp/yaml.h>
 
-#include "symoro/identify/report.hpp"
-#include "symoro/identify/reproduction.hpp"
+#include "symoro/study/report.hpp"
+#include "symoro/study/reproduction.hpp"
 #include "symoro/report/svg_plot.hpp"
 #include "svg_test_support.hpp"
 
 namespace symoro::test::report {
 
-using namespace symoro::identify;
+using namespace symoro::study;
 namespace fs = std::filesystem;
 using symoro::test::panels;
 using symoro::test::tick_values;

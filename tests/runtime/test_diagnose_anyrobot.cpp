@@ -26,8 +26,8 @@
 #include "symoro/diagnose/gap_report.hpp"
 #include "symoro/diagnose/stack_builder.hpp"
 #include "symoro/io/dataset.hpp"
-#include "symoro/identify/study.hpp"
-#include "symoro/identify/validation_io.hpp"
+#include "symoro/study/study.hpp"
+#include "symoro/study/validation_io.hpp"
 #include "symoro/io/import.hpp"
 #include "../removed_at_exit.hpp"
 #include "symoro/diagnose/dataset_diagnosis.hpp"
@@ -149,16 +149,16 @@ TYPED_TEST(AnyRobotGap, AControllersCsvThroughImportIdentifyDiagnoseAndCompare) 
   // Identification of both models, no controller description: open loop on arm_heldout.
   auto study = [&](auto model, const std::string& name) {
     using Model = decltype(model);
-    identify::StudyOptions o;
+    study::StudyOptions o;
     o.data = this->dir_ / "data";
     o.out = this->dir_ / name;
     o.intervals = {0.010};
-    identify::Study s(identify::identification_model<Model>(), o, identify::ClosedLoopSource{});
-    const identify::StudyResult r = s.run();
-    identify::write_validation(r, o.out);
+    study::Study s(identify::identification_model<Model>(), o, study::ClosedLoopSource{});
+    const study::StudyResult r = s.run();
+    study::write_validation(r, o.out);
     return r;
   };
-  const identify::StudyResult before_study = study(Before{}, "study-before"), after_study = study(After{}, "study-after");
+  const study::StudyResult before_study = study(Before{}, "study-before"), after_study = study(After{}, "study-after");
   for (const auto* r : {&before_study, &after_study}) {
     ASSERT_EQ(r->runs.size(), 1u);
     EXPECT_EQ(r->runs[0].trajectory, "arm");
@@ -213,8 +213,8 @@ TYPED_TEST(AnyRobotGap, AControllersCsvThroughImportIdentifyDiagnoseAndCompare) 
   EXPECT_LT(d.selection.after.heldout_total, 0.9 * d.selection.before.heldout_total);
 
   // The comparison: the model with what the data have validates better on the held-out part.
-  const auto before = identify::read_validation(this->dir_ / "study-before");
-  const auto after = identify::read_validation(this->dir_ / "study-after");
+  const auto before = study::read_validation(this->dir_ / "study-before");
+  const auto after = study::read_validation(this->dir_ / "study-after");
   const diagnose::GapComparison c = diagnose::compare_studies(before, after);
   ASSERT_EQ(c.trajectories.size(), 1u);
   EXPECT_EQ(c.trajectories[0].kind, "open-loop");

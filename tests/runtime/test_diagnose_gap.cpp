@@ -16,8 +16,8 @@
 
 #include "symoro/diagnose/gap_report.hpp"
 #include "symoro/error.hpp"
-#include "symoro/identify/study.hpp"
-#include "symoro/identify/validation_io.hpp"
+#include "symoro/study/study.hpp"
+#include "symoro/study/validation_io.hpp"
 #include "symoro/io/atomic_file.hpp"
 #include "symoro/robot/compiled_model.hpp"
 #include "symoro/trajectory/design.hpp"
@@ -66,27 +66,27 @@ const std::filesystem::path& dataset() {
 }
 
 template <class Model>
-identify::StudyResult study(const std::filesystem::path& out) {
-  identify::StudyOptions o;
+study::StudyResult study(const std::filesystem::path& out) {
+  study::StudyOptions o;
   o.data = dataset();
   o.out = out;
   o.trajectories = {"AG02"};
   o.validation = kValid;
   o.intervals = {0.010};
   o.threads = 1;
-  identify::Study s(identify::identification_model<Model>(), o,
+  study::Study s(identify::identification_model<Model>(), o,
                            trajectory::TrajectoryDesign::read(kRobot + "/trajectories.yaml",
                                                               std::vector<JointInfo>(Model::joints.begin(), Model::joints.end())),
                            identify::closed_loop_setup(twin::read_twin_config(kRobot + "/twin.yaml", Model::nq).controller));
-  identify::StudyResult r = s.run();
+  study::StudyResult r = s.run();
   r.truth = twin::identified_truth(symoro::robot::compiled_model<Model>(), hidden_effects());
-  identify::write_validation(r, out);
+  study::write_validation(r, out);
   return r;
 }
 
 struct Studies {
   std::filesystem::path before_dir = temp("before"), after_dir = temp("after");
-  identify::StudyResult before, after;
+  study::StudyResult before, after;
   Studies() {
     std::filesystem::remove_all(before_dir);
     std::filesystem::remove_all(after_dir);
@@ -100,7 +100,7 @@ const Studies& studies() {
   return s;
 }
 
-int index_of(const identify::StudyResult& r, const std::string& name) {
+int index_of(const study::StudyResult& r, const std::string& name) {
   for (std::size_t k = 0; k < r.names.size(); ++k)
     if (r.names[k] == name) return static_cast<int>(k);
   return -1;
@@ -123,7 +123,7 @@ void heldout_error_shrinks_and_the_offset_is_found() {
   const auto& s = studies();
   ASSERT_EQ(s.before.validation.size(), kValid.size());
   ASSERT_EQ(s.after.validation.size(), kValid.size());
-  const identify::StudyValidation b = identify::read_validation(s.before_dir), a = identify::read_validation(s.after_dir);
+  const study::StudyValidation b = study::read_validation(s.before_dir), a = study::read_validation(s.after_dir);
   const diagnose::GapComparison c = diagnose::compare_studies(b, a);
   ASSERT_EQ(c.trajectories.size(), kValid.size());
   // Every held-out trajectory improves, the pooled error by more than a fifth (35 % measured),
@@ -147,7 +147,7 @@ void the_comparison_recomputes_the_studies_own_errors() {
   // it from the simulation in memory: the two must agree (and the CSV round trip be exact).
   const auto& s = studies();
   const diagnose::GapComparison c =
-      diagnose::compare_studies(identify::read_validation(s.before_dir), identify::read_validation(s.after_dir));
+      diagnose::compare_studies(study::read_validation(s.before_dir), study::read_validation(s.after_dir));
   for (std::size_t i = 0; i < c.trajectories.size(); ++i) {
     EXPECT_EQ(c.trajectories[i].trajectory, s.before.validation[i].trajectory);
     EXPECT_NEAR(c.trajectories[i].rmse_before, s.before.validation[i].rmse_rescue, 1e-12);
@@ -155,8 +155,8 @@ void the_comparison_recomputes_the_studies_own_errors() {
     for (Eigen::Index j = 0; j < c.trajectories[i].joint_after.size(); ++j)
       EXPECT_NEAR(c.trajectories[i].joint_after(j), s.after.validation[i].rmse_joint_rescue(j), 1e-12);
   }
-  const auto files = diagnose::write_gap_report(identify::read_validation(s.before_dir),
-                                                identify::read_validation(s.after_dir), c, temp("report"));
+  const auto files = diagnose::write_gap_report(study::read_validation(s.before_dir),
+                                                study::read_validation(s.after_dir), c, temp("report"));
   // gap.md, the joint bars, the torque figure and three localization figures per model.
   EXPECT_EQ(files.size(), 9u);
   std::ifstream md(temp("report") / "gap.md");
@@ -181,7 +181,7 @@ void malformed_validation_files_name_file_and_line() {
   in.close();
   std::ofstream(csv) << header << "\n" << first << "\n" << "0.5,abc" << "\n" << rest;
   try {
-    identify::read_validation(dir);
+    study::read_validation(dir);
     FAIL() << "no error";
   } catch (const DataError& e) {
     EXPECT_EQ(e.file(), csv.string());
@@ -189,9 +189,9 @@ void malformed_validation_files_name_file_and_line() {
     EXPECT_NE(std::string(e.what()).find("'abc' is not a number"), std::string::npos) << e.what();
   }
   std::filesystem::remove(dir / "validation.yaml");
-  EXPECT_THROW(identify::read_validation(dir), DataError);
+  EXPECT_THROW(study::read_validation(dir), DataError);
   // Studies of other data cannot be compared.
-  identify::StudyValidation b = identify::read_validation(s.before_dir), a = identify::read_validation(s.after_dir);
+  study::StudyValidation b = study::read_validation(s.before_dir), a = study::read_validation(s.after_dir);
   a.records[0].tau_measured(0, 0) += 1;
   EXPECT_THROW(diagnose::compare_studies(b, a), std::invalid_argument);
 }

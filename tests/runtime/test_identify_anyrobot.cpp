@@ -22,17 +22,17 @@
 #include <symoro/rx90.hpp>
 
 #include "symoro/control/ffpd.hpp"
-#include "symoro/identify/report.hpp"
+#include "symoro/study/report.hpp"
 #include "symoro/error.hpp"
 #include "symoro/identify/detail/closed_loop_model.hpp"
 #include "symoro/io/dataset.hpp"
-#include "symoro/identify/validation.hpp"
+#include "symoro/study/validation.hpp"
 #include "symoro/identify/least_squares.hpp"
-#include "symoro/identify/raw_torque.hpp"
+#include "symoro/study/raw_torque.hpp"
 #include "symoro/identify/regression.hpp"
 #include "symoro/preprocess/butterworth.hpp"
 #include "symoro/preprocess/zero_phase.hpp"
-#include "symoro/identify/study.hpp"
+#include "symoro/study/study.hpp"
 #include "symoro/trajectory/sampled_reference.hpp"
 #include "symoro/io/log.hpp"
 #include "synthetic_log.hpp"
@@ -67,8 +67,8 @@ class AnyRobotStudy : public ::testing::Test {
   }
   void TearDown() override { std::filesystem::remove_all(dir_); }
 
-  identify::StudyOptions options() const {
-    identify::StudyOptions o;
+  study::StudyOptions options() const {
+    study::StudyOptions o;
     o.data = dir_ / "data";
     o.out = dir_ / "study";
     o.intervals = {0.010, 0.020};
@@ -76,8 +76,8 @@ class AnyRobotStudy : public ::testing::Test {
     return o;
   }
 
-  static identify::ClosedLoopSource no_controller() {
-    identify::ClosedLoopSource none;  // move-only (a trajectory design is)
+  static study::ClosedLoopSource no_controller() {
+    study::ClosedLoopSource none;  // move-only (a trajectory design is)
     none.why = "no controller description (test)";
     return none;
   }
@@ -92,8 +92,8 @@ TYPED_TEST_SUITE(AnyRobotStudy, Robots);
 
 TYPED_TEST(AnyRobotStudy, RunsWithoutTwinDesignOrControllerAndValidatesOpenLoop) {
   using Model = TypeParam;
-  identify::Study study(identify::identification_model<Model>(), this->options(), this->no_controller());
-  const identify::StudyResult r = study.run();
+  study::Study study(identify::identification_model<Model>(), this->options(), this->no_controller());
+  const study::StudyResult r = study.run();
 
   ASSERT_EQ(r.runs.size(), 4u);  // R1 and R2 at 10 and 20 ms
   for (const auto& run : r.runs) {
@@ -113,7 +113,7 @@ TYPED_TEST(AnyRobotStudy, RunsWithoutTwinDesignOrControllerAndValidatesOpenLoop)
 
   // Held-out H1, open loop, against the truth's own torque on the same measurement.
   ASSERT_EQ(r.validation.size(), 1u);
-  const identify::ValidationRecord& v = r.validation[0];
+  const study::ValidationRecord& v = r.validation[0];
   EXPECT_EQ(v.trajectory, "H1");
   EXPECT_EQ(v.kind, "open-loop");
   EXPECT_NE(v.note.find("no controller description (test)"), std::string::npos) << v.note;
@@ -123,8 +123,8 @@ TYPED_TEST(AnyRobotStudy, RunsWithoutTwinDesignOrControllerAndValidatesOpenLoop)
   s.qd = v.qd;
   s.qdd = v.qdd;
   s.tau = v.tau_measured;
-  const Eigen::MatrixXd floor_tau = identify::open_loop_torque<Model>(s, this->truth_);
-  const double floor = identify::torque_error(v.tau_measured, floor_tau).rmse;
+  const Eigen::MatrixXd floor_tau = study::open_loop_torque<Model>(s, this->truth_);
+  const double floor = study::torque_error(v.tau_measured, floor_tau).rmse;
   // The floor holds at least the hidden offset (on one of n joints); the rest is the filtered
   // noise and what filtering q before the nonlinear model costs (0.7 % of the RX-90 shoulder's
   // 17 N m). The accepted model must do as well as the truth on data it did not see.
@@ -138,7 +138,7 @@ TYPED_TEST(AnyRobotStudy, RunsWithoutTwinDesignOrControllerAndValidatesOpenLoop)
     preprocess::Options po;
     po.drop_stale = drop;
     const preprocess::Samples hs = preprocess::preprocess(held, v.interval, po);
-    return identify::torque_error(hs.tau, identify::open_loop_torque<Model>(hs, this->truth_)).rmse;
+    return study::torque_error(hs.tau, study::open_loop_torque<Model>(hs, this->truth_)).rmse;
   };
   EXPECT_NEAR(truth_error(true), floor, 1e-9 * floor);
   // Measured: RX-90 0.118 -> 0.064 N m without noise or offset (planar 2R 0.044 -> 0.042, its
@@ -151,8 +151,8 @@ TYPED_TEST(AnyRobotStudy, RunsWithoutTwinDesignOrControllerAndValidatesOpenLoop)
   }
 
   // A rerun skips every run and gives the same accepted vector.
-  identify::Study again(identify::identification_model<Model>(), this->options(), this->no_controller());
-  const identify::StudyResult r2 = again.run();
+  study::Study again(identify::identification_model<Model>(), this->options(), this->no_controller());
+  const study::StudyResult r2 = again.run();
   EXPECT_EQ(r2.phi_rescue, r.phi_rescue);
 }
 
@@ -165,11 +165,11 @@ TYPED_TEST(AnyRobotStudy, AFailingRunIsRecordedAndTheStudyGoesOn) {
     std::ofstream m(this->dir_ / "data" / "dataset.yaml", std::ios::app);
     m << "  - {trajectory: R3, family: F, trial: 1, file: R3.csv}\n";
   }
-  identify::StudyOptions o = this->options();
+  study::StudyOptions o = this->options();
   o.trajectories = {"R1", "R3", "R3"};
   o.intervals = {0.010};
-  identify::Study study(identify::identification_model<Model>(), o, identify::ClosedLoopSource{});
-  const identify::StudyResult r = study.run();
+  study::Study study(identify::identification_model<Model>(), o, study::ClosedLoopSource{});
+  const study::StudyResult r = study.run();
   ASSERT_EQ(r.runs.size(), 2u);  // R3 once
   EXPECT_FALSE(r.runs[0].failed);
   EXPECT_TRUE(r.runs[1].failed);
@@ -209,26 +209,26 @@ TYPED_TEST(AnyRobotStudy, ADivergingClosedLoopValidationFallsBackToOpenLoopWithI
   const identify::ClosedLoopSimulator<Model> sim(unstable_setup<Model>(), ref);
   identify::ClieOptions co;
   co.preprocess = po;
-  const identify::ValidationRecord v = identify::validate_trajectory<Model>(&sim, s, this->truth_, this->truth_, co);
+  const study::ValidationRecord v = study::validate_trajectory<Model>(&sim, s, this->truth_, this->truth_, co);
   EXPECT_EQ(v.kind, "open-loop");
   EXPECT_NE(v.note.find("the closed loop of the accepted vector diverged at t = "), std::string::npos) << v.note;
   ASSERT_TRUE(std::isfinite(v.rmse_rescue)) << v.note;
-  EXPECT_NEAR(v.rmse_rescue, identify::torque_error(s.tau, identify::open_loop_torque<Model>(s, this->truth_)).rmse, 1e-12);
+  EXPECT_NEAR(v.rmse_rescue, study::torque_error(s.tau, study::open_loop_torque<Model>(s, this->truth_)).rmse, 1e-12);
 }
 
 TYPED_TEST(AnyRobotStudy, TheControllerDescriptionIsPartOfARunsFingerprint) {
   using Model = TypeParam;
   int skipped = -1;
-  auto run = [&](identify::ClosedLoopSource source) {
-    identify::StudyOptions o = this->options();
+  auto run = [&](study::ClosedLoopSource source) {
+    study::StudyOptions o = this->options();
     o.intervals = {0.020};
     o.on_start = [&](int, int k) { skipped = k; };
-    identify::Study(identify::identification_model<Model>(), o, std::move(source)).run();
+    study::Study(identify::identification_model<Model>(), o, std::move(source)).run();
   };
   run(this->no_controller());
   run(this->no_controller());
   EXPECT_EQ(skipped, 2);  // the same inputs: both runs loaded
-  identify::ClosedLoopSource with;
+  study::ClosedLoopSource with;
   with.setup = unstable_setup<Model>();
   run(std::move(with));   // a controller now (CLIE still skipped: the logs have no references)
   EXPECT_EQ(skipped, 0);  // another controller: every run redone
@@ -244,19 +244,19 @@ TYPED_TEST(AnyRobotStudy, AOneRunStudyWhoseClieDivergedEndsWithAReport) {
   log.qdd_ref = Eigen::MatrixXd::Zero(log.samples(), Model::nq);
   io::write_log(this->dir_ / "data" / "R4.csv", log);
   std::ofstream(this->dir_ / "data" / "dataset.yaml", std::ios::app) << "  - {trajectory: R4, family: F, trial: 1, file: R4.csv}\n";
-  identify::StudyOptions o = this->options();
+  study::StudyOptions o = this->options();
   o.trajectories = {"R4"};
   o.intervals = {0.020};
-  identify::ClosedLoopSource source;
+  study::ClosedLoopSource source;
   source.setup = unstable_setup<Model>();
-  const identify::StudyResult r = identify::Study(identify::identification_model<Model>(), o, std::move(source)).run();
+  const study::StudyResult r = study::Study(identify::identification_model<Model>(), o, std::move(source)).run();
   ASSERT_EQ(r.runs.size(), 1u);
   EXPECT_TRUE(r.runs[0].clie_ran);
   EXPECT_FALSE(r.runs[0].clie_success);
   EXPECT_NE(r.runs[0].clie_termination.find("start diverged"), std::string::npos) << r.runs[0].clie_termination;
   EXPECT_LT(r.selection.run, 0);
   std::vector<std::filesystem::path> files;
-  ASSERT_NO_THROW(files = identify::write_report(r, this->dir_ / "report"));
+  ASSERT_NO_THROW(files = study::write_report(r, this->dir_ / "report"));
   std::ifstream in(this->dir_ / "report" / "report.md");
   const std::string md((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   EXPECT_NE(md.find("**Accepted model**: none"), std::string::npos);
@@ -275,7 +275,7 @@ TYPED_TEST(AnyRobotStudy, ALoggedTorqueThatLagsIsReadLater) {
     po.drop_stale = false;  // a lagged torque hides which rows are stale
     po.torque_delay = delay;
     const preprocess::Samples s = preprocess::preprocess(l, 0.010, po);
-    return identify::torque_error(s.tau, identify::open_loop_torque<Model>(s, this->truth_)).rmse;
+    return study::torque_error(s.tau, study::open_loop_torque<Model>(s, this->truth_)).rmse;
   };
   // The truth's error on the log without the lag is the floor (filtered Coulomb steps, stale
   // rows); the lag adds to it, the shift takes (nearly) all of that back.
@@ -314,10 +314,10 @@ TYPED_TEST(AnyRobotStudy, ALogOfAnotherRobotOrJointCountIsNamed) {
         << e.what();
   }
   // In a study they are failed runs with those reasons; the others go on.
-  identify::StudyOptions o = this->options();
+  study::StudyOptions o = this->options();
   o.trajectories = {"R1", "R5", "R6"};
   o.intervals = {0.020};
-  const identify::StudyResult r = identify::Study(identify::identification_model<Model>(), o, this->no_controller()).run();
+  const study::StudyResult r = study::Study(identify::identification_model<Model>(), o, this->no_controller()).run();
   ASSERT_EQ(r.runs.size(), 3u);
   EXPECT_FALSE(r.runs[0].failed);
   EXPECT_TRUE(r.runs[1].failed && r.runs[2].failed);
@@ -378,7 +378,7 @@ TYPED_TEST(AnyRobotStudy, ThePreprocessedOlsBeatsAPlainOlsOnRawTorque) {
   const io::Log train = test::with_real_sensors(test::synthesize<Model>("T", this->truth_, 30.0, 301, this->kNoise), 1 << 16, 0.3, 80, 1);
   const io::Log held = test::with_real_sensors(test::synthesize<Model>("V", this->truth_, 15.0, 302, this->kNoise), 1 << 16, 0.3, 80, 2);
   auto score = [&](const Eigen::VectorXd& phi) {
-    return identify::raw_torque_error(held, &identify::open_loop_torque<Model>, phi).error.rmse;
+    return study::raw_torque_error(held, &study::open_loop_torque<Model>, phi).error.rmse;
   };
   const double truth = score(this->truth_);
   const double study = score(project_ols<Model>(train, 0.010, preprocess::Options{}));
@@ -416,14 +416,14 @@ TYPED_TEST(AnyRobotStudy, ThePriorsWeightIsChosenByHeldOutError) {
     manifest.runs.push_back({name, r < 2 ? "F" : "V", 1, name + ".csv"});
   }
   io::write_dataset(manifest);
-  identify::StudyOptions o = this->options();
+  study::StudyOptions o = this->options();
   o.data = noisy;
   o.out = this->dir_ / "noisy-study";
   o.intervals = {0.010};
-  o.consistency = identify::Consistency::physical;
+  o.consistency = study::Consistency::physical;
   o.rescue_prior = 1.6 * truth.s;
   o.rescue_prior_weights = {1e-6, 10.0};
-  const identify::StudyResult r = identify::Study(identify::identification_model<Model>(), o, this->no_controller()).run();
+  const study::StudyResult r = study::Study(identify::identification_model<Model>(), o, this->no_controller()).run();
   ASSERT_GE(r.selection.run, 0);
   ASSERT_TRUE(r.rescued) << "the representative is consistent: no rescue, no weight to choose";
   ASSERT_EQ(r.rescue_prior_scores.size(), 2u);

@@ -1,4 +1,4 @@
-// Optimized excitation (identify/excitation_criterion.hpp, excitation_design.hpp) on CRANE-X7
+// Optimized excitation (excitation/criterion.hpp, design.hpp) on CRANE-X7
 // and the UR5: the criterion's gradient and the constraints' Jacobians against central finite
 // differences; designs whose every limit holds on a dense grid, checked here with the generated
 // inverse dynamics directly and the MDH frames; the gain over a structured trajectory of the
@@ -15,8 +15,8 @@
 #include <symoro/crane_x7.hpp>
 #include <symoro/ur5.hpp>
 
-#include "symoro/identify/excitation_design.hpp"
-#include "symoro/identify/excitation_quality.hpp"
+#include "symoro/excitation/design.hpp"
+#include "symoro/excitation/quality.hpp"
 #include "symoro/identify/identification_model.hpp"
 #include "symoro/mdh.hpp"
 #include "symoro/robot/compiled_model.hpp"
@@ -27,6 +27,7 @@
 namespace {
 
 using namespace symoro::identify;
+using namespace symoro::excitation;
 using Crane = symoro::crane_x7::Model;
 using Ur5 = symoro::ur5::Model;
 

@@ -18,8 +18,8 @@
 #include <symoro/crane_x7.hpp>
 
 #include "symoro/identify/identification_model.hpp"
-#include "symoro/identify/prediction.hpp"
-#include "symoro/identify/study_options.hpp"
+#include "symoro/study/prediction.hpp"
+#include "symoro/study/options.hpp"
 #include "symoro/io/dataset.hpp"
 #include "symoro/identify/loaded_closed_loop.hpp"
 #include "symoro/identify/detail/loaded_closed_loop_sizes.hpp"
@@ -239,7 +239,7 @@ TEST(PredictOnALogCutInMotion, GivesTheModelsOwnErrorAndASplitScoresAsTheUncutLo
       log.qd.row(k) = qd.transpose();
       log.tau.row(k) = full.inverse_dynamics(q, qd, qdd, phi).transpose();
     }
-    const identify::Prediction p = identify::predict(log, *model, phi, 0.010);
+    const study::Prediction p = study::predict(log, *model, phi, {0.010});
     EXPECT_EQ(p.samples.report.moving_ends, 2);
     EXPECT_GT(p.samples.report.edge_samples, 20);
     for (int j = 0; j < dof; ++j) {
@@ -247,7 +247,7 @@ TEST(PredictOnALogCutInMotion, GivesTheModelsOwnErrorAndASplitScoresAsTheUncutLo
       EXPECT_LT(p.raw.error.rmse_joint(j), 0.005 * p.rms(j) + 1e-4) << "raw, joint " << j + 1;
     }
     // The settling samples kept: the ends' error alone breaks the bound on some joint.
-    preprocess::Options keep = identify::StudyOptions{}.preprocess;
+    preprocess::Options keep = study::StudyOptions{}.preprocess;
     keep.trim_settling = false;
     const preprocess::Samples all = preprocess::preprocess(log, 0.010, keep);
     const Eigen::MatrixXd e = all.tau - model->open_loop_torque(all, phi);
@@ -263,15 +263,15 @@ TEST(PredictOnALogCutInMotion, GivesTheModelsOwnErrorAndASplitScoresAsTheUncutLo
     const double split = log.time(0) + 0.7 * (log.time(n - 1) - log.time(0));
     const io::DatasetRun held{"run_heldout", "V", 1, dir / "run.csv", split, INFINITY};
     const auto torque = [&](const preprocess::Samples& s, const Eigen::VectorXd& x) { return model->open_loop_torque(s, x); };
-    const identify::RawTorqueScore window = identify::raw_torque_error(io::read_run_log(held), torque, phi);
+    const study::RawTorqueScore window = study::raw_torque_error(io::read_run_log(held), torque, phi);
     // The same instants scored inside the uncut log.
-    preprocess::Samples uncut = identify::raw_torque_samples(log);
+    preprocess::Samples uncut = study::raw_torque_samples(log);
     std::vector<Eigen::Index> rows;
     for (Eigen::Index k = 0; k < uncut.time.size(); ++k)
       if (uncut.time(k) >= split - 0.0005) rows.push_back(k);
     for (auto* m : {&uncut.q, &uncut.qd, &uncut.qdd, &uncut.tau}) *m = Eigen::MatrixXd((*m)(rows, Eigen::all));
     uncut.time = Eigen::VectorXd(uncut.time(rows));
-    const identify::RawTorqueScore inside = identify::raw_torque_error(uncut, torque, phi);
+    const study::RawTorqueScore inside = study::raw_torque_error(uncut, torque, phi);
     EXPECT_EQ(window.samples, inside.samples);
     EXPECT_NEAR(window.error.rmse, inside.error.rmse, 0.02 * inside.error.rmse + 1e-12);
     std::filesystem::remove_all(dir);

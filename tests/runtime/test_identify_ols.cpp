@@ -13,7 +13,7 @@
 #include <symoro/crane_x7.hpp>
 #include <symoro/rx90.hpp>
 
-#include "symoro/identify/excitation_quality.hpp"
+#include "symoro/excitation/quality.hpp"
 #include "symoro/identify/least_squares.hpp"
 #include "symoro/identify/regression.hpp"
 #include "symoro/preprocess/preprocess.hpp"
@@ -24,6 +24,7 @@
 namespace {
 
 using namespace symoro::identify;
+using namespace symoro::excitation;
 
 // A synthetic regression: random W with columns of very different scales, known phi, noise of
 // per-joint standard deviation sigma_j.
@@ -143,7 +144,7 @@ TEST(LeastSquares, RecoversTheTwinsWellExcitedParameters) {
 
 }  // namespace
 
-// Excitation quality (identify/excitation_quality.hpp): hand-derived values on a regressor whose
+// Excitation quality (excitation/quality.hpp): hand-derived values on a regressor whose
 // singular values are known, and on two robots against the generated regressor stacked here.
 
 namespace {

@@ -21,7 +21,7 @@
 
 #include "consistency_test_support.hpp"
 #include "symoro/identify/physical_projection.hpp"
-#include "symoro/identify/study.hpp"
+#include "symoro/study/study.hpp"
 #include "symoro/io/dataset.hpp"
 #include "symoro/io/log.hpp"
 #include "synthetic_log.hpp"
@@ -148,10 +148,10 @@ TEST(PhysicalProjection, ModelsWithEffectsAreRefusedWithTheReason) {
   const identify::ConsistencyResult r = identify::physical_check<Diagnosed>(VectorXd::Zero(Diagnosed::np));
   EXPECT_EQ(r.status, identify::ConsistencyStatus::SolverFailure);
   EXPECT_NE(r.message.find("effect parameters"), std::string::npos) << r.message;
-  identify::StudyOptions o;
+  study::StudyOptions o;
   o.data = "/nonexistent";
-  o.consistency = identify::Consistency::physical;
-  identify::Study study(identify::identification_model<Diagnosed>(), o, identify::ClosedLoopSource{});
+  o.consistency = study::Consistency::physical;
+  study::Study study(identify::identification_model<Diagnosed>(), o, study::ClosedLoopSource{});
   try {
     study.run();
     ADD_FAILURE() << "a physical study of a model with effects ran";
@@ -184,17 +184,17 @@ class PhysicalStudy : public ::testing::Test {
   }
   void TearDown() override { std::filesystem::remove_all(dir_); }
 
-  identify::StudyResult study(identify::Consistency c, bool physical_start = false) const {
-    identify::StudyOptions o;
+  study::StudyResult study(study::Consistency c, bool physical_start = false) const {
+    study::StudyOptions o;
     o.data = dir_ / "data";
-    o.out = dir_ / (std::string(identify::to_string(c)) + (physical_start ? "-start" : ""));
+    o.out = dir_ / (std::string(study::to_string(c)) + (physical_start ? "-start" : ""));
     o.intervals = {0.010, 0.020};
     o.threads = 2;
     o.consistency = c;
     o.physical_start = physical_start;
-    identify::ClosedLoopSource none;
+    study::ClosedLoopSource none;
     none.why = "no controller description (test)";
-    return identify::Study(identify::identification_model<Model>(), o, std::move(none)).run();
+    return study::Study(identify::identification_model<Model>(), o, std::move(none)).run();
   }
 
   // Noise enough that some OLS vectors pass the audit but have no consistent set, the case both
@@ -213,14 +213,14 @@ TYPED_TEST_SUITE(PhysicalStudy, Robots);
 // consistent set, and the accepted vector has one (checked independently).
 TYPED_TEST(PhysicalStudy, AcceptsAVectorWithAConsistentSetAndValidatesLikeThePdPath) {
   using Model = TypeParam;
-  const identify::StudyResult phys = this->study(identify::Consistency::physical);
-  const identify::StudyResult pd = this->study(identify::Consistency::pd);
+  const study::StudyResult phys = this->study(study::Consistency::physical);
+  const study::StudyResult pd = this->study(study::Consistency::pd);
   EXPECT_EQ(phys.consistency, "physical");
   ASSERT_EQ(phys.runs.size(), 6u);
   ASSERT_EQ(pd.runs.size(), 6u);
   int inconsistent = 0, not_pd = 0;
   for (std::size_t i = 0; i < phys.runs.size(); ++i) {
-    const identify::RunRecord& r = phys.runs[i];
+    const study::RunRecord& r = phys.runs[i];
     ASSERT_FALSE(r.failed) << r.id() << ": " << r.failure;
     EXPECT_TRUE(r.physical);
     EXPECT_FALSE(pd.runs[i].physical);
@@ -248,7 +248,7 @@ TYPED_TEST(PhysicalStudy, AcceptsAVectorWithAConsistentSetAndValidatesLikeThePdP
   test::expect_consistent<Model>(acc, phys.phi_rescue, 0);
   EXPECT_GT(phys.final_lambda_min, 0);  // consistency implies M(q) > 0; the audit agrees
   EXPECT_EQ(phys.selection.run, pd.selection.run);
-  const identify::RunRecord& sel = phys.runs[static_cast<std::size_t>(phys.selection.run)];
+  const study::RunRecord& sel = phys.runs[static_cast<std::size_t>(phys.selection.run)];
   EXPECT_EQ(phys.rescued, !sel.clie_consistent);
   // The PD path reports its accepted vector's consistency too, and the solver's verdict is right.
   EXPECT_EQ(pd.consistency, "pd");
@@ -266,10 +266,10 @@ TYPED_TEST(PhysicalStudy, AcceptsAVectorWithAConsistentSetAndValidatesLikeThePdP
 // the OLS estimate when it has one, else its projection.
 TYPED_TEST(PhysicalStudy, APhysicalStartProjectsTheOlsVectorsThatHaveNoConsistentSet) {
   using Model = TypeParam;
-  const identify::StudyResult phys = this->study(identify::Consistency::physical, true);
+  const study::StudyResult phys = this->study(study::Consistency::physical, true);
   ASSERT_EQ(phys.runs.size(), 6u);
   int projected = 0;
-  for (const identify::RunRecord& r : phys.runs) {
+  for (const study::RunRecord& r : phys.runs) {
     ASSERT_FALSE(r.failed) << r.id() << ": " << r.failure;
     EXPECT_EQ(r.ols_consistent, identify::physical_check<Model>(r.phi_ols).ok()) << r.id();
     const auto c = identify::consistent_standard_parameters<Model>(r.phi_sdp, VectorXd::Zero(Model::ns));

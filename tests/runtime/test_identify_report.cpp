@@ -7,7 +7,7 @@
 
 namespace {
 
-using namespace symoro::identify;
+using namespace symoro::study;
 using namespace symoro::test::report;
 namespace fs = std::filesystem;
 
@@ -374,7 +374,7 @@ namespace {
 // A robot without a controller description: CLIE skipped, validation open loop by design.
 // The reproduction table must say "n/a", not that the paper's findings failed.
 TEST(Reproduction, WithoutAControllerTheClosedLoopFindingsAreNotApplicable) {
-  using namespace symoro::identify;
+  using namespace symoro::study;
   StudyResult s;
   for (int i = 0; i < 3; ++i) {
     RunRecord r;

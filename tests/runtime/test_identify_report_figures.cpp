@@ -4,7 +4,7 @@
 
 namespace {
 
-using namespace symoro::identify;
+using namespace symoro::study;
 namespace svg = symoro::svg;
 using namespace symoro::test::report;
 namespace fs = std::filesystem;

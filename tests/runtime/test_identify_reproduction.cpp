@@ -16,13 +16,13 @@
 
 #include <symoro/crane_x7.hpp>
 
-#include "symoro/identify/reproduction.hpp"
-#include "symoro/identify/run_record_io.hpp"
+#include "symoro/study/reproduction.hpp"
+#include "symoro/study/run_record_io.hpp"
 #include "symoro/identify/detail/closed_loop_model.hpp"
 #include "symoro/io/dataset.hpp"
 #include "symoro/identify/detail/inertia_function_model.hpp"
-#include "symoro/identify/validation.hpp"
-#include "symoro/identify/study.hpp"
+#include "symoro/study/validation.hpp"
+#include "symoro/study/study.hpp"
 #include "symoro/twin/config.hpp"
 #include "twin_dataset.hpp"
 
@@ -45,8 +45,8 @@ identify::ClosedLoopSetup setup() {
   return identify::closed_loop_setup(twin::read_twin_config(kRobot + "/twin.yaml", Model::nq).controller);
 }
 
-identify::StudyOptions options(const std::filesystem::path& data, const std::filesystem::path& out) {
-  identify::StudyOptions o;  // the defaults, as dynid identify runs them
+study::StudyOptions options(const std::filesystem::path& data, const std::filesystem::path& out) {
+  study::StudyOptions o;  // the defaults, as dynid identify runs them
   o.data = data;
   o.out = out;
   o.trajectories = kIdent;
@@ -59,12 +59,12 @@ identify::StudyOptions options(const std::filesystem::path& data, const std::fil
 
 struct Studies {
   std::filesystem::path data = kTmp / ("symoro_repro_data_" + kPid);
-  identify::StudyResult quiet, loaded;
+  study::StudyResult quiet, loaded;
   Studies() {
     names.insert(names.end(), kValid.begin(), kValid.end());
     test::write_twin_dataset<Full>(data, twin::read_twin_config(kRobot + "/twin.yaml", Full::nq), design(), names, 1,
                                    kRobot + "/twin.yaml");
-    quiet = identify::Study(identify::identification_model<Model>(), options(data, kTmp / ("symoro_repro_a_" + kPid)), design(), setup()).run();
+    quiet = study::Study(identify::identification_model<Model>(), options(data, kTmp / ("symoro_repro_a_" + kPid)), design(), setup()).run();
     // The same study again while two threads compete for both cores.
     std::atomic<bool> stop{false};
     std::vector<std::thread> load;
@@ -73,7 +73,7 @@ struct Studies {
         volatile double x = 1;
         while (!stop.load(std::memory_order_relaxed)) x = std::sqrt(x + 1);
       });
-    loaded = identify::Study(identify::identification_model<Model>(), options(data, kTmp / ("symoro_repro_b_" + kPid)), design(), setup()).run();
+    loaded = study::Study(identify::identification_model<Model>(), options(data, kTmp / ("symoro_repro_b_" + kPid)), design(), setup()).run();
     stop = true;
     for (auto& t : load) t.join();
   }
@@ -90,7 +90,7 @@ Studies& studies() {
 }
 
 // tr Sigma_z of one stage's cloud in the PCA's standardization, computed here independently.
-double dispersion(const identify::StudyResult& r, int stage) {
+double dispersion(const study::StudyResult& r, int stage) {
   std::vector<Eigen::VectorXd> z;
   for (const auto& run : r.runs) {
     const Eigen::VectorXd& v = stage == 0 ? run.phi_ols : stage == 1 ? run.phi_sdp : run.phi_clie;
@@ -110,7 +110,7 @@ void cloud_contracts_from_ols_to_clie() {
   std::printf("tr Sigma_z: OLS %.4g, SDP %.4g, CLIE %.4g\n", ols, sdp, clie);
   EXPECT_LT(clie, ols);
   // The report's numbers are these.
-  const identify::FindingValues f = identify::finding_values(r);
+  const study::FindingValues f = study::finding_values(r);
   EXPECT_NEAR(f.at_selected[0], ols, 1e-12 * ols);
   EXPECT_NEAR(f.at_selected[2], clie, 1e-12 * clie);
 }
@@ -136,9 +136,9 @@ void rescue_keeps_accuracy() {
     // In the closed loop where both vectors can be simulated; a vector that is not PD at the
     // start pose cannot be, and then both are compared in open loop (the model's torque on the
     // measured motion).
-    auto v = identify::validate_trajectory<Model>(&sim, measured, run.phi_clie, p.phi, identify::ClieOptions{});
+    auto v = study::validate_trajectory<Model>(&sim, measured, run.phi_clie, p.phi, identify::ClieOptions{});
     if (v.kind != "closed-loop")
-      v = identify::validate_trajectory<Model>(nullptr, measured, run.phi_clie, p.phi, identify::ClieOptions{});
+      v = study::validate_trajectory<Model>(nullptr, measured, run.phi_clie, p.phi, identify::ClieOptions{});
     const double change = v.rmse_rescue / v.rmse_clie - 1;
     std::printf("%s rescue: V02 RMSE (%s) %.5f -> %.5f N m (%+.2f %%)\n", run.id().c_str(), v.kind.c_str(), v.rmse_clie,
                 v.rmse_rescue, 100 * change);
@@ -162,9 +162,9 @@ void no_validation_is_nan() {
 // Bit for bit: every field of every run record (its text as saved, the stage times set aside),
 // the selection, the accepted vector and the validation. Each trajectory runs in a process of
 // its own and every program links the reference BLAS (docs/identification.md, Reproducibility).
-std::string record_without_times(identify::RunRecord r) {
+std::string record_without_times(study::RunRecord r) {
   r.t_ols = r.t_audit = r.t_sdp = r.t_clie = 0;
-  return identify::run_record_text(r, "");
+  return study::run_record_text(r, "");
 }
 
 void two_runs_agree() {

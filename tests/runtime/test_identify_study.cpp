@@ -17,9 +17,9 @@
 
 #include "symoro/identify/detail/closed_loop_model.hpp"
 #include "symoro/io/dataset.hpp"
-#include "symoro/identify/validation.hpp"
-#include "symoro/identify/acceptance.hpp"
-#include "symoro/identify/study.hpp"
+#include "symoro/study/validation.hpp"
+#include "symoro/study/acceptance.hpp"
+#include "symoro/study/study.hpp"
 #include "symoro/robot/compiled_model.hpp"
 #include "twin_dataset.hpp"
 #include "symoro/io/atomic_file.hpp"
@@ -55,8 +55,8 @@ const std::filesystem::path& dataset() {
   return dir;
 }
 
-identify::StudyOptions options(const std::filesystem::path& out) {
-  identify::StudyOptions o;
+study::StudyOptions options(const std::filesystem::path& out) {
+  study::StudyOptions o;
   o.data = dataset();
   o.out = out;
   o.trajectories = kIdent;
@@ -73,7 +73,7 @@ identify::ClosedLoopSetup setup() {
 struct Fixture {
   std::filesystem::path out =
       std::filesystem::temp_directory_path() / ("symoro_study_test_out_" + std::to_string(::getpid()));
-  identify::StudyResult first;
+  study::StudyResult first;
   int ran_first = 0;
   ~Fixture() {
     std::filesystem::remove_all(out);
@@ -82,8 +82,8 @@ struct Fixture {
   Fixture() {
     std::filesystem::remove_all(out);
     auto o = options(out);
-    o.on_run = [this](const identify::RunRecord&) { ++ran_first; };
-    first = identify::Study(identify::identification_model<Model>(), o, design(), setup()).run();
+    o.on_run = [this](const study::RunRecord&) { ++ran_first; };
+    first = study::Study(identify::identification_model<Model>(), o, design(), setup()).run();
   }
 };
 
@@ -113,9 +113,9 @@ void rerun_skips_finished_runs_and_redoes_stale_ones() {
   auto& f = fixture();
   int ran = 0, skipped = -1;
   auto o = options(f.out);
-  o.on_run = [&](const identify::RunRecord&) { ++ran; };
+  o.on_run = [&](const study::RunRecord&) { ++ran; };
   o.on_start = [&](int, int s) { skipped = s; };
-  const auto again = identify::Study(identify::identification_model<Model>(), o, design(), setup()).run();
+  const auto again = study::Study(identify::identification_model<Model>(), o, design(), setup()).run();
   EXPECT_EQ(ran, 0);
   EXPECT_EQ(skipped, 6);
   ASSERT_EQ(again.runs.size(), f.first.runs.size());
@@ -131,8 +131,8 @@ void rerun_skips_finished_runs_and_redoes_stale_ones() {
   { std::ofstream(runs / "PC09@80ms.yaml") << n; }
   ran = 0;
   std::vector<std::string> redone;
-  o.on_run = [&](const identify::RunRecord& r) { redone.push_back(r.id()); };
-  const auto third = identify::Study(identify::identification_model<Model>(), o, design(), setup()).run();
+  o.on_run = [&](const study::RunRecord& r) { redone.push_back(r.id()); };
+  const auto third = study::Study(identify::identification_model<Model>(), o, design(), setup()).run();
   std::sort(redone.begin(), redone.end());
   EXPECT_EQ(redone, (std::vector<std::string>{"PA06@40ms", "PC09@80ms"}));
   for (size_t i = 0; i < third.runs.size(); ++i)
@@ -171,13 +171,13 @@ void validation_is_near_the_twins_floor() {
   const identify::ClosedLoopSimulator<Model> sim(setup(), design().build("V02"));
   const auto log = io::read_log(dataset() / "V02_t1.csv");
   const auto s = preprocess::preprocess(log, v.interval);
-  const auto floor = identify::validate_trajectory<Model>(&sim, s, truth, truth, identify::ClieOptions{});
+  const auto floor = study::validate_trajectory<Model>(&sim, s, truth, truth, identify::ClieOptions{});
   std::printf("V02 at %.0f ms: RMSE accepted %.4f, CLIE %.4f, truth floor %.4f N m; MNE %.4f / floor %.4f\n",
               v.interval * 1e3, v.rmse_rescue, v.rmse_clie, floor.rmse_clie, v.mne_rescue, floor.mne_clie);
   EXPECT_LT(v.rmse_rescue, 1.5 * floor.rmse_clie);
   EXPECT_LT(v.mne_rescue, 1.5 * floor.mne_clie);
   // And the metrics are what they say: recomputed from the stored series.
-  const identify::TorqueError e = identify::torque_error(v.tau_measured, v.tau_rescue);
+  const study::TorqueError e = study::torque_error(v.tau_measured, v.tau_rescue);
   EXPECT_NEAR(e.rmse, v.rmse_rescue, 1e-12);
 }
 
@@ -207,14 +207,14 @@ TEST(Acceptance, FinalAuditIsDenserAndOnOtherPoses) {
   pipeline.samples = 1000;
   pipeline.starts = 5;
   pipeline.seed = 3;
-  const identify::AuditOptions a = identify::final_audit_options(pipeline, identify::FinalAuditOptions{});
+  const identify::AuditOptions a = study::final_audit_options(pipeline, study::FinalAuditOptions{});
   EXPECT_EQ(a.samples, 4000);
   EXPECT_EQ(a.starts, 10);
   EXPECT_EQ(a.seed, 3u + 7919u);
-  EXPECT_EQ(identify::describe(a), "4000 quasi-random poses, 10 local minimizations, seed 7922");
-  identify::FinalAuditOptions same;
+  EXPECT_EQ(study::describe(a), "4000 quasi-random poses, 10 local minimizations, seed 7922");
+  study::FinalAuditOptions same;
   same.sample_factor = 1, same.start_factor = 1, same.seed_offset = 0;
-  EXPECT_EQ(identify::final_audit_options(pipeline, same).samples, 1000);
+  EXPECT_EQ(study::final_audit_options(pipeline, same).samples, 1000);
 }
 
 TEST(Acceptance, PriorWeightBySmallestHeldOutErrorSmallerOnATie) {
@@ -230,7 +230,7 @@ TEST(Acceptance, PriorWeightBySmallestHeldOutErrorSmallerOnATie) {
     const double w = phi(0);
     return w == 1e-6 ? 2.0 : w == 1e-4 ? 1.0005 : w == 1e-2 ? 1.0 : 0.5;
   };
-  const identify::PriorWeightChoice c = identify::choose_prior_weight({1e-6, 1e-4, 1e-2, 1.0}, 1e-6, rescue, rmse);
+  const study::PriorWeightChoice c = study::choose_prior_weight({1e-6, 1e-4, 1e-2, 1.0}, 1e-6, rescue, rmse);
   EXPECT_EQ(c.weight, 1e-4);
   EXPECT_EQ(c.projection.phi(0), 1e-4);
   ASSERT_EQ(c.scores.size(), 4u);
@@ -241,25 +241,25 @@ TEST(Acceptance, PriorWeightBySmallestHeldOutErrorSmallerOnATie) {
     p.phi = Eigen::VectorXd::Constant(1, w);
     return p;
   };
-  const identify::PriorWeightChoice d = identify::choose_prior_weight({1e-4, 1e-2}, 1e-6, never, rmse);
+  const study::PriorWeightChoice d = study::choose_prior_weight({1e-4, 1e-2}, 1e-6, never, rmse);
   EXPECT_EQ(d.weight, 1e-6);
   EXPECT_EQ(d.projection.phi(0), 1e-6);
 }
 
 TEST(Acceptance, TheVerdictSaysWhyNot) {
-  identify::StudyResult r;
-  EXPECT_FALSE(identify::acceptance_verdict(r).accepted);
-  EXPECT_EQ(identify::acceptance_verdict(r).reasons.front(), "no representative run: no run produced a final vector");
+  study::StudyResult r;
+  EXPECT_FALSE(study::acceptance_verdict(r).accepted);
+  EXPECT_EQ(study::acceptance_verdict(r).reasons.front(), "no representative run: no run produced a final vector");
   r.selection.run = 0;
   r.final_lambda_min = 1e-3;
   r.consistency = "pd";
-  EXPECT_TRUE(identify::acceptance_verdict(r).accepted);
-  EXPECT_TRUE(identify::acceptance_verdict(r).reasons.empty());
+  EXPECT_TRUE(study::acceptance_verdict(r).accepted);
+  EXPECT_TRUE(study::acceptance_verdict(r).reasons.empty());
   // The PD path does not ask for a consistent set; the physical path does.
   r.consistency = "physical";
   r.final_consistent = false;
   r.final_consistency_note = "link 3's pseudo-inertia is not positive definite";
-  identify::Verdict v = identify::acceptance_verdict(r);
+  study::Verdict v = study::acceptance_verdict(r);
   EXPECT_FALSE(v.accepted);
   ASSERT_EQ(v.reasons.size(), 1u);
   EXPECT_EQ(v.reasons[0], "no physically consistent set maps onto it (link 3's pseudo-inertia is not positive definite)");
@@ -269,7 +269,7 @@ TEST(Acceptance, TheVerdictSaysWhyNot) {
   r.rescued = true;
   r.rescue_feasible = false;
   r.rescue_status = "the SDP solver stopped";
-  v = identify::acceptance_verdict(r);
+  v = study::acceptance_verdict(r);
   EXPECT_FALSE(v.accepted);
   ASSERT_EQ(v.reasons.size(), 2u);
   EXPECT_EQ(v.reasons[0], "the final audit found M(q) not positive definite (lambda_min -0.0002)");
@@ -277,12 +277,12 @@ TEST(Acceptance, TheVerdictSaysWhyNot) {
 }
 
 TEST(Acceptance, RepresentativeOfNoRunOneRunAndACloud) {
-  std::vector<identify::RunRecord> runs(1);
+  std::vector<study::RunRecord> runs(1);
   runs[0].failed = true;
-  EXPECT_FALSE(identify::select_representative(runs, 3, 0.9).has_value());
+  EXPECT_FALSE(study::select_representative(runs, 3, 0.9).has_value());
   runs[0].failed = false;
   runs[0].phi_clie = Eigen::VectorXd::Ones(4);
-  const auto one = identify::select_representative(runs, 3, 0.9);
+  const auto one = study::select_representative(runs, 3, 0.9);
   ASSERT_TRUE(one.has_value());
   EXPECT_EQ(one->selection.run, 0);
   EXPECT_EQ(one->selection.rule, "the only run (no PCA cloud)");

@@ -1,4 +1,4 @@
-// URDF export (identify/urdf_export.hpp, dynid export --urdf), read back with urdfdom: random
+// URDF export (model_export/urdf_export.hpp, dynid export --urdf), read back with urdfdom: random
 // consistent standard parameters -> base vector -> consistent standard parameters nearest a
 // prior -> URDF file -> urdf::parseURDFFile. Each link's mass, CoM and inertia are the written
 // ones; the joints' origins and axes, composed here from the parsed model, give the generated
@@ -19,7 +19,7 @@
 #include <symoro/stanford_rrp.hpp>
 
 #include "symoro/identify/detail/physical_consistency_model.hpp"
-#include "symoro/identify/urdf_export.hpp"
+#include "symoro/model_export/urdf_export.hpp"
 #include "symoro/io/parameters_yaml.hpp"
 #include "symoro/mdh.hpp"
 #include "test_support.hpp"
@@ -31,6 +31,7 @@ using Crane = symoro::crane_x7::Model;
 using Rx90 = symoro::rx90::Model;
 using Rrp = symoro::stanford_rrp::Model;
 namespace id = symoro::identify;
+namespace mx = symoro::model_export;
 
 void write_file(const std::string& path, const std::string& text) {
   std::FILE* f = std::fopen(path.c_str(), "wb");
@@ -49,21 +50,21 @@ Eigen::Isometry3d pose_of(const urdf::Pose& p) {
 // The pose of every URDF link (by model frame number) at q, composed from the parsed joints:
 // origin, then the motion along the joint axis.
 template <class Model>
-std::vector<Eigen::Isometry3d> urdf_frames(const urdf::ModelInterface& m, const id::UrdfDescription& d,
+std::vector<Eigen::Isometry3d> urdf_frames(const urdf::ModelInterface& m, const mx::UrdfDescription& d,
                                            const VectorXd& q) {
   std::vector<Eigen::Isometry3d> T(Model::frames.size() + 1, Eigen::Isometry3d::Identity());
   int k = 0;
   for (int f = 1; f <= static_cast<int>(Model::frames.size()); ++f) {
-    const auto j = m.getJoint(id::urdf_joint_name(d, f));
-    EXPECT_TRUE(j) << id::urdf_joint_name(d, f);
+    const auto j = m.getJoint(mx::urdf_joint_name(d, f));
+    EXPECT_TRUE(j) << mx::urdf_joint_name(d, f);
     if (!j) return T;
     const Eigen::Vector3d axis(j->axis.x, j->axis.y, j->axis.z);
     Eigen::Isometry3d motion = Eigen::Isometry3d::Identity();
     if (j->type == urdf::Joint::REVOLUTE) motion.rotate(Eigen::AngleAxisd(q(k++), axis));
     else if (j->type == urdf::Joint::PRISMATIC) motion.translate(q(k++) * axis);
     const int ant = Model::frames[static_cast<std::size_t>(f - 1)].ant;
-    EXPECT_EQ(j->parent_link_name, id::urdf_link_name(d, ant));
-    EXPECT_EQ(j->child_link_name, id::urdf_link_name(d, f));
+    EXPECT_EQ(j->parent_link_name, mx::urdf_link_name(d, ant));
+    EXPECT_EQ(j->child_link_name, mx::urdf_link_name(d, f));
     T[static_cast<std::size_t>(f)] = T[static_cast<std::size_t>(ant)] * pose_of(j->parent_to_joint_origin_transform) * motion;
   }
   return T;
@@ -82,13 +83,13 @@ void urdf_round_trip(unsigned seed, int fk_frame) {
   const id::ConsistencyResult r = id::consistent_standard_parameters<Model>(phi, prior, o);
   ASSERT_TRUE(r.ok()) << r.message;
 
-  id::UrdfDescription d = id::urdf_description<Model>(r.s);
+  mx::UrdfDescription d = mx::urdf_description<Model>(r.s);
   d.notes.push_back("test -- a note with a double dash");
   const std::string dir = ::testing::TempDir();
   const std::string file = dir + "/" + Model::robot_name + "_" + std::to_string(seed) + ".urdf";
   const std::string yaml = dir + "/" + Model::robot_name + "_" + std::to_string(seed) + ".standard.yaml";
-  write_file(file, id::urdf_text(d));
-  write_file(yaml, id::standard_parameters_yaml(d, "robot: test\n"));
+  write_file(file, mx::urdf_text(d));
+  write_file(yaml, mx::standard_parameters_yaml(d, "robot: test\n"));
   const urdf::ModelInterfaceSharedPtr m = urdf::parseURDFFile(file);
   ASSERT_TRUE(m) << "urdfdom could not read " << file;
   EXPECT_EQ(m->getName(), Model::robot_name);
@@ -105,9 +106,9 @@ void urdf_round_trip(unsigned seed, int fk_frame) {
   double worst_inertial = 0;
   int with_inertial = 0;
   for (int f = 1; f <= static_cast<int>(Model::frames.size()); ++f) {
-    const auto link = m->getLink(id::urdf_link_name(d, f));
-    ASSERT_TRUE(link) << id::urdf_link_name(d, f);
-    const id::UrdfInertial want = id::link_inertial(d, f);
+    const auto link = m->getLink(mx::urdf_link_name(d, f));
+    ASSERT_TRUE(link) << mx::urdf_link_name(d, f);
+    const mx::UrdfInertial want = mx::link_inertial(d, f);
     if (!want.present) {
       EXPECT_FALSE(link->inertial) << "frame " << f;
       continue;
@@ -115,7 +116,7 @@ void urdf_round_trip(unsigned seed, int fk_frame) {
     ASSERT_TRUE(link->inertial) << "frame " << f;
     ++with_inertial;
     const urdf::Inertial& in = *link->inertial;
-    id::UrdfInertial got;
+    mx::UrdfInertial got;
     got.present = true;
     got.mass = in.mass;
     got.com = Eigen::Vector3d(in.origin.position.x, in.origin.position.y, in.origin.position.z);
@@ -132,7 +133,7 @@ void urdf_round_trip(unsigned seed, int fk_frame) {
     Eigen::Matrix3d I;
     Eigen::Vector3d h;
     double mass;
-    id::inertial_about_origin(got, I, h, mass);
+    mx::inertial_about_origin(got, I, h, mass);
     for (int k = 0; k < Model::ns; ++k) {
       const auto& p = Model::standard_parameters[static_cast<std::size_t>(k)];
       if (p.joint != f) continue;
@@ -159,7 +160,7 @@ void urdf_round_trip(unsigned seed, int fk_frame) {
       back(k) = from_yaml(k);
       continue;
     }
-    const auto j = m->getJoint(id::urdf_joint_name(d, p.joint));
+    const auto j = m->getJoint(mx::urdf_joint_name(d, p.joint));
     ASSERT_TRUE(j && j->dynamics) << p.name;
     back(k) = fam == "FV" ? j->dynamics->damping : j->dynamics->friction;
     EXPECT_EQ(back(k), r.s(k)) << p.name;
@@ -208,17 +209,17 @@ TEST(UrdfExport, InertialFormsAreInverse) {
   for (int i = 0; i < 9; ++i) A(i / 3, i % 3) = rng.uniform(-1, 1);
   const Eigen::Matrix3d I = A * A.transpose() + Eigen::Matrix3d::Identity();
   const Eigen::Vector3d h(0.3, -0.2, 0.1);
-  const id::UrdfInertial u = id::inertial_about_com(I, h, 2.0);
+  const mx::UrdfInertial u = mx::inertial_about_com(I, h, 2.0);
   EXPECT_TRUE(u.present);
   EXPECT_LE((u.com - h / 2.0).norm(), 1e-16);
   Eigen::Matrix3d I2;
   Eigen::Vector3d h2;
   double m2;
-  id::inertial_about_origin(u, I2, h2, m2);
+  mx::inertial_about_origin(u, I2, h2, m2);
   EXPECT_LE((I2 - I).cwiseAbs().maxCoeff(), 1e-15);
   EXPECT_LE((h2 - h).cwiseAbs().maxCoeff(), 1e-16);
   EXPECT_EQ(m2, 2.0);
-  EXPECT_FALSE(id::inertial_about_com(Eigen::Matrix3d::Zero(), Eigen::Vector3d::Zero(), 0).present);
+  EXPECT_FALSE(mx::inertial_about_com(Eigen::Matrix3d::Zero(), Eigen::Vector3d::Zero(), 0).present);
 }
 
 TEST(UrdfExport, RpyOfRotations) {
@@ -229,7 +230,7 @@ TEST(UrdfExport, RpyOfRotations) {
                     Eigen::AngleAxisd(0.3, Eigen::Vector3d::UnitX()).toRotationMatrix();
     if (i == 1) R = Eigen::AngleAxisd(-M_PI / 2, Eigen::Vector3d::UnitY()).toRotationMatrix() *
                     Eigen::AngleAxisd(0.3, Eigen::Vector3d::UnitX()).toRotationMatrix();
-    const Eigen::Vector3d rpy = id::urdf_rpy(R);
+    const Eigen::Vector3d rpy = mx::urdf_rpy(R);
     const Eigen::Matrix3d back = (Eigen::AngleAxisd(rpy(2), Eigen::Vector3d::UnitZ()) *
                                   Eigen::AngleAxisd(rpy(1), Eigen::Vector3d::UnitY()) *
                                   Eigen::AngleAxisd(rpy(0), Eigen::Vector3d::UnitX()))
@@ -252,11 +253,11 @@ TEST(UrdfExport, RoundTripStanfordRrp) {  // a prismatic joint
 
 TEST(UrdfExport, CraneX7HandIsMassless) {
   symoro::test::Random rng(4);
-  const id::UrdfDescription d = id::urdf_description<Crane>(symoro::test::random_standard_parameters<Crane>(rng).s);
-  EXPECT_FALSE(id::link_inertial(d, 8).present);
-  EXPECT_EQ(id::urdf_link_name(d, 8), "hand_link");
-  EXPECT_EQ(id::urdf_link_name(d, 0), "base_link");
-  const std::string x = id::urdf_text(d);
+  const mx::UrdfDescription d = mx::urdf_description<Crane>(symoro::test::random_standard_parameters<Crane>(rng).s);
+  EXPECT_FALSE(mx::link_inertial(d, 8).present);
+  EXPECT_EQ(mx::urdf_link_name(d, 8), "hand_link");
+  EXPECT_EQ(mx::urdf_link_name(d, 0), "base_link");
+  const std::string x = mx::urdf_text(d);
   EXPECT_NE(x.find("Khalil-Kleinfinger"), std::string::npos);
   EXPECT_NE(x.find("rotor inertia IA1"), std::string::npos);
   EXPECT_NE(x.find("<link name=\"hand_link\"/>"), std::string::npos);

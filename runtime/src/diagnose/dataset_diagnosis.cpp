@@ -10,7 +10,7 @@
 
 #include "symoro/control/description.hpp"
 #include "symoro/diagnose/effects.hpp"
-#include "symoro/identify/raw_torque.hpp"
+#include "symoro/study/raw_torque.hpp"
 #include "symoro/io/atomic_file.hpp"
 #include "symoro/io/parameters_yaml.hpp"
 #include "symoro/io/text_file.hpp"
@@ -83,9 +83,9 @@ namespace {
 // band (0.4 of the rate).
 void score_raw_torque(const DiagnosisModel& model, const DesignStack& train, const std::vector<std::pair<std::string, io::Log>>& heldout_logs,
                       const StackOptions& so, const Eigen::VectorXd& held, Diagnosis& d) {
-  const identify::RawTorqueOptions ro;
+  const study::RawTorqueOptions ro;
   std::vector<NamedSamples> raw_runs;
-  for (const auto& [name, log] : heldout_logs) raw_runs.push_back({name, identify::raw_torque_samples(log, ro)});
+  for (const auto& [name, log] : heldout_logs) raw_runs.push_back({name, study::raw_torque_samples(log, ro)});
   StackOptions rs = so;
   rs.interval = raw_runs.front().samples.interval;
   rs.cutoff = 0.4 / rs.interval;
@@ -99,7 +99,7 @@ void score_raw_torque(const DiagnosisModel& model, const DesignStack& train, con
   d.raw_after = a.heldout_rmse;
   d.raw_total_before = b.heldout_total;
   d.raw_total_after = a.heldout_total;
-  d.raw_filter = identify::raw_torque_filter_text(ro);
+  d.raw_filter = study::raw_torque_filter_text(ro);
 }
 
 }  // namespace

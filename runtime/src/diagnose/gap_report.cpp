@@ -17,8 +17,8 @@ namespace symoro::diagnose {
 
 namespace {
 
-using identify::StudyValidation;
-using identify::ValidationRecord;
+using study::StudyValidation;
+using study::ValidationRecord;
 
 const ValidationRecord* find(const StudyValidation& s, const std::string& trajectory) {
   for (const auto& v : s.records)

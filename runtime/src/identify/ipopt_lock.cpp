@@ -1,4 +1,4 @@
-#include "ipopt_lock.hpp"
+#include "symoro/identify/detail/ipopt_lock.hpp"
 
 namespace symoro::identify::detail {
 

@@ -1,6 +1,6 @@
 #include "symoro/identify/least_squares.hpp"
 
-#include "singular_values.hpp"
+#include "symoro/identify/detail/singular_values.hpp"
 
 #include <cmath>
 #include <limits>

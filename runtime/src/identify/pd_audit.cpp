@@ -19,7 +19,7 @@
 
 #include <Eigen/Eigenvalues>
 
-#include "ipopt_lock.hpp"
+#include "symoro/identify/detail/ipopt_lock.hpp"
 
 namespace symoro::identify {
 namespace {

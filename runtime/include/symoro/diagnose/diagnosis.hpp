@@ -36,7 +36,7 @@ struct Diagnosis {
   // When the stage did not run or failed: why (no twin, no references in the log, the
   // simulation refused the robot...). The stages before it are reported all the same.
   std::string backlash_note;
-  // The held-out gap against the raw measured torque at the logs' own rate (identify/raw_torque.hpp),
+  // The held-out gap against the raw measured torque at the logs' own rate (study/raw_torque.hpp),
   // beside the diagnosis band's: rms per joint and over all, before and after the effects.
   Eigen::VectorXd raw_before, raw_after;
   double raw_total_before = 0, raw_total_after = 0;

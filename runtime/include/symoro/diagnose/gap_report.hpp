@@ -10,7 +10,7 @@
 
 #include <Eigen/Core>
 
-#include "symoro/identify/validation_io.hpp"
+#include "symoro/study/validation_io.hpp"
 
 namespace symoro::diagnose {
 
@@ -37,7 +37,7 @@ struct GapComparison {
 
 // Throws std::invalid_argument when the studies cannot be compared (other robots, no common
 // trajectory, a trajectory validated at different intervals or sample counts).
-GapComparison compare_studies(const identify::StudyValidation& before, const identify::StudyValidation& after);
+GapComparison compare_studies(const study::StudyValidation& before, const study::StudyValidation& after);
 
 struct GapReportOptions {
   std::string before_label = "before", after_label = "after";  // e.g. the study folders
@@ -53,8 +53,8 @@ GapReportOptions gap_report_options(const std::filesystem::path& before_dir, con
                                     const std::vector<int>& joints);
 
 // Writes <dir>/gap.md and <dir>/figures/*.svg atomically; returns the files written.
-std::vector<std::filesystem::path> write_gap_report(const identify::StudyValidation& before,
-                                                    const identify::StudyValidation& after,
+std::vector<std::filesystem::path> write_gap_report(const study::StudyValidation& before,
+                                                    const study::StudyValidation& after,
                                                     const GapComparison& comparison, const std::filesystem::path& dir,
                                                     const GapReportOptions& options = {});
 

@@ -1,5 +1,5 @@
 // An identification's accepted parameters read back from a study's report/parameters.yaml
-// (identify/report.hpp writes it): the controller's model feed-forward and the diagnosis of an
+// (study/report.hpp writes it): the controller's model feed-forward and the diagnosis of an
 // earlier identification's gap (dynid control --params, dynid diagnose --params) use it.
 #pragma once
 

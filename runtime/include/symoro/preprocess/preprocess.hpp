@@ -40,7 +40,7 @@ struct Options {
   // filtered grid, linear between grid points) so that it lines up with the motion. 0: none.
   double torque_delay = 0;
   // false: the torque is only brought onto the grid (interpolated between its stamps), not
-  // low-passed: the raw measured torque, against which a model is scored (identify/raw_torque.hpp).
+  // low-passed: the raw measured torque, against which a model is scored (study/raw_torque.hpp).
   bool filter_torque = true;
   // Leave out the target samples within the filter's settling time of an end where the arm
   // moves (edges.hpp; counted in Report::edge_samples). false: keep them, transients and all.
