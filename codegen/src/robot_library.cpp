@@ -237,6 +237,104 @@ fs::path default_robot_cache_dir() {
   return fs::temp_directory_path() / "symoro-robots";
 }
 
+namespace {
+
+// The digest of the generated code, then the cache key: that code, the ABI, compiler, flags and
+// symoro's headers the units compile (the ABI, its export, the generated code's support).
+struct CacheKey {
+  std::string code_digest, build_line, key;
+};
+CacheKey cache_key(const Generation& gen, const RobotToolchain& tc) {
+  std::vector<const GeneratedFile*> files;
+  for (const auto& f : gen.files) files.push_back(&f);
+  std::sort(files.begin(), files.end(), [](const auto* a, const auto* b) { return a->path < b->path; });
+  std::string all;
+  for (const auto* f : files) all += f->path + '\0' + f->content + '\0';
+  CacheKey k;
+  k.code_digest = hex128(all);
+  k.build_line = tc.identity() + " | " + joined(tc.flags);
+  std::string key_text = "symoro robot library abi " + std::to_string(SYMORO_ROBOT_ABI_VERSION) + '\0' +
+                         k.code_digest + '\0' + k.build_line;
+  for (const auto& d : tc.include_dirs) {
+    key_text += '\0' + d;
+    for (const char* h : {SYMORO_ROBOT_ABI_HEADERS}) {
+      std::ifstream in(fs::path(d) / "symoro" / h, std::ios::binary);
+      if (in) key_text += '\0' + std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    }
+  }
+  k.key = hex128(key_text).substr(0, 20);
+  return k;
+}
+
+// The units of a robot library, written into its build folder `work`, each with its compile
+// command, its log and its object.
+struct LibraryUnits {
+  fs::path work, exe;
+  const RobotToolchain* tc = nullptr;
+  std::vector<std::vector<std::string>> compiles;
+  std::vector<fs::path> logs, objects;
+
+  void add(const std::string& name, const std::string& text) {
+    const fs::path unit = work / "src" / (name + ".cpp");
+    write_file(unit, text);
+    objects.push_back(work / "src" / (name + ".o"));
+    logs.push_back(work / "src" / (name + ".log"));
+    std::vector<std::string> c = {exe.string()};
+    c.insert(c.end(), tc->flags.begin(), tc->flags.end());
+    c.push_back("-I" + (work / "include").string());
+    for (const auto& d : tc->include_dirs) c.push_back("-I" + d);
+    c.insert(c.end(), {"-c", unit.string(), "-o", objects.back().string()});
+    compiles.push_back(std::move(c));
+  }
+};
+
+// Two units per model: its kernels in the C ABI, and its inertia second derivatives (Jets), half
+// of the model's compile time, beside it. Adds to `declarations` and `entries` the model's entry
+// point for the library's unit.
+void add_model_units(LibraryUnits& units, const RobotModel& robot, const Generation& gen, std::string& declarations,
+                     std::string& entries) {
+  for (std::size_t i = 0; i < gen.models.size(); ++i) {
+    const auto [header, type] = model_names(robot.name, gen.models[i].name);
+    // Named after the robot: the objects of several robots link into one program (--objects).
+    const std::string fn = "symoro_" + robot.name + "_model_" + std::to_string(i);
+    units.add(fn, "// Written by symoroc build for robot " + robot.name + ": model " + gen.models[i].name +
+                      " in the robot library's C ABI; do not edit.\n"
+                      "#include \"symoro/robot_abi_export-inl.hpp\"\n#include \"" + header + "\"\n\n"
+                      "// For a program that links these objects too (compiled_model<Model>()).\n"
+                      "template symoro_abi_model symoro::abi_export::model_abi<" + type + ">();\n\n"
+                      "symoro_abi_model " + fn + "() { return symoro::abi_export::model_abi<" + type + ">(); }\n");
+    declarations += "symoro_abi_model " + fn + "();\n";
+    entries += "      " + fn + "(),\n";
+    units.add(fn + "_d2", "// Written by symoroc build for robot " + robot.name + ": model " + gen.models[i].name +
+                              "'s inertia second derivatives; do not edit.\n"
+                              "#include \"symoro/robot_abi_second_derivatives-inl.hpp\"\n#include \"" + header + "\"\n\n"
+                              "template void symoro::abi_export::inertia_second_derivatives<" + type +
+                              ">(const double*, const double*, double*, double*, double*);\n");
+  }
+}
+
+// The library's entry points (symoro/robot_abi.h): its ABI version and its robot's table.
+void add_entry_unit(LibraryUnits& units, const RobotModel& robot, const Generation& gen, const CacheKey& key,
+                    const std::string& declarations, const std::string& entries) {
+  std::string sources;
+  for (const auto& [name, digest] : robot.sources) sources += "    {" + c_string(name) + ", " + c_string(digest) + "},\n";
+  const std::string identified = robot.spec.identified == "full" ? "" : robot.spec.identified;
+  units.add("robot", "// Written by symoroc build for robot " + robot.name +
+                         ": the library's entry points (symoro/robot_abi.h); do not edit.\n"
+                         "#include \"symoro/robot_abi.h\"\n\n" + declarations +
+                         "\nnamespace {\nconst symoro_abi_source_file sources[] = {\n" + sources + "};\n}  // namespace\n\n"
+                         "extern \"C\" __attribute__((visibility(\"default\"))) unsigned symoro_robot_abi_version(void) {\n"
+                         "  return SYMORO_ROBOT_ABI_VERSION;\n}\n\n"
+                         "extern \"C\" __attribute__((visibility(\"default\"))) const symoro_abi_robot* symoro_robot(void) {\n"
+                         "  static const symoro_abi_model models[] = {\n" + entries + "  };\n"
+                         "  static const symoro_abi_robot robot = {SYMORO_ROBOT_ABI_VERSION, " + c_string(robot.name) + ", " +
+                         c_string(identified) + ", " + c_string(key.code_digest) + ", " + c_string(key.build_line) + ", " +
+                         std::to_string(gen.models.size()) + ", models, " + std::to_string(robot.sources.size()) +
+                         ", sources};\n  return &robot;\n}\n");
+}
+
+}  // namespace
+
 RobotLibraryBuild build_robot_library(const fs::path& robot_dir, const RobotLibraryOptions& options) {
   using clock = std::chrono::steady_clock;
   const auto say = [&](const std::string& line) {
@@ -248,27 +346,10 @@ RobotLibraryBuild build_robot_library(const fs::path& robot_dir, const RobotLibr
   RobotLibraryBuild out;
   out.robot = robot.name;
   out.models = static_cast<int>(gen.models.size());
-
-  // The digest of the generated code, then the cache key: that code, the ABI, compiler, flags.
-  std::vector<const GeneratedFile*> files;
-  for (const auto& f : gen.files) files.push_back(&f);
-  std::sort(files.begin(), files.end(), [](const auto* a, const auto* b) { return a->path < b->path; });
-  std::string all;
-  for (const auto* f : files) all += f->path + '\0' + f->content + '\0';
-  out.code_digest = hex128(all);
   const RobotToolchain& tc = options.toolchain;
-  const std::string build_line = tc.identity() + " | " + joined(tc.flags);
-  std::string key_text = "symoro robot library abi " + std::to_string(SYMORO_ROBOT_ABI_VERSION) + '\0' +
-                         out.code_digest + '\0' + build_line;
-  // symoro's headers the units compile (the ABI, its export, the generated code's support).
-  for (const auto& d : tc.include_dirs) {
-    key_text += '\0' + d;
-    for (const char* h : {SYMORO_ROBOT_ABI_HEADERS}) {
-      std::ifstream in(fs::path(d) / "symoro" / h, std::ios::binary);
-      if (in) key_text += '\0' + std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-    }
-  }
-  out.key = hex128(key_text).substr(0, 20);
+  const CacheKey key = cache_key(gen, tc);
+  out.code_digest = key.code_digest;
+  out.key = key.key;
   out.generate_seconds = std::chrono::duration<double>(clock::now() - t0).count();
 
   const fs::path cache = options.cache_dir.empty() ? default_robot_cache_dir() : options.cache_dir;
@@ -290,73 +371,19 @@ RobotLibraryBuild build_robot_library(const fs::path& robot_dir, const RobotLibr
     const std::string rel = f.path.substr(f.path.find('/') + 1);
     write_file(work / rel, f.content);
   }
-  std::vector<std::vector<std::string>> compiles;
-  std::vector<fs::path> logs, objects;
-  const fs::path exe = resolve_compiler(tc.compiler);
-  auto compile_command = [&](const fs::path& unit, const fs::path& object) {
-    std::vector<std::string> c = {exe.string()};
-    c.insert(c.end(), tc.flags.begin(), tc.flags.end());
-    c.push_back("-I" + (work / "include").string());
-    for (const auto& d : tc.include_dirs) c.push_back("-I" + d);
-    c.insert(c.end(), {"-c", unit.string(), "-o", object.string()});
-    return c;
-  };
+  LibraryUnits units{work, resolve_compiler(tc.compiler), &tc, {}, {}, {}};
   std::string declarations, entries;
-  for (std::size_t i = 0; i < gen.models.size(); ++i) {
-    const auto [header, type] = model_names(robot.name, gen.models[i].name);
-    // Named after the robot: the objects of several robots link into one program (--objects).
-    const std::string fn = "symoro_" + robot.name + "_model_" + std::to_string(i);
-    const fs::path unit = work / "src" / (fn + ".cpp");
-    write_file(unit, "// Written by symoroc build for robot " + robot.name + ": model " + gen.models[i].name +
-                         " in the robot library's C ABI; do not edit.\n"
-                         "#include \"symoro/robot_abi_export-inl.hpp\"\n#include \"" + header + "\"\n\n"
-                         "// For a program that links these objects too (compiled_model<Model>()).\n"
-                         "template symoro_abi_model symoro::abi_export::model_abi<" + type + ">();\n\n"
-                         "symoro_abi_model " + fn + "() { return symoro::abi_export::model_abi<" + type + ">(); }\n");
-    declarations += "symoro_abi_model " + fn + "();\n";
-    entries += "      " + fn + "(),\n";
-    objects.push_back(work / "src" / (fn + ".o"));
-    compiles.push_back(compile_command(unit, objects.back()));
-    logs.push_back(work / "src" / (fn + ".log"));
-    // The second derivatives (Jets), half of the model's compile time, beside it.
-    const fs::path second = work / "src" / (fn + "_d2.cpp");
-    write_file(second, "// Written by symoroc build for robot " + robot.name + ": model " + gen.models[i].name +
-                           "'s inertia second derivatives; do not edit.\n"
-                           "#include \"symoro/robot_abi_second_derivatives-inl.hpp\"\n#include \"" + header + "\"\n\n"
-                           "template void symoro::abi_export::inertia_second_derivatives<" + type +
-                           ">(const double*, const double*, double*, double*, double*);\n");
-    objects.push_back(work / "src" / (fn + "_d2.o"));
-    compiles.push_back(compile_command(second, objects.back()));
-    logs.push_back(work / "src" / (fn + "_d2.log"));
-  }
-  std::string sources;
-  for (const auto& [name, digest] : robot.sources) sources += "    {" + c_string(name) + ", " + c_string(digest) + "},\n";
-  const std::string identified = robot.spec.identified == "full" ? "" : robot.spec.identified;
-  const fs::path entry = work / "src" / "robot.cpp";
-  write_file(entry, "// Written by symoroc build for robot " + robot.name +
-                        ": the library's entry points (symoro/robot_abi.h); do not edit.\n"
-                        "#include \"symoro/robot_abi.h\"\n\n" + declarations +
-                        "\nnamespace {\nconst symoro_abi_source_file sources[] = {\n" + sources + "};\n}  // namespace\n\n"
-                        "extern \"C\" __attribute__((visibility(\"default\"))) unsigned symoro_robot_abi_version(void) {\n"
-                        "  return SYMORO_ROBOT_ABI_VERSION;\n}\n\n"
-                        "extern \"C\" __attribute__((visibility(\"default\"))) const symoro_abi_robot* symoro_robot(void) {\n"
-                        "  static const symoro_abi_model models[] = {\n" + entries + "  };\n"
-                        "  static const symoro_abi_robot robot = {SYMORO_ROBOT_ABI_VERSION, " + c_string(robot.name) + ", " +
-                        c_string(identified) + ", " + c_string(out.code_digest) + ", " + c_string(build_line) + ", " +
-                        std::to_string(gen.models.size()) + ", models, " + std::to_string(robot.sources.size()) +
-                        ", sources};\n  return &robot;\n}\n");
-  objects.push_back(work / "src" / "robot.o");
-  compiles.push_back(compile_command(entry, objects.back()));
-  logs.push_back(work / "src" / "robot.log");
+  add_model_units(units, robot, gen, declarations, entries);
+  add_entry_unit(units, robot, gen, key, declarations, entries);
 
   const int jobs = options.jobs > 0 ? options.jobs : std::max(1u, std::thread::hardware_concurrency());
-  say(robot.name + ": compiling " + std::to_string(gen.models.size()) + " model(s) with " + exe.string() + " into " +
-      final_dir.string());
+  say(robot.name + ": compiling " + std::to_string(gen.models.size()) + " model(s) with " + units.exe.string() +
+      " into " + final_dir.string());
   const auto t1 = clock::now();
   try {
-    run_all(compiles, logs, jobs);
-    std::vector<std::string> link = {exe.string(), "-shared", "-o", (work / out.library.filename()).string()};
-    for (const auto& o : objects) link.push_back(o.string());
+    run_all(units.compiles, units.logs, jobs);
+    std::vector<std::string> link = {units.exe.string(), "-shared", "-o", (work / out.library.filename()).string()};
+    for (const auto& o : units.objects) link.push_back(o.string());
     run_all({link}, {work / "link.log"}, 1);
   } catch (const BuildError& e) {
     throw BuildError("robot library for " + robot_dir.string() + ": " + e.what());
@@ -364,7 +391,7 @@ RobotLibraryBuild build_robot_library(const fs::path& robot_dir, const RobotLibr
   out.compile_seconds = std::chrono::duration<double>(clock::now() - t1).count();
   out.built = true;
   write_file(work / "build.txt", "robot: " + robot.name + "\nfolder: " + fs::absolute(robot_dir).string() +
-                                     "\ncode digest: " + out.code_digest + "\nbuild: " + build_line + "\n");
+                                     "\ncode digest: " + out.code_digest + "\nbuild: " + key.build_line + "\n");
 
   // Into place; when another process finished the same library first, keep its copy.
   fs::rename(work, final_dir, ec);

@@ -20,26 +20,26 @@ struct CompareOptions {
   std::vector<int> joints;  // 1-based on the command line
 };
 
-void run(const Common& common, const CompareOptions& o) {
-  const study::StudyValidation before = study::read_validation(o.before);
-  const study::StudyValidation after = study::read_validation(o.after);
+void run(const Common& common, const CompareOptions& options) {
+  const study::StudyValidation before = study::read_validation(options.before);
+  const study::StudyValidation after = study::read_validation(options.after);
   if (!common.robot.empty() && before.robot != common.robot)
-    throw UsageError(fmt::format("--robot {}, but {} is a study of '{}'", common.robot, o.before, before.robot));
+    throw UsageError(fmt::format("--robot {}, but {} is a study of '{}'", common.robot, options.before, before.robot));
   diagnose::GapComparison c;
   try {
     c = diagnose::compare_studies(before, after);
   } catch (const std::invalid_argument& e) {
-    throw UsageError(fmt::format("cannot compare {} with {}: {}", o.before, o.after, e.what()));
+    throw UsageError(fmt::format("cannot compare {} with {}: {}", options.before, options.after, e.what()));
   }
   diagnose::GapReportOptions ro;
   try {
-    ro = diagnose::gap_report_options(o.before, o.after, c, o.trajectory, o.joints);
+    ro = diagnose::gap_report_options(options.before, options.after, c, options.trajectory, options.joints);
   } catch (const std::invalid_argument& e) {
     throw UsageError(fmt::format("--joints: {}", e.what()));
   }
   std::vector<std::filesystem::path> files;
   try {
-    files = diagnose::write_gap_report(before, after, c, o.out, ro);
+    files = diagnose::write_gap_report(before, after, c, options.out, ro);
   } catch (const std::invalid_argument& e) {
     throw UsageError(e.what());
   }
@@ -48,7 +48,7 @@ void run(const Common& common, const CompareOptions& o) {
                t.rmse_after);
   fmt::print("held-out rms error: {:.4f} N m ({}) -> {:.4f} N m ({}), {:+.1f} %\n", c.rmse_before, c.before_model,
              c.rmse_after, c.after_model, 100 * (c.rmse_after - c.rmse_before) / c.rmse_before);
-  fmt::print("report: {} ({} files)\n", (std::filesystem::path(o.out) / "gap.md").string(), files.size());
+  fmt::print("report: {} ({} files)\n", (std::filesystem::path(options.out) / "gap.md").string(), files.size());
 }
 
 }  // namespace

@@ -74,127 +74,154 @@ class LogClaim {
   std::filesystem::path path_;
 };
 
+// hardware.yaml (or --hardware), with --at-stop and --hold-time over its stop; `override` says
+// which (empty: none), and is printed.
+hardware::HardwareConfig read_hardware(const Common& common, const ControlCliOptions& options, const std::vector<JointInfo>& joints,
+                                       std::string& override) {
+  const auto hw_path = options.hardware.empty() ? common.robot_dir() / "hardware.yaml" : std::filesystem::path(options.hardware);
+  if (!std::filesystem::exists(hw_path))
+    throw UsageError(fmt::format("robot '{}' has no hardware description ({} not found)", common.robot, hw_path.string()));
+  hardware::HardwareConfig hw = hardware::read_hardware_config(hw_path, joints);
+  // What happens at a stop is the lab's choice in hardware.yaml; an override is said and logged.
+  if (!options.at_stop.empty()) {
+    hw.safety.at_stop = options.at_stop == "hold" ? hardware::StopAction::hold : hardware::StopAction::torque_off;
+    override = fmt::format("--at-stop {}", options.at_stop);
+  }
+  if (options.hold_time > 0) {
+    hw.safety.hold_time = options.hold_time;
+    override += fmt::format("{}--hold-time {}", override.empty() ? "" : " ", options.hold_time);
+  }
+  if (!override.empty())
+    fmt::print(stderr, "control: at a stop: {} for {} s then torque off ({} overrides {})\n", hardware::to_string(hw.safety.at_stop),
+               hw.safety.hold_time, override, hw_path.string());
+  return hw;
+}
+
+// The gains are the lab's controller description's, on the real arm and the virtual one alike;
+// twin.yaml (and --config, --ideal) shape only the emulated arm behind --virtual, whose twin
+// this returns (none without --virtual).
+std::optional<twin::TwinConfig> read_gains_and_twin(const Common& common, const ControlCliOptions& options, int nq,
+                                                    const hardware::HardwareConfig& hw, control::FfpdGains& gains) {
+  const auto controller_path = common.robot_dir() / control::controller_file_name();
+  if (!std::filesystem::exists(controller_path))
+    throw UsageError(fmt::format("robot '{}' has no controller description ({} not found): it holds the FF+PD gains",
+                                 common.robot, controller_path.string()));
+  gains = control::read_controller_description(controller_path, nq).gains();
+  gains.period = hw.period;
+  if (!options.virtual_bus && (!options.twin_config.empty() || options.ideal))
+    throw UsageError("--config and --ideal change the emulated arm of --virtual only; the real arm's gains come from " +
+                     controller_path.string());
+  std::optional<twin::TwinConfig> tc;
+  if (options.virtual_bus) {
+    const auto twin_path = common.robot_dir() / "twin.yaml";
+    if (!std::filesystem::exists(twin_path))
+      throw UsageError(fmt::format("--virtual needs the robot's digital twin ({} not found)", twin_path.string()));
+    tc = twin::read_twin_config(twin_path, nq, options.twin_config);
+    if (options.ideal) tc->effects.disable_all();
+  }
+  return tc;
+}
+
+// --params: the identified model's feed-forward and inertia for the loop, with what the log
+// notes of them.
+void add_model_feedforward(const Common& common, const ControlCliOptions& options, hardware::ControlOptions& co) {
+  const robot::ModelHandle identified = robot_model(common, "");
+  std::vector<std::string> names;
+  for (const auto& p : identified.parameters()) names.emplace_back(p.name);
+  const Eigen::VectorXd phi = io::read_parameters_yaml(options.params, names);
+  // Parameters whose final audit failed may not be positive definite everywhere: their
+  // inverse dynamics is no feed-forward for a real arm unless the user says so, and the log
+  // records it. The flag counts only in a file as identify wrote it (its digest): an edited
+  // value or flag makes it a file of unknown origin. Whatever the file says, the loop checks
+  // the model on every reference before torque on (hardware::ControlOptions::inertia).
+  const io::ParametersIntegrity integrity = io::parameters_integrity(options.params, names);
+  const bool accepted = io::parameters_accepted(options.params);
+  if (!accepted || !integrity.intact) {
+    const std::string why = !integrity.intact ? "the file is not as identify wrote it: " + integrity.why
+                                              : "the identification was not accepted (its final all-pose audit failed, or "
+                                                "the file has no 'accepted: true')";
+    if (!options.unaccepted_params)
+      throw UsageError(fmt::format("{}: {}; --unaccepted-params drives with it anyway (the model is still checked before "
+                                   "torque on)",
+                                   options.params, why));
+    co.notes += !integrity.intact ? "; PARAMETERS EDITED OR NOT FROM IDENTIFY (--unaccepted-params)"
+                                  : "; PARAMETERS NOT ACCEPTED (--unaccepted-params)";
+  }
+  co.feedforward = hardware::model_feedforward(identified, phi);
+  co.inertia = hardware::model_inertia(identified, phi);
+  co.notes += "; model feedforward from " + options.params;
+}
+
+// --virtual: the emulated servo chain driving the twin, at the trajectory's start. With
+// --rt-priority the emulated servos' thread gets SCHED_FIFO one below the loop (a thread
+// inherits its creator's scheduling).
+std::unique_ptr<dynamixel::VirtualBus> start_virtual_bus(const ControlCliOptions& options, const robot::ModelHandle& full,
+                                                         const twin::TwinConfig& tc, const hardware::HardwareConfig& hw,
+                                                         const trajectory::Trajectory& traj) {
+  Eigen::VectorXd q(full.nq()), qd(full.nq()), qdd(full.nq());
+  traj.evaluate(0, q, qd, qdd);
+  int policy = 0;
+  sched_param saved{};
+  bool raised = false;
+  if (options.priority > 1) {
+    pthread_getschedparam(pthread_self(), &policy, &saved);
+    sched_param p{};
+    p.sched_priority = options.priority - 1;
+    raised = pthread_setschedparam(pthread_self(), SCHED_FIFO, &p) == 0;
+  }
+  auto virt = std::make_unique<dynamixel::VirtualBus>(twin_bus::virtual_servos(hw),
+                                                      std::make_unique<twin_bus::TwinServoBackend>(full, tc, hw, q));
+  if (raised) pthread_setschedparam(pthread_self(), policy, &saved);
+  return virt;
+}
+
 }  // namespace
 
-void run_control_command(const Common& common, const ControlCliOptions& o) {
+void run_control_command(const Common& common, const ControlCliOptions& options) {
   // A closed terminal or pipe must neither end a run nor the command: SIGPIPE is ignored until
   // dynid exits (the report is written first, then flushed at exit), and from here on every
   // signal that would end dynid is a stop request.
   std::signal(SIGPIPE, SIG_IGN);
   hardware::StopSignals signals;
-  const LogClaim claim(o.out, o.if_exists);  // before anything moves
+  const LogClaim claim(options.out, options.if_exists);  // before anything moves
   const std::string out = claim.path().string();
   const robot::ModelHandle full = full_model(common);
   const std::vector<JointInfo>& joints = full.joints();
-  const auto hw_path = o.hardware.empty() ? common.robot_dir() / "hardware.yaml" : std::filesystem::path(o.hardware);
-  if (!std::filesystem::exists(hw_path))
-    throw UsageError(fmt::format("robot '{}' has no hardware description ({} not found)", common.robot, hw_path.string()));
-  hardware::HardwareConfig hw = hardware::read_hardware_config(hw_path, joints);
-  // What happens at a stop is the lab's choice in hardware.yaml; an override is said and logged.
   std::string stop_override;
-  if (!o.at_stop.empty()) {
-    hw.safety.at_stop = o.at_stop == "hold" ? hardware::StopAction::hold : hardware::StopAction::torque_off;
-    stop_override = fmt::format("--at-stop {}", o.at_stop);
-  }
-  if (o.hold_time > 0) {
-    hw.safety.hold_time = o.hold_time;
-    stop_override += fmt::format("{}--hold-time {}", stop_override.empty() ? "" : " ", o.hold_time);
-  }
-  if (!stop_override.empty())
-    fmt::print(stderr, "control: at a stop: {} for {} s then torque off ({} overrides {})\n", hardware::to_string(hw.safety.at_stop),
-               hw.safety.hold_time, stop_override, hw_path.string());
-  // The gains are the lab's controller description's, on the real arm and the virtual one alike;
-  // twin.yaml (and --config, --ideal) shape only the emulated arm behind --virtual.
-  const auto controller_path = common.robot_dir() / control::controller_file_name();
-  if (!std::filesystem::exists(controller_path))
-    throw UsageError(fmt::format("robot '{}' has no controller description ({} not found): it holds the FF+PD gains",
-                                 common.robot, controller_path.string()));
-  control::FfpdGains gains = control::read_controller_description(controller_path, full.nq()).gains();
-  gains.period = hw.period;
-  if (!o.virtual_bus && (!o.twin_config.empty() || o.ideal))
-    throw UsageError("--config and --ideal change the emulated arm of --virtual only; the real arm's gains come from " +
-                     controller_path.string());
-  std::optional<twin::TwinConfig> tc;
-  if (o.virtual_bus) {
-    const auto twin_path = common.robot_dir() / "twin.yaml";
-    if (!std::filesystem::exists(twin_path))
-      throw UsageError(fmt::format("--virtual needs the robot's digital twin ({} not found)", twin_path.string()));
-    tc = twin::read_twin_config(twin_path, full.nq(), o.twin_config);
-    if (o.ideal) tc->effects.disable_all();
-  }
+  const hardware::HardwareConfig hw = read_hardware(common, options, joints, stop_override);
+  control::FfpdGains gains;
+  const std::optional<twin::TwinConfig> tc = read_gains_and_twin(common, options, full.nq(), hw, gains);
   const trajectory::Trajectory traj =
-      read_design(common, joints).build(o.trajectory);
+      read_design(common, joints).build(options.trajectory);
 
   hardware::ControlOptions co;
   co.robot = common.robot;
-  co.trial = o.trial;
-  co.seconds = o.seconds;
-  co.realtime_priority = o.priority;
+  co.trial = options.trial;
+  co.seconds = options.seconds;
+  co.realtime_priority = options.priority;
   // The emulated servos are a thread that may wait for a core on a loaded machine.
-  if (!o.virtual_bus && o.watchdog > hardware::kMaxWatchdogCycles)
-    throw UsageError(fmt::format("--watchdog {}: at most {} cycles on a real port (the arm runs blind that long)", o.watchdog,
+  if (!options.virtual_bus && options.watchdog > hardware::kMaxWatchdogCycles)
+    throw UsageError(fmt::format("--watchdog {}: at most {} cycles on a real port (the arm runs blind that long)", options.watchdog,
                                  hardware::kMaxWatchdogCycles));
-  co.watchdog_cycles = o.watchdog > 0 ? o.watchdog : (o.virtual_bus ? std::max(20, hw.safety.watchdog_cycles) : 0);
-  co.source = o.virtual_bus ? "twin" : "robot";
-  co.notes = o.virtual_bus ? "dynid control --virtual: virtual DYNAMIXEL bus driving the " + twin::ClosedLoopTwin(full, *tc).notes()
-                           : "dynid control on " + o.port;
+  co.watchdog_cycles = options.watchdog > 0 ? options.watchdog : (options.virtual_bus ? std::max(20, hw.safety.watchdog_cycles) : 0);
+  co.source = options.virtual_bus ? "twin" : "robot";
+  co.notes = options.virtual_bus ? "dynid control --virtual: virtual DYNAMIXEL bus driving the " + twin::ClosedLoopTwin(full, *tc).notes()
+                           : "dynid control on " + options.port;
   co.notes += fmt::format("; at stop: {}{}", hardware::to_string(hw.safety.at_stop),
                           hw.safety.at_stop == hardware::StopAction::hold ? fmt::format(" {} s then torque off", hw.safety.hold_time) : "");
   if (!stop_override.empty()) co.notes += " (" + stop_override + ")";
-  if (!o.params.empty()) {
-    const robot::ModelHandle identified = robot_model(common, "");
-    std::vector<std::string> names;
-    for (const auto& p : identified.parameters()) names.emplace_back(p.name);
-    const Eigen::VectorXd phi = io::read_parameters_yaml(o.params, names);
-    // Parameters whose final audit failed may not be positive definite everywhere: their
-    // inverse dynamics is no feed-forward for a real arm unless the user says so, and the log
-    // records it. The flag counts only in a file as identify wrote it (its digest): an edited
-    // value or flag makes it a file of unknown origin. Whatever the file says, the loop checks
-    // the model on every reference before torque on (hardware::ControlOptions::inertia).
-    const io::ParametersIntegrity integrity = io::parameters_integrity(o.params, names);
-    const bool accepted = io::parameters_accepted(o.params);
-    if (!accepted || !integrity.intact) {
-      const std::string why = !integrity.intact ? "the file is not as identify wrote it: " + integrity.why
-                                                : "the identification was not accepted (its final all-pose audit failed, or "
-                                                  "the file has no 'accepted: true')";
-      if (!o.unaccepted_params)
-        throw UsageError(fmt::format("{}: {}; --unaccepted-params drives with it anyway (the model is still checked before "
-                                     "torque on)",
-                                     o.params, why));
-      co.notes += !integrity.intact ? "; PARAMETERS EDITED OR NOT FROM IDENTIFY (--unaccepted-params)"
-                                    : "; PARAMETERS NOT ACCEPTED (--unaccepted-params)";
-    }
-    co.feedforward = hardware::model_feedforward(identified, phi);
-    co.inertia = hardware::model_inertia(identified, phi);
-    co.notes += "; model feedforward from " + o.params;
-  }
+  if (!options.params.empty()) add_model_feedforward(common, options, co);
 
   std::unique_ptr<dynamixel::VirtualBus> virt;
-  std::string device = o.port;
-  if (o.virtual_bus) {
-    Eigen::VectorXd q(full.nq()), qd(full.nq()), qdd(full.nq());
-    traj.evaluate(0, q, qd, qdd);
-    // With --rt-priority the emulated servos' thread gets SCHED_FIFO one below the loop (a
-    // thread inherits its creator's scheduling).
-    int policy = 0;
-    sched_param saved{};
-    bool raised = false;
-    if (o.priority > 1) {
-      pthread_getschedparam(pthread_self(), &policy, &saved);
-      sched_param p{};
-      p.sched_priority = o.priority - 1;
-      raised = pthread_setschedparam(pthread_self(), SCHED_FIFO, &p) == 0;
-    }
-    virt = std::make_unique<dynamixel::VirtualBus>(
-        twin_bus::virtual_servos(hw),
-        std::make_unique<twin_bus::TwinServoBackend>(full, *tc, hw, q));
-    if (raised) pthread_setschedparam(pthread_self(), policy, &saved);
+  std::string device = options.port;
+  if (options.virtual_bus) {
+    virt = start_virtual_bus(options, full, *tc, hw, traj);
     device = virt->device();
   }
   dynamixel::SerialPort port(device, hw.baud);
   dynamixel::Bus bus(port);
   const hardware::ControlResult r = hardware::run_control(bus, hw, joints, gains, traj, out, co);
-  fmt::print("{}: {} rows, {:.3f} s of {}; max |q_ref - q| per joint (deg):", out, r.rows, r.trajectory_time, o.trajectory);
+  fmt::print("{}: {} rows, {:.3f} s of {}; max |q_ref - q| per joint (deg):", out, r.rows, r.trajectory_time, options.trajectory);
   for (int j = 0; j < r.max_error.size(); ++j) fmt::print(" {:.3f}", r.max_error(j) * 180 / 3.14159265358979323846);
   fmt::print("\nat stop: {}\n{}\n", r.at_stop, r.timing.summary());
   if (r.reason != hardware::StopReason::completed)
@@ -202,7 +229,6 @@ void run_control_command(const Common& common, const ControlCliOptions& o) {
                                          r.torque_off_confirmed ? "confirmed" : "NOT confirmed for every servo"));
   fmt::print("completed; torque off {}\n", r.torque_off_confirmed ? "confirmed" : "NOT confirmed for every servo");
 }
-
 
 void add_control_commands(CLI::App& app, Common& common) {
   auto o = std::make_shared<ControlCliOptions>();

@@ -27,6 +27,6 @@ struct ControlCliOptions {
   double hold_time = 0;  // s; 0: hardware.yaml's safety.hold_time
 };
 
-void run_control_command(const Common& common, const ControlCliOptions& o);
+void run_control_command(const Common& common, const ControlCliOptions& options);
 
 }  // namespace symoro::dynid

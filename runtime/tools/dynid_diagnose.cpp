@@ -16,34 +16,34 @@ namespace symoro::dynid {
 
 namespace {
 
-diagnose::DatasetDiagnosisOptions library_options(const Common& common, const DiagnoseOptions& o) {
+diagnose::DatasetDiagnosisOptions library_options(const Common& common, const DiagnoseOptions& options) {
   diagnose::DatasetDiagnosisOptions d;
-  d.data = o.data;
-  d.out = o.out;
+  d.data = options.data;
+  d.out = options.out;
   d.robot_dir = common.robot_dir();
-  d.train = o.train;
-  d.heldout = o.heldout;
-  d.trial = o.trial;
-  d.interval = o.interval_ms / 1000;
-  d.cutoff = o.cutoff;
-  d.only = o.only;
-  d.alpha = o.alpha;
-  d.min_heldout_gain = o.min_gain;
-  d.min_effect_torque = o.min_torque;
-  d.backlash = !o.no_backlash;
-  d.params = o.params;
-  d.variant = o.variant;
+  d.train = options.train;
+  d.heldout = options.heldout;
+  d.trial = options.trial;
+  d.interval = options.interval_ms / 1000;
+  d.cutoff = options.cutoff;
+  d.only = options.only;
+  d.alpha = options.alpha;
+  d.min_heldout_gain = options.min_gain;
+  d.min_effect_torque = options.min_torque;
+  d.backlash = !options.no_backlash;
+  d.params = options.params;
+  d.variant = options.variant;
   return d;
 }
 
 }  // namespace
 
-void run_diagnose(const Common& common, const DiagnoseOptions& o, const diagnose::DiagnosisModel& model) {
-  diagnose::DatasetDiagnosisOptions d = library_options(common, o);
+void run_diagnose(const Common& common, const DiagnoseOptions& options, const diagnose::DiagnosisModel& model) {
+  diagnose::DatasetDiagnosisOptions d = library_options(common, options);
   d.say = [](const std::string& line) { fmt::print("{}\n", line); };
   try {
     const diagnose::DatasetDiagnosis r = diagnose::diagnose_dataset(model, d);
-    if (o.apply.empty()) return;
+    if (options.apply.empty()) return;
     const auto yaml = common.robot_dir() / "robot.yaml";
     diagnose::add_variant_to_robot_yaml(yaml, r.variant_name, r.variant_yaml);
     // A robot compiled into dynid needs its code regenerated; any other is compiled again from

@@ -23,6 +23,6 @@ struct DiagnoseOptions {
 };
 
 // The command on one model (dynid_diagnose.cpp).
-void run_diagnose(const Common& common, const DiagnoseOptions& o, const diagnose::DiagnosisModel& model);
+void run_diagnose(const Common& common, const DiagnoseOptions& options, const diagnose::DiagnosisModel& model);
 
 }  // namespace symoro::dynid

@@ -73,14 +73,14 @@ std::vector<double> numbers_of(const std::string& text, char sep, const std::str
   return out;
 }
 
-std::vector<excitation::HalfSpace> half_spaces(const ExciteOptions& o, const identify::ModelDescription& d) {
+std::vector<excitation::HalfSpace> half_spaces(const ExciteOptions& options, const identify::ModelDescription& d) {
   const int frames = static_cast<int>(d.frames.size());
   std::vector<excitation::HalfSpace> out;
-  if (o.table >= 0) {  // every frame origin past the first two above the table, "down" along gravity
+  if (options.table >= 0) {  // every frame origin past the first two above the table, "down" along gravity
     if (!(d.gravity.norm() > 0)) throw UsageError("--table: the model has no gravity to tell down from up; use --half-space");
-    for (int f = 3; f <= frames; ++f) out.push_back({fmt::format("table@{}", f), f, d.gravity.normalized(), o.table});
+    for (int f = 3; f <= frames; ++f) out.push_back({fmt::format("table@{}", f), f, d.gravity.normalized(), options.table});
   }
-  for (const auto& spec : o.half_spaces) {
+  for (const auto& spec : options.half_spaces) {
     const auto colon = spec.find(':'), last = spec.rfind(':');
     if (colon == std::string::npos || last == colon) throw UsageError("--half-space takes frame:nx,ny,nz:offset, not " + spec);
     const auto frame = numbers_of(spec.substr(0, colon), ',', "--half-space frame");
@@ -120,7 +120,7 @@ double auto_period(const Eigen::VectorXd& lower, const Eigen::VectorXd& upper, c
 }
 
 // The design options of one series from rest at `posture`.
-excitation::ExcitationDesignOptions design_options(const ExciteOptions& o, const PeriodRung& rung, const YAML::Node& design,
+excitation::ExcitationDesignOptions design_options(const ExciteOptions& options, const PeriodRung& rung, const YAML::Node& design,
                                                  const std::string& posture,
                                                  const Eigen::VectorXd& lower, const Eigen::VectorXd& upper,
                                                  const Eigen::VectorXd& velocity, const Eigen::VectorXd& acceleration,
@@ -138,10 +138,10 @@ excitation::ExcitationDesignOptions design_options(const ExciteOptions& o, const
   if (nominal.size() > 0) {
     eo.nominal = nominal;
     eo.limits.torque.resize(n);
-    for (int j = 0; j < n; ++j) eo.limits.torque(j) = o.torque_fraction * d.joints[static_cast<std::size_t>(j)].effort;
+    for (int j = 0; j < n; ++j) eo.limits.torque(j) = options.torque_fraction * d.joints[static_cast<std::size_t>(j)].effort;
   }
-  eo.workspace = half_spaces(o, d);
-  eo.starts = o.starts;
+  eo.workspace = half_spaces(options, d);
+  eo.starts = options.starts;
   return eo;
 }
 
@@ -372,25 +372,25 @@ std::string optimized_series(const Common& common, SeriesDesigner& sd, const std
   return out;
 }
 
-void run(const Common& common, const ExciteOptions& o) {
-  const auto model = identification_model(common, o.model);
+void run(const Common& common, const ExciteOptions& options) {
+  const auto model = identification_model(common, options.model);
   const identify::ModelDescription& d = model->description();
   const int n = d.nq;
-  const fs::path design_file = fs::path(o.out) / "trajectories.yaml";
+  const fs::path design_file = fs::path(options.out) / "trajectories.yaml";
   // Like import, control and export: what is there stays unless the user says so.
-  for (const fs::path& f : {design_file, fs::path(o.out) / "quality.txt"})
-    if (fs::exists(f) && !o.force)
+  for (const fs::path& f : {design_file, fs::path(options.out) / "quality.txt"})
+    if (fs::exists(f) && !options.force)
       throw UsageError(fmt::format("{} exists: dynid excite does not replace it; choose another -o, or --force", f.string()));
-  fs::create_directories(o.out);
+  fs::create_directories(options.out);
 
   // 1. The structured families.
   std::string text;
   trajectory::StructuredDesignOptions so;
   so.robot = common.robot;
   so.joints = d.joints;
-  so.seed = o.seed;
-  if (!o.from_design.empty()) {
-    text = io::read_text_file(o.from_design);
+  so.seed = options.seed;
+  if (!options.from_design.empty()) {
+    text = io::read_text_file(options.from_design);
   } else {
     try {
       text = trajectory::structured_design_yaml(so);
@@ -398,17 +398,17 @@ void run(const Common& common, const ExciteOptions& o) {
       throw UsageError(e.what());
     }
   }
-  const YAML::Node design = io::load_yaml_text(text, o.from_design.empty() ? std::string("the structured design") : o.from_design);
+  const YAML::Node design = io::load_yaml_text(text, options.from_design.empty() ? std::string("the structured design") : options.from_design);
   // Another robot's design was reported at the temporary file it became (its joints differ).
-  if (!o.from_design.empty()) {
+  if (!options.from_design.empty()) {
     const YAML::Node robot = design.IsMap() ? design["robot"] : YAML::Node();
     if (!robot || !robot.IsScalar())
       throw UsageError(fmt::format("{}: no `robot:`: --from-design takes a trajectory design of {} (e.g. its trajectories.yaml)",
-                                   o.from_design, common.robot));
+                                   options.from_design, common.robot));
     if (robot.as<std::string>() != common.robot)
       throw UsageError(fmt::format("{}:{}: the design is of robot '{}', not {}: --from-design takes a design of the robot "
                                    "being excited",
-                                   o.from_design, robot.Mark().line + 1, robot.as<std::string>(), common.robot));
+                                   options.from_design, robot.Mark().line + 1, robot.as<std::string>(), common.robot));
   }
   Eigen::VectorXd velocity, acceleration;
   fastest_level(design, n, velocity, acceleration);
@@ -422,9 +422,9 @@ void run(const Common& common, const ExciteOptions& o) {
   std::string nominal_from;
   std::vector<std::string> names;
   for (const auto& p : d.parameters) names.push_back(p.name);
-  if (!o.params.empty()) {
-    nominal = io::read_parameters_yaml(o.params, names);
-    nominal_from = o.params;
+  if (!options.params.empty()) {
+    nominal = io::read_parameters_yaml(options.params, names);
+    nominal_from = options.params;
   } else if (std::vector<double> s; nominal_standard_parameters(common, d.standard, s)) {
     nominal = model->base_from_standard(Eigen::Map<const Eigen::VectorXd>(s.data(), static_cast<Eigen::Index>(s.size())));
     nominal_from = "robot.yaml nominal";
@@ -435,16 +435,16 @@ void run(const Common& common, const ExciteOptions& o) {
 
   // 3. The optimized series, one per posture in turn, each from rest at its posture.
   TrajectoryOptions to;
-  to.interval_ms = o.interval_ms;
-  to.compare = o.compare;
-  SeriesDesigner designer{o, *model, design, text, to, lower, upper, velocity, acceleration, nominal};
+  to.interval_ms = options.interval_ms;
+  to.compare = options.compare;
+  SeriesDesigner designer{options, *model, design, text, to, lower, upper, velocity, acceleration, nominal};
   for (const auto& p : design["postures"]) designer.postures.push_back(p.first.as<std::string>());
   std::string failure;
   const std::string optimized_text = optimized_series(common, designer, nominal_from, failure);
-  if (o.optimized > 0 && text.find("\ntrajectories:") == std::string::npos) throw UsageError("the design has no trajectories list");
+  if (options.optimized > 0 && text.find("\ntrajectories:") == std::string::npos) throw UsageError("the design has no trajectories list");
   const std::string full = text + (text.empty() || text.back() == '\n' ? "" : "\n") + optimized_text;
   // Read back before it is kept: the file must build, every trajectory inside its limits.
-  const fs::path tmp = fs::path(o.out) / "trajectories.yaml.new";
+  const fs::path tmp = fs::path(options.out) / "trajectories.yaml.new";
   io::write_file_atomically(tmp, full);
   std::vector<trajectory::Trajectory> all;
   try {
@@ -456,12 +456,12 @@ void run(const Common& common, const ExciteOptions& o) {
   }
   fs::rename(tmp, design_file);
   fmt::print("{}: {} trajectories\n", design_file.string(), all.size());
-  warn_crossings(all, half_spaces(o, d), d);
+  warn_crossings(all, half_spaces(options, d), d);
 
   // 4. The excitation quality of each, side by side.
-  const std::string table = trajectory_quality_table(common, all, to, o.model);
+  const std::string table = trajectory_quality_table(common, all, to, options.model);
   fmt::print("{}", table);
-  io::write_file_atomically(fs::path(o.out) / "quality.txt", table);
+  io::write_file_atomically(fs::path(options.out) / "quality.txt", table);
   if (!failure.empty()) throw UsageError(failure + fmt::format(" ({} keeps the series designed before it)", design_file.string()));
 }
 

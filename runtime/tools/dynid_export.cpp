@@ -104,121 +104,132 @@ std::string torque_cost(const FittingRun& f, const Eigen::VectorXd& phi, const E
                      rms(f.reg.y - f.reg.W * phi_consistent));
 }
 
+// The study's parameters (its report/parameters.yaml), checked as control checks them: of this
+// robot, as identify wrote them (its digest), accepted; --not-accepted exports them anyway.
+Eigen::VectorXd read_study_parameters(const Common& common, const ExportOptions& options, const identify::ModelDescription& d,
+                                      const std::filesystem::path& params, bool& accepted) {
+  {
+    const YAML::Node root = io::load_yaml_file(params);
+    const std::string robot = root["robot"] ? root["robot"].as<std::string>() : std::string();
+    if (!robot.empty() && robot != common.robot)
+      throw UsageError(fmt::format("--robot {}, but {} is a study of '{}'", common.robot, params.string(), robot));
+  }
+  std::vector<std::string> names;
+  for (const auto& p : d.parameters) names.emplace_back(p.name);
+  const Eigen::VectorXd phi = io::read_parameters_yaml(params.string(), names);
+  // As control refuses it: a file whose digest no longer matches is not as identify wrote it
+  // (a value or the flag edited), and the URDF would carry the edit as identified.
+  const io::ParametersIntegrity integrity = io::parameters_integrity(params.string(), names);
+  if (!integrity.intact && !options.not_accepted)
+    throw UsageError(fmt::format("{}: the file is not as identify wrote it: {}; --not-accepted exports it anyway", params.string(),
+                                 integrity.why));
+  if (!integrity.intact)
+    fmt::print(stderr, "export: {}: the file is not as identify wrote it: {} (exported anyway: --not-accepted)\n", params.string(),
+               integrity.why);
+  accepted = io::parameters_accepted(params.string());
+  if (!accepted && !options.not_accepted)
+    throw UsageError(params.string() + ": the study's final audit did not accept these parameters (accepted: false); "
+                                       "--not-accepted exports them anyway");
+  return phi;
+}
+
+// The prior the consistent set is nearest to along what the data barely sees: --prior (a file,
+// or zero), else the twin's CAD truth, else robot.yaml's nominal parameters (a URDF's);
+// `what` says which.
+Eigen::VectorXd export_prior(const Common& common, const ExportOptions& options, const identify::ModelDescription& d,
+                             std::string& what) {
+  std::vector<std::string> standard_names;
+  for (const auto& p : d.standard) standard_names.emplace_back(p.name);
+  const int ns = static_cast<int>(d.standard.size());
+  const auto twin_path = common.robot_dir() / "twin.yaml";
+  if (options.prior == "zero") {
+    what = "zero (the consistent set nearest 0)";
+    return Eigen::VectorXd::Zero(ns);
+  }
+  if (!options.prior.empty()) {
+    what = options.prior;
+    return io::read_parameters_yaml(options.prior, standard_names);
+  }
+  if (std::filesystem::exists(twin_path)) {
+    const twin::TwinConfig tc = twin::read_twin_config(twin_path, d.nq);
+    what = twin_path.string() + " (CAD truth)";
+    return twin::make_truth(full_model(common), tc).standard;
+  }
+  if (std::vector<double> nominal; nominal_standard_parameters(common, d.standard, nominal)) {
+    // symoroc model's robot.yaml from a URDF: the URDF's own inertials.
+    what = (common.robot_dir() / "robot.yaml").string() + " (nominal: the URDF's inertials)";
+    return Eigen::Map<const Eigen::VectorXd>(nominal.data(), ns);
+  }
+  throw UsageError(fmt::format("robot '{}' has no twin.yaml to take a prior from: give --prior <standard-parameter "
+                               "YAML> or --prior zero (see dynid export --help)",
+                               common.robot));
+}
+
+// What the export says: the consistency, the files, and what a URDF consumer loses.
+void print_export(const model_export::ModelExport& e, const model_export::ModelExportFiles& files,
+                  const std::string& prior_what) {
+  const identify::ConsistencyResult& r = e.consistency;
+  if (e.nearest)
+    fmt::print("WARNING: {}; exported the nearest base vector with a consistent set ({:.4g} away); {}\n", r.message,
+               r.base_distance, e.cost);
+  fmt::print("{}: {}; max |B s - phi| = {:.3g}, lambda_min = {:.4g}, prior {}\n",
+             e.nearest ? "standard parameters of the nearest consistent base vector" : "consistent standard parameters",
+             r.message, e.residual, r.lambda_min, prior_what);
+  fmt::print("urdf: {}\nstandard parameters: {}, {}\n", files.urdf.string(), files.yaml.string(), files.csv.string());
+  // The rotor inertia (a simulator's joint armature) has no URDF field.
+  std::string rotor;
+  for (std::size_t k = 0; k < e.description.names.size(); ++k)
+    if (std::string(e.description.names[k].family) == "IA" && e.description.s(static_cast<Eigen::Index>(k)) != 0)
+      rotor += fmt::format("{}{} {:.6g}", rotor.empty() ? "" : ", ", e.description.names[k].name,
+                           e.description.s(static_cast<Eigen::Index>(k)));
+  if (!rotor.empty())
+    fmt::print("rotor inertia has no URDF field: the URDF holds it only as comments, which URDF readers ignore; a "
+               "simulator takes it from {} (MuJoCo: each joint's armature): {}\n",
+               files.yaml.string(), rotor);
+}
+
 }  // namespace export_detail
 
-void run_export(const Common& common, const ExportOptions& o, const std::string& label) {
+void run_export(const Common& common, const ExportOptions& options, const std::string& label) {
   // parent: the robot's full model (the fitting run's regression).
   const std::shared_ptr<const identify::IdentificationModel> model = identification_model(common, label);
   const std::shared_ptr<const identify::IdentificationModel> parent = identification_model(common, "full");
   const identify::ModelDescription& d = model->description();
-  if (!model->supports_physical_consistency()) {
+  if (!model->supports_physical_consistency())
     throw UsageError(fmt::format("model '{}' has model-gap effect parameters, which have no URDF counterpart and no "
                                  "standard-parameter form: export a study of a model without effects",
                                  d.variant));
-  } else {
-    const std::filesystem::path params = std::filesystem::path(o.study) / "report" / "parameters.yaml";
-    {
-      const YAML::Node root = io::load_yaml_file(params);
-      const std::string robot = root["robot"] ? root["robot"].as<std::string>() : std::string();
-      if (!robot.empty() && robot != common.robot)
-        throw UsageError(fmt::format("--robot {}, but {} is a study of '{}'", common.robot, params.string(), robot));
-    }
-    std::vector<std::string> names;
-    for (const auto& p : d.parameters) names.emplace_back(p.name);
-    const Eigen::VectorXd phi = io::read_parameters_yaml(params.string(), names);
-    // As control refuses it: a file whose digest no longer matches is not as identify wrote it
-    // (a value or the flag edited), and the URDF would carry the edit as identified.
-    const io::ParametersIntegrity integrity = io::parameters_integrity(params.string(), names);
-    if (!integrity.intact && !o.not_accepted)
-      throw UsageError(fmt::format("{}: the file is not as identify wrote it: {}; --not-accepted exports it anyway", params.string(),
-                                   integrity.why));
-    if (!integrity.intact)
-      fmt::print(stderr, "export: {}: the file is not as identify wrote it: {} (exported anyway: --not-accepted)\n", params.string(),
-                 integrity.why);
-    const bool accepted = io::parameters_accepted(params.string());
-    if (!accepted && !o.not_accepted)
-      throw UsageError(params.string() + ": the study's final audit did not accept these parameters (accepted: false); "
-                                         "--not-accepted exports them anyway");
-
-    // The prior.
-    std::vector<std::string> standard_names;
-    for (const auto& p : d.standard) standard_names.emplace_back(p.name);
-    const int ns = static_cast<int>(d.standard.size());
-    Eigen::VectorXd prior;
-    std::string prior_what;
-    const auto twin_path = common.robot_dir() / "twin.yaml";
-    if (o.prior == "zero") {
-      prior = Eigen::VectorXd::Zero(ns);
-      prior_what = "zero (the consistent set nearest 0)";
-    } else if (!o.prior.empty()) {
-      prior = io::read_parameters_yaml(o.prior, standard_names);
-      prior_what = o.prior;
-    } else if (std::filesystem::exists(twin_path)) {
-      const twin::TwinConfig tc = twin::read_twin_config(twin_path, d.nq);
-      prior = twin::make_truth(full_model(common), tc).standard;
-      prior_what = twin_path.string() + " (CAD truth)";
-    } else if (std::vector<double> nominal;
-               nominal_standard_parameters(common, d.standard, nominal)) {
-      // symoroc model's robot.yaml from a URDF: the URDF's own inertials.
-      prior = Eigen::Map<const Eigen::VectorXd>(nominal.data(), ns);
-      prior_what = (common.robot_dir() / "robot.yaml").string() + " (nominal: the URDF's inertials)";
-    } else {
-      throw UsageError(fmt::format("robot '{}' has no twin.yaml to take a prior from: give --prior <standard-parameter "
-                                   "YAML> or --prior zero (see dynid export --help)",
-                                   common.robot));
-    }
-
-    model_export::ModelExportOptions eo;
-    eo.prior = prior;
-    eo.prior_what = prior_what;
-    eo.study = o.study;
-    eo.accepted = accepted;
-    eo.margin = o.margin;
-    eo.nearest = o.nearest;
-    std::optional<export_detail::FittingRun> fitting;
-    if (!o.data.empty()) {
-      fitting = export_detail::fitting_run(*parent, params, o.data, o.trial);
-      eo.base_metric_root = export_detail::torque_metric_root(fitting->reg);
-    }
-    eo.cost = [&](const Eigen::VectorXd& target, const Eigen::VectorXd& phi_consistent) {
-      return fitting ? export_detail::torque_cost(*fitting, target, phi_consistent)
-                     : std::string("--data <the study's dataset> measures the torque it costs on the fitting data (and takes "
-                                   "the nearest vector in that metric)");
-    };
-    const model_export::ModelExport e = model_export::export_model(*model, phi, eo);
-    const identify::ConsistencyResult& r = e.consistency;
-    const bool nearest = e.nearest;
-    const std::string& cost = e.cost;
-    const double residual = e.residual;
-    std::string urdf_text;
-    if (o.into.empty()) {
-      urdf_text = model_export::urdf_text(e.description);
-    } else {
-      std::vector<std::string> notes;
-      urdf_text = urdf_into(e.description, (common.robot_dir() / "robot.yaml").string(), o.into, notes);
-      for (const auto& note : notes) fmt::print("{}\n", note);
-    }
-    const model_export::ModelExportFiles files = model_export::write_model_export(e, o.urdf, urdf_text);
-    if (nearest)
-      fmt::print("WARNING: {}; exported the nearest base vector with a consistent set ({:.4g} away); {}\n", r.message,
-                 r.base_distance, cost);
-    fmt::print("{}: {}; max |B s - phi| = {:.3g}, lambda_min = {:.4g}, prior {}\n",
-               nearest ? "standard parameters of the nearest consistent base vector" : "consistent standard parameters",
-               r.message, residual, r.lambda_min, prior_what);
-    fmt::print("urdf: {}\nstandard parameters: {}, {}\n", files.urdf.string(), files.yaml.string(), files.csv.string());
-    // What a URDF consumer loses: the rotor inertia (a simulator's joint armature).
-    std::string rotor;
-    for (std::size_t k = 0; k < e.description.names.size(); ++k)
-      if (std::string(e.description.names[k].family) == "IA" && e.description.s(static_cast<Eigen::Index>(k)) != 0)
-        rotor += fmt::format("{}{} {:.6g}", rotor.empty() ? "" : ", ", e.description.names[k].name,
-                             e.description.s(static_cast<Eigen::Index>(k)));
-    if (!rotor.empty())
-      fmt::print("rotor inertia has no URDF field: the URDF holds it only as comments, which URDF readers ignore; a "
-                 "simulator takes it from {} (MuJoCo: each joint's armature): {}\n",
-                 files.yaml.string(), rotor);
+  const std::filesystem::path params = std::filesystem::path(options.study) / "report" / "parameters.yaml";
+  bool accepted = false;
+  const Eigen::VectorXd phi = export_detail::read_study_parameters(common, options, d, params, accepted);
+  model_export::ModelExportOptions eo;
+  eo.prior = export_detail::export_prior(common, options, d, eo.prior_what);
+  eo.study = options.study;
+  eo.accepted = accepted;
+  eo.margin = options.margin;
+  eo.nearest = options.nearest;
+  std::optional<export_detail::FittingRun> fitting;
+  if (!options.data.empty()) {
+    fitting = export_detail::fitting_run(*parent, params, options.data, options.trial);
+    eo.base_metric_root = export_detail::torque_metric_root(fitting->reg);
   }
+  eo.cost = [&](const Eigen::VectorXd& target, const Eigen::VectorXd& phi_consistent) {
+    return fitting ? export_detail::torque_cost(*fitting, target, phi_consistent)
+                   : std::string("--data <the study's dataset> measures the torque it costs on the fitting data (and takes "
+                                 "the nearest vector in that metric)");
+  };
+  const model_export::ModelExport e = model_export::export_model(*model, phi, eo);
+  std::string urdf_text;
+  if (options.into.empty()) {
+    urdf_text = model_export::urdf_text(e.description);
+  } else {
+    std::vector<std::string> notes;
+    urdf_text = urdf_into(e.description, (common.robot_dir() / "robot.yaml").string(), options.into, notes);
+    for (const auto& note : notes) fmt::print("{}\n", note);
+  }
+  const model_export::ModelExportFiles files = model_export::write_model_export(e, options.urdf, urdf_text);
+  export_detail::print_export(e, files, eo.prior_what);
 }
-
 
 void add_export_commands(CLI::App& app, Common& common) {
   auto o = std::make_shared<ExportOptions>();

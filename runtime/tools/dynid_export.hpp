@@ -22,6 +22,6 @@ struct ExportOptions {
 // The study's accepted base vector of model `label` -> the physically consistent standard
 // parameters nearest the prior (--prior; else the twin's CAD truth when the robot has a twin.yaml,
 // else robot.yaml's nominal) that map onto it exactly -> URDF + standard-parameter YAML/CSV.
-void run_export(const Common& common, const ExportOptions& o, const std::string& label);
+void run_export(const Common& common, const ExportOptions& options, const std::string& label);
 
 }  // namespace symoro::dynid

@@ -33,12 +33,12 @@ namespace symoro::dynid {
 
 namespace identify_detail {
 
-study::StudyResult study(const Common& common, const IdentifyOptions& o, const robot::ModelHandle& handle,
+study::StudyResult study(const Common& common, const IdentifyOptions& options, const robot::ModelHandle& handle,
                             const std::shared_ptr<const identify::IdentificationModel>& model, bool quiet) {
   const identify::ModelDescription& d = model->description();
   study::StudyOptions so;
   try {
-    so = study::study_options(o, d, common.robot_dir());
+    so = study::study_options(options, d, common.robot_dir());
   } catch (const study::StudyRequestError& e) {
     throw UsageError(e.what());
   }
@@ -72,11 +72,11 @@ study::StudyResult study(const Common& common, const IdentifyOptions& o, const r
 
 }  // namespace identify_detail
 
-void run_identify(const Common& common, const IdentifyOptions& o) {
-  if (o.out.empty()) throw UsageError("--out is required");
-  const robot::ModelHandle handle = robot_model(common, o.model);
+void run_identify(const Common& common, const IdentifyOptions& options) {
+  if (options.out.empty()) throw UsageError("--out is required");
+  const robot::ModelHandle handle = robot_model(common, options.model);
   const study::StudyResult r =
-      identify_detail::study(common, o, handle, identify::identification_model(handle, full_model(common)), false);
+      identify_detail::study(common, options, handle, identify::identification_model(handle, full_model(common)), false);
   if (!parallel::place().coordinator()) return;  // rank 0 reports
   rusage usage{};
   getrusage(RUSAGE_SELF, &usage);
@@ -109,11 +109,11 @@ void run_identify(const Common& common, const IdentifyOptions& o) {
     }
   }
   // The held-out series on disk: dynid compare reads them to set two model variants side by side.
-  if (!study::write_validation(r, o.out).empty())
-    fmt::print("validation: {}\n", (std::filesystem::path(o.out) / "validation.yaml").string());
-  if (!o.no_report) {
-    const auto files = study::write_report(r, std::filesystem::path(o.out) / "report");
-    fmt::print("report: {} ({} files)\n", (std::filesystem::path(o.out) / "report" / "report.md").string(), files.size());
+  if (!study::write_validation(r, options.out).empty())
+    fmt::print("validation: {}\n", (std::filesystem::path(options.out) / "validation.yaml").string());
+  if (!options.no_report) {
+    const auto files = study::write_report(r, std::filesystem::path(options.out) / "report");
+    fmt::print("report: {} ({} files)\n", (std::filesystem::path(options.out) / "report" / "report.md").string(), files.size());
   }
   // A study without a model fails, after its records and report are written: `identify &&
   // export` must not carry on as if there were parameters.

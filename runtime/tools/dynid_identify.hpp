@@ -17,6 +17,6 @@ struct IdentifyOptions : study::StudyRequest {
   bool no_report = false;
 };
 
-void run_identify(const Common& common, const IdentifyOptions& o);
+void run_identify(const Common& common, const IdentifyOptions& options);
 
 }  // namespace symoro::dynid

@@ -27,10 +27,10 @@ constexpr const char* selector_help =
 namespace import_detail {
 
 // The command line's settings over the mapping file's (or the defaults).
-io::ImportMapping mapping_of(const ImportOptions& o) {
-  io::ImportMapping m = o.mapping.empty() ? io::ImportMapping{} : io::read_import_mapping(o.mapping);
-  io::apply_settings(m, {o.time, o.q, o.qd, o.tau, o.q_ref, o.qd_ref, o.qdd_ref, o.time_unit, o.angle, o.header,
-                         o.delimiter, o.torque_scale});
+io::ImportMapping mapping_of(const ImportOptions& options) {
+  io::ImportMapping m = options.mapping.empty() ? io::ImportMapping{} : io::read_import_mapping(options.mapping);
+  io::apply_settings(m, {options.time, options.q, options.qd, options.tau, options.q_ref, options.qd_ref, options.qdd_ref, options.time_unit, options.angle, options.header,
+                         options.delimiter, options.torque_scale});
   if (m.time.empty() || m.q.empty() || m.tau.empty())
     throw UsageError("say which columns hold time, q and tau: --time, --q, --tau, or --mapping map.yaml");
   return m;
@@ -38,21 +38,21 @@ io::ImportMapping mapping_of(const ImportOptions& o) {
 
 }  // namespace import_detail
 
-void run_import(const Common& common, const ImportOptions& o, const std::vector<JointInfo>& joints) {
+void run_import(const Common& common, const ImportOptions& options, const std::vector<JointInfo>& joints) {
   io::DatasetImport di;
   di.target = io::import_target(common.robot, joints);
-  di.mapping = import_detail::mapping_of(o);
-  di.split = o.split;
-  di.allow_implausible = o.allow_implausible;
-  if (!o.names.empty() && o.names.size() != o.inputs.size())
-    throw UsageError(fmt::format("--name: {} names for {} input files", o.names.size(), o.inputs.size()));
-  for (const std::string& h : o.heldout)
-    if (std::find(o.inputs.begin(), o.inputs.end(), h) == o.inputs.end())
+  di.mapping = import_detail::mapping_of(options);
+  di.split = options.split;
+  di.allow_implausible = options.allow_implausible;
+  if (!options.names.empty() && options.names.size() != options.inputs.size())
+    throw UsageError(fmt::format("--name: {} names for {} input files", options.names.size(), options.inputs.size()));
+  for (const std::string& h : options.heldout)
+    if (std::find(options.inputs.begin(), options.inputs.end(), h) == options.inputs.end())
       throw UsageError(fmt::format("--heldout {}: not one of the input files", h));
-  for (std::size_t i = 0; i < o.inputs.size(); ++i)
-    di.inputs.push_back({o.inputs[i], o.names.empty() ? "" : o.names[i],
-                         std::find(o.heldout.begin(), o.heldout.end(), o.inputs[i]) != o.heldout.end()});
-  const io::DatasetImportResult r = io::import_dataset(o.out, di);
+  for (std::size_t i = 0; i < options.inputs.size(); ++i)
+    di.inputs.push_back({options.inputs[i], options.names.empty() ? "" : options.names[i],
+                         std::find(options.heldout.begin(), options.heldout.end(), options.inputs[i]) != options.heldout.end()});
+  const io::DatasetImportResult r = io::import_dataset(options.out, di);
   for (const io::ImportedLog& l : r.logs) {
     const io::Log& log = l.log;
     fmt::print("{}: {} rows -> {}.csv: {} samples over {:.3f} s, sample time {:g} ms (median), {} stale rows kept, "

@@ -17,6 +17,6 @@ struct ImportOptions {
   bool allow_implausible = false;
 };
 
-void run_import(const Common& common, const ImportOptions& o, const std::vector<JointInfo>& joints);
+void run_import(const Common& common, const ImportOptions& options, const std::vector<JointInfo>& joints);
 
 }  // namespace symoro::dynid

@@ -65,8 +65,8 @@ Eigen::VectorXd nominal_phi(const Common& common, const identify::Identification
 
 // The prediction of one log, its samples written to `csv`.
 study::Prediction predict_log(const io::Log& log, const identify::IdentificationModel& model, const Eigen::VectorXd& phi,
-                                 const PredictOptions& o, const fs::path& csv) {
-  study::Prediction p = study::predict(log, model, phi, {o.interval_ms / 1000, o.torque_delay_ms / 1000});
+                                 const PredictOptions& options, const fs::path& csv) {
+  study::Prediction p = study::predict(log, model, phi, {options.interval_ms / 1000, options.torque_delay_ms / 1000});
   const preprocess::Samples& s = p.samples;
   const int n = static_cast<int>(s.tau.cols());
   const auto& joints = model.description().joints;
@@ -84,56 +84,56 @@ study::Prediction predict_log(const io::Log& log, const identify::Identification
   return p;
 }
 
-void run(const Common& common, const PredictOptions& o) {
-  std::string label = o.model;
-  if (o.params != "nominal") {
-    const std::string in_file = file_model(o.params);
+void run(const Common& common, const PredictOptions& options) {
+  std::string label = options.model;
+  if (options.params != "nominal") {
+    const std::string in_file = file_model(options.params);
     if (!label.empty() && label != in_file)
-      throw UsageError(fmt::format("--model {}, but {} holds the parameters of model {}", label, o.params, in_file));
+      throw UsageError(fmt::format("--model {}, but {} holds the parameters of model {}", label, options.params, in_file));
     label = in_file;
   }
   const auto model = identification_model(common, label);
   const identify::ModelDescription& d = model->description();
   Eigen::VectorXd phi;
-  if (o.params == "nominal") {
+  if (options.params == "nominal") {
     phi = nominal_phi(common, *model);
   } else {
     std::vector<std::string> names;
     for (const auto& p : d.parameters) names.push_back(p.name);
-    const io::ParametersIntegrity integrity = io::parameters_integrity(o.params, names);
-    if (!integrity.intact) fmt::print(stderr, "warning: {}: {}\n", o.params, integrity.why);
-    phi = io::read_parameters_yaml(o.params, names);
+    const io::ParametersIntegrity integrity = io::parameters_integrity(options.params, names);
+    if (!integrity.intact) fmt::print(stderr, "warning: {}: {}\n", options.params, integrity.why);
+    phi = io::read_parameters_yaml(options.params, names);
   }
 
   // What to predict: one log, or every run of a dataset's trial.
   std::vector<std::pair<std::string, io::Log>> logs;
-  const fs::path input(o.input);
+  const fs::path input(options.input);
   if (fs::is_directory(input)) {
     const io::Dataset data = io::read_dataset(input);
     io::check_dataset_robot(data, common.robot);
     for (const auto& r : data.runs)
-      if (r.trial == o.trial) logs.emplace_back(r.trajectory, io::read_run_log(r, common.robot, d.nq));
-    if (logs.empty()) throw UsageError(fmt::format("{}: no run of trial {}", input.string(), o.trial));
+      if (r.trial == options.trial) logs.emplace_back(r.trajectory, io::read_run_log(r, common.robot, d.nq));
+    if (logs.empty()) throw UsageError(fmt::format("{}: no run of trial {}", input.string(), options.trial));
   } else {
     io::Log log = io::read_log(input);
     io::check_log_robot(log, input, d.robot, d.nq);
     logs.emplace_back(input.stem().string(), std::move(log));
   }
-  const fs::path out(o.out);
+  const fs::path out(options.out);
   const bool one = logs.size() == 1 && !fs::is_directory(input);
   std::vector<fs::path> files;
   for (const auto& [name, log] : logs) files.push_back(one ? out : out / (name + ".predicted.csv"));
   for (const auto& f : files)
-    if (fs::exists(f) && !o.force) throw UsageError(f.string() + " exists: dynid predict does not overwrite it; choose another --out, or --force");
+    if (fs::exists(f) && !options.force) throw UsageError(f.string() + " exists: dynid predict does not overwrite it; choose another --out, or --force");
   if (!one) fs::create_directories(out);
 
   fmt::print("{} model {} with {} parameters, at {:.0f} ms: RMSE of tau - tau_model (RMS of tau) per joint, N m\n", common.robot,
-             d.variant.empty() ? "full" : d.variant, o.params == "nominal" ? "the nominal" : o.params, o.interval_ms);
+             d.variant.empty() ? "full" : d.variant, options.params == "nominal" ? "the nominal" : options.params, options.interval_ms);
   Eigen::VectorXd sq = Eigen::VectorXd::Zero(d.nq);
   int total = 0;
   std::string raw_filter;
   for (std::size_t i = 0; i < logs.size(); ++i) {
-    const study::Prediction p = predict_log(logs[i].second, *model, phi, o, files[i]);
+    const study::Prediction p = predict_log(logs[i].second, *model, phi, options, files[i]);
     const int samples = static_cast<int>(p.samples.tau.rows());
     std::string line = fmt::format("  {:<10} {:>6} samples:", logs[i].first, samples);
     for (int j = 0; j < d.nq; ++j) line += fmt::format(" {:.4f} ({:.3f})", p.rmse(j), p.rms(j));

@@ -40,23 +40,23 @@ void write_samples(const std::filesystem::path& file, const preprocess::Samples&
   io::write_file_atomically(file, text);
 }
 
-void run(const Common& common, const PreprocessOptions& o) {
+void run(const Common& common, const PreprocessOptions& cli) {
   std::vector<double> intervals;
-  for (double ms : o.intervals_ms) intervals.push_back(ms / 1000);
+  for (double ms : cli.intervals_ms) intervals.push_back(ms / 1000);
   if (intervals.empty()) intervals = preprocess::paper_intervals();
-  for (const auto& path : o.logs) {
+  for (const auto& path : cli.logs) {
     const io::Log log = io::read_log(path);
     if (!common.robot.empty() && log.meta.robot != common.robot)
       throw UsageError(fmt::format("{} is a log of robot '{}', not '{}'", path, log.meta.robot, common.robot));
     fmt::print("{}: {} samples, {:.1f} s, robot {}, trajectory {}\n", path, log.samples(),
                log.time(log.samples() - 1) - log.time(0), log.meta.robot, log.meta.trajectory);
     for (double interval : intervals) {
-      const auto s = preprocess::preprocess(log, interval, o.options);
+      const auto s = preprocess::preprocess(log, interval, cli.options);
       fmt::print("  {:>3.0f} ms: {}\n", interval * 1000, s.report.summary());
-      if (!o.out.empty()) {
-        std::filesystem::create_directories(o.out);
+      if (!cli.out.empty()) {
+        std::filesystem::create_directories(cli.out);
         const auto stem = std::filesystem::path(path).stem().string();
-        write_samples(std::filesystem::path(o.out) / fmt::format("{}_{:.0f}ms.csv", stem, interval * 1000), s);
+        write_samples(std::filesystem::path(cli.out) / fmt::format("{}_{:.0f}ms.csv", stem, interval * 1000), s);
       }
     }
   }

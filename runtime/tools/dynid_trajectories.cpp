@@ -44,35 +44,35 @@ double log_det_per_sample(const RegressorFactor& f, int joints) {
   return 2 * sigma.array().log().sum() - static_cast<double>(p) * std::log(samples);
 }
 
-Eigen::MatrixXd reference_regressor(const identify::IdentificationModel& model, const std::string& file, const TrajectoryOptions& o,
+Eigen::MatrixXd reference_regressor(const identify::IdentificationModel& model, const std::string& file, const TrajectoryOptions& options,
                                     double& duration) {
   const identify::ModelDescription& d = model.description();
-  const double interval = o.interval_ms / 1000;
+  const double interval = options.interval_ms / 1000;
   const io::Log log = io::read_log(file);
   const auto joints = log.has_references() ? log.q_ref.cols() : log.joints();
   if (joints != d.nq) throw UsageError(fmt::format("--compare {}: {} joints, the model {}", file, joints, d.nq));
   duration = log.time(log.samples() - 1) - log.time(0);
   if (log.has_references()) {
-    const auto period = log.meta.sample_time > 0 ? log.meta.sample_time : o.period;
+    const auto period = log.meta.sample_time > 0 ? log.meta.sample_time : options.period;
     return model.stack_regression(excitation::reference_samples(trajectory::sampled_reference(log, period), interval)).W;
   }
   return model.stack_regression(preprocess::preprocess(log, interval, study::StudyOptions{}.preprocess)).W;
 }
 
 Eigen::MatrixXd trajectory_regressor(const identify::IdentificationModel& model, const trajectory::Trajectory& t,
-                                     const TrajectoryOptions& o) {
-  return model.stack_regression(excitation::reference_samples(trajectory::sample(t, o.period), o.interval_ms / 1000)).W;
+                                     const TrajectoryOptions& options) {
+  return model.stack_regression(excitation::reference_samples(trajectory::sample(t, options.period), options.interval_ms / 1000)).W;
 }
 
 std::string trajectory_quality_table(const Common& common, const std::vector<trajectory::Trajectory>& trajectories,
-                                     const TrajectoryOptions& o, const std::string& model_name) {
+                                     const TrajectoryOptions& options, const std::string& model_name) {
   const auto model = identification_model(common, model_name);
   std::string out;
   const identify::ModelDescription& d = model->description();
   out += fmt::format("excitation of {} model {} ({} base parameters) at {:.0f} ms: kappa of W, kappa of W and log det of W'W with "
                      "unit columns (<= 0, 0 when the columns are orthogonal), log det of W'W / N per sample (the model's SI "
                      "units, N samples: larger is more information per sample), the weakest direction's largest components\n",
-             common.robot, d.variant.empty() ? "full" : d.variant, d.np, o.interval_ms);
+             common.robot, d.variant.empty() ? "full" : d.variant, d.np, options.interval_ms);
   out += fmt::format("{:<6} {:<4} {:>8} {:>11} {:>11} {:>10} {:>10}  {}\n", "name", "fam", "duration", "kappa", "kappa_scl",
                      "logdet_scl", "logdet/N", "weakest");
   auto row = [&](const std::string& name, const std::string& family, double duration, const RegressorFactor& f) {
@@ -86,14 +86,14 @@ std::string trajectory_quality_table(const Common& common, const std::vector<tra
   std::vector<RegressorFactor> factors;
   double total = 0;
   for (const auto& t : trajectories) {
-    factors.push_back(RegressorFactor::of(trajectory_regressor(*model, t, o)));
+    factors.push_back(RegressorFactor::of(trajectory_regressor(*model, t, options)));
     row(t.name, t.family, t.duration(), factors.back());
     total += t.duration();
   }
   // The reference motions the user compares with (not in the design's whole below).
-  for (const auto& file : o.compare) {
+  for (const auto& file : options.compare) {
     double duration = 0;
-    const RegressorFactor f = RegressorFactor::of(reference_regressor(*model, file, o, duration));
+    const RegressorFactor f = RegressorFactor::of(reference_regressor(*model, file, options, duration));
     row(std::filesystem::path(file).stem().string(), "ref", duration, f);
   }
   // The design as a whole: all its trajectories stacked.
@@ -101,19 +101,19 @@ std::string trajectory_quality_table(const Common& common, const std::vector<tra
   return out;
 }
 
-void run_trajectories(const Common& common, const TrajectoryOptions& o) {
+void run_trajectories(const Common& common, const TrajectoryOptions& options) {
   const robot::ModelHandle full = full_model(common);
   const auto design = read_design(common, full.joints());
-  const std::vector<std::string> names = o.only.empty() ? design.names() : o.only;
+  const std::vector<std::string> names = options.only.empty() ? design.names() : options.only;
   std::vector<std::string> joint_names;
   for (const auto& j : full.joints()) joint_names.push_back(j.name);
-  if (o.out.empty() && o.quality) {
+  if (options.out.empty() && options.quality) {
     std::vector<trajectory::Trajectory> all;
     for (const auto& name : names) all.push_back(design.build(name));
-    fmt::print("{}", trajectory_quality_table(common, all, o));
+    fmt::print("{}", trajectory_quality_table(common, all, options));
     return;
   }
-  if (o.out.empty()) {
+  if (options.out.empty()) {
     fmt::print("{:<6} {:<4} {:>9}  {}\n", "name", "fam", "duration", "description");
     double total = 0;
     for (const auto& name : names) {
@@ -124,11 +124,11 @@ void run_trajectories(const Common& common, const TrajectoryOptions& o) {
     fmt::print("{} trajectories, {:.1f} s in all\n", names.size(), total);
     return;
   }
-  std::filesystem::create_directories(o.out);
+  std::filesystem::create_directories(options.out);
   Progress progress(static_cast<int>(names.size()), "reference");
   for (const auto& name : names) {
     const auto t = design.build(name);
-    io::write_log(std::filesystem::path(o.out) / (name + ".csv"), trajectory::reference_log(t, o.period, common.robot, joint_names));
+    io::write_log(std::filesystem::path(options.out) / (name + ".csv"), trajectory::reference_log(t, options.period, common.robot, joint_names));
     progress.done(name, fmt::format("{:.1f} s", t.duration()));
   }
 }

@@ -28,7 +28,7 @@ struct TrajectoryOptions {
 // The excitation quality of each trajectory and of all of them together, for the robot's model
 // `model` ("" robot.yaml's identified), as a table (compiled once: dynid_trajectories.cpp).
 std::string trajectory_quality_table(const Common& common, const std::vector<trajectory::Trajectory>& trajectories,
-                                     const TrajectoryOptions& o, const std::string& model = "");
+                                     const TrajectoryOptions& options, const std::string& model = "");
 
 // A stacked regressor W as the table rates it: its triangular factor (W'W = R'R,
 // excitation::triangular_factor) and its row count; factors of several motions stack into their whole.
@@ -45,13 +45,13 @@ double log_det_per_sample(const RegressorFactor& f, int joints);
 
 // The stacked regressor of a designed trajectory sampled at o's period, every o's interval.
 Eigen::MatrixXd trajectory_regressor(const identify::IdentificationModel& model, const trajectory::Trajectory& t,
-                                     const TrajectoryOptions& o);
+                                     const TrajectoryOptions& options);
 
 // The stacked regressor of a reference log (--compare) at o's interval, as the table rates it;
 // `duration` its length, s.
-Eigen::MatrixXd reference_regressor(const identify::IdentificationModel& model, const std::string& file, const TrajectoryOptions& o,
+Eigen::MatrixXd reference_regressor(const identify::IdentificationModel& model, const std::string& file, const TrajectoryOptions& options,
                                     double& duration);
 
-void run_trajectories(const Common& common, const TrajectoryOptions& o);
+void run_trajectories(const Common& common, const TrajectoryOptions& options);
 
 }  // namespace symoro::dynid

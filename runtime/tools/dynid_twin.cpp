@@ -18,15 +18,15 @@ namespace symoro::dynid {
 
 namespace {
 
-twin::TwinConfig load_config(const Common& common, const TwinOptions& o, int joints) {
+twin::TwinConfig load_config(const Common& common, const TwinOptions& options, int joints) {
   const auto path = common.robot_dir() / "twin.yaml";
   if (!std::filesystem::exists(path))
     throw UsageError(fmt::format("robot '{}' has no digital twin ({} not found)", common.robot, path.string()));
-  twin::TwinConfig c = twin::read_twin_config(path, joints, o.config);
+  twin::TwinConfig c = twin::read_twin_config(path, joints, options.config);
   try {
-    if (o.ideal) c.effects.disable_all();
-    for (const auto& e : o.effects) c.effects.set(e, true);
-    for (const auto& e : o.without) c.effects.set(e, false);
+    if (options.ideal) c.effects.disable_all();
+    for (const auto& e : options.effects) c.effects.set(e, true);
+    for (const auto& e : options.without) c.effects.set(e, false);
   } catch (const std::invalid_argument& e) {
     throw UsageError(e.what());
   }
@@ -34,23 +34,23 @@ twin::TwinConfig load_config(const Common& common, const TwinOptions& o, int joi
 }
 
 // The robot's twin: its full model's plant, twin.yaml with the command's overrides.
-twin::ClosedLoopTwin make_twin(const Common& common, const TwinOptions& o) {
+twin::ClosedLoopTwin make_twin(const Common& common, const TwinOptions& options) {
   robot::ModelHandle full = full_model(common);
-  twin::TwinConfig c = load_config(common, o, full.nq());
+  twin::TwinConfig c = load_config(common, options, full.nq());
   return twin::ClosedLoopTwin(std::move(full), std::move(c));
 }
 
-void twin_run(const Common& common, const TwinOptions& o) {
-  const twin::ClosedLoopTwin sim = make_twin(common, o);
-  const auto traj = read_design(common, sim.model().joints()).build(o.trajectory);
+void twin_run(const Common& common, const TwinOptions& options) {
+  const twin::ClosedLoopTwin sim = make_twin(common, options);
+  const auto traj = read_design(common, sim.model().joints()).build(options.trajectory);
   twin::RunOptions ro;
   ro.robot = common.robot;
-  ro.trial = o.trial;
-  ro.seed = twin::run_seed(o.seed, o.trajectory, o.trial);
+  ro.trial = options.trial;
+  ro.seed = twin::run_seed(options.seed, options.trajectory, options.trial);
   twin::RunStats stats;
   const io::Log log = sim.run(traj, ro, &stats);
-  std::filesystem::create_directories(o.out);
-  const auto file = std::filesystem::path(o.out) / twin::run_file_name(o.trajectory, o.trial);
+  std::filesystem::create_directories(options.out);
+  const auto file = std::filesystem::path(options.out) / twin::run_file_name(options.trajectory, options.trial);
   io::write_log(file, log);
   fmt::print("{}: {} rows; {}\n", file.string(), log.samples(), twin::describe_run(stats));
   fmt::print("max |q_ref - q| per joint (deg):");
@@ -60,71 +60,71 @@ void twin_run(const Common& common, const TwinOptions& o) {
   fmt::print("\n");
 }
 
-void twin_dataset(const Common& common, const TwinOptions& o) {
-  const twin::ClosedLoopTwin sim = make_twin(common, o);
+void twin_dataset(const Common& common, const TwinOptions& options) {
+  const twin::ClosedLoopTwin sim = make_twin(common, options);
   const auto design = read_design(common, sim.model().joints());
   std::vector<trajectory::Trajectory> trajs;
-  for (const auto& n : o.only.empty() ? design.names() : o.only) trajs.push_back(design.build(n));
+  for (const auto& n : options.only.empty() ? design.names() : options.only) trajs.push_back(design.build(n));
   twin::TwinDatasetOptions d;
-  d.out = o.out;
+  d.out = options.out;
   d.robot = common.robot;
-  d.seed = o.seed;
-  d.trials = o.trials;
-  d.workers = o.jobs;
-  d.overrides = o.config;
+  d.seed = options.seed;
+  d.trials = options.trials;
+  d.workers = options.jobs;
+  d.overrides = options.config;
   std::optional<Progress> progress;
   d.on_start = [&](int to_run, int skipped) {
-    if (skipped > 0) fmt::print(stderr, "{} runs already finished in {} (same seed and twin): skipped\n", skipped, o.out);
+    if (skipped > 0) fmt::print(stderr, "{} runs already finished in {} (same seed and twin): skipped\n", skipped, options.out);
     progress.emplace(to_run, "twin");
   };
   d.on_run = [&](const std::string& run, const std::string& what) { progress->done(run, what); };
   const twin::TwinDatasetSummary s = twin::make_twin_dataset(sim, trajs, d);
   if (!s.coordinator) return;
   fmt::print("{} runs ({} new, {} skipped) in {}: {:.0f} s simulated in {:.1f} s wall on {}{} workers\n", s.runs, s.made,
-             s.skipped, o.out, s.simulated, s.wall, s.ranks > 1 ? fmt::format("{} ranks x ", s.ranks) : "", s.workers);
+             s.skipped, options.out, s.simulated, s.wall, s.ranks > 1 ? fmt::format("{} ranks x ", s.ranks) : "", s.workers);
 }
 
-void twin_bench(const Common& common, const TwinOptions& o) {
-  const twin::ClosedLoopTwin sim = make_twin(common, o);
-  const auto traj = read_design(common, sim.model().joints()).build(o.trajectory);
+void twin_bench(const Common& common, const TwinOptions& options) {
+  const twin::ClosedLoopTwin sim = make_twin(common, options);
+  const auto traj = read_design(common, sim.model().joints()).build(options.trajectory);
   twin::RunOptions ro;
   ro.robot = common.robot;
   double best = 0, total_sim = 0, total_wall = 0;
   int runs = 0;
-  while (total_wall < o.repeat_seconds || runs < 2) {
-    ro.seed = twin::run_seed(o.seed, o.trajectory, ++runs);
+  while (total_wall < options.repeat_seconds || runs < 2) {
+    ro.seed = twin::run_seed(options.seed, options.trajectory, ++runs);
     twin::RunStats st;
     sim.run(traj, ro, &st);
     total_sim += st.simulated;
     total_wall += st.wall;
     best = std::max(best, st.simulated / st.wall);
   }
-  fmt::print("twin {} on {} ({:.1f} s), one core, effects: {}\n", common.robot, o.trajectory, traj.duration(),
+  fmt::print("twin {} on {} ({:.1f} s), one core, effects: {}\n", common.robot, options.trajectory, traj.duration(),
              fmt::join(sim.config().effects.enabled(), ", "));
   fmt::print("{} runs: {:.0f} simulated s per wall s on average, {:.0f} best ({:.2f} us per 1 ms control cycle)\n", runs,
              total_sim / total_wall, best, 1e3 / (total_sim / total_wall));
 }
 
 
-void add_config_options(CLI::App* cmd, Common& common, TwinOptions& o) {
+void add_config_options(CLI::App* cmd, Common& common, TwinOptions& options) {
   add_robot_options(cmd, common);
   cmd->add_option("--design", common.design, "A trajectory design file (e.g. dynid excite's) instead of robots/<robot>/trajectories.yaml")
       ->check(CLI::ExistingFile);
-  cmd->add_option("--config", o.config, "A YAML file overriding parts of robots/<robot>/twin.yaml")->check(CLI::ExistingFile);
-  cmd->add_flag("--ideal", o.ideal, "Turn every effect off (quantization and delay remain)");
-  cmd->add_option("--effects", o.effects, "Turn these effects on (coulomb, stribeck, torque_offset, backlash, payload, "
+  cmd->add_option("--config", options.config, "A YAML file overriding parts of robots/<robot>/twin.yaml")->check(CLI::ExistingFile);
+  cmd->add_flag("--ideal", options.ideal, "Turn every effect off (quantization and delay remain)");
+  cmd->add_option("--effects", options.effects, "Turn these effects on (coulomb, stribeck, torque_offset, backlash, payload, "
                                            "torque_constant_error, actuation_delay, sensor_noise, timestamp_jitter, dropped_samples)")
       ->delimiter(',');
-  cmd->add_option("--without", o.without, "Turn these effects off")->delimiter(',');
+  cmd->add_option("--without", options.without, "Turn these effects off")->delimiter(',');
 }
 
 }  // namespace
 
-void run_twin(const Common& common, const TwinOptions& o) {
-  switch (o.mode) {
-    case TwinOptions::Mode::run: return twin_run(common, o);
-    case TwinOptions::Mode::dataset: return twin_dataset(common, o);
-    case TwinOptions::Mode::bench: return twin_bench(common, o);
+void run_twin(const Common& common, const TwinOptions& options) {
+  switch (options.mode) {
+    case TwinOptions::Mode::run: return twin_run(common, options);
+    case TwinOptions::Mode::dataset: return twin_dataset(common, options);
+    case TwinOptions::Mode::bench: return twin_bench(common, options);
   }
 }
 

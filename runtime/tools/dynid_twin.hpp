@@ -24,6 +24,6 @@ struct TwinOptions {
   double repeat_seconds = 3;
 };
 
-void run_twin(const Common& common, const TwinOptions& o);
+void run_twin(const Common& common, const TwinOptions& options);
 
 }  // namespace symoro::dynid

@@ -20,58 +20,58 @@
 
 namespace symoro::diagnose {
 
-void check_request(const DatasetDiagnosisOptions& o) {
+void check_request(const DatasetDiagnosisOptions& options) {
   // The ranges dynid diagnose's options check, for every caller (Python passed alpha=nan).
   const auto range = [](const char* option, double v, double lo, double hi, bool lo_open, const char* what) {
     if (!(std::isfinite(v) && (lo_open ? v > lo : v >= lo) && v <= hi))
       throw DiagnosisRequestError(fmt::format("{} {}: must be {}", option, v, what));
   };
-  if (o.trial < 1 || o.trial > 1'000'000) throw DiagnosisRequestError(fmt::format("--trial {}: must be from 1 to 1000000", o.trial));
-  range("--interval", o.interval * 1000, 1, 10000, false, "from 1 to 10000 ms");
-  range("--cutoff", o.cutoff, 0, 1e5, true, "> 0 and <= 1e5 Hz");
-  range("--alpha", o.alpha, 0, 0.5, true, "> 0 and <= 0.5");
-  range("--min-gain", o.min_heldout_gain, 0, 1, false, ">= 0 and <= 1");
-  range("--min-torque", o.min_effect_torque, 0, 1e6, false, ">= 0 and <= 1e6 N m");
+  if (options.trial < 1 || options.trial > 1'000'000) throw DiagnosisRequestError(fmt::format("--trial {}: must be from 1 to 1000000", options.trial));
+  range("--interval", options.interval * 1000, 1, 10000, false, "from 1 to 10000 ms");
+  range("--cutoff", options.cutoff, 0, 1e5, true, "> 0 and <= 1e5 Hz");
+  range("--alpha", options.alpha, 0, 0.5, true, "> 0 and <= 0.5");
+  range("--min-gain", options.min_heldout_gain, 0, 1, false, ">= 0 and <= 1");
+  range("--min-torque", options.min_effect_torque, 0, 1e6, false, ">= 0 and <= 1e6 N m");
   static const std::regex lower_id("^[a-z][a-z0-9_]*$");
-  if (!o.variant.empty() && (!std::regex_match(o.variant, lower_id) || o.variant == "full" || o.variant == "param"))
-    throw DiagnosisRequestError("--variant '" + o.variant + "' must be a lower-case identifier other than 'full' and 'param' "
+  if (!options.variant.empty() && (!std::regex_match(options.variant, lower_id) || options.variant == "full" || options.variant == "param"))
+    throw DiagnosisRequestError("--variant '" + options.variant + "' must be a lower-case identifier other than 'full' and 'param' "
                                 "(symoroc's rule)");
-  for (const auto& e : o.only) {
+  for (const auto& e : options.only) {
     effect_kind(e);  // unknown names: a clear error first
-    if (e == "payload" && o.params.empty())
+    if (e == "payload" && options.params.empty())
       throw DiagnosisRequestError("--only payload needs --params: a refit absorbs a payload into the last link's parameters, "
                                   "so it is judged against an earlier identification held fixed");
   }
 }
 
 std::pair<std::vector<std::string>, std::vector<std::string>> diagnosis_runs(const io::Dataset& data,
-                                                                              const DatasetDiagnosisOptions& o) {
+                                                                              const DatasetDiagnosisOptions& options) {
   // Held out: the held-out family (V, as a split at import records it); fitting: every other run
   // of the trial.
   auto pick = [&](bool heldout) {
     std::vector<std::string> v;
     for (const auto& r : data.runs)
-      if (r.trial == o.trial && (r.family == o.heldout_family) == heldout && std::find(v.begin(), v.end(), r.trajectory) == v.end())
+      if (r.trial == options.trial && (r.family == options.heldout_family) == heldout && std::find(v.begin(), v.end(), r.trajectory) == v.end())
         v.push_back(r.trajectory);
     return v;
   };
-  std::vector<std::string> train = o.train.empty() ? pick(false) : o.train, heldout = o.heldout.empty() ? pick(true) : o.heldout;
+  std::vector<std::string> train = options.train.empty() ? pick(false) : options.train, heldout = options.heldout.empty() ? pick(true) : options.heldout;
   std::string all;
   for (const auto& r : data.runs) all += fmt::format("{}{} (family {}, trial {})", all.empty() ? "" : ", ", r.trajectory, r.family, r.trial);
   const auto manifest = (data.dir / "dataset.yaml").string();
   if (train.empty())
-    throw DiagnosisRequestError(fmt::format("{}: no fitting run for trial {} (runs: {}); name them with --train", manifest, o.trial, all));
+    throw DiagnosisRequestError(fmt::format("{}: no fitting run for trial {} (runs: {}); name them with --train", manifest, options.trial, all));
   if (heldout.empty())
     throw DiagnosisRequestError(fmt::format("{}: no held-out run (family {}) for trial {} (runs: {}); name them with --heldout, "
                                             "or split a long run at import (dynid import --split 0.7)",
-                                            manifest, o.heldout_family, o.trial, all));
+                                            manifest, options.heldout_family, options.trial, all));
   for (const auto* list : {&train, &heldout})
     for (const auto& name : *list) {
       bool found = false;
-      for (const auto& r : data.runs) found = found || (r.trajectory == name && r.trial == o.trial);
+      for (const auto& r : data.runs) found = found || (r.trajectory == name && r.trial == options.trial);
       if (!found)
         throw DiagnosisRequestError(fmt::format("{}: no run {} of trial {} to {} (runs: {}); choose others with --train / --heldout",
-                                                manifest, name, o.trial, list == &train ? "fit" : "hold out", all));
+                                                manifest, name, options.trial, list == &train ? "fit" : "hold out", all));
     }
   return {train, heldout};
 }
@@ -108,14 +108,14 @@ namespace {
 
 // Backlash from the closed loop's high band: the robot's digital twin replays the fitting run's
 // own references. A stage that cannot run, or fails, is said in the report (d.backlash_note).
-void backlash_stage(const DiagnosisModel& model, const DatasetDiagnosisOptions& o, const std::string& robot,
+void backlash_stage(const DiagnosisModel& model, const DatasetDiagnosisOptions& options, const std::string& robot,
                     const io::Log& first_train, const std::string& first_train_name, const std::function<void()>& check_stop,
                     Diagnosis& d) {
   const identify::ModelDescription& md = model.description();
-  const auto twin_path = o.robot_dir / "twin.yaml";
-  if (!o.backlash) {
+  const auto twin_path = options.robot_dir / "twin.yaml";
+  if (!options.backlash) {
     d.backlash_note = "Not run (--no-backlash).";
-  } else if (o.robot_dir.empty()) {
+  } else if (options.robot_dir.empty()) {
     d.backlash_note = "Not run: the stage simulates the robot's digital twin, and no robot folder was given.";
   } else if (!std::filesystem::exists(twin_path)) {
     d.backlash_note = fmt::format("Not run: the stage simulates the robot's digital twin, and {} has none ({} not found).",
@@ -153,29 +153,29 @@ void say_findings(const Diagnosis& d, const std::function<void(const std::string
 
 }  // namespace
 
-DatasetDiagnosis diagnose_dataset(const DiagnosisModel& model, const DatasetDiagnosisOptions& o) {
-  check_request(o);
+DatasetDiagnosis diagnose_dataset(const DiagnosisModel& model, const DatasetDiagnosisOptions& options) {
+  check_request(options);
   const identify::ModelDescription& md = model.description();
   auto say = [&](const std::string& line) {
-    if (o.say) o.say(line);
+    if (options.say) options.say(line);
   };
   auto check_stop = [&] {
-    if (o.stop && o.stop()) throw DiagnosisStopped();
+    if (options.stop && options.stop()) throw DiagnosisStopped();
   };
-  const io::Dataset data = io::read_dataset(o.data);
+  const io::Dataset data = io::read_dataset(options.data);
   io::check_dataset_robot(data, md.robot);
-  const auto [train_names, heldout_names] = diagnosis_runs(data, o);
+  const auto [train_names, heldout_names] = diagnosis_runs(data, options);
   StackOptions so;
-  so.interval = o.interval;
-  so.cutoff = o.cutoff;
-  so.candidates.only = o.only;
+  so.interval = options.interval;
+  so.cutoff = options.cutoff;
+  so.candidates.only = options.only;
   io::Log first_train;  // the backlash stage's run
   std::vector<std::pair<std::string, io::Log>> heldout_logs;  // for the raw-torque gap
   auto stack = [&](const std::vector<std::string>& names, bool fitting) {
     std::vector<NamedSamples> runs;
     for (const auto& name : names) {
       check_stop();
-      io::Log log = io::read_run_log(data.find(name, o.trial), md.robot, md.nq);
+      io::Log log = io::read_run_log(data.find(name, options.trial), md.robot, md.nq);
       if (fitting && name == names.front()) first_train = log;
       if (!fitting) heldout_logs.emplace_back(name, log);
       runs.push_back({name, preprocess::preprocess(log, log.meta.sample_time > 0 ? log.meta.sample_time : 0.001, light_preprocessing())});
@@ -185,10 +185,10 @@ DatasetDiagnosis diagnose_dataset(const DiagnosisModel& model, const DatasetDiag
   // The gap of an earlier identification as it stands: its parameters are held, not refitted
   // (read first: a bad file is named before the logs are worked through).
   Eigen::VectorXd held;
-  if (!o.params.empty()) {
+  if (!options.params.empty()) {
     std::vector<std::string> names;
     for (const auto& p : md.parameters) names.emplace_back(p.name);
-    held = io::read_parameters_yaml(o.params.string(), names);
+    held = io::read_parameters_yaml(options.params.string(), names);
   }
   DesignStack train = stack(train_names, true), heldout = stack(heldout_names, false);
   if (held.size()) {
@@ -196,13 +196,13 @@ DatasetDiagnosis diagnose_dataset(const DiagnosisModel& model, const DatasetDiag
     heldout.hold(held);
   }
   DiagnosisOptions dopt;
-  dopt.selection.alpha = o.alpha;
-  dopt.selection.min_heldout_gain = o.min_heldout_gain;
-  dopt.selection.min_effect_torque = o.min_effect_torque;
+  dopt.selection.alpha = options.alpha;
+  dopt.selection.min_heldout_gain = options.min_heldout_gain;
+  dopt.selection.min_effect_torque = options.min_effect_torque;
   dopt.selection.candidates = so.candidates;
   // A delay the controller description already models is not a missing effect.
-  const auto controller_path = o.robot_dir / control::controller_file_name();
-  if (!o.robot_dir.empty() && std::filesystem::exists(controller_path))
+  const auto controller_path = options.robot_dir / control::controller_file_name();
+  if (!options.robot_dir.empty() && std::filesystem::exists(controller_path))
     dopt.selection.modeled_delay = control::read_controller_description(controller_path, md.nq).communication_delay;
   check_stop();
   DatasetDiagnosis result;
@@ -216,23 +216,23 @@ DatasetDiagnosis diagnose_dataset(const DiagnosisModel& model, const DatasetDiag
     d.raw_note = e.what();
   }
   // Backlash from the closed loop's high band (a stage that cannot run is said in the report).
-  const std::string robot = o.robot_dir.empty() ? md.robot : o.robot_dir.filename().string();
-  backlash_stage(model, o, robot, first_train, train_names.front(), check_stop, d);
+  const std::string robot = options.robot_dir.empty() ? md.robot : options.robot_dir.filename().string();
+  backlash_stage(model, options, robot, first_train, train_names.front(), check_stop, d);
   if (!d.backlash_note.empty()) say(fmt::format("backlash stage: {}", d.backlash_note));
   d.robot = robot;
   d.model = md.robot + (md.variant.empty() ? "" : "::" + md.variant);
-  d.cutoff = o.cutoff;
-  d.held_parameters = o.params.string();
+  d.cutoff = options.cutoff;
+  d.held_parameters = options.params.string();
   say_findings(d, say);
   say(fmt::format("held-out rms residual: {:.4f} -> {:.4f} N m", d.selection.before.heldout_total, d.selection.after.heldout_total));
   check_stop();  // the last chance: from here the report is written whole
-  result.files = write_diagnosis_report(d, o.out);
-  result.report = o.out / "diagnosis.md";
+  result.files = write_diagnosis_report(d, options.out);
+  result.report = options.out / "diagnosis.md";
   const std::string& base = md.variant;
-  result.variant_name = o.variant.empty() ? (base.empty() ? "diagnosed" : base + "_diagnosed") : o.variant;
+  result.variant_name = options.variant.empty() ? (base.empty() ? "diagnosed" : base + "_diagnosed") : options.variant;
   result.variant_yaml = variant_yaml(d, result.variant_name, base.empty() ? "full" : base);
   if (!result.variant_yaml.empty()) {
-    result.variant_file = o.out / "variant.yaml";
+    result.variant_file = options.out / "variant.yaml";
     io::write_file_atomically(result.variant_file, "# Add under `variants:` of robots/" + robot + "/robot.yaml\n" + result.variant_yaml);
     say(fmt::format("variant: {}", result.variant_file.string()));
   }

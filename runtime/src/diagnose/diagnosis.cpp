@@ -35,7 +35,7 @@ std::vector<ResidualSeries> residual_series(const DesignStack& d, const Eigen::V
   return out;
 }
 
-Diagnosis diagnose(const DesignStack& train, const DesignStack& heldout, const DiagnosisOptions& o) {
+Diagnosis diagnose(const DesignStack& train, const DesignStack& heldout, const DiagnosisOptions& options) {
   Diagnosis d;
   d.interval = train.interval;
   std::set<std::string> seen;
@@ -43,12 +43,12 @@ Diagnosis diagnose(const DesignStack& train, const DesignStack& heldout, const D
     if (seen.insert("t" + t).second) d.train.push_back(t);
   for (const auto& t : heldout.segment_trajectory)
     if (seen.insert("h" + t).second) d.heldout.push_back(t);
-  d.options = o.selection;
-  d.selection = select_effects(train, heldout, o.selection);
+  d.options = options.selection;
+  d.selection = select_effects(train, heldout, options.selection);
   d.before_series = residual_series(heldout, d.selection.before.heldout_tau);
   d.after_series = residual_series(heldout, d.selection.after.heldout_tau);
-  d.before = localize(d.before_series, heldout.joint_names, o.localize);
-  d.after = localize(d.after_series, heldout.joint_names, o.localize);
+  d.before = localize(d.before_series, heldout.joint_names, options.localize);
+  d.after = localize(d.after_series, heldout.joint_names, options.localize);
   return d;
 }
 

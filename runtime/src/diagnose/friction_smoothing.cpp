@@ -36,7 +36,7 @@ std::vector<Option> options(const std::vector<Candidate>& friction) {
 
 }  // namespace
 
-void choose_friction_smoothing(const DesignStack& train, const DesignStack& heldout, const SelectionOptions& o,
+void choose_friction_smoothing(const DesignStack& train, const DesignStack& heldout, const SelectionOptions& selection,
                                const Eigen::VectorXd& weights, std::vector<Candidate>& chosen,
                                std::vector<SelectedEffect>& effects) {
   for (int j = 1; j <= train.joints; ++j) {
@@ -54,9 +54,9 @@ void choose_friction_smoothing(const DesignStack& train, const DesignStack& held
     }
     if (named.empty()) continue;
     // The other effects, refitted without the joint's friction; each option is added to them.
-    const Fit without = fit_with_effects(train, heldout, others, weights, o.max_lag);
+    const Fit without = fit_with_effects(train, heldout, others, weights, selection.max_lag);
     const NestedDesign nd = nested_design(train, heldout, others, without, weights);
-    const std::vector<Candidate> friction = friction_options(train, o.candidates, j);
+    const std::vector<Candidate> friction = friction_options(train, selection.candidates, j);
     std::vector<Option> opts = options(friction);
     const Option* single = nullptr;
     const Option* pair = nullptr;
@@ -81,7 +81,7 @@ void choose_friction_smoothing(const DesignStack& train, const DesignStack& held
       if (!best || op.sse < best->sse) best = &op;
     }
     if (!single) continue;  // nothing physical: the forward steps' choice stands
-    const bool both = pair && pair->sse <= (1 - o.min_heldout_gain) * single->sse;
+    const bool both = pair && pair->sse <= (1 - selection.min_heldout_gain) * single->sse;
     const Option& pick = both ? *pair : *single;
     // The terms, with the forward step's record where it named the same effect; another gets
     // its Wald statistic in the refit and its held-out gain: a pair's second term over the best
@@ -103,7 +103,7 @@ void choose_friction_smoothing(const DesignStack& train, const DesignStack& held
           recorded = true;
         }
       if (!recorded) {
-        if (sds.empty()) f = fit_with_effects(train, heldout, refit, weights, o.max_lag, &sds);
+        if (sds.empty()) f = fit_with_effects(train, heldout, refit, weights, selection.max_lag, &sds);
         const std::size_t i = at + k;
         const double z = sds[i](0) > 0 ? f.theta[i](0) / sds[i](0) : 0.0;
         e.f = z * z;

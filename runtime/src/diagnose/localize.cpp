@@ -187,20 +187,20 @@ Pooled pool(const std::vector<const ResidualSeries*>& series, Index j, Index tot
   return p;
 }
 
-void check_options(const LocalizeOptions& o) {
+void check_options(const LocalizeOptions& options) {
   auto bad = [](const std::string& what) { throw std::invalid_argument("localize: " + what); };
-  if (!(o.reversal_window >= 0) || !std::isfinite(o.reversal_window)) bad("reversal_window must be finite and >= 0");
-  if (!(o.direction_velocity >= 0) || !std::isfinite(o.direction_velocity))
+  if (!(options.reversal_window >= 0) || !std::isfinite(options.reversal_window)) bad("reversal_window must be finite and >= 0");
+  if (!(options.direction_velocity >= 0) || !std::isfinite(options.direction_velocity))
     bad("direction_velocity must be finite and >= 0");
-  if (!(o.high_acceleration_quantile > 0 && o.high_acceleration_quantile < 1))
+  if (!(options.high_acceleration_quantile > 0 && options.high_acceleration_quantile < 1))
     bad("high_acceleration_quantile must be in (0, 1)");
-  if (o.position_bands < 1) bad("position_bands must be >= 1");
-  if (o.band_edges.empty()) bad("band_edges must not be empty");
-  for (std::size_t i = 0; i < o.band_edges.size(); ++i)
-    if (!std::isfinite(o.band_edges[i]) || o.band_edges[i] < 0 || (i > 0 && o.band_edges[i] <= o.band_edges[i - 1]))
+  if (options.position_bands < 1) bad("position_bands must be >= 1");
+  if (options.band_edges.empty()) bad("band_edges must not be empty");
+  for (std::size_t i = 0; i < options.band_edges.size(); ++i)
+    if (!std::isfinite(options.band_edges[i]) || options.band_edges[i] < 0 || (i > 0 && options.band_edges[i] <= options.band_edges[i - 1]))
       bad("band_edges must be finite, >= 0 and strictly ascending");
-  if (!(o.segment_seconds > 0) || !std::isfinite(o.segment_seconds)) bad("segment_seconds must be finite and > 0");
-  if (!(o.max_lag >= 0) || !std::isfinite(o.max_lag)) bad("max_lag must be finite and >= 0");
+  if (!(options.segment_seconds > 0) || !std::isfinite(options.segment_seconds)) bad("segment_seconds must be finite and > 0");
+  if (!(options.max_lag >= 0) || !std::isfinite(options.max_lag)) bad("max_lag must be finite and >= 0");
 }
 
 // The series with samples, after checking shapes, grids and values.

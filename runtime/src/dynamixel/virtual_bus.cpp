@@ -334,15 +334,80 @@ void VirtualBus::reply(Servo& servo, std::uint8_t error, ByteView params) {
   out_.insert(out_.end(), packet_.begin(), packet_.end());
 }
 
+bool VirtualBus::answers(const Servo& s, int level) {
+  return !s.dead && get(s.table, xs::kStatusReturnLevel, false) >= level;
+}
+
+void VirtualBus::read_into(Servo& s, std::uint16_t address, std::uint16_t length, int level) {
+  if (!answers(s, level)) return;
+  if (std::size_t{address} + length > kTableSize) {
+    reply(s, static_cast<std::uint8_t>(ErrorNumber::access_error), ByteView());
+    return;
+  }
+  reply(s, 0, ByteView(s.table + address, length));
+}
+
+// A unicast instruction whose CRC failed gets the CRC error status.
+void VirtualBus::answer_decode_error(const DecodeEvent& event) {
+  ++stats_.decode_errors;
+  if (event.error == DecodeError::bad_crc && event.raw.size() > 4)
+    if (Servo* s = find(event.raw[4]); s && !s->dead && get(s->table, xs::kStatusReturnLevel, false) == 2)
+      reply(*s, static_cast<std::uint8_t>(ErrorNumber::crc_error), ByteView());
+}
+
+void VirtualBus::answer_ping(const Packet& p, bool broadcast) {
+  for (Servo& s : servos_)
+    if ((broadcast || s.id == p.id) && answers(s, 0)) {
+      std::uint8_t params[3];
+      store_le<std::uint16_t>(params, static_cast<std::uint16_t>(get(s.table, xs::kModelNumber, false)));
+      params[2] = s.table[xs::kFirmwareVersion.address];
+      reply(s, 0, ByteView(params, 3));
+    }
+}
+
+void VirtualBus::answer_read(const Packet& p) {
+  Servo* s = p.id == kBroadcastId ? nullptr : find(p.id);
+  if (!s) return;
+  const auto r = parse_read(p);
+  if (!r) {
+    if (answers(*s, 1)) reply(*s, static_cast<std::uint8_t>(ErrorNumber::data_length_error), ByteView());
+    return;
+  }
+  refresh_present();
+  read_into(*s, r->address, r->length, 1);
+}
+
+void VirtualBus::answer_write(const Packet& p, bool broadcast) {
+  const auto w = parse_write(p);
+  for (Servo& s : servos_) {
+    if (s.dead || !(broadcast || s.id == p.id)) continue;
+    const std::uint8_t old_reply_id = s.reply_id;
+    const ErrorNumber e = w ? apply_write(s, w->address, w->data) : ErrorNumber::data_length_error;
+    if (!broadcast && get(s.table, xs::kStatusReturnLevel, false) == 2) {
+      const std::uint8_t now_reply_id = s.reply_id;
+      s.reply_id = old_reply_id;  // the status of an ID change comes from the old ID
+      reply(s, static_cast<std::uint8_t>(e), ByteView());
+      s.reply_id = now_reply_id;
+    }
+    if (!broadcast) break;
+  }
+}
+
+void VirtualBus::answer_reboot(const Packet& p, bool broadcast) {
+  for (Servo& s : servos_)
+    if (!s.dead && (broadcast || s.id == p.id)) {
+      put(s.table, xs::kHardwareErrorStatus, 0);
+      put(s.table, xs::kTorqueEnable, 0);
+      put(s.table, xs::kGoalCurrent, 0);
+      update_command(index_of(s));
+      if (!broadcast && answers(s, 2)) reply(s, 0, ByteView());
+    }
+}
+
 void VirtualBus::process(const DecodeEvent& event, double now) {
   std::lock_guard<std::mutex> lock(mutex_);
   if (event.kind == DecodeEvent::Kind::error) {
-    ++stats_.decode_errors;
-    // A unicast instruction whose CRC failed gets the CRC error status.
-    if (event.error == DecodeError::bad_crc && event.raw.size() > 4)
-      if (Servo* s = find(event.raw[4]); s && !s->dead &&
-                                         get(s->table, xs::kStatusReturnLevel, false) == 2)
-        reply(*s, static_cast<std::uint8_t>(ErrorNumber::crc_error), ByteView());
+    answer_decode_error(event);
     return;
   }
   const Packet& p = event.packet;
@@ -352,67 +417,11 @@ void VirtualBus::process(const DecodeEvent& event, double now) {
   last_instruction_ = now;
   backend_->advance(now);
   const bool broadcast = p.id == kBroadcastId;
-  // Level 0: ping only; 1: ping and reads; 2: everything (the factory value).
-  auto answers = [](const Servo& s, int level) {
-    return !s.dead && get(s.table, xs::kStatusReturnLevel, false) >= level;
-  };
-  auto read_into = [this](Servo& s, std::uint16_t address, std::uint16_t length, int level) {
-    if (s.dead || get(s.table, xs::kStatusReturnLevel, false) < level) return;
-    if (std::size_t{address} + length > kTableSize) {
-      reply(s, static_cast<std::uint8_t>(ErrorNumber::access_error), ByteView());
-      return;
-    }
-    reply(s, 0, ByteView(s.table + address, length));
-  };
-
   switch (p.instruction) {
-    case Instruction::ping:
-      for (Servo& s : servos_)
-        if ((broadcast || s.id == p.id) && answers(s, 0)) {
-          std::uint8_t params[3];
-          store_le<std::uint16_t>(params, static_cast<std::uint16_t>(get(s.table, xs::kModelNumber, false)));
-          params[2] = s.table[xs::kFirmwareVersion.address];
-          reply(s, 0, ByteView(params, 3));
-        }
-      break;
-    case Instruction::read: {
-      Servo* s = broadcast ? nullptr : find(p.id);
-      if (!s) break;
-      const auto r = parse_read(p);
-      if (!r) {
-        if (answers(*s, 1)) reply(*s, static_cast<std::uint8_t>(ErrorNumber::data_length_error), ByteView());
-        break;
-      }
-      refresh_present();
-      read_into(*s, r->address, r->length, 1);
-      break;
-    }
-    case Instruction::write: {
-      const auto w = parse_write(p);
-      for (Servo& s : servos_) {
-        if (s.dead || !(broadcast || s.id == p.id)) continue;
-        const std::uint8_t old_reply_id = s.reply_id;
-        const ErrorNumber e = w ? apply_write(s, w->address, w->data) : ErrorNumber::data_length_error;
-        if (!broadcast && get(s.table, xs::kStatusReturnLevel, false) == 2) {
-          const std::uint8_t now_reply_id = s.reply_id;
-          s.reply_id = old_reply_id;  // the status of an ID change comes from the old ID
-          reply(s, static_cast<std::uint8_t>(e), ByteView());
-          s.reply_id = now_reply_id;
-        }
-        if (!broadcast) break;
-      }
-      break;
-    }
-    case Instruction::reboot:
-      for (Servo& s : servos_)
-        if (!s.dead && (broadcast || s.id == p.id)) {
-          put(s.table, xs::kHardwareErrorStatus, 0);
-          put(s.table, xs::kTorqueEnable, 0);
-          put(s.table, xs::kGoalCurrent, 0);
-          update_command(index_of(s));
-          if (!broadcast && answers(s, 2)) reply(s, 0, ByteView());
-        }
-      break;
+    case Instruction::ping: answer_ping(p, broadcast); break;
+    case Instruction::read: answer_read(p); break;
+    case Instruction::write: answer_write(p, broadcast); break;
+    case Instruction::reboot: answer_reboot(p, broadcast); break;
     case Instruction::sync_read:
       if (const auto r = parse_sync_read(p); r && broadcast) {
         refresh_present();

@@ -59,15 +59,15 @@ double aggregate(const Eigen::VectorXd& v, double s, Eigen::VectorXd& weights) {
 
 class DesignProblem : public Ipopt::TNLP {
  public:
-  DesignProblem(const ExcitationCriterion& criterion, const ExcitationDesignOptions& o, Eigen::VectorXd x0)
-      : c_(criterion), o_(o), x0_(std::move(x0)) {
+  DesignProblem(const ExcitationCriterion& criterion, const ExcitationDesignOptions& options, Eigen::VectorXd x0)
+      : c_(criterion), o_(options), x0_(std::move(x0)) {
     const FourierBasis& b = c_.basis();
     n_ = b.joints();
     N_ = b.samples();
     L_ = b.harmonics();
     V_ = b.variables();
-    torque_ = o.limits.torque.size() > 0;
-    H_ = static_cast<int>(o.workspace.size());
+    torque_ = options.limits.torque.size() > 0;
+    H_ = static_cast<int>(options.workspace.size());
     rp_ = 2 * n_;
     rv_ = rp_ + N_ * n_;
     ra_ = rv_ + N_ * n_;
@@ -267,7 +267,7 @@ class DesignProblem : public Ipopt::TNLP {
 
 // Random coefficients at rest at t = 0, scaled per joint to half of its limits by the
 // closed-form bounds (trajectory/fourier.hpp).
-Eigen::VectorXd random_start(const FourierBasis& basis, const ExcitationDesignOptions& o, std::uint64_t seed) {
+Eigen::VectorXd random_start(const FourierBasis& basis, const ExcitationDesignOptions& options, std::uint64_t seed) {
   std::mt19937_64 rng(seed);
   std::normal_distribution<double> normal;
   trajectory::FourierTrajectory t;
@@ -280,12 +280,12 @@ Eigen::VectorXd random_start(const FourierBasis& basis, const ExcitationDesignOp
       t.a(j, l) = normal(rng) / (l + 1);
       t.b(j, l) = normal(rng) / (l + 1);
     }
-  t.come_to_rest_at(o.start);
+  t.come_to_rest_at(options.start);
   const Eigen::VectorXd pb = t.position_bound(), vb = t.velocity_bound(), ab = t.acceleration_bound();
   for (int j = 0; j < n; ++j) {
-    const double room = std::min(o.limits.upper(j) - o.start(j), o.start(j) - o.limits.lower(j));
+    const double room = std::min(options.limits.upper(j) - options.start(j), options.start(j) - options.limits.lower(j));
     // |q - start| <= 2 sum r / (w l): the series' offset moves with b.
-    const double s = 0.5 * std::min({room / (2 * pb(j)), o.limits.velocity(j) / vb(j), o.limits.acceleration(j) / ab(j)});
+    const double s = 0.5 * std::min({room / (2 * pb(j)), options.limits.velocity(j) / vb(j), options.limits.acceleration(j) / ab(j)});
     t.a.row(j) *= s;
     t.b.row(j) *= s;
   }
@@ -314,79 +314,79 @@ std::string status_name(Ipopt::ApplicationReturnStatus s) {
   }
 }
 
-void refuse_unmeetable(const identify::IdentificationModel& model, const ExcitationDesignOptions& o) {
+void refuse_unmeetable(const identify::IdentificationModel& model, const ExcitationDesignOptions& options) {
   const identify::ModelDescription& d = model.description();
   const int n = d.nq;
-  const auto& lim = o.limits;
+  const auto& lim = options.limits;
   auto sized = [n](const Eigen::VectorXd& v) { return v.size() == n; };
-  if (!sized(o.start) || !sized(lim.lower) || !sized(lim.upper) || !sized(lim.velocity) || !sized(lim.acceleration) ||
+  if (!sized(options.start) || !sized(lim.lower) || !sized(lim.upper) || !sized(lim.velocity) || !sized(lim.acceleration) ||
       (lim.torque.size() > 0 && !sized(lim.torque)))
     throw std::invalid_argument(fmt::format("design_excitation: the start pose and the limits need {} joints", n));
-  if (lim.torque.size() > 0 && o.nominal.size() != d.np)
+  if (lim.torque.size() > 0 && options.nominal.size() != d.np)
     throw std::invalid_argument(fmt::format("design_excitation: torque limits need the nominal model's {} parameters", d.np));
   for (int j = 0; j < n; ++j) {
     const std::string name = joint_name(model, j);
     if (!(lim.velocity(j) > 0)) throw ExcitationInfeasible(fmt::format("velocity limit of joint {} ({}) is {}: it must be > 0", j + 1, name, lim.velocity(j)));
     if (!(lim.acceleration(j) > 0))
       throw ExcitationInfeasible(fmt::format("acceleration limit of joint {} ({}) is {}: it must be > 0", j + 1, name, lim.acceleration(j)));
-    if (!(o.start(j) > lim.lower(j) && o.start(j) < lim.upper(j)))
+    if (!(options.start(j) > lim.lower(j) && options.start(j) < lim.upper(j)))
       throw ExcitationInfeasible(fmt::format("position limit of joint {} ({}): the start {:.6g} is not inside [{:.6g}, {:.6g}]",
-                                             j + 1, name, o.start(j), lim.lower(j), lim.upper(j)));
+                                             j + 1, name, options.start(j), lim.lower(j), lim.upper(j)));
   }
   const Eigen::VectorXd zero = Eigen::VectorXd::Zero(n);
   if (lim.torque.size() > 0) {
     identify::StateDerivatives rest;
-    model.state_derivatives(o.start, zero, zero, o.nominal, true, rest);
+    model.state_derivatives(options.start, zero, zero, options.nominal, true, rest);
     for (int j = 0; j < n; ++j)
-      if (std::abs(rest.tau(j)) > lim.torque(j) * o.torque_margin)
+      if (std::abs(rest.tau(j)) > lim.torque(j) * options.torque_margin)
         throw ExcitationInfeasible(fmt::format(
             "torque limit of joint {} ({}): holding the start pose takes {:.4g} (gravity, nominal model), more than {} % of "
             "its limit {:.4g}",
-            j + 1, joint_name(model, j), rest.tau(j), std::lround(100 * o.torque_margin), lim.torque(j)));
+            j + 1, joint_name(model, j), rest.tau(j), std::lround(100 * options.torque_margin), lim.torque(j)));
   }
-  if (!o.workspace.empty()) {
-    const Eigen::VectorXd v = half_space_values(d.frames, o.start, o.workspace);
-    for (std::size_t h = 0; h < o.workspace.size(); ++h)
+  if (!options.workspace.empty()) {
+    const Eigen::VectorXd v = half_space_values(d.frames, options.start, options.workspace);
+    for (std::size_t h = 0; h < options.workspace.size(); ++h)
       if (v(static_cast<Eigen::Index>(h)) > 0)
         throw ExcitationInfeasible(fmt::format("workspace half-space {}: frame {}'s origin at the start pose is {:.4g} beyond it",
-                                               o.workspace[h].name, o.workspace[h].frame, v(static_cast<Eigen::Index>(h))));
+                                               options.workspace[h].name, options.workspace[h].frame, v(static_cast<Eigen::Index>(h))));
   }
 }
 
 }  // namespace
 
 std::vector<ExcitationSlack> check_excitation(const identify::IdentificationModel& model, const trajectory::FourierTrajectory& t,
-                                              const ExcitationDesignOptions& o) {
+                                              const ExcitationDesignOptions& options) {
   const int n = model.description().nq;
-  const bool torque = o.limits.torque.size() > 0;
+  const bool torque = options.limits.torque.size() > 0;
   std::vector<ExcitationSlack> worst{{"position", "", kInfinity, 0}, {"velocity", "", kInfinity, 0},
                                      {"acceleration", "", kInfinity, 0}};
   if (torque) worst.push_back({"torque", "", kInfinity, 0});
-  if (!o.workspace.empty()) worst.push_back({"workspace", "", kInfinity, 0});
+  if (!options.workspace.empty()) worst.push_back({"workspace", "", kInfinity, 0});
   // The name is looked up only when a new tightest slack is found (not per joint per millisecond).
   auto note = [](ExcitationSlack& w, double slack, const auto& where, double time) {
     if (slack < w.slack) w = {w.constraint, where(), slack, time};
   };
-  const int cycles = static_cast<int>(std::lround(t.period() / o.check_period));
+  const int cycles = static_cast<int>(std::lround(t.period() / options.check_period));
   Eigen::VectorXd q, qd, qdd;
   identify::StateDerivatives d;
   for (int k = 0; k <= cycles; ++k) {
-    const double time = k * o.check_period;
+    const double time = k * options.check_period;
     t.evaluate(time, q, qd, qdd);
     for (int j = 0; j < n; ++j) {
       const auto name = [&] { return joint_name(model, j); };
-      note(worst[0], std::min(o.limits.upper(j) - q(j), q(j) - o.limits.lower(j)), name, time);
-      note(worst[1], o.limits.velocity(j) - std::abs(qd(j)), name, time);
-      note(worst[2], o.limits.acceleration(j) - std::abs(qdd(j)), name, time);
+      note(worst[0], std::min(options.limits.upper(j) - q(j), q(j) - options.limits.lower(j)), name, time);
+      note(worst[1], options.limits.velocity(j) - std::abs(qd(j)), name, time);
+      note(worst[2], options.limits.acceleration(j) - std::abs(qdd(j)), name, time);
     }
     if (torque) {
-      model.state_derivatives(q, qd, qdd, o.nominal, true, d);
-      for (int j = 0; j < n; ++j) note(worst[3], o.limits.torque(j) - std::abs(d.tau(j)), [&] { return joint_name(model, j); }, time);
+      model.state_derivatives(q, qd, qdd, options.nominal, true, d);
+      for (int j = 0; j < n; ++j) note(worst[3], options.limits.torque(j) - std::abs(d.tau(j)), [&] { return joint_name(model, j); }, time);
     }
-    if (!o.workspace.empty()) {
-      const Eigen::VectorXd v = half_space_values(model.description().frames, q, o.workspace);
-      for (std::size_t h = 0; h < o.workspace.size(); ++h)
-        note(worst.back(), -v(static_cast<Eigen::Index>(h)), [&] { return o.workspace[h].name; }, time);
+    if (!options.workspace.empty()) {
+      const Eigen::VectorXd v = half_space_values(model.description().frames, q, options.workspace);
+      for (std::size_t h = 0; h < options.workspace.size(); ++h)
+        note(worst.back(), -v(static_cast<Eigen::Index>(h)), [&] { return options.workspace[h].name; }, time);
     }
   }
   return worst;

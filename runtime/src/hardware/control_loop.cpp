@@ -345,6 +345,41 @@ void Loop::plan() {
   k_end_ = std::llround((approach_ + hw_.safety.pre_roll) / T_) + std::llround(end / T_);
 }
 
+void Loop::command_torque(control::FfpdController& ctrl, double t) {
+  const Eigen::VectorXd& u = ctrl.update(q_, qr_, qdr_, qddr_);
+  tau_ = u;
+  if (o_.feedforward) {
+    o_.feedforward(qr_, qdr_, qddr_, ff_);
+    tau_ += ff_ - gains_.inertia.cwiseProduct(qddr_) - gains_.damping.cwiseProduct(qdr_);
+  }
+  bool saturated = false;
+  for (int j = 0; j < n_; ++j) {
+    const double raw = std::round(hw_.joints[j].direction * tau_(j) / kt_(j) / unit_(j));
+    const double bound = limit_raw_[j];
+    // A command that is not a number is a fault upstream (the feedforward model, the
+    // controller's state): stopping says so, where a silent 0 or a saturation would not.
+    if (!std::isfinite(raw))
+      throw StopNow{StopReason::invalid_command,
+                    fmt::format("joint {} {}: the torque command is {} (feedforward {}) at trajectory time {:.3f} s", j + 1,
+                                joints_[j].name, tau_(j), o_.feedforward ? fmt::format("{}", ff_(j)) : "none", t)};
+    if (std::abs(raw) >= bound) saturated = true;
+    command_[j] = static_cast<std::int32_t>(std::clamp(raw, -bound, bound));
+  }
+  timing_.saturated += saturated;
+}
+
+void Loop::log_row(const control::FfpdController& ctrl, double time, double t) {
+  traj_time_ = t;
+  for (int j = 0; j < n_; ++j) {
+    tau_meas_[j] = kt_(j) * current_(j);
+    max_error_(j) = std::max(max_error_(j), std::abs(qr_(j) - q_(j)));
+  }
+  log_->append(time, q_.data(), ctrl.velocity().data(), tau_meas_.data(), qr_.data(), qdr_.data(), qddr_.data());
+  // A run whose log cannot be written stops (safely): its rows would be lost.
+  if (log_->failed())
+    throw StopNow{StopReason::error, fmt::format("{}: {} ({} rows on disk)", log_->path().string(), log_->error(), log_->written())};
+}
+
 StopNow Loop::loop() {
   const double distance = (qr0_ - q0_).cwiseAbs().maxCoeff();
   const double end = o_.seconds > 0 ? std::min(o_.seconds, traj_.duration()) : traj_.duration();
@@ -393,42 +428,12 @@ StopNow Loop::loop() {
     check_limits();
     const double t = reference(k * T_);
     if (o_.timeline) o_.timeline->store(t, std::memory_order_relaxed);
-    const Eigen::VectorXd& u = ctrl.update(q_, qr_, qdr_, qddr_);
-    tau_ = u;
-    if (o_.feedforward) {
-      o_.feedforward(qr_, qdr_, qddr_, ff_);
-      tau_ += ff_ - gains_.inertia.cwiseProduct(qddr_) - gains_.damping.cwiseProduct(qdr_);
-    }
-    bool saturated = false;
-    for (int j = 0; j < n_; ++j) {
-      const double raw = std::round(hw_.joints[j].direction * tau_(j) / kt_(j) / unit_(j));
-      const double bound = limit_raw_[j];
-      // A command that is not a number is a fault upstream (the feedforward model, the
-      // controller's state): stopping says so, where a silent 0 or a saturation would not.
-      if (!std::isfinite(raw))
-        throw StopNow{StopReason::invalid_command,
-                      fmt::format("joint {} {}: the torque command is {} (feedforward {}) at trajectory time {:.3f} s", j + 1,
-                                  joints_[j].name, tau_(j), o_.feedforward ? fmt::format("{}", ff_(j)) : "none", t)};
-      if (std::abs(raw) >= bound) saturated = true;
-      command_[j] = static_cast<std::int32_t>(std::clamp(raw, -bound, bound));
-    }
-    timing_.saturated += saturated;
+    command_torque(ctrl, t);
     if (!bus_.sync_write(ids_, xs::kGoalCurrent, dynamixel::Span<const std::int32_t>(command_.data(), command_.size()),
                          clock_.io_deadline(std::max(deadline + T * 95 / 100, clock_.now() + T / 4))))
       ++timing_.write_failures;
 
-    if (t >= -1e-9 && fresh) {
-      traj_time_ = t;
-      for (int j = 0; j < n_; ++j) {
-        tau_meas_[j] = kt_(j) * current_(j);
-        max_error_(j) = std::max(max_error_(j), std::abs(qr_(j) - q_(j)));
-      }
-      log_->append(seconds(wake - (start + k_traj0 * T)), q_.data(), ctrl.velocity().data(), tau_meas_.data(), qr_.data(),
-                   qdr_.data(), qddr_.data());
-      // A run whose log cannot be written stops (safely): its rows would be lost.
-      if (log_->failed())
-        throw StopNow{StopReason::error, fmt::format("{}: {} ({} rows on disk)", log_->path().string(), log_->error(), log_->written())};
-    }
+    if (t >= -1e-9 && fresh) log_row(ctrl, seconds(wake - (start + k_traj0 * T)), t);
     const auto done = clock_.now();
     const double work = seconds(done - wake);
     work_sum += work;

@@ -67,6 +67,11 @@ class Loop {
   // before torque is enabled (ControlOptions::inertia says what is checked).
   void check_feedforward();
   StopNow loop();
+  // One cycle's command: the controller's torque (with the model feedforward) in current units,
+  // saturated at each joint's limit; a command that is not a number stops the run.
+  void command_torque(control::FfpdController& ctrl, double t);
+  // One row of the log (time: since the trajectory's start); a log that cannot be written stops.
+  void log_row(const control::FfpdController& ctrl, double time, double t);
   void finish_timing();
   // stop_hold.cpp: what the arm does between the stop and torque off (result.at_stop says).
   void at_stop(const StopNow& stop, ControlResult& result);

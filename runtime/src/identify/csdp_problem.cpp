@@ -80,6 +80,144 @@ struct CsdpWorkspace {
   }
 };
 
+
+// C = -F_k0 per block, exactly symmetric (CSDP checks C(i,j) == C(j,i) bitwise).
+void set_constant(CsdpWorkspace& w, const std::vector<Eigen::MatrixXd>& constant) {
+  const int nb = static_cast<int>(constant.size());
+  for (const auto& c : constant) w.n += static_cast<int>(c.rows());
+  w.C.nblocks = nb;
+  w.C.blocks = allocate<blockrec>(nb + 1);
+  for (int b = 0; b < nb; ++b) {
+    const Eigen::MatrixXd& F = constant[b];
+    const int s = static_cast<int>(F.rows());
+    blockrec& r = w.C.blocks[b + 1];
+    r.blockcategory = MATRIX;
+    r.blocksize = s;
+    r.data.mat = allocate<double>(static_cast<std::size_t>(s) * s);
+    for (int i = 0; i < s; ++i)
+      for (int j = i; j < s; ++j) {
+        const double v = i == j ? -F(i, i) : -0.5 * (F(i, j) + F(j, i));
+        r.data.mat[ijtok(i + 1, j + 1, s)] = v;
+        r.data.mat[ijtok(j + 1, i + 1, s)] = v;
+      }
+  }
+}
+
+// The constraint matrices: per variable a list of its nonzero blocks, ascending.
+// coefficient[variable][block]: the entries {i, j, value} of F_ki's upper triangle.
+template <class Coefficients>
+void set_constraints(CsdpWorkspace& w, const Coefficients& coefficient) {
+  const int k = w.k, nb = w.C.nblocks;
+  w.constraints = allocate<constraintmatrix>(k + 1);
+  for (int v = 0; v < k; ++v) {
+    sparseblock** tail = &w.constraints[v + 1].blocks;
+    for (int b = 0; b < nb; ++b) {
+      const auto& entries = coefficient[v][b];
+      if (entries.empty()) continue;
+      auto* p = allocate<sparseblock>(1);
+      *tail = p;
+      tail = &p->next;
+      const int m = static_cast<int>(entries.size());
+      p->numentries = m;
+      p->blocknum = b + 1;
+      p->blocksize = w.C.blocks[b + 1].blocksize;
+      p->constraintnum = v + 1;
+      p->entries = allocate<double>(m + 1);
+      p->iindices = allocate<int>(m + 1);
+      p->jindices = allocate<int>(m + 1);
+      for (int e = 0; e < m; ++e) {
+        p->entries[e + 1] = entries[e].value;
+        p->iindices[e + 1] = entries[e].i;
+        p->jindices[e + 1] = entries[e].j;
+      }
+      // Sparse or dense handling is a speed choice only: dense once a block holds a good share
+      // of the Schur-complement work (CSDP's own rule of thumb, restated).
+      const double s = p->blocksize;
+      p->issparse = !(m > 5 && 1.0 * k * m * m > 0.125 * s * s * s);
+    }
+  }
+}
+
+// byblocks[b]: the first constraint block on block b; nextbyblock chains the others upward.
+void link_by_block(CsdpWorkspace& w) {
+  w.byblocks = allocate<sparseblock*>(w.C.nblocks + 1);
+  std::vector<sparseblock*> last(w.C.nblocks + 1, nullptr);
+  for (int v = 1; v <= w.k; ++v)
+    for (sparseblock* p = w.constraints[v].blocks; p; p = p->next) {
+      p->nextbyblock = nullptr;
+      if (last[p->blocknum]) last[p->blocknum]->nextbyblock = p;
+      else w.byblocks[p->blocknum] = p;
+      last[p->blocknum] = p;
+    }
+}
+
+paramstruc csdp_parameters(const LmiSettings& settings) {
+  paramstruc params{};
+  params.axtol = settings.tolerance;
+  params.atytol = settings.tolerance;
+  params.objtol = settings.tolerance;
+  params.pinftol = 1.0e8;
+  params.dinftol = 1.0e8;
+  params.maxiter = settings.max_iterations;
+  params.minstepfrac = 0.90;
+  params.maxstepfrac = 0.97;
+  params.minstepp = 1.0e-8;
+  params.minstepd = 1.0e-8;
+  params.usexzgap = 1;
+  params.tweakgap = 0;
+  params.affine = 0;
+  params.perturbobj = 0;  // the optimum is unique (strictly convex distance): no perturbation
+  params.fastmode = 0;
+  return params;
+}
+
+// CSDP's start (its own, or X = Z = I, y = 0), its work space and its solve, under the lock:
+// CSDP's return code; its primal and dual objectives in pobj, dobj.
+int run_csdp(CsdpWorkspace& w, const LmiSettings& settings, double& pobj, double& dobj) {
+  const paramstruc params = csdp_parameters(settings);
+  const int printlevel = 0;  // CSDP prints nothing (initparams() is bypassed: no param.csdp)
+  const int k = w.k, nb = w.C.nblocks;
+  const int ldam = k % 2 == 0 ? k + 1 : k;
+  const std::size_t nk = static_cast<std::size_t>(std::max(w.n, k)) + 1;
+  std::lock_guard<std::mutex> lock(csdp_mutex());
+  initsoln(w.n, k, w.C, w.a, w.constraints, &w.X, &w.y, &w.Z);
+  if (settings.identity_start) {
+    for (int b = 1; b <= nb; ++b) {
+      const int size = w.X.blocks[b].blocksize;
+      for (int i = 1; i <= size; ++i)
+        for (int j = 1; j <= size; ++j) {
+          w.X.blocks[b].data.mat[ijtok(i, j, size)] = i == j ? 1.0 : 0.0;
+          w.Z.blocks[b].data.mat[ijtok(i, j, size)] = i == j ? 1.0 : 0.0;
+        }
+    }
+    for (int v = 1; v <= k; ++v) w.y[v] = 0;
+  }
+  alloc_mat(w.C, &w.work1);
+  alloc_mat(w.C, &w.work2);
+  alloc_mat(w.C, &w.work3);
+  alloc_mat(w.C, &w.Zi);
+  alloc_mat(w.C, &w.dZ);
+  alloc_mat(w.C, &w.dX);
+  alloc_mat_packed(w.C, &w.bestx);
+  alloc_mat_packed(w.C, &w.bestz);
+  alloc_mat_packed(w.C, &w.cholxinv);
+  alloc_mat_packed(w.C, &w.cholzinv);
+  double* wv[8];
+  for (double*& v : wv) v = w.vector(nk);
+  double* diagO = w.vector(nk);
+  double* besty = w.vector(k + 1);
+  double* rhs = w.vector(k + 1);
+  double* dy = w.vector(k + 1);
+  double* dy1 = w.vector(k + 1);
+  double* Fp = w.vector(k + 1);
+  double* O = w.vector(static_cast<std::size_t>(ldam) * ldam);
+  makefill(k, w.C, w.constraints, &w.fill, w.work1, printlevel);
+  w.have_fill = true;
+  return sdp(w.n, k, w.C, w.a, 0.0, w.constraints, w.byblocks, w.fill, w.X, w.y, w.Z, w.cholxinv, w.cholzinv, &pobj,
+             &dobj, w.work1, w.work2, w.work3, wv[0], wv[1], wv[2], wv[3], wv[4], wv[5], wv[6], wv[7], diagO, w.bestx,
+             besty, w.bestz, w.Zi, O, rhs, w.dZ, w.dX, dy, dy1, Fp, printlevel, params);
+}
+
 }  // namespace
 
 std::string LmiSolution::message() const {
@@ -147,137 +285,15 @@ LmiSolution LmiProblem::solve(const LmiSettings& settings) const {
 
   CsdpWorkspace w;
   w.k = k;
-  for (const auto& c : constant_) w.n += static_cast<int>(c.rows());
-
-  // C = -F_k0, exactly symmetric (CSDP checks C(i,j) == C(j,i) bitwise).
-  w.C.nblocks = nb;
-  w.C.blocks = allocate<blockrec>(nb + 1);
-  for (int b = 0; b < nb; ++b) {
-    const Eigen::MatrixXd& F = constant_[b];
-    const int s = static_cast<int>(F.rows());
-    blockrec& r = w.C.blocks[b + 1];
-    r.blockcategory = MATRIX;
-    r.blocksize = s;
-    r.data.mat = allocate<double>(static_cast<std::size_t>(s) * s);
-    for (int i = 0; i < s; ++i)
-      for (int j = i; j < s; ++j) {
-        const double v = i == j ? -F(i, i) : -0.5 * (F(i, j) + F(j, i));
-        r.data.mat[ijtok(i + 1, j + 1, s)] = v;
-        r.data.mat[ijtok(j + 1, i + 1, s)] = v;
-      }
-  }
-
+  set_constant(w, constant_);
   w.a = allocate<double>(k + 1);
   for (int v = 0; v < k; ++v) w.a[v + 1] = objective_(v);
+  set_constraints(w, coefficient_);
+  link_by_block(w);
 
-  // The constraint matrices: per variable a list of its nonzero blocks, ascending.
-  w.constraints = allocate<constraintmatrix>(k + 1);
-  for (int v = 0; v < k; ++v) {
-    sparseblock** tail = &w.constraints[v + 1].blocks;
-    for (int b = 0; b < nb; ++b) {
-      const auto& entries = coefficient_[v][b];
-      if (entries.empty()) continue;
-      auto* p = allocate<sparseblock>(1);
-      *tail = p;
-      tail = &p->next;
-      const int m = static_cast<int>(entries.size());
-      p->numentries = m;
-      p->blocknum = b + 1;
-      p->blocksize = w.C.blocks[b + 1].blocksize;
-      p->constraintnum = v + 1;
-      p->entries = allocate<double>(m + 1);
-      p->iindices = allocate<int>(m + 1);
-      p->jindices = allocate<int>(m + 1);
-      for (int e = 0; e < m; ++e) {
-        p->entries[e + 1] = entries[e].value;
-        p->iindices[e + 1] = entries[e].i;
-        p->jindices[e + 1] = entries[e].j;
-      }
-      // Sparse or dense handling is a speed choice only: dense once a block holds a good share
-      // of the Schur-complement work (CSDP's own rule of thumb, restated).
-      const double s = p->blocksize;
-      p->issparse = !(m > 5 && 1.0 * k * m * m > 0.125 * s * s * s);
-    }
-  }
-
-  // byblocks[b]: the first constraint block on block b; nextbyblock chains the others upward.
-  w.byblocks = allocate<sparseblock*>(nb + 1);
-  {
-    std::vector<sparseblock*> last(nb + 1, nullptr);
-    for (int v = 1; v <= k; ++v)
-      for (sparseblock* p = w.constraints[v].blocks; p; p = p->next) {
-        p->nextbyblock = nullptr;
-        if (last[p->blocknum]) last[p->blocknum]->nextbyblock = p;
-        else w.byblocks[p->blocknum] = p;
-        last[p->blocknum] = p;
-      }
-  }
-
-  paramstruc params{};
-  params.axtol = settings.tolerance;
-  params.atytol = settings.tolerance;
-  params.objtol = settings.tolerance;
-  params.pinftol = 1.0e8;
-  params.dinftol = 1.0e8;
-  params.maxiter = settings.max_iterations;
-  params.minstepfrac = 0.90;
-  params.maxstepfrac = 0.97;
-  params.minstepp = 1.0e-8;
-  params.minstepd = 1.0e-8;
-  params.usexzgap = 1;
-  params.tweakgap = 0;
-  params.affine = 0;
-  params.perturbobj = 0;  // the optimum is unique (strictly convex distance): no perturbation
-  params.fastmode = 0;
-  const int printlevel = 0;  // CSDP prints nothing (initparams() is bypassed: no param.csdp)
-
-  const int ldam = k % 2 == 0 ? k + 1 : k;
-  const std::size_t nk = static_cast<std::size_t>(std::max(w.n, k)) + 1;
   double pobj = 0, dobj = 0;
-  int code;
-  {
-    std::lock_guard<std::mutex> lock(csdp_mutex());
-    initsoln(w.n, k, w.C, w.a, w.constraints, &w.X, &w.y, &w.Z);
-    if (settings.identity_start) {
-      for (int b = 1; b <= nb; ++b) {
-        const int size = w.X.blocks[b].blocksize;
-        for (int i = 1; i <= size; ++i)
-          for (int j = 1; j <= size; ++j) {
-            w.X.blocks[b].data.mat[ijtok(i, j, size)] = i == j ? 1.0 : 0.0;
-            w.Z.blocks[b].data.mat[ijtok(i, j, size)] = i == j ? 1.0 : 0.0;
-          }
-      }
-      for (int v = 1; v <= k; ++v) w.y[v] = 0;
-    }
-    alloc_mat(w.C, &w.work1);
-    alloc_mat(w.C, &w.work2);
-    alloc_mat(w.C, &w.work3);
-    alloc_mat(w.C, &w.Zi);
-    alloc_mat(w.C, &w.dZ);
-    alloc_mat(w.C, &w.dX);
-    alloc_mat_packed(w.C, &w.bestx);
-    alloc_mat_packed(w.C, &w.bestz);
-    alloc_mat_packed(w.C, &w.cholxinv);
-    alloc_mat_packed(w.C, &w.cholzinv);
-    double* wv[8];
-    for (double*& v : wv) v = w.vector(nk);
-    double* diagO = w.vector(nk);
-    double* besty = w.vector(k + 1);
-    double* rhs = w.vector(k + 1);
-    double* dy = w.vector(k + 1);
-    double* dy1 = w.vector(k + 1);
-    double* Fp = w.vector(k + 1);
-    double* O = w.vector(static_cast<std::size_t>(ldam) * ldam);
-    makefill(k, w.C, w.constraints, &w.fill, w.work1, printlevel);
-    w.have_fill = true;
-    code = sdp(w.n, k, w.C, w.a, 0.0, w.constraints, w.byblocks, w.fill, w.X, w.y, w.Z, w.cholxinv,
-               w.cholzinv, &pobj, &dobj, w.work1, w.work2, w.work3, wv[0], wv[1], wv[2], wv[3], wv[4],
-               wv[5], wv[6], wv[7], diagO, w.bestx, besty, w.bestz, w.Zi, O, rhs, w.dZ, w.dX, dy, dy1,
-               Fp, printlevel, params);
-  }
-
   LmiSolution s;
-  s.code = code;
+  s.code = run_csdp(w, settings, pobj, dobj);
   s.y.resize(k);
   for (int v = 0; v < k; ++v) s.y(v) = w.y[v + 1];
   s.objective = dobj;

@@ -170,8 +170,8 @@ TaskEnd run_task(const Farm& farm, const std::string& task, bool isolate, const 
   return end;
 }
 
-int worker_count(const FarmOptions& o, int ranks_on_this_machine) {
-  if (o.workers > 0) return o.workers;
+int worker_count(const FarmOptions& options, int ranks_on_this_machine) {
+  if (options.workers > 0) return options.workers;
   const int cores = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
   // A process bound to fewer cores (mpirun binds each rank to a core when it starts two or
   // fewer; Slurm's --cpus-per-task) gets as many workers as it may use cores.
@@ -185,9 +185,9 @@ int worker_count(const FarmOptions& o, int ranks_on_this_machine) {
 
 namespace {
 
-FarmSummary run_local(const std::vector<std::string>& tasks, const Farm& farm, const FarmOptions& o) {
+FarmSummary run_local(const std::vector<std::string>& tasks, const Farm& farm, const FarmOptions& options) {
   FarmSummary summary;
-  summary.workers = std::min(detail::worker_count(o, 1), std::max(1, static_cast<int>(tasks.size())));
+  summary.workers = std::min(detail::worker_count(options, 1), std::max(1, static_cast<int>(tasks.size())));
   summary.tasks.resize(tasks.size());
   std::mutex m;  // one callback at a time
   std::size_t next = 0;  // under m
@@ -200,7 +200,7 @@ FarmSummary run_local(const std::vector<std::string>& tasks, const Farm& farm, c
         if (summary.stopped || next >= tasks.size()) return;
         i = next++;
       }
-      TaskEnd e = detail::run_task(farm, tasks[i], o.isolate, [&](const std::string& r) {
+      TaskEnd e = detail::run_task(farm, tasks[i], options.isolate, [&](const std::string& r) {
         std::lock_guard<std::mutex> lock(m);
         if (farm.on_result) farm.on_result(i, r);
       });

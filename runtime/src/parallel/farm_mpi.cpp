@@ -125,126 +125,161 @@ std::string end_message(const TaskEnd& e) {
   return b + e.failure;
 }
 
-FarmSummary coordinate(const std::vector<std::string>& tasks, const Farm& farm, const FarmOptions& options) {
-  const Session& s = session();
-  FarmSummary summary;
-  summary.ranks = s.place.ranks;
-  summary.workers = detail::worker_count(options, s.ranks_on_node);
-  summary.tasks.resize(tasks.size());
-  std::mutex m;  // the list and the callbacks
-  std::size_t next = 0;
-  // Every task is handed out here, to this rank's workers and to the others: Farm::stop is
-  // asked before each, as the local farm does; once stopped, every rank is told there is none.
-  auto take_next = [&]() -> std::int64_t {
-    std::lock_guard<std::mutex> lock(m);
-    if (!summary.stopped && next < tasks.size() && farm.stop && farm.stop()) summary.stopped = true;
-    return !summary.stopped && next < tasks.size() ? static_cast<std::int64_t>(next++) : -1;
-  };
-  auto ended = [&](TaskEnd e) {
-    std::lock_guard<std::mutex> lock(m);
-    summary.tasks[e.task] = e;
-    if (farm.on_end) farm.on_end(e);
-  };
-  auto worker = [&] {
+// Rank 0: hands every task out, to this rank's workers and to the other ranks, and gathers
+// their ends.
+class Coordinator {
+ public:
+  Coordinator(const std::vector<std::string>& tasks, const Farm& farm, const FarmOptions& options)
+      : tasks_(tasks), farm_(farm), options_(options), ranks_(session().place.ranks) {
+    summary_.ranks = ranks_;
+    summary_.workers = detail::worker_count(options, session().ranks_on_node);
+    summary_.tasks.resize(tasks.size());
+    heard_.assign(ranks_, Clock::now());
+    spoke_.assign(ranks_, false);
+    done_.assign(ranks_, false);
+    lost_.assign(ranks_, false);
+  }
+
+  FarmSummary run() {
+    std::vector<std::thread> pool;
+    for (int w = 0; w < summary_.workers; ++w) pool.emplace_back([this] { work(); });
+    std::string b;
+    MPI_Status st;
+    while (byes_ < ranks_ - 1) {
+      if (!receive(MPI_ANY_SOURCE, MPI_ANY_TAG, b, st)) {
+        fail_silent_ranks();
+        std::this_thread::sleep_for(kPoll);
+        continue;
+      }
+      heard_[st.MPI_SOURCE] = Clock::now();
+      spoke_[st.MPI_SOURCE] = true;
+      if (lost_[st.MPI_SOURCE]) continue;  // a rank taken as lost that was only slow: too late
+      if (st.MPI_TAG == kRequest) {
+        hand_out(b, st.MPI_SOURCE);
+      } else if (st.MPI_TAG == kResult) {
+        gather(b, st.MPI_SOURCE);
+      } else if (st.MPI_TAG == kBye) {
+        done_[st.MPI_SOURCE] = true;
+        ++byes_;
+      }
+    }
+    for (auto& t : pool) t.join();
+    for (std::size_t i = next_; i < tasks_.size(); ++i) summary_.tasks[i] = TaskEnd{i, 0, true, "stopped"};
+    // The end, to every rank still there, with whether one was lost: then no rank calls
+    // MPI_Finalize, which would wait for the lost one forever.
+    std::string end;
+    put<std::int32_t>(end, session().lost_rank);
+    for (int r = 1; r < ranks_; ++r)
+      if (!lost_[r]) send(end, r, kEnd);
+    return summary_;
+  }
+
+ private:
+  // The next task, or -1: Farm::stop is asked before each, as the local farm does; once stopped,
+  // every rank is told there is none.
+  std::int64_t take_next() {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (!summary_.stopped && next_ < tasks_.size() && farm_.stop && farm_.stop()) summary_.stopped = true;
+    return !summary_.stopped && next_ < tasks_.size() ? static_cast<std::int64_t>(next_++) : -1;
+  }
+
+  void ended(const TaskEnd& e) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    summary_.tasks[e.task] = e;
+    if (farm_.on_end) farm_.on_end(e);
+  }
+
+  // One of this rank's workers.
+  void work() {
     for (std::int64_t i; (i = take_next()) >= 0;) {
-      TaskEnd e = detail::run_task(farm, tasks[i], options.isolate, [&](const std::string& r) {
-        std::lock_guard<std::mutex> lock(m);
-        if (farm.on_result) farm.on_result(static_cast<std::size_t>(i), r);
+      TaskEnd e = detail::run_task(farm_, tasks_[i], options_.isolate, [&](const std::string& r) {
+        std::lock_guard<std::mutex> lock(mutex_);
+        if (farm_.on_result) farm_.on_result(static_cast<std::size_t>(i), r);
       });
       e.task = static_cast<std::size_t>(i);
       ended(e);
     }
-  };
-  std::vector<std::thread> pool;
-  for (int w = 0; w < summary.workers; ++w) pool.emplace_back(worker);
+  }
 
   // Every other rank sends something at least every second (kBeat); one silent for longer than
   // rank_timeout is taken as lost (its process or node died; the job goes on only when the
   // launcher lets it, e.g. Open MPI's --mca orte_enable_recovery 1): its tasks in flight fail
-  // with that reason and the others finish.
-  int byes = 0;
-  std::vector<Clock::time_point> heard(s.place.ranks, Clock::now());
-  // Before its first message a rank gets ten times as long: it may still be reading the study's
-  // inputs (a study's finished records, on a slow shared file system).
-  std::vector<bool> spoke(s.place.ranks, false);
-  std::vector<bool> done(s.place.ranks, false), lost(s.place.ranks, false);  // done: said bye, or lost
-  std::vector<std::pair<std::int64_t, int>> running;  // (task, rank) handed to other ranks
-  const auto timeout = std::chrono::duration<double>(options.rank_timeout);
-  std::string b;
-  MPI_Status st;
-  while (byes < s.place.ranks - 1) {
-    if (!receive(MPI_ANY_SOURCE, MPI_ANY_TAG, b, st)) {
-      const auto now = Clock::now();
-      for (int r = 1; r < s.place.ranks; ++r) {
-        if (done[r] || now - heard[r] < (spoke[r] ? 1 : 10) * timeout) continue;
-        done[r] = lost[r] = true;
-        ++byes;
-        session().lost_rank = true;
-        for (auto t = running.begin(); t != running.end();) {
-          if (t->second != r) {
-            ++t;
-            continue;
-          }
-          TaskEnd e;
-          e.task = static_cast<std::size_t>(t->first);
-          e.rank = r;
-          e.failed = true;
-          e.failure = fmt::format("rank {} stopped answering for {:g} s while running this task (its process or node was lost)",
-                                  r, options.rank_timeout);
-          ended(e);
-          t = running.erase(t);
+  // with that reason and the others finish. Before its first message a rank gets ten times as
+  // long: it may still be reading the study's inputs (a study's finished records, on a slow
+  // shared file system).
+  void fail_silent_ranks() {
+    const auto now = Clock::now();
+    const auto timeout = std::chrono::duration<double>(options_.rank_timeout);
+    for (int r = 1; r < ranks_; ++r) {
+      if (done_[r] || now - heard_[r] < (spoke_[r] ? 1 : 10) * timeout) continue;
+      done_[r] = lost_[r] = true;
+      ++byes_;
+      session().lost_rank = true;
+      for (auto t = running_.begin(); t != running_.end();) {
+        if (t->second != r) {
+          ++t;
+          continue;
         }
-      }
-      std::this_thread::sleep_for(kPoll);
-      continue;
-    }
-    heard[st.MPI_SOURCE] = Clock::now();
-    spoke[st.MPI_SOURCE] = true;
-    if (lost[st.MPI_SOURCE]) continue;  // a rank taken as lost that was only slow: too late
-    std::size_t at = 0;
-    if (st.MPI_TAG == kRequest) {
-      const auto slot = take<std::int32_t>(b, at);
-      const std::int64_t i = take_next();
-      std::string reply;
-      put<std::int64_t>(reply, i);
-      if (i >= 0) {
-        reply += tasks[i];
-        running.emplace_back(i, st.MPI_SOURCE);
-      }
-      send(reply, st.MPI_SOURCE, kTaskBase + slot);
-    } else if (st.MPI_TAG == kResult) {
-      const char kind = b[at++];
-      const auto i = take<std::uint64_t>(b, at);
-      if (kind == 'R') {
-        std::lock_guard<std::mutex> lock(m);
-        if (farm.on_result) farm.on_result(i, b.substr(at));
-      } else {
         TaskEnd e;
-        e.task = i;
-        e.rank = st.MPI_SOURCE;
-        e.failed = take<std::int32_t>(b, at) != 0;
-        e.wall = take<double>(b, at);
-        e.peak_memory_mb = take<double>(b, at);
-        e.failure = b.substr(at);
-        running.erase(std::remove(running.begin(), running.end(), std::make_pair(static_cast<std::int64_t>(i), st.MPI_SOURCE)),
-                      running.end());
+        e.task = static_cast<std::size_t>(t->first);
+        e.rank = r;
+        e.failed = true;
+        e.failure = fmt::format("rank {} stopped answering for {:g} s while running this task (its process or node was lost)",
+                                r, options_.rank_timeout);
         ended(e);
+        t = running_.erase(t);
       }
-    } else if (st.MPI_TAG == kBye) {
-      done[st.MPI_SOURCE] = true;
-      ++byes;
     }
   }
-  for (auto& t : pool) t.join();
-  for (std::size_t i = next; i < tasks.size(); ++i) summary.tasks[i] = TaskEnd{i, 0, true, "stopped"};
-  // The end, to every rank still there, with whether one was lost: then no rank calls
-  // MPI_Finalize, which would wait for the lost one forever.
-  std::string end;
-  put<std::int32_t>(end, session().lost_rank);
-  for (int r = 1; r < s.place.ranks; ++r)
-    if (!lost[r]) send(end, r, kEnd);
-  return summary;
-}
+
+  // A worker slot of another rank asks for a task: the next, or -1.
+  void hand_out(const std::string& b, int rank) {
+    std::size_t at = 0;
+    const auto slot = take<std::int32_t>(b, at);
+    const std::int64_t i = take_next();
+    std::string reply;
+    put<std::int64_t>(reply, i);
+    if (i >= 0) {
+      reply += tasks_[i];
+      running_.emplace_back(i, rank);
+    }
+    send(reply, rank, kTaskBase + slot);
+  }
+
+  // A result ('R') or the end ('E', end_message) of a task another rank ran.
+  void gather(const std::string& b, int rank) {
+    std::size_t at = 0;
+    const char kind = b[at++];
+    const auto i = take<std::uint64_t>(b, at);
+    if (kind == 'R') {
+      std::lock_guard<std::mutex> lock(mutex_);
+      if (farm_.on_result) farm_.on_result(i, b.substr(at));
+      return;
+    }
+    TaskEnd e;
+    e.task = i;
+    e.rank = rank;
+    e.failed = take<std::int32_t>(b, at) != 0;
+    e.wall = take<double>(b, at);
+    e.peak_memory_mb = take<double>(b, at);
+    e.failure = b.substr(at);
+    running_.erase(std::remove(running_.begin(), running_.end(), std::make_pair(static_cast<std::int64_t>(i), rank)),
+                   running_.end());
+    ended(e);
+  }
+
+  const std::vector<std::string>& tasks_;
+  const Farm& farm_;
+  const FarmOptions& options_;
+  const int ranks_;
+  FarmSummary summary_;
+  std::mutex mutex_;  // the list and the callbacks
+  std::size_t next_ = 0;
+  int byes_ = 0;
+  std::vector<Clock::time_point> heard_;
+  std::vector<bool> spoke_, done_, lost_;  // done: said bye, or lost
+  std::vector<std::pair<std::int64_t, int>> running_;  // (task, rank) handed to other ranks
+};
 
 void serve(const Farm& farm, const FarmOptions& options) {
   const Session& s = session();
@@ -315,7 +350,7 @@ void abort_job(int code) {
 
 namespace detail {
 FarmSummary run_farm_mpi(const std::vector<std::string>& tasks, const Farm& farm, const FarmOptions& options) {
-  if (session().place.rank == 0) return coordinate(tasks, farm, options);
+  if (session().place.rank == 0) return Coordinator(tasks, farm, options).run();
   serve(farm, options);
   FarmSummary summary;
   summary.ranks = session().place.ranks;

@@ -23,10 +23,10 @@ namespace symoro::preprocess {
 
 namespace {
 
-void validate_options(const Options& o) {
-  if (!(o.base_period >= 0) || !std::isfinite(o.base_period) || !std::isfinite(o.torque_delay) || !(o.max_gap > 0) ||
-      o.filter_order < 1 ||
-      !(o.derivative_cutoff > 0) || !(o.anti_alias_fraction > 0) || !(o.anti_alias_fraction <= 1))
+void validate_options(const Options& options) {
+  if (!(options.base_period >= 0) || !std::isfinite(options.base_period) || !std::isfinite(options.torque_delay) || !(options.max_gap > 0) ||
+      options.filter_order < 1 ||
+      !(options.derivative_cutoff > 0) || !(options.anti_alias_fraction > 0) || !(options.anti_alias_fraction <= 1))
     throw std::invalid_argument(
         "preprocess options: base_period >= 0 (0: the log's), max_gap, derivative_cutoff "
         "positive, filter_order >= 1 and anti_alias_fraction in (0, 1]");

@@ -61,11 +61,11 @@ struct DatasetDiagnosis {
 // The options' own rules, before any work: the variant's name (symoroc's rule), the effects
 // named in `only` (std::invalid_argument for an unknown one), a payload only against held
 // parameters. diagnose_dataset checks them too.
-void check_request(const DatasetDiagnosisOptions& o);
+void check_request(const DatasetDiagnosisOptions& options);
 
 // The fitting and held-out runs of `o.trial`: as named, else the dataset's.
 std::pair<std::vector<std::string>, std::vector<std::string>> diagnosis_runs(const io::Dataset& data,
-                                                                              const DatasetDiagnosisOptions& o);
+                                                                              const DatasetDiagnosisOptions& options);
 
 DatasetDiagnosis diagnose_dataset(const DiagnosisModel& model, const DatasetDiagnosisOptions& options);
 

@@ -113,6 +113,17 @@ class VirtualBus {
 
   void run();
   void process(const DecodeEvent& event, double now);
+  // The instructions process() answers (p: addressed to `broadcast` or one ID).
+  void answer_decode_error(const DecodeEvent& event);
+  void answer_ping(const Packet& p, bool broadcast);
+  void answer_read(const Packet& p);
+  void answer_write(const Packet& p, bool broadcast);
+  void answer_reboot(const Packet& p, bool broadcast);
+  // Whether `s` answers an instruction that needs status return level `level` (0: ping only;
+  // 1: ping and reads; 2: everything, the factory value).
+  static bool answers(const Servo& s, int level);
+  // A read's reply from `s` when it answers at `level`, or an access error.
+  void read_into(Servo& s, std::uint16_t address, std::uint16_t length, int level);
   void reply(Servo& servo, std::uint8_t error, ByteView params);
   ErrorNumber apply_write(Servo& servo, std::uint16_t address, ByteView data);
   void update_command(std::size_t index);

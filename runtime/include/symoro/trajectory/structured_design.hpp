@@ -49,11 +49,11 @@ struct StructuredDesignOptions {
 
 // The working box per joint (rad): the position limits less the margin, cut to the audit box
 // and to +-120 deg around its middle.
-void structured_box(const StructuredDesignOptions& o, Eigen::VectorXd& lower, Eigen::VectorXd& upper);
+void structured_box(const StructuredDesignOptions& options, Eigen::VectorXd& lower, Eigen::VectorXd& upper);
 
 // The design file's text. Throws std::invalid_argument for a robot with a prismatic joint (the
 // design format is in degrees) or options whose sizes do not match the joints.
-std::string structured_design_yaml(const StructuredDesignOptions& o);
+std::string structured_design_yaml(const StructuredDesignOptions& options);
 
 // A trajectory entry of the design file holding a Fourier series (`periods` periods from rest at
 // `posture` back to it), its coefficients at full precision so that it reads back bit for bit.
