@@ -36,10 +36,11 @@ const std::string kRobot = std::string(SYMORO_ROBOTS_DIR) + "/crane_x7";
 struct Fixture {
   symoro::twin::TwinConfig config = symoro::twin::read_twin_config(kRobot + "/twin.yaml", Full::nq);
   symoro::trajectory::Trajectory trajectory =
-      symoro::trajectory::TrajectoryDesign::read(kRobot + "/trajectories.yaml",
-                                                 std::vector<symoro::JointInfo>(Full::joints.begin(), Full::joints.end()))
+      symoro::trajectory::TrajectoryDesign::read(
+          kRobot + "/trajectories.yaml", std::vector<symoro::JointInfo>(Full::joints.begin(), Full::joints.end()))
           .build("AG02");
-  Eigen::VectorXd truth = Reduced::from_parent(symoro::twin::make_truth(symoro::robot::compiled_model<Full>(), config).phi);
+  Eigen::VectorXd truth =
+      Reduced::from_parent(symoro::twin::make_truth(symoro::robot::compiled_model<Full>(), config).phi);
   identify::ClosedLoopSimulator<Reduced> sim{identify::closed_loop_setup(config.controller), trajectory};
   // The exact derivatives of the discrete map (ClosedLoopSetup::exact_sensitivities).
   identify::ClosedLoopSimulator<Reduced> sim_exact{exact_setup(config), trajectory};
@@ -116,7 +117,8 @@ void clie_ag02(benchmark::State& state, Path path, bool runtime = false) {
   const Fixture& f = fixture();
   symoro::twin::RunOptions run;
   run.robot = "crane_x7";
-  const symoro::io::Log log = symoro::twin::ClosedLoopTwin(symoro::robot::compiled_model<Full>(), f.config).run(f.trajectory, run);
+  const symoro::io::Log log =
+      symoro::twin::ClosedLoopTwin(symoro::robot::compiled_model<Full>(), f.config).run(f.trajectory, run);
   identify::ClieOptions options;
   const symoro::preprocess::Samples samples = symoro::preprocess::preprocess(log, 0.04, options.preprocess);
   Eigen::VectorXd phi0 = f.truth;

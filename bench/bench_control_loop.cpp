@@ -39,7 +39,8 @@ void BM_ControlLoopOverThePty(benchmark::State& state) {
   const symoro::control::FfpdGains gains = symoro::twin::controller_gains(twin);
   const symoro::trajectory::Trajectory traj =
       symoro::trajectory::TrajectoryDesign::read(kRobot / "trajectories.yaml", joints).build("AG02");
-  const std::string csv = (std::filesystem::temp_directory_path() / ("bench_control_loop_" + std::to_string(::getpid()) + ".csv")).string();
+  const std::string csv =
+      (std::filesystem::temp_directory_path() / ("bench_control_loop_" + std::to_string(::getpid()) + ".csv")).string();
   hw::ControlOptions o;
   o.seconds = 3.0;
   o.robot = "crane_x7";

@@ -211,7 +211,7 @@ void m_second(benchmark::State& state) {
   }
 }
 
-#define SYMORO_BENCH_MODEL(label, M)                  \
+#define SYMORO_BENCH_MODEL(label, M)                                    \
   BENCHMARK_TEMPLATE(m_derivatives, M)->Name(label "/m_derivatives");   \
   BENCHMARK_TEMPLATE(m_jet, M)->Name(label "/m_jet");                   \
   BENCHMARK_TEMPLATE(m_second, M)->Name(label "/m_second");             \

@@ -35,7 +35,8 @@ void BM_EncodeSyncWriteGoalCurrent8(benchmark::State& state) {
   std::array<std::uint8_t, 16> data{};
   for (std::size_t i = 0; i < data.size(); ++i) data[i] = i % 3 == 0 ? 0xFF : static_cast<std::uint8_t>(i);
   for (auto _ : state) {
-    const ByteView v = encode_sync_write(102, 2, ByteView(kIds.data(), kIds.size()), ByteView(data.data(), data.size()), out);
+    const ByteView v =
+        encode_sync_write(102, 2, ByteView(kIds.data(), kIds.size()), ByteView(data.data(), data.size()), out);
     benchmark::DoNotOptimize(v);
   }
 }

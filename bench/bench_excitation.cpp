@@ -51,7 +51,8 @@ void BM_ExcitationDesign_CraneX7Full(benchmark::State& state) {
   for (auto _ : state) {
     const ExcitationDesign d = design_excitation(*model, o);
     criterion = d.criterion;
-    state.counters["starts_passed"] = static_cast<double>(std::count_if(d.starts.begin(), d.starts.end(), [](const auto& s) { return s.passed; }));
+    state.counters["starts_passed"] =
+        static_cast<double>(std::count_if(d.starts.begin(), d.starts.end(), [](const auto& s) { return s.passed; }));
     benchmark::DoNotOptimize(criterion);
   }
   state.counters["log_det"] = criterion;

@@ -23,14 +23,16 @@ namespace {
 
 using Full = symoro::crane_x7::Model;
 using Model = symoro::crane_x7::reduced::Model;
-const std::filesystem::path kDir = std::filesystem::temp_directory_path() / ("symoro_bench_import_" + std::to_string(::getpid()));
+const std::filesystem::path kDir =
+    std::filesystem::temp_directory_path() / ("symoro_bench_import_" + std::to_string(::getpid()));
 
 // The export, written once: the twin's true parameters, 5 % stale rows, noise.
 const std::filesystem::path& export_csv() {
   static const std::filesystem::path file = [] {
     std::filesystem::create_directories(kDir);
     const auto twin = symoro::twin::read_twin_config(std::string(SYMORO_ROBOTS_DIR) + "/crane_x7/twin.yaml", Full::nq);
-    const Eigen::Matrix<double, Full::np, 1> phi = symoro::twin::make_truth(symoro::robot::compiled_model<Full>(), twin).phi;
+    const Eigen::Matrix<double, Full::np, 1> phi =
+        symoro::twin::make_truth(symoro::robot::compiled_model<Full>(), twin).phi;
     const symoro::io::Log log = symoro::test::synthesize<Full>("arm", phi, 20.0, 3, 0.01);
     const auto f = kDir / "export.csv";
     symoro::test::write_export_csv<Full>(log, f);

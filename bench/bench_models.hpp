@@ -132,14 +132,14 @@ void forward_dynamics(benchmark::State& state) {
   }
 }
 
-#define SYMORO_BENCH_ALL(model)                                 \
-  BENCHMARK_TEMPLATE(regressor, model, Double);                 \
-  BENCHMARK_TEMPLATE(regressor, model, Jet);                    \
-  BENCHMARK_TEMPLATE(inverse_dynamics, model, Double);          \
-  BENCHMARK_TEMPLATE(inverse_dynamics, model, Jet);             \
-  BENCHMARK_TEMPLATE(inertia, model, Double);                   \
-  BENCHMARK_TEMPLATE(inertia, model, Jet);                      \
-  BENCHMARK_TEMPLATE(forward_dynamics, model, Double);          \
+#define SYMORO_BENCH_ALL(model)                        \
+  BENCHMARK_TEMPLATE(regressor, model, Double);        \
+  BENCHMARK_TEMPLATE(regressor, model, Jet);           \
+  BENCHMARK_TEMPLATE(inverse_dynamics, model, Double); \
+  BENCHMARK_TEMPLATE(inverse_dynamics, model, Jet);    \
+  BENCHMARK_TEMPLATE(inertia, model, Double);          \
+  BENCHMARK_TEMPLATE(inertia, model, Jet);             \
+  BENCHMARK_TEMPLATE(forward_dynamics, model, Double); \
   BENCHMARK_TEMPLATE(forward_dynamics, model, Jet)
 
 }  // namespace

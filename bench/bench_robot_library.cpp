@@ -32,7 +32,8 @@ struct State {
   State() {
     std::mt19937 g(1);
     std::uniform_real_distribution<double> u(-1, 1);
-    for (auto* v : {&q, &qd, &qdd}) for (int i = 0; i < Model::nq; ++i) (*v)(i) = u(g);
+    for (auto* v : {&q, &qd, &qdd})
+      for (int i = 0; i < Model::nq; ++i) (*v)(i) = u(g);
     for (int i = 0; i < Model::np; ++i) phi(i) = u(g);
   }
 };
@@ -110,7 +111,8 @@ using Rx90 = symoro::rx90::Model;
 // Registered in pairs, inline then loaded, so the table reads as the comparison.
 const bool registered = [] {
   benchmark::RegisterBenchmark("crane_x7.reduced/inverse_dynamics/inline", InverseDynamicsInline<Crane>);
-  benchmark::RegisterBenchmark("crane_x7.reduced/inverse_dynamics/loaded", InverseDynamicsLoaded<Crane>, "crane_x7", "reduced");
+  benchmark::RegisterBenchmark("crane_x7.reduced/inverse_dynamics/loaded", InverseDynamicsLoaded<Crane>, "crane_x7",
+                               "reduced");
   benchmark::RegisterBenchmark("crane_x7.reduced/regressor/inline", RegressorInline<Crane>);
   benchmark::RegisterBenchmark("crane_x7.reduced/regressor/loaded", RegressorLoaded<Crane>, "crane_x7", "reduced");
   benchmark::RegisterBenchmark("crane_x7.reduced/inertia/inline", InertiaInline<Crane>);

@@ -26,8 +26,10 @@ int main(int argc, char** argv) {
     const auto& p = Model::standard_parameters[k];
     const std::string fam = p.family;
     double v = s(k);
-    if (fam == "IA" || fam == "FV" || fam == "FS") v *= 1 + u(rng);
-    else v *= link_factor[p.joint];
+    if (fam == "IA" || fam == "FV" || fam == "FS")
+      v *= 1 + u(rng);
+    else
+      v *= link_factor[p.joint];
     std::printf("  - {name: \"%s\", value: %.17g}\n", p.name, v);
   }
 }

@@ -3,6 +3,7 @@
 set -euo pipefail
 packages=(
   build-essential cmake ninja-build clang libclang-rt-14-dev
+  clang-format-14  # the code's format (.clang-format), checked by the test format.clang_format
   libeigen3-dev libboost-dev libfmt-dev libcli11-dev libyaml-cpp-dev
   libceres-dev coinor-libipopt-dev libsdp-dev
   libblas3 liblapack3  # the reference BLAS/LAPACK every program links (CMakeLists.txt says why)

@@ -11,7 +11,8 @@ namespace {
 
 std::string str(int v) { return std::to_string(v); }
 
-void bind_symbols(std::map<std::string, std::string>& inputs, const std::vector<std::string>& symbols, const std::string& vector) {
+void bind_symbols(std::map<std::string, std::string>& inputs, const std::vector<std::string>& symbols,
+                  const std::string& vector) {
   for (std::size_t k = 0; k < symbols.size(); ++k) inputs[symbols[k]] = vector + "[" + str(static_cast<int>(k)) + "]";
 }
 
@@ -29,13 +30,15 @@ void assign_columns(const ExprGraph& g, const std::string& target, const std::ve
     for (std::size_t j = 0; j < by_column[k].size(); ++j) {
       const NodeId v = by_column[k][j];
       roots.push_back(v);
-      if (!g.is_constant(v, 0.0)) out.push_back({target + "(" + str(static_cast<int>(j)) + ", " + str(static_cast<int>(k)) + ")", v});
+      if (!g.is_constant(v, 0.0))
+        out.push_back({target + "(" + str(static_cast<int>(j)) + ", " + str(static_cast<int>(k)) + ")", v});
     }
 }
 
 std::string size_checks(const std::vector<std::pair<std::string, std::size_t>>& args) {
   std::string s;
-  for (const auto& [name, size] : args) s += "  eigen_assert(" + name + ".size() == " + str(static_cast<int>(size)) + ");\n";
+  for (const auto& [name, size] : args)
+    s += "  eigen_assert(" + name + ".size() == " + str(static_cast<int>(size)) + ");\n";
   for (const auto& a : args) s += "  static_cast<void>(" + a.first + ");\n";
   return s;
 }
@@ -67,9 +70,10 @@ std::string inverse_dynamics_derivatives_code(const DerivativeModel& m, std::vec
   s += "  Eigen::Matrix<Scalar, nq, nq> dq;   // d tau / d q\n";
   s += "  Eigen::Matrix<Scalar, nq, nq> dqd;  // d tau / d qd\n};\n\n";
   s += "template <class Q, class QD, class QDD, class Phi, class Scalar>\n";
-  s += "inline void inverse_dynamics_derivatives(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<QD>& qd,\n"
-       "                                         const Eigen::MatrixBase<QDD>& qdd, const Eigen::MatrixBase<Phi>& phi,\n"
-       "                                         InverseDynamicsDerivatives<Scalar>& d) {\n";
+  s +=
+      "inline void inverse_dynamics_derivatives(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<QD>& qd,\n"
+      "                                         const Eigen::MatrixBase<QDD>& qdd, const Eigen::MatrixBase<Phi>& phi,\n"
+      "                                         InverseDynamicsDerivatives<Scalar>& d) {\n";
   s += math_usings(g, roots);
   s += size_checks({{"q", m.q.size()}, {"qd", m.qd.size()}, {"qdd", m.qdd.size()}, {"phi", m.phi.size()}});
   s += "  d.tau.setZero();\n  d.dq.setZero();\n  d.dqd.setZero();\n";
@@ -126,9 +130,10 @@ std::string forward_dynamics_derivatives_code(const DerivativeModel& m, std::vec
   s += "  Scalar min_pivot;  // the smallest pivot of M's (unpivoted) LDL^T factorization\n};\n\n";
   s += "// False (the derivatives unset) when M(q; phi) is not positive definite (min_pivot <= 0).\n";
   s += "template <class Q, class QD, class Tau, class Phi, class Scalar>\n";
-  s += "inline bool forward_dynamics_derivatives(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<QD>& qd,\n"
-       "                                         const Eigen::MatrixBase<Tau>& tau, const Eigen::MatrixBase<Phi>& phi,\n"
-       "                                         ForwardDynamicsDerivatives<Scalar>& d) {\n";
+  s +=
+      "inline bool forward_dynamics_derivatives(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<QD>& qd,\n"
+      "                                         const Eigen::MatrixBase<Tau>& tau, const Eigen::MatrixBase<Phi>& phi,\n"
+      "                                         ForwardDynamicsDerivatives<Scalar>& d) {\n";
   s += math_usings(g, all);
   s += size_checks({{"q", m.q.size()}, {"qd", m.qd.size()}, {"tau", m.tau.size()}, {"phi", m.phi.size()}});
   s += "  " + mat + " stage_M;\n  Eigen::Matrix<Scalar, nq, 1> stage_h;\n  stage_M.setZero();\n  stage_h.setZero();\n";

@@ -18,10 +18,10 @@ struct DerivativeModel {
   ExprGraph* graph = nullptr;
   int n = 0, np = 0;
   std::vector<std::string> q, qd, qdd, tau, phi;  // symbol names; phi: the identified parameters
-  std::vector<NodeId> id;                          // tau = ID(q, qd, qdd; phi), with effects
-  std::vector<std::vector<NodeId>> M;              // n x n inertia matrix M(q; phi)
-  std::vector<NodeId> h;                           // ID(q, qd, 0; phi)
-  std::vector<std::vector<NodeId>> W;              // n x np: d ID / d phi (the regressor)
+  std::vector<NodeId> id;                         // tau = ID(q, qd, qdd; phi), with effects
+  std::vector<std::vector<NodeId>> M;             // n x n inertia matrix M(q; phi)
+  std::vector<NodeId> h;                          // ID(q, qd, 0; phi)
+  std::vector<std::vector<NodeId>> W;             // n x np: d ID / d phi (the regressor)
 };
 
 // The struct InverseDynamicsDerivatives<Scalar> and the function filling it (tau, d tau / d q,

@@ -14,12 +14,12 @@ namespace {
 
 // The variant effects in canonical order (EffectKind's, which orders the parameters they add),
 // each a row of the effect table by its variant name.
-constexpr std::array<std::string_view, 7> kVariantOrder{"coulomb",           "inertia_products",   "offset",
-                                                        "stribeck",          "viscous_asymmetry",  "position_harmonics",
-                                                        "smooth_coulomb"};
+constexpr std::array<std::string_view, 7> kVariantOrder{
+    "coulomb", "inertia_products", "offset", "stribeck", "viscous_asymmetry", "position_harmonics", "smooth_coulomb"};
 static_assert(kVariantOrder.size() == static_cast<std::size_t>(EffectKind::SmoothCoulomb) + 1);
 
-static_assert(every_name_has_a_row(&EffectRow::variant, kVariantOrder), "a variant effect without its row in symoro/effect_table.hpp");
+static_assert(every_name_has_a_row(&EffectRow::variant, kVariantOrder),
+              "a variant effect without its row in symoro/effect_table.hpp");
 
 struct Entry {
   EffectKind kind;
@@ -64,8 +64,8 @@ bool effect_has_velocity(EffectKind kind) { return entry(kind).row->velocity_sca
 
 const std::vector<std::string>& unfixed_families(EffectKind kind) { return entry(kind).unfixes; }
 
-std::vector<EffectParameter> effect_parameters(
-    const std::vector<EffectSpec>& effects, const std::function<std::string(const std::string&, int)>& unit) {
+std::vector<EffectParameter> effect_parameters(const std::vector<EffectSpec>& effects,
+                                               const std::function<std::string(const std::string&, int)>& unit) {
   std::vector<const EffectSpec*> sorted;
   for (const auto& e : effects)
     if (unfixed_families(e.kind).empty()) sorted.push_back(&e);

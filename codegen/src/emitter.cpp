@@ -22,7 +22,12 @@ std::string cpp_literal(double v) {
 namespace {
 
 using Text = BodyEmitter::Text;
-enum Prec { kSum = BodyEmitter::kSum, kProduct = BodyEmitter::kProduct, kUnary = BodyEmitter::kUnary, kAtom = BodyEmitter::kAtom };
+enum Prec {
+  kSum = BodyEmitter::kSum,
+  kProduct = BodyEmitter::kProduct,
+  kUnary = BodyEmitter::kUnary,
+  kAtom = BodyEmitter::kAtom
+};
 
 std::string wrap(const Text& t, int min_prec) { return t.prec >= min_prec ? t.s : "(" + t.s + ")"; }
 
@@ -30,8 +35,8 @@ constexpr std::size_t kMaxInlineLength = 90;
 
 }  // namespace
 
-BodyEmitter::BodyEmitter(const ExprGraph& g, std::map<std::string, std::string> inputs, const std::vector<NodeId>& all_roots,
-                         std::string indent)
+BodyEmitter::BodyEmitter(const ExprGraph& g, std::map<std::string, std::string> inputs,
+                         const std::vector<NodeId>& all_roots, std::string indent)
     : g_(g), inputs_(std::move(inputs)), indent_(std::move(indent)) {
   for (NodeId id : reachable(g_, all_roots)) {
     const Node& n = g_.node(id);
@@ -44,7 +49,9 @@ BodyEmitter::BodyEmitter(const ExprGraph& g, std::map<std::string, std::string> 
 
 std::string BodyEmitter::emit(const std::vector<Assignment>& outputs) {
   static const std::regex plain_name("^[A-Za-z][A-Za-z0-9_]*$");
-  static const std::regex reserved("^(t[0-9]+|Scalar|q|qd|qdd|tau|phi|s|out|[A-Z]|M|W|T|J|h|basis|sin|cos|sign|pow|exp|int|do|if|for|new|and|or|not|xor|auto|case|char|long|this|true|false|void|ldlt|stage_[a-z_]+)$");
+  static const std::regex reserved(
+      "^(t[0-9]+|Scalar|q|qd|qdd|tau|phi|s|out|[A-Z]|M|W|T|J|h|basis|sin|cos|sign|pow|exp|int|do|if|for|new|and|or|not|"
+      "xor|auto|case|char|long|this|true|false|void|ldlt|stage_[a-z_]+)$");
   std::vector<NodeId> roots;
   for (const auto& o : outputs) roots.push_back(o.value);
   std::string body;
@@ -67,16 +74,36 @@ std::string BodyEmitter::emit(const std::vector<Assignment>& outputs) {
     auto arg = [&](NodeId c) -> const Text& { return text_.at(c); };
     Text t;
     switch (n.op) {
-      case Op::Add: t = {wrap(arg(n.a), kSum) + " + " + wrap(arg(n.b), kProduct), kSum}; break;
-      case Op::Sub: t = {wrap(arg(n.a), kSum) + " - " + wrap(arg(n.b), kProduct), kSum}; break;
-      case Op::Mul: t = {wrap(arg(n.a), kProduct) + " * " + wrap(arg(n.b), kUnary), kProduct}; break;
-      case Op::Div: t = {wrap(arg(n.a), kProduct) + " / " + wrap(arg(n.b), kUnary), kProduct}; break;
-      case Op::Neg: t = {"-" + wrap(arg(n.a), kUnary), kUnary}; break;
-      case Op::Sin: t = {"sin(" + arg(n.a).s + ")", kAtom}; break;
-      case Op::Cos: t = {"cos(" + arg(n.a).s + ")", kAtom}; break;
-      case Op::Sign: t = {"sign(" + arg(n.a).s + ")", kAtom}; break;
-      case Op::Exp: t = {"exp(" + arg(n.a).s + ")", kAtom}; break;
-      case Op::Tanh: t = {"tanh(" + arg(n.a).s + ")", kAtom}; break;
+      case Op::Add:
+        t = {wrap(arg(n.a), kSum) + " + " + wrap(arg(n.b), kProduct), kSum};
+        break;
+      case Op::Sub:
+        t = {wrap(arg(n.a), kSum) + " - " + wrap(arg(n.b), kProduct), kSum};
+        break;
+      case Op::Mul:
+        t = {wrap(arg(n.a), kProduct) + " * " + wrap(arg(n.b), kUnary), kProduct};
+        break;
+      case Op::Div:
+        t = {wrap(arg(n.a), kProduct) + " / " + wrap(arg(n.b), kUnary), kProduct};
+        break;
+      case Op::Neg:
+        t = {"-" + wrap(arg(n.a), kUnary), kUnary};
+        break;
+      case Op::Sin:
+        t = {"sin(" + arg(n.a).s + ")", kAtom};
+        break;
+      case Op::Cos:
+        t = {"cos(" + arg(n.a).s + ")", kAtom};
+        break;
+      case Op::Sign:
+        t = {"sign(" + arg(n.a).s + ")", kAtom};
+        break;
+      case Op::Exp:
+        t = {"exp(" + arg(n.a).s + ")", kAtom};
+        break;
+      case Op::Tanh:
+        t = {"tanh(" + arg(n.a).s + ")", kAtom};
+        break;
       case Op::Pow: {
         const double e = n.value;
         const std::string x = wrap(arg(n.a), kAtom);
@@ -90,7 +117,8 @@ std::string BodyEmitter::emit(const std::vector<Assignment>& outputs) {
         break;
       }
       case Op::Constant:
-      case Op::Symbol: break;
+      case Op::Symbol:
+        break;
     }
     // A node used once is written inline into its user.
     if (uses_[id] == 1 && t.s.size() <= kMaxInlineLength && !pow_operand_.count(id)) {
@@ -115,8 +143,8 @@ std::string math_usings(const ExprGraph& g, const std::vector<NodeId>& roots) {
     exp = exp || g.node(id).op == Op::Exp;
     tanh = tanh || g.node(id).op == Op::Tanh;
   }
-  return std::string("  using std::cos;\n") + (exp ? "  using std::exp;\n" : "") + "  using std::pow;\n  using std::sin;\n" +
-         (tanh ? "  using std::tanh;\n" : "") + "  using ::symoro::sign;\n";
+  return std::string("  using std::cos;\n") + (exp ? "  using std::exp;\n" : "") +
+         "  using std::pow;\n  using std::sin;\n" + (tanh ? "  using std::tanh;\n" : "") + "  using ::symoro::sign;\n";
 }
 
 std::string emit_body(const ExprGraph& g, const std::map<std::string, std::string>& inputs,

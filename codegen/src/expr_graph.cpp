@@ -121,8 +121,7 @@ NodeId ExprGraph::mul(NodeId a, NodeId b) {
 }
 
 NodeId ExprGraph::div(NodeId a, NodeId b) {
-  if (is_constant(a) && is_constant(b) && node(b).value != 0.0)
-    return constant(node(a).value / node(b).value);
+  if (is_constant(a) && is_constant(b) && node(b).value != 0.0) return constant(node(a).value / node(b).value);
   if (is_constant(a, 0.0)) return zero_;
   if (is_constant(b, 1.0)) return a;
   if (is_constant(b, -1.0)) return neg(a);

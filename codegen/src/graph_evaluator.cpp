@@ -18,23 +18,47 @@ std::vector<double> Evaluator::operator()(const std::map<std::string, double>& s
     const double a = n.a >= 0 ? v[n.a] : 0, b = n.b >= 0 ? v[n.b] : 0;
     double& out = v[id];
     switch (n.op) {
-      case Op::Constant: out = n.value; break;
+      case Op::Constant:
+        out = n.value;
+        break;
       case Op::Symbol: {
         auto it = symbols.find(g.symbol_name(n.symbol));
         out = it == symbols.end() ? 0.0 : it->second;
         break;
       }
-      case Op::Add: out = a + b; break;
-      case Op::Sub: out = a - b; break;
-      case Op::Mul: out = a * b; break;
-      case Op::Div: out = a / b; break;
-      case Op::Neg: out = -a; break;
-      case Op::Pow: out = std::pow(a, n.value); break;
-      case Op::Sin: out = std::sin(a); break;
-      case Op::Cos: out = std::cos(a); break;
-      case Op::Sign: out = double((a > 0) - (a < 0)); break;
-      case Op::Exp: out = std::exp(a); break;
-      case Op::Tanh: out = std::tanh(a); break;
+      case Op::Add:
+        out = a + b;
+        break;
+      case Op::Sub:
+        out = a - b;
+        break;
+      case Op::Mul:
+        out = a * b;
+        break;
+      case Op::Div:
+        out = a / b;
+        break;
+      case Op::Neg:
+        out = -a;
+        break;
+      case Op::Pow:
+        out = std::pow(a, n.value);
+        break;
+      case Op::Sin:
+        out = std::sin(a);
+        break;
+      case Op::Cos:
+        out = std::cos(a);
+        break;
+      case Op::Sign:
+        out = double((a > 0) - (a < 0));
+        break;
+      case Op::Exp:
+        out = std::exp(a);
+        break;
+      case Op::Tanh:
+        out = std::tanh(a);
+        break;
     }
   }
   std::vector<double> out;

@@ -71,7 +71,8 @@ fs::path installed_include_dir() {
 // The compiler as an executable path: itself when it names a path, else found on PATH.
 fs::path resolve_compiler(const std::string& compiler) {
   if (compiler.empty()) return {};
-  if (compiler.find('/') != std::string::npos) return access(compiler.c_str(), X_OK) == 0 ? fs::path(compiler) : fs::path();
+  if (compiler.find('/') != std::string::npos)
+    return access(compiler.c_str(), X_OK) == 0 ? fs::path(compiler) : fs::path();
   std::istringstream path(env("PATH"));
   for (std::string dir; std::getline(path, dir, ':');) {
     const fs::path p = fs::path(dir.empty() ? "." : dir) / compiler;
@@ -129,7 +130,8 @@ void run_all(const std::vector<std::vector<std::string>>& commands, const std::v
       for (auto r = running.begin(); r != running.end() && it == running.end(); ++r) {
         const bool only = running.size() == 1;
         const pid_t done = waitpid(r->first, &status, only ? 0 : WNOHANG);
-        if (done == r->first) it = r;
+        if (done == r->first)
+          it = r;
         else if (done < 0 && errno != EINTR)
           throw BuildError(std::string("waiting for the compiler: ") + std::strerror(errno));
       }
@@ -178,12 +180,14 @@ void write_objects(const fs::path& library_dir, const RobotLibraryOptions& optio
   for (const auto& e : fs::directory_iterator(library_dir / "src", ec))
     if (e.path().extension() == ".o" && e.path().filename() != "robot.o") objects.push_back(e.path().string());
   if (objects.empty())
-    throw BuildError("the robot library in " + library_dir.string() + " has no model objects (src/*.o): rebuild it with --force");
+    throw BuildError("the robot library in " + library_dir.string() +
+                     " has no model objects (src/*.o): rebuild it with --force");
   std::sort(objects.begin(), objects.end());
   const fs::path out = options.objects;
   fs::create_directories(out.parent_path().empty() ? fs::path(".") : out.parent_path(), ec);
   const fs::path partial = out.string() + ".part-" + std::to_string(getpid());
-  std::vector<std::string> link = {resolve_compiler(options.toolchain.compiler).string(), "-r", "-nostdlib", "-o", partial.string()};
+  std::vector<std::string> link = {resolve_compiler(options.toolchain.compiler).string(), "-r", "-nostdlib", "-o",
+                                   partial.string()};
   link.insert(link.end(), objects.begin(), objects.end());
   run_all({link}, {fs::path(out.string() + ".log")}, 1);
   fs::rename(partial, out, ec);
@@ -196,7 +200,8 @@ RobotToolchain RobotToolchain::configured() {
   RobotToolchain t;
   t.compiler = env("SYMORO_CXX").empty() ? SYMORO_CONFIGURED_CXX : env("SYMORO_CXX");
   t.flags = split_flags(SYMORO_CONFIGURED_CXX_FLAGS);
-  for (const char* f : {"-std=c++17", "-fPIC", "-fvisibility=hidden", "-fvisibility-inlines-hidden"}) t.flags.push_back(f);
+  for (const char* f : {"-std=c++17", "-fPIC", "-fvisibility=hidden", "-fvisibility-inlines-hidden"})
+    t.flags.push_back(f);
   fs::path headers = env("SYMORO_INCLUDE_DIR");
   if (headers.empty()) headers = installed_include_dir();
   if (headers.empty()) headers = SYMORO_SOURCE_INCLUDE_DIR;
@@ -209,8 +214,7 @@ std::string RobotToolchain::identity() const {
   const fs::path exe = resolve_compiler(compiler);
   if (exe.empty())
     throw BuildError("the compiler '" + compiler + "' is missing (" +
-                     (env("SYMORO_CXX").empty() ? "the one symoro was configured with"
-                                                : "named by SYMORO_CXX") +
+                     (env("SYMORO_CXX").empty() ? "the one symoro was configured with" : "named by SYMORO_CXX") +
                      "): a robot library is compiled from its generated C++; install it, or set SYMORO_CXX to a "
                      "C++17 compiler");
   // Once per compiler and process: every load forms the cache key with it.
@@ -253,8 +257,8 @@ CacheKey cache_key(const Generation& gen, const RobotToolchain& tc) {
   CacheKey k;
   k.code_digest = hex128(all);
   k.build_line = tc.identity() + " | " + joined(tc.flags);
-  std::string key_text = "symoro robot library abi " + std::to_string(SYMORO_ROBOT_ABI_VERSION) + '\0' +
-                         k.code_digest + '\0' + k.build_line;
+  std::string key_text = "symoro robot library abi " + std::to_string(SYMORO_ROBOT_ABI_VERSION) + '\0' + k.code_digest +
+                         '\0' + k.build_line;
   for (const auto& d : tc.include_dirs) {
     key_text += '\0' + d;
     for (const char* h : {SYMORO_ROBOT_ABI_HEADERS}) {
@@ -299,17 +303,24 @@ void add_model_units(LibraryUnits& units, const RobotModel& robot, const Generat
     const std::string fn = "symoro_" + robot.name + "_model_" + std::to_string(i);
     units.add(fn, "// Written by symoroc build for robot " + robot.name + ": model " + gen.models[i].name +
                       " in the robot library's C ABI; do not edit.\n"
-                      "#include \"symoro/robot_abi_export-inl.hpp\"\n#include \"" + header + "\"\n\n"
+                      "#include \"symoro/robot_abi_export-inl.hpp\"\n#include \"" +
+                      header +
+                      "\"\n\n"
                       "// For a program that links these objects too (compiled_model<Model>()).\n"
-                      "template symoro_abi_model symoro::abi_export::model_abi<" + type + ">();\n\n"
-                      "symoro_abi_model " + fn + "() { return symoro::abi_export::model_abi<" + type + ">(); }\n");
+                      "template symoro_abi_model symoro::abi_export::model_abi<" +
+                      type +
+                      ">();\n\n"
+                      "symoro_abi_model " +
+                      fn + "() { return symoro::abi_export::model_abi<" + type + ">(); }\n");
     declarations += "symoro_abi_model " + fn + "();\n";
     entries += "      " + fn + "(),\n";
     units.add(fn + "_d2", "// Written by symoroc build for robot " + robot.name + ": model " + gen.models[i].name +
                               "'s inertia second derivatives; do not edit.\n"
-                              "#include \"symoro/robot_abi_second_derivatives-inl.hpp\"\n#include \"" + header + "\"\n\n"
-                              "template void symoro::abi_export::inertia_second_derivatives<" + type +
-                              ">(const double*, const double*, double*, double*, double*);\n");
+                              "#include \"symoro/robot_abi_second_derivatives-inl.hpp\"\n#include \"" +
+                              header +
+                              "\"\n\n"
+                              "template void symoro::abi_export::inertia_second_derivatives<" +
+                              type + ">(const double*, const double*, double*, double*, double*);\n");
   }
 }
 
@@ -317,20 +328,25 @@ void add_model_units(LibraryUnits& units, const RobotModel& robot, const Generat
 void add_entry_unit(LibraryUnits& units, const RobotModel& robot, const Generation& gen, const CacheKey& key,
                     const std::string& declarations, const std::string& entries) {
   std::string sources;
-  for (const auto& [name, digest] : robot.sources) sources += "    {" + c_string(name) + ", " + c_string(digest) + "},\n";
+  for (const auto& [name, digest] : robot.sources)
+    sources += "    {" + c_string(name) + ", " + c_string(digest) + "},\n";
   const std::string identified = robot.spec.identified == "full" ? "" : robot.spec.identified;
-  units.add("robot", "// Written by symoroc build for robot " + robot.name +
-                         ": the library's entry points (symoro/robot_abi.h); do not edit.\n"
-                         "#include \"symoro/robot_abi.h\"\n\n" + declarations +
-                         "\nnamespace {\nconst symoro_abi_source_file sources[] = {\n" + sources + "};\n}  // namespace\n\n"
-                         "extern \"C\" __attribute__((visibility(\"default\"))) unsigned symoro_robot_abi_version(void) {\n"
-                         "  return SYMORO_ROBOT_ABI_VERSION;\n}\n\n"
-                         "extern \"C\" __attribute__((visibility(\"default\"))) const symoro_abi_robot* symoro_robot(void) {\n"
-                         "  static const symoro_abi_model models[] = {\n" + entries + "  };\n"
-                         "  static const symoro_abi_robot robot = {SYMORO_ROBOT_ABI_VERSION, " + c_string(robot.name) + ", " +
-                         c_string(identified) + ", " + c_string(key.code_digest) + ", " + c_string(key.build_line) + ", " +
-                         std::to_string(gen.models.size()) + ", models, " + std::to_string(robot.sources.size()) +
-                         ", sources};\n  return &robot;\n}\n");
+  units.add("robot",
+            "// Written by symoroc build for robot " + robot.name +
+                ": the library's entry points (symoro/robot_abi.h); do not edit.\n"
+                "#include \"symoro/robot_abi.h\"\n\n" +
+                declarations + "\nnamespace {\nconst symoro_abi_source_file sources[] = {\n" + sources +
+                "};\n}  // namespace\n\n"
+                "extern \"C\" __attribute__((visibility(\"default\"))) unsigned symoro_robot_abi_version(void) {\n"
+                "  return SYMORO_ROBOT_ABI_VERSION;\n}\n\n"
+                "extern \"C\" __attribute__((visibility(\"default\"))) const symoro_abi_robot* symoro_robot(void) {\n"
+                "  static const symoro_abi_model models[] = {\n" +
+                entries +
+                "  };\n"
+                "  static const symoro_abi_robot robot = {SYMORO_ROBOT_ABI_VERSION, " +
+                c_string(robot.name) + ", " + c_string(identified) + ", " + c_string(key.code_digest) + ", " +
+                c_string(key.build_line) + ", " + std::to_string(gen.models.size()) + ", models, " +
+                std::to_string(robot.sources.size()) + ", sources};\n  return &robot;\n}\n");
 }
 
 }  // namespace

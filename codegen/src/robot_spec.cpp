@@ -13,17 +13,15 @@
 namespace symoro::codegen {
 
 InputError::InputError(const std::string& file, int line, int column, const std::string& message)
-    : std::runtime_error(file + ":" + std::to_string(line) + ":" + std::to_string(column) +
-                         ": error: " + message) {}
+    : std::runtime_error(file + ":" + std::to_string(line) + ":" + std::to_string(column) + ": error: " + message) {}
 
 namespace {
 
 const std::map<std::string, std::string> kDefaultUnits = {
-    {"XX", "kg*m^2"}, {"XY", "kg*m^2"}, {"XZ", "kg*m^2"}, {"YY", "kg*m^2"}, {"YZ", "kg*m^2"},
-    {"ZZ", "kg*m^2"}, {"MX", "kg*m"},   {"MY", "kg*m"},   {"MZ", "kg*m"},   {"M", "kg"},
+    {"XX", "kg*m^2"}, {"XY", "kg*m^2"},    {"XZ", "kg*m^2"}, {"YY", "kg*m^2"}, {"YZ", "kg*m^2"},
+    {"ZZ", "kg*m^2"}, {"MX", "kg*m"},      {"MY", "kg*m"},   {"MZ", "kg*m"},   {"M", "kg"},
     {"IA", "kg*m^2"}, {"FV", "N*m*s/rad"}, {"FS", "N*m"}};
-const std::map<std::string, std::string> kDefaultPrismaticUnits = {
-    {"IA", "kg"}, {"FV", "N*s/m"}, {"FS", "N"}};
+const std::map<std::string, std::string> kDefaultPrismaticUnits = {{"IA", "kg"}, {"FV", "N*s/m"}, {"FS", "N"}};
 
 struct Reader {
   std::string path;
@@ -55,8 +53,7 @@ struct Reader {
     return n.Scalar();
   }
 
-  void only_keys(const YAML::Node& map, const std::vector<std::string>& allowed,
-                 const std::string& where) const {
+  void only_keys(const YAML::Node& map, const std::vector<std::string>& allowed, const std::string& where) const {
     check_keys(map, allowed, path, where);
   }
 };
@@ -71,8 +68,10 @@ int whole_number(const Reader& r, const YAML::Node& n, const std::string& what, 
                  const std::string& where) {
   const double v = r.number(n, where + ": " + what);
   if (v != std::floor(v)) r.fail(n, where + ": " + what + " must be a whole number, not '" + n.Scalar() + "'");
-  if (v < lo) r.fail(n, where + ": " + what + " " + n.Scalar() + " is out of range (at least " + std::to_string(lo) + ")");
-  if (v > hi) r.fail(n, where + ": " + what + " " + n.Scalar() + " is out of range (at most " + std::to_string(hi) + ")");
+  if (v < lo)
+    r.fail(n, where + ": " + what + " " + n.Scalar() + " is out of range (at least " + std::to_string(lo) + ")");
+  if (v > hi)
+    r.fail(n, where + ": " + what + " " + n.Scalar() + " is out of range (at most " + std::to_string(hi) + ")");
   return static_cast<int>(v);
 }
 
@@ -111,7 +110,8 @@ std::vector<EffectSpec> read_effects(const Reader& r, const YAML::Node& effects,
         known.push_back(effect_names().substr(at, comma - at));
       }
       const std::string near = nearest_name(name, known);
-      r.fail(kv.first, where + ": unknown effect '" + name + "'" + (near.empty() ? "" : "; did you mean '" + near + "'?") +
+      r.fail(kv.first, where + ": unknown effect '" + name + "'" +
+                           (near.empty() ? "" : "; did you mean '" + near + "'?") +
                            " (known effects: " + effect_names() + ")");
     }
     if (!seen.insert(name).second) r.fail(kv.first, where + ": effect " + name + " appears twice");
@@ -128,8 +128,10 @@ std::vector<EffectSpec> read_effects(const Reader& r, const YAML::Node& effects,
           *kind == EffectKind::Stribeck ? "the Stribeck velocity" : "the velocity scale of tanh(qd/v)";
       const std::string form = stribeck ? "{joints: [...], velocity: <rad/s>}" : "{joints: [...], orders: [...]}";
       if (!kv.second.IsMap()) r.fail(kv.second, effect + " takes " + form);
-      r.only_keys(kv.second, stribeck ? std::vector<std::string>{"joints", "velocity"} : std::vector<std::string>{"joints", "orders"},
-                  effect);
+      r.only_keys(
+          kv.second,
+          stribeck ? std::vector<std::string>{"joints", "velocity"} : std::vector<std::string>{"joints", "orders"},
+          effect);
       list.reset(kv.second["joints"]);
       if (!list) r.fail(kv.second, effect + " needs 'joints': " + form);
       if (stribeck) {
@@ -144,8 +146,8 @@ std::vector<EffectSpec> read_effects(const Reader& r, const YAML::Node& effects,
           };
           if (vel.IsSequence()) {
             if (!list.IsSequence() || vel.size() != list.size())
-              r.fail(vel, effect + ": a list of velocities needs one per joint (" + std::to_string(vel.size()) + " for " +
-                              std::to_string(list.IsSequence() ? list.size() : 0) + " joints)");
+              r.fail(vel, effect + ": a list of velocities needs one per joint (" + std::to_string(vel.size()) +
+                              " for " + std::to_string(list.IsSequence() ? list.size() : 0) + " joints)");
             for (const auto& v : vel) velocities.push_back(positive(v));
           } else {
             velocity = positive(vel);
@@ -169,7 +171,7 @@ std::vector<EffectSpec> read_effects(const Reader& r, const YAML::Node& effects,
 }
 
 struct RawVariant {
-  VariantSpec spec;     // its own fixed patterns and effects until resolve_bases
+  VariantSpec spec;      // its own fixed patterns and effects until resolve_bases
   YAML::Node base_node;  // `base:`, when present
 };
 
@@ -188,11 +190,13 @@ void resolve_bases(const Reader& r, std::vector<RawVariant>& raw) {
       if (b == raw.size()) {
         std::string names;
         for (const auto& o : raw) names += (names.empty() ? "" : ", ") + o.spec.name;
-        r.fail(v.base_node, "variant " + v.spec.name + ": unknown base variant '" + v.spec.base + "' (variants: " + names + ")");
+        r.fail(v.base_node,
+               "variant " + v.spec.name + ": unknown base variant '" + v.spec.base + "' (variants: " + names + ")");
       }
       if (state[b] == 1) {
         std::string cycle;
-        for (auto it = std::find(chain.begin(), chain.end(), raw[b].spec.name); it != chain.end(); ++it) cycle += *it + " -> ";
+        for (auto it = std::find(chain.begin(), chain.end(), raw[b].spec.name); it != chain.end(); ++it)
+          cycle += *it + " -> ";
         r.fail(v.base_node, "variant " + v.spec.name + ": the base chain " + cycle + raw[b].spec.name + " is a cycle");
       }
       resolve(b);
@@ -260,7 +264,8 @@ void read_joints(const Reader& r, const YAML::Node& root, RobotSpec& spec) {
     if (!j["velocity"] || !j["effort"]) r.fail(j, "joint " + js.name + " needs 'velocity' and 'effort'");
     js.velocity = r.number(j["velocity"], "velocity");
     js.effort = r.number(j["effort"], "effort");
-    if (js.velocity <= 0 || js.effort <= 0) r.fail(j, "joint " + js.name + ": velocity and effort limits must be positive");
+    if (js.velocity <= 0 || js.effort <= 0)
+      r.fail(j, "joint " + js.name + ": velocity and effort limits must be positive");
     js.audit_lower = js.lower;
     js.audit_upper = js.upper;
     if (const auto a = j["audit"]) {
@@ -271,7 +276,6 @@ void read_joints(const Reader& r, const YAML::Node& root, RobotSpec& spec) {
     }
     spec.joints.push_back(js);
   }
-
 }
 
 // robot.yaml's `parameter_units` over the defaults, per family, for revolute and prismatic joints.
@@ -290,7 +294,8 @@ void read_units(const Reader& r, const YAML::Node& root, RobotSpec& spec) {
           std::vector<std::string> known;
           for (const auto& [f, unit] : kDefaultUnits) known.push_back(f);
           const std::string near = nearest_name(fam, known);
-          r.fail(kv.first, "unknown parameter family '" + fam + "'" + (near.empty() ? "" : "; did you mean '" + near + "'?"));
+          r.fail(kv.first,
+                 "unknown parameter family '" + fam + "'" + (near.empty() ? "" : "; did you mean '" + near + "'?"));
         }
         into[fam] = r.string(kv.second, "unit");
       }
@@ -298,7 +303,6 @@ void read_units(const Reader& r, const YAML::Node& root, RobotSpec& spec) {
     read(u["revolute"], spec.units);
     read(u["prismatic"], spec.prismatic_units);
   }
-
 }
 
 // robot.yaml's `variants`: each with its description, base, fixed patterns and effects, bases
@@ -314,8 +318,8 @@ void read_variants(const Reader& r, const YAML::Node& root, RobotSpec& spec) {
       vs.line = kv.first.Mark().line + 1;
       static const std::regex lower_id("^[a-z][a-z0-9_]*$");
       if (!std::regex_match(vs.name, lower_id) || vs.name == "full" || vs.name == "param")
-        r.fail(kv.first, "variant name '" + vs.name +
-                             "' must be a lower-case identifier other than 'full' and 'param'");
+        r.fail(kv.first,
+               "variant name '" + vs.name + "' must be a lower-case identifier other than 'full' and 'param'");
       for (const auto& other : raw)
         if (other.spec.name == vs.name) r.fail(kv.first, "duplicate variant name '" + vs.name + "'");
       if (!kv.second.IsMap())
@@ -330,8 +334,8 @@ void read_variants(const Reader& r, const YAML::Node& root, RobotSpec& spec) {
       const auto e = kv.second["effects"];
       if (f && !f.IsMap()) r.fail(f, "variant " + vs.name + ": 'fixed' must map parameter patterns to values");
       if ((!f || f.size() == 0) && vs.base.empty() && !e)
-        r.fail(kv.second, "variant " + vs.name +
-                              " needs 'fixed': a map of parameter patterns to values (or 'base' or 'effects')");
+        r.fail(kv.second,
+               "variant " + vs.name + " needs 'fixed': a map of parameter patterns to values (or 'base' or 'effects')");
       if (f)
         for (const auto& p : f) vs.fixed.emplace_back(p.first.Scalar(), r.number(p.second, "fixed value"));
       if (e) vs.effects = read_effects(r, e, vs.name);
@@ -346,7 +350,9 @@ void read_variants(const Reader& r, const YAML::Node& root, RobotSpec& spec) {
 void read_urdf_section(const Reader& r, const YAML::Node& root, RobotSpec& spec) {
   if (const auto u = root["urdf"]) {
     if (!u.IsMap()) r.fail(u, "urdf must be a mapping (file, base_link, tip_link, ...)");
-    r.only_keys(u, {"file", "base_link", "tip_link", "frame0_in_base", "tip_in_last_frame", "joints", "links", "locked"}, "urdf");
+    r.only_keys(u,
+                {"file", "base_link", "tip_link", "frame0_in_base", "tip_in_last_frame", "joints", "links", "locked"},
+                "urdf");
     for (const char* k : {"file", "base_link", "tip_link"})
       if (!u[k]) r.fail(u, std::string("urdf needs '") + k + "'");
     spec.urdf.file = r.string(u["file"], "urdf file");
@@ -363,9 +369,10 @@ RobotSpec read_robot_spec_checked(const std::string& path) {
   const YAML::Node root = load_yaml_file(path);
   Reader r{path};
   if (!root.IsMap()) throw InputError(path, 1, 1, "robot.yaml must be a mapping of keys");
-  r.only_keys(root, {"name", "description", "constants", "joints", "parameter_units",
-                     "identified", "variants", "nominal", "urdf"},
-              "robot.yaml");
+  r.only_keys(
+      root,
+      {"name", "description", "constants", "joints", "parameter_units", "identified", "variants", "nominal", "urdf"},
+      "robot.yaml");
 
   RobotSpec spec;
   spec.path = path;

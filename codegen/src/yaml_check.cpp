@@ -23,7 +23,8 @@ struct Fail {
 }  // namespace
 
 YAML::Node load_yaml_file(const std::string& path) {
-  if (const std::string why = ::symoro::detail::not_a_regular_file(path); !why.empty()) throw InputError(path, 0, 0, why);
+  if (const std::string why = ::symoro::detail::not_a_regular_file(path); !why.empty())
+    throw InputError(path, 0, 0, why);
   std::ifstream in(path, std::ios::binary);
   if (!in) throw InputError(path, 0, 0, "cannot open file");
   std::ostringstream content;

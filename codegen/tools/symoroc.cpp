@@ -72,7 +72,8 @@ void write_all_or_none(const std::vector<std::pair<fs::path, std::string>>& file
     fs::rename(temps[i], files[i].first, ec);
     if (ec) {
       for (std::size_t k = i; k < temps.size(); ++k) ::unlink(temps[k].c_str());
-      throw std::runtime_error("cannot rename " + temps[i].string() + " to " + files[i].first.string() + ": " + ec.message());
+      throw std::runtime_error("cannot rename " + temps[i].string() + " to " + files[i].first.string() + ": " +
+                               ec.message());
     }
   }
 }
@@ -156,8 +157,10 @@ int check(const std::string& robots, const std::string& generated) {
         ++problems;
       }
   if (problems) {
-    fmt::print("symoroc check: {} difference(s) between {} and a fresh generation from {}.\n"
-               "Run: symoroc generate {}/* -o {}\n", problems, generated, robots, robots, generated);
+    fmt::print(
+        "symoroc check: {} difference(s) between {} and a fresh generation from {}.\n"
+        "Run: symoroc generate {}/* -o {}\n",
+        problems, generated, robots, robots, generated);
     return 1;
   }
   fmt::print("symoroc check: {} is up to date ({} robots).\n", generated, names.size());
@@ -173,9 +176,9 @@ int info(const std::string& dir) {
   fmt::print("joints:\n");
   for (int j = 0; j < robot.n; ++j) {
     const auto& js = robot.spec.joints[j];
-    fmt::print("  {:>2} {:<18} {} {:<6} [{:.4g}, {:.4g}]  |qd| <= {:.4g}  |tau| <= {:.4g}  audit [{:.4g}, {:.4g}]\n", j + 1,
-               js.name, robot.frames[j].sigma ? "prismatic" : "revolute ", robot.q[j], js.lower, js.upper, js.velocity,
-               js.effort, js.audit_lower, js.audit_upper);
+    fmt::print("  {:>2} {:<18} {} {:<6} [{:.4g}, {:.4g}]  |qd| <= {:.4g}  |tau| <= {:.4g}  audit [{:.4g}, {:.4g}]\n",
+               j + 1, js.name, robot.frames[j].sigma ? "prismatic" : "revolute ", robot.q[j], js.lower, js.upper,
+               js.velocity, js.effort, js.audit_lower, js.audit_upper);
   }
   for (const auto& m : gen.models) {
     fmt::print("\nmodel {}: {} identified parameters", m.name, m.identified.size());
@@ -225,7 +228,8 @@ int model(const std::string& input, const std::string& out_dir, const ModelingOp
   const fs::path dir = fs::path(out_dir).lexically_normal();
   // The folder's name becomes the robot's namespace at symoroc generate: refuse it now.
   const std::string folder = (dir.has_filename() ? dir.filename() : dir.parent_path().filename()).string();
-  if (const std::string why = robot_name_problem(folder); !why.empty()) throw std::runtime_error(out_dir + ": " + why + " (the folder's name)");
+  if (const std::string why = robot_name_problem(folder); !why.empty())
+    throw std::runtime_error(out_dir + ": " + why + " (the folder's name)");
   Modeling m = urdf ? model_from_urdf(input, options) : model_from_par(input, options);
   if (!urdf) m.files.insert(m.files.begin(), {in.filename().string(), read_text(in)});
   std::vector<std::string> changed;
@@ -239,10 +243,12 @@ int model(const std::string& input, const std::string& out_dir, const ModelingOp
   std::vector<std::pair<fs::path, std::string>> files;
   for (const auto& f : m.files) files.emplace_back(dir / f.name, f.text);
   write_all_or_none(files);
-  fmt::print("{}: {} base parameters, {} files in {}\n", m.robot, m.base_parameters.size(), m.files.size(), dir.string());
+  fmt::print("{}: {} base parameters, {} files in {}\n", m.robot, m.base_parameters.size(), m.files.size(),
+             dir.string());
   for (const auto& note : m.notes) fmt::print("  {}\n", note);
   if (!fs::exists(dir / "robot.yaml"))
-    fmt::print("  {} has no robot.yaml yet: write one (joints, limits, constants) before symoroc generate\n", dir.string());
+    fmt::print("  {} has no robot.yaml yet: write one (joints, limits, constants) before symoroc generate\n",
+               dir.string());
   return 0;
 }
 
@@ -256,7 +262,8 @@ int main(int argc, char** argv) {
   std::string out_root = "generated";
   auto* gen = app.add_subcommand("generate", "Generate the headers of one or more robot folders");
   gen->add_option("robot_dirs", gen_dirs, "robots/<name> folders")->required()->check(CLI::ExistingDirectory);
-  gen->add_option("-o,--output", out_root, "Output root (headers go to <output>/<name>/include)")->capture_default_str();
+  gen->add_option("-o,--output", out_root, "Output root (headers go to <output>/<name>/include)")
+      ->capture_default_str();
 
   std::string robots = "robots", generated = "generated";
   auto* chk = app.add_subcommand("check", "Fail when the generated headers differ from a fresh generation");
@@ -268,14 +275,16 @@ int main(int argc, char** argv) {
   inf->add_option("robot_dir", info_dir, "robots/<name>")->required()->check(CLI::ExistingDirectory);
 
   std::string model_input, model_out;
-  auto* mdl = app.add_subcommand("model", "Compute a robot's model files (base parameters, dynamics, geometry) from its .par");
+  auto* mdl =
+      app.add_subcommand("model", "Compute a robot's model files (base parameters, dynamics, geometry) from its .par");
   mdl->add_option("description", model_input, "<robot>.urdf or <robot>.par")->required()->check(CLI::ExistingFile);
   mdl->add_option("-o,--output", model_out, "The robot folder to write (robots/<name>)")->required();
   ModelingOptions model_options;
   mdl->add_option("--frame", model_options.frame, "Frame of the geometric model and the Jacobian (default: the last)");
   mdl->add_option("--name", model_options.name, "The robot's name (URDF: default the URDF's)");
   mdl->add_option("--base-link", model_options.base_link, "URDF: the chain's first link (default: the root)");
-  mdl->add_option("--tip-link", model_options.tip_link, "URDF: the chain's last link (default: where the moving joints end)");
+  mdl->add_option("--tip-link", model_options.tip_link,
+                  "URDF: the chain's last link (default: where the moving joints end)");
   std::vector<std::string> locks;
   mdl->add_option("--lock", locks, "URDF: joint=position for a moving joint off the chain (default 0)");
   bool no_ia = false, no_fv = false, no_fs = false, force = false;
@@ -287,8 +296,9 @@ int main(int argc, char** argv) {
   std::vector<std::string> build_dirs;
   RobotLibraryOptions build_options;
   std::string build_cache;
-  auto* bld = app.add_subcommand("build", "Compile robot folders into robot libraries (the runtime loads them; "
-                                          "dynid and Python build on first use)");
+  auto* bld = app.add_subcommand("build",
+                                 "Compile robot folders into robot libraries (the runtime loads them; "
+                                 "dynid and Python build on first use)");
   bld->add_option("robot_dirs", build_dirs, "robots/<name> folders")->required()->check(CLI::ExistingDirectory);
   bld->add_option("--cache", build_cache, "The robot cache (default: $SYMORO_CACHE_DIR, else ~/.cache/symoro/robots)");
   bld->add_option("-j,--jobs", build_options.jobs, "Parallel compiles (default: the machine's cores)");

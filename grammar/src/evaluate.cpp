@@ -13,8 +13,7 @@ double evaluate(const Expr& e, const Bindings& symbols) {
       auto it = symbols.find(e.name);
       if (it != symbols.end()) return it->second;
       if (e.name == "pi") return M_PI;
-      throw std::runtime_error("unknown symbol '" + e.name + "' at line " +
-                               std::to_string(e.at.line));
+      throw std::runtime_error("unknown symbol '" + e.name + "' at line " + std::to_string(e.at.line));
     }
     case Expr::Kind::Negate:
       return -evaluate(e.args.at(0), symbols);
@@ -29,8 +28,7 @@ double evaluate(const Expr& e, const Bindings& symbols) {
     case Expr::Kind::Power:
       return std::pow(evaluate(e.args.at(0), symbols), evaluate(e.args.at(1), symbols));
     case Expr::Kind::Call: {
-      if (e.args.size() != 1)
-        throw std::runtime_error("function '" + e.name + "' takes one argument");
+      if (e.args.size() != 1) throw std::runtime_error("function '" + e.name + "' takes one argument");
       const double x = evaluate(e.args[0], symbols);
       if (e.name == "sin") return std::sin(x);
       if (e.name == "cos") return std::cos(x);

@@ -36,19 +36,17 @@ std::string printable_line(const std::string& line) {
 std::string format_error(const std::string& file, int line, int column, const std::string& message,
                          const std::string& source_line) {
   if (line <= 0) return file + ": error: " + message;
-  std::string out = file + ":" + std::to_string(line) + ":" + std::to_string(column) +
-                    ": error: " + message + "\n" + printable_line(source_line) + "\n";
+  std::string out = file + ":" + std::to_string(line) + ":" + std::to_string(column) + ": error: " + message + "\n" +
+                    printable_line(source_line) + "\n";
   // Copy tabs from the source line so the caret lines up however the terminal expands them.
   const auto indent = static_cast<std::size_t>(std::max(column - 1, 0));
-  for (std::size_t i = 0; i < indent; ++i)
-    out += i < source_line.size() && source_line[i] == '\t' ? '\t' : ' ';
+  for (std::size_t i = 0; i < indent; ++i) out += i < source_line.size() && source_line[i] == '\t' ? '\t' : ' ';
   return out + "^";
 }
 
 }  // namespace
 
-ParseError::ParseError(std::string file, int line, int column, std::string message,
-                       std::string source_line)
+ParseError::ParseError(std::string file, int line, int column, std::string message, std::string source_line)
     : std::runtime_error(format_error(file, line, column, message, source_line)),
       file_(std::move(file)),
       line_(line),
@@ -119,11 +117,10 @@ class Source {
 
   Position position(Iterator p) const {
     // Parsing goes line by line, so the line of the previous lookup is the usual answer.
-    const bool on_hint = lines_[hint_].begin <= p &&
-                         (hint_ + 1 == lines_.size() || p < lines_[hint_ + 1].begin);
+    const bool on_hint = lines_[hint_].begin <= p && (hint_ + 1 == lines_.size() || p < lines_[hint_ + 1].begin);
     if (!on_hint) {
-      const auto next = std::upper_bound(lines_.begin(), lines_.end(), p,
-                                         [](Iterator q, const Line& l) { return q < l.begin; });
+      const auto next =
+          std::upper_bound(lines_.begin(), lines_.end(), p, [](Iterator q, const Line& l) { return q < l.begin; });
       hint_ = static_cast<std::size_t>(next - lines_.begin()) - 1;
     }
     return {static_cast<int>(hint_) + 1, static_cast<int>(p - lines_[hint_].begin) + 1};
@@ -134,8 +131,7 @@ class Source {
     const Line& line = lines_[static_cast<std::size_t>(p.line) - 1];
     const auto offset = static_cast<std::size_t>(line.begin - parsed_);
     const auto length = static_cast<std::size_t>(line.end - line.begin);
-    throw ParseError(path_, p.line, p.column, message,
-                     std::string(original_.substr(offset, length)));
+    throw ParseError(path_, p.line, p.column, message, std::string(original_.substr(offset, length)));
   }
 
   // `at` is where a parser wanted `what`; `last` ends the text it was given.
@@ -219,16 +215,14 @@ struct Builder {
       n.expr.args.push_back(std::move(operand.expr));
     }
     if (n.height > kMaxTreeHeight)
-      source.fail(report_at, "expression more than " + std::to_string(kMaxTreeHeight) +
-                                 " operations deep");
+      source.fail(report_at, "expression more than " + std::to_string(kMaxTreeHeight) + " operations deep");
     stack.push_back(std::move(n));
   }
 
   void push_number(Iterator first, Iterator last) {
     double value = 0;
     const auto [end, ec] = std::from_chars(first, last, value);
-    if (ec != std::errc() || end != last || !std::isfinite(value))
-      source.fail(first, "number out of range");
+    if (ec != std::errc() || end != last || !std::isfinite(value)) source.fail(first, "number out of range");
     push(Expr::Kind::Number, first, {}, first);
     stack.back().expr.number = value;
   }
@@ -263,8 +257,7 @@ struct Builder {
     const std::size_t mark = calls.back();
     calls.pop_back();
     const auto first_arg = stack.begin() + static_cast<std::ptrdiff_t>(mark);
-    std::vector<Node> args(std::make_move_iterator(first_arg),
-                           std::make_move_iterator(stack.end()));
+    std::vector<Node> args(std::make_move_iterator(first_arg), std::make_move_iterator(stack.end()));
     stack.resize(mark);
     Node function = pop();
     push(Expr::Kind::Call, function.begin, std::move(args), function.begin);
@@ -384,65 +377,52 @@ const auto letter = x3::char_('a', 'z') | x3::char_('A', 'Z') | x3::char_('_');
 const auto digit = x3::char_('0', '9');
 const auto identifier = x3::raw[x3::lexeme[letter >> *(letter | digit)]];
 const auto exponent = (x3::lit('e') | 'E') >> -(x3::lit('+') | '-') >> +digit;
-const auto number =
-    x3::raw[x3::lexeme[((+digit >> -('.' >> *digit)) | ('.' >> +digit)) >> -exponent]];
+const auto number = x3::raw[x3::lexeme[((+digit >> -('.' >> *digit)) | ('.' >> +digit)) >> -exponent]];
 
 const x3::rule<class expr_rule> expr = "expression";
 const x3::rule<class unary_rule> unary = "unary expression";
 
 const auto arguments = -(expr >> *(',' >> expect(expr, "an argument after ','")));
-const auto call_or_symbol =
-    identifier[push_symbol] >>
-    -nest(x3::lit('(')[open_call],
-          arguments >> expect(')', "')' after the function arguments"))[close_call];
-const auto group = x3::raw[nest('(', expect(expr, "an expression after '('") >>
-                                         expect(')', "')'"))][starts_here];
+const auto call_or_symbol = identifier[push_symbol] >>
+                            -nest(x3::lit('(')[open_call],
+                                  arguments >> expect(')', "')' after the function arguments"))[close_call];
+const auto group = x3::raw[nest('(', expect(expr, "an expression after '('") >> expect(')', "')'"))][starts_here];
 const auto primary = number[push_number] | call_or_symbol | group;
 
 // Python precedence: `**` binds tighter than a sign on its left and takes a signed operand on
 // its right (-x**2 is -(x**2), 2**-1 is 2**(-1)) and is right-associative.
-const auto power =
-    primary >> -nest("**", expect(unary, "an expression after '**'"))[binary<Expr::Kind::Power>];
+const auto power = primary >> -nest("**", expect(unary, "an expression after '**'"))[binary<Expr::Kind::Power>];
 const auto unary_def = x3::raw[nest('-', expect(unary, "an expression after '-'"))][negate] |
-                       x3::raw[nest('+', expect(unary, "an expression after '+'"))][starts_here] |
-                       power;
-const auto term = unary >> *(('*' >> expect(unary, "an expression after '*'"))
-                                 [binary<Expr::Kind::Multiply>] |
-                             ('/' >> expect(unary, "an expression after '/'"))
-                                 [binary<Expr::Kind::Divide>]);
-const auto expr_def = term >> *(('+' >> expect(term, "an expression after '+'"))
-                                    [binary<Expr::Kind::Add>] |
-                                ('-' >> expect(term, "an expression after '-'"))
-                                    [binary<Expr::Kind::Subtract>]);
+                       x3::raw[nest('+', expect(unary, "an expression after '+'"))][starts_here] | power;
+const auto term = unary >> *(('*' >> expect(unary, "an expression after '*'"))[binary<Expr::Kind::Multiply>] |
+                             ('/' >> expect(unary, "an expression after '/'"))[binary<Expr::Kind::Divide>]);
+const auto expr_def = term >> *(('+' >> expect(term, "an expression after '+'"))[binary<Expr::Kind::Add>] |
+                                ('-' >> expect(term, "an expression after '-'"))[binary<Expr::Kind::Subtract>]);
 
 BOOST_SPIRIT_DEFINE(expr, unary)
 
-const auto whole_expression =
-    expect(expr, "an expression") >> expect(x3::eoi, "an operator or the end of the expression");
+const auto whole_expression = expect(expr, "an expression") >>
+                              expect(x3::eoi, "an operator or the end of the expression");
 
-const auto equation_line =
-    expect(identifier[set_name], "an equation 'NAME = expression;' or '*=*'") >>
-    expect('=', "'=' after the name") >> expect(expr, "an expression after '='") >>
-    expect(';', "';' at the end of the equation") >>
-    expect(x3::eoi, "the end of the line after ';'");
+const auto equation_line = expect(identifier[set_name], "an equation 'NAME = expression;' or '*=*'") >>
+                           expect('=', "'=' after the name") >> expect(expr, "an expression after '='") >>
+                           expect(';', "';' at the end of the equation") >>
+                           expect(x3::eoi, "the end of the line after ';'");
 
 const auto header_line = +identifier[add_column] >> expect(x3::eoi, "a column name");
 
 // Cells are expressions without spaces: a space ends a cell.
-const auto row_line =
-    *x3::lexeme[expr] >> expect(x3::eoi, "a space between cells or the end of the row");
+const auto row_line = *x3::lexeme[expr] >> expect(x3::eoi, "a space between cells or the end of the row");
 
-const auto par_list = x3::lit('{')[set_list] >>
-                      -(expr >> *(',' >> expect(expr, "a value after ','"))) >>
+const auto par_list = x3::lit('{')[set_list] >> -(expr >> *(',' >> expect(expr, "a value after ','"))) >>
                       expect('}', "',' or '}' in the list");
-const auto par_line = expect(identifier[set_name], "'NAME = value'") >>
-                      expect('=', "'=' after the name") >>
+const auto par_line = expect(identifier[set_name], "'NAME = value'") >> expect('=', "'=' after the name") >>
                       expect(par_list | expr, "a value after '='") >>
                       expect(x3::eoi, "the end of the line after the value");
 
 // The inside of `(* Robotname = 'planar2r' *)`; its attribute is the name.
-const auto robotname_comment = *blank >> "Robotname" >> *blank >> '=' >> *blank >> '\'' >>
-                               *(x3::char_ - '\'') >> '\'' >> *blank >> x3::eoi;
+const auto robotname_comment = *blank >> "Robotname" >> *blank >> '=' >> *blank >> '\'' >> *(x3::char_ - '\'') >>
+                               '\'' >> *blank >> x3::eoi;
 
 // Runs `grammar` over [first, last); every failure inside throws, so only success returns.
 template <typename Grammar>
@@ -525,20 +505,18 @@ class ModelParser {
 
   // Free-text lines (at most `max_free`, before the first table) and tables, up to the line
   // `marker`; leaves i_ on the marker.
-  void section(std::string_view marker, std::vector<std::string>& free_lines,
-               std::vector<Table>& tables, std::size_t max_free) {
+  void section(std::string_view marker, std::vector<std::string>& free_lines, std::vector<Table>& tables,
+               std::size_t max_free) {
     for (;;) {
       if (i_ == lines_.size())
-        src_.fail(src_.end_of_content(), marker == kEnd ? "missing '*=*' end marker"
-                                                         : "missing 'Equations:' section");
+        src_.fail(src_.end_of_content(), marker == kEnd ? "missing '*=*' end marker" : "missing 'Equations:' section");
       const auto t = text(i_);
       if (t.empty()) {
         ++i_;
       } else if (t == marker) {
         return;
       } else if (t == kEnd || t == kEquations) {
-        src_.fail(first_char(i_), "expected '" + std::string(marker) + "' before '" +
-                                      std::string(t) + "'");
+        src_.fail(first_char(i_), "expected '" + std::string(marker) + "' before '" + std::string(t) + "'");
       } else if (is_title(i_)) {
         tables.push_back(table(marker));
       } else if (is_header(t)) {
@@ -549,7 +527,8 @@ class ModelParser {
       } else {
         src_.fail(first_char(i_),
                   "expected a table (a title line, then a header row starting with 'j' or "
-                  "'axis') or '" + std::string(marker) + "'");
+                  "'axis') or '" +
+                      std::string(marker) + "'");
       }
     }
   }
@@ -564,8 +543,7 @@ class ModelParser {
     run(b_, header_line, lines_[i_].begin, lines_[i_].end);
     std::set<std::string_view> seen;
     for (std::size_t c = 0; c < b_.columns.size(); ++c)
-      if (!seen.insert(b_.columns[c]).second)
-        src_.fail(b_.column_at[c], "duplicate column '" + b_.columns[c] + "'");
+      if (!seen.insert(b_.columns[c]).second) src_.fail(b_.column_at[c], "duplicate column '" + b_.columns[c] + "'");
     table.columns = std::move(b_.columns);
 
     for (++i_; i_ < lines_.size(); ++i_) {
@@ -576,8 +554,7 @@ class ModelParser {
       const std::size_t columns = table.columns.size();
       if (cells != columns) {
         const Iterator where = cells > columns ? b_.stack[columns].begin : t.data() + t.size();
-        src_.fail(where, "row has " + plural(cells, "cell") + " but the header has " +
-                             plural(columns, "column"));
+        src_.fail(where, "row has " + plural(cells, "cell") + " but the header has " + plural(columns, "column"));
       }
       Table::Row row;
       row.at = at(i_);
@@ -602,8 +579,7 @@ std::string blank_comments(const Source& src, std::string& text) {
   std::size_t pos = 0;
   while ((pos = text.find("(*", pos)) != std::string::npos) {
     const auto close = text.find("*)", pos + 2);
-    if (close == std::string::npos)
-      src.fail(text.data() + pos, "unterminated comment: expected '*)'");
+    if (close == std::string::npos) src.fail(text.data() + pos, "unterminated comment: expected '*)'");
     const char* first = text.data() + pos + 2;
     const char* last = text.data() + close;
     std::string name;
@@ -676,9 +652,7 @@ std::string read_file(const std::string& path) {
 
 }  // namespace
 
-ModelFile read_model_file(const std::string& path) {
-  return parse_model_file(read_file(path), path);
-}
+ModelFile read_model_file(const std::string& path) { return parse_model_file(read_file(path), path); }
 
 ParFile read_par_file(const std::string& path) { return parse_par_file(read_file(path), path); }
 

@@ -74,8 +74,10 @@ void inverse_dynamics_one(benchmark::State& state) {
 }  // namespace
 
 BENCHMARK_TEMPLATE(inverse_dynamics_batch, symoro::planar2r::Model)->Name("inverse_dynamics_batch/planar2r.full");
-BENCHMARK_TEMPLATE(inverse_dynamics_batch, symoro::crane_x7::reduced::Model)->Name("inverse_dynamics_batch/crane_x7.reduced");
+BENCHMARK_TEMPLATE(inverse_dynamics_batch, symoro::crane_x7::reduced::Model)
+    ->Name("inverse_dynamics_batch/crane_x7.reduced");
 BENCHMARK_TEMPLATE(regressor_batch, symoro::crane_x7::reduced::Model)->Name("regressor_batch/crane_x7.reduced");
 BENCHMARK_TEMPLATE(inverse_dynamics_one, symoro::planar2r::Model)->Name("inverse_dynamics_one/planar2r.full");
-BENCHMARK_TEMPLATE(inverse_dynamics_one, symoro::crane_x7::reduced::Model)->Name("inverse_dynamics_one/crane_x7.reduced");
+BENCHMARK_TEMPLATE(inverse_dynamics_one, symoro::crane_x7::reduced::Model)
+    ->Name("inverse_dynamics_one/crane_x7.reduced");
 BENCHMARK_MAIN();

@@ -32,11 +32,13 @@ DoubleArray converted(py::handle value, const char* name, int width) {
   py::array any = py::array::ensure(value);
   if (!any) {
     PyErr_Clear();
-    throw py::type_error(fmt::format("{}: expected an array of numbers, got {}", name, py::str(value.get_type()).cast<std::string>()));
+    throw py::type_error(
+        fmt::format("{}: expected an array of numbers, got {}", name, py::str(value.get_type()).cast<std::string>()));
   }
   const char kind = any.dtype().kind();
   if (kind != 'f' && kind != 'i' && kind != 'u')
-    throw py::type_error(fmt::format("{}: expected real numbers, got an array of dtype {}", name, py::str(any.dtype()).cast<std::string>()));
+    throw py::type_error(fmt::format("{}: expected real numbers, got an array of dtype {}", name,
+                                     py::str(any.dtype()).cast<std::string>()));
   DoubleArray a = DoubleArray::ensure(any);
   if (!a) throw py::error_already_set();
   return a;
@@ -53,7 +55,8 @@ StateArg state_arg(py::handle value, const char* name, int width) {
   }
   const py::ssize_t nd = arg.array.ndim();
   if (!((nd == 1 && arg.array.shape(0) == width) || (nd == 2 && arg.array.shape(1) == width)))
-    throw py::value_error(fmt::format("{}: expected shape ({},) or (N, {}), got {}", name, width, width, shape_text(arg.array)));
+    throw py::value_error(
+        fmt::format("{}: expected shape ({},) or (N, {}), got {}", name, width, width, shape_text(arg.array)));
   arg.batch = nd == 2;
   arg.n = arg.batch ? arg.array.shape(0) : 1;
   const double* p = arg.array.data();
@@ -66,14 +69,14 @@ StateArg state_arg(py::handle value, const char* name, int width) {
   return arg;
 }
 
-
 std::ptrdiff_t common_batch(std::initializer_list<std::pair<const char*, const StateArg*>> args, bool& batch) {
   const auto& [first_name, first] = *args.begin();
   for (const auto& [name, a] : args)
     if (a->batch != first->batch || a->n != first->n)
-      throw py::value_error(fmt::format("{}: {} where {} is {} (the same number of states for every argument)", name,
-                                        a->batch ? fmt::format("a batch of {}", a->n) : std::string("one state"),
-                                        first_name, first->batch ? fmt::format("a batch of {}", first->n) : std::string("one state")));
+      throw py::value_error(
+          fmt::format("{}: {} where {} is {} (the same number of states for every argument)", name,
+                      a->batch ? fmt::format("a batch of {}", a->n) : std::string("one state"), first_name,
+                      first->batch ? fmt::format("a batch of {}", first->n) : std::string("one state")));
   batch = first->batch;
   return first->n;
 }
@@ -81,8 +84,8 @@ std::ptrdiff_t common_batch(std::initializer_list<std::pair<const char*, const S
 std::ptrdiff_t phi_stride(const StateArg& phi, const char* name, std::ptrdiff_t n, bool batch) {
   if (!phi.batch) return 0;
   if (!batch || phi.n != n)
-    throw py::value_error(fmt::format("{}: a batch of {} parameter vectors for {} (give one vector, or one per state)", name,
-                                      phi.n, batch ? fmt::format("{} states", n) : std::string("one state")));
+    throw py::value_error(fmt::format("{}: a batch of {} parameter vectors for {} (give one vector, or one per state)",
+                                      name, phi.n, batch ? fmt::format("{} states", n) : std::string("one state")));
   return phi.array.shape(1);
 }
 
@@ -93,8 +96,8 @@ py::array_t<double> output(bool batch, std::ptrdiff_t n, std::initializer_list<p
   for (py::ssize_t d : dims) shape[nd++] = d;
   const auto& api = py::detail::npy_api::get();
   // NumPy's own constructor, without the shape and stride vectors pybind11's would allocate.
-  PyObject* a = api.PyArray_NewFromDescr_(api.PyArray_Type_, py::dtype::of<double>().release().ptr(), nd, shape, nullptr,
-                                          nullptr, 0, nullptr);
+  PyObject* a = api.PyArray_NewFromDescr_(api.PyArray_Type_, py::dtype::of<double>().release().ptr(), nd, shape,
+                                          nullptr, nullptr, 0, nullptr);
   if (!a) throw py::error_already_set();
   return py::reinterpret_steal<py::array_t<double>>(a);
 }

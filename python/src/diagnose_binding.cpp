@@ -100,69 +100,75 @@ py::dict diagnosis_dict(const diagnose::DatasetDiagnosis& r) {
 void bind_diagnose(py::module_& m) {
   // dynid diagnose's defaults are DatasetDiagnosisOptions' own: taken from it.
   const diagnose::DatasetDiagnosisOptions defaults;
-  m.def("diagnose", [](py::handle model, const std::filesystem::path& data, const std::filesystem::path& out,
-                       const std::optional<std::filesystem::path>& robot_dir_given, const std::vector<std::string>& train,
-                       const std::vector<std::string>& heldout, int trial, double interval_ms, double cutoff,
-                       const std::vector<std::string>& only, double alpha, double min_gain, double min_torque, bool backlash,
-                       const std::optional<std::filesystem::path>& params, const std::string& variant, bool apply,
-                       py::object progress) {
-    const auto dm = diagnosis_of(model);
-    const std::optional<std::filesystem::path> robot_dir = robot_dir_of(model, robot_dir_given);
-    diagnose::DatasetDiagnosisOptions o;
-    o.data = data;
-    o.out = out;
-    o.robot_dir = robot_dir.value_or("");
-    o.train = train;
-    o.heldout = heldout;
-    o.trial = trial;
-    o.interval = interval_ms / 1000;
-    o.cutoff = cutoff;
-    o.only = only;
-    o.alpha = alpha;
-    o.min_heldout_gain = min_gain;
-    o.min_effect_torque = min_torque;
-    o.backlash = backlash;
-    o.params = params.value_or("");
-    o.variant = variant;
-    if (apply && !robot_dir) throw py::value_error("apply: needs robot_dir, the folder whose robot.yaml gains the variant");
-    diagnose::check_request(o);  // before any work
-    std::atomic<bool> stop{false};
-    o.stop = [&stop] { return stop.load(); };
-    std::exception_ptr callback_error;
-    std::mutex callback_mutex;
-    if (!progress.is_none())
-      o.say = [&](const std::string& line) {
-        py::gil_scoped_acquire gil;
+  m.def(
+      "diagnose",
+      [](py::handle model, const std::filesystem::path& data, const std::filesystem::path& out,
+         const std::optional<std::filesystem::path>& robot_dir_given, const std::vector<std::string>& train,
+         const std::vector<std::string>& heldout, int trial, double interval_ms, double cutoff,
+         const std::vector<std::string>& only, double alpha, double min_gain, double min_torque, bool backlash,
+         const std::optional<std::filesystem::path>& params, const std::string& variant, bool apply,
+         py::object progress) {
+        const auto dm = diagnosis_of(model);
+        const std::optional<std::filesystem::path> robot_dir = robot_dir_of(model, robot_dir_given);
+        diagnose::DatasetDiagnosisOptions o;
+        o.data = data;
+        o.out = out;
+        o.robot_dir = robot_dir.value_or("");
+        o.train = train;
+        o.heldout = heldout;
+        o.trial = trial;
+        o.interval = interval_ms / 1000;
+        o.cutoff = cutoff;
+        o.only = only;
+        o.alpha = alpha;
+        o.min_heldout_gain = min_gain;
+        o.min_effect_torque = min_torque;
+        o.backlash = backlash;
+        o.params = params.value_or("");
+        o.variant = variant;
+        if (apply && !robot_dir)
+          throw py::value_error("apply: needs robot_dir, the folder whose robot.yaml gains the variant");
+        diagnose::check_request(o);  // before any work
+        std::atomic<bool> stop{false};
+        o.stop = [&stop] { return stop.load(); };
+        std::exception_ptr callback_error;
+        std::mutex callback_mutex;
+        if (!progress.is_none())
+          o.say = [&](const std::string& line) {
+            py::gil_scoped_acquire gil;
+            try {
+              progress(line);
+            } catch (py::error_already_set&) {  // the callback raised: stop, and raise it afterwards
+              std::lock_guard<std::mutex> lock(callback_mutex);
+              if (!callback_error) callback_error = std::current_exception();
+              stop = true;
+            }
+          };
+        diagnose::DatasetDiagnosis r;
         try {
-          progress(line);
-        } catch (py::error_already_set&) {  // the callback raised: stop, and raise it afterwards
-          std::lock_guard<std::mutex> lock(callback_mutex);
-          if (!callback_error) callback_error = std::current_exception();
-          stop = true;
+          run_interruptible(stop, [&] { r = diagnose::diagnose_dataset(*dm, o); });
+        } catch (const diagnose::DiagnosisStopped&) {
+          if (callback_error) std::rethrow_exception(callback_error);
+          throw;
         }
-      };
-    diagnose::DatasetDiagnosis r;
-    try {
-      run_interruptible(stop, [&] { r = diagnose::diagnose_dataset(*dm, o); });
-    } catch (const diagnose::DiagnosisStopped&) {
-      if (callback_error) std::rethrow_exception(callback_error);
-      throw;
-    }
-    if (callback_error) std::rethrow_exception(callback_error);
-    py::dict result = diagnosis_dict(r);
-    result["applied"] = py::none();
-    if (apply) {
-      const auto yaml = *robot_dir / "robot.yaml";
-      diagnose::add_variant_to_robot_yaml(yaml, r.variant_name, r.variant_yaml);
-      result["applied"] = yaml;
-    }
-    return result;
-  }, py::arg("model"), py::arg("data"), py::arg("out"), py::kw_only(), py::arg("robot_dir") = py::none(),
-     py::arg("train") = std::vector<std::string>{}, py::arg("heldout") = std::vector<std::string>{},
-     py::arg("trial") = defaults.trial, py::arg("interval_ms") = defaults.interval * 1000, py::arg("cutoff") = defaults.cutoff,
-     py::arg("only") = std::vector<std::string>{}, py::arg("alpha") = defaults.alpha, py::arg("min_gain") = defaults.min_heldout_gain,
-     py::arg("min_torque") = defaults.min_effect_torque, py::arg("backlash") = defaults.backlash, py::arg("params") = py::none(),
-     py::arg("variant") = "", py::arg("apply") = false, py::arg("progress") = py::none());
+        if (callback_error) std::rethrow_exception(callback_error);
+        py::dict result = diagnosis_dict(r);
+        result["applied"] = py::none();
+        if (apply) {
+          const auto yaml = *robot_dir / "robot.yaml";
+          diagnose::add_variant_to_robot_yaml(yaml, r.variant_name, r.variant_yaml);
+          result["applied"] = yaml;
+        }
+        return result;
+      },
+      py::arg("model"), py::arg("data"), py::arg("out"), py::kw_only(), py::arg("robot_dir") = py::none(),
+      py::arg("train") = std::vector<std::string>{}, py::arg("heldout") = std::vector<std::string>{},
+      py::arg("trial") = defaults.trial, py::arg("interval_ms") = defaults.interval * 1000,
+      py::arg("cutoff") = defaults.cutoff, py::arg("only") = std::vector<std::string>{},
+      py::arg("alpha") = defaults.alpha, py::arg("min_gain") = defaults.min_heldout_gain,
+      py::arg("min_torque") = defaults.min_effect_torque, py::arg("backlash") = defaults.backlash,
+      py::arg("params") = py::none(), py::arg("variant") = "", py::arg("apply") = false,
+      py::arg("progress") = py::none());
 }
 
 }  // namespace symoro::python

@@ -66,7 +66,8 @@ ModelKernels handle_kernels(const robot::ModelHandle& model) {
     }
   };
   k.nonlinear_effects = [m, nq](const double* q, const double* qd, const double* phi, double* h, Batch b) {
-    for (std::ptrdiff_t i = 0; i < b.n; ++i) m.nonlinear_effects(q + i * nq, qd + i * nq, phi + i * b.phi_stride, h + i * nq);
+    for (std::ptrdiff_t i = 0; i < b.n; ++i)
+      m.nonlinear_effects(q + i * nq, qd + i * nq, phi + i * b.phi_stride, h + i * nq);
   };
   k.forward_dynamics = [m, nq](const double* q, const double* qd, const double* tau, const double* phi, double* qdd,
                                Batch b) {

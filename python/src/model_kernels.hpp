@@ -32,23 +32,24 @@ struct ModelKernels {
   // (n, nq, np)
   std::function<void(const double* q, const double* qd, const double* qdd, double* w, Batch b)> regressor;
   // (n, nq)
-  std::function<void(const double* q, const double* qd, const double* qdd, const double* phi, double* tau,
-                           Batch b)> inverse_dynamics;
+  std::function<void(const double* q, const double* qd, const double* qdd, const double* phi, double* tau, Batch b)>
+      inverse_dynamics;
   // (n, nq, nq)
   std::function<void(const double* q, const double* phi, double* m, Batch b)> inertia;
   // (n, nq)
   std::function<void(const double* q, const double* qd, const double* phi, double* h, Batch b)> nonlinear_effects;
   // (n, nq)
-  std::function<void(const double* q, const double* qd, const double* tau, const double* phi, double* qdd,
-                           Batch b)> forward_dynamics;
+  std::function<void(const double* q, const double* qd, const double* tau, const double* phi, double* qdd, Batch b)>
+      forward_dynamics;
   // tau (n, nq), d tau / d q and d qd (n, nq, nq)
-  std::function<void(const double* q, const double* qd, const double* qdd, const double* phi,
-                                       double* tau, double* dq, double* dqd, Batch b)> inverse_dynamics_derivatives;
+  std::function<void(const double* q, const double* qd, const double* qdd, const double* phi, double* tau, double* dq,
+                     double* dqd, Batch b)>
+      inverse_dynamics_derivatives;
   // qdd (n, nq), d qdd / d q, d qd, d tau (n, nq, nq), d phi (n, nq, np), min_pivot (n): where M
   // is not positive definite (min_pivot <= 0) the derivatives are NaN.
-  std::function<void(const double* q, const double* qd, const double* tau, const double* phi,
-                                       double* qdd, double* dq, double* dqd, double* dtau, double* dphi,
-                                       double* min_pivot, Batch b)> forward_dynamics_derivatives;
+  std::function<void(const double* q, const double* qd, const double* tau, const double* phi, double* qdd, double* dq,
+                     double* dqd, double* dtau, double* dphi, double* min_pivot, Batch b)>
+      forward_dynamics_derivatives;
   // (n, 4, 4): the last arm frame in frame 0
   std::function<void(const double* q, double* pose, Batch b)> forward_kinematics;
   // (n, 6, nq)

@@ -35,9 +35,10 @@ Eigen::VectorXd parameters_of(const identify::IdentificationModel& model, py::ha
   if (py::isinstance<py::str>(params) && params.cast<std::string>() == "nominal") {
     std::vector<double> s;
     if (!robot_dir || !study::nominal_standard_parameters(*robot_dir, d.standard, s))
-      throw py::value_error("params='nominal': " + (robot_dir ? (*robot_dir / "robot.yaml").string() +
-                                                                    " has no nominal parameters (symoroc model writes them from a URDF)"
-                                                              : std::string("no robot_dir given")));
+      throw py::value_error("params='nominal': " +
+                            (robot_dir ? (*robot_dir / "robot.yaml").string() +
+                                             " has no nominal parameters (symoroc model writes them from a URDF)"
+                                       : std::string("no robot_dir given")));
     return model.base_from_standard(Eigen::Map<const Eigen::VectorXd>(s.data(), static_cast<Eigen::Index>(s.size())));
   }
   if (py::isinstance<py::str>(params) || py::hasattr(params, "__fspath__")) {
@@ -74,158 +75,176 @@ py::dict prediction_dict(const std::string& name, const study::Prediction& p) {
 }  // namespace
 
 void bind_results(py::module_& m) {
-  m.def("predict", [](py::handle model, py::handle params, const std::filesystem::path& input, double interval_ms,
-                      double torque_delay_ms, int trial, const std::optional<std::filesystem::path>& robot_dir_given) {
-    // dynid predict's ranges (a NaN or infinite value is named, never computed with).
-    if (!(std::isfinite(interval_ms) && interval_ms >= 1 && interval_ms <= 10000))
-      throw py::value_error(fmt::format("interval_ms {}: must be from 1 to 10000", interval_ms));
-    if (!(std::isfinite(torque_delay_ms) && torque_delay_ms >= -1000 && torque_delay_ms <= 1000))
-      throw py::value_error(fmt::format("torque_delay_ms {}: must be from -1000 to 1000", torque_delay_ms));
-    if (trial < 1) throw py::value_error(fmt::format("trial {}: must be 1 or more", trial));
-    const auto id = identification_of(model);
-    const std::optional<std::filesystem::path> robot_dir = robot_dir_of(model, robot_dir_given);
-    const identify::ModelDescription& d = id->description();
-    const Eigen::VectorXd phi = parameters_of(*id, params, robot_dir);
-    // One log, or every run of a dataset's trial (as dynid predict).
-    std::vector<std::pair<std::string, io::Log>> logs;
-    if (std::filesystem::is_directory(input)) {
-      const io::Dataset data = io::read_dataset(input);
-      io::check_dataset_robot(data, d.robot);
-      for (const auto& r : data.runs)
-        if (r.trial == trial) logs.emplace_back(r.trajectory, io::read_run_log(r, d.robot, d.nq));
-      if (logs.empty()) throw py::value_error(fmt::format("{}: no run of trial {}", input.string(), trial));
-    } else {
-      io::Log log = io::read_log(input);
-      io::check_log_robot(log, input, d.robot, d.nq);
-      logs.emplace_back(input.stem().string(), std::move(log));
-    }
-    std::vector<study::Prediction> out(logs.size());
-    {
-      py::gil_scoped_release release;
-      for (std::size_t i = 0; i < logs.size(); ++i)
-        out[i] = study::predict(logs[i].second, *id, phi, {interval_ms / 1000, torque_delay_ms / 1000});
-    }
-    py::list result;
-    for (std::size_t i = 0; i < logs.size(); ++i) result.append(prediction_dict(logs[i].first, out[i]));
-    return result;
-  }, py::arg("model"), py::arg("params"), py::arg("input"), py::kw_only(), py::arg("interval_ms") = study::PredictionOptions{}.interval * 1000,
-     py::arg("torque_delay_ms") = study::PredictionOptions{}.torque_delay * 1000, py::arg("trial") = 1, py::arg("robot_dir") = py::none(),
-     "The model's torque on a log or a dataset's runs: a list of {'name', 'time', 'q', 'qd', 'qdd', 'tau', 'tau_model', "
-     "'rmse', 'rms', 'raw_rmse', 'raw_rmse_overall', 'raw_samples', 'edge_samples', 'context_rows', 'preprocessing'}; params: an array, a parameters file or 'nominal' (with robot_dir)");
+  m.def(
+      "predict",
+      [](py::handle model, py::handle params, const std::filesystem::path& input, double interval_ms,
+         double torque_delay_ms, int trial, const std::optional<std::filesystem::path>& robot_dir_given) {
+        // dynid predict's ranges (a NaN or infinite value is named, never computed with).
+        if (!(std::isfinite(interval_ms) && interval_ms >= 1 && interval_ms <= 10000))
+          throw py::value_error(fmt::format("interval_ms {}: must be from 1 to 10000", interval_ms));
+        if (!(std::isfinite(torque_delay_ms) && torque_delay_ms >= -1000 && torque_delay_ms <= 1000))
+          throw py::value_error(fmt::format("torque_delay_ms {}: must be from -1000 to 1000", torque_delay_ms));
+        if (trial < 1) throw py::value_error(fmt::format("trial {}: must be 1 or more", trial));
+        const auto id = identification_of(model);
+        const std::optional<std::filesystem::path> robot_dir = robot_dir_of(model, robot_dir_given);
+        const identify::ModelDescription& d = id->description();
+        const Eigen::VectorXd phi = parameters_of(*id, params, robot_dir);
+        // One log, or every run of a dataset's trial (as dynid predict).
+        std::vector<std::pair<std::string, io::Log>> logs;
+        if (std::filesystem::is_directory(input)) {
+          const io::Dataset data = io::read_dataset(input);
+          io::check_dataset_robot(data, d.robot);
+          for (const auto& r : data.runs)
+            if (r.trial == trial) logs.emplace_back(r.trajectory, io::read_run_log(r, d.robot, d.nq));
+          if (logs.empty()) throw py::value_error(fmt::format("{}: no run of trial {}", input.string(), trial));
+        } else {
+          io::Log log = io::read_log(input);
+          io::check_log_robot(log, input, d.robot, d.nq);
+          logs.emplace_back(input.stem().string(), std::move(log));
+        }
+        std::vector<study::Prediction> out(logs.size());
+        {
+          py::gil_scoped_release release;
+          for (std::size_t i = 0; i < logs.size(); ++i)
+            out[i] = study::predict(logs[i].second, *id, phi, {interval_ms / 1000, torque_delay_ms / 1000});
+        }
+        py::list result;
+        for (std::size_t i = 0; i < logs.size(); ++i) result.append(prediction_dict(logs[i].first, out[i]));
+        return result;
+      },
+      py::arg("model"), py::arg("params"), py::arg("input"), py::kw_only(),
+      py::arg("interval_ms") = study::PredictionOptions{}.interval * 1000,
+      py::arg("torque_delay_ms") = study::PredictionOptions{}.torque_delay * 1000, py::arg("trial") = 1,
+      py::arg("robot_dir") = py::none(),
+      "The model's torque on a log or a dataset's runs: a list of {'name', 'time', 'q', 'qd', 'qdd', 'tau', "
+      "'tau_model', "
+      "'rmse', 'rms', 'raw_rmse', 'raw_rmse_overall', 'raw_samples', 'edge_samples', 'context_rows', 'preprocessing'}; "
+      "params: an array, a parameters file or 'nominal' (with robot_dir)");
 
-  m.def("compare", [](const std::filesystem::path& before_dir, const std::filesystem::path& after_dir,
-                      const std::filesystem::path& out, const std::string& trajectory, const std::vector<int>& joints) {
-    const study::StudyValidation before = study::read_validation(before_dir);
-    const study::StudyValidation after = study::read_validation(after_dir);
-    const diagnose::GapComparison c = diagnose::compare_studies(before, after);
-    diagnose::GapReportOptions ro;
-    try {
-      ro = diagnose::gap_report_options(before_dir, after_dir, c, trajectory, joints);
-    } catch (const std::invalid_argument& e) {
-      throw py::value_error(fmt::format("joints: {}", e.what()));
-    }
-    diagnose::write_gap_report(before, after, c, out, ro);
-    py::list trajectories;
-    for (const auto& t : c.trajectories) {
-      py::dict x;
-      x["trajectory"] = t.trajectory;
-      x["kind"] = t.kind;
-      x["interval"] = t.interval;
-      x["samples"] = t.samples;
-      x["rmse_before"] = t.rmse_before;
-      x["rmse_after"] = t.rmse_after;
-      x["joint_before"] = t.joint_before;
-      x["joint_after"] = t.joint_after;
-      trajectories.append(x);
-    }
-    py::dict r;
-    r["robot"] = c.robot;
-    r["before_model"] = c.before_model;
-    r["after_model"] = c.after_model;
-    r["trajectories"] = trajectories;
-    r["rmse_before"] = c.rmse_before;
-    r["rmse_after"] = c.rmse_after;
-    r["joint_before"] = c.joint_before;
-    r["joint_after"] = c.joint_after;
-    r["added"] = c.added;
-    r["report"] = out / "gap.md";
-    return r;
-  }, py::arg("before"), py::arg("after"), py::arg("out"), py::kw_only(), py::arg("trajectory") = "",
-     py::arg("joints") = std::vector<int>{},
-     "Two studies of one robot on the same data side by side on their held-out trajectories (dynid compare): gap.md and "
-     "figures in out, the numbers as a dict");
+  m.def(
+      "compare",
+      [](const std::filesystem::path& before_dir, const std::filesystem::path& after_dir,
+         const std::filesystem::path& out, const std::string& trajectory, const std::vector<int>& joints) {
+        const study::StudyValidation before = study::read_validation(before_dir);
+        const study::StudyValidation after = study::read_validation(after_dir);
+        const diagnose::GapComparison c = diagnose::compare_studies(before, after);
+        diagnose::GapReportOptions ro;
+        try {
+          ro = diagnose::gap_report_options(before_dir, after_dir, c, trajectory, joints);
+        } catch (const std::invalid_argument& e) {
+          throw py::value_error(fmt::format("joints: {}", e.what()));
+        }
+        diagnose::write_gap_report(before, after, c, out, ro);
+        py::list trajectories;
+        for (const auto& t : c.trajectories) {
+          py::dict x;
+          x["trajectory"] = t.trajectory;
+          x["kind"] = t.kind;
+          x["interval"] = t.interval;
+          x["samples"] = t.samples;
+          x["rmse_before"] = t.rmse_before;
+          x["rmse_after"] = t.rmse_after;
+          x["joint_before"] = t.joint_before;
+          x["joint_after"] = t.joint_after;
+          trajectories.append(x);
+        }
+        py::dict r;
+        r["robot"] = c.robot;
+        r["before_model"] = c.before_model;
+        r["after_model"] = c.after_model;
+        r["trajectories"] = trajectories;
+        r["rmse_before"] = c.rmse_before;
+        r["rmse_after"] = c.rmse_after;
+        r["joint_before"] = c.joint_before;
+        r["joint_after"] = c.joint_after;
+        r["added"] = c.added;
+        r["report"] = out / "gap.md";
+        return r;
+      },
+      py::arg("before"), py::arg("after"), py::arg("out"), py::kw_only(), py::arg("trajectory") = "",
+      py::arg("joints") = std::vector<int>{},
+      "Two studies of one robot on the same data side by side on their held-out trajectories (dynid compare): gap.md "
+      "and "
+      "figures in out, the numbers as a dict");
 }
 
 void bind_export(py::module_& m) {
-  m.def("export_urdf", [](py::handle model, const std::filesystem::path& study, const std::filesystem::path& urdf,
-                          py::handle prior, const std::optional<std::filesystem::path>& robot_dir_given, double margin,
-                          bool nearest, bool not_accepted) {
-    const auto id = identification_of(model);
-    const std::optional<std::filesystem::path> robot_dir = robot_dir_of(model, robot_dir_given);
-    const identify::ModelDescription& d = id->description();
-    if (!id->supports_physical_consistency())
-      throw py::value_error(fmt::format("model '{}' has model-gap effect parameters, which have no URDF counterpart and no "
-                                        "standard-parameter form: export a study of a model without effects", d.variant));
-    // As dynid export: the study's accepted vector, refused when its final audit did not accept it.
-    const std::filesystem::path params = study / "report" / "parameters.yaml";
-    std::vector<std::string> names;
-    for (const auto& p : d.parameters) names.push_back(p.name);
-    const Eigen::VectorXd phi = io::read_parameters_yaml(params.string(), names);
-    const bool accepted = io::parameters_accepted(params.string());
-    if (!accepted && !not_accepted)
-      throw py::value_error(params.string() + ": the study's final audit did not accept these parameters (accepted: false); "
-                                              "not_accepted=True exports them anyway");
-    model_export::ModelExportOptions eo;
-    std::vector<std::string> standard;
-    for (const auto& p : d.standard) standard.push_back(p.name);
-    const std::string prior_name = py::isinstance<py::str>(prior) ? prior.cast<std::string>() : "";
-    if (prior_name == "zero") {
-      eo.prior = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(d.standard.size()));
-      eo.prior_what = "zero (the consistent set nearest 0)";
-    } else if (prior.is_none() || prior_name == "nominal") {
-      std::vector<double> s;
-      if (!robot_dir || !study::nominal_standard_parameters(*robot_dir, d.standard, s))
-        throw py::value_error("prior: robot.yaml's nominal parameters are needed (robot_dir=, a folder symoroc model wrote "
-                              "from a URDF), else give prior='zero', a standard-parameter file or an array");
-      eo.prior = Eigen::Map<const Eigen::VectorXd>(s.data(), static_cast<Eigen::Index>(s.size()));
-      eo.prior_what = (*robot_dir / "robot.yaml").string() + " (nominal: the URDF's inertials)";
-    } else if (!prior_name.empty() || py::hasattr(prior, "__fspath__")) {
-      const auto file = prior.cast<std::filesystem::path>();
-      eo.prior = io::read_parameters_yaml(file.string(), standard);
-      eo.prior_what = file.string();
-    } else {
-      const StateArg s = state_arg(prior, "prior", static_cast<int>(d.standard.size()));
-      if (s.batch) throw py::value_error("prior: one vector of standard parameters expected");
-      eo.prior = Eigen::Map<const Eigen::VectorXd>(s.data(), static_cast<Eigen::Index>(d.standard.size()));
-      eo.prior_what = "an array given from Python";
-    }
-    eo.study = study.string();
-    eo.accepted = accepted;
-    eo.margin = margin;
-    eo.nearest = nearest;
-    model_export::ModelExport e;
-    model_export::ModelExportFiles files;
-    {
-      py::gil_scoped_release release;
-      e = model_export::export_model(*id, phi, eo);
-      files = model_export::write_model_export(e, urdf, model_export::urdf_text(e.description));
-    }
-    py::dict r;
-    r["urdf"] = files.urdf;
-    r["standard_yaml"] = files.yaml;
-    r["standard_csv"] = files.csv;
-    r["s"] = e.description.s;
-    r["standard_names"] = standard;
-    r["residual"] = e.residual;
-    r["lambda_min"] = e.consistency.lambda_min;
-    r["nearest"] = e.nearest;
-    r["message"] = e.consistency.message;
-    return r;
-  }, py::arg("model"), py::arg("study"), py::arg("urdf"), py::kw_only(), py::arg("prior") = py::none(),
-     py::arg("robot_dir") = py::none(), py::arg("margin") = model_export::ModelExportOptions{}.margin,
-     py::arg("nearest") = model_export::ModelExportOptions{}.nearest, py::arg("not_accepted") = false,
-     "The study's accepted parameters as a URDF (dynid export): the physically consistent standard parameters nearest the "
-     "prior that reproduce them, written to urdf and <stem>.standard.yaml/.csv");
+  m.def(
+      "export_urdf",
+      [](py::handle model, const std::filesystem::path& study, const std::filesystem::path& urdf, py::handle prior,
+         const std::optional<std::filesystem::path>& robot_dir_given, double margin, bool nearest, bool not_accepted) {
+        const auto id = identification_of(model);
+        const std::optional<std::filesystem::path> robot_dir = robot_dir_of(model, robot_dir_given);
+        const identify::ModelDescription& d = id->description();
+        if (!id->supports_physical_consistency())
+          throw py::value_error(
+              fmt::format("model '{}' has model-gap effect parameters, which have no URDF counterpart and no "
+                          "standard-parameter form: export a study of a model without effects",
+                          d.variant));
+        // As dynid export: the study's accepted vector, refused when its final audit did not accept it.
+        const std::filesystem::path params = study / "report" / "parameters.yaml";
+        std::vector<std::string> names;
+        for (const auto& p : d.parameters) names.push_back(p.name);
+        const Eigen::VectorXd phi = io::read_parameters_yaml(params.string(), names);
+        const bool accepted = io::parameters_accepted(params.string());
+        if (!accepted && !not_accepted)
+          throw py::value_error(params.string() +
+                                ": the study's final audit did not accept these parameters (accepted: false); "
+                                "not_accepted=True exports them anyway");
+        model_export::ModelExportOptions eo;
+        std::vector<std::string> standard;
+        for (const auto& p : d.standard) standard.push_back(p.name);
+        const std::string prior_name = py::isinstance<py::str>(prior) ? prior.cast<std::string>() : "";
+        if (prior_name == "zero") {
+          eo.prior = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(d.standard.size()));
+          eo.prior_what = "zero (the consistent set nearest 0)";
+        } else if (prior.is_none() || prior_name == "nominal") {
+          std::vector<double> s;
+          if (!robot_dir || !study::nominal_standard_parameters(*robot_dir, d.standard, s))
+            throw py::value_error(
+                "prior: robot.yaml's nominal parameters are needed (robot_dir=, a folder symoroc model wrote "
+                "from a URDF), else give prior='zero', a standard-parameter file or an array");
+          eo.prior = Eigen::Map<const Eigen::VectorXd>(s.data(), static_cast<Eigen::Index>(s.size()));
+          eo.prior_what = (*robot_dir / "robot.yaml").string() + " (nominal: the URDF's inertials)";
+        } else if (!prior_name.empty() || py::hasattr(prior, "__fspath__")) {
+          const auto file = prior.cast<std::filesystem::path>();
+          eo.prior = io::read_parameters_yaml(file.string(), standard);
+          eo.prior_what = file.string();
+        } else {
+          const StateArg s = state_arg(prior, "prior", static_cast<int>(d.standard.size()));
+          if (s.batch) throw py::value_error("prior: one vector of standard parameters expected");
+          eo.prior = Eigen::Map<const Eigen::VectorXd>(s.data(), static_cast<Eigen::Index>(d.standard.size()));
+          eo.prior_what = "an array given from Python";
+        }
+        eo.study = study.string();
+        eo.accepted = accepted;
+        eo.margin = margin;
+        eo.nearest = nearest;
+        model_export::ModelExport e;
+        model_export::ModelExportFiles files;
+        {
+          py::gil_scoped_release release;
+          e = model_export::export_model(*id, phi, eo);
+          files = model_export::write_model_export(e, urdf, model_export::urdf_text(e.description));
+        }
+        py::dict r;
+        r["urdf"] = files.urdf;
+        r["standard_yaml"] = files.yaml;
+        r["standard_csv"] = files.csv;
+        r["s"] = e.description.s;
+        r["standard_names"] = standard;
+        r["residual"] = e.residual;
+        r["lambda_min"] = e.consistency.lambda_min;
+        r["nearest"] = e.nearest;
+        r["message"] = e.consistency.message;
+        return r;
+      },
+      py::arg("model"), py::arg("study"), py::arg("urdf"), py::kw_only(), py::arg("prior") = py::none(),
+      py::arg("robot_dir") = py::none(), py::arg("margin") = model_export::ModelExportOptions{}.margin,
+      py::arg("nearest") = model_export::ModelExportOptions{}.nearest, py::arg("not_accepted") = false,
+      "The study's accepted parameters as a URDF (dynid export): the physically consistent standard parameters nearest "
+      "the "
+      "prior that reproduce them, written to urdf and <stem>.standard.yaml/.csv");
 }
 
 }  // namespace symoro::python

@@ -28,7 +28,9 @@ void put(std::ofstream& out, const Eigen::MatrixBase<M>& m) {
 
 struct Files {
   std::string prefix;
-  std::ofstream open(const std::string& quantity) const { return std::ofstream(prefix + quantity + ".bin", std::ios::binary); }
+  std::ofstream open(const std::string& quantity) const {
+    return std::ofstream(prefix + quantity + ".bin", std::ios::binary);
+  }
 };
 
 template <class Model>
@@ -42,21 +44,22 @@ void write_model(const std::string& dir, const std::string& name, std::uint64_t 
   for (int i = 0; i < ns; ++i) {
     const std::string f = Model::standard_parameters[i].family;
     const double r = u(rng);
-    s[i] = f == "XX" || f == "YY" || f == "ZZ" ? 0.6 + 0.3 * r
-         : f == "M"                              ? 1.5 + 0.5 * r
-         : f == "IA" || f == "FV" || f == "FS"   ? 0.05 + 0.04 * r
-         : f == "MX" || f == "MY" || f == "MZ"   ? 0.1 * r
+    s[i] = f == "XX" || f == "YY" || f == "ZZ"   ? 0.6 + 0.3 * r
+           : f == "M"                            ? 1.5 + 0.5 * r
+           : f == "IA" || f == "FV" || f == "FS" ? 0.05 + 0.04 * r
+           : f == "MX" || f == "MY" || f == "MZ" ? 0.1 * r
                                                  : 0.01 * r;
   }
   const Eigen::Matrix<double, np, 1> phi = Model::base_from_standard(s);
   const Files f{dir + "/" + name + "."};
-  auto in_q = f.open("q"), in_qd = f.open("qd"), in_qdd = f.open("qdd"), in_tau = f.open("tau_in"), in_phi = f.open("phi"),
-       in_s = f.open("s");
-  auto w = f.open("regressor"), id = f.open("inverse_dynamics"), mm = f.open("inertia"), h = f.open("nonlinear_effects"),
-       fd = f.open("forward_dynamics"), idd_tau = f.open("idd_tau"), idd_dq = f.open("idd_dq"), idd_dqd = f.open("idd_dqd"),
-       fdd_qdd = f.open("fdd_qdd"), fdd_dq = f.open("fdd_dq"), fdd_dqd = f.open("fdd_dqd"), fdd_dtau = f.open("fdd_dtau"),
-       fdd_dphi = f.open("fdd_dphi"), fdd_pivot = f.open("fdd_min_pivot"), fk = f.open("forward_kinematics"),
-       jac = f.open("jacobian"), bfs = f.open("base_from_standard");
+  auto in_q = f.open("q"), in_qd = f.open("qd"), in_qdd = f.open("qdd"), in_tau = f.open("tau_in"),
+       in_phi = f.open("phi"), in_s = f.open("s");
+  auto w = f.open("regressor"), id = f.open("inverse_dynamics"), mm = f.open("inertia"),
+       h = f.open("nonlinear_effects"), fd = f.open("forward_dynamics"), idd_tau = f.open("idd_tau"),
+       idd_dq = f.open("idd_dq"), idd_dqd = f.open("idd_dqd"), fdd_qdd = f.open("fdd_qdd"), fdd_dq = f.open("fdd_dq"),
+       fdd_dqd = f.open("fdd_dqd"), fdd_dtau = f.open("fdd_dtau"), fdd_dphi = f.open("fdd_dphi"),
+       fdd_pivot = f.open("fdd_min_pivot"), fk = f.open("forward_kinematics"), jac = f.open("jacobian"),
+       bfs = f.open("base_from_standard");
   put(in_phi, phi.transpose());
   put(in_s, s.transpose());
   put(bfs, phi.transpose());

@@ -38,8 +38,9 @@ struct Common {
 // folder's.
 template <class App>
 void add_robot_options(App* cmd, Common& common,
-                       const std::string& robot_help = "Robot: a folder name under robots/, or a robot folder "
-                                                       "(robots/my_arm, ./my_arm)") {
+                       const std::string& robot_help =
+                           "Robot: a folder name under robots/, or a robot folder "
+                           "(robots/my_arm, ./my_arm)") {
   cmd->add_option("--robot", common.robot, robot_help)->required()->transform([&common](std::string v) {
     if (v.find('/') == std::string::npos) return v;
     common.folder = v;
@@ -64,8 +65,8 @@ class Progress {
     ++count_;
     const double elapsed = std::chrono::duration<double>(clock::now() - start_).count();
     const double eta = count_ > 0 ? elapsed / count_ * (total_ - count_) : 0;
-    std::fprintf(stderr, "%s[%*d/%d] %s %-10s %s  elapsed %.0f s, eta %.0f s%s", tty_ ? "\r\033[K" : "",
-                 width(), count_, total_, what_.c_str(), item.c_str(), detail.c_str(), elapsed, eta,
+    std::fprintf(stderr, "%s[%*d/%d] %s %-10s %s  elapsed %.0f s, eta %.0f s%s", tty_ ? "\r\033[K" : "", width(),
+                 count_, total_, what_.c_str(), item.c_str(), detail.c_str(), elapsed, eta,
                  tty_ && count_ < total_ ? "" : "\n");
     std::fflush(stderr);
   }

@@ -55,8 +55,9 @@ void run(const Common& common, const CompareOptions& options) {
 
 void add_compare_commands(CLI::App& app, Common& common) {
   auto o = std::make_shared<CompareOptions>();
-  auto* cmd = app.add_subcommand("compare", "Before/after report of two identification studies (e.g. the identified "
-                                            "model and its diagnosed variant) on their held-out trajectories");
+  auto* cmd = app.add_subcommand("compare",
+                                 "Before/after report of two identification studies (e.g. the identified "
+                                 "model and its diagnosed variant) on their held-out trajectories");
   cmd->add_option("--robot", common.robot, "Robot the studies are of (checked)");
   cmd->add_option("--before", o->before, "Study folder of the model before (dynid identify -o)")
       ->required()

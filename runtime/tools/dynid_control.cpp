@@ -45,7 +45,8 @@ class LogClaim {
   LogClaim(const std::filesystem::path& out, const std::string& if_exists) {
     if (!out.parent_path().empty()) std::filesystem::create_directories(out.parent_path());
     for (int k = 0;; ++k) {
-      const auto p = k == 0 ? out : out.parent_path() / fmt::format("{}-{}{}", out.stem().string(), k, out.extension().string());
+      const auto p =
+          k == 0 ? out : out.parent_path() / fmt::format("{}-{}{}", out.stem().string(), k, out.extension().string());
       bool taken = std::filesystem::exists(io::metadata_path(p));
       if (!taken) {
         const int fd = ::open(p.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0644);
@@ -54,12 +55,13 @@ class LogClaim {
           path_ = p;
           return;
         }
-        if (errno != EEXIST) throw UsageError(fmt::format("cannot create the log {}: {}", p.string(), std::strerror(errno)));
+        if (errno != EEXIST)
+          throw UsageError(fmt::format("cannot create the log {}: {}", p.string(), std::strerror(errno)));
         taken = true;
       }
       if (if_exists != "new-name")
-        throw UsageError(fmt::format("{} exists: a run never overwrites a log; choose another -o, or --if-exists new-name",
-                                     p.string()));
+        throw UsageError(fmt::format(
+            "{} exists: a run never overwrites a log; choose another -o, or --if-exists new-name", p.string()));
     }
   }
   ~LogClaim() {
@@ -76,11 +78,13 @@ class LogClaim {
 
 // hardware.yaml (or --hardware), with --at-stop and --hold-time over its stop; `override` says
 // which (empty: none), and is printed.
-hardware::HardwareConfig read_hardware(const Common& common, const ControlCliOptions& options, const std::vector<JointInfo>& joints,
-                                       std::string& override) {
-  const auto hw_path = options.hardware.empty() ? common.robot_dir() / "hardware.yaml" : std::filesystem::path(options.hardware);
+hardware::HardwareConfig read_hardware(const Common& common, const ControlCliOptions& options,
+                                       const std::vector<JointInfo>& joints, std::string& override) {
+  const auto hw_path =
+      options.hardware.empty() ? common.robot_dir() / "hardware.yaml" : std::filesystem::path(options.hardware);
   if (!std::filesystem::exists(hw_path))
-    throw UsageError(fmt::format("robot '{}' has no hardware description ({} not found)", common.robot, hw_path.string()));
+    throw UsageError(
+        fmt::format("robot '{}' has no hardware description ({} not found)", common.robot, hw_path.string()));
   hardware::HardwareConfig hw = hardware::read_hardware_config(hw_path, joints);
   // What happens at a stop is the lab's choice in hardware.yaml; an override is said and logged.
   if (!options.at_stop.empty()) {
@@ -92,8 +96,8 @@ hardware::HardwareConfig read_hardware(const Common& common, const ControlCliOpt
     override += fmt::format("{}--hold-time {}", override.empty() ? "" : " ", options.hold_time);
   }
   if (!override.empty())
-    fmt::print(stderr, "control: at a stop: {} for {} s then torque off ({} overrides {})\n", hardware::to_string(hw.safety.at_stop),
-               hw.safety.hold_time, override, hw_path.string());
+    fmt::print(stderr, "control: at a stop: {} for {} s then torque off ({} overrides {})\n",
+               hardware::to_string(hw.safety.at_stop), hw.safety.hold_time, override, hw_path.string());
   return hw;
 }
 
@@ -137,13 +141,15 @@ void add_model_feedforward(const Common& common, const ControlCliOptions& option
   const io::ParametersIntegrity integrity = io::parameters_integrity(options.params, names);
   const bool accepted = io::parameters_accepted(options.params);
   if (!accepted || !integrity.intact) {
-    const std::string why = !integrity.intact ? "the file is not as identify wrote it: " + integrity.why
-                                              : "the identification was not accepted (its final all-pose audit failed, or "
-                                                "the file has no 'accepted: true')";
+    const std::string why = !integrity.intact
+                                ? "the file is not as identify wrote it: " + integrity.why
+                                : "the identification was not accepted (its final all-pose audit failed, or "
+                                  "the file has no 'accepted: true')";
     if (!options.unaccepted_params)
-      throw UsageError(fmt::format("{}: {}; --unaccepted-params drives with it anyway (the model is still checked before "
-                                   "torque on)",
-                                   options.params, why));
+      throw UsageError(
+          fmt::format("{}: {}; --unaccepted-params drives with it anyway (the model is still checked before "
+                      "torque on)",
+                      options.params, why));
     co.notes += !integrity.intact ? "; PARAMETERS EDITED OR NOT FROM IDENTIFY (--unaccepted-params)"
                                   : "; PARAMETERS NOT ACCEPTED (--unaccepted-params)";
   }
@@ -155,8 +161,9 @@ void add_model_feedforward(const Common& common, const ControlCliOptions& option
 // --virtual: the emulated servo chain driving the twin, at the trajectory's start. With
 // --rt-priority the emulated servos' thread gets SCHED_FIFO one below the loop (a thread
 // inherits its creator's scheduling).
-std::unique_ptr<dynamixel::VirtualBus> start_virtual_bus(const ControlCliOptions& options, const robot::ModelHandle& full,
-                                                         const twin::TwinConfig& tc, const hardware::HardwareConfig& hw,
+std::unique_ptr<dynamixel::VirtualBus> start_virtual_bus(const ControlCliOptions& options,
+                                                         const robot::ModelHandle& full, const twin::TwinConfig& tc,
+                                                         const hardware::HardwareConfig& hw,
                                                          const trajectory::Trajectory& traj) {
   Eigen::VectorXd q(full.nq()), qd(full.nq()), qdd(full.nq());
   traj.evaluate(0, q, qd, qdd);
@@ -191,8 +198,7 @@ void run_control_command(const Common& common, const ControlCliOptions& options)
   const hardware::HardwareConfig hw = read_hardware(common, options, joints, stop_override);
   control::FfpdGains gains;
   const std::optional<twin::TwinConfig> tc = read_gains_and_twin(common, options, full.nq(), hw, gains);
-  const trajectory::Trajectory traj =
-      read_design(common, joints).build(options.trajectory);
+  const trajectory::Trajectory traj = read_design(common, joints).build(options.trajectory);
 
   hardware::ControlOptions co;
   co.robot = common.robot;
@@ -201,14 +207,17 @@ void run_control_command(const Common& common, const ControlCliOptions& options)
   co.realtime_priority = options.priority;
   // The emulated servos are a thread that may wait for a core on a loaded machine.
   if (!options.virtual_bus && options.watchdog > hardware::kMaxWatchdogCycles)
-    throw UsageError(fmt::format("--watchdog {}: at most {} cycles on a real port (the arm runs blind that long)", options.watchdog,
-                                 hardware::kMaxWatchdogCycles));
-  co.watchdog_cycles = options.watchdog > 0 ? options.watchdog : (options.virtual_bus ? std::max(20, hw.safety.watchdog_cycles) : 0);
+    throw UsageError(fmt::format("--watchdog {}: at most {} cycles on a real port (the arm runs blind that long)",
+                                 options.watchdog, hardware::kMaxWatchdogCycles));
+  co.watchdog_cycles =
+      options.watchdog > 0 ? options.watchdog : (options.virtual_bus ? std::max(20, hw.safety.watchdog_cycles) : 0);
   co.source = options.virtual_bus ? "twin" : "robot";
-  co.notes = options.virtual_bus ? "dynid control --virtual: virtual DYNAMIXEL bus driving the " + twin::ClosedLoopTwin(full, *tc).notes()
-                           : "dynid control on " + options.port;
-  co.notes += fmt::format("; at stop: {}{}", hardware::to_string(hw.safety.at_stop),
-                          hw.safety.at_stop == hardware::StopAction::hold ? fmt::format(" {} s then torque off", hw.safety.hold_time) : "");
+  co.notes = options.virtual_bus ? "dynid control --virtual: virtual DYNAMIXEL bus driving the " +
+                                       twin::ClosedLoopTwin(full, *tc).notes()
+                                 : "dynid control on " + options.port;
+  co.notes += fmt::format(
+      "; at stop: {}{}", hardware::to_string(hw.safety.at_stop),
+      hw.safety.at_stop == hardware::StopAction::hold ? fmt::format(" {} s then torque off", hw.safety.hold_time) : "");
   if (!stop_override.empty()) co.notes += " (" + stop_override + ")";
   if (!options.params.empty()) add_model_feedforward(common, options, co);
 
@@ -221,45 +230,60 @@ void run_control_command(const Common& common, const ControlCliOptions& options)
   dynamixel::SerialPort port(device, hw.baud);
   dynamixel::Bus bus(port);
   const hardware::ControlResult r = hardware::run_control(bus, hw, joints, gains, traj, out, co);
-  fmt::print("{}: {} rows, {:.3f} s of {}; max |q_ref - q| per joint (deg):", out, r.rows, r.trajectory_time, options.trajectory);
+  fmt::print("{}: {} rows, {:.3f} s of {}; max |q_ref - q| per joint (deg):", out, r.rows, r.trajectory_time,
+             options.trajectory);
   for (int j = 0; j < r.max_error.size(); ++j) fmt::print(" {:.3f}", r.max_error(j) * 180 / 3.14159265358979323846);
   fmt::print("\nat stop: {}\n{}\n", r.at_stop, r.timing.summary());
   if (r.reason != hardware::StopReason::completed)
-    throw std::runtime_error(fmt::format("run stopped ({}): {}; torque off {}", hardware::to_string(r.reason), r.message,
+    throw std::runtime_error(fmt::format("run stopped ({}): {}; torque off {}", hardware::to_string(r.reason),
+                                         r.message,
                                          r.torque_off_confirmed ? "confirmed" : "NOT confirmed for every servo"));
   fmt::print("completed; torque off {}\n", r.torque_off_confirmed ? "confirmed" : "NOT confirmed for every servo");
 }
 
 void add_control_commands(CLI::App& app, Common& common) {
   auto o = std::make_shared<ControlCliOptions>();
-  auto* cmd = app.add_subcommand("control", "Run a trajectory on the arm (DYNAMIXEL bus, FF+PD at 1 kHz) and log it; "
-                                            "--virtual: on the emulated bus driving the digital twin");
+  auto* cmd = app.add_subcommand("control",
+                                 "Run a trajectory on the arm (DYNAMIXEL bus, FF+PD at 1 kHz) and log it; "
+                                 "--virtual: on the emulated bus driving the digital twin");
   add_robot_options(cmd, common);
-  cmd->add_option("--design", common.design, "A trajectory design file (e.g. dynid excite's) instead of robots/<robot>/trajectories.yaml")
+  cmd->add_option("--design", common.design,
+                  "A trajectory design file (e.g. dynid excite's) instead of robots/<robot>/trajectories.yaml")
       ->check(CLI::ExistingFile);
   cmd->add_option("--port", o->port, "Serial device of the DYNAMIXEL bus (default /dev/ttyUSB0)");
   cmd->add_flag("--virtual", o->virtual_bus, "Emulated servos on a pseudo-terminal, driving the digital twin");
   cmd->add_option("--trajectory", o->trajectory, "Trajectory name (default AG02)");
   cmd->add_option("-o,--output", o->out, "Log file (CSV; its .meta.yaml sidecar next to it)")->required();
-  cmd->add_option("--params", o->params, "A study's report/parameters.yaml: add the identified model's inverse dynamics "
-                                         "as feedforward")->check(CLI::ExistingFile);
-  cmd->add_flag("--unaccepted-params", o->unaccepted_params, "Drive with --params whose identification was not "
-                                                             "accepted (recorded in the log)");
+  cmd->add_option("--params", o->params,
+                  "A study's report/parameters.yaml: add the identified model's inverse dynamics "
+                  "as feedforward")
+      ->check(CLI::ExistingFile);
+  cmd->add_flag("--unaccepted-params", o->unaccepted_params,
+                "Drive with --params whose identification was not "
+                "accepted (recorded in the log)");
   cmd->add_option("--if-exists", o->if_exists, "When -o exists: refuse (default) or new-name (<stem>-<k>.csv)")
       ->check(CLI::IsMember({"refuse", "new-name"}));
-  cmd->add_option("--seconds", o->seconds, "Run only this much of the trajectory")->check(numbers::positive(1e6, "> 0 and <= 1e6 s"));
-  cmd->add_option("--hardware", o->hardware, "Hardware description (default robots/<robot>/hardware.yaml)")->check(CLI::ExistingFile);
-  cmd->add_option("--config", o->twin_config, "--virtual: a YAML file overriding parts of twin.yaml")->check(CLI::ExistingFile);
+  cmd->add_option("--seconds", o->seconds, "Run only this much of the trajectory")
+      ->check(numbers::positive(1e6, "> 0 and <= 1e6 s"));
+  cmd->add_option("--hardware", o->hardware, "Hardware description (default robots/<robot>/hardware.yaml)")
+      ->check(CLI::ExistingFile);
+  cmd->add_option("--config", o->twin_config, "--virtual: a YAML file overriding parts of twin.yaml")
+      ->check(CLI::ExistingFile);
   cmd->add_flag("--ideal", o->ideal, "--virtual: turn every twin effect off");
   cmd->add_option("--trial", o->trial, "Trial number in the log")->check(numbers::count(1, 1e6));
-  cmd->add_option("--watchdog", o->watchdog, "Consecutive failed reads that stop the arm (default: hardware.yaml's; "
-                                             "--virtual: at least 20)")->check(numbers::count(1, 1e6));
-  cmd->add_option("--at-stop", o->at_stop, "At a stop with torque on: hold the stop pose for the hold time, then torque off; "
-                                           "or torque-off at once (default: hardware.yaml's safety.at_stop; logged)")
+  cmd->add_option("--watchdog", o->watchdog,
+                  "Consecutive failed reads that stop the arm (default: hardware.yaml's; "
+                  "--virtual: at least 20)")
+      ->check(numbers::count(1, 1e6));
+  cmd->add_option("--at-stop", o->at_stop,
+                  "At a stop with torque on: hold the stop pose for the hold time, then torque off; "
+                  "or torque-off at once (default: hardware.yaml's safety.at_stop; logged)")
       ->check(CLI::IsMember({"hold", "torque-off"}));
-  cmd->add_option("--hold-time", o->hold_time, "Seconds of hold at a stop (default: hardware.yaml's safety.hold_time; logged)")
+  cmd->add_option("--hold-time", o->hold_time,
+                  "Seconds of hold at a stop (default: hardware.yaml's safety.hold_time; logged)")
       ->check(numbers::positive(600, "> 0 and <= 600 s"));
-  cmd->add_option("--rt-priority", o->priority, "SCHED_FIFO priority of the loop (default 30; 0: normal scheduling; refused: normal, with a note)")
+  cmd->add_option("--rt-priority", o->priority,
+                  "SCHED_FIFO priority of the loop (default 30; 0: normal scheduling; refused: normal, with a note)")
       ->check(numbers::count(0, 99));
   cmd->callback([&common, o] { run_control_command(common, *o); });
 }

@@ -21,10 +21,10 @@ struct ControlCliOptions {
   int trial = 1;
   int priority = 30;  // SCHED_FIFO when the system allows it (else normal scheduling, said once)
   int watchdog = 0;
-  bool unaccepted_params = false;  // drive with parameters whose identification was not accepted
+  bool unaccepted_params = false;    // drive with parameters whose identification was not accepted
   std::string if_exists = "refuse";  // or "new-name": the log never overwrites one
-  std::string at_stop;   // "", "hold" or "torque-off": overrides hardware.yaml's safety.at_stop
-  double hold_time = 0;  // s; 0: hardware.yaml's safety.hold_time
+  std::string at_stop;               // "", "hold" or "torque-off": overrides hardware.yaml's safety.at_stop
+  double hold_time = 0;              // s; 0: hardware.yaml's safety.hold_time
 };
 
 void run_control_command(const Common& common, const ControlCliOptions& options);

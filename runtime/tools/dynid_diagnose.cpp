@@ -49,8 +49,10 @@ void run_diagnose(const Common& common, const DiagnoseOptions& options, const di
     // A robot compiled into dynid needs its code regenerated; any other is compiled again from
     // its folder by the next command that uses it.
     if (compiled_robot(common))
-      fmt::print("added variant '{}' to {}; regenerate (symoroc generate {} -o generated) and rebuild, then "
-                 "dynid identify --model {}\n", r.variant_name, yaml.string(), common.robot_dir().string(), r.variant_name);
+      fmt::print(
+          "added variant '{}' to {}; regenerate (symoroc generate {} -o generated) and rebuild, then "
+          "dynid identify --model {}\n",
+          r.variant_name, yaml.string(), common.robot_dir().string(), r.variant_name);
     else
       fmt::print("added variant '{}' to {}; dynid identify --model {} compiles it\n", r.variant_name, yaml.string(),
                  r.variant_name);
@@ -70,33 +72,48 @@ void add_diagnose_commands(CLI::App& app, Common& common) {
     o->min_gain = d.min_heldout_gain;
     o->min_torque = d.min_effect_torque;
   }
-  auto* cmd = app.add_subcommand("diagnose", "Model-gap diagnosis: which effects the identified model misses, how large, "
-                                             "where the residual is; before/after report");
+  auto* cmd = app.add_subcommand("diagnose",
+                                 "Model-gap diagnosis: which effects the identified model misses, how large, "
+                                 "where the residual is; before/after report");
   add_robot_options(cmd, common);
-  cmd->add_option("--data", o->data, "Dataset folder (dataset.yaml and logs)")->required()->check(CLI::ExistingDirectory);
+  cmd->add_option("--data", o->data, "Dataset folder (dataset.yaml and logs)")
+      ->required()
+      ->check(CLI::ExistingDirectory);
   cmd->add_option("-o,--out", o->out, "Report folder")->required();
-  cmd->add_option("--train", o->train, "Runs the effects are fitted on (default: the dataset's runs of families other "
-                                       "than V, e.g. the fitting part of a split run)")->delimiter(',');
-  cmd->add_option("--heldout", o->heldout, "Held-out runs that judge them (default: the dataset's family V, e.g. the "
-                                           "held-out part of a split run)")->delimiter(',');
+  cmd->add_option("--train", o->train,
+                  "Runs the effects are fitted on (default: the dataset's runs of families other "
+                  "than V, e.g. the fitting part of a split run)")
+      ->delimiter(',');
+  cmd->add_option("--heldout", o->heldout,
+                  "Held-out runs that judge them (default: the dataset's family V, e.g. the "
+                  "held-out part of a split run)")
+      ->delimiter(',');
   cmd->add_option("--trial", o->trial, "Which trial of each trajectory")->check(numbers::count(1, 1e6));
   cmd->add_option("--interval", o->interval_ms, "Diagnosis grid, ms")->check(numbers::interval_ms());
-  cmd->add_option("--cutoff", o->cutoff, "Low-pass on every column and the torque, Hz")->check(numbers::positive(1e5, "> 0 and <= 1e5 Hz"));
-  cmd->add_option("--only", o->only, "Only these effects (coulomb, stribeck, offset, viscous_asymmetry, "
-                                     "position_harmonics, inertia_products, torque_constant, actuation_delay, backlash, payload)")
+  cmd->add_option("--cutoff", o->cutoff, "Low-pass on every column and the torque, Hz")
+      ->check(numbers::positive(1e5, "> 0 and <= 1e5 Hz"));
+  cmd->add_option("--only", o->only,
+                  "Only these effects (coulomb, stribeck, offset, viscous_asymmetry, "
+                  "position_harmonics, inertia_products, torque_constant, actuation_delay, backlash, payload)")
       ->delimiter(',');
-  cmd->add_option("--alpha", o->alpha, "Family-wise level of each step")->check(numbers::checked(0, 0.5, true, false, "> 0 and <= 0.5"));
-  cmd->add_option("--min-gain", o->min_gain, "Least relative fall of the held-out residual")->check(numbers::non_negative(1, ">= 0 and <= 1"));
-  cmd->add_option("--min-torque", o->min_torque, "Least effect torque that matters, N m")->check(numbers::non_negative(1e6, ">= 0 and <= 1e6 N m"));
+  cmd->add_option("--alpha", o->alpha, "Family-wise level of each step")
+      ->check(numbers::checked(0, 0.5, true, false, "> 0 and <= 0.5"));
+  cmd->add_option("--min-gain", o->min_gain, "Least relative fall of the held-out residual")
+      ->check(numbers::non_negative(1, ">= 0 and <= 1"));
+  cmd->add_option("--min-torque", o->min_torque, "Least effect torque that matters, N m")
+      ->check(numbers::non_negative(1e6, ">= 0 and <= 1e6 N m"));
   cmd->add_flag("--no-backlash", o->no_backlash, "Skip the closed-loop high-band stage (backlash; simulates the twin)");
-  cmd->add_option("--model", o->model, "Model whose gap is diagnosed: a robot.yaml variant, or full (default: "
-                                       "robot.yaml's identified)");
-  cmd->add_option("--params", o->params, "An earlier identification (a study's report/parameters.yaml of this model): "
-                                         "hold its parameters and diagnose its gap, e.g. a payload added since; "
-                                         "default: refit the model's parameters with the effects")
+  cmd->add_option("--model", o->model,
+                  "Model whose gap is diagnosed: a robot.yaml variant, or full (default: "
+                  "robot.yaml's identified)");
+  cmd->add_option("--params", o->params,
+                  "An earlier identification (a study's report/parameters.yaml of this model): "
+                  "hold its parameters and diagnose its gap, e.g. a payload added since; "
+                  "default: refit the model's parameters with the effects")
       ->check(CLI::ExistingFile);
   cmd->add_option("--variant", o->variant, "Name of the variant to write (default: <identified>_diagnosed)");
-  cmd->add_flag("--apply", [o](std::int64_t) { o->apply = "yes"; }, "Add the variant to the robot's robot.yaml");
+  cmd->add_flag(
+      "--apply", [o](std::int64_t) { o->apply = "yes"; }, "Add the variant to the robot's robot.yaml");
   cmd->callback([&common, o] {
     try {  // the options' own rules, before any work
       diagnose::check_request(library_options(common, *o));

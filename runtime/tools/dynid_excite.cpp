@@ -44,14 +44,14 @@ struct ExciteOptions {
   int optimized = 3;
   int harmonics = excitation::ExcitationDesignOptions{}.harmonics;
   bool harmonics_given = false;
-  double period = 0;  // s; 0: from the limits (auto_period), or chosen (excite_choice.hpp)
+  double period = 0;         // s; 0: from the limits (auto_period), or chosen (excite_choice.hpp)
   double kappa_target = 0;   // > 0: choose the period for a scaled kappa below it
   double max_duration = 25;  // s, the longest optimized trajectory the choice may make
   int periods = 1;
   int starts = excitation::ExcitationDesignOptions{}.starts;
   std::uint64_t seed = excitation::ExcitationDesignOptions{}.seed;
   double torque_fraction = 0.8;
-  double table = -1;                    // m below frame 0; < 0: none
+  double table = -1;                     // m below frame 0; < 0: none
   std::vector<std::string> half_spaces;  // "frame:nx,ny,nz:offset"
   double interval_ms = 10;
   std::vector<std::string> compare;  // logs of reference motions rated beside the design
@@ -65,7 +65,8 @@ std::vector<double> numbers_of(const std::string& text, char sep, const std::str
     try {
       std::size_t used = 0;
       out.push_back(std::stod(item, &used));
-      if (used != item.size() || !std::isfinite(out.back()) || std::abs(out.back()) > 1e6) throw std::invalid_argument(item);
+      if (used != item.size() || !std::isfinite(out.back()) || std::abs(out.back()) > 1e6)
+        throw std::invalid_argument(item);
     } catch (const std::exception&) {
       throw UsageError(fmt::format("{}: '{}' is not a finite number within 1e6", what, item));
     }
@@ -77,17 +78,21 @@ std::vector<excitation::HalfSpace> half_spaces(const ExciteOptions& options, con
   const int frames = static_cast<int>(d.frames.size());
   std::vector<excitation::HalfSpace> out;
   if (options.table >= 0) {  // every frame origin past the first two above the table, "down" along gravity
-    if (!(d.gravity.norm() > 0)) throw UsageError("--table: the model has no gravity to tell down from up; use --half-space");
-    for (int f = 3; f <= frames; ++f) out.push_back({fmt::format("table@{}", f), f, d.gravity.normalized(), options.table});
+    if (!(d.gravity.norm() > 0))
+      throw UsageError("--table: the model has no gravity to tell down from up; use --half-space");
+    for (int f = 3; f <= frames; ++f)
+      out.push_back({fmt::format("table@{}", f), f, d.gravity.normalized(), options.table});
   }
   for (const auto& spec : options.half_spaces) {
     const auto colon = spec.find(':'), last = spec.rfind(':');
-    if (colon == std::string::npos || last == colon) throw UsageError("--half-space takes frame:nx,ny,nz:offset, not " + spec);
+    if (colon == std::string::npos || last == colon)
+      throw UsageError("--half-space takes frame:nx,ny,nz:offset, not " + spec);
     const auto frame = numbers_of(spec.substr(0, colon), ',', "--half-space frame");
     const auto normal = numbers_of(spec.substr(colon + 1, last - colon - 1), ',', "--half-space normal");
     const auto offset = numbers_of(spec.substr(last + 1), ',', "--half-space offset");
     if (frame.size() != 1 || normal.size() != 3 || offset.size() != 1 || frame[0] < 1 || frame[0] > frames)
-      throw UsageError(fmt::format("--half-space {}: a frame 1..{}, a normal of 3 numbers and an offset", spec, frames));
+      throw UsageError(
+          fmt::format("--half-space {}: a frame 1..{}, a normal of 3 numbers and an offset", spec, frames));
     Eigen::Vector3d nv(normal[0], normal[1], normal[2]);
     if (!(nv.norm() > 0)) throw UsageError("--half-space " + spec + ": the normal is zero");
     out.push_back({spec, static_cast<int>(frame[0]), nv.normalized(), offset[0] / nv.norm()});
@@ -114,17 +119,19 @@ void fastest_level(const YAML::Node& design, int n, Eigen::VectorXd& velocity, E
 // (the Kinova's 0.28 rad/s) needs tens of seconds to use its range; a fast one a few.
 double auto_period(const Eigen::VectorXd& lower, const Eigen::VectorXd& upper, const Eigen::VectorXd& velocity) {
   std::vector<double> t;
-  for (Eigen::Index j = 0; j < velocity.size(); ++j) t.push_back(2 * 3.14159265358979323846 * (upper(j) - lower(j)) / 4 / velocity(j));
+  for (Eigen::Index j = 0; j < velocity.size(); ++j)
+    t.push_back(2 * 3.14159265358979323846 * (upper(j) - lower(j)) / 4 / velocity(j));
   std::nth_element(t.begin(), t.begin() + static_cast<std::ptrdiff_t>(t.size() / 2), t.end());
   return std::round(std::clamp(t[t.size() / 2], 5.0, 60.0) * 10) / 10;
 }
 
 // The design options of one series from rest at `posture`.
-excitation::ExcitationDesignOptions design_options(const ExciteOptions& options, const PeriodRung& rung, const YAML::Node& design,
-                                                 const std::string& posture,
-                                                 const Eigen::VectorXd& lower, const Eigen::VectorXd& upper,
-                                                 const Eigen::VectorXd& velocity, const Eigen::VectorXd& acceleration,
-                                                 const Eigen::VectorXd& nominal, const identify::ModelDescription& d) {
+excitation::ExcitationDesignOptions design_options(const ExciteOptions& options, const PeriodRung& rung,
+                                                   const YAML::Node& design, const std::string& posture,
+                                                   const Eigen::VectorXd& lower, const Eigen::VectorXd& upper,
+                                                   const Eigen::VectorXd& velocity, const Eigen::VectorXd& acceleration,
+                                                   const Eigen::VectorXd& nominal,
+                                                   const identify::ModelDescription& d) {
   const int n = d.nq;
   excitation::ExcitationDesignOptions eo;
   eo.period = rung.period;
@@ -138,7 +145,8 @@ excitation::ExcitationDesignOptions design_options(const ExciteOptions& options,
   if (nominal.size() > 0) {
     eo.nominal = nominal;
     eo.limits.torque.resize(n);
-    for (int j = 0; j < n; ++j) eo.limits.torque(j) = options.torque_fraction * d.joints[static_cast<std::size_t>(j)].effort;
+    for (int j = 0; j < n; ++j)
+      eo.limits.torque(j) = options.torque_fraction * d.joints[static_cast<std::size_t>(j)].effort;
   }
   eo.workspace = half_spaces(options, d);
   eo.starts = options.starts;
@@ -162,16 +170,18 @@ void warn_crossings(const std::vector<trajectory::Trajectory>& all, const std::v
       if (v.maxCoeff(&h) > worst) worst = v(h), when = time, where = spaces[static_cast<std::size_t>(h)].name;
     }
     if (worst > 0)
-      fmt::print("warning: {} takes a frame {:.3f} m beyond {} at t = {:.2f} s: the structured families know the joint "
-                 "limits, not the surroundings; edit their postures or amplitudes\n",
-                 t.name, worst, where, when);
+      fmt::print(
+          "warning: {} takes a frame {:.3f} m beyond {} at t = {:.2f} s: the structured families know the joint "
+          "limits, not the surroundings; edit their postures or amplitudes\n",
+          t.name, worst, where, when);
   }
 }
 
 // A regressor's two measures the choice compares: column-scaled kappa, log det per sample.
 ReferenceMeasures measures_of(const std::string& name, const Eigen::MatrixXd& W, const identify::ModelDescription& d) {
   const RegressorFactor f = RegressorFactor::of(W);
-  return {name, excitation::excitation_quality_of_factor(f.R, f.rows, d.parameters, 0).kappa_scaled, log_det_per_sample(f, d.nq)};
+  return {name, excitation::excitation_quality_of_factor(f.R, f.rows, d.parameters, 0).kappa_scaled,
+          log_det_per_sample(f, d.nq)};
 }
 
 // The optimized series of one run: the design of one series from the postures in turn, and its
@@ -234,10 +244,11 @@ struct SeriesDesigner {
   }
 
   std::string yaml_of(const Series& s) const {
-    return "\n" + trajectory::fourier_trajectory_yaml(s.eo.name, s.posture, s.r.trajectory, o.periods,
-                                                      fmt::format("Optimized (D-optimal) from rest at {}: log det {:.4g}, period "
-                                                                  "{:.3g} s, {} harmonics",
-                                                                  s.posture, s.r.criterion, s.rung.period, s.rung.harmonics));
+    return "\n" + trajectory::fourier_trajectory_yaml(
+                      s.eo.name, s.posture, s.r.trajectory, o.periods,
+                      fmt::format("Optimized (D-optimal) from rest at {}: log det {:.4g}, period "
+                                  "{:.3g} s, {} harmonics",
+                                  s.posture, s.r.criterion, s.rung.period, s.rung.harmonics));
   }
 
   // The other passed starts in order of log det: the first that meets the targets replaces the
@@ -267,14 +278,19 @@ struct SeriesDesigner {
     const auto& r = out.r;
     std::string starts;
     for (std::size_t s = 0; s < r.starts.size(); ++s)
-      starts += fmt::format("{}{}{:.2f} ({}, {} it, {:.1f} s{})", s ? "; " : "", static_cast<int>(s) == r.chosen ? "*" : "",
-                            r.starts[s].criterion, r.starts[s].status, r.starts[s].iterations, r.starts[s].seconds,
-                            r.starts[s].passed ? "" : !r.starts[s].solved ? ", no design" : ", fails " + r.starts[s].worst.constraint);
-    fmt::print("{} from {} (period {:.3g} s, {} harmonics): log det {:.2f} in {:.1f} s; starts: {}{}\n", out.eo.name, out.posture,
-               out.rung.period, out.rung.harmonics, r.criterion, r.seconds, starts,
+      starts +=
+          fmt::format("{}{}{:.2f} ({}, {} it, {:.1f} s{})", s ? "; " : "", static_cast<int>(s) == r.chosen ? "*" : "",
+                      r.starts[s].criterion, r.starts[s].status, r.starts[s].iterations, r.starts[s].seconds,
+                      r.starts[s].passed    ? ""
+                      : !r.starts[s].solved ? ", no design"
+                                            : ", fails " + r.starts[s].worst.constraint);
+    fmt::print("{} from {} (period {:.3g} s, {} harmonics): log det {:.2f} in {:.1f} s; starts: {}{}\n", out.eo.name,
+               out.posture, out.rung.period, out.rung.harmonics, r.criterion, r.seconds, starts,
                out.best_start ? "" : "; * the start of the largest log det that meets the targets");
     std::string tight;
-    for (const auto& s : r.slack) tight += fmt::format("{}{} {:.3g} ({}, t = {:.2f} s)", tight.empty() ? "" : ", ", s.constraint, s.slack, s.where, s.time);
+    for (const auto& s : r.slack)
+      tight += fmt::format("{}{} {:.3g} ({}, t = {:.2f} s)", tight.empty() ? "" : ", ", s.constraint, s.slack, s.where,
+                           s.time);
     fmt::print("  tightest limits (dense check every 1 ms): {}\n", tight);
   }
 
@@ -284,7 +300,8 @@ struct SeriesDesigner {
     io::write_file_atomically(tmp, text + (text.empty() || text.back() == '\n' ? "" : "\n") + s.yaml);
     Eigen::MatrixXd W;
     try {
-      W = trajectory_regressor(model, trajectory::TrajectoryDesign::read(tmp, model.description().joints).build(s.eo.name), to);
+      W = trajectory_regressor(
+          model, trajectory::TrajectoryDesign::read(tmp, model.description().joints).build(s.eo.name), to);
     } catch (...) {
       fs::remove(tmp);
       throw;
@@ -304,21 +321,23 @@ std::vector<PeriodRung> series_ladder(const SeriesDesigner& sd, double first_per
   std::vector<ReferenceMeasures> references;
   for (const auto& file : o.compare) {
     double duration = 0;
-    references.push_back(measures_of(fs::path(file).stem().string(), reference_regressor(sd.model, file, sd.to, duration),
-                                     sd.model.description()));
+    references.push_back(measures_of(fs::path(file).stem().string(),
+                                     reference_regressor(sd.model, file, sd.to, duration), sd.model.description()));
   }
   targets = excitation_targets(o.kappa_target, references);
   const double holds = sd.design["timing"]["start_hold"].as<double>() + sd.design["timing"]["end_hold"].as<double>();
   const double longest = (o.max_duration - holds) / o.periods;
   if (longest < 0.5)
-    throw UsageError(fmt::format("--max-duration {:.3g} s leaves no period after the design's holds ({:.3g} s)", o.max_duration, holds));
+    throw UsageError(fmt::format("--max-duration {:.3g} s leaves no period after the design's holds ({:.3g} s)",
+                                 o.max_duration, holds));
   return period_ladder(first_period, o.harmonics, longest);
 }
 
 // The optimized series' YAML. With targets, each series climbs the ladder from the period the
 // one before it was kept at until it meets them (or keeps its lowest scaled kappa). A series no
 // posture can start ends the run there: `failure` says why (thrown at the first).
-std::string optimized_series(const Common& common, SeriesDesigner& sd, const std::string& nominal_from, std::string& failure) {
+std::string optimized_series(const Common& common, SeriesDesigner& sd, const std::string& nominal_from,
+                             std::string& failure) {
   const ExciteOptions& o = sd.o;
   const identify::ModelDescription& d = sd.model.description();
   ExcitationTargets targets;
@@ -326,12 +345,14 @@ std::string optimized_series(const Common& common, SeriesDesigner& sd, const std
       series_ladder(sd, o.period > 0 ? o.period : auto_period(sd.lower, sd.upper, sd.velocity), targets);
   if (o.optimized == 0) return "";
   std::string periods;
-  for (const auto& r : ladder) periods += fmt::format("{}{:.3g} s ({} harmonics)", periods.empty() ? "" : ", ", r.period, r.harmonics);
-  fmt::print("optimized excitation of {} model {} ({} base parameters): period {}, {} starts each; limits: the box, the "
-             "structured families' fastest level, torque {:.0f} % of effort{}\n",
-             common.robot, d.variant.empty() ? "full" : d.variant, d.np,
-             targets.any() ? "chosen for " + targets.text + " among " + periods : periods, o.starts, 100 * o.torque_fraction,
-             nominal_from.empty() ? " (not enforced)" : " (" + nominal_from + ")");
+  for (const auto& r : ladder)
+    periods += fmt::format("{}{:.3g} s ({} harmonics)", periods.empty() ? "" : ", ", r.period, r.harmonics);
+  fmt::print(
+      "optimized excitation of {} model {} ({} base parameters): period {}, {} starts each; limits: the box, the "
+      "structured families' fastest level, torque {:.0f} % of effort{}\n",
+      common.robot, d.variant.empty() ? "full" : d.variant, d.np,
+      targets.any() ? "chosen for " + targets.text + " among " + periods : periods, o.starts, 100 * o.torque_fraction,
+      nominal_from.empty() ? " (not enforced)" : " (" + nominal_from + ")");
   std::string out;
   std::size_t at = 0;  // the ladder's rung the last series was kept at
   for (int k = 0; k < o.optimized; ++k) {
@@ -364,9 +385,11 @@ std::string optimized_series(const Common& common, SeriesDesigner& sd, const std
     }
     sd.next = kept_next, at = kept_at;
     if (targets.any() && !targets.met_by(best.kappa_scaled, best.per_sample))
-      fmt::print("{}: no period up to --max-duration {:.3g} s meets the targets; kept period {:.3g} s, the lowest scaled kappa "
-                 "(more --starts, a longer --max-duration or more --harmonics may reach them)\n",
-                 kept.eo.name, o.max_duration, ladder[at].period);
+      fmt::print(
+          "{}: no period up to --max-duration {:.3g} s meets the targets; kept period {:.3g} s, the lowest scaled "
+          "kappa "
+          "(more --starts, a longer --max-duration or more --harmonics may reach them)\n",
+          kept.eo.name, o.max_duration, ladder[at].period);
     out += kept.yaml;
   }
   return out;
@@ -380,7 +403,8 @@ void run(const Common& common, const ExciteOptions& options) {
   // Like import, control and export: what is there stays unless the user says so.
   for (const fs::path& f : {design_file, fs::path(options.out) / "quality.txt"})
     if (fs::exists(f) && !options.force)
-      throw UsageError(fmt::format("{} exists: dynid excite does not replace it; choose another -o, or --force", f.string()));
+      throw UsageError(
+          fmt::format("{} exists: dynid excite does not replace it; choose another -o, or --force", f.string()));
   fs::create_directories(options.out);
 
   // 1. The structured families.
@@ -398,17 +422,20 @@ void run(const Common& common, const ExciteOptions& options) {
       throw UsageError(e.what());
     }
   }
-  const YAML::Node design = io::load_yaml_text(text, options.from_design.empty() ? std::string("the structured design") : options.from_design);
+  const YAML::Node design = io::load_yaml_text(
+      text, options.from_design.empty() ? std::string("the structured design") : options.from_design);
   // Another robot's design was reported at the temporary file it became (its joints differ).
   if (!options.from_design.empty()) {
     const YAML::Node robot = design.IsMap() ? design["robot"] : YAML::Node();
     if (!robot || !robot.IsScalar())
-      throw UsageError(fmt::format("{}: no `robot:`: --from-design takes a trajectory design of {} (e.g. its trajectories.yaml)",
-                                   options.from_design, common.robot));
+      throw UsageError(
+          fmt::format("{}: no `robot:`: --from-design takes a trajectory design of {} (e.g. its trajectories.yaml)",
+                      options.from_design, common.robot));
     if (robot.as<std::string>() != common.robot)
-      throw UsageError(fmt::format("{}:{}: the design is of robot '{}', not {}: --from-design takes a design of the robot "
-                                   "being excited",
-                                   options.from_design, robot.Mark().line + 1, robot.as<std::string>(), common.robot));
+      throw UsageError(
+          fmt::format("{}:{}: the design is of robot '{}', not {}: --from-design takes a design of the robot "
+                      "being excited",
+                      options.from_design, robot.Mark().line + 1, robot.as<std::string>(), common.robot));
   }
   Eigen::VectorXd velocity, acceleration;
   fastest_level(design, n, velocity, acceleration);
@@ -426,10 +453,12 @@ void run(const Common& common, const ExciteOptions& options) {
     nominal = io::read_parameters_yaml(options.params, names);
     nominal_from = options.params;
   } else if (std::vector<double> s; nominal_standard_parameters(common, d.standard, s)) {
-    nominal = model->base_from_standard(Eigen::Map<const Eigen::VectorXd>(s.data(), static_cast<Eigen::Index>(s.size())));
+    nominal =
+        model->base_from_standard(Eigen::Map<const Eigen::VectorXd>(s.data(), static_cast<Eigen::Index>(s.size())));
     nominal_from = "robot.yaml nominal";
   } else {
-    fmt::print(stderr, "excite: {} has no nominal parameters and no --params was given: torque limits are NOT enforced\n",
+    fmt::print(stderr,
+               "excite: {} has no nominal parameters and no --params was given: torque limits are NOT enforced\n",
                (common.robot_dir() / "robot.yaml").string());
   }
 
@@ -441,7 +470,8 @@ void run(const Common& common, const ExciteOptions& options) {
   for (const auto& p : design["postures"]) designer.postures.push_back(p.first.as<std::string>());
   std::string failure;
   const std::string optimized_text = optimized_series(common, designer, nominal_from, failure);
-  if (options.optimized > 0 && text.find("\ntrajectories:") == std::string::npos) throw UsageError("the design has no trajectories list");
+  if (options.optimized > 0 && text.find("\ntrajectories:") == std::string::npos)
+    throw UsageError("the design has no trajectories list");
   const std::string full = text + (text.empty() || text.back() == '\n' ? "" : "\n") + optimized_text;
   // Read back before it is kept: the file must build, every trajectory inside its limits.
   const fs::path tmp = fs::path(options.out) / "trajectories.yaml.new";
@@ -462,56 +492,77 @@ void run(const Common& common, const ExciteOptions& options) {
   const std::string table = trajectory_quality_table(common, all, to, options.model);
   fmt::print("{}", table);
   io::write_file_atomically(fs::path(options.out) / "quality.txt", table);
-  if (!failure.empty()) throw UsageError(failure + fmt::format(" ({} keeps the series designed before it)", design_file.string()));
+  if (!failure.empty())
+    throw UsageError(failure + fmt::format(" ({} keeps the series designed before it)", design_file.string()));
 }
 
 }  // namespace
 
 void add_excite_commands(CLI::App& app, Common& common) {
   auto o = std::make_shared<ExciteOptions>();
-  auto* cmd = app.add_subcommand("excite", "Identification trajectories for any robot: the structured families and optimized "
-                                           "Fourier series, in one design file, with their excitation quality");
+  auto* cmd = app.add_subcommand("excite",
+                                 "Identification trajectories for any robot: the structured families and optimized "
+                                 "Fourier series, in one design file, with their excitation quality");
   add_robot_options(cmd, common);
   cmd->add_option("-o,--output", o->out, "Write trajectories.yaml and quality.txt here")->required();
-  cmd->add_option("--model", o->model, "The model whose base parameters are excited (default: robot.yaml's identified)");
-  cmd->add_option("--from-design", o->from_design, "Take the structured families from this design file (e.g. the robot's "
-                                                   "trajectories.yaml) instead of generating them")
+  cmd->add_option("--model", o->model,
+                  "The model whose base parameters are excited (default: robot.yaml's identified)");
+  cmd->add_option("--from-design", o->from_design,
+                  "Take the structured families from this design file (e.g. the robot's "
+                  "trajectories.yaml) instead of generating them")
       ->check(CLI::ExistingFile);
-  cmd->add_option("--params", o->params, "Nominal parameters of --model for the torque limits (default: robot.yaml's nominal)")
+  cmd->add_option("--params", o->params,
+                  "Nominal parameters of --model for the torque limits (default: robot.yaml's nominal)")
       ->check(CLI::ExistingFile);
   cmd->add_option("--optimized", o->optimized, "Optimized trajectories (OF01...), from the postures in turn")
       ->check(numbers::count(0, 99))
       ->capture_default_str();
-  auto* harmonics = cmd->add_option("--harmonics", o->harmonics, "Harmonics of each series (with a period chosen: of its first "
-                                                                   "period, 1.5 more per doubling)")
+  auto* harmonics = cmd->add_option("--harmonics", o->harmonics,
+                                    "Harmonics of each series (with a period chosen: of its first "
+                                    "period, 1.5 more per doubling)")
                         ->check(numbers::count(2, 20))
                         ->capture_default_str();
-  auto* period = cmd->add_option("--period", o->period, "Period of each series, s (default: from the joints' box and speed, 5-60 "
-                                                        "s; with --compare or --kappa-target, chosen to meet them)")
+  auto* period = cmd->add_option("--period", o->period,
+                                 "Period of each series, s (default: from the joints' box and speed, 5-60 "
+                                 "s; with --compare or --kappa-target, chosen to meet them)")
                      ->check(numbers::checked(0.5, 3600, false, false, "from 0.5 to 3600 s"));
-  cmd->add_option("--kappa-target", o->kappa_target, "Choose the period and the harmonics for a first series whose column-scaled "
-                                                     "kappa is below this (and that beats every --compare reference on scaled "
-                                                     "kappa and log det per sample)")
+  cmd->add_option("--kappa-target", o->kappa_target,
+                  "Choose the period and the harmonics for a first series whose column-scaled "
+                  "kappa is below this (and that beats every --compare reference on scaled "
+                  "kappa and log det per sample)")
       ->check(numbers::checked(1, 1e6, false, false, "from 1 to 1e6"))
       ->excludes(period);
-  cmd->add_option("--max-duration", o->max_duration, "Longest optimized trajectory, holds included, s, when the period is chosen")
+  cmd->add_option("--max-duration", o->max_duration,
+                  "Longest optimized trajectory, holds included, s, when the period is chosen")
       ->check(numbers::checked(1, 3600, false, false, "from 1 to 3600 s"))
       ->capture_default_str();
-  cmd->add_option("--periods", o->periods, "Periods each optimized trajectory runs")->check(numbers::count(1, 100))->capture_default_str();
-  cmd->add_option("--starts", o->starts, "Random starts of each optimization")->check(numbers::count(1, 100))->capture_default_str();
-  cmd->add_option("--seed", o->seed, "Seed of the starts and of the validation waypoints")->capture_default_str()->check(numbers::seed());
+  cmd->add_option("--periods", o->periods, "Periods each optimized trajectory runs")
+      ->check(numbers::count(1, 100))
+      ->capture_default_str();
+  cmd->add_option("--starts", o->starts, "Random starts of each optimization")
+      ->check(numbers::count(1, 100))
+      ->capture_default_str();
+  cmd->add_option("--seed", o->seed, "Seed of the starts and of the validation waypoints")
+      ->capture_default_str()
+      ->check(numbers::seed());
   cmd->add_option("--torque-fraction", o->torque_fraction, "Torque limit as a fraction of each joint's effort limit")
       ->check(numbers::checked(0.01, 1, false, false, "from 0.01 to 1"))  // CLI::Range let NaN through
       ->capture_default_str();
-  cmd->add_option("--table", o->table, "A table this far below frame 0's origin (m, along gravity): every frame origin "
-                                       "from 3 on stays above it (1 cm clearance)")
-      ->check(numbers::checked(0, 100, false, false, "from 0 to 100 m"));  // -5 meant no table, nan and 1e300 were taken
-  cmd->add_option("--half-space", o->half_spaces, "frame:nx,ny,nz:offset: that frame's origin p keeps n.p <= offset (m, frame 0)");
-  cmd->add_option("--compare", o->compare, "Logs of reference motions (e.g. a published trajectory's recording, imported) "
-                                            "rated beside the design in the quality table")
+  cmd->add_option("--table", o->table,
+                  "A table this far below frame 0's origin (m, along gravity): every frame origin "
+                  "from 3 on stays above it (1 cm clearance)")
+      ->check(
+          numbers::checked(0, 100, false, false, "from 0 to 100 m"));  // -5 meant no table, nan and 1e300 were taken
+  cmd->add_option("--half-space", o->half_spaces,
+                  "frame:nx,ny,nz:offset: that frame's origin p keeps n.p <= offset (m, frame 0)");
+  cmd->add_option("--compare", o->compare,
+                  "Logs of reference motions (e.g. a published trajectory's recording, imported) "
+                  "rated beside the design in the quality table")
       ->check(CLI::ExistingFile);
   cmd->add_flag("--force", o->force, "Replace trajectories.yaml and quality.txt when -o holds them");
-  cmd->add_option("--interval", o->interval_ms, "Sampling interval of the quality table, ms")->check(numbers::interval_ms())->capture_default_str();
+  cmd->add_option("--interval", o->interval_ms, "Sampling interval of the quality table, ms")
+      ->check(numbers::interval_ms())
+      ->capture_default_str();
   cmd->callback([&common, o, harmonics] {
     o->harmonics_given = harmonics->count() > 0;
     run(common, *o);

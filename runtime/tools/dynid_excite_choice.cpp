@@ -12,7 +12,8 @@ bool ExcitationTargets::met_by(double k, double p) const { return k < kappa_scal
 std::string ExcitationTargets::missed_by(double k, double p) const {
   std::string out;
   if (!(k < kappa_scaled)) out = fmt::format("scaled kappa {:.4g} is not below {:.4g}", k, kappa_scaled);
-  if (!(p > per_sample)) out += fmt::format("{}logdet/N {:.4g} is not above {:.4g}", out.empty() ? "" : ", ", p, per_sample);
+  if (!(p > per_sample))
+    out += fmt::format("{}logdet/N {:.4g} is not above {:.4g}", out.empty() ? "" : ", ", p, per_sample);
   return out;
 }
 

@@ -13,7 +13,7 @@ namespace symoro::dynid {
 struct ExcitationTargets {
   double kappa_scaled = std::numeric_limits<double>::infinity();  // the series' must be below
   double per_sample = -std::numeric_limits<double>::infinity();   // its log det(W'W / N) above
-  std::string text;                                                // what they are and where from
+  std::string text;                                               // what they are and where from
   bool any() const { return !text.empty(); }
   bool met_by(double kappa_scaled, double per_sample) const;
   // What a series with these measures misses ("" when it meets them).

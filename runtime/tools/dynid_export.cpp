@@ -36,16 +36,18 @@ namespace {
 // The model label the study was identified with (report/parameters.yaml `model:`; "" is the
 // full model), to pick the instantiation when --model is not given.
 std::string study_model(const std::string& file) {
-  if (!std::filesystem::exists(file)) throw UsageError(file + ": not found (is --study a dynid identify folder with its report?)");
+  if (!std::filesystem::exists(file))
+    throw UsageError(file + ": not found (is --study a dynid identify folder with its report?)");
   try {
     const YAML::Node root = io::load_yaml_file(file);
     // A study that produced no model says so here, before its (empty) parameter list is read
     // against the model's names.
     const YAML::Node list = root["parameters"];
     if (!list || !list.IsSequence() || list.size() == 0)
-      throw UsageError(fmt::format("{}: the study has no model to export: no run produced a final vector, so there is "
-                                   "no representative and no accepted parameters (see the study's report.md)",
-                                   file));
+      throw UsageError(
+          fmt::format("{}: the study has no model to export: no run produced a final vector, so there is "
+                      "no representative and no accepted parameters (see the study's report.md)",
+                      file));
     const std::string m = root["model"] ? root["model"].as<std::string>() : std::string();
     return m.empty() ? "full" : m;
   } catch (const YAML::BadFile&) {
@@ -97,17 +99,19 @@ Eigen::MatrixXd torque_metric_root(const identify::Regression& reg) {
 std::string torque_cost(const FittingRun& f, const Eigen::VectorXd& phi, const Eigen::VectorXd& phi_consistent) {
   auto rms = [](const Eigen::VectorXd& v) { return std::sqrt(v.squaredNorm() / std::max<Eigen::Index>(1, v.size())); };
   const Eigen::VectorXd change = f.reg.W * (phi_consistent - phi);
-  return fmt::format("on {} (trial {}, {} samples), the nearest consistent vector (nearest in this run's predicted "
-                     "torque) changes the predicted torque by RMS {:.4g} N m (max {:.4g}); the fit's RMS residual "
-                     "goes from {:.4g} to {:.4g} N m",
-                     f.id, f.trial, f.reg.samples, rms(change), change.cwiseAbs().maxCoeff(), rms(f.reg.y - f.reg.W * phi),
-                     rms(f.reg.y - f.reg.W * phi_consistent));
+  return fmt::format(
+      "on {} (trial {}, {} samples), the nearest consistent vector (nearest in this run's predicted "
+      "torque) changes the predicted torque by RMS {:.4g} N m (max {:.4g}); the fit's RMS residual "
+      "goes from {:.4g} to {:.4g} N m",
+      f.id, f.trial, f.reg.samples, rms(change), change.cwiseAbs().maxCoeff(), rms(f.reg.y - f.reg.W * phi),
+      rms(f.reg.y - f.reg.W * phi_consistent));
 }
 
 // The study's parameters (its report/parameters.yaml), checked as control checks them: of this
 // robot, as identify wrote them (its digest), accepted; --not-accepted exports them anyway.
-Eigen::VectorXd read_study_parameters(const Common& common, const ExportOptions& options, const identify::ModelDescription& d,
-                                      const std::filesystem::path& params, bool& accepted) {
+Eigen::VectorXd read_study_parameters(const Common& common, const ExportOptions& options,
+                                      const identify::ModelDescription& d, const std::filesystem::path& params,
+                                      bool& accepted) {
   {
     const YAML::Node root = io::load_yaml_file(params);
     const std::string robot = root["robot"] ? root["robot"].as<std::string>() : std::string();
@@ -121,15 +125,16 @@ Eigen::VectorXd read_study_parameters(const Common& common, const ExportOptions&
   // (a value or the flag edited), and the URDF would carry the edit as identified.
   const io::ParametersIntegrity integrity = io::parameters_integrity(params.string(), names);
   if (!integrity.intact && !options.not_accepted)
-    throw UsageError(fmt::format("{}: the file is not as identify wrote it: {}; --not-accepted exports it anyway", params.string(),
-                                 integrity.why));
+    throw UsageError(fmt::format("{}: the file is not as identify wrote it: {}; --not-accepted exports it anyway",
+                                 params.string(), integrity.why));
   if (!integrity.intact)
-    fmt::print(stderr, "export: {}: the file is not as identify wrote it: {} (exported anyway: --not-accepted)\n", params.string(),
-               integrity.why);
+    fmt::print(stderr, "export: {}: the file is not as identify wrote it: {} (exported anyway: --not-accepted)\n",
+               params.string(), integrity.why);
   accepted = io::parameters_accepted(params.string());
   if (!accepted && !options.not_accepted)
-    throw UsageError(params.string() + ": the study's final audit did not accept these parameters (accepted: false); "
-                                       "--not-accepted exports them anyway");
+    throw UsageError(params.string() +
+                     ": the study's final audit did not accept these parameters (accepted: false); "
+                     "--not-accepted exports them anyway");
   return phi;
 }
 
@@ -160,9 +165,10 @@ Eigen::VectorXd export_prior(const Common& common, const ExportOptions& options,
     what = (common.robot_dir() / "robot.yaml").string() + " (nominal: the URDF's inertials)";
     return Eigen::Map<const Eigen::VectorXd>(nominal.data(), ns);
   }
-  throw UsageError(fmt::format("robot '{}' has no twin.yaml to take a prior from: give --prior <standard-parameter "
-                               "YAML> or --prior zero (see dynid export --help)",
-                               common.robot));
+  throw UsageError(
+      fmt::format("robot '{}' has no twin.yaml to take a prior from: give --prior <standard-parameter "
+                  "YAML> or --prior zero (see dynid export --help)",
+                  common.robot));
 }
 
 // What the export says: the consistency, the files, and what a URDF consumer loses.
@@ -183,9 +189,10 @@ void print_export(const model_export::ModelExport& e, const model_export::ModelE
       rotor += fmt::format("{}{} {:.6g}", rotor.empty() ? "" : ", ", e.description.names[k].name,
                            e.description.s(static_cast<Eigen::Index>(k)));
   if (!rotor.empty())
-    fmt::print("rotor inertia has no URDF field: the URDF holds it only as comments, which URDF readers ignore; a "
-               "simulator takes it from {} (MuJoCo: each joint's armature): {}\n",
-               files.yaml.string(), rotor);
+    fmt::print(
+        "rotor inertia has no URDF field: the URDF holds it only as comments, which URDF readers ignore; a "
+        "simulator takes it from {} (MuJoCo: each joint's armature): {}\n",
+        files.yaml.string(), rotor);
 }
 
 }  // namespace export_detail
@@ -196,9 +203,10 @@ void run_export(const Common& common, const ExportOptions& options, const std::s
   const std::shared_ptr<const identify::IdentificationModel> parent = identification_model(common, "full");
   const identify::ModelDescription& d = model->description();
   if (!model->supports_physical_consistency())
-    throw UsageError(fmt::format("model '{}' has model-gap effect parameters, which have no URDF counterpart and no "
-                                 "standard-parameter form: export a study of a model without effects",
-                                 d.variant));
+    throw UsageError(
+        fmt::format("model '{}' has model-gap effect parameters, which have no URDF counterpart and no "
+                    "standard-parameter form: export a study of a model without effects",
+                    d.variant));
   const std::filesystem::path params = std::filesystem::path(options.study) / "report" / "parameters.yaml";
   bool accepted = false;
   const Eigen::VectorXd phi = export_detail::read_study_parameters(common, options, d, params, accepted);
@@ -215,8 +223,9 @@ void run_export(const Common& common, const ExportOptions& options, const std::s
   }
   eo.cost = [&](const Eigen::VectorXd& target, const Eigen::VectorXd& phi_consistent) {
     return fitting ? export_detail::torque_cost(*fitting, target, phi_consistent)
-                   : std::string("--data <the study's dataset> measures the torque it costs on the fitting data (and takes "
-                                 "the nearest vector in that metric)");
+                   : std::string(
+                         "--data <the study's dataset> measures the torque it costs on the fitting data (and takes "
+                         "the nearest vector in that metric)");
   };
   const model_export::ModelExport e = model_export::export_model(*model, phi, eo);
   std::string urdf_text;
@@ -244,8 +253,9 @@ void add_export_commands(CLI::App& app, Common& common) {
   cmd->add_option("--urdf", o->urdf, "URDF file to write; <stem>.standard.yaml and <stem>.standard.csv go beside it")
       ->required();
   cmd->add_option("--model", o->model, "Model the study identified (checked; default: the study's own)");
-  cmd->add_option("--into", o->into, "The robot's own URDF (the one symoroc model read): --urdf is then that file with "
-                                     "the identified inertials and joint dynamics, everything else unchanged")
+  cmd->add_option("--into", o->into,
+                  "The robot's own URDF (the one symoroc model read): --urdf is then that file with "
+                  "the identified inertials and joint dynamics, everything else unchanged")
       ->check(CLI::ExistingFile);
   cmd->add_option("--prior", o->prior,
                   "Standard parameters the consistent set is drawn towards where the base parameters leave it free: "
@@ -253,32 +263,39 @@ void add_export_commands(CLI::App& app, Common& common) {
                   "(the consistent set nearest 0: smallest masses and inertias, a generic choice with no physical "
                   "meaning for the unidentifiable part). Default: the CAD truth of robots/<robot>/twin.yaml, else "
                   "robot.yaml's nominal parameters (a URDF's); a robot with neither needs --prior");
-  cmd->add_option("--margin", o->margin, "Strictness of the consistency: every link's pseudo-inertia >= margin I "
-                                         "(kg m^2 / kg; 0 allows singular links)")
+  cmd->add_option("--margin", o->margin,
+                  "Strictness of the consistency: every link's pseudo-inertia >= margin I "
+                  "(kg m^2 / kg; 0 allows singular links)")
       ->check(numbers::non_negative(1, ">= 0 and <= 1"))
       ->capture_default_str();
-  cmd->add_flag("--not-accepted", o->not_accepted, "Export even when the study's final audit did not accept its "
-                                                   "parameters, or the file is not as identify wrote it (edited)");
-  cmd->add_option("--data", o->data, "The study's dataset: when no consistent set reproduces the accepted parameters, "
-                                     "the nearest consistent vector is the one that changes the predicted torque on "
-                                     "the study's fitting run least, and that change is reported")
+  cmd->add_flag("--not-accepted", o->not_accepted,
+                "Export even when the study's final audit did not accept its "
+                "parameters, or the file is not as identify wrote it (edited)");
+  cmd->add_option("--data", o->data,
+                  "The study's dataset: when no consistent set reproduces the accepted parameters, "
+                  "the nearest consistent vector is the one that changes the predicted torque on "
+                  "the study's fitting run least, and that change is reported")
       ->check(CLI::ExistingDirectory);
-  cmd->add_option("--trial", o->trial, "Which trial of the fitting run (with --data)")->check(numbers::count(1, 1e6))->capture_default_str();
-  cmd->add_flag("--nearest", o->nearest, "When no consistent set reproduces the accepted base parameters, export the "
-                                         "consistent set of the nearest base vector that has one (said in the files) "
-                                         "instead of failing");
+  cmd->add_option("--trial", o->trial, "Which trial of the fitting run (with --data)")
+      ->check(numbers::count(1, 1e6))
+      ->capture_default_str();
+  cmd->add_flag("--nearest", o->nearest,
+                "When no consistent set reproduces the accepted base parameters, export the "
+                "consistent set of the nearest base vector that has one (said in the files) "
+                "instead of failing");
   cmd->add_flag("--force", o->force, "Overwrite the URDF and its .standard.yaml/.csv when they exist");
   cmd->callback([&common, o] {
     // One export to a URDF at a time (its own lock file beside it, held to the end: two at once
     // both passed the check below, and the last writer won), and, like import and control, an
     // existing file is replaced only when the user says so, before any work is done.
     const std::filesystem::path target(o->urdf);
-    const io::FolderLock lock(target.parent_path().empty() ? std::filesystem::path(".") : target.parent_path(), "dynid export",
-                              "." + target.filename().string() + ".lock", /*remove_when_done=*/true);
+    const io::FolderLock lock(target.parent_path().empty() ? std::filesystem::path(".") : target.parent_path(),
+                              "dynid export", "." + target.filename().string() + ".lock", /*remove_when_done=*/true);
     std::filesystem::path stem = o->urdf;
     stem.replace_extension();
-    for (const std::filesystem::path& f : {std::filesystem::path(o->urdf), std::filesystem::path(stem.string() + ".standard.yaml"),
-                                           std::filesystem::path(stem.string() + ".standard.csv")}) {
+    for (const std::filesystem::path& f :
+         {std::filesystem::path(o->urdf), std::filesystem::path(stem.string() + ".standard.yaml"),
+          std::filesystem::path(stem.string() + ".standard.csv")}) {
       if (std::filesystem::is_directory(f))
         throw UsageError(fmt::format("{} is a directory: --urdf names the file to write", f.string()));
       if (std::filesystem::exists(f) && !o->force)

@@ -29,8 +29,9 @@ namespace import_detail {
 // The command line's settings over the mapping file's (or the defaults).
 io::ImportMapping mapping_of(const ImportOptions& options) {
   io::ImportMapping m = options.mapping.empty() ? io::ImportMapping{} : io::read_import_mapping(options.mapping);
-  io::apply_settings(m, {options.time, options.q, options.qd, options.tau, options.q_ref, options.qd_ref, options.qdd_ref, options.time_unit, options.angle, options.header,
-                         options.delimiter, options.torque_scale});
+  io::apply_settings(m,
+                     {options.time, options.q, options.qd, options.tau, options.q_ref, options.qd_ref, options.qdd_ref,
+                      options.time_unit, options.angle, options.header, options.delimiter, options.torque_scale});
   if (m.time.empty() || m.q.empty() || m.tau.empty())
     throw UsageError("say which columns hold time, q and tau: --time, --q, --tau, or --mapping map.yaml");
   return m;
@@ -50,16 +51,18 @@ void run_import(const Common& common, const ImportOptions& options, const std::v
     if (std::find(options.inputs.begin(), options.inputs.end(), h) == options.inputs.end())
       throw UsageError(fmt::format("--heldout {}: not one of the input files", h));
   for (std::size_t i = 0; i < options.inputs.size(); ++i)
-    di.inputs.push_back({options.inputs[i], options.names.empty() ? "" : options.names[i],
-                         std::find(options.heldout.begin(), options.heldout.end(), options.inputs[i]) != options.heldout.end()});
+    di.inputs.push_back(
+        {options.inputs[i], options.names.empty() ? "" : options.names[i],
+         std::find(options.heldout.begin(), options.heldout.end(), options.inputs[i]) != options.heldout.end()});
   const io::DatasetImportResult r = io::import_dataset(options.out, di);
   for (const io::ImportedLog& l : r.logs) {
     const io::Log& log = l.log;
-    fmt::print("{}: {} rows -> {}.csv: {} samples over {:.3f} s, sample time {:g} ms (median), {} stale rows kept, "
-               "{} duplicates dropped, velocity {}\n",
-               l.input.string(), l.rows, log.meta.trajectory, log.samples(), log.time[log.samples() - 1] - log.time[0],
-               log.meta.sample_time * 1e3, l.stale_lines.size(), l.duplicate_lines.size(),
-               log.meta.velocity == io::Velocity::measured ? "measured" : "differentiated from q");
+    fmt::print(
+        "{}: {} rows -> {}.csv: {} samples over {:.3f} s, sample time {:g} ms (median), {} stale rows kept, "
+        "{} duplicates dropped, velocity {}\n",
+        l.input.string(), l.rows, log.meta.trajectory, log.samples(), log.time[log.samples() - 1] - log.time[0],
+        log.meta.sample_time * 1e3, l.stale_lines.size(), l.duplicate_lines.size(),
+        log.meta.velocity == io::Velocity::measured ? "measured" : "differentiated from q");
     if (!l.stale_lines.empty())
       fmt::print("  stale rows (same state as the row before, new stamp) on lines {}{}\n", l.stale_lines.front(),
                  l.stale_lines.size() > 1 ? fmt::format(" .. {}", l.stale_lines.back()) : "");
@@ -73,11 +76,11 @@ void run_import(const Common& common, const ImportOptions& options, const std::v
   fmt::print("dataset: {} (mapping kept in import.yaml)\n", r.dataset.string());
 }
 
-
 void add_import_commands(CLI::App& app, Common& common) {
   auto o = std::make_shared<ImportOptions>();
-  auto* cmd = app.add_subcommand("import", "Import a controller's exported logs (CSV, ';' or whitespace text) into a "
-                                           "dataset folder");
+  auto* cmd = app.add_subcommand("import",
+                                 "Import a controller's exported logs (CSV, ';' or whitespace text) into a "
+                                 "dataset folder");
   cmd->footer(
       "Examples:\n"
       "  dynid import --robot crane_x7 -o data/ run1.csv run2.csv --time t --time-unit ms \\\n"
@@ -91,7 +94,8 @@ void add_import_commands(CLI::App& app, Common& common) {
   cmd->add_option("inputs", o->inputs, "Exported files, one run each")->required()->check(CLI::ExistingFile);
   add_robot_options(cmd, common, "Robot folder name under robots/ (its joints set n)");
   cmd->add_option("-o,--out", o->out, "Dataset folder to create (existing files are never replaced)")->required();
-  cmd->add_option("--mapping", o->mapping, "Mapping file (YAML); the options below override it")->check(CLI::ExistingFile);
+  cmd->add_option("--mapping", o->mapping, "Mapping file (YAML); the options below override it")
+      ->check(CLI::ExistingFile);
   cmd->add_option("--time", o->time, std::string("Time column: ") + selector_help);
   cmd->add_option("--q", o->q, std::string("Position columns (n): ") + selector_help);
   cmd->add_option("--qd", o->qd, "Velocity columns (n); without them qd is differentiated from q");
@@ -99,7 +103,8 @@ void add_import_commands(CLI::App& app, Common& common) {
   cmd->add_option("--q-ref", o->q_ref, "Reference position columns (with --qd-ref and --qdd-ref)");
   cmd->add_option("--qd-ref", o->qd_ref, "Reference velocity columns");
   cmd->add_option("--qdd-ref", o->qdd_ref, "Reference acceleration columns");
-  cmd->add_option("--time-unit", o->time_unit, "Unit of the time column (default s)")->check(CLI::IsMember({"s", "ms", "us", "ns"}));
+  cmd->add_option("--time-unit", o->time_unit, "Unit of the time column (default s)")
+      ->check(CLI::IsMember({"s", "ms", "us", "ns"}));
   cmd->add_option("--angle", o->angle, "Unit of angles (and angle/s, angle/s^2; prismatic joints stay in m)")
       ->check(CLI::IsMember({"rad", "deg"}));
   cmd->add_option("--torque-scale", o->torque_scale, "Factor from the torque columns to N m (e.g. 0.001 for mN m)")
@@ -113,13 +118,11 @@ void add_import_commands(CLI::App& app, Common& common) {
                   "recorded in dataset.yaml")
       ->check(numbers::checked(0, 1, false, false, "a fraction from 0 (no split) to 1"));
   cmd->add_flag("--allow-implausible", o->allow_implausible,
-               "Import positions far beyond the robot's joint limits, or a median time step outside "
-               "[0.1 ms, 0.5 s] (refused by default: a unit declared wrong)");
+                "Import positions far beyond the robot's joint limits, or a median time step outside "
+                "[0.1 ms, 0.5 s] (refused by default: a unit declared wrong)");
   cmd->add_option("--name", o->names, "Run names, one per input (default: the file names' stems)")->delimiter(',');
   cmd->add_option("--heldout", o->heldout, "Inputs held out whole (family V)")->delimiter(',');
-  cmd->callback([&common, o] {
-    run_import(common, *o, robot_model(common, "").joints());
-  });
+  cmd->callback([&common, o] { run_import(common, *o, robot_model(common, "").joints()); });
 }
 
 }  // namespace symoro::dynid

@@ -25,7 +25,8 @@ inline CLI::Validator checked(double lo, double hi, bool lo_open, bool integer, 
         if (end == s || *end != '\0') return fmt::format("'{}' is not a number", text);
         if (!std::isfinite(v)) return fmt::format("'{}': a finite number is needed ({})", text, range);
         if (integer && v != std::floor(v)) return fmt::format("'{}': a whole number is needed ({})", text, range);
-        if ((lo_open ? v <= lo : v < lo) || v > hi) return fmt::format("{} is out of range: it must be {}", text, range);
+        if ((lo_open ? v <= lo : v < lo) || v > hi)
+          return fmt::format("{} is out of range: it must be {}", text, range);
         return "";
       },
       range);
@@ -37,7 +38,8 @@ inline CLI::Validator non_negative(double hi, const std::string& range) { return
 inline CLI::Validator seed() {
   return CLI::Validator(
       [](std::string& text) -> std::string {
-        return text.find('-') == std::string::npos ? std::string() : fmt::format("'{}': a seed is a whole number of at least 0", text);
+        return text.find('-') == std::string::npos ? std::string()
+                                                   : fmt::format("'{}': a seed is a whole number of at least 0", text);
       },
       "a whole number >= 0");
 }

@@ -64,8 +64,8 @@ Eigen::VectorXd nominal_phi(const Common& common, const identify::Identification
 }
 
 // The prediction of one log, its samples written to `csv`.
-study::Prediction predict_log(const io::Log& log, const identify::IdentificationModel& model, const Eigen::VectorXd& phi,
-                                 const PredictOptions& options, const fs::path& csv) {
+study::Prediction predict_log(const io::Log& log, const identify::IdentificationModel& model,
+                              const Eigen::VectorXd& phi, const PredictOptions& options, const fs::path& csv) {
   study::Prediction p = study::predict(log, model, phi, {options.interval_ms / 1000, options.torque_delay_ms / 1000});
   const preprocess::Samples& s = p.samples;
   const int n = static_cast<int>(s.tau.cols());
@@ -76,7 +76,8 @@ study::Prediction predict_log(const io::Log& log, const identify::Identification
   text += "\n";
   for (Eigen::Index k = 0; k < s.tau.rows(); ++k) {
     text += io::number_text(s.time(k));
-    for (const Eigen::MatrixXd* m : std::initializer_list<const Eigen::MatrixXd*>{&s.q, &s.qd, &s.qdd, &s.tau, &p.tau_model})
+    for (const Eigen::MatrixXd* m :
+         std::initializer_list<const Eigen::MatrixXd*>{&s.q, &s.qd, &s.qdd, &s.tau, &p.tau_model})
       for (int j = 0; j < n; ++j) text += "," + io::number_text((*m)(k, j));
     text += "\n";
   }
@@ -89,7 +90,8 @@ void run(const Common& common, const PredictOptions& options) {
   if (options.params != "nominal") {
     const std::string in_file = file_model(options.params);
     if (!label.empty() && label != in_file)
-      throw UsageError(fmt::format("--model {}, but {} holds the parameters of model {}", label, options.params, in_file));
+      throw UsageError(
+          fmt::format("--model {}, but {} holds the parameters of model {}", label, options.params, in_file));
     label = in_file;
   }
   const auto model = identification_model(common, label);
@@ -124,11 +126,13 @@ void run(const Common& common, const PredictOptions& options) {
   std::vector<fs::path> files;
   for (const auto& [name, log] : logs) files.push_back(one ? out : out / (name + ".predicted.csv"));
   for (const auto& f : files)
-    if (fs::exists(f) && !options.force) throw UsageError(f.string() + " exists: dynid predict does not overwrite it; choose another --out, or --force");
+    if (fs::exists(f) && !options.force)
+      throw UsageError(f.string() + " exists: dynid predict does not overwrite it; choose another --out, or --force");
   if (!one) fs::create_directories(out);
 
-  fmt::print("{} model {} with {} parameters, at {:.0f} ms: RMSE of tau - tau_model (RMS of tau) per joint, N m\n", common.robot,
-             d.variant.empty() ? "full" : d.variant, options.params == "nominal" ? "the nominal" : options.params, options.interval_ms);
+  fmt::print("{} model {} with {} parameters, at {:.0f} ms: RMSE of tau - tau_model (RMS of tau) per joint, N m\n",
+             common.robot, d.variant.empty() ? "full" : d.variant,
+             options.params == "nominal" ? "the nominal" : options.params, options.interval_ms);
   Eigen::VectorXd sq = Eigen::VectorXd::Zero(d.nq);
   int total = 0;
   std::string raw_filter;
@@ -141,8 +145,8 @@ void run(const Common& common, const PredictOptions& options) {
     line = fmt::format("  {:<10} {:>6} raw:    ", "", p.raw.samples);
     for (int j = 0; j < d.nq; ++j) line += fmt::format(" {:.4f}        ", p.raw.error.rmse_joint(j));
     fmt::print("{}\n", line);
-    fmt::print("  {:<10} {:>6} raw RMSE {:.4f} N m over all joints and samples, mean of the joints' RMSE {:.4f} N m\n", "",
-               "", p.raw.error.rmse, p.raw.error.rmse_joint.mean());
+    fmt::print("  {:<10} {:>6} raw RMSE {:.4f} N m over all joints and samples, mean of the joints' RMSE {:.4f} N m\n",
+               "", "", p.raw.error.rmse, p.raw.error.rmse_joint.mean());
     if (p.samples.report.edge_samples > 0 || p.samples.report.context_rows > 0)
       fmt::print("  {:<10} {}\n", "", p.samples.report.summary());
     if (i + 1 == logs.size()) raw_filter = p.raw.filter;
@@ -162,20 +166,29 @@ void run(const Common& common, const PredictOptions& options) {
 
 void add_predict_commands(CLI::App& app, Common& common) {
   auto o = std::make_shared<PredictOptions>();
-  auto* cmd = app.add_subcommand("predict", "A model's inverse-dynamics torque on a log's measured motion (or every run of "
-                                            "a dataset), beside the measured torque, with the RMSE per joint");
+  auto* cmd = app.add_subcommand("predict",
+                                 "A model's inverse-dynamics torque on a log's measured motion (or every run of "
+                                 "a dataset), beside the measured torque, with the RMSE per joint");
   add_robot_options(cmd, common);
-  cmd->add_option("--params", o->params, "A study's report/parameters.yaml, or `nominal` (robot.yaml's nominal "
-                                         "standard parameters, e.g. a URDF's)")
+  cmd->add_option("--params", o->params,
+                  "A study's report/parameters.yaml, or `nominal` (robot.yaml's nominal "
+                  "standard parameters, e.g. a URDF's)")
       ->capture_default_str();
-  cmd->add_option("--model", o->model, "Model: a robot.yaml variant or full (default: the parameters file's, or "
-                                       "robot.yaml's identified)");
-  cmd->add_option("input", o->input, "A log (CSV with its .meta.yaml) or a dataset folder")->required()->check(CLI::ExistingPath);
+  cmd->add_option("--model", o->model,
+                  "Model: a robot.yaml variant or full (default: the parameters file's, or "
+                  "robot.yaml's identified)");
+  cmd->add_option("input", o->input, "A log (CSV with its .meta.yaml) or a dataset folder")
+      ->required()
+      ->check(CLI::ExistingPath);
   cmd->add_option("-o,--out", o->out, "The CSV to write (a folder of <run>.predicted.csv for a dataset)")->required();
-  cmd->add_option("--interval", o->interval_ms, "Sampling interval in ms, as in identification")->check(numbers::interval_ms())->capture_default_str();
+  cmd->add_option("--interval", o->interval_ms, "Sampling interval in ms, as in identification")
+      ->check(numbers::interval_ms())
+      ->capture_default_str();
   cmd->add_option("--torque-delay", o->torque_delay_ms, "ms the logged torque lags the links' (as dynid identify)")
       ->check(numbers::checked(-1000, 1000, false, false, "from -1000 to 1000 ms"));
-  cmd->add_option("--trial", o->trial, "Which trial of a dataset's runs")->check(numbers::count(1, 1e6))->capture_default_str();
+  cmd->add_option("--trial", o->trial, "Which trial of a dataset's runs")
+      ->check(numbers::count(1, 1e6))
+      ->capture_default_str();
   cmd->add_flag("--force", o->force, "Overwrite existing output files");
   cmd->callback([&common, o] { run(common, *o); });
 }

@@ -66,13 +66,17 @@ void run(const Common& common, const PreprocessOptions& cli) {
 
 void add_preprocess_commands(CLI::App& app, Common& common) {
   auto o = std::make_shared<PreprocessOptions>();
-  auto* cmd = app.add_subcommand("preprocess", "Preprocess logs: time axis, zero-phase filter, derivatives, resampling");
+  auto* cmd =
+      app.add_subcommand("preprocess", "Preprocess logs: time axis, zero-phase filter, derivatives, resampling");
   cmd->add_option("logs", o->logs, "Log CSV files")->required()->check(CLI::ExistingFile);
   cmd->add_option("--robot", common.robot, "Check that the logs are of this robot");
-  cmd->add_option("--interval", o->intervals_ms, "Target intervals in ms (default: 10 20 40 80)")->check(numbers::interval_ms());
+  cmd->add_option("--interval", o->intervals_ms, "Target intervals in ms (default: 10 20 40 80)")
+      ->check(numbers::interval_ms());
   cmd->add_option("-o,--output", o->out, "Write <log>_<interval>ms.csv samples here");
-  cmd->add_option("--cutoff", o->options.derivative_cutoff, "Low-pass cutoff for the derivatives, Hz")->check(numbers::positive(1e5, "> 0 and <= 1e5 Hz"));
-  cmd->add_option("--max-gap", o->options.max_gap, "Longest gap bridged by interpolation, s")->check(numbers::non_negative(3600, ">= 0 and <= 3600 s"));
+  cmd->add_option("--cutoff", o->options.derivative_cutoff, "Low-pass cutoff for the derivatives, Hz")
+      ->check(numbers::positive(1e5, "> 0 and <= 1e5 Hz"));
+  cmd->add_option("--max-gap", o->options.max_gap, "Longest gap bridged by interpolation, s")
+      ->check(numbers::non_negative(3600, ">= 0 and <= 3600 s"));
   cmd->add_option("--base-period", o->options.base_period,
                   "Grid period, s (default: each log's sample_time, else its median stamp interval)")
       ->check(numbers::positive(10, "> 0 and <= 10 s"));

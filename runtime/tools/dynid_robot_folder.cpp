@@ -19,14 +19,15 @@ void check_robot_folder(const Common& common) {
   for (const SourceFile& f : robot_sources(common.robot)) {
     const std::filesystem::path file = dir / f.name;
     if (!std::filesystem::exists(file))
-      throw UsageError(fmt::format("{} is missing: robot '{}' was compiled from a folder that has it", file.string(),
-                                   common.robot));
+      throw UsageError(
+          fmt::format("{} is missing: robot '{}' was compiled from a folder that has it", file.string(), common.robot));
     const std::string now = io::file_digest(file);
     if (now != f.digest)
-      throw UsageError(fmt::format("{} differs from the {} robot '{}' was compiled from (digest {}, compiled {}): this "
-                                   "dynid would use the compiled copy; regenerate (symoroc generate {} -o generated) and "
-                                   "rebuild, or point --robots-dir at the folder it was compiled from",
-                                   file.string(), f.name, common.robot, now, f.digest, dir.string()));
+      throw UsageError(
+          fmt::format("{} differs from the {} robot '{}' was compiled from (digest {}, compiled {}): this "
+                      "dynid would use the compiled copy; regenerate (symoroc generate {} -o generated) and "
+                      "rebuild, or point --robots-dir at the folder it was compiled from",
+                      file.string(), f.name, common.robot, now, f.digest, dir.string()));
   }
 }
 

@@ -19,13 +19,16 @@ std::shared_ptr<const robot::RobotLibrary> library_of(const Common& common) {
   if (!std::filesystem::is_directory(dir)) {
     std::string known;
     for (const auto& r : robot_names()) known += (known.empty() ? "" : ", ") + r;
-    throw UsageError(fmt::format("unknown robot '{}': {} is not a folder (robots compiled into this dynid: {}; any "
-                                 "robot folder works with --robot path/to/folder)",
-                                 common.robot, dir.string(), known));
+    throw UsageError(
+        fmt::format("unknown robot '{}': {} is not a folder (robots compiled into this dynid: {}; any "
+                    "robot folder works with --robot path/to/folder)",
+                    common.robot, dir.string(), known));
   }
   if (!std::filesystem::exists(dir / "robot.yaml"))
-    throw UsageError(fmt::format("{} is not a robot folder: it has no robot.yaml (symoroc model <robot>.urdf -o {} "
-                                 "writes one)", dir.string(), dir.string()));
+    throw UsageError(
+        fmt::format("{} is not a robot folder: it has no robot.yaml (symoroc model <robot>.urdf -o {} "
+                    "writes one)",
+                    dir.string(), dir.string()));
   // Once per command: its models (an export's and its full model, say) share the library.
   static std::map<std::string, std::shared_ptr<const robot::RobotLibrary>> loaded;
   if (const auto it = loaded.find(dir.string()); it != loaded.end()) return it->second;
@@ -46,9 +49,10 @@ robot::ModelHandle linked_model(const Common& common, const robot::LinkedRobot& 
     if (m->label() == label) return *m;
     list += (list.empty() ? "" : ", ") + m->label();
   }
-  throw UsageError(fmt::format("robot '{}' has no compiled model '{}' (it has: {}); a variant just added to robot.yaml must be "
-                               "generated (symoroc generate robots/{} -o generated) and dynid rebuilt",
-                               common.robot, label, list, common.robot));
+  throw UsageError(
+      fmt::format("robot '{}' has no compiled model '{}' (it has: {}); a variant just added to robot.yaml must be "
+                  "generated (symoroc generate robots/{} -o generated) and dynid rebuilt",
+                  common.robot, label, list, common.robot));
 }
 
 }  // namespace
@@ -56,9 +60,10 @@ robot::ModelHandle linked_model(const Common& common, const robot::LinkedRobot& 
 trajectory::TrajectoryDesign read_design(const Common& common, const std::vector<JointInfo>& joints) {
   const std::filesystem::path path = common.design_path();
   if (common.design.empty() && !std::filesystem::exists(path))
-    throw UsageError(fmt::format("robot '{}' has no trajectory design ({} not found): dynid excite --robot {} -o <folder> "
-                                 "designs one, which --design <folder>/trajectories.yaml then uses",
-                                 common.robot, path.string(), common.robot_dir().string()));
+    throw UsageError(
+        fmt::format("robot '{}' has no trajectory design ({} not found): dynid excite --robot {} -o <folder> "
+                    "designs one, which --design <folder>/trajectories.yaml then uses",
+                    common.robot, path.string(), common.robot_dir().string()));
   return trajectory::TrajectoryDesign::read(path, joints);
 }
 
@@ -85,7 +90,8 @@ robot::ModelHandle robot_model(const Common& common, const std::string& label) {
   }
 }
 
-std::shared_ptr<const identify::IdentificationModel> identification_model(const Common& common, const std::string& label) {
+std::shared_ptr<const identify::IdentificationModel> identification_model(const Common& common,
+                                                                          const std::string& label) {
   return identify::identification_model(robot_model(common, label), full_model(common));
 }
 

@@ -49,7 +49,8 @@ inline robot::ModelHandle full_model(const Common& common) { return robot_model(
 
 // The IdentificationModel of model `label` (identify::identification_model over its handle and
 // its robot's full model's).
-std::shared_ptr<const identify::IdentificationModel> identification_model(const Common& common, const std::string& label);
+std::shared_ptr<const identify::IdentificationModel> identification_model(const Common& common,
+                                                                          const std::string& label);
 
 // The trajectory design the command reads (Common::design_path) for these joints; a robot folder
 // without one gets a UsageError saying how to make one (dynid excite).

@@ -44,8 +44,8 @@ double log_det_per_sample(const RegressorFactor& f, int joints) {
   return 2 * sigma.array().log().sum() - static_cast<double>(p) * std::log(samples);
 }
 
-Eigen::MatrixXd reference_regressor(const identify::IdentificationModel& model, const std::string& file, const TrajectoryOptions& options,
-                                    double& duration) {
+Eigen::MatrixXd reference_regressor(const identify::IdentificationModel& model, const std::string& file,
+                                    const TrajectoryOptions& options, double& duration) {
   const identify::ModelDescription& d = model.description();
   const double interval = options.interval_ms / 1000;
   const io::Log log = io::read_log(file);
@@ -54,14 +54,18 @@ Eigen::MatrixXd reference_regressor(const identify::IdentificationModel& model, 
   duration = log.time(log.samples() - 1) - log.time(0);
   if (log.has_references()) {
     const auto period = log.meta.sample_time > 0 ? log.meta.sample_time : options.period;
-    return model.stack_regression(excitation::reference_samples(trajectory::sampled_reference(log, period), interval)).W;
+    return model.stack_regression(excitation::reference_samples(trajectory::sampled_reference(log, period), interval))
+        .W;
   }
   return model.stack_regression(preprocess::preprocess(log, interval, study::StudyOptions{}.preprocess)).W;
 }
 
 Eigen::MatrixXd trajectory_regressor(const identify::IdentificationModel& model, const trajectory::Trajectory& t,
                                      const TrajectoryOptions& options) {
-  return model.stack_regression(excitation::reference_samples(trajectory::sample(t, options.period), options.interval_ms / 1000)).W;
+  return model
+      .stack_regression(
+          excitation::reference_samples(trajectory::sample(t, options.period), options.interval_ms / 1000))
+      .W;
 }
 
 std::string trajectory_quality_table(const Common& common, const std::vector<trajectory::Trajectory>& trajectories,
@@ -69,19 +73,21 @@ std::string trajectory_quality_table(const Common& common, const std::vector<tra
   const auto model = identification_model(common, model_name);
   std::string out;
   const identify::ModelDescription& d = model->description();
-  out += fmt::format("excitation of {} model {} ({} base parameters) at {:.0f} ms: kappa of W, kappa of W and log det of W'W with "
-                     "unit columns (<= 0, 0 when the columns are orthogonal), log det of W'W / N per sample (the model's SI "
-                     "units, N samples: larger is more information per sample), the weakest direction's largest components\n",
-             common.robot, d.variant.empty() ? "full" : d.variant, d.np, options.interval_ms);
-  out += fmt::format("{:<6} {:<4} {:>8} {:>11} {:>11} {:>10} {:>10}  {}\n", "name", "fam", "duration", "kappa", "kappa_scl",
-                     "logdet_scl", "logdet/N", "weakest");
+  out += fmt::format(
+      "excitation of {} model {} ({} base parameters) at {:.0f} ms: kappa of W, kappa of W and log det of W'W with "
+      "unit columns (<= 0, 0 when the columns are orthogonal), log det of W'W / N per sample (the model's SI "
+      "units, N samples: larger is more information per sample), the weakest direction's largest components\n",
+      common.robot, d.variant.empty() ? "full" : d.variant, d.np, options.interval_ms);
+  out += fmt::format("{:<6} {:<4} {:>8} {:>11} {:>11} {:>10} {:>10}  {}\n", "name", "fam", "duration", "kappa",
+                     "kappa_scl", "logdet_scl", "logdet/N", "weakest");
   auto row = [&](const std::string& name, const std::string& family, double duration, const RegressorFactor& f) {
     const excitation::ExcitationQuality q = excitation::excitation_quality_of_factor(f.R, f.rows, d.parameters);
     std::string weakest;
-    if (!q.unexcited.empty()) weakest = fmt::format("{} parameters not excited (e.g. {})", q.unexcited.size(), q.unexcited.front());
+    if (!q.unexcited.empty())
+      weakest = fmt::format("{} parameters not excited (e.g. {})", q.unexcited.size(), q.unexcited.front());
     for (const auto& [p, v] : q.weakest) weakest += fmt::format("{}{} {:+.2f}", weakest.empty() ? "" : ", ", p, v);
-    out += fmt::format("{:<6} {:<4} {:>7.1f}s {:>11.4g} {:>11.4g} {:>10.3f} {:>10.2f}  {}\n", name, family, duration, q.kappa,
-                       q.kappa_scaled, q.log_det_scaled, log_det_per_sample(f, d.nq), weakest);
+    out += fmt::format("{:<6} {:<4} {:>7.1f}s {:>11.4g} {:>11.4g} {:>10.3f} {:>10.2f}  {}\n", name, family, duration,
+                       q.kappa, q.kappa_scaled, q.log_det_scaled, log_det_per_sample(f, d.nq), weakest);
   };
   std::vector<RegressorFactor> factors;
   double total = 0;
@@ -128,29 +134,34 @@ void run_trajectories(const Common& common, const TrajectoryOptions& options) {
   Progress progress(static_cast<int>(names.size()), "reference");
   for (const auto& name : names) {
     const auto t = design.build(name);
-    io::write_log(std::filesystem::path(options.out) / (name + ".csv"), trajectory::reference_log(t, options.period, common.robot, joint_names));
+    io::write_log(std::filesystem::path(options.out) / (name + ".csv"),
+                  trajectory::reference_log(t, options.period, common.robot, joint_names));
     progress.done(name, fmt::format("{:.1f} s", t.duration()));
   }
 }
 
 void add_trajectory_commands(CLI::App& app, Common& common) {
   auto o = std::make_shared<TrajectoryOptions>();
-  auto* cmd = app.add_subcommand("trajectories", "List the identification trajectories, or write them as reference files");
+  auto* cmd =
+      app.add_subcommand("trajectories", "List the identification trajectories, or write them as reference files");
   add_robot_options(cmd, common);
-  cmd->add_option("--design", common.design, "A trajectory design file (e.g. dynid excite's) instead of robots/<robot>/trajectories.yaml")
+  cmd->add_option("--design", common.design,
+                  "A trajectory design file (e.g. dynid excite's) instead of robots/<robot>/trajectories.yaml")
       ->check(CLI::ExistingFile);
   cmd->add_option("-o,--output", o->out, "Write <name>.csv and <name>.meta.yaml here (default: list only)");
   cmd->add_option("--only", o->only, "Only these trajectories");
   // At least 0.1 ms (10 kHz): --period 1e-9 ran out of memory, 1e-6 wrote 7.9 GB.
   cmd->add_option("--period", o->period, "Sample period of the reference files, s")
       ->check(numbers::checked(1e-4, 10, false, false, "from 0.0001 to 10 s"));
-  cmd->add_flag("--quality", o->quality, "Print each trajectory's excitation of the robot's identified model: kappa, "
-                                         "kappa and log det with unit columns, the weakest direction");
+  cmd->add_flag("--quality", o->quality,
+                "Print each trajectory's excitation of the robot's identified model: kappa, "
+                "kappa and log det with unit columns, the weakest direction");
   cmd->add_option("--interval", o->interval_ms, "Sampling interval of --quality, ms (as in identification)")
       ->check(numbers::interval_ms())
       ->capture_default_str();
-  cmd->add_option("--compare", o->compare, "With --quality: logs of reference motions (e.g. a published trajectory's "
-                                            "recording, imported) rated beside the design")
+  cmd->add_option("--compare", o->compare,
+                  "With --quality: logs of reference motions (e.g. a published trajectory's "
+                  "recording, imported) rated beside the design")
       ->check(CLI::ExistingFile);
   cmd->callback([&common, o] { run_trajectories(common, *o); });
 }

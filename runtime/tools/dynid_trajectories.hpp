@@ -17,8 +17,8 @@ struct TrajectoryOptions {
   std::string out;
   std::vector<std::string> only;
   double period = 0.001;
-  bool quality = false;      // print each trajectory's excitation quality (excitation/quality.hpp)
-  double interval_ms = 10;   // ... at this sampling interval
+  bool quality = false;     // print each trajectory's excitation quality (excitation/quality.hpp)
+  double interval_ms = 10;  // ... at this sampling interval
   // Logs (symoro-log CSV, e.g. dynid import's) of reference motions rated beside the designed
   // ones: their reference columns when they have them, else their measured motion as the study
   // preprocesses it (a published trajectory's recording).
@@ -49,8 +49,8 @@ Eigen::MatrixXd trajectory_regressor(const identify::IdentificationModel& model,
 
 // The stacked regressor of a reference log (--compare) at o's interval, as the table rates it;
 // `duration` its length, s.
-Eigen::MatrixXd reference_regressor(const identify::IdentificationModel& model, const std::string& file, const TrajectoryOptions& options,
-                                    double& duration);
+Eigen::MatrixXd reference_regressor(const identify::IdentificationModel& model, const std::string& file,
+                                    const TrajectoryOptions& options, double& duration);
 
 void run_trajectories(const Common& common, const TrajectoryOptions& options);
 

@@ -74,14 +74,16 @@ void twin_dataset(const Common& common, const TwinOptions& options) {
   d.overrides = options.config;
   std::optional<Progress> progress;
   d.on_start = [&](int to_run, int skipped) {
-    if (skipped > 0) fmt::print(stderr, "{} runs already finished in {} (same seed and twin): skipped\n", skipped, options.out);
+    if (skipped > 0)
+      fmt::print(stderr, "{} runs already finished in {} (same seed and twin): skipped\n", skipped, options.out);
     progress.emplace(to_run, "twin");
   };
   d.on_run = [&](const std::string& run, const std::string& what) { progress->done(run, what); };
   const twin::TwinDatasetSummary s = twin::make_twin_dataset(sim, trajs, d);
   if (!s.coordinator) return;
-  fmt::print("{} runs ({} new, {} skipped) in {}: {:.0f} s simulated in {:.1f} s wall on {}{} workers\n", s.runs, s.made,
-             s.skipped, options.out, s.simulated, s.wall, s.ranks > 1 ? fmt::format("{} ranks x ", s.ranks) : "", s.workers);
+  fmt::print("{} runs ({} new, {} skipped) in {}: {:.0f} s simulated in {:.1f} s wall on {}{} workers\n", s.runs,
+             s.made, s.skipped, options.out, s.simulated, s.wall,
+             s.ranks > 1 ? fmt::format("{} ranks x ", s.ranks) : "", s.workers);
 }
 
 void twin_bench(const Common& common, const TwinOptions& options) {
@@ -101,19 +103,21 @@ void twin_bench(const Common& common, const TwinOptions& options) {
   }
   fmt::print("twin {} on {} ({:.1f} s), one core, effects: {}\n", common.robot, options.trajectory, traj.duration(),
              fmt::join(sim.config().effects.enabled(), ", "));
-  fmt::print("{} runs: {:.0f} simulated s per wall s on average, {:.0f} best ({:.2f} us per 1 ms control cycle)\n", runs,
-             total_sim / total_wall, best, 1e3 / (total_sim / total_wall));
+  fmt::print("{} runs: {:.0f} simulated s per wall s on average, {:.0f} best ({:.2f} us per 1 ms control cycle)\n",
+             runs, total_sim / total_wall, best, 1e3 / (total_sim / total_wall));
 }
-
 
 void add_config_options(CLI::App* cmd, Common& common, TwinOptions& options) {
   add_robot_options(cmd, common);
-  cmd->add_option("--design", common.design, "A trajectory design file (e.g. dynid excite's) instead of robots/<robot>/trajectories.yaml")
+  cmd->add_option("--design", common.design,
+                  "A trajectory design file (e.g. dynid excite's) instead of robots/<robot>/trajectories.yaml")
       ->check(CLI::ExistingFile);
-  cmd->add_option("--config", options.config, "A YAML file overriding parts of robots/<robot>/twin.yaml")->check(CLI::ExistingFile);
+  cmd->add_option("--config", options.config, "A YAML file overriding parts of robots/<robot>/twin.yaml")
+      ->check(CLI::ExistingFile);
   cmd->add_flag("--ideal", options.ideal, "Turn every effect off (quantization and delay remain)");
-  cmd->add_option("--effects", options.effects, "Turn these effects on (coulomb, stribeck, torque_offset, backlash, payload, "
-                                           "torque_constant_error, actuation_delay, sensor_noise, timestamp_jitter, dropped_samples)")
+  cmd->add_option("--effects", options.effects,
+                  "Turn these effects on (coulomb, stribeck, torque_offset, backlash, payload, "
+                  "torque_constant_error, actuation_delay, sensor_noise, timestamp_jitter, dropped_samples)")
       ->delimiter(',');
   cmd->add_option("--without", options.without, "Turn these effects off")->delimiter(',');
 }
@@ -122,9 +126,12 @@ void add_config_options(CLI::App* cmd, Common& common, TwinOptions& options) {
 
 void run_twin(const Common& common, const TwinOptions& options) {
   switch (options.mode) {
-    case TwinOptions::Mode::run: return twin_run(common, options);
-    case TwinOptions::Mode::dataset: return twin_dataset(common, options);
-    case TwinOptions::Mode::bench: return twin_bench(common, options);
+    case TwinOptions::Mode::run:
+      return twin_run(common, options);
+    case TwinOptions::Mode::dataset:
+      return twin_dataset(common, options);
+    case TwinOptions::Mode::bench:
+      return twin_bench(common, options);
   }
 }
 
@@ -138,7 +145,8 @@ void add_twin_commands(CLI::App& app, Common& common) {
   run->add_option("--trajectory", o->trajectory, "Trajectory name (see dynid trajectories)")->required();
   run->add_option("-o,--output", o->out, "Output directory")->required();
   run->add_option("--trial", o->trial, "Trial number")->check(numbers::count(1, 1e6));
-  run->add_option("--seed", o->seed, "Dataset seed (the run's seed derives from it, the trajectory and the trial)")->check(numbers::seed());
+  run->add_option("--seed", o->seed, "Dataset seed (the run's seed derives from it, the trajectory and the trial)")
+      ->check(numbers::seed());
   run->callback([&common, o] {
     o->mode = TwinOptions::Mode::run;
     run_twin(common, *o);
@@ -149,7 +157,9 @@ void add_twin_commands(CLI::App& app, Common& common) {
   data->add_option("-o,--output", o->out, "Output directory")->required();
   data->add_option("--trials", o->trials, "Repeated trials per trajectory")->check(numbers::count(1, 1e4));
   data->add_option("--seed", o->seed, "Dataset seed")->check(numbers::seed());
-  data->add_option("--jobs", o->jobs, "Worker threads per rank (default: the cores, shared among the MPI ranks on a machine)")->check(numbers::count(1, 1024));
+  data->add_option("--jobs", o->jobs,
+                   "Worker threads per rank (default: the cores, shared among the MPI ranks on a machine)")
+      ->check(numbers::count(1, 1024));
   data->add_option("--only", o->only, "Only these trajectories");
   data->callback([&common, o] {
     o->mode = TwinOptions::Mode::dataset;
@@ -159,7 +169,8 @@ void add_twin_commands(CLI::App& app, Common& common) {
   auto* bench = twin->add_subcommand("bench", "Simulated seconds per wall second on one core");
   add_config_options(bench, common, *o);
   bench->add_option("--trajectory", o->trajectory, "Trajectory to simulate (default AG02)");
-  bench->add_option("--seconds", o->repeat_seconds, "Measure for at least this long")->check(numbers::positive(3600, "> 0 and <= 3600 s"));
+  bench->add_option("--seconds", o->repeat_seconds, "Measure for at least this long")
+      ->check(numbers::positive(3600, "> 0 and <= 3600 s"));
   bench->callback([&common, o] {
     o->mode = TwinOptions::Mode::bench;
     run_twin(common, *o);

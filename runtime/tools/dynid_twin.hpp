@@ -12,10 +12,10 @@ namespace symoro::dynid {
 
 struct TwinOptions {
   enum class Mode { run, dataset, bench } mode = Mode::run;  // which subcommand (one entry for all three)
-  std::string config;                 // override YAML
-  std::vector<std::string> effects;   // enable
-  std::vector<std::string> without;   // disable
-  bool ideal = false;                 // disable all first
+  std::string config;                                        // override YAML
+  std::vector<std::string> effects;                          // enable
+  std::vector<std::string> without;                          // disable
+  bool ideal = false;                                        // disable all first
   std::string out;
   std::string trajectory = "AG02";
   std::vector<std::string> only;

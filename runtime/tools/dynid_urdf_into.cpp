@@ -25,10 +25,10 @@ namespace symoro::dynid {
 
 namespace {
 
-using urdf_geometry::pose;
 using Eigen::Isometry3d;
 using Eigen::Matrix3d;
 using Eigen::Vector3d;
+using urdf_geometry::pose;
 
 struct Origin {
   std::string base_link;
@@ -52,7 +52,8 @@ Origin read_origin(const std::string& robot_yaml) {
   Origin o;
   try {
     const YAML::Node u = io::load_yaml_file(robot_yaml)["urdf"];
-    if (!u) throw UsageError(robot_yaml + " has no `urdf:` section: --into needs a robot symoroc model made from a URDF");
+    if (!u)
+      throw UsageError(robot_yaml + " has no `urdf:` section: --into needs a robot symoroc model made from a URDF");
     o.base_link = u["base_link"].as<std::string>();
     o.joints = u["joints"].as<std::vector<std::string>>();
     o.links = u["links"].as<std::vector<std::vector<std::string>>>();
@@ -64,7 +65,6 @@ Origin read_origin(const std::string& robot_yaml) {
   }
   return o;
 }
-
 
 // A body's parameters about a frame's origin: inertia J, first moment h, mass m.
 struct Body {
@@ -124,8 +124,10 @@ Span find_element(const std::string& x, const std::string& tag, const std::strin
     const std::size_t gt = x.find('>', at);
     if (gt == std::string::npos) break;
     const std::string head = x.substr(at, gt - at + 1);
-    const bool is_tag = head.compare(0, tag.size() + 1, "<" + tag) == 0 && std::isspace(static_cast<unsigned char>(head[tag.size() + 1]));
-    if (is_tag && head.find("name=\"" + name + "\"") != std::string::npos && (tag != "joint" || head.find("type=") != std::string::npos)) {
+    const bool is_tag = head.compare(0, tag.size() + 1, "<" + tag) == 0 &&
+                        std::isspace(static_cast<unsigned char>(head[tag.size() + 1]));
+    if (is_tag && head.find("name=\"" + name + "\"") != std::string::npos &&
+        (tag != "joint" || head.find("type=") != std::string::npos)) {
       Span s;
       s.begin = at;
       s.open_end = gt + 1;
@@ -145,7 +147,8 @@ Span find_element(const std::string& x, const std::string& tag, const std::strin
 }
 
 // The span of a child element <tag ...>...</tag> or <tag .../> inside [from, to), or npos.
-std::pair<std::size_t, std::size_t> find_child(const std::string& x, const std::string& tag, std::size_t from, std::size_t to) {
+std::pair<std::size_t, std::size_t> find_child(const std::string& x, const std::string& tag, std::size_t from,
+                                               std::size_t to) {
   std::size_t at = from;
   while ((at = x.find("<" + tag, at)) != std::string::npos && at < to) {
     const char next = x[at + tag.size() + 1];
@@ -173,16 +176,17 @@ std::string num(double v) { return io::number_text(std::abs(v) < 1e-300 ? 0.0 : 
 
 std::string inertial_xml(const ComForm& f, const std::string& indent) {
   const std::string i2 = indent + "  ";
-  return "<inertial>\n" + i2 + "<origin xyz=\"" + num(f.c.x()) + " " + num(f.c.y()) + " " + num(f.c.z()) + "\" rpy=\"0 0 0\"/>\n" + i2 +
-         "<mass value=\"" + num(f.m) + "\"/>\n" + i2 + "<inertia ixx=\"" + num(f.Ic(0, 0)) + "\" ixy=\"" + num(f.Ic(0, 1)) +
-         "\" ixz=\"" + num(f.Ic(0, 2)) + "\" iyy=\"" + num(f.Ic(1, 1)) + "\" iyz=\"" + num(f.Ic(1, 2)) + "\" izz=\"" +
-         num(f.Ic(2, 2)) + "\"/>\n" + indent + "</inertial>";
+  return "<inertial>\n" + i2 + "<origin xyz=\"" + num(f.c.x()) + " " + num(f.c.y()) + " " + num(f.c.z()) +
+         "\" rpy=\"0 0 0\"/>\n" + i2 + "<mass value=\"" + num(f.m) + "\"/>\n" + i2 + "<inertia ixx=\"" +
+         num(f.Ic(0, 0)) + "\" ixy=\"" + num(f.Ic(0, 1)) + "\" ixz=\"" + num(f.Ic(0, 2)) + "\" iyy=\"" +
+         num(f.Ic(1, 1)) + "\" iyz=\"" + num(f.Ic(1, 2)) + "\" izz=\"" + num(f.Ic(2, 2)) + "\"/>\n" + indent +
+         "</inertial>";
 }
 
 }  // namespace
 
-std::string urdf_into(const model_export::UrdfDescription& d, const std::string& robot_yaml, const std::string& user_urdf,
-                      std::vector<std::string>& notes) {
+std::string urdf_into(const model_export::UrdfDescription& d, const std::string& robot_yaml,
+                      const std::string& user_urdf, std::vector<std::string>& notes) {
   const Origin origin = read_origin(robot_yaml);
   std::ifstream in(user_urdf, std::ios::binary);
   if (!in) throw UsageError(user_urdf + ": cannot read it");
@@ -195,7 +199,8 @@ std::string urdf_into(const model_export::UrdfDescription& d, const std::string&
     TiXmlDocument doc;
     doc.Parse(x.c_str());
     if (doc.Error())
-      throw UsageError(fmt::format("{}:{}:{}: malformed XML: {}", user_urdf, doc.ErrorRow(), doc.ErrorCol(), doc.ErrorDesc()));
+      throw UsageError(
+          fmt::format("{}:{}:{}: malformed XML: {}", user_urdf, doc.ErrorRow(), doc.ErrorCol(), doc.ErrorDesc()));
   }
   const console_bridge::LogLevel level = console_bridge::getLogLevel();
   console_bridge::setLogLevel(console_bridge::CONSOLE_BRIDGE_LOG_NONE);
@@ -205,7 +210,8 @@ std::string urdf_into(const model_export::UrdfDescription& d, const std::string&
   const int n = static_cast<int>(d.joints.size());
   if (static_cast<int>(origin.joints.size()) != n || static_cast<int>(origin.links.size()) != n)
     throw UsageError(fmt::format("{}: `urdf:` lists {} joints, the model has {}", robot_yaml, origin.joints.size(), n));
-  if (!model->getLink(origin.base_link)) throw UsageError(user_urdf + ": no link '" + origin.base_link + "' (robot.yaml urdf base_link)");
+  if (!model->getLink(origin.base_link))
+    throw UsageError(user_urdf + ": no link '" + origin.base_link + "' (robot.yaml urdf base_link)");
 
   // Every link's pose at q = 0 (off-chain moving joints at their locked positions).
   std::map<std::string, Isometry3d> T;
@@ -229,7 +235,8 @@ std::string urdf_into(const model_export::UrdfDescription& d, const std::string&
   int replaced = 0;
   for (int k = 1; k <= n; ++k) {
     const urdf::JointConstSharedPtr joint = model->getJoint(origin.joints[k - 1]);
-    if (!joint) throw UsageError(fmt::format("{}: no joint '{}' (robot.yaml urdf joints)", user_urdf, origin.joints[k - 1]));
+    if (!joint)
+      throw UsageError(fmt::format("{}: no joint '{}' (robot.yaml urdf joints)", user_urdf, origin.joints[k - 1]));
     const std::string chain_link = joint->child_link_name;
     // The URDF's joint must be the model's: its axis along frame k's z and, for a revolute
     // joint, on that line. Another arm's URDF (an origin changed) would get inertials computed
@@ -241,10 +248,11 @@ std::string urdf_into(const model_export::UrdfDescription& d, const std::string&
       const double angle = std::acos(std::min(1.0, std::abs(a.dot(z))));
       const double off = joint->type == urdf::Joint::PRISMATIC ? 0.0 : (r - r.dot(z) * z).norm();
       if (!(angle <= 1e-6) || !(off <= 1e-6))
-        throw UsageError(fmt::format("{}: joint '{}' is not the model's joint {}: its axis is {:.4g} deg from the model's and "
-                                     "{:.4g} mm off it. This URDF's geometry differs from the one symoroc model read ({}'s "
-                                     "`urdf:` record); export into that URDF, or model this one",
-                                     user_urdf, joint->name, k, angle * 180 / M_PI, off * 1e3, robot_yaml));
+        throw UsageError(
+            fmt::format("{}: joint '{}' is not the model's joint {}: its axis is {:.4g} deg from the model's and "
+                        "{:.4g} mm off it. This URDF's geometry differs from the one symoroc model read ({}'s "
+                        "`urdf:` record); export into that URDF, or model this one",
+                        user_urdf, joint->name, k, angle * 180 / M_PI, off * 1e3, robot_yaml));
     }
     // The identified body of model link k, about frame k's origin.
     model_export::UrdfInertial id = model_export::link_inertial(d, k);
@@ -257,7 +265,8 @@ std::string urdf_into(const model_export::UrdfDescription& d, const std::string&
       if (name == chain_link) continue;
       const auto l = model->getLink(name);
       if (!l) throw UsageError(fmt::format("{}: no link '{}' (robot.yaml urdf links)", user_urdf, name));
-      if (!T.count(name)) throw UsageError(fmt::format("{}: link '{}' is not under '{}'", user_urdf, name, origin.base_link));
+      if (!T.count(name))
+        throw UsageError(fmt::format("{}: link '{}' is not under '{}'", user_urdf, name, origin.base_link));
       if (!l->inertial || l->inertial->mass == 0) continue;
       const Body b = body_of(*l->inertial, F[k].inverse() * T[name] * pose(l->inertial->origin));
       rest.J -= b.J;
@@ -270,9 +279,10 @@ std::string urdf_into(const model_export::UrdfDescription& d, const std::string&
     if (!merged.empty() && !f.consistent) {
       whole = true;
       f = com_form(identified);
-      notes.push_back(fmt::format("model link {}: the identified body less the merged links' inertials ({}) is not physically "
-                                  "consistent: {} takes the whole body and their <inertial> are removed",
-                                  k, fmt::join(merged, ", "), chain_link));
+      notes.push_back(
+          fmt::format("model link {}: the identified body less the merged links' inertials ({}) is not physically "
+                      "consistent: {} takes the whole body and their <inertial> are removed",
+                      k, fmt::join(merged, ", "), chain_link));
     }
     // Into the chain link's own frame.
     const Isometry3d L = F[k].inverse() * T[chain_link];  // the chain link in frame k
@@ -286,7 +296,8 @@ std::string urdf_into(const model_export::UrdfDescription& d, const std::string&
     if (link.self_closing) {
       if (!block.empty()) {
         const std::string head = x.substr(link.begin, link.end - link.begin - 2);  // without "/>"
-        x.replace(link.begin, link.end - link.begin, head + ">\n" + indent + block + "\n" + indent_at(x, link.begin) + "</link>");
+        x.replace(link.begin, link.end - link.begin,
+                  head + ">\n" + indent + block + "\n" + indent_at(x, link.begin) + "</link>");
       }
     } else {
       const auto [b, e] = find_child(x, "inertial", link.open_end, link.end);
@@ -317,7 +328,8 @@ std::string urdf_into(const model_export::UrdfDescription& d, const std::string&
     }
     if (has_fv || has_fs) {
       const Span js = find_element(x, "joint", joint->name);
-      if (js.begin == std::string::npos || js.self_closing) throw UsageError(user_urdf + ": no <joint name=\"" + joint->name + "\">");
+      if (js.begin == std::string::npos || js.self_closing)
+        throw UsageError(user_urdf + ": no <joint name=\"" + joint->name + "\">");
       const std::string dyn = "<dynamics damping=\"" + num(fv) + "\" friction=\"" + num(fs) + "\"/>";
       const auto [b, e] = find_child(x, "dynamics", js.open_end, js.end);
       if (b != std::string::npos) {
@@ -328,8 +340,9 @@ std::string urdf_into(const model_export::UrdfDescription& d, const std::string&
       }
     }
   }
-  notes.push_back(fmt::format("{} chain links' <inertial> and their joints' <dynamics> written into {}; every other line is unchanged",
-                              replaced, user_urdf));
+  notes.push_back(fmt::format(
+      "{} chain links' <inertial> and their joints' <dynamics> written into {}; every other line is unchanged",
+      replaced, user_urdf));
   return x;
 }
 

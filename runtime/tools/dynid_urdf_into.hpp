@@ -23,7 +23,7 @@ namespace symoro::dynid {
 // frame0_in_base); `user_urdf` is the file to write into (its text is read here). Returns the
 // new text; `notes` gets what the user should know. Throws UsageError on a file that is not the
 // robot's (a chain joint or link missing) and DataError on malformed input.
-std::string urdf_into(const model_export::UrdfDescription& d, const std::string& robot_yaml, const std::string& user_urdf,
-                      std::vector<std::string>& notes);
+std::string urdf_into(const model_export::UrdfDescription& d, const std::string& robot_yaml,
+                      const std::string& user_urdf, std::vector<std::string>& notes);
 
 }  // namespace symoro::dynid

@@ -22,19 +22,45 @@ double eval(const ExprGraph& g, NodeId root, const std::map<std::string, double>
     auto a = [&] { return v.at(n.a); };
     auto b = [&] { return v.at(n.b); };
     switch (n.op) {
-      case Op::Constant: v[id] = n.value; break;
-      case Op::Symbol: v[id] = at.at(g.symbol_name(n.symbol)); break;
-      case Op::Add: v[id] = a() + b(); break;
-      case Op::Sub: v[id] = a() - b(); break;
-      case Op::Mul: v[id] = a() * b(); break;
-      case Op::Div: v[id] = a() / b(); break;
-      case Op::Neg: v[id] = -a(); break;
-      case Op::Pow: v[id] = std::pow(a(), n.value); break;
-      case Op::Sin: v[id] = std::sin(a()); break;
-      case Op::Cos: v[id] = std::cos(a()); break;
-      case Op::Sign: v[id] = double((a() > 0) - (a() < 0)); break;
-      case Op::Exp: v[id] = std::exp(a()); break;
-      case Op::Tanh: v[id] = std::tanh(a()); break;
+      case Op::Constant:
+        v[id] = n.value;
+        break;
+      case Op::Symbol:
+        v[id] = at.at(g.symbol_name(n.symbol));
+        break;
+      case Op::Add:
+        v[id] = a() + b();
+        break;
+      case Op::Sub:
+        v[id] = a() - b();
+        break;
+      case Op::Mul:
+        v[id] = a() * b();
+        break;
+      case Op::Div:
+        v[id] = a() / b();
+        break;
+      case Op::Neg:
+        v[id] = -a();
+        break;
+      case Op::Pow:
+        v[id] = std::pow(a(), n.value);
+        break;
+      case Op::Sin:
+        v[id] = std::sin(a());
+        break;
+      case Op::Cos:
+        v[id] = std::cos(a());
+        break;
+      case Op::Sign:
+        v[id] = double((a() > 0) - (a() < 0));
+        break;
+      case Op::Exp:
+        v[id] = std::exp(a());
+        break;
+      case Op::Tanh:
+        v[id] = std::tanh(a());
+        break;
     }
   }
   return v.at(root);
@@ -96,10 +122,9 @@ TEST(Passes, DerivativesMatchFiniteDifferences) {
   ExprGraph g;
   const NodeId x = g.symbol("x"), y = g.symbol("y");
   // A mix of every operator, shaped like the model files' expressions.
-  const NodeId e = g.add(
-      g.add(g.div(g.mul(g.sin(x), g.pow(y, 3.0)), g.add(g.constant(2.0), g.cos(g.mul(x, y)))),
-            g.sub(g.neg(g.mul(g.constant(0.5), g.pow(x, 2.0))), g.mul(g.sign(y), y))),
-      g.mul(g.sign(x), g.exp(g.neg(g.pow(g.mul(g.constant(1.5), x), 2.0)))));  // a Stribeck term
+  const NodeId e = g.add(g.add(g.div(g.mul(g.sin(x), g.pow(y, 3.0)), g.add(g.constant(2.0), g.cos(g.mul(x, y)))),
+                               g.sub(g.neg(g.mul(g.constant(0.5), g.pow(x, 2.0))), g.mul(g.sign(y), y))),
+                         g.mul(g.sign(x), g.exp(g.neg(g.pow(g.mul(g.constant(1.5), x), 2.0)))));  // a Stribeck term
   std::mt19937 rng(7);
   std::uniform_real_distribution<double> u(-2, 2);
   for (int trial = 0; trial < 20; ++trial) {

@@ -77,7 +77,8 @@ KDL::Chain kdl_chain(const urdf::ModelInterface& m, const std::string& base, con
     return I;
   };
   KDL::Chain chain;
-  chain.addSegment(KDL::Segment("base", KDL::Joint(KDL::Joint::Fixed), KDL::Frame::Identity(), KDL::RigidBodyInertia::Zero()));
+  chain.addSegment(
+      KDL::Segment("base", KDL::Joint(KDL::Joint::Fixed), KDL::Frame::Identity(), KDL::RigidBodyInertia::Zero()));
   for (const auto& j : way) {
     const KDL::Frame F = frame(j->parent_to_joint_origin_transform);
     KDL::Joint joint(j->name, KDL::Joint::Fixed);
@@ -253,9 +254,11 @@ std::string error_of(const std::string& text, ModelingOptions o = {}) {
 }
 
 std::string arm(const std::string& joint2) {
-  return std::string(R"(<robot name="a"><link name="b"/><link name="l1"><inertial><mass value="1"/><inertia ixx="1" ixy="0" ixz="0" iyy="1" iyz="0" izz="1"/></inertial></link>
+  return std::string(
+             R"(<robot name="a"><link name="b"/><link name="l1"><inertial><mass value="1"/><inertia ixx="1" ixy="0" ixz="0" iyy="1" iyz="0" izz="1"/></inertial></link>
 <joint name="j1" type="revolute"><parent link="b"/><child link="l1"/><axis xyz="0 0 1"/><limit lower="-1" upper="1" velocity="1" effort="1"/></joint>
-<link name="l2"/>)") + (joint2.find("\"l3\"") != std::string::npos ? "<link name=\"l3\"/>" : "") + joint2 + "</robot>";
+<link name="l2"/>)") +
+         (joint2.find("\"l3\"") != std::string::npos ? "<link name=\"l3\"/>" : "") + joint2 + "</robot>";
 }
 
 // Sizes no serial arm has: elements nested 100,000 deep (the XML parser's recursion crashed
@@ -272,15 +275,18 @@ TEST(ModelFromUrdf, SizesNoArmHasAreRefusedAtOnce) {
   const auto chain = [](int links) {
     std::string t = "<robot name=\"r\">\n<link name=\"l0\"/>\n";
     for (int i = 1; i < links; ++i)
-      t += fmt::format(R"(<link name="l{}"><inertial><mass value="1"/><inertia ixx="1" ixy="0" ixz="0" iyy="1" iyz="0" izz="1"/></inertial></link>
+      t += fmt::format(
+          R"(<link name="l{}"><inertial><mass value="1"/><inertia ixx="1" ixy="0" ixz="0" iyy="1" iyz="0" izz="1"/></inertial></link>
 <joint name="j{}" type="revolute"><parent link="l{}"/><child link="l{}"/><axis xyz="0 0 1"/><limit lower="-1" upper="1" velocity="1" effort="1"/></joint>
-)", i, i, i - 1, i);
+)",
+          i, i, i - 1, i);
     return t + "</robot>\n";
   };
   const std::string many = error_of(chain(2001));
   EXPECT_NE(many.find("2001 links: more than the 2000"), std::string::npos) << many;
   const std::string long_chain = error_of(chain(101));
-  EXPECT_NE(long_chain.find("100 moving joints between 'l0' and 'l100': symoroc models serial arms of at most 64"), std::string::npos)
+  EXPECT_NE(long_chain.find("100 moving joints between 'l0' and 'l100': symoroc models serial arms of at most 64"),
+            std::string::npos)
       << long_chain;
   EXPECT_NE(long_chain.find(".urdf:132:"), std::string::npos) << long_chain;  // the 65th joint's line
 }
@@ -289,16 +295,21 @@ TEST(ModelFromUrdf, BadInputIsNamed) {
   const std::string malformed = error_of("<robot name=\"a\">\n<link name=\"b\">\n</robot>");
   EXPECT_NE(malformed.find(".urdf:3:"), std::string::npos) << malformed;  // where the mismatch is
   EXPECT_NE(malformed.find("malformed XML"), std::string::npos) << malformed;
-  EXPECT_NE(error_of("<robot name=\"a\"><link name=\"b\"/><link name=\"c\"/></robot>").find("not a valid URDF"), std::string::npos);
-  const std::string floating = error_of(arm(R"(<joint name="free" type="floating"><parent link="l1"/><child link="l2"/></joint>)"));
+  EXPECT_NE(error_of("<robot name=\"a\"><link name=\"b\"/><link name=\"c\"/></robot>").find("not a valid URDF"),
+            std::string::npos);
+  const std::string floating =
+      error_of(arm(R"(<joint name="free" type="floating"><parent link="l1"/><child link="l2"/></joint>)"));
   EXPECT_NE(floating.find("joint 'free' on the chain is floating"), std::string::npos) << floating;
   EXPECT_NE(floating.find(".urdf:3:"), std::string::npos) << floating;  // the joint's line
-  const std::string branch = error_of(arm(R"(<joint name="x" type="revolute"><parent link="l1"/><child link="l2"/><axis xyz="0 0 1"/><limit lower="-1" upper="1" velocity="1" effort="1"/></joint>
+  const std::string branch = error_of(arm(
+      R"(<joint name="x" type="revolute"><parent link="l1"/><child link="l2"/><axis xyz="0 0 1"/><limit lower="-1" upper="1" velocity="1" effort="1"/></joint>
 <joint name="y" type="revolute"><parent link="l1"/><child link="l3"/><axis xyz="0 0 1"/><limit lower="-1" upper="1" velocity="1" effort="1"/></joint>)"));
   EXPECT_NE(branch.find("'l1' branches into moving joints ('x' and 'y')"), std::string::npos) << branch;
   ModelingOptions tip;
   tip.tip_link = "l2";
-  const std::string mimic = error_of(arm(R"(<joint name="m" type="revolute"><parent link="l1"/><child link="l2"/><axis xyz="0 0 1"/><mimic joint="j1"/><limit lower="-1" upper="1" velocity="1" effort="1"/></joint>)"), tip);
+  const std::string mimic = error_of(
+      arm(R"(<joint name="m" type="revolute"><parent link="l1"/><child link="l2"/><axis xyz="0 0 1"/><mimic joint="j1"/><limit lower="-1" upper="1" velocity="1" effort="1"/></joint>)"),
+      tip);
   EXPECT_NE(mimic.find("joint 'm' on the chain mimics 'j1'"), std::string::npos) << mimic;
   tip.tip_link = "nowhere";
   const std::string fixed = R"(<joint name="f" type="fixed"><parent link="l1"/><child link="l2"/></joint>)";
@@ -308,11 +319,13 @@ TEST(ModelFromUrdf, BadInputIsNamed) {
   EXPECT_NE(error_of(arm(fixed), lock).find("--lock j1: not a moving joint off the chain"), std::string::npos);
   // An inconsistent inertial is a warning that names the link, not an error.
   const fs::path p = symoro::test::removed_at_exit("symoro_warn_" + std::to_string(::getpid()) + ".urdf");
-  std::ofstream(p) << R"(<robot name="w"><link name="b"/><link name="l1"><inertial><mass value="1"/><inertia ixx="1" ixy="0" ixz="0" iyy="1" iyz="0" izz="3"/></inertial></link>
+  std::ofstream(p)
+      << R"(<robot name="w"><link name="b"/><link name="l1"><inertial><mass value="1"/><inertia ixx="1" ixy="0" ixz="0" iyy="1" iyz="0" izz="3"/></inertial></link>
 <joint name="j1" type="revolute"><parent link="b"/><child link="l1"/><axis xyz="0 0 1"/><limit lower="-1" upper="1" velocity="1" effort="1"/></joint></robot>)";
   const Modeling m = model_from_urdf(p.string());
   bool warned = false;
-  for (const auto& note : m.notes) warned = warned || note.find("link 'l1' (line 1) is not physically consistent") != std::string::npos;
+  for (const auto& note : m.notes)
+    warned = warned || note.find("link 'l1' (line 1) is not physically consistent") != std::string::npos;
   EXPECT_TRUE(warned);
 }
 
@@ -323,7 +336,8 @@ TEST(ModelFromUrdf, BadInputIsNamed) {
 TEST(ModelFromUrdf, ValuesUrdfdomTakesSilentlyAreRefusedWhereTheyAre) {
   // arm() with the first link's inertial, the first joint's origin or its limits replaced.
   auto with = [](const std::string& from, const std::string& to) {
-    std::string a = arm(R"(<joint name="j2" type="revolute"><parent link="l1"/><child link="l2"/><axis xyz="0 0 1"/><limit lower="-1" upper="1" velocity="1" effort="1"/></joint>)");
+    std::string a = arm(
+        R"(<joint name="j2" type="revolute"><parent link="l1"/><child link="l2"/><axis xyz="0 0 1"/><limit lower="-1" upper="1" velocity="1" effort="1"/></joint>)");
     const std::size_t at = a.find(from);
     EXPECT_NE(at, std::string::npos) << from;
     return a.replace(at, from.size(), to);
@@ -347,17 +361,22 @@ TEST(ModelFromUrdf, ValuesUrdfdomTakesSilentlyAreRefusedWhereTheyAre) {
                                         R"(<origin rpy="0 nan 0"/><axis xyz="0 0 1"/><limit lower="-1" upper="1")"));
   EXPECT_NE(rpy.find("joint 'j1': <origin rpy=\"0 nan 0\">: 'nan' is not a finite number"), std::string::npos) << rpy;
   const std::string inverted = error_of(with(R"(<limit lower="-1" upper="1")", R"(<limit lower="2" upper="-2")"));
-  EXPECT_NE(inverted.find("joint 'j1': <limit lower=\"2\" upper=\"-2\"> has its lower limit above its upper one"), std::string::npos)
+  EXPECT_NE(inverted.find("joint 'j1': <limit lower=\"2\" upper=\"-2\"> has its lower limit above its upper one"),
+            std::string::npos)
       << inverted;
-  EXPECT_NE(error_of(with(R"(velocity="1")", R"(velocity="-3")")).find("joint 'j1': <limit velocity=\"-3\"> is outside 0"),
-            std::string::npos);
-  const std::string xacro = error_of(with(R"(<link name="l2"/>)", "<xacro:include filename=\"hand.xacro\"/>\n<link name=\"l2\"/>"));
-  EXPECT_NE(xacro.find("<xacro:include> is a xacro macro: expand the file with xacro first"), std::string::npos) << xacro;
+  EXPECT_NE(
+      error_of(with(R"(velocity="1")", R"(velocity="-3")")).find("joint 'j1': <limit velocity=\"-3\"> is outside 0"),
+      std::string::npos);
+  const std::string xacro =
+      error_of(with(R"(<link name="l2"/>)", "<xacro:include filename=\"hand.xacro\"/>\n<link name=\"l2\"/>"));
+  EXPECT_NE(xacro.find("<xacro:include> is a xacro macro: expand the file with xacro first"), std::string::npos)
+      << xacro;
   const std::string expression = error_of(with(R"(velocity="1")", R"(velocity="${v_max}")"));
   EXPECT_NE(expression.find("holds a xacro expression"), std::string::npos) << expression;
 
   // --lock: a position outside the locked joint's limits, and no position at all.
-  const std::string finger = arm(R"(<joint name="f" type="prismatic"><parent link="l1"/><child link="l2"/><axis xyz="1 0 0"/><limit lower="0" upper="0.04" velocity="1" effort="1"/></joint>)");
+  const std::string finger = arm(
+      R"(<joint name="f" type="prismatic"><parent link="l1"/><child link="l2"/><axis xyz="1 0 0"/><limit lower="0" upper="0.04" velocity="1" effort="1"/></joint>)");
   ModelingOptions lock;
   lock.tip_link = "l1";  // the finger hangs off the chain
   lock.locked = {{"f", -5}};
@@ -384,22 +403,31 @@ TEST(ModelFromUrdf, ValuesUrdfdomTakesSilentlyAreRefusedWhereTheyAre) {
 // identifier, and empty limits.
 TEST(ModelFromUrdf, NamesAndLimitsTheModelChangesAreWarnedAbout) {
   const fs::path p = symoro::test::removed_at_exit("symoro_names_" + std::to_string(::getpid()) + ".urdf");
-  std::ofstream(p) << R"(<robot name="bras-léger"><link name="b"/><link name="l1"><inertial><mass value="1"/><inertia ixx="1" ixy="0" ixz="0" iyy="1" iyz="0" izz="1"/></inertial></link>
+  std::ofstream(p)
+      << R"(<robot name="bras-léger"><link name="b"/><link name="l1"><inertial><mass value="1"/><inertia ixx="1" ixy="0" ixz="0" iyy="1" iyz="0" izz="1"/></inertial></link>
 <joint name="épaule" type="revolute"><parent link="b"/><child link="l1"/><axis xyz="0 0 1"/><limit lower="0" upper="0" velocity="1" effort="1"/></joint></robot>)";
   const Modeling m = model_from_urdf(p.string());
   std::string notes;
   for (const auto& n : m.notes) notes += n + "\n";
-  EXPECT_NE(notes.find("the robot's name 'bras-léger' is no C++ identifier: written as 'bras_l__ger'"), std::string::npos) << notes;
-  EXPECT_NE(notes.find("joint 'épaule' (line 2) is no C++ identifier: robot.yaml names it '__paule'"), std::string::npos) << notes;
-  EXPECT_NE(notes.find("joint 'épaule' (line 2) has empty limits (0 .. 0): robot.yaml gets -pi .. pi"), std::string::npos) << notes;
+  EXPECT_NE(notes.find("the robot's name 'bras-léger' is no C++ identifier: written as 'bras_l__ger'"),
+            std::string::npos)
+      << notes;
+  EXPECT_NE(notes.find("joint 'épaule' (line 2) is no C++ identifier: robot.yaml names it '__paule'"),
+            std::string::npos)
+      << notes;
+  EXPECT_NE(notes.find("joint 'épaule' (line 2) has empty limits (0 .. 0): robot.yaml gets -pi .. pi"),
+            std::string::npos)
+      << notes;
 }
 
 // The folder's name is the robot's namespace: `class`, `int` or `std` generated code that did not
 // compile.
 TEST(RobotName, KeywordsAndNamesTheGeneratedCodeUsesAreRefused) {
-  for (const std::string bad : {"class", "int", "std", "Eigen", "detail", "and", "co_await", "a__b", "_Arm", "2arm", "arm-2", "bras_é", ""})
+  for (const std::string bad :
+       {"class", "int", "std", "Eigen", "detail", "and", "co_await", "a__b", "_Arm", "2arm", "arm-2", "bras_é", ""})
     EXPECT_NE(robot_name_problem(bad), "") << bad;
-  for (const std::string good : {"crane_x7", "ur5", "Panda", "_arm", "classic", "integer", "stdarm"}) EXPECT_EQ(robot_name_problem(good), "") << good;
+  for (const std::string good : {"crane_x7", "ur5", "Panda", "_arm", "classic", "integer", "stdarm"})
+    EXPECT_EQ(robot_name_problem(good), "") << good;
   EXPECT_NE(robot_name_problem("class").find("is a C++ keyword"), std::string::npos);
 }
 
@@ -448,7 +476,8 @@ void expect_written_into(double extra_mass, bool expect_whole) {
   for (const auto& f : r.frames) d.frames.push_back({f.ant, f.sigma, f.mu, f.gamma, f.b, f.alpha, f.d, f.theta, f.r});
   for (int j = 0; j < r.n; ++j) {
     const auto& js = r.spec.joints[j];
-    d.joints.push_back({js.name.c_str(), JointType::Revolute, js.lower, js.upper, js.velocity, js.effort, js.audit_lower, js.audit_upper});
+    d.joints.push_back({js.name.c_str(), JointType::Revolute, js.lower, js.upper, js.velocity, js.effort,
+                        js.audit_lower, js.audit_upper});
   }
   for (const auto& p : r.standard) d.names.push_back({p.name.c_str(), p.family.c_str(), p.joint});
   d.s.resize(static_cast<Eigen::Index>(r.standard.size()));

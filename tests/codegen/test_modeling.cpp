@@ -92,15 +92,25 @@ TEST_P(ModelFromPar, MatchesOpenSymoro) {
     for (int j = 1; j <= ref.n; ++j) {
       const double m = 0.5 + 2 * std::abs(u(rng));
       const double c[3] = {0.1 * u(rng), 0.1 * u(rng), 0.1 * u(rng)};
-      const double I[3] = {0.01 + 0.02 * std::abs(u(rng)), 0.01 + 0.02 * std::abs(u(rng)), 0.01 + 0.02 * std::abs(u(rng))};
+      const double I[3] = {0.01 + 0.02 * std::abs(u(rng)), 0.01 + 0.02 * std::abs(u(rng)),
+                           0.01 + 0.02 * std::abs(u(rng))};
       const double cc = c[0] * c[0] + c[1] * c[1] + c[2] * c[2];
       const double J[3][3] = {{I[0] + m * (cc - c[0] * c[0]), -m * c[0] * c[1], -m * c[0] * c[2]},
                               {-m * c[0] * c[1], I[1] + m * (cc - c[1] * c[1]), -m * c[1] * c[2]},
                               {-m * c[0] * c[2], -m * c[1] * c[2], I[2] + m * (cc - c[2] * c[2])}};
-      const std::map<std::string, double> value = {
-          {"XX", J[0][0]}, {"XY", J[0][1]}, {"XZ", J[0][2]}, {"YY", J[1][1]}, {"YZ", J[1][2]},
-          {"ZZ", J[2][2]}, {"MX", m * c[0]}, {"MY", m * c[1]}, {"MZ", m * c[2]}, {"M", m},
-          {"IA", 0.05 * std::abs(u(rng))}, {"FV", 0.1 * std::abs(u(rng))}, {"FS", 0.1 * std::abs(u(rng))}};
+      const std::map<std::string, double> value = {{"XX", J[0][0]},
+                                                   {"XY", J[0][1]},
+                                                   {"XZ", J[0][2]},
+                                                   {"YY", J[1][1]},
+                                                   {"YZ", J[1][2]},
+                                                   {"ZZ", J[2][2]},
+                                                   {"MX", m * c[0]},
+                                                   {"MY", m * c[1]},
+                                                   {"MZ", m * c[2]},
+                                                   {"M", m},
+                                                   {"IA", 0.05 * std::abs(u(rng))},
+                                                   {"FV", 0.1 * std::abs(u(rng))},
+                                                   {"FS", 0.1 * std::abs(u(rng))}};
       for (const auto& p : ref.standard)
         if (p.joint == j) standard[p.name] = value.at(p.family);
     }
@@ -120,7 +130,8 @@ TEST_P(ModelFromPar, MatchesOpenSymoro) {
     const std::size_t n = ref.n, nb = ref.base.size();
     std::size_t at_part = 0;
     auto part = [&](const char* what, std::size_t size, double tol) {
-      const std::vector<double> x(a.begin() + at_part, a.begin() + at_part + size), y(b.begin() + at_part, b.begin() + at_part + size);
+      const std::vector<double> x(a.begin() + at_part, a.begin() + at_part + size),
+          y(b.begin() + at_part, b.begin() + at_part + size);
       EXPECT_LT(relative_difference(x, y), tol) << robot << " " << what << ", trial " << trial;
       at_part += size;
     };

@@ -107,10 +107,12 @@ TEST_F(BrokenRobot, BadJointLimitsPointAtTheYamlLine) {
 // A misspelt key is refused at its line with the key it resembles, not ignored, on two robots.
 TEST_F(BrokenRobot, MisspeltKeyNamesItsLineAndTheNearestKey) {
   replace("robot.yaml", "{name: elbow,    lower: -150 deg", "{name: elbow,    lowr: -150 deg");
-  expect_error(R"(robot\.yaml:10:\d+: error: unknown key 'lowr' in a joint; did you mean 'lower'\? \(known keys: name, lower, )");
+  expect_error(
+      R"(robot\.yaml:10:\d+: error: unknown key 'lowr' in a joint; did you mean 'lower'\? \(known keys: name, lower, )");
   start_from("rx90");
   replace("robot.yaml", "parameter_units:", "parameter_unts:");
-  expect_error(R"(robot\.yaml:17:1: error: unknown key 'parameter_unts' in robot\.yaml; did you mean 'parameter_units'\?)");
+  expect_error(
+      R"(robot\.yaml:17:1: error: unknown key 'parameter_unts' in robot\.yaml; did you mean 'parameter_units'\?)");
   start_from("rx90");
   replace("robot.yaml", "    fixed: {\"FS*\": 0}", "    fixde: {\"FS*\": 0}");
   expect_error(R"(robot\.yaml:26:5: error: unknown key 'fixde' in variant rigid; did you mean 'fixed'\?)");
@@ -119,7 +121,8 @@ TEST_F(BrokenRobot, MisspeltKeyNamesItsLineAndTheNearestKey) {
   expect_error(R"(robot\.yaml:19:24: error: unknown parameter family 'YM'; did you mean 'MY'\?)");
   start_from("planar2r");
   replace("robot.yaml", "      stribeck:", "      stribek:");
-  expect_error(R"(robot\.yaml:\d+:7: error: variant effects: unknown effect 'stribek'; did you mean 'stribeck'\? \(known effects: )");
+  expect_error(
+      R"(robot\.yaml:\d+:7: error: variant effects: unknown effect 'stribek'; did you mean 'stribeck'\? \(known effects: )");
 }
 
 // yaml-cpp reads a quoted value without its closing quote as text to the end of the file (here
@@ -231,9 +234,9 @@ TEST_F(BrokenRobot, BaseVariantChainsFixedPatternsAndEffects) {
     const ModelSummary& m = gen.models[k];
     SCOPED_TRACE(m.name);
     EXPECT_EQ(names_of(m.identified),
-              (std::vector<std::string>{"ZZR1", "MXR1", "MY1", "ZZ2", "MX2", "MY2", "IA2", "FV1", "FS1", "OFF1", "OFF2",
-                                        "FST1", "FST2", "FVA2", "HS1_1", "HC1_1", "HS1_2", "HC1_2", "HS2_3", "HC2_3",
-                                        "FC2"}));
+              (std::vector<std::string>{"ZZR1",  "MXR1",  "MY1",   "ZZ2",   "MX2",   "MY2",   "IA2",
+                                        "FV1",   "FS1",   "OFF1",  "OFF2",  "FST1",  "FST2",  "FVA2",
+                                        "HS1_1", "HC1_1", "HS1_2", "HC1_2", "HS2_3", "HC2_3", "FC2"}));
     EXPECT_EQ(m.fixed, (std::vector<std::pair<std::string, double>>{{"FV2", 0.0}, {"FS2", 0.0}}));
     EXPECT_EQ(m.effects[2].second, "sign(QP1)*exp(-(QP1/0.05)^2)");  // the default Stribeck velocity
   }
@@ -263,7 +266,8 @@ TEST_F(BrokenRobot, UnknownEffect) {
 
 TEST_F(BrokenRobot, EffectJointOutOfRange) {
   add_variants("  bad:\n    effects:\n      offset: [1, 3]\n");
-  expect_error(R"(robot\.yaml:31:19: error: variant bad, effect offset: joint 3 is out of range \(the robot has 2 joints\))");
+  expect_error(
+      R"(robot\.yaml:31:19: error: variant bad, effect offset: joint 3 is out of range \(the robot has 2 joints\))");
 }
 
 TEST_F(BrokenRobot, EffectJointMustBeAWholeNumberFromOne) {
@@ -290,12 +294,15 @@ TEST_F(BrokenRobot, StribeckVelocityMustBePositive) {
 
 TEST_F(BrokenRobot, SmoothCoulombVelocityMustBePositive) {
   add_variants("  bad:\n    effects:\n      smooth_coulomb: {joints: [1], velocity: -0.1}\n");
-  expect_error(R"(robot\.yaml:31:47: error: variant bad, effect smooth_coulomb: the velocity scale of tanh\(qd/v\) must be positive)");
+  expect_error(
+      R"(robot\.yaml:31:47: error: variant bad, effect smooth_coulomb: the velocity scale of tanh\(qd/v\) must be positive)");
 }
 
 TEST_F(BrokenRobot, SmoothCoulombTakesAVelocityPerJoint) {
   // dynid diagnose selects a tanh width per joint: a variant keeps each.
-  add_variants("  widths:\n    fixed: {\"FS*\": 0}\n    effects:\n      smooth_coulomb: {joints: [2, 1], velocity: [0.05, 0.02]}\n");
+  add_variants(
+      "  widths:\n    fixed: {\"FS*\": 0}\n    effects:\n      smooth_coulomb: {joints: [2, 1], velocity: [0.05, "
+      "0.02]}\n");
   RobotModel r = load_robot(dir_.string());
   const Generation gen = generate_robot(r);
   ASSERT_EQ(gen.models.size(), 3u);
@@ -307,7 +314,8 @@ TEST_F(BrokenRobot, SmoothCoulombTakesAVelocityPerJoint) {
 
 TEST_F(BrokenRobot, SmoothCoulombVelocitiesOnePerJoint) {
   add_variants("  bad:\n    effects:\n      smooth_coulomb: {joints: [1, 2], velocity: [0.05]}\n");
-  expect_error(R"(robot\.yaml:31:50: error: variant bad, effect smooth_coulomb: a list of velocities needs one per joint \(1 for 2 joints\))");
+  expect_error(
+      R"(robot\.yaml:31:50: error: variant bad, effect smooth_coulomb: a list of velocities needs one per joint \(1 for 2 joints\))");
 }
 
 TEST_F(BrokenRobot, OneCoulombTermPerJoint) {
@@ -317,7 +325,8 @@ TEST_F(BrokenRobot, OneCoulombTermPerJoint) {
 
 TEST_F(BrokenRobot, HarmonicOrderMustBeAtLeastOne) {
   add_variants("  bad:\n    effects:\n      position_harmonics: {joints: [1], orders: [1, 0]}\n");
-  expect_error(R"(robot\.yaml:31:53: error: variant bad, effect position_harmonics: order 0 is out of range \(at least 1\))");
+  expect_error(
+      R"(robot\.yaml:31:53: error: variant bad, effect position_harmonics: order 0 is out of range \(at least 1\))");
 }
 
 TEST_F(BrokenRobot, HarmonicsNeedOrders) {
@@ -355,7 +364,8 @@ TEST_F(BrokenRobot, VariantIsItsOwnBase) {
 
 TEST_F(BrokenRobot, EffectAlreadyInTheBaseVariant) {
   add_variants("  more:\n    base: effects\n    effects:\n      offset: [2]\n");
-  expect_error(R"(robot\.yaml:32:16: error: variant more: effect offset on joint 2 is already in its base variant 'effects')");
+  expect_error(
+      R"(robot\.yaml:32:16: error: variant more: effect offset on joint 2 is already in its base variant 'effects')");
 }
 
 TEST_F(BrokenRobot, EffectsMustBeAMap) {

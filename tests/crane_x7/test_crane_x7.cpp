@@ -17,8 +17,8 @@
 namespace symoro::test {
 namespace {
 
-using Reduced = symoro::crane_x7::reduced::Model;        // variant of the full robot
-using ReducedFiles = symoro::crane_x7_reduced::Model;    // generated from OpenSYMORO's reduced files
+using Reduced = symoro::crane_x7::reduced::Model;      // variant of the full robot
+using ReducedFiles = symoro::crane_x7_reduced::Model;  // generated from OpenSYMORO's reduced files
 
 // Same tolerance and reasoning as tests/robot: different evaluation orders of the same model.
 constexpr double kRelTol = 1e-9;
@@ -74,10 +74,9 @@ TEST_F(CraneX7, ParameterCounts) {
 
 TEST_F(CraneX7, ReducedParametersAreThePapersInOrder) {
   const std::vector<std::string> paper = {
-      "ZZR1", "XXR2", "ZZR2", "MX2", "MYR2", "XXR3", "ZZR3", "MX3", "MYR3", "XXR4",
-      "ZZR4", "MX4",  "MYR4", "XXR5", "ZZR5", "MX5", "MYR5", "XXR6", "ZZR6", "MX6",
-      "MYR6", "XXR7", "ZZ7",  "MX7", "MY7",  "IA3", "IA4",  "IA5",  "IA6",  "IA7",
-      "IA8",  "FV1",  "FV2",  "FV3", "FV4",  "FV5", "FV6",  "FV7",  "FV8"};
+      "ZZR1", "XXR2", "ZZR2", "MX2",  "MYR2", "XXR3", "ZZR3", "MX3",  "MYR3", "XXR4", "ZZR4", "MX4", "MYR4",
+      "XXR5", "ZZR5", "MX5",  "MYR5", "XXR6", "ZZR6", "MX6",  "MYR6", "XXR7", "ZZ7",  "MX7",  "MY7", "IA3",
+      "IA4",  "IA5",  "IA6",  "IA7",  "IA8",  "FV1",  "FV2",  "FV3",  "FV4",  "FV5",  "FV6",  "FV7", "FV8"};
   EXPECT_EQ(parameter_names<Reduced>(), paper);
   EXPECT_EQ(parameter_names<ReducedFiles>(), paper);
 }
@@ -98,10 +97,9 @@ TEST_F(CraneX7, ReducedDynamicsAreOpenSymorosReducedModels) {
     EXPECT_TRUE(close(Reduced::inverse_dynamics(s.q, s.qd, s.qdd, phi),
                       reduced_files().inverse_dynamics(s.q, s.qd, s.qdd, values), kRelTol))
         << "idm.txt";
-    EXPECT_TRUE(close(Reduced::inertia(s.q, phi), reduced_files().inertia(s.q, values), kRelTol))
-        << "inm.txt";
-    EXPECT_TRUE(close(Reduced::nonlinear_effects(s.q, s.qd, phi),
-                      reduced_files().nonlinear_effects(s.q, s.qd, values), kRelTol))
+    EXPECT_TRUE(close(Reduced::inertia(s.q, phi), reduced_files().inertia(s.q, values), kRelTol)) << "inm.txt";
+    EXPECT_TRUE(close(Reduced::nonlinear_effects(s.q, s.qd, phi), reduced_files().nonlinear_effects(s.q, s.qd, values),
+                      kRelTol))
         << "ccg.txt";
     EXPECT_TRUE(close(Reduced::forward_dynamics(s.q, s.qd, tau, phi),
                       reduced_files().forward_dynamics(s.q, s.qd, tau, values), kRelTol))
@@ -116,16 +114,15 @@ TEST_F(CraneX7, ReducedVariantEqualsTheModelOfTheReducedFiles) {
     const ParameterVector<ReducedFiles> other = by_name<ReducedFiles, Reduced>(phi);
     const JointVector<Reduced> tau = random_torque();
     // The files' columns in the variant's order.
-    const Eigen::Matrix<double, ReducedFiles::nq, ReducedFiles::np> W =
-        ReducedFiles::regressor(s.q, s.qd, s.qdd);
+    const Eigen::Matrix<double, ReducedFiles::nq, ReducedFiles::np> W = ReducedFiles::regressor(s.q, s.qd, s.qdd);
     Eigen::Matrix<double, Reduced::nq, Reduced::np> W_by_name;
     for (int i = 0; i < Reduced::np; ++i) W_by_name.col(i) = W.col(index_of<ReducedFiles>(names[i]));
     EXPECT_TRUE(close(Reduced::regressor(s.q, s.qd, s.qdd), W_by_name, kRelTol, names));
     EXPECT_TRUE(close(Reduced::inverse_dynamics(s.q, s.qd, s.qdd, phi),
                       ReducedFiles::inverse_dynamics(s.q, s.qd, s.qdd, other), kRelTol));
     EXPECT_TRUE(close(Reduced::inertia(s.q, phi), ReducedFiles::inertia(s.q, other), kRelTol));
-    EXPECT_TRUE(close(Reduced::nonlinear_effects(s.q, s.qd, phi),
-                      ReducedFiles::nonlinear_effects(s.q, s.qd, other), kRelTol));
+    EXPECT_TRUE(
+        close(Reduced::nonlinear_effects(s.q, s.qd, phi), ReducedFiles::nonlinear_effects(s.q, s.qd, other), kRelTol));
     EXPECT_TRUE(close(Reduced::forward_dynamics(s.q, s.qd, tau, phi),
                       ReducedFiles::forward_dynamics(s.q, s.qd, tau, other), kRelTol));
     EXPECT_TRUE(close(Reduced::forward_kinematics(s.q), ReducedFiles::forward_kinematics(s.q), kRelTol));
@@ -146,8 +143,8 @@ TEST_F(CraneX7, ReducedIsTheFullModelWithoutProductsAndCoulombFriction) {
   }
   for_states([&](const State<Reduced>& s, const ParameterVector<Reduced>& phi) {
     const Eigen::Matrix<double, Full::np, 1> full = Reduced::to_parent(phi);
-    EXPECT_TRUE(close(Reduced::inverse_dynamics(s.q, s.qd, s.qdd, phi),
-                      Full::inverse_dynamics(s.q, s.qd, s.qdd, full), kRelTol));
+    EXPECT_TRUE(close(Reduced::inverse_dynamics(s.q, s.qd, s.qdd, phi), Full::inverse_dynamics(s.q, s.qd, s.qdd, full),
+                      kRelTol));
   });
 }
 

@@ -39,10 +39,10 @@ V2 effect_torque_by_hand(const V2& q, const V2& qd, const ParameterVector<Effect
   using namespace fx::param;
   const double v = kStribeckVelocity;
   V2 tau;
-  tau(0) = phi(OFF1) + phi(HS1_1) * std::sin(q(0)) + phi(HC1_1) * std::cos(q(0)) +
-           phi(HS1_2) * std::sin(2 * q(0)) + phi(HC1_2) * std::cos(2 * q(0));
-  tau(1) = phi(OFF2) + phi(FST2) * sgn(qd(1)) * std::exp(-std::pow(qd(1) / v, 2)) +
-           phi(FVA2) * std::fabs(qd(1)) + phi(FC2) * std::tanh(qd(1) / kCoulombVelocity);
+  tau(0) = phi(OFF1) + phi(HS1_1) * std::sin(q(0)) + phi(HC1_1) * std::cos(q(0)) + phi(HS1_2) * std::sin(2 * q(0)) +
+           phi(HC1_2) * std::cos(2 * q(0));
+  tau(1) = phi(OFF2) + phi(FST2) * sgn(qd(1)) * std::exp(-std::pow(qd(1) / v, 2)) + phi(FVA2) * std::fabs(qd(1)) +
+           phi(FC2) * std::tanh(qd(1) / kCoulombVelocity);
   return tau;
 }
 
@@ -64,8 +64,9 @@ class PlanarEffects : public ::testing::Test {
 
 TEST_F(PlanarEffects, ParametersAreAppendedInCanonicalOrderWithUnits) {
   static_assert(Effects::np == 19 && Effects::ne == 9 && Effects::ns == Full::ns + 9);
-  const std::array<const char*, 19> names = {"ZZR1", "MXR1", "MY1",  "ZZ2",  "MX2",   "MY2",   "IA2",   "FV1",   "FV2",   "FS1",
-                                             "OFF1", "OFF2", "FST2", "FVA2", "HS1_1", "HC1_1", "HS1_2", "HC1_2", "FC2"};
+  const std::array<const char*, 19> names = {"ZZR1",  "MXR1",  "MY1",   "ZZ2",   "MX2",  "MY2",  "IA2",
+                                             "FV1",   "FV2",   "FS1",   "OFF1",  "OFF2", "FST2", "FVA2",
+                                             "HS1_1", "HC1_1", "HS1_2", "HC1_2", "FC2"};
   const std::array<const char*, 9> units = {"N*m", "N*m", "N*m", "N*m*s/rad", "N*m", "N*m", "N*m", "N*m", "N*m"};
   const std::array<int, 9> joints = {1, 2, 2, 2, 1, 1, 1, 1, 2};
   for (int i = 0; i < Effects::np; ++i) EXPECT_EQ(std::string(Effects::parameters[i].name), names[i]) << i;
@@ -120,7 +121,8 @@ TEST_F(PlanarEffects, FunctionsAgreeAndAddTheTermsToTheFullModel) {
     const State<Effects> s = state(k);
     const ParameterVector<Effects> phi = this->phi();
     const V2 tau = Effects::inverse_dynamics(s.q, s.qd, s.qdd, phi);
-    EXPECT_TRUE(close(Effects::regressor(s.q, s.qd, s.qdd) * phi + Effects::fixed_torque(s.q, s.qd, s.qdd), tau, kRelTol));
+    EXPECT_TRUE(
+        close(Effects::regressor(s.q, s.qd, s.qdd) * phi + Effects::fixed_torque(s.q, s.qd, s.qdd), tau, kRelTol));
     EXPECT_TRUE(Effects::fixed_torque(s.q, s.qd, s.qdd).isZero(0.0));
     const V2 by_hand = effect_torque_by_hand(s.q, s.qd, phi);
     const auto full_phi = Effects::to_parent(phi);

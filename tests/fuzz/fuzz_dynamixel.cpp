@@ -55,10 +55,8 @@ void check_packet(const DecodeEvent& e, std::size_t max_length, Bytes& out) {
 
   check(same(encode(p, out), e.raw));
 
-  if (const auto r = parse_read(p))
-    check(same(encode_read(p.id, r->address, r->length, out), e.raw));
-  if (const auto w = parse_write(p))
-    check(same(encode_write(p.id, w->address, w->data, out), e.raw));
+  if (const auto r = parse_read(p)) check(same(encode_read(p.id, r->address, r->length, out), e.raw));
+  if (const auto w = parse_write(p)) check(same(encode_write(p.id, w->address, w->data, out), e.raw));
   if (const auto s = parse_sync_read(p); s && p.id == kBroadcastId && valid_ids(s->ids))
     check(same(encode_sync_read(s->address, s->length, s->ids, out), e.raw));
   if (const auto s = parse_sync_write(p); s && p.id == kBroadcastId) {
@@ -69,8 +67,7 @@ void check_packet(const DecodeEvent& e, std::size_t max_length, Bytes& out) {
       check(d.size() == s->length);
       data.insert(data.end(), d.begin(), d.end());
     }
-    if (valid_ids(ids))
-      check(same(encode_sync_write(s->address, s->length, ids, data, out), e.raw));
+    if (valid_ids(ids)) check(same(encode_sync_write(s->address, s->length, ids, data, out), e.raw));
   }
   if (const auto b = parse_bulk_read(p); b && p.id == kBroadcastId) {
     std::vector<BulkReadItem> items;
@@ -89,8 +86,7 @@ void check_packet(const DecodeEvent& e, std::size_t max_length, Bytes& out) {
 
 // Decodes the input in chunks of `chunk(i)` bytes; checks each packet; returns the events.
 template <class Chunk>
-std::vector<Event> run(const std::uint8_t* data, std::size_t size, std::size_t max_length,
-                       Chunk chunk) {
+std::vector<Event> run(const std::uint8_t* data, std::size_t size, std::size_t max_length, Chunk chunk) {
   Decoder dec(max_length);
   Bytes out;
   std::vector<Event> events;
@@ -121,9 +117,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   for (std::size_t max_length : {Decoder::kDefaultMaxLength, std::size_t{24}}) {
     const auto whole = run(data, size, max_length, [&](std::size_t) { return size; });
     const auto bytewise = run(data, size, max_length, [](std::size_t) { return std::size_t{1}; });
-    const auto varying = run(data, size, max_length, [&](std::size_t i) {
-      return std::size_t{1} + (data[i] * 7u + i) % 23;
-    });
+    const auto varying =
+        run(data, size, max_length, [&](std::size_t i) { return std::size_t{1} + (data[i] * 7u + i) % 23; });
     check(whole == bytewise);
     check(whole == varying);
   }

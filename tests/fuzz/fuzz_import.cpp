@@ -22,10 +22,18 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   const std::string_view text(reinterpret_cast<const char*>(data + 1), size - 1);
   io::ImportMapping m;
   switch (pick & 3) {
-    case 0: m.time = "1", m.q = "2-3", m.tau = "4,5"; break;
-    case 1: m.time = "t", m.q = "pos_*", m.qd = "vel_%", m.tau = "eff_*"; break;
-    case 2: m.time = "1", m.q = "2,3", m.tau = "4-5", m.q_ref = "6-7", m.qd_ref = "8-9", m.qdd_ref = "10-11"; break;
-    default: m.time = "time", m.q = "{name}_pos", m.tau = "e1,e2"; break;
+    case 0:
+      m.time = "1", m.q = "2-3", m.tau = "4,5";
+      break;
+    case 1:
+      m.time = "t", m.q = "pos_*", m.qd = "vel_%", m.tau = "eff_*";
+      break;
+    case 2:
+      m.time = "1", m.q = "2,3", m.tau = "4-5", m.q_ref = "6-7", m.qd_ref = "8-9", m.qdd_ref = "10-11";
+      break;
+    default:
+      m.time = "time", m.q = "{name}_pos", m.tau = "e1,e2";
+      break;
   }
   m.time_unit = static_cast<io::TimeUnit>((pick >> 2) & 3);
   m.angle_unit = (pick >> 4) & 1 ? io::AngleUnit::deg : io::AngleUnit::rad;

@@ -65,8 +65,7 @@ double value(const std::string& text, const Bindings& symbols = {}) {
 }
 
 // Runs `parse` and checks that it throws a ParseError at `line`:`column` with `message`.
-void expect_error(const std::function<void()>& parse, int line, int column,
-                  const std::string& message) {
+void expect_error(const std::function<void()>& parse, int line, int column, const std::string& message) {
   try {
     parse();
     ADD_FAILURE() << "no error; expected " << line << ":" << column << ": " << message;
@@ -191,8 +190,7 @@ TEST(RealFiles, EveryParFileParses) {
 
 TEST(Planar2r, DimStructure) {
   const ModelFile dim = read_model_file((kRobots / "planar2r" / "dim.txt").string());
-  EXPECT_EQ(dim.title,
-            std::vector<std::string>{"Dynamic Identification Model (Newton-Euler method)"});
+  EXPECT_EQ(dim.title, std::vector<std::string>{"Dynamic Identification Model (Newton-Euler method)"});
   ASSERT_EQ(dim.tables.size(), 4u);
   EXPECT_EQ(dim.tables[0].title, "Geometric parameters");
   EXPECT_EQ(dim.tables[1].title, "Dynamic inertia parameters");
@@ -236,17 +234,17 @@ TEST(Planar2r, DimStructure) {
 }
 
 TEST(Planar2r, EquationCounts) {
-  const std::vector<std::pair<std::string, std::size_t>> counts = {
-      {"ccg.txt", 28}, {"ddm.txt", 130}, {"dim.txt", 132}, {"fgm.txt", 16},
-      {"idm.txt", 32}, {"inm.txt", 16},  {"jac.txt", 21},  {"regp.txt", 14}};
+  const std::vector<std::pair<std::string, std::size_t>> counts = {{"ccg.txt", 28}, {"ddm.txt", 130}, {"dim.txt", 132},
+                                                                   {"fgm.txt", 16}, {"idm.txt", 32},  {"inm.txt", 16},
+                                                                   {"jac.txt", 21}, {"regp.txt", 14}};
   for (const auto& [name, n] : counts)
     EXPECT_EQ(read_model_file((kRobots / "planar2r" / name).string()).equations.size(), n) << name;
 }
 
 TEST(Planar2r, JacobianAndGeometry) {
   const ModelFile jac = read_model_file((kRobots / "planar2r" / "jac.txt").string());
-  EXPECT_EQ(jac.title, (std::vector<std::string>{"Jacobian matrix for frame 2",
-                                                 "Projection frame 0, intermediate frame 2"}));
+  EXPECT_EQ(jac.title,
+            (std::vector<std::string>{"Jacobian matrix for frame 2", "Projection frame 0, intermediate frame 2"}));
   EXPECT_EQ(jac.tables.size(), 1u);
   const double th1 = 0.3, th2 = -1.1, L1 = 0.7;
   auto v = run_equations(jac.equations, {{"th1", th1}, {"th2", th2}, {"L1", L1}});
@@ -265,10 +263,9 @@ TEST(Planar2r, JacobianAndGeometry) {
 }
 
 Bindings planar2r_point() {
-  return {{"th1", 0.4},  {"th2", -0.9}, {"QP1", 1.3},  {"QP2", -0.6}, {"QDP1", 0.5},
-          {"QDP2", 2.0}, {"L1", 0.8},   {"G3", 9.81},  {"ZZR1", 1.7}, {"ZZ2", 0.35},
-          {"MXR1", 2.1}, {"MY1", -0.2}, {"MX2", 0.45}, {"MY2", 0.07}, {"IA2", 0.02},
-          {"FS1", 0.3},  {"FS2", 0.25}, {"FV1", 0.11}, {"FV2", 0.09}};
+  return {{"th1", 0.4},  {"th2", -0.9}, {"QP1", 1.3},  {"QP2", -0.6}, {"QDP1", 0.5}, {"QDP2", 2.0}, {"L1", 0.8},
+          {"G3", 9.81},  {"ZZR1", 1.7}, {"ZZ2", 0.35}, {"MXR1", 2.1}, {"MY1", -0.2}, {"MX2", 0.45}, {"MY2", 0.07},
+          {"IA2", 0.02}, {"FS1", 0.3},  {"FS2", 0.25}, {"FV1", 0.11}, {"FV2", 0.09}};
 }
 
 TEST(Planar2r, InertiaMatrixByHand) {
@@ -298,9 +295,7 @@ TEST(Planar2r, GravityTorquesByHand) {
 
 TEST(Planar2r, InverseDynamicsIsInertiaTimesAccelerationPlusCcg) {
   Bindings in = planar2r_point();
-  const auto model = [](const char* name) {
-    return read_model_file((kRobots / "planar2r" / name).string());
-  };
+  const auto model = [](const char* name) { return read_model_file((kRobots / "planar2r" / name).string()); };
   const auto idm = run_equations(model("idm.txt").equations, in);
   const auto inm = run_equations(model("inm.txt").equations, in);
   const auto ccg = run_equations(model("ccg.txt").equations, in);
@@ -318,9 +313,8 @@ TEST(Planar2r, GroupedParameters) {
   EXPECT_EQ(regp.grouped_tables[0].at.line, 43);
   EXPECT_EQ(regp.grouped_tables[1].rows[0].cells[6].name, "ZZR1");
 
-  const Bindings in = {{"th1", 0.1}, {"th2", 0.2},  {"L1", 0.8},  {"M1", 3.0}, {"M2", 1.5},
-                       {"MX1", 0.4}, {"IA1", 0.01}, {"ZZ1", 0.2}, {"XX1", 0},  {"XX2", 0},
-                       {"YY1", 0.6}, {"YY2", 0.3},  {"MZ1", 0},   {"MZ2", 0}};
+  const Bindings in = {{"th1", 0.1}, {"th2", 0.2}, {"L1", 0.8}, {"M1", 3.0},  {"M2", 1.5},  {"MX1", 0.4}, {"IA1", 0.01},
+                       {"ZZ1", 0.2}, {"XX1", 0},   {"XX2", 0},  {"YY1", 0.6}, {"YY2", 0.3}, {"MZ1", 0},   {"MZ2", 0}};
   const auto v = run_equations(regp.equations, in);
   EXPECT_DOUBLE_EQ(v.at("ZZR1"), 0.01 + 0.64 * 1.5 + 0.2);
   EXPECT_DOUBLE_EQ(v.at("MXR1"), 0.8 * 1.5 + 0.4);
@@ -435,18 +429,15 @@ TEST(Expressions, Positions) {
 TEST(Expressions, NestingLimit) {
   const auto nested = [](int n) { return std::string(n, '(') + "x" + std::string(n, ')'); };
   EXPECT_EQ(parse_expression(nested(kMaxExpressionDepth), "t").kind, Kind::Symbol);
-  expect_expr_error(nested(kMaxExpressionDepth + 1), 1, kMaxExpressionDepth + 1,
-                    "nesting deeper than 256 levels");
+  expect_expr_error(nested(kMaxExpressionDepth + 1), 1, kMaxExpressionDepth + 1, "nesting deeper than 256 levels");
 
   EXPECT_EQ(value(std::string(kMaxExpressionDepth, '-') + "3"), 3);
-  expect_expr_error(std::string(kMaxExpressionDepth + 1, '-') + "3", 1, 257,
-                    "nesting deeper than 256 levels");
+  expect_expr_error(std::string(kMaxExpressionDepth + 1, '-') + "3", 1, 257, "nesting deeper than 256 levels");
 
   std::string power;
   for (int i = 0; i < kMaxExpressionDepth; ++i) power += "1**";
   EXPECT_EQ(value(power + "1"), 1);
-  expect_expr_error(power + "1**1", 1, 3 * kMaxExpressionDepth + 2,
-                    "nesting deeper than 256 levels");
+  expect_expr_error(power + "1**1", 1, 3 * kMaxExpressionDepth + 2, "nesting deeper than 256 levels");
 }
 
 TEST(Expressions, HugeInputsFailFast) {
@@ -466,10 +457,8 @@ TEST(Expressions, HugeInputsFailFast) {
   expect_expr_error(std::string(1000000, '9'), 1, 1, "number out of range");
   EXPECT_EQ(parse_expression(std::string(1000000, 'a'), "t").name.size(), 1000000u);
   // The same inside a model file and a .par file.
-  expect_model_error(model_with("A = " + std::string(100000, '(') + ";\n"), 8, 261,
-                     "nesting deeper than 256 levels");
-  expect_par_error("x = {" + std::string(100000, '-') + "}\n", 1, 262,
-                   "nesting deeper than 256 levels");
+  expect_model_error(model_with("A = " + std::string(100000, '(') + ";\n"), 8, 261, "nesting deeper than 256 levels");
+  expect_par_error("x = {" + std::string(100000, '-') + "}\n", 1, 262, "nesting deeper than 256 levels");
   const auto elapsed = std::chrono::steady_clock::now() - start;
   EXPECT_LT(std::chrono::duration_cast<std::chrono::milliseconds>(elapsed).count(), 2000);
 }
@@ -477,8 +466,7 @@ TEST(Expressions, HugeInputsFailFast) {
 // Input variations that must parse.
 
 TEST(Layout, CrlfTabsTrailingSpaceAndNoFinalNewline) {
-  const std::string text =
-      "Title\r\n\r\nT\r\n\tj\taxis2\t\r\n\t1\t-x \r\n\r\nEquations:  \r\n\tA =\tb ;  \r\n*=*";
+  const std::string text = "Title\r\n\r\nT\r\n\tj\taxis2\t\r\n\t1\t-x \r\n\r\nEquations:  \r\n\tA =\tb ;  \r\n*=*";
   const ModelFile file = parse_model_file(text, "crlf.txt");
   ASSERT_EQ(file.tables.size(), 1u);
   EXPECT_EQ(file.tables[0].title, "T");
@@ -527,11 +515,9 @@ TEST(Errors, Equations) {
   expect_model_error(model_with("A = b;\nB = c @ d;\n"), 9, 7, "unexpected character '@'");
   expect_model_error(model_with("A = (b + c;\n"), 8, 11, "expected ')'");
   expect_model_error(model_with("A = b + c);\n"), 8, 10, "expected ';' at the end of the equation");
-  expect_model_error(model_with("A = cos(b;\n"), 8, 10,
-                     "expected ')' after the function arguments");
+  expect_model_error(model_with("A = cos(b;\n"), 8, 10, "expected ')' after the function arguments");
   expect_model_error(model_with("A b;\n"), 8, 3, "expected '=' after the name");
-  expect_model_error(model_with("2A = b;\n"), 8, 1,
-                     "expected an equation 'NAME = expression;' or '*=*'");
+  expect_model_error(model_with("2A = b;\n"), 8, 1, "expected an equation 'NAME = expression;' or '*=*'");
   expect_model_error(model_with("A = b; c\n"), 8, 8, "expected the end of the line after ';'");
   expect_model_error(model_with("A = b*;\n"), 8, 7, "expected an expression after '*'");
   expect_model_error(model_with("A = 1e400;\n"), 8, 5, "number out of range");
@@ -543,8 +529,7 @@ TEST(Errors, Tables) {
                      "row has 9 cells but the header has 10 columns");
   expect_model_error(head + "1 2 3 4 5 6 7 8 9 10 11\n\nEquations:\n*=*\n", 5, 22,
                      "row has 11 cells but the header has 10 columns");
-  expect_model_error("T\nj a\n1 2)\n\nEquations:\n*=*\n", 3, 4,
-                     "expected a space between cells or the end of the row");
+  expect_model_error("T\nj a\n1 2)\n\nEquations:\n*=*\n", 3, 4, "expected a space between cells or the end of the row");
   expect_model_error("T\nj a\n1 -\n\nEquations:\n*=*\n", 3, 4, "expected an expression after '-'");
   expect_model_error("T\nj a 3b\n1 2\n\nEquations:\n*=*\n", 2, 5, "expected a column name");
   expect_model_error("T\nj a a\n\nEquations:\n*=*\n", 2, 5, "duplicate column 'a'");
@@ -559,10 +544,8 @@ TEST(Errors, FileStructure) {
   expect_model_error("Title\n\nT\nj a\n1 2\n", 5, 4, "missing 'Equations:' section");
   expect_model_error("Title\n\nEquations:\nA = b;\n\n", 4, 7, "missing '*=*' end marker");
   expect_model_error("Title\n*=*\n", 2, 1, "expected 'Equations:' before '*=*'");
-  expect_model_error("Title\n\nEquations:\nA = b;\n*=*\nGrouped\n\nT\nj a\n1 2\n", 10, 4,
-                     "missing '*=*' end marker");
-  expect_model_error("Title\n\nEquations:\n*=*\nG\nT\nj a\n*=*\nmore\n", 9, 1,
-                     "unexpected text after the final '*=*'");
+  expect_model_error("Title\n\nEquations:\nA = b;\n*=*\nGrouped\n\nT\nj a\n1 2\n", 10, 4, "missing '*=*' end marker");
+  expect_model_error("Title\n\nEquations:\n*=*\nG\nT\nj a\n*=*\nmore\n", 9, 1, "unexpected text after the final '*=*'");
   expect_model_error("Title\n\nEquations:\nA = b;\n*=*\nG\nH\n*=*\n", 7, 1,
                      "expected a table (a title line, then a header row starting with 'j' or "
                      "'axis') or '*=*'");
@@ -588,8 +571,7 @@ TEST(Errors, WhatShowsLineAndCaret) {
     FAIL() << "no error";
   } catch (const ParseError& e) {
     EXPECT_EQ(e.file(), "dir/idm.txt");
-    EXPECT_STREQ(e.what(),
-                 "dir/idm.txt:9:8: error: unexpected character '@'\n\tB = c @ d;\n\t      ^");
+    EXPECT_STREQ(e.what(), "dir/idm.txt:9:8: error: unexpected character '@'\n\tB = c @ d;\n\t      ^");
   }
   try {
     parse_expression("a +", "expr");

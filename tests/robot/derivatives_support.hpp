@@ -42,7 +42,9 @@ class RobotDerivatives : public ::testing::Test {
   // A random direction for the Jet references (jet_support.hpp), entries in [-1, 1], from a
   // generator of its own: the states and parameters stay those drawn from rng_.
   template <class Vector>
-  Vector random_direction() { return direction_rng_.vector<Vector>(Vector::RowsAtCompileTime, -1, 1); }
+  Vector random_direction() {
+    return direction_rng_.vector<Vector>(Vector::RowsAtCompileTime, -1, 1);
+  }
 
   Random rng_{20261124};
   Random direction_rng_{20261125};

@@ -12,8 +12,7 @@ namespace symoro::test {
 
 // x as Jets whose derivative part is the identity: x(i) carries d/dx_i.
 template <int N, class Derived>
-Eigen::Matrix<ceres::Jet<double, N>, Derived::RowsAtCompileTime, 1> seeded(
-    const Eigen::MatrixBase<Derived>& x) {
+Eigen::Matrix<ceres::Jet<double, N>, Derived::RowsAtCompileTime, 1> seeded(const Eigen::MatrixBase<Derived>& x) {
   static_assert(Derived::RowsAtCompileTime == N, "seed a vector of N entries");
   Eigen::Matrix<ceres::Jet<double, N>, N, 1> out;
   for (int i = 0; i < N; ++i) out(i) = ceres::Jet<double, N>(x(i), i);

@@ -33,8 +33,8 @@ inline double sign_of(double x) { return double((x > 0) - (x < 0)); }
 // robot description in frame 0; the base is given the acceleration -G.
 template <class Frames>
 Eigen::VectorXd newton_euler(const Frames& frames, const Eigen::Vector3d& gravity,
-                             const std::vector<LinkInertia>& links, const Eigen::VectorXd& q,
-                             const Eigen::VectorXd& qd, const Eigen::VectorXd& qdd) {
+                             const std::vector<LinkInertia>& links, const Eigen::VectorXd& q, const Eigen::VectorXd& qd,
+                             const Eigen::VectorXd& qdd) {
   const int n = static_cast<int>(frames.size());
   // Index 0 is the base frame; frame j (1-based) is frames[j - 1].
   std::vector<Eigen::Matrix3d> R(n + 1);  // ^{ant}R_j
@@ -49,8 +49,7 @@ Eigen::VectorXd newton_euler(const Frames& frames, const Eigen::Vector3d& gravit
     const FrameInfo& fr = frames[j - 1];
     const bool moves = fr.sigma != 2;
     if (moves) joint[j] = k++;
-    const double qj = moves ? q(joint[j]) : 0.0, qdj = moves ? qd(joint[j]) : 0.0,
-                 qddj = moves ? qdd(joint[j]) : 0.0;
+    const double qj = moves ? q(joint[j]) : 0.0, qdj = moves ? qd(joint[j]) : 0.0, qddj = moves ? qdd(joint[j]) : 0.0;
     const Eigen::Isometry3d T = frame_transform(fr, qj);
     R[j] = T.linear();
     P[j] = T.translation();
@@ -74,8 +73,7 @@ Eigen::VectorXd newton_euler(const Frames& frames, const Eigen::Vector3d& gravit
     if (joint[j] >= 0) {
       const int i = joint[j];
       const LinkInertia& L = links[j - 1];
-      tau(i) = (fr.sigma == 0 ? nm[j].dot(z) : f[j].dot(z)) + L.ia * qdd(i) + L.fv * qd(i) +
-               L.fs * sign_of(qd(i));
+      tau(i) = (fr.sigma == 0 ? nm[j].dot(z) : f[j].dot(z)) + L.ia * qdd(i) + L.fv * qd(i) + L.fs * sign_of(qd(i));
     }
     // Pass the link's wrench to its antecedent (frame 0 needs none).
     const int a = fr.ant;

@@ -21,8 +21,7 @@ using grammar::Expr;
 using grammar::ModelFile;
 using grammar::Table;
 
-const Table& find_table(const std::vector<Table>& tables, const std::string& title,
-                        const std::string& path) {
+const Table& find_table(const std::vector<Table>& tables, const std::string& title, const std::string& path) {
   for (const auto& t : tables)
     if (t.title.find(title) != std::string::npos) return t;
   throw std::runtime_error(path + ": no table '" + title + "'");
@@ -30,8 +29,7 @@ const Table& find_table(const std::vector<Table>& tables, const std::string& tit
 
 int column_index(const Table& table, const std::string& name) {
   const auto it = std::find(table.columns.begin(), table.columns.end(), name);
-  if (it == table.columns.end())
-    throw std::runtime_error("table '" + table.title + "' has no column '" + name + "'");
+  if (it == table.columns.end()) throw std::runtime_error("table '" + table.title + "' has no column '" + name + "'");
   return static_cast<int>(it - table.columns.begin());
 }
 
@@ -73,8 +71,7 @@ std::string joint_variable(const Expr& e, const Bindings& constants) {
   for (const auto& s : symbols)
     if (s != "pi" && !constants.count(s)) free.push_back(s);
   if (free.size() != 1)
-    throw std::runtime_error("a joint cell must hold exactly one variable (found " +
-                             std::to_string(free.size()) + ")");
+    throw std::runtime_error("a joint cell must hold exactly one variable (found " + std::to_string(free.size()) + ")");
   return free.front();
 }
 
@@ -105,8 +102,7 @@ Reference::Reference(const std::string& robot_dir) : dir_(robot_dir) {
     const int sigma = static_cast<int>(grammar::evaluate(cell(geometry_, row, "sigma"), {}));
     if (sigma == 2) continue;  // a fixed frame has no joint variable
     const int frame = static_cast<int>(grammar::evaluate(cell(geometry_, row, "j"), {}));
-    joints_.push_back(
-        {frame, joint_variable(cell(geometry_, row, sigma == 0 ? "theta" : "r"), constants_)});
+    joints_.push_back({frame, joint_variable(cell(geometry_, row, sigma == 0 ? "theta" : "r"), constants_)});
   }
 
   const Table& inertia = find_table(dim_.tables, "Dynamic inertia parameters", dim_.path);
@@ -131,9 +127,8 @@ std::vector<std::string> Reference::regressor_columns() const {
   return {columns.begin(), columns.end()};
 }
 
-Bindings Reference::inputs(const Eigen::VectorXd* q, const Eigen::VectorXd* qd,
-                           const Eigen::VectorXd* qdd, const Eigen::VectorXd* tau,
-                           const ParameterValues* phi) const {
+Bindings Reference::inputs(const Eigen::VectorXd* q, const Eigen::VectorXd* qd, const Eigen::VectorXd* qdd,
+                           const Eigen::VectorXd* tau, const ParameterValues* phi) const {
   Bindings b = constants_;
   for (int k = 0; k < nq(); ++k) {
     const std::string j = std::to_string(joints_[k].frame);
@@ -153,8 +148,7 @@ Bindings Reference::inputs(const Eigen::VectorXd* q, const Eigen::VectorXd* qd,
   return b;
 }
 
-Eigen::MatrixXd Reference::regressor(const Eigen::VectorXd& q, const Eigen::VectorXd& qd,
-                                     const Eigen::VectorXd& qdd,
+Eigen::MatrixXd Reference::regressor(const Eigen::VectorXd& q, const Eigen::VectorXd& qd, const Eigen::VectorXd& qdd,
                                      const std::vector<std::string>& columns) const {
   const Bindings v = grammar::run_equations(dim_.equations, inputs(&q, &qd, &qdd, nullptr, nullptr));
   Eigen::MatrixXd W(nq(), columns.size());
@@ -165,8 +159,7 @@ Eigen::MatrixXd Reference::regressor(const Eigen::VectorXd& q, const Eigen::Vect
 }
 
 namespace {
-Eigen::VectorXd joint_outputs(const Bindings& v, const std::vector<JointSymbol>& joints,
-                              const std::string& prefix) {
+Eigen::VectorXd joint_outputs(const Bindings& v, const std::vector<JointSymbol>& joints, const std::string& prefix) {
   Eigen::VectorXd out(joints.size());
   for (std::size_t k = 0; k < joints.size(); ++k) {
     const std::string name = prefix + std::to_string(joints[k].frame);
@@ -178,38 +171,30 @@ Eigen::VectorXd joint_outputs(const Bindings& v, const std::vector<JointSymbol>&
 }  // namespace
 
 Eigen::VectorXd Reference::inverse_dynamics(const Eigen::VectorXd& q, const Eigen::VectorXd& qd,
-                                            const Eigen::VectorXd& qdd,
-                                            const ParameterValues& phi) const {
-  return joint_outputs(grammar::run_equations(idm_.equations, inputs(&q, &qd, &qdd, nullptr, &phi)),
-                       joints_, "GAM");
+                                            const Eigen::VectorXd& qdd, const ParameterValues& phi) const {
+  return joint_outputs(grammar::run_equations(idm_.equations, inputs(&q, &qd, &qdd, nullptr, &phi)), joints_, "GAM");
 }
 
 Eigen::MatrixXd Reference::inertia(const Eigen::VectorXd& q, const ParameterValues& phi) const {
-  const Bindings v =
-      grammar::run_equations(inm_.equations, inputs(&q, nullptr, nullptr, nullptr, &phi));
+  const Bindings v = grammar::run_equations(inm_.equations, inputs(&q, nullptr, nullptr, nullptr, &phi));
   Eigen::MatrixXd M(nq(), nq());
   for (int i = 0; i < nq(); ++i)
-    for (int j = 0; j <= i; ++j)
-      M(i, j) = M(j, i) = get(v, index_name("A", joints_[i].frame, joints_[j].frame));
+    for (int j = 0; j <= i; ++j) M(i, j) = M(j, i) = get(v, index_name("A", joints_[i].frame, joints_[j].frame));
   return M;
 }
 
 Eigen::VectorXd Reference::nonlinear_effects(const Eigen::VectorXd& q, const Eigen::VectorXd& qd,
                                              const ParameterValues& phi) const {
-  return joint_outputs(grammar::run_equations(ccg_.equations, inputs(&q, &qd, nullptr, nullptr, &phi)),
-                       joints_, "GAM");
+  return joint_outputs(grammar::run_equations(ccg_.equations, inputs(&q, &qd, nullptr, nullptr, &phi)), joints_, "GAM");
 }
 
 Eigen::VectorXd Reference::forward_dynamics(const Eigen::VectorXd& q, const Eigen::VectorXd& qd,
-                                            const Eigen::VectorXd& tau,
-                                            const ParameterValues& phi) const {
-  return joint_outputs(grammar::run_equations(ddm_.equations, inputs(&q, &qd, nullptr, &tau, &phi)),
-                       joints_, "QDP");
+                                            const Eigen::VectorXd& tau, const ParameterValues& phi) const {
+  return joint_outputs(grammar::run_equations(ddm_.equations, inputs(&q, &qd, nullptr, &tau, &phi)), joints_, "QDP");
 }
 
 Eigen::Matrix4d Reference::forward_kinematics(const Eigen::VectorXd& q) const {
-  const Bindings v =
-      grammar::run_equations(fgm_.equations, inputs(&q, nullptr, nullptr, nullptr, nullptr));
+  const Bindings v = grammar::run_equations(fgm_.equations, inputs(&q, nullptr, nullptr, nullptr, nullptr));
   // T0T{f}{r}{c}: r and c are one digit each, so the greedy frame number takes the rest.
   const std::regex name("T0T([0-9]+)[1-4][1-4]");
   int last = -1;
@@ -226,8 +211,7 @@ Eigen::Matrix4d Reference::forward_kinematics(const Eigen::VectorXd& q) const {
 }
 
 Eigen::MatrixXd Reference::jacobian(const Eigen::VectorXd& q) const {
-  const Bindings v =
-      grammar::run_equations(jac_.equations, inputs(&q, nullptr, nullptr, nullptr, nullptr));
+  const Bindings v = grammar::run_equations(jac_.equations, inputs(&q, nullptr, nullptr, nullptr, nullptr));
   Eigen::MatrixXd J(6, nq());
   for (int r = 0; r < 6; ++r)
     for (int k = 0; k < nq(); ++k) J(r, k) = get(v, index_name("J", r + 1, joints_[k].frame));
@@ -259,8 +243,7 @@ std::string par_file_path(const std::string& robot_dir) {
     if (ends_with(".par") && !ends_with("_base.par")) found.push_back(entry.path().string());
   }
   if (found.size() != 1)
-    throw std::runtime_error(robot_dir + ": expected one robot .par file, found " +
-                             std::to_string(found.size()));
+    throw std::runtime_error(robot_dir + ": expected one robot .par file, found " + std::to_string(found.size()));
   return found.front();
 }
 

@@ -45,20 +45,19 @@ class Reference {
   const grammar::Table& geometry() const { return geometry_; }
 
   // dim.txt: the regressor columns named by `columns` (DG{j}{P}; absent entries are 0).
-  Eigen::MatrixXd regressor(const Eigen::VectorXd& q, const Eigen::VectorXd& qd,
-                            const Eigen::VectorXd& qdd,
+  Eigen::MatrixXd regressor(const Eigen::VectorXd& q, const Eigen::VectorXd& qd, const Eigen::VectorXd& qdd,
                             const std::vector<std::string>& columns) const;
   // idm.txt: GAM{j}.
-  Eigen::VectorXd inverse_dynamics(const Eigen::VectorXd& q, const Eigen::VectorXd& qd,
-                                   const Eigen::VectorXd& qdd, const ParameterValues& phi) const;
+  Eigen::VectorXd inverse_dynamics(const Eigen::VectorXd& q, const Eigen::VectorXd& qd, const Eigen::VectorXd& qdd,
+                                   const ParameterValues& phi) const;
   // inm.txt: A{i}{j} for i >= j, mirrored.
   Eigen::MatrixXd inertia(const Eigen::VectorXd& q, const ParameterValues& phi) const;
   // ccg.txt: GAM{j} with zero accelerations.
   Eigen::VectorXd nonlinear_effects(const Eigen::VectorXd& q, const Eigen::VectorXd& qd,
                                     const ParameterValues& phi) const;
   // ddm.txt: QDP{j} from GAM{j}.
-  Eigen::VectorXd forward_dynamics(const Eigen::VectorXd& q, const Eigen::VectorXd& qd,
-                                   const Eigen::VectorXd& tau, const ParameterValues& phi) const;
+  Eigen::VectorXd forward_dynamics(const Eigen::VectorXd& q, const Eigen::VectorXd& qd, const Eigen::VectorXd& tau,
+                                   const ParameterValues& phi) const;
   // fgm.txt: T0T{f}{r}{c} of the highest frame f it computes; rows 1..3, last row 0 0 0 1.
   Eigen::Matrix4d forward_kinematics(const Eigen::VectorXd& q) const;
   // jac.txt: J{r}{c}, 6 x nq; columns it does not list are 0.
@@ -69,9 +68,8 @@ class Reference {
   double constant_value(const grammar::Expr& e) const;
 
  private:
-  grammar::Bindings inputs(const Eigen::VectorXd* q, const Eigen::VectorXd* qd,
-                           const Eigen::VectorXd* qdd, const Eigen::VectorXd* tau,
-                           const ParameterValues* phi) const;
+  grammar::Bindings inputs(const Eigen::VectorXd* q, const Eigen::VectorXd* qd, const Eigen::VectorXd* qdd,
+                           const Eigen::VectorXd* tau, const ParameterValues* phi) const;
 
   std::string dir_;
   grammar::Bindings constants_;

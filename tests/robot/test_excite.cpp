@@ -57,10 +57,14 @@ class Excite : public ::testing::TestWithParam<std::string> {
     Eigen::VectorXd s = Eigen::VectorXd::Zero(model().ns());
     for (int k = 0; k < model().ns(); ++k) {
       const std::string name = model().standard_parameters()[k].name, family = model().standard_parameters()[k].family;
-      if (nominal && nominal[name]) s(k) = nominal[name].as<double>();
-      else if (!nominal && family == "M") s(k) = 0.5;
-      else if (!nominal && family == "MX") s(k) = 0.05;
-      else if (!nominal && (family == "XX" || family == "YY" || family == "ZZ")) s(k) = 0.01;
+      if (nominal && nominal[name])
+        s(k) = nominal[name].as<double>();
+      else if (!nominal && family == "M")
+        s(k) = 0.5;
+      else if (!nominal && family == "MX")
+        s(k) = 0.05;
+      else if (!nominal && (family == "XX" || family == "YY" || family == "ZZ"))
+        s(k) = 0.01;
     }
     return model().base_from_standard(s);
   }

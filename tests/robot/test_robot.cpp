@@ -140,8 +140,7 @@ TYPED_TEST(RobotModel, NewtonEulerWithStandardParametersMatchesInverseDynamics) 
     const Eigen::Matrix<double, Parent::ns, 1> par_s = standard.s.template head<Parent::ns>();
     ASSERT_TRUE(close(M::to_parent(phi), Parent::base_from_standard(par_s), kRelTol));
     EXPECT_TRUE(close(M::inverse_dynamics(s.q, s.qd, s.qdd, phi),
-                      newton_euler_torque<M>(standard.links, s) + effect_torque<M>(s.q, s.qd, standard.s),
-                      kRelTol));
+                      newton_euler_torque<M>(standard.links, s) + effect_torque<M>(s.q, s.qd, standard.s), kRelTol));
   });
 }
 

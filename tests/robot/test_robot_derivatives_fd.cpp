@@ -28,9 +28,12 @@ TYPED_TEST(ForwardDynamicsDerivatives, ForwardDynamicsDerivativesAreTheJetAndFin
     // The value: ddm.txt's forward dynamics, which the generated code evaluates another way.
     EXPECT_TRUE(close(d.qdd, M::forward_dynamics(s.q, s.qd, tau, phi), kSameValue)) << "qdd";
     const auto fd = [&](const auto& f, const auto& x) { return finite_difference_jacobian(f, x, kFdStep); };
-    const Eigen::MatrixXd fd_q = fd([&](const JointVector<M>& x) { return M::forward_dynamics(x, s.qd, tau, phi); }, s.q);
-    const Eigen::MatrixXd fd_qd = fd([&](const JointVector<M>& x) { return M::forward_dynamics(s.q, x, tau, phi); }, s.qd);
-    const Eigen::MatrixXd fd_phi = fd([&](const ParameterVector<M>& x) { return M::forward_dynamics(s.q, s.qd, tau, x); }, phi);
+    const Eigen::MatrixXd fd_q =
+        fd([&](const JointVector<M>& x) { return M::forward_dynamics(x, s.qd, tau, phi); }, s.q);
+    const Eigen::MatrixXd fd_qd =
+        fd([&](const JointVector<M>& x) { return M::forward_dynamics(s.q, x, tau, phi); }, s.qd);
+    const Eigen::MatrixXd fd_phi =
+        fd([&](const ParameterVector<M>& x) { return M::forward_dynamics(s.q, s.qd, tau, x); }, phi);
     EXPECT_TRUE(close(d.dq, fd_q, kFdTol)) << "d qdd / d q, finite differences";
     EXPECT_TRUE(close(d.dqd, fd_qd, kFdTol)) << "d qdd / d qd, finite differences";
     EXPECT_TRUE(close(d.dphi, fd_phi, kFdTol)) << "d qdd / d phi, finite differences";
@@ -58,14 +61,14 @@ TYPED_TEST(ForwardDynamicsDerivatives, ForwardDynamicsDerivativesAreTheJetAndFin
   });
 }
 
-
 // An inertia matrix that is not positive definite is reported, not inverted.
 TYPED_TEST(ForwardDynamicsDerivatives, ForwardDynamicsDerivativesRefuseAnIndefiniteInertia) {
   using M = TypeParam;
   this->for_states([&](const State<M>& s, const ParameterVector<M>&) {
     const ParameterVector<M> phi = -this->physical_phi();  // M(q; -phi) = -M(q; phi) + constant part
     const Eigen::Matrix<double, M::nq, M::nq> A = M::inertia(s.q, phi);
-    const double smallest = Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, M::nq, M::nq>>(A).eigenvalues().minCoeff();
+    const double smallest =
+        Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, M::nq, M::nq>>(A).eigenvalues().minCoeff();
     typename M::template ForwardDynamicsDerivatives<double> d;
     const bool ok = M::forward_dynamics_derivatives(s.q, s.qd, this->random_torque(), phi, d);
     EXPECT_EQ(ok, smallest > 0) << "smallest eigenvalue of M " << smallest << ", smallest pivot " << d.min_pivot;

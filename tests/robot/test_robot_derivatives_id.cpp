@@ -41,8 +41,8 @@ TYPED_TEST(InverseDynamicsDerivatives, JetDerivativeOfRegressorInQMatchesFiniteD
   using M = TypeParam;
   this->for_states([&](const State<M>& s, const ParameterVector<M>&) {
     const auto u = this->template random_direction<JointVector<M>>();
-    const Eigen::MatrixXd fd = finite_difference_jacobian(
-        [&](const JointVector<M>& x) { return M::regressor(x, s.qd, s.qdd); }, s.q, kFdStep);
+    const Eigen::MatrixXd fd =
+        finite_difference_jacobian([&](const JointVector<M>& x) { return M::regressor(x, s.qd, s.qdd); }, s.q, kFdStep);
     EXPECT_TRUE(close(flat_derivative(M::regressor(jet(s.q, u), jet(s.qd), jet(s.qdd))), fd * u, kFdTol));
   });
 }

@@ -28,9 +28,9 @@
 namespace symoro::test {
 namespace {
 
-using robot::ModelHandle;
 using Eigen::MatrixXd;
 using Eigen::VectorXd;
+using robot::ModelHandle;
 
 // As test_robot.cpp: round-off of two evaluation orders times M's conditioning; central
 // differences as test_support.hpp's kFdStep, kFdTol.
@@ -128,7 +128,8 @@ class RobotValues : public ::testing::TestWithParam<std::string> {
     Standard out{VectorXd(m.ns()), {}};
     for (int k = 0; k < m.ns(); ++k) {
       const auto& p = m.standard_parameters()[k];
-      out.s(k) = is_effect_family(p.family) ? rng_.uniform(-0.5, 0.5) : *link_entry(drawn.at(p.joint - 1), p.family).front();
+      out.s(k) =
+          is_effect_family(p.family) ? rng_.uniform(-0.5, 0.5) : *link_entry(drawn.at(p.joint - 1), p.family).front();
     }
     out.links = links_of(m, out.s);
     return out;
@@ -282,7 +283,8 @@ TEST_P(RobotValues, ForwardDynamicsSolvesInertiaAndInvertsInverseDynamics) {
   for_models_and_states([&](const ModelHandle& m, const ModelHandle&, const State& s, const VectorXd&) {
     const VectorXd phi = physical_phi(m), tau = random_torque(m);
     const VectorXd qdd = forward_dynamics(m, s.q, s.qd, tau, phi);
-    EXPECT_TRUE(close(qdd, m.inertia(s.q, phi).partialPivLu().solve(tau - nonlinear_effects(m, s.q, s.qd, phi)), kRelTol));
+    EXPECT_TRUE(
+        close(qdd, m.inertia(s.q, phi).partialPivLu().solve(tau - nonlinear_effects(m, s.q, s.qd, phi)), kRelTol));
     EXPECT_TRUE(close(m.inverse_dynamics(s.q, s.qd, qdd, phi), tau, kRelTol));
   });
 }
@@ -293,7 +295,8 @@ TEST_P(RobotValues, JacobianIsTheDerivativeOfForwardKinematics) {
   for_models_and_states([&](const ModelHandle& m, const ModelHandle&, const State& s, const VectorXd&) {
     const VectorXd u = direction(m.nq());
     const MatrixXd T = forward_kinematics(m, s.q);
-    const MatrixXd dT = (forward_kinematics(m, s.q + kFdStep * u) - forward_kinematics(m, s.q - kFdStep * u)) / (2 * kFdStep);
+    const MatrixXd dT =
+        (forward_kinematics(m, s.q + kFdStep * u) - forward_kinematics(m, s.q - kFdStep * u)) / (2 * kFdStep);
     const Eigen::Matrix3d w = dT.topLeftCorner<3, 3>() * T.topLeftCorner<3, 3>().transpose();
     Eigen::Matrix<double, 6, 1> expected;
     expected << dT(0, 3), dT(1, 3), dT(2, 3), w(2, 1), w(0, 2), w(1, 0);
@@ -312,7 +315,8 @@ TEST_P(RobotValues, NewtonEulerWithStandardParametersGivesInverseDynamicsAndIner
     m.to_parent(phi.data(), parent.data());
     ASSERT_TRUE(close(parent, full.base_from_standard(VectorXd(standard.s.head(full.ns()))), kRelTol));
     const VectorXd ne = newton_euler(m.frames(), m.gravity(), standard.links, s.q, s.qd, s.qdd);
-    EXPECT_TRUE(close(m.inverse_dynamics(s.q, s.qd, s.qdd, phi), ne + effect_torque(m, s.q, s.qd, standard.s), kRelTol));
+    EXPECT_TRUE(
+        close(m.inverse_dynamics(s.q, s.qd, s.qdd, phi), ne + effect_torque(m, s.q, s.qd, standard.s), kRelTol));
     // Column k of M: the torque at rest without gravity for qdd = e_k.
     MatrixXd expected(m.nq(), m.nq());
     for (int k = 0; k < m.nq(); ++k)
@@ -331,14 +335,17 @@ TEST_P(RobotValues, InverseDynamicsDerivativesAreTheFiniteDifferences) {
     const int n = m.nq();
     VectorXd tau(n);
     MatrixXd dq(n, n), dqd(n, n);
-    m.inverse_dynamics_derivatives(s.q.data(), s.qd.data(), s.qdd.data(), phi.data(), tau.data(), dq.data(), dqd.data());
+    m.inverse_dynamics_derivatives(s.q.data(), s.qd.data(), s.qdd.data(), phi.data(), tau.data(), dq.data(),
+                                   dqd.data());
     EXPECT_TRUE(close(tau, m.inverse_dynamics(s.q, s.qd, s.qdd, phi), kSameValue)) << "tau";
-    EXPECT_TRUE(close(dq, finite_difference_jacobian([&](const VectorXd& x) { return m.inverse_dynamics(x, s.qd, s.qdd, phi); },
-                                                     s.q, kFdStep),
+    EXPECT_TRUE(close(dq,
+                      finite_difference_jacobian(
+                          [&](const VectorXd& x) { return m.inverse_dynamics(x, s.qd, s.qdd, phi); }, s.q, kFdStep),
                       kFdTol))
         << "d tau / d q";
-    EXPECT_TRUE(close(dqd, finite_difference_jacobian([&](const VectorXd& x) { return m.inverse_dynamics(s.q, x, s.qdd, phi); },
-                                                      s.qd, kFdStep),
+    EXPECT_TRUE(close(dqd,
+                      finite_difference_jacobian(
+                          [&](const VectorXd& x) { return m.inverse_dynamics(s.q, x, s.qdd, phi); }, s.qd, kFdStep),
                       kFdTol))
         << "d tau / d qd";
   });
@@ -356,9 +363,12 @@ TEST_P(RobotValues, ForwardDynamicsDerivativesAreTheFiniteDifferencesAndRefuseAn
     EXPECT_GT(pivot, 0);
     EXPECT_TRUE(close(qdd, forward_dynamics(m, s.q, s.qd, tau, phi), kRelTol)) << "qdd";
     const auto fd = [&](const auto& f, const VectorXd& x) { return finite_difference_jacobian(f, x, kFdStep); };
-    EXPECT_TRUE(close(dq, fd([&](const VectorXd& x) { return forward_dynamics(m, x, s.qd, tau, phi); }, s.q), kFdTol)) << "d q";
-    EXPECT_TRUE(close(dqd, fd([&](const VectorXd& x) { return forward_dynamics(m, s.q, x, tau, phi); }, s.qd), kFdTol)) << "d qd";
-    EXPECT_TRUE(close(dphi, fd([&](const VectorXd& x) { return forward_dynamics(m, s.q, s.qd, tau, x); }, phi), kFdTol)) << "d phi";
+    EXPECT_TRUE(close(dq, fd([&](const VectorXd& x) { return forward_dynamics(m, x, s.qd, tau, phi); }, s.q), kFdTol))
+        << "d q";
+    EXPECT_TRUE(close(dqd, fd([&](const VectorXd& x) { return forward_dynamics(m, s.q, x, tau, phi); }, s.qd), kFdTol))
+        << "d qd";
+    EXPECT_TRUE(close(dphi, fd([&](const VectorXd& x) { return forward_dynamics(m, s.q, s.qd, tau, x); }, phi), kFdTol))
+        << "d phi";
     const MatrixXd Minv = m.inertia(s.q, phi).inverse();
     EXPECT_TRUE(close(dtau, Minv, 1e-10)) << "M^-1";
     EXPECT_TRUE(close(dphi, -Minv * m.regressor(s.q, s.qd, qdd), 1e-10)) << "-M^-1 W";
@@ -379,7 +389,8 @@ TEST_P(RobotValues, InertiaFirstAndSecondDerivativesAreTheFiniteDifferences) {
     MatrixXd M(n, n), dM(n, nn), M2(n, n), dM2(n, nn), d2M(n, nn * n);
     m.inertia_derivatives(s.q.data(), phi.data(), M.data(), dM.data());
     EXPECT_TRUE(close(M, m.inertia(s.q, phi), kSameValue)) << "M";
-    const MatrixXd first = finite_difference_jacobian([&](const VectorXd& x) { return m.inertia(x, phi); }, s.q, kFdStep);
+    const MatrixXd first =
+        finite_difference_jacobian([&](const VectorXd& x) { return m.inertia(x, phi); }, s.q, kFdStep);
     EXPECT_TRUE(close(Eigen::Map<const MatrixXd>(dM.data(), nn, n), first, kFdTol)) << "d M / d q";
     m.inertia_second_derivatives(s.q.data(), phi.data(), M2.data(), dM2.data(), d2M.data());
     EXPECT_EQ(M2, M);
@@ -404,8 +415,8 @@ TEST_P(RobotValues, InertiaFirstAndSecondDerivativesAreTheFiniteDifferences) {
 // ---- g. Metadata -------------------------------------------------------------------------------
 
 TEST_P(RobotValues, ParameterMetadataIsWellFormed) {
-  static const std::set<std::string> families = {"XX", "XY", "XZ", "YY", "YZ", "ZZ", "MX",  "MY", "MZ",
-                                                 "M",  "IA", "FV", "FS", "OFF", "FST", "FVA", "HS", "HC", "FC"};
+  static const std::set<std::string> families = {"XX", "XY", "XZ", "YY",  "YZ",  "ZZ",  "MX", "MY", "MZ", "M",
+                                                 "IA", "FV", "FS", "OFF", "FST", "FVA", "HS", "HC", "FC"};
   for_models([&](const ModelHandle& m, const ModelHandle&) {
     std::set<std::string> seen;
     const int np = m.np(), ne = m.ne();
@@ -524,7 +535,8 @@ TEST_P(RobotValues, JointsFramesGravityAndStandardParametersFollowTheFiles) {
     for (std::size_t j = 0; j < m.frames().size(); ++j)
       for (const char* family : families) {
         const grammar::Expr& e = entry(family).values.at(j);
-        if (e.kind == grammar::Expr::Kind::Symbol) expected.push_back(e.name + " " + family + " " + std::to_string(j + 1));
+        if (e.kind == grammar::Expr::Kind::Symbol)
+          expected.push_back(e.name + " " + family + " " + std::to_string(j + 1));
       }
     std::vector<std::string> listed;
     for (int i = 0; i < m.ns() - m.ne(); ++i) {

@@ -33,13 +33,11 @@ inline constexpr int kStates = 5;
 // nearly 0 are not held to a relative precision no floating-point evaluation has. `columns`
 // names the columns in the failure message.
 template <class A, class B>
-::testing::AssertionResult close(const Eigen::MatrixBase<A>& actual,
-                                 const Eigen::MatrixBase<B>& expected, double rel_tol,
-                                 const std::vector<std::string>& columns = {}) {
+::testing::AssertionResult close(const Eigen::MatrixBase<A>& actual, const Eigen::MatrixBase<B>& expected,
+                                 double rel_tol, const std::vector<std::string>& columns = {}) {
   if (actual.rows() != expected.rows() || actual.cols() != expected.cols())
-    return ::testing::AssertionFailure() << "size " << actual.rows() << "x" << actual.cols()
-                                         << ", expected " << expected.rows() << "x"
-                                         << expected.cols();
+    return ::testing::AssertionFailure() << "size " << actual.rows() << "x" << actual.cols() << ", expected "
+                                         << expected.rows() << "x" << expected.cols();
   const Eigen::MatrixXd a = actual.template cast<double>(), e = expected.template cast<double>();
   if (!a.allFinite()) return ::testing::AssertionFailure() << "non-finite result\n" << a;
   const double scale = std::max(a.cwiseAbs().maxCoeff(), e.cwiseAbs().maxCoeff());
@@ -47,12 +45,10 @@ template <class A, class B>
   const double err = (a - e).cwiseAbs().maxCoeff(&r, &c);
   if (err <= rel_tol * scale) return ::testing::AssertionSuccess();
   std::ostringstream where;
-  where << "(" << r << ", " << (c < Eigen::Index(columns.size()) ? columns[c] : std::to_string(c))
-        << ")";
-  return ::testing::AssertionFailure()
-         << "largest difference " << err << " at " << where.str() << ": " << a(r, c) << " vs "
-         << e(r, c) << "; relative " << err / scale << " > " << rel_tol << " (scale " << scale
-         << ")";
+  where << "(" << r << ", " << (c < Eigen::Index(columns.size()) ? columns[c] : std::to_string(c)) << ")";
+  return ::testing::AssertionFailure() << "largest difference " << err << " at " << where.str() << ": " << a(r, c)
+                                       << " vs " << e(r, c) << "; relative " << err / scale << " > " << rel_tol
+                                       << " (scale " << scale << ")";
 }
 
 // A fixed-seed generator, so that every run checks the same states.
@@ -176,7 +172,7 @@ inline double effect_term(const std::string& family, int order, double velocity,
 template <class Model, class Q, class QD>
 Eigen::MatrixXd effect_columns(const Q& q, const QD& qd) {
   Eigen::MatrixXd W = Eigen::MatrixXd::Zero(Model::nq, effect_count<Model>);
-  if constexpr (effect_count<Model> > 0) {
+  if constexpr (effect_count < Model >> 0) {
     for (int k = 0; k < Model::ne; ++k) {
       const auto& e = Model::effect_parameters[k];
       const int j = e.joint - 1;
@@ -228,7 +224,8 @@ StandardParameters<Model> random_standard_parameters(Random& rng) {
   StandardParameters<Model> out;
   for (int k = 0; k < Model::ns; ++k) {
     const auto& p = Model::standard_parameters[k];
-    out.s(k) = is_effect_family(p.family) ? rng.uniform(-0.5, 0.5) : *link_entry(drawn.at(p.joint - 1), p.family).front();
+    out.s(k) =
+        is_effect_family(p.family) ? rng.uniform(-0.5, 0.5) : *link_entry(drawn.at(p.joint - 1), p.family).front();
   }
   out.links = links_from_standard<Model>(out.s);
   return out;

@@ -89,8 +89,8 @@ void expect_consistent(const ConsistencyResult& r, const VectorXd& phi, double m
   EXPECT_GE(smallest_drive_parameter<Model>(r.s), -1e-12);
   EXPECT_NEAR(r.lambda_min, smallest_link_eigenvalue<Model>(r.s), 1e-12);
   std::printf("  %s: %s; max|B s - phi| = %.3g, lambda_min = %.4g, prior distance %.4g, %d CSDP solves, %.3f s\n",
-              Model::description, r.message.c_str(), (back - phi).cwiseAbs().maxCoeff(), r.lambda_min,
-              r.prior_distance, r.solves, r.wall);
+              Model::description, r.message.c_str(), (back - phi).cwiseAbs().maxCoeff(), r.lambda_min, r.prior_distance,
+              r.solves, r.wall);
 }
 
 inline VectorXd perturbed(const VectorXd& s, double fraction, unsigned seed) {

@@ -111,14 +111,14 @@ class GeneratedIdentificationModel final : public IdentificationModel {
 
  private:
   static std::string unsupported() {
-    return std::string("the ") + Model::variant_name + " model has effect parameters, which have no standard-parameter form";
+    return std::string("the ") + Model::variant_name +
+           " model has effect parameters, which have no standard-parameter form";
   }
   ModelDescription d_;
   bool has_fixed_ = false;
 };
 
 }  // namespace detail
-
 
 template <class Model>
 std::shared_ptr<const IdentificationModel> generated_identification_model() {

@@ -67,8 +67,7 @@ twin::TwinConfig ideal_twin() {
 
 // The first segments of a designed trajectory, covering at least `seconds`.
 trajectory::Trajectory first_seconds(const std::string& name, double seconds) {
-  trajectory::Trajectory t =
-      trajectory::TrajectoryDesign::read(kRobot / "trajectories.yaml", joints()).build(name);
+  trajectory::Trajectory t = trajectory::TrajectoryDesign::read(kRobot / "trajectories.yaml", joints()).build(name);
   std::size_t keep = 0;
   while (keep < t.segments.size() && t.segments[keep].start < seconds) ++keep;
   t.segments.resize(keep);
@@ -110,19 +109,21 @@ struct Realtime {
 enum class RigClock { paced, unpaced, wall };
 
 struct Rig {
-  Rig(const twin::TwinConfig& twin, const HardwareConfig& h, const trajectory::Trajectory& traj, RigClock mode = RigClock::paced)
+  Rig(const twin::TwinConfig& twin, const HardwareConfig& h, const trajectory::Trajectory& traj,
+      RigClock mode = RigClock::paced)
       : hw(h),
         realtime(),
         clock(mode == RigClock::paced),
-        virt(virtual_servos(h), make_backend(twin, h, traj),
-             mode == RigClock::wall ? std::function<double()>() : [this] { return clock.seconds(); }),
+        virt(
+            virtual_servos(h), make_backend(twin, h, traj),
+            mode == RigClock::wall ? std::function<double()>() : [this] { return clock.seconds(); }),
         port(virt.device(), h.baud),
         bus(port) {
     realtime.release();  // the virtual servos' thread keeps it
   }
 
   std::unique_ptr<dynamixel::ServoBackend> make_backend(const twin::TwinConfig& twin, const HardwareConfig& h,
-                                                         const trajectory::Trajectory& traj) {
+                                                        const trajectory::Trajectory& traj) {
     Eigen::VectorXd q(Model::nq), qd(Model::nq), qdd(Model::nq);
     traj.evaluate(0, q, qd, qdd);
     auto b = std::make_unique<TwinServoBackend>(symoro::robot::compiled_model<Model>(), twin, h, q);
@@ -177,7 +178,8 @@ class HardwareControl : public ::testing::Test {
   // trajectory time reaches `after` s (its own timeline: the approach and pre-roll before t = 0
   // take a machine-dependent wall time, so a wall-clock trigger could land before the start).
   ControlResult run(Rig& rig, const trajectory::Trajectory& traj, const std::string& csv, ControlOptions o,
-                    double after = -1, std::function<void(Rig&)> inject = {}, std::vector<JointInfo> limits = joints()) {
+                    double after = -1, std::function<void(Rig&)> inject = {},
+                    std::vector<JointInfo> limits = joints()) {
     std::atomic<double> timeline{-1e9};
     std::atomic<bool> finished{false};
     o.timeline = &timeline;
@@ -207,7 +209,8 @@ class HardwareControl : public ::testing::Test {
         io::read_log(csv);
         ADD_FAILURE() << "a log without samples was read";
       } catch (const DataError& e) {
-        EXPECT_NE(std::string(e.what()).find(std::string("stop: ") + to_string(r.reason)), std::string::npos) << e.what();
+        EXPECT_NE(std::string(e.what()).find(std::string("stop: ") + to_string(r.reason)), std::string::npos)
+            << e.what();
       }
       return;
     }

@@ -46,7 +46,8 @@ struct IndependentArmOptions {
 // Runs `ref` on the arm that `c` describes (its chain, drives, servos and controller gains;
 // its effects are ignored: the options say what the arm has) and returns the log.
 template <class Model>
-io::Log run_independent_arm(const twin::TwinConfig& c, const trajectory::SampledReference& ref, const IndependentArmOptions& o) {
+io::Log run_independent_arm(const twin::TwinConfig& c, const trajectory::SampledReference& ref,
+                            const IndependentArmOptions& o) {
   constexpr int n = Model::nq;
   using Vec = Eigen::Matrix<double, n, 1>;
   std::mt19937 gen(o.seed);
@@ -57,7 +58,8 @@ io::Log run_independent_arm(const twin::TwinConfig& c, const trajectory::Sampled
   // The links' friction: smooth through zero speed (tanh over 0.01 rad/s), so that the
   // integrator needs no stick-slip logic.
   auto friction = [&](int j, double v) {
-    return (coulomb(j) + stribeck(j) * std::exp(-std::pow(std::abs(v) / o.stribeck_velocity, o.stribeck_shape))) * std::tanh(v / 0.01);
+    return (coulomb(j) + stribeck(j) * std::exp(-std::pow(std::abs(v) / o.stribeck_velocity, o.stribeck_shape))) *
+           std::tanh(v / 0.01);
   };
   // The links' parameters: rotors and viscous friction of joints with play move to their rotors.
   twin::TwinConfig links = c;
@@ -136,7 +138,8 @@ io::Log run_independent_arm(const twin::TwinConfig& c, const trajectory::Sampled
     q_prev = qe;
     Vec cmd;
     for (int j = 0; j < n; ++j) {
-      const double u = g.inertia(j) * (g.kv(j) * (qdr(j) - v(j)) + g.kp(j) * (qr(j) - qe(j)) + qddr(j)) + g.damping(j) * qdr(j);
+      const double u =
+          g.inertia(j) * (g.kv(j) * (qdr(j) - v(j)) + g.kp(j) * (qr(j) - qe(j)) + qddr(j)) + g.damping(j) * qdr(j);
       cmd(j) = std::clamp(std::round(u / kt(j) / unit(j)) * unit(j), -limit(j), limit(j));
     }
     if (log) {
@@ -144,7 +147,8 @@ io::Log run_independent_arm(const twin::TwinConfig& c, const trajectory::Sampled
       log->q.row(row) = qe.transpose();
       log->qd.row(row) = v.transpose();
       for (int j = 0; j < n; ++j)
-        log->tau(row, j) = kt(j) * std::round((applied(j) + o.current_noise * unit(j) * gauss(gen)) / unit(j)) * unit(j);
+        log->tau(row, j) =
+            kt(j) * std::round((applied(j) + o.current_noise * unit(j) * gauss(gen)) / unit(j)) * unit(j);
       log->q_ref.row(row) = qr.transpose();
       log->qd_ref.row(row) = qdr.transpose();
       log->qdd_ref.row(row) = qddr.transpose();

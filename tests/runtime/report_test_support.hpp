@@ -228,9 +228,8 @@ inline Synthetic make_study() {
   st.final_worst_pose = Eigen::VectorXd::Constant(7, 0.5);
   st.accepted = true;
 
-  const double rmse[3][4] = {{0.16761, 0.16729, 0.07726, 0.07709},
-                             {0.17057, 0.17032, 0.08814, 0.08805},
-                             {0.16642, 0.16630, 0.06721, 0.06719}};
+  const double rmse[3][4] = {
+      {0.16761, 0.16729, 0.07726, 0.07709}, {0.17057, 0.17032, 0.08814, 0.08805}, {0.16642, 0.16630, 0.06721, 0.06719}};
   for (int v = 0; v < 3; ++v) {
     ValidationRecord rec;
     rec.trajectory = "V0" + std::to_string(v + 1);
@@ -282,7 +281,5 @@ class Report : public ::testing::Test {
   inline static std::vector<fs::path>* written_ = nullptr;
   inline static std::string* md_ = nullptr;
 };
-
-
 
 }  // namespace symoro::test::report

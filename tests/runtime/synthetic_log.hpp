@@ -94,7 +94,8 @@ io::Log synthesize(const std::string& name, const Eigen::Matrix<double, Model::n
 // revolution, plus noise in counts), qd the controller's own estimate (the backward difference of
 // the encoder over the nominal period, through a first-order low-pass at `velocity_cutoff` Hz),
 // the torque as synthesized (noise included). A stale row stays a copy of the row before.
-inline io::Log with_real_sensors(io::Log log, double counts, double encoder_noise, double velocity_cutoff, unsigned seed) {
+inline io::Log with_real_sensors(io::Log log, double counts, double encoder_noise, double velocity_cutoff,
+                                 unsigned seed) {
   constexpr double kPi = 3.14159265358979323846;
   std::mt19937 gen(seed);
   std::normal_distribution<double> gauss(0, 1);
@@ -108,7 +109,8 @@ inline io::Log with_real_sensors(io::Log log, double counts, double encoder_nois
       log.qd.row(i) = log.qd.row(i - 1);
       continue;
     }
-    for (Eigen::Index j = 0; j < log.q.cols(); ++j) log.q(i, j) = std::round(q_true(i, j) / lsb + encoder_noise * gauss(gen)) * lsb;
+    for (Eigen::Index j = 0; j < log.q.cols(); ++j)
+      log.q(i, j) = std::round(q_true(i, j) / lsb + encoder_noise * gauss(gen)) * lsb;
     if (i > 0) v = a * v + (1 - a) * (log.q.row(i) - log.q.row(i - 1)) / T;
     log.qd.row(i) = v;
   }

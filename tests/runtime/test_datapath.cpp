@@ -59,7 +59,8 @@ TEST(DataPath, TwinLogThroughPreprocessingSatisfiesTheTrueModel) {
         sq_res += (tau - s.tau.row(k).transpose()).cwiseAbs2();
         sq_tau += s.tau.row(k).transpose().cwiseAbs2();
       }
-      const Eigen::VectorXd rms_res = (sq_res / s.time.size()).cwiseSqrt(), rms_tau = (sq_tau / s.time.size()).cwiseSqrt();
+      const Eigen::VectorXd rms_res = (sq_res / s.time.size()).cwiseSqrt(),
+                            rms_tau = (sq_tau / s.time.size()).cwiseSqrt();
       std::cout << name << " at " << interval * 1e3 << " ms: rms residual / rms torque (N m):";
       for (int j = 0; j < n; ++j) std::cout << " " << rms_res(j) << "/" << rms_tau(j);
       std::cout << "\n";
@@ -85,8 +86,8 @@ TEST(DataPath, AShiftedTorqueIsNoticed) {
   double res = 0, tau2 = 0;
   for (int k = 1; k < s.time.size(); ++k) {
     Eigen::Matrix<double, n, 1> tau;
-    Model::inverse_dynamics(s.q.row(k).transpose(), s.qd.row(k).transpose(), s.qdd.row(k).transpose(),
-                            twin.truth().phi, tau);
+    Model::inverse_dynamics(s.q.row(k).transpose(), s.qd.row(k).transpose(), s.qdd.row(k).transpose(), twin.truth().phi,
+                            tau);
     res += std::pow(tau(1) - s.tau(k - 1, 1), 2);
     tau2 += std::pow(s.tau(k, 1), 2);
   }

@@ -69,7 +69,8 @@ class AnyRobotGap : public ::testing::Test {
   static diagnose::DesignStack stack(const std::vector<io::Log>& logs) {
     std::vector<diagnose::NamedSamples> runs;
     for (const auto& log : logs)
-      runs.push_back({log.meta.trajectory, preprocess::preprocess(log, log.meta.sample_time, diagnose::light_preprocessing())});
+      runs.push_back(
+          {log.meta.trajectory, preprocess::preprocess(log, log.meta.sample_time, diagnose::light_preprocessing())});
     return diagnose::stack_design<Full, Model>(runs, diagnose::StackOptions{});
   }
 
@@ -84,7 +85,7 @@ class AnyRobotGap : public ::testing::Test {
 };
 
 using Robots = ::testing::Types<Models<rx90::Model, rx90::rigid::Model, rx90::Model>,
-                                 Models<stanford_rrp::Model, stanford_rrp::rigid::Model, stanford_rrp::Model>>;
+                                Models<stanford_rrp::Model, stanford_rrp::rigid::Model, stanford_rrp::Model>>;
 TYPED_TEST_SUITE(AnyRobotGap, Robots);
 
 TYPED_TEST(AnyRobotGap, AnOffsetOnAnyJointIsNamed) {
@@ -94,21 +95,27 @@ TYPED_TEST(AnyRobotGap, AnOffsetOnAnyJointIsNamed) {
     // m g cos q2 on the Stanford arm's boom, absorbs more of a constant).
     const double size = Full::joints[j - 1].type == JointType::Prismatic ? 0.2 : 0.05;
     const double offset = size * (j % 2 ? 1 : -1);
-    const auto train = test::synthesize<Full>("R1", this->truth_, 30.0, 10 * j + 1, 0.05, test::offset_on<Full>(j, offset));
-    const auto held = test::synthesize<Full>("H1", this->truth_, 20.0, 10 * j + 2, 0.05, test::offset_on<Full>(j, offset));
+    const auto train =
+        test::synthesize<Full>("R1", this->truth_, 30.0, 10 * j + 1, 0.05, test::offset_on<Full>(j, offset));
+    const auto held =
+        test::synthesize<Full>("H1", this->truth_, 20.0, 10 * j + 2, 0.05, test::offset_on<Full>(j, offset));
     const diagnose::Diagnosis d =
         diagnose::diagnose(TestFixture::template stack<Full>({train}), TestFixture::template stack<Full>({held}));
     const auto* e = TestFixture::find(d.selection, diagnose::EffectKind::Offset, j);
     if (!e && !d.selection.steps.empty())
       for (const auto& t : d.selection.steps[0].tests)
         if (t.key.find("offset") != std::string::npos || t.f > 5)
-          std::cout << fmt::format("  {:28s} F {:8.1f} p {:.1e} level {:.1e} gain {:.4f} all {:.4f} phys {} matters {} rms {:.4f} df2 {:.0f} {}\n", t.key, t.f, t.p_value,
-                                   d.selection.steps[0].level, t.heldout_gain, t.heldout_reduction, t.physical, t.matters, t.effect_rms, t.df2, t.absorbed ? "absorbed" : "");
+          std::cout << fmt::format(
+              "  {:28s} F {:8.1f} p {:.1e} level {:.1e} gain {:.4f} all {:.4f} phys {} matters {} rms {:.4f} df2 "
+              "{:.0f} {}\n",
+              t.key, t.f, t.p_value, d.selection.steps[0].level, t.heldout_gain, t.heldout_reduction, t.physical,
+              t.matters, t.effect_rms, t.df2, t.absorbed ? "absorbed" : "");
     ASSERT_NE(e, nullptr) << "offset on joint " << j << " not named (" << d.selection.stop_reason << ")";
     // Added to the measured torque: the diagnosis finds it as it is (a twin offset is external).
     EXPECT_NEAR(e->magnitude.values[0], offset, 0.2 * std::abs(offset)) << "joint " << j << ": " << e->magnitude.text;
     for (const auto& other : d.selection.effects)
-      EXPECT_TRUE(&other == e) << "joint " << j << ": spurious " << other.candidate.label() << " " << other.magnitude.text;
+      EXPECT_TRUE(&other == e) << "joint " << j << ": spurious " << other.candidate.label() << " "
+                               << other.magnitude.text;
     EXPECT_LT(d.selection.after.heldout_total, d.selection.before.heldout_total) << "joint " << j;
   }
 }
@@ -119,7 +126,8 @@ TYPED_TEST(AnyRobotGap, AControllersCsvThroughImportIdentifyDiagnoseAndCompare) 
   using After = typename TypeParam::After;
   constexpr int n = Full::nq;
   const int offset_joint = n;  // the last joint, -0.06 N m
-  const io::Log log = test::synthesize<Full>("arm", this->truth_, 60.0, 5, 0.05, test::offset_on<Full>(offset_joint, -0.06));
+  const io::Log log =
+      test::synthesize<Full>("arm", this->truth_, 60.0, 5, 0.05, test::offset_on<Full>(offset_joint, -0.06));
 
   // The controller's export: milliseconds, degrees (m for a prismatic joint), its own column
   // names, a text column.
@@ -142,7 +150,8 @@ TYPED_TEST(AnyRobotGap, AControllersCsvThroughImportIdentifyDiagnoseAndCompare) 
   const io::DatasetImportResult imported = io::import_dataset(this->dir_ / "data", im);
   ASSERT_EQ(imported.runs.size(), 2u);
   int stale = 0;
-  for (int i = 1; i < log.samples(); ++i) stale += log.q.row(i) == log.q.row(i - 1) && log.tau.row(i) == log.tau.row(i - 1);
+  for (int i = 1; i < log.samples(); ++i)
+    stale += log.q.row(i) == log.q.row(i - 1) && log.tau.row(i) == log.tau.row(i - 1);
   EXPECT_EQ(static_cast<int>(imported.logs[0].stale_lines.size()), stale);
   EXPECT_GT(stale, log.samples() / 40);
 
@@ -237,8 +246,9 @@ namespace {
 TEST(DiagnoseVariant, EverySelectedWidthIsKept) {
   using symoro::diagnose::EffectKind;
   symoro::diagnose::Diagnosis d;
-  for (const auto& [kind, joint, width] : {std::tuple{EffectKind::Coulomb, 4, 0.01}, std::tuple{EffectKind::Offset, 5, 0.0},
-                                           std::tuple{EffectKind::Coulomb, 2, 0.03}}) {
+  for (const auto& [kind, joint, width] :
+       {std::tuple{EffectKind::Coulomb, 4, 0.01}, std::tuple{EffectKind::Offset, 5, 0.0},
+        std::tuple{EffectKind::Coulomb, 2, 0.03}}) {
     symoro::diagnose::SelectedEffect e;
     e.candidate.kind = kind;
     e.candidate.joint = joint;
@@ -246,7 +256,8 @@ TEST(DiagnoseVariant, EverySelectedWidthIsKept) {
     d.selection.effects.push_back(e);
   }
   const std::string y = symoro::diagnose::variant_yaml(d, "reduced_diagnosed", "reduced");
-  EXPECT_NE(y.find("      smooth_coulomb: {joints: [2, 4], velocity: [0.0375994, 0.0125331]}\n"), std::string::npos) << y;
+  EXPECT_NE(y.find("      smooth_coulomb: {joints: [2, 4], velocity: [0.0375994, 0.0125331]}\n"), std::string::npos)
+      << y;
   EXPECT_NE(y.find("      offset: [5]\n"), std::string::npos) << y;
   EXPECT_EQ(y.find("# also"), std::string::npos) << y;
   EXPECT_NE(y.find("    base: reduced\n"), std::string::npos) << y;
@@ -272,7 +283,8 @@ TEST(DiagnoseVariant, ApplyAddsTheVariantsSectionARobotYamlLacks) {
   e.candidate.kind = symoro::diagnose::EffectKind::Offset;
   e.candidate.joint = 2;
   d.selection.effects.push_back(e);
-  symoro::diagnose::add_variant_to_robot_yaml(yaml, "diagnosed", symoro::diagnose::variant_yaml(d, "diagnosed", "full"));
+  symoro::diagnose::add_variant_to_robot_yaml(yaml, "diagnosed",
+                                              symoro::diagnose::variant_yaml(d, "diagnosed", "full"));
   const std::string once = symoro::io::read_text_file(yaml);
   EXPECT_EQ(once.substr(0, original.size()), original);
   EXPECT_EQ(once.substr(original.size()), "variants:\n" + symoro::diagnose::variant_yaml(d, "diagnosed", "full"));
@@ -280,8 +292,9 @@ TEST(DiagnoseVariant, ApplyAddsTheVariantsSectionARobotYamlLacks) {
   const std::string twice = symoro::io::read_text_file(yaml);
   EXPECT_EQ(twice.find("\nvariants:"), twice.rfind("\nvariants:")) << "one section: " << twice;
   EXPECT_EQ(twice.substr(once.size()), symoro::diagnose::variant_yaml(d, "again", "full"));
-  EXPECT_THROW(symoro::diagnose::add_variant_to_robot_yaml(yaml, "again", symoro::diagnose::variant_yaml(d, "again", "full")),
-               symoro::diagnose::DiagnosisRequestError);
+  EXPECT_THROW(
+      symoro::diagnose::add_variant_to_robot_yaml(yaml, "again", symoro::diagnose::variant_yaml(d, "again", "full")),
+      symoro::diagnose::DiagnosisRequestError);
 }
 
 }  // namespace

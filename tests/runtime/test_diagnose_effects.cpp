@@ -80,14 +80,17 @@ TwinConfig base_config() { return symoro::twin::read_twin_config(kRobot + "/twin
 // The closed-loop high-band stage on AG02: the robot's twin description (robots/crane_x7/twin.yaml,
 // none of the hidden effects) plus what the selection named.
 BacklashFit high_band(const Data& d, const Selection& s) {
-  const BacklashFit b = fit_backlash(symoro::robot::compiled_model<Full>(), d.train_log, symoro::trajectory::sampled_reference(d.train_log, 0.001), with_selected_effects(base_config(), s));
+  const BacklashFit b =
+      fit_backlash(symoro::robot::compiled_model<Full>(), d.train_log,
+                   symoro::trajectory::sampled_reference(d.train_log, 0.001), with_selected_effects(base_config(), s));
   if (std::getenv("SYMORO_DIAGNOSE_VERBOSE")) {
     for (const auto& f : b.findings)
-      std::cout << fmt::format("  -> backlash joint {}: {:.3f} deg ({:.4f} measured, {:.4f} +- {:.4f} before, {:.4f} after)\n",
-                               f.joint, f.width * 180 / M_PI, f.measured, f.simulated_before, f.spread, f.simulated_after);
+      std::cout << fmt::format(
+          "  -> backlash joint {}: {:.3f} deg ({:.4f} measured, {:.4f} +- {:.4f} before, {:.4f} after)\n", f.joint,
+          f.width * 180 / M_PI, f.measured, f.simulated_before, f.spread, f.simulated_after);
     for (Eigen::Index j = 0; j < b.measured.size(); ++j)
-      std::cout << fmt::format("  joint {}: measured {:.4f} null {:.4f} (floor {:.4f}) spread {:.4f}\n", j + 1, b.measured(j),
-                               b.simulated(j), b.floor.rms(j), b.spread(j));
+      std::cout << fmt::format("  joint {}: measured {:.4f} null {:.4f} (floor {:.4f}) spread {:.4f}\n", j + 1,
+                               b.measured(j), b.simulated(j), b.floor.rms(j), b.spread(j));
     std::cout << fmt::format("  encoder noise {:.3f} counts, lag {}\n", b.floor.encoder_noise, b.floor.lag);
     std::cout << fmt::format("  high band: {} simulations, delay {:.3f} ms\n", b.simulations, b.delay * 1e3);
   }
@@ -99,18 +102,22 @@ bool verbose() { return std::getenv("SYMORO_DIAGNOSE_VERBOSE") != nullptr; }
 void print(const Selection& s) {
   if (!verbose()) return;
   for (const auto& st : s.steps) {
-    std::cout << fmt::format("step: tau_int {:.1f}, level {:.2e}, chosen '{}'\n", st.autocorrelation_time, st.level, st.chosen);
+    std::cout << fmt::format("step: tau_int {:.1f}, level {:.2e}, chosen '{}'\n", st.autocorrelation_time, st.level,
+                             st.chosen);
     for (std::size_t i = 0; i < st.tests.size(); ++i) {
       const auto& t = st.tests[i];
       const char* watch = std::getenv("WATCH");
       if (i >= 6 && !(watch && t.key.find(watch) != std::string::npos)) continue;
-      std::cout << fmt::format("  {:28s}{} F {:10.1f} p {:.1e} tau {:5.1f} gain {:7.4f} all {:7.4f} rms {:.4f} mag {:.3g} {}{}{}\n", t.key,
-                               t.absorbed ? " absorbed" : "", t.f, t.p_value, t.effective_time, t.heldout_gain, t.heldout_reduction,
-                               t.effect_rms, t.magnitude.empty() ? 0.0 : t.magnitude[0], t.significant ? "S" : "-", t.generalizes ? "G" : "-", t.physical ? "" : " non-physical");
+      std::cout << fmt::format(
+          "  {:28s}{} F {:10.1f} p {:.1e} tau {:5.1f} gain {:7.4f} all {:7.4f} rms {:.4f} mag {:.3g} {}{}{}\n", t.key,
+          t.absorbed ? " absorbed" : "", t.f, t.p_value, t.effective_time, t.heldout_gain, t.heldout_reduction,
+          t.effect_rms, t.magnitude.empty() ? 0.0 : t.magnitude[0], t.significant ? "S" : "-",
+          t.generalizes ? "G" : "-", t.physical ? "" : " non-physical");
     }
   }
   for (const auto& e : s.effects) std::cout << "  -> " << e.candidate.label() << ": " << e.magnitude.text << "\n";
-  std::cout << fmt::format("held-out rmse {:.4f} -> {:.4f} N m; {}\n", s.before.heldout_total, s.after.heldout_total, s.stop_reason);
+  std::cout << fmt::format("held-out rmse {:.4f} -> {:.4f} N m; {}\n", s.before.heldout_total, s.after.heldout_total,
+                           s.stop_reason);
 }
 
 const SelectedEffect* find(const Selection& s, EffectKind kind, int joint) {
@@ -230,15 +237,17 @@ TEST(DiagnoseTwin, Backlash) {
     symoro::twin::RunOptions ro;
     ro.robot = "crane_x7";
     ro.seed = 4242;
-    return high_band_rms(symoro::twin::ClosedLoopTwin(symoro::robot::compiled_model<Full>(), tc).run(design().build("V01"), ro));
+    return high_band_rms(
+        symoro::twin::ClosedLoopTwin(symoro::robot::compiled_model<Full>(), tc).run(design().build("V01"), ro));
   };
   const Eigen::VectorXd measured = high_band_rms(d.heldout_log), before = simulate_v01(fitted);
   fitted.effects.backlash = true;
   for (const auto& f : b.findings) fitted.effects.backlash_width(f.joint - 1) = f.width;
   const Eigen::VectorXd after = simulate_v01(fitted);
   for (int j : {0}) {
-    std::cout << fmt::format("V01 joint {}: high-band torque {:.4f} measured, {:.4f} simulated without play, {:.4f} with\n",
-                             j + 1, measured(j), before(j), after(j));
+    std::cout << fmt::format(
+        "V01 joint {}: high-band torque {:.4f} measured, {:.4f} simulated without play, {:.4f} with\n", j + 1,
+        measured(j), before(j), after(j));
     EXPECT_LT(std::abs(after(j) - measured(j)), 0.5 * std::abs(before(j) - measured(j))) << "joint " << j + 1;
   }
 }
@@ -257,7 +266,9 @@ TEST(DiagnoseTwin, CoulombOffsetAndDelayTogether) {
   const Data d = simulate(c, 16);
   const Selection s = select_effects(d.train, d.heldout);
   print(s);
-  expect_effects(s, {{EffectKind::Coulomb, 2, 0.10}, {EffectKind::Coulomb, 4, 0.06}, {EffectKind::Offset, 5, -0.02},
+  expect_effects(s, {{EffectKind::Coulomb, 2, 0.10},
+                     {EffectKind::Coulomb, 4, 0.06},
+                     {EffectKind::Offset, 5, -0.02},
                      {EffectKind::ActuationDelay, 0, 0.004}});
   const BacklashFit b = high_band(d, s);
   EXPECT_TRUE(b.findings.empty()) << "backlash named with Coulomb, offset and delay";
@@ -272,16 +283,21 @@ TEST(DiagnoseTwin, CoulombOffsetAndDelayTogether) {
 // flange axis the diagnosis names the payload, its mass within 20 % and its centre.
 TEST(DiagnoseTwin, PayloadAgainstAnEarlierIdentification) {
   const Data before = simulate(base_config(), 17);
-  const Eigen::VectorXd phi = fit_with_effects(before.train, before.heldout, {}, Eigen::VectorXd::Ones(n), SelectionOptions{}.max_lag).phi;
+  const Eigen::VectorXd phi =
+      fit_with_effects(before.train, before.heldout, {}, Eigen::VectorXd::Ones(n), SelectionOptions{}.max_lag).phi;
   // The twin's true parameters are not what is held: the estimate, with its own errors.
-  ASSERT_GT((phi - Reduced::from_parent(symoro::twin::make_truth(symoro::robot::compiled_model<Full>(), base_config()).phi)).norm(), 0.0);
+  ASSERT_GT(
+      (phi - Reduced::from_parent(symoro::twin::make_truth(symoro::robot::compiled_model<Full>(), base_config()).phi))
+          .norm(),
+      0.0);
 
   Data clean = simulate(base_config(), 19);
   clean.train.hold(phi);
   clean.heldout.hold(phi);
   const Selection none = select_effects(clean.train, clean.heldout);
   print(none);
-  EXPECT_TRUE(none.effects.empty()) << "named on clean data with held parameters: " << none.effects.front().candidate.label();
+  EXPECT_TRUE(none.effects.empty()) << "named on clean data with held parameters: "
+                                    << none.effects.front().candidate.label();
 
   TwinConfig c = base_config();
   c.effects.payload = true;
@@ -306,7 +322,6 @@ TEST(DiagnoseTwin, PayloadAgainstAnEarlierIdentification) {
 }
 
 }  // namespace
-
 
 #include <symoro/planar2r.hpp>
 
@@ -377,7 +392,6 @@ TEST(DiagnoseEffects, TermsMatchTheCompiledVariant) {
 }
 
 }  // namespace
-
 
 #include "symoro/codegen/effects.hpp"
 #include "symoro/codegen/graph_evaluator.hpp"
@@ -474,7 +488,8 @@ TEST(EffectTable, TheDiagnosisTheCompilerAndTheTwinAgreeOnEveryRow) {
   const cg::EffectParameter fst{"FST1", "FST", 1, "N*m", 0, fx.stribeck_velocity};
   for (int j = 0; j < n; ++j)
     for (double qd : {-0.3, -0.12, 0.15, 0.25}) {  // |qd| >= 12 smoothing widths: tanh is the sign to 1e-10
-      const double expected = fx.coulomb_torque(j) * compiled_term(fc, 0, qd) + fx.stribeck_torque(j) * compiled_term(fst, 0, qd);
+      const double expected =
+          fx.coulomb_torque(j) * compiled_term(fc, 0, qd) + fx.stribeck_torque(j) * compiled_term(fst, 0, qd);
       EXPECT_NEAR(plant.extra_friction(j, qd), expected, 1e-9) << "joint " << j + 1 << ", qd " << qd;
     }
   // Offset: the plant with it under torques tau moves as the plant without it under tau + t.
@@ -487,7 +502,14 @@ TEST(EffectTable, TheDiagnosisTheCompilerAndTheTwinAgreeOnEveryRow) {
   plant.derivative(x, tau, dx_with);
   without.derivative(x, tau + fx.offset_torque, dx_without);
   EXPECT_LT((dx_with - dx_without).norm(), 1e-9 * dx_with.norm());
-  EXPECT_GT((dx_with - [&] { Eigen::VectorXd d(x.size()); without.derivative(x, tau, d); return d; }()).norm(), 1e-3);
+  EXPECT_GT((dx_with -
+             [&] {
+               Eigen::VectorXd d(x.size());
+               without.derivative(x, tau, d);
+               return d;
+             }())
+                .norm(),
+            1e-3);
 }
 
 }  // namespace

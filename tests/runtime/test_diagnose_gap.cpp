@@ -56,10 +56,11 @@ const std::filesystem::path& dataset() {
     const auto d = temp("data");
     std::vector<std::string> names{"AG02"};
     names.insert(names.end(), kValid.begin(), kValid.end());
-    test::write_twin_dataset<Full>(d, hidden_effects(),
-                                   trajectory::TrajectoryDesign::read(kRobot + "/trajectories.yaml",
-                                                                      std::vector<JointInfo>(Full::joints.begin(), Full::joints.end())),
-                                   names, 2);
+    test::write_twin_dataset<Full>(
+        d, hidden_effects(),
+        trajectory::TrajectoryDesign::read(kRobot + "/trajectories.yaml",
+                                           std::vector<JointInfo>(Full::joints.begin(), Full::joints.end())),
+        names, 2);
     return d;
   }();
   return dir;
@@ -75,9 +76,9 @@ study::StudyResult study(const std::filesystem::path& out) {
   o.intervals = {0.010};
   o.threads = 1;
   study::Study s(identify::identification_model<Model>(), o,
-                           trajectory::TrajectoryDesign::read(kRobot + "/trajectories.yaml",
-                                                              std::vector<JointInfo>(Model::joints.begin(), Model::joints.end())),
-                           identify::closed_loop_setup(twin::read_twin_config(kRobot + "/twin.yaml", Model::nq).controller));
+                 trajectory::TrajectoryDesign::read(kRobot + "/trajectories.yaml",
+                                                    std::vector<JointInfo>(Model::joints.begin(), Model::joints.end())),
+                 identify::closed_loop_setup(twin::read_twin_config(kRobot + "/twin.yaml", Model::nq).controller));
   study::StudyResult r = s.run();
   r.truth = twin::identified_truth(symoro::robot::compiled_model<Model>(), hidden_effects());
   study::write_validation(r, out);
@@ -179,7 +180,11 @@ void malformed_validation_files_name_file_and_line() {
   std::getline(in, first);
   while (std::getline(in, line)) rest += line + "\n";
   in.close();
-  std::ofstream(csv) << header << "\n" << first << "\n" << "0.5,abc" << "\n" << rest;
+  std::ofstream(csv) << header << "\n"
+                     << first << "\n"
+                     << "0.5,abc"
+                     << "\n"
+                     << rest;
   try {
     study::read_validation(dir);
     FAIL() << "no error";

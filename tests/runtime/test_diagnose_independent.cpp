@@ -46,18 +46,22 @@ bool verbose() { return std::getenv("SYMORO_DIAGNOSE_VERBOSE") != nullptr; }
 void print(const BacklashFit& b) {
   if (!verbose()) return;
   for (Eigen::Index j = 0; j < b.measured.size(); ++j)
-    std::cout << fmt::format("  joint {}: measured {:.4f} null {:.4f} (floor {:.4f}, encoder noise {:.3f}) spread {:.4f}\n", j + 1,
-                             b.measured(j), b.simulated(j), b.floor.rms(j), b.floor.encoder_noise_per_joint(j), b.spread(j));
+    std::cout << fmt::format(
+        "  joint {}: measured {:.4f} null {:.4f} (floor {:.4f}, encoder noise {:.3f}) spread {:.4f}\n", j + 1,
+        b.measured(j), b.simulated(j), b.floor.rms(j), b.floor.encoder_noise_per_joint(j), b.spread(j));
   std::cout << fmt::format("  encoder noise {:.3f} counts, lag {}\n", b.floor.encoder_noise, b.floor.lag);
-  for (const auto& f : b.findings) std::cout << fmt::format("  -> play on joint {}: {:.3f} deg\n", f.joint, f.width / kDeg);
+  for (const auto& f : b.findings)
+    std::cout << fmt::format("  -> play on joint {}: {:.3f} deg\n", f.joint, f.width / kDeg);
   for (const auto& n : b.notes) std::cout << "  note: " << n << "\n";
 }
 
 void print(const Selection& s) {
   if (!verbose()) return;
   for (const auto& e : s.effects) std::cout << "  -> " << e.candidate.label() << ": " << e.magnitude.text << "\n";
-  for (const auto& e : s.dropped) std::cout << "  dropped " << e.candidate.label() << ": " << e.magnitude << " (" << e.reason << ")\n";
-  std::cout << fmt::format("  held-out rmse {:.4f} -> {:.4f} N m; {}\n", s.before.heldout_total, s.after.heldout_total, s.stop_reason);
+  for (const auto& e : s.dropped)
+    std::cout << "  dropped " << e.candidate.label() << ": " << e.magnitude << " (" << e.reason << ")\n";
+  std::cout << fmt::format("  held-out rmse {:.4f} -> {:.4f} N m; {}\n", s.before.heldout_total, s.after.heldout_total,
+                           s.stop_reason);
 }
 
 std::vector<int> play_joints(const BacklashFit& b) {
@@ -70,13 +74,15 @@ std::vector<int> play_joints(const BacklashFit& b) {
 template <class Full>
 BacklashFit backlash_stage(const io::Log& log, const TwinConfig& c, const Selection* s = nullptr) {
   const TwinConfig nominal = s ? with_selected_effects(c, *s) : c;
-  const BacklashFit b = fit_backlash(symoro::robot::compiled_model<Full>(), log, trajectory::sampled_reference(log, c.controller.period), nominal);
+  const BacklashFit b = fit_backlash(symoro::robot::compiled_model<Full>(), log,
+                                     trajectory::sampled_reference(log, c.controller.period), nominal);
   print(b);
   return b;
 }
 
 // Every selected effect must be one of `expected` (kind, joint), each present within `within`.
-void expect_effects(const Selection& s, const std::vector<std::tuple<EffectKind, int, double>>& expected, double within = 0.2) {
+void expect_effects(const Selection& s, const std::vector<std::tuple<EffectKind, int, double>>& expected,
+                    double within = 0.2) {
   for (const auto& [kind, joint, value] : expected) {
     const SelectedEffect* found = nullptr;
     for (const auto& e : s.effects)
@@ -95,7 +101,8 @@ void expect_effects(const Selection& s, const std::vector<std::tuple<EffectKind,
 // friction, and the Coulomb friction stands (`coulomb`: joint, N m). Before the joint's
 // friction shared one velocity spread, the forward steps named one on the CRANE-X7's data,
 // which the backward check (selection.hpp) then dropped.
-void lax_friction_selection(const DesignStack& train, const DesignStack& heldout, const std::vector<std::pair<int, double>>& coulomb) {
+void lax_friction_selection(const DesignStack& train, const DesignStack& heldout,
+                            const std::vector<std::pair<int, double>>& coulomb) {
   SelectionOptions lax;
   lax.alpha = 0.5;
   lax.min_heldout_gain = 0.002;
@@ -104,7 +111,8 @@ void lax_friction_selection(const DesignStack& train, const DesignStack& heldout
   const Selection l = select_effects(train, heldout, lax);
   print(l);
   for (const auto& e : l.dropped) EXPECT_NE(e.candidate.kind, EffectKind::Coulomb) << e.candidate.label() << " dropped";
-  for (const auto& e : l.effects) EXPECT_NE(e.candidate.kind, EffectKind::Stribeck) << e.candidate.label() << ": " << e.magnitude.text;
+  for (const auto& e : l.effects)
+    EXPECT_NE(e.candidate.kind, EffectKind::Stribeck) << e.candidate.label() << ": " << e.magnitude.text;
   for (const auto& [joint, value] : coulomb) {
     const SelectedEffect* c = nullptr;
     for (const auto& e : l.effects)
@@ -148,7 +156,8 @@ CraneRuns crane_runs(const test::IndependentArmOptions& base, bool stacks) {
   so.cutoff = 5;
   auto stack = [&](const std::vector<std::pair<std::string, io::Log>>& logs) {
     std::vector<NamedSamples> runs;
-    for (const auto& [name, log] : logs) runs.push_back({name, preprocess::preprocess(log, 0.001, light_preprocessing())});
+    for (const auto& [name, log] : logs)
+      runs.push_back({name, preprocess::preprocess(log, 0.001, light_preprocessing())});
     return stack_design<Crane, CraneReduced>(runs, so);
   };
   r.train = stack({{"AG02", r.fit}});
@@ -167,8 +176,8 @@ TEST(DiagnoseIndependentCrane, NoPlayIsNamedOnAnArmWithoutPlay) {
   twin::RunOptions ro;
   ro.robot = "crane_x7";
   ro.seed = 5;
-  const Eigen::VectorXd plain =
-      high_band_rms(twin::ClosedLoopTwin(symoro::robot::compiled_model<Crane>(), crane_twin()).run(trajectory::sampled_reference(r.fit, 0.001), ro));
+  const Eigen::VectorXd plain = high_band_rms(twin::ClosedLoopTwin(symoro::robot::compiled_model<Crane>(), crane_twin())
+                                                  .run(trajectory::sampled_reference(r.fit, 0.001), ro));
   int above = 0;
   for (int j = 0; j < Crane::nq; ++j) above += b.measured(j) > 1.5 * plain(j);
   EXPECT_GE(above, 1) << "the independent arm's high band is the twin's: the test tests nothing";
@@ -237,8 +246,11 @@ TwinConfig rx90_twin() {
     twin::UrdfJoint J;
     J.name = fmt::format("joint{}", j + 1);
     J.model_joint = j + 1;
-    const Eigen::Matrix3d R = (Eigen::AngleAxisd(f.alpha, Eigen::Vector3d::UnitX()) * Eigen::AngleAxisd(f.theta, Eigen::Vector3d::UnitZ())).toRotationMatrix();
-    J.xyz = Eigen::Vector3d(f.d, 0, 0) + Eigen::AngleAxisd(f.alpha, Eigen::Vector3d::UnitX()) * Eigen::Vector3d(0, 0, f.r);
+    const Eigen::Matrix3d R =
+        (Eigen::AngleAxisd(f.alpha, Eigen::Vector3d::UnitX()) * Eigen::AngleAxisd(f.theta, Eigen::Vector3d::UnitZ()))
+            .toRotationMatrix();
+    J.xyz =
+        Eigen::Vector3d(f.d, 0, 0) + Eigen::AngleAxisd(f.alpha, Eigen::Vector3d::UnitX()) * Eigen::Vector3d(0, 0, f.r);
     const Eigen::Vector3d ypr = R.eulerAngles(2, 1, 0);
     J.rpy = Eigen::Vector3d(ypr(2), ypr(1), ypr(0));
     c.chain.joints.push_back(J);
@@ -373,7 +385,8 @@ TEST(DiagnoseIndependentRx90, StribeckOfAnotherLawIsNamedBesideCoulomb) {
   const Rx90Runs r = rx90_runs(c, o);
   const Selection s = select_effects(r.train, r.heldout);
   print(s);
-  expect_effects(s, {{EffectKind::Coulomb, 2, 2.0}, {EffectKind::Stribeck, 2, 1.5}, {EffectKind::Coulomb, 4, 0.5}}, 0.25);
+  expect_effects(s, {{EffectKind::Coulomb, 2, 2.0}, {EffectKind::Stribeck, 2, 1.5}, {EffectKind::Coulomb, 4, 0.5}},
+                 0.25);
 }
 
 }  // namespace

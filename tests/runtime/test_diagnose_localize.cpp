@@ -157,17 +157,20 @@ class XmlCheck {
   void skip_misc() {
     for (;;) {
       ws();
-      if (at("<?")) skip_until("?>");
-      else if (at("<!--")) skip_until("-->");
-      else return;
+      if (at("<?"))
+        skip_until("?>");
+      else if (at("<!--"))
+        skip_until("-->");
+      else
+        return;
     }
   }
   std::string name() {
     const std::size_t b = i_;
     auto first = [](char c) { return std::isalpha(static_cast<unsigned char>(c)) || c == '_' || c == ':'; };
     if (i_ >= s_.size() || !first(s_[i_])) throw std::string("bad name");
-    while (i_ < s_.size() && (first(s_[i_]) || std::isdigit(static_cast<unsigned char>(s_[i_])) || s_[i_] == '-' ||
-                              s_[i_] == '.'))
+    while (i_ < s_.size() &&
+           (first(s_[i_]) || std::isdigit(static_cast<unsigned char>(s_[i_])) || s_[i_] == '-' || s_[i_] == '.'))
       ++i_;
     return s_.substr(b, i_ - b);
   }
@@ -176,11 +179,11 @@ class XmlCheck {
     if (end == std::string::npos || end - i_ > 10) throw std::string("bad reference");
     const std::string r = s_.substr(i_ + 1, end - i_ - 1);
     const bool named = r == "amp" || r == "lt" || r == "gt" || r == "quot" || r == "apos";
-    const bool numeric = r.size() > 1 && r[0] == '#' &&
-                         std::all_of(r.begin() + (r[1] == 'x' ? 2 : 1), r.end(), [&](char c) {
-                           return r[1] == 'x' ? std::isxdigit(static_cast<unsigned char>(c)) != 0
-                                              : std::isdigit(static_cast<unsigned char>(c)) != 0;
-                         });
+    const bool numeric =
+        r.size() > 1 && r[0] == '#' && std::all_of(r.begin() + (r[1] == 'x' ? 2 : 1), r.end(), [&](char c) {
+          return r[1] == 'x' ? std::isxdigit(static_cast<unsigned char>(c)) != 0
+                             : std::isdigit(static_cast<unsigned char>(c)) != 0;
+        });
     if (!named && !numeric) throw std::string("unknown reference &") + r + ";";
     i_ = end + 1;
   }
@@ -214,8 +217,10 @@ class XmlCheck {
       const char quote = s_[i_++];
       while (i_ < s_.size() && s_[i_] != quote) {
         if (s_[i_] == '<') throw std::string("'<' in an attribute");
-        if (s_[i_] == '&') reference();
-        else ++i_;
+        if (s_[i_] == '&')
+          reference();
+        else
+          ++i_;
       }
       if (i_ >= s_.size()) throw std::string("unterminated attribute");
       ++i_;
@@ -230,11 +235,16 @@ class XmlCheck {
         ++i_;
         return true;
       }
-      if (at("<!--")) skip_until("-->");
-      else if (at("<?")) skip_until("?>");
-      else if (at("<")) element();
-      else if (s_[i_] == '&') reference();
-      else ++i_;
+      if (at("<!--"))
+        skip_until("-->");
+      else if (at("<?"))
+        skip_until("?>");
+      else if (at("<"))
+        element();
+      else if (s_[i_] == '&')
+        reference();
+      else
+        ++i_;
     }
   }
 };
@@ -322,9 +332,9 @@ TEST(DiagnoseWelch, ParsevalOverPiecesOfUnequalLength) {
   EXPECT_NEAR(integral(psd, 0) / variance, 1, 0.03);
   EXPECT_NEAR(integral(psd, 1) / (sq1 / used), 1, 0.03);
   // The mean's power sits in the lowest bins (DC and the Hann lobe's first neighbour).
-  EXPECT_NEAR((integral(psd, 1, -1, 1.5 / (length * dt)) - integral(psd, 0, -1, 1.5 / (length * dt))) /
-                  (offset * offset),
-              1, 0.05);
+  EXPECT_NEAR(
+      (integral(psd, 1, -1, 1.5 / (length * dt)) - integral(psd, 0, -1, 1.5 / (length * dt))) / (offset * offset), 1,
+      0.05);
 }
 
 TEST(DiagnoseWelch, NoSegmentGivesAnEmptySpectrumAndBadLengthsThrow) {
@@ -342,8 +352,8 @@ TEST(DiagnoseLag, TorqueLagRecoversKnownShifts) {
   struct Case {
     double dt, delay;
   };
-  for (const Case c : {Case{0.001, 0.0030}, Case{0.001, 0.0024}, Case{0.001, -0.0017}, Case{0.01, 0.0043},
-                       Case{0.01, -0.0312}}) {
+  for (const Case c :
+       {Case{0.001, 0.0030}, Case{0.001, 0.0024}, Case{0.001, -0.0017}, Case{0.01, 0.0043}, Case{0.01, -0.0312}}) {
     std::mt19937 rng(17);
     std::normal_distribution<double> noise(0, 0.02);
     std::vector<Eigen::VectorXd> measured, model;
@@ -433,10 +443,9 @@ std::vector<ResidualSeries> coulomb_series(unsigned seed, double ar, double sigm
   for (int k = 0; k < trajectories; ++k) {
     const int n = static_cast<int>(seconds / dt);
     const Eigen::VectorXd noise = ar1(rng, n, ar, sigma);
-    out.push_back(make_series("C" + std::to_string(k), 100.0 * k, n, dt, {motion},
-                              [&](int i, Eigen::Index, double t) {
-                                return kCoulomb * (motion.qd(t) > 0 ? 1 : -1) + noise(i);
-                              }));
+    out.push_back(make_series("C" + std::to_string(k), 100.0 * k, n, dt, {motion}, [&](int i, Eigen::Index, double t) {
+      return kCoulomb * (motion.qd(t) > 0 ? 1 : -1) + noise(i);
+    }));
   }
   return out;
 }
@@ -678,14 +687,15 @@ TEST(DiagnoseLocalize, FrictionMisfitBiasesTheTorqueLagButNotTheAdjustedOne) {
   std::vector<ResidualSeries> series;
   for (int k = 0; k < 3; ++k) {
     const std::vector<Motion> motion{{1.0, 2 * pi * (0.2 + 0.05 * k), 0.3}, {1.0, 2 * pi * (0.3 + 0.05 * k), 1.3}};
-    auto s = make_series("F" + std::to_string(k), 40.0 * k, 6000, dt, motion, [](int, Eigen::Index, double) { return 0.0; });
+    auto s =
+        make_series("F" + std::to_string(k), 40.0 * k, 6000, dt, motion, [](int, Eigen::Index, double) { return 0.0; });
     for (Eigen::Index i = 0; i < s.time.size(); ++i)
       for (Eigen::Index j = 0; j < 2; ++j) {
         const Motion& m = motion[static_cast<std::size_t>(j)];
         const double t = s.time(i), late = t - delay;
         const double friction = j == 0 ? 0.05 * (m.qd(t) > 0 ? 1 : -1) : 0.02 * m.qd(t);
-        s.tau_measured(i, j) = 2 * std::sin(m.q(late)) + 0.3 * m.qdd(late) + 0.1 * static_cast<double>(j) +
-                               friction + noise(rng);  // the model's torque (make_series), delayed
+        s.tau_measured(i, j) = 2 * std::sin(m.q(late)) + 0.3 * m.qdd(late) + 0.1 * static_cast<double>(j) + friction +
+                               noise(rng);  // the model's torque (make_series), delayed
       }
     series.push_back(s);
   }

@@ -132,8 +132,7 @@ TEST(SerialPort, ReadHonoursDeadlineAndWritesArrive) {
   ASSERT_EQ(::write(master, hello, sizeof hello), 5);
   std::size_t got = 0;
   while (got < 5) {
-    const std::size_t n = port.read_some(Span<std::uint8_t>(buf + got, 64 - got),
-                                         Clock::now() + microseconds(100'000));
+    const std::size_t n = port.read_some(Span<std::uint8_t>(buf + got, 64 - got), Clock::now() + microseconds(100'000));
     ASSERT_GT(n, 0u);
     got += n;
   }
@@ -144,8 +143,10 @@ TEST(SerialPort, ReadHonoursDeadlineAndWritesArrive) {
   std::size_t n = 0;
   for (int i = 0; i < 100 && n < 5; ++i) {
     const ssize_t r = ::read(master, back + n, sizeof back - n);
-    if (r > 0) n += static_cast<std::size_t>(r);
-    else std::this_thread::sleep_for(microseconds(1000));
+    if (r > 0)
+      n += static_cast<std::size_t>(r);
+    else
+      std::this_thread::sleep_for(microseconds(1000));
   }
   EXPECT_EQ(n, 5u);
   EXPECT_TRUE(std::equal(hello, hello + 5, back));
@@ -204,8 +205,7 @@ TEST(DynamixelBus, WritesTorqueEnableAndOperatingModeWithProtocolErrors) {
 
   // Torque off: EEPROM writable again; an undefined mode is a range error.
   EXPECT_EQ(rig.bus.write(id, xs::kTorqueEnable, 0).outcome, Outcome::ok);
-  EXPECT_EQ(rig.bus.write(id, xs::kOperatingMode, 2).error.number(),
-            ErrorNumber::data_range_error);
+  EXPECT_EQ(rig.bus.write(id, xs::kOperatingMode, 2).error.number(), ErrorNumber::data_range_error);
   EXPECT_EQ(rig.bus.write(id, xs::kOperatingMode, 3).outcome, Outcome::ok);
   EXPECT_EQ(rig.virt.value(id, xs::kOperatingMode), 3);
 }
@@ -258,9 +258,8 @@ TEST(DynamixelBus, ControlLoopFollowsClosedFormAt1kHz) {
     s.write_start = Clock::now();
     const bool sent = rig.bus.sync_write(kIds, xs::kGoalCurrent, goal, deadline);
     s.read_start = Clock::now();
-    const Span<const Reply> replies =
-        rig.bus.sync_read(kIds, xs::kPresentCurrentVelocityPosition.address,
-                          xs::kPresentCurrentVelocityPosition.size, deadline);
+    const Span<const Reply> replies = rig.bus.sync_read(kIds, xs::kPresentCurrentVelocityPosition.address,
+                                                        xs::kPresentCurrentVelocityPosition.size, deadline);
     s.read_end = Clock::now();
     s.ok = sent;
     for (std::size_t i = 0; i < kServos; ++i) {
@@ -334,8 +333,8 @@ TEST(DynamixelBus, ControlLoopFollowsClosedFormAt1kHz) {
       "%.0f us, p99 %.0f us, max %.0f us; overruns %d, failed cycles %d; timeouts %llu, CRC %llu, "
       "retries %llu\n",
       kCycles, us[us.size() / 2], us[us.size() * 99 / 100], us.back(), overruns, failed,
-      static_cast<unsigned long long>(st.timeouts),
-      static_cast<unsigned long long>(st.crc_errors), static_cast<unsigned long long>(st.retries));
+      static_cast<unsigned long long>(st.timeouts), static_cast<unsigned long long>(st.crc_errors),
+      static_cast<unsigned long long>(st.retries));
 }
 
 // ---- Faults ------------------------------------------------------------------------------------
@@ -455,9 +454,8 @@ TEST(DynamixelBusFaults, ReplyFromAnotherIdIsWrongId) {
 
 TEST(DynamixelBus, BulkReadAndReturnDelay) {
   Rig rig;
-  const BulkReadItem items[] = {{2, xs::kModelNumber.address, 2},
-                                {3, xs::kModelNumber.address, 2},
-                                {9, xs::kPresentPosition.address, 4}};
+  const BulkReadItem items[] = {
+      {2, xs::kModelNumber.address, 2}, {3, xs::kModelNumber.address, 2}, {9, xs::kPresentPosition.address, 4}};
   const Span<const Reply> rs = rig.bus.bulk_read(items);
   ASSERT_EQ(rs.size(), 3u);
   EXPECT_EQ(rs[0].get<std::uint16_t>(), 1020);

@@ -47,43 +47,32 @@ struct Example {
 const std::vector<Example>& examples() {
   static const std::vector<Example> e = {
       {"ping", "FF FF FD 00 01 03 00 01 19 4E", 1, Instruction::ping, 0, ""},
-      {"ping status ID 1", "FF FF FD 00 01 07 00 55 00 06 04 26 65 5D", 1, Instruction::status, 0,
-       "06 04 26"},
+      {"ping status ID 1", "FF FF FD 00 01 07 00 55 00 06 04 26 65 5D", 1, Instruction::status, 0, "06 04 26"},
       {"broadcast ping", "FF FF FD 00 FE 03 00 01 31 42", 0xFE, Instruction::ping, 0, ""},
-      {"ping status ID 2", "FF FF FD 00 02 07 00 55 00 06 04 26 6F 6D", 2, Instruction::status, 0,
-       "06 04 26"},
-      {"read", "FF FF FD 00 01 07 00 02 84 00 04 00 1D 15", 1, Instruction::read, 0,
-       "84 00 04 00"},
-      {"read status", "FF FF FD 00 01 08 00 55 00 A6 00 00 00 8C C0", 1, Instruction::status, 0,
-       "A6 00 00 00"},
-      {"write", "FF FF FD 00 01 09 00 03 74 00 00 02 00 00 CA 89", 1, Instruction::write, 0,
-       "74 00 00 02 00 00"},
+      {"ping status ID 2", "FF FF FD 00 02 07 00 55 00 06 04 26 6F 6D", 2, Instruction::status, 0, "06 04 26"},
+      {"read", "FF FF FD 00 01 07 00 02 84 00 04 00 1D 15", 1, Instruction::read, 0, "84 00 04 00"},
+      {"read status", "FF FF FD 00 01 08 00 55 00 A6 00 00 00 8C C0", 1, Instruction::status, 0, "A6 00 00 00"},
+      {"write", "FF FF FD 00 01 09 00 03 74 00 00 02 00 00 CA 89", 1, Instruction::write, 0, "74 00 00 02 00 00"},
       {"write status", "FF FF FD 00 01 04 00 55 00 A1 0C", 1, Instruction::status, 0, ""},
-      {"reg write", "FF FF FD 00 01 09 00 04 68 00 C8 00 00 00 AE 8E", 1, Instruction::reg_write,
-       0, "68 00 C8 00 00 00"},
+      {"reg write", "FF FF FD 00 01 09 00 04 68 00 C8 00 00 00 AE 8E", 1, Instruction::reg_write, 0,
+       "68 00 C8 00 00 00"},
       {"action", "FF FF FD 00 01 03 00 05 02 CE", 1, Instruction::action, 0, ""},
-      {"factory reset", "FF FF FD 00 01 04 00 06 01 A1 E6", 1, Instruction::factory_reset, 0,
-       "01"},
+      {"factory reset", "FF FF FD 00 01 04 00 06 01 A1 E6", 1, Instruction::factory_reset, 0, "01"},
       {"reboot", "FF FF FD 00 01 03 00 08 2F 4E", 1, Instruction::reboot, 0, ""},
-      {"clear", "FF FF FD 00 01 08 00 10 01 44 58 4C 22 B1 DC", 1, Instruction::clear, 0,
-       "01 44 58 4C 22"},
-      {"sync read", "FF FF FD 00 FE 09 00 82 84 00 04 00 01 02 CE FA", 0xFE,
-       Instruction::sync_read, 0, "84 00 04 00 01 02"},
-      {"sync read status ID 1", "FF FF FD 00 01 08 00 55 00 A6 00 00 00 8C C0", 1,
-       Instruction::status, 0, "A6 00 00 00"},
-      {"sync read status ID 2", "FF FF FD 00 02 08 00 55 00 1F 08 00 00 BA BE", 2,
-       Instruction::status, 0, "1F 08 00 00"},
-      {"sync write",
-       "FF FF FD 00 FE 11 00 83 74 00 04 00 01 96 00 00 00 02 AA 00 00 00 82 87", 0xFE,
+      {"clear", "FF FF FD 00 01 08 00 10 01 44 58 4C 22 B1 DC", 1, Instruction::clear, 0, "01 44 58 4C 22"},
+      {"sync read", "FF FF FD 00 FE 09 00 82 84 00 04 00 01 02 CE FA", 0xFE, Instruction::sync_read, 0,
+       "84 00 04 00 01 02"},
+      {"sync read status ID 1", "FF FF FD 00 01 08 00 55 00 A6 00 00 00 8C C0", 1, Instruction::status, 0,
+       "A6 00 00 00"},
+      {"sync read status ID 2", "FF FF FD 00 02 08 00 55 00 1F 08 00 00 BA BE", 2, Instruction::status, 0,
+       "1F 08 00 00"},
+      {"sync write", "FF FF FD 00 FE 11 00 83 74 00 04 00 01 96 00 00 00 02 AA 00 00 00 82 87", 0xFE,
        Instruction::sync_write, 0, "74 00 04 00 01 96 00 00 00 02 AA 00 00 00"},
-      {"bulk read", "FF FF FD 00 FE 0D 00 92 01 90 00 02 00 02 92 00 01 00 1A 05", 0xFE,
-       Instruction::bulk_read, 0, "01 90 00 02 00 02 92 00 01 00"},
-      {"bulk read status ID 1", "FF FF FD 00 01 06 00 55 00 77 00 C3 69", 1, Instruction::status,
-       0, "77 00"},
-      {"bulk read status ID 2", "FF FF FD 00 02 05 00 55 00 24 8B A9", 2, Instruction::status, 0,
-       "24"},
-      {"bulk write",
-       "FF FF FD 00 FE 10 00 93 01 20 00 02 00 A0 00 02 1F 00 01 00 50 B7 68", 0xFE,
+      {"bulk read", "FF FF FD 00 FE 0D 00 92 01 90 00 02 00 02 92 00 01 00 1A 05", 0xFE, Instruction::bulk_read, 0,
+       "01 90 00 02 00 02 92 00 01 00"},
+      {"bulk read status ID 1", "FF FF FD 00 01 06 00 55 00 77 00 C3 69", 1, Instruction::status, 0, "77 00"},
+      {"bulk read status ID 2", "FF FF FD 00 02 05 00 55 00 24 8B A9", 2, Instruction::status, 0, "24"},
+      {"bulk write", "FF FF FD 00 FE 10 00 93 01 20 00 02 00 A0 00 02 1F 00 01 00 50 B7 68", 0xFE,
        Instruction::bulk_write, 0, "01 20 00 02 00 A0 00 02 1F 00 01 00 50"},
   };
   return e;
@@ -110,8 +99,7 @@ struct Outcome {
   Bytes raw;
   std::size_t skipped;
 };
-std::vector<Outcome> decode_all(const Bytes& input, std::mt19937* chunk_rng = nullptr,
-                                std::size_t fixed_chunk = 0,
+std::vector<Outcome> decode_all(const Bytes& input, std::mt19937* chunk_rng = nullptr, std::size_t fixed_chunk = 0,
                                 std::size_t max_length = Decoder::kDefaultMaxLength) {
   Decoder dec(max_length);
   std::vector<Outcome> out;
@@ -211,40 +199,31 @@ TEST(DynamixelInstructions, BuildersReproduceTheManualPackets) {
   Bytes out;
   EXPECT_EQ(copy(encode_ping(1, out)), hex("FF FF FD 00 01 03 00 01 19 4E"));
   EXPECT_EQ(copy(encode_ping(kBroadcastId, out)), hex("FF FF FD 00 FE 03 00 01 31 42"));
-  EXPECT_EQ(copy(encode_ping_reply(1, 1030, 38, out)),
-            hex("FF FF FD 00 01 07 00 55 00 06 04 26 65 5D"));
-  EXPECT_EQ(copy(encode_ping_reply(2, 1030, 38, out)),
-            hex("FF FF FD 00 02 07 00 55 00 06 04 26 6F 6D"));
+  EXPECT_EQ(copy(encode_ping_reply(1, 1030, 38, out)), hex("FF FF FD 00 01 07 00 55 00 06 04 26 65 5D"));
+  EXPECT_EQ(copy(encode_ping_reply(2, 1030, 38, out)), hex("FF FF FD 00 02 07 00 55 00 06 04 26 6F 6D"));
   EXPECT_EQ(copy(encode_read(1, 132, 4, out)), hex("FF FF FD 00 01 07 00 02 84 00 04 00 1D 15"));
   std::uint8_t value[4];
   store_le<std::int32_t>(value, 166);
-  EXPECT_EQ(copy(encode_status(1, 0, value, out)),
-            hex("FF FF FD 00 01 08 00 55 00 A6 00 00 00 8C C0"));
+  EXPECT_EQ(copy(encode_status(1, 0, value, out)), hex("FF FF FD 00 01 08 00 55 00 A6 00 00 00 8C C0"));
   store_le<std::int32_t>(value, 512);
-  EXPECT_EQ(copy(encode_write(1, 116, value, out)),
-            hex("FF FF FD 00 01 09 00 03 74 00 00 02 00 00 CA 89"));
+  EXPECT_EQ(copy(encode_write(1, 116, value, out)), hex("FF FF FD 00 01 09 00 03 74 00 00 02 00 00 CA 89"));
   EXPECT_EQ(copy(encode_status(1, 0, {}, out)), hex("FF FF FD 00 01 04 00 55 00 A1 0C"));
-  EXPECT_EQ(copy(encode_sync_read(132, 4, {1, 2}, out)),
-            hex("FF FF FD 00 FE 09 00 82 84 00 04 00 01 02 CE FA"));
+  EXPECT_EQ(copy(encode_sync_read(132, 4, {1, 2}, out)), hex("FF FF FD 00 FE 09 00 82 84 00 04 00 01 02 CE FA"));
   store_le<std::int32_t>(value, 2079);
-  EXPECT_EQ(copy(encode_status(2, 0, value, out)),
-            hex("FF FF FD 00 02 08 00 55 00 1F 08 00 00 BA BE"));
+  EXPECT_EQ(copy(encode_status(2, 0, value, out)), hex("FF FF FD 00 02 08 00 55 00 1F 08 00 00 BA BE"));
   std::uint8_t goals[8];
   store_le<std::int32_t>(goals, 150);
   store_le<std::int32_t>(goals + 4, 170);
   EXPECT_EQ(copy(encode_sync_write(116, 4, {1, 2}, goals, out)),
             hex("FF FF FD 00 FE 11 00 83 74 00 04 00 01 96 00 00 00 02 AA 00 00 00 82 87"));
   const BulkReadItem items[] = {{1, 144, 2}, {2, 146, 1}};
-  EXPECT_EQ(copy(encode_bulk_read(items, out)),
-            hex("FF FF FD 00 FE 0D 00 92 01 90 00 02 00 02 92 00 01 00 1A 05"));
-  EXPECT_EQ(copy(encode_status(1, 0, {0x77, 0x00}, out)),
-            hex("FF FF FD 00 01 06 00 55 00 77 00 C3 69"));
+  EXPECT_EQ(copy(encode_bulk_read(items, out)), hex("FF FF FD 00 FE 0D 00 92 01 90 00 02 00 02 92 00 01 00 1A 05"));
+  EXPECT_EQ(copy(encode_status(1, 0, {0x77, 0x00}, out)), hex("FF FF FD 00 01 06 00 55 00 77 00 C3 69"));
   EXPECT_EQ(copy(encode_status(2, 0, {0x24}, out)), hex("FF FF FD 00 02 05 00 55 00 24 8B A9"));
   // Bulk Write has no builder; PacketWriter composes it.
   PacketWriter w(out, kBroadcastId, Instruction::bulk_write);
   w.u8(1).u16(32).u16(2).u16(160).u8(2).u16(31).u16(1).u8(80);
-  EXPECT_EQ(copy(w.finish()),
-            hex("FF FF FD 00 FE 10 00 93 01 20 00 02 00 A0 00 02 1F 00 01 00 50 B7 68"));
+  EXPECT_EQ(copy(w.finish()), hex("FF FF FD 00 FE 10 00 93 01 20 00 02 00 A0 00 02 1F 00 01 00 50 B7 68"));
 }
 
 TEST(DynamixelInstructions, ParsersReadTheManualPackets) {
@@ -290,8 +269,8 @@ TEST(DynamixelInstructions, ParsersReadTheManualPackets) {
   EXPECT_EQ(sread->length, 4);
   EXPECT_EQ(copy(sread->ids), (Bytes{1, 2}));
 
-  const auto swrite = parse_sync_write(
-      packet("FF FF FD 00 FE 11 00 83 74 00 04 00 01 96 00 00 00 02 AA 00 00 00 82 87"));
+  const auto swrite =
+      parse_sync_write(packet("FF FF FD 00 FE 11 00 83 74 00 04 00 01 96 00 00 00 02 AA 00 00 00 82 87"));
   ASSERT_TRUE(swrite);
   EXPECT_EQ(swrite->address, 116);
   EXPECT_EQ(swrite->length, 4);
@@ -301,8 +280,7 @@ TEST(DynamixelInstructions, ParsersReadTheManualPackets) {
   EXPECT_EQ(swrite->id(1), 2);
   EXPECT_EQ(load_le<std::int32_t>(swrite->data(1).data()), 170);
 
-  const auto bread =
-      parse_bulk_read(packet("FF FF FD 00 FE 0D 00 92 01 90 00 02 00 02 92 00 01 00 1A 05"));
+  const auto bread = parse_bulk_read(packet("FF FF FD 00 FE 0D 00 92 01 90 00 02 00 02 92 00 01 00 1A 05"));
   ASSERT_TRUE(bread);
   ASSERT_EQ(bread->count(), 2u);
   EXPECT_EQ(bread->item(0).id, 1);
@@ -348,10 +326,10 @@ TEST(DynamixelInstructions, ReusedBufferDoesNotReallocate) {
   const std::uint8_t* before = out.data();
   std::uint8_t currents[16] = {};
   for (int cycle = 0; cycle < 100; ++cycle) {
-    encode_sync_read(xseries::kPresentCurrentVelocityPosition.address,
-                     xseries::kPresentCurrentVelocityPosition.size, {1, 2, 3, 4, 5, 6, 7, 8}, out);
-    encode_sync_write(xseries::kGoalCurrent.address, xseries::kGoalCurrent.size,
-                      {1, 2, 3, 4, 5, 6, 7, 8}, currents, out);
+    encode_sync_read(xseries::kPresentCurrentVelocityPosition.address, xseries::kPresentCurrentVelocityPosition.size,
+                     {1, 2, 3, 4, 5, 6, 7, 8}, out);
+    encode_sync_write(xseries::kGoalCurrent.address, xseries::kGoalCurrent.size, {1, 2, 3, 4, 5, 6, 7, 8}, currents,
+                      out);
   }
   EXPECT_EQ(out.data(), before);
 }
@@ -393,8 +371,7 @@ TEST(DynamixelStuffing, InsertsFdAfterEachHeaderPattern) {
   encode_write(1, 0xFFFF, {0xFF, 0xFD, 0xFD}, out);
   EXPECT_EQ(Bytes(out.begin() + 7, out.end() - 2), hex("03 FF FF FF FD FD FD"));
   encode_write(1, 0xFFFF, {0xFD, 0xFF, 0xFF, 0xFD, 0xFD, 0xFF, 0xFF, 0xFD}, out);
-  EXPECT_EQ(Bytes(out.begin() + 7, out.end() - 2),
-            hex("03 FF FF FD FD FF FF FD FD FD FF FF FD FD"));
+  EXPECT_EQ(Bytes(out.begin() + 7, out.end() - 2), hex("03 FF FF FD FD FF FF FD FD FD FF FF FD FD"));
 }
 
 TEST(DynamixelStuffing, RoundTripsPayloadsFullOfPatterns) {
@@ -406,8 +383,7 @@ TEST(DynamixelStuffing, RoundTripsPayloadsFullOfPatterns) {
     Bytes params(rng() % 40);
     for (auto& b : params) b = alphabet[rng() % 5];
     const bool status = rng() % 2;
-    Packet p{static_cast<std::uint8_t>(rng() % 253),
-             status ? Instruction::status : Instruction::write,
+    Packet p{static_cast<std::uint8_t>(rng() % 253), status ? Instruction::status : Instruction::write,
              status ? alphabet[rng() % 5] : std::uint8_t{0}, params};
     encode(p, out);
     const Bytes wire = out;
@@ -429,7 +405,7 @@ TEST(DynamixelStuffing, RoundTripsPayloadsFullOfPatterns) {
 // The manual's packets with garbage between them: random bytes free of FF, lone FF runs, and
 // header prefixes that never complete.
 Bytes noisy_stream(std::mt19937& rng, std::vector<Bytes>& expected) {
-  const std::vector<Bytes> junk = {hex("FF"), hex("FF FF"), hex("FF FF FD"), hex("FF FF FF FD 01"),
+  const std::vector<Bytes> junk = {hex("FF"),          hex("FF FF"),   hex("FF FF FD"), hex("FF FF FF FD 01"),
                                    hex("FF FF FD FD"), hex("00 FD 00")};
   Bytes stream;
   for (int round = 0; round < 3; ++round) {
@@ -472,8 +448,7 @@ TEST(DynamixelDecoder, ResynchronizesWhateverTheChunking) {
 }
 
 TEST(DynamixelDecoder, CutOffPacketIsTruncatedAndTheNextOneSurvives) {
-  const Bytes sync_write =
-      hex("FF FF FD 00 FE 11 00 83 74 00 04 00 01 96 00 00 00 02 AA 00 00 00 82 87");
+  const Bytes sync_write = hex("FF FF FD 00 FE 11 00 83 74 00 04 00 01 96 00 00 00 02 AA 00 00 00 82 87");
   const Bytes status = hex("FF FF FD 00 01 08 00 55 00 A6 00 00 00 8C C0");
   for (std::size_t cut = 1; cut < sync_write.size(); ++cut) {
     Bytes stream(sync_write.begin(), sync_write.begin() + static_cast<std::ptrdiff_t>(cut));
@@ -485,13 +460,12 @@ TEST(DynamixelDecoder, CutOffPacketIsTruncatedAndTheNextOneSurvives) {
         ASSERT_GE(events.size(), 2u);
         EXPECT_EQ(events[0].kind, DecodeEvent::Kind::error);
         // Cut within ID or Length, the next header's FF bytes make them invalid.
-        const DecodeError expected = cut == 4   ? DecodeError::bad_id
+        const DecodeError expected = cut == 4  ? DecodeError::bad_id
                                      : cut < 7 ? DecodeError::bad_length
                                                : DecodeError::truncated;
         EXPECT_EQ(events[0].error, expected) << "cut " << cut;
         if (cut >= 7)  // the rejected bytes are exactly the cut-off packet
-          EXPECT_EQ(events[0].raw, Bytes(sync_write.begin(),
-                                         sync_write.begin() + static_cast<std::ptrdiff_t>(cut)));
+          EXPECT_EQ(events[0].raw, Bytes(sync_write.begin(), sync_write.begin() + static_cast<std::ptrdiff_t>(cut)));
       }
     }
   }
@@ -556,7 +530,7 @@ TEST(DynamixelDecoder, CorruptedBytesGiveBadCrc) {
 }
 
 TEST(DynamixelDecoder, LengthOutOfRangeIsRejectedWithoutWaiting) {
-  Decoder dec;  // max Length 1024
+  Decoder dec;                                                   // max Length 1024
   DecodeEvent e = decode_one(dec, hex("FF FF FD 00 01 01 04"));  // Length 1025
   ASSERT_EQ(e.kind, DecodeEvent::Kind::error);
   EXPECT_EQ(e.error, DecodeError::bad_length);
@@ -605,9 +579,8 @@ TEST(DynamixelDecoder, OtherTypedErrors) {
   EXPECT_EQ(e.error, DecodeError::bad_stuffing);
   e = decode_one(dec, with_crc(hex("FF FF FD 00 01 08 00 03 FF FF FD 01 00")));
   EXPECT_EQ(e.error, DecodeError::bad_stuffing);
-  for (DecodeError err : {DecodeError::bad_id, DecodeError::bad_length, DecodeError::bad_crc,
-                          DecodeError::truncated, DecodeError::bad_stuffing,
-                          DecodeError::unknown_instruction})
+  for (DecodeError err : {DecodeError::bad_id, DecodeError::bad_length, DecodeError::bad_crc, DecodeError::truncated,
+                          DecodeError::bad_stuffing, DecodeError::unknown_instruction})
     EXPECT_STRNE(to_string(err), "unknown decode error");
 }
 
@@ -619,16 +592,12 @@ TEST(DynamixelDecoder, StatusErrorByte) {
     bool alert;
     ErrorNumber number;
   };
-  for (const Case& c : {Case{0x00, false, ErrorNumber::none},
-                        Case{0x01, false, ErrorNumber::result_fail},
-                        Case{0x02, false, ErrorNumber::instruction_error},
-                        Case{0x03, false, ErrorNumber::crc_error},
-                        Case{0x04, false, ErrorNumber::data_range_error},
-                        Case{0x05, false, ErrorNumber::data_length_error},
-                        Case{0x06, false, ErrorNumber::data_limit_error},
-                        Case{0x07, false, ErrorNumber::access_error},
-                        Case{0x80, true, ErrorNumber::none},
-                        Case{0x84, true, ErrorNumber::data_range_error}}) {
+  for (const Case& c :
+       {Case{0x00, false, ErrorNumber::none}, Case{0x01, false, ErrorNumber::result_fail},
+        Case{0x02, false, ErrorNumber::instruction_error}, Case{0x03, false, ErrorNumber::crc_error},
+        Case{0x04, false, ErrorNumber::data_range_error}, Case{0x05, false, ErrorNumber::data_length_error},
+        Case{0x06, false, ErrorNumber::data_limit_error}, Case{0x07, false, ErrorNumber::access_error},
+        Case{0x80, true, ErrorNumber::none}, Case{0x84, true, ErrorNumber::data_range_error}}) {
     encode_status(3, c.raw, {}, out);
     const DecodeEvent e = decode_one(dec, out);
     ASSERT_EQ(e.kind, DecodeEvent::Kind::packet);

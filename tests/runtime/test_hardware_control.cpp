@@ -34,13 +34,14 @@ TEST_F(HardwareControl, ConfigErrorsNameFileAndLine) {
   std::ofstream(bad) << broken;
   EXPECT_THROW(read_hardware_config(bad, joints()), DataError);
   // No value switches a limit off: each is bounded, and the error names the file's line.
-  for (const auto& [from, to] : std::vector<std::pair<std::string, std::string>>{{"velocity_factor: 1.0", "velocity_factor: 100"},
-                                                                                 {"position_tolerance: 0.05", "position_tolerance: 1e9"},
-                                                                                 {"current_trip_factor: 1.5", "current_trip_factor: 0.5"},
-                                                                                 {"approach_speed: 0.3", "approach_speed: 5"},
-                                                                                 {"pre_roll: 0.5", "pre_roll: -1"},
-                                                                                 {"hold_time: 2.0", "hold_time: 1000"},
-                                                                                 {"zero: 2048", "zero: 99999"}}) {
+  for (const auto& [from, to] :
+       std::vector<std::pair<std::string, std::string>>{{"velocity_factor: 1.0", "velocity_factor: 100"},
+                                                        {"position_tolerance: 0.05", "position_tolerance: 1e9"},
+                                                        {"current_trip_factor: 1.5", "current_trip_factor: 0.5"},
+                                                        {"approach_speed: 0.3", "approach_speed: 5"},
+                                                        {"pre_roll: 0.5", "pre_roll: -1"},
+                                                        {"hold_time: 2.0", "hold_time: 1000"},
+                                                        {"zero: 2048", "zero: 99999"}}) {
     broken = text;
     const auto at = broken.find(from);
     ASSERT_NE(at, std::string::npos) << from;
@@ -150,12 +151,13 @@ TEST_F(HardwareControl, TracksFiveSecondsOverThePtyLikeTheTwin) {
   std::printf("\n");
   // The tracking-error bound of that loop (twin/tracking_bound.hpp: the controller, its timing,
   // the plant's unmodelled torque along the trajectory).
-  const Eigen::VectorXd sup_w = twin::unmodeled_torque(reference, traj, [&](const Eigen::VectorXd& q, const Eigen::VectorXd& qd, const Eigen::VectorXd& qdd) {
-    Eigen::Matrix<double, Model::nq, 1> tau;
-    Model::inverse_dynamics(Eigen::Matrix<double, Model::nq, 1>(q), Eigen::Matrix<double, Model::nq, 1>(qd),
-                            Eigen::Matrix<double, Model::nq, 1>(qdd), rig.backend->truth().phi, tau);
-    return Eigen::VectorXd(tau);
-  });
+  const Eigen::VectorXd sup_w = twin::unmodeled_torque(
+      reference, traj, [&](const Eigen::VectorXd& q, const Eigen::VectorXd& qd, const Eigen::VectorXd& qdd) {
+        Eigen::Matrix<double, Model::nq, 1> tau;
+        Model::inverse_dynamics(Eigen::Matrix<double, Model::nq, 1>(q), Eigen::Matrix<double, Model::nq, 1>(qd),
+                                Eigen::Matrix<double, Model::nq, 1>(qdd), rig.backend->truth().phi, tau);
+        return Eigen::VectorXd(tau);
+      });
   const Eigen::VectorXd bound = twin::tracking_error_bound(reference, sup_w);
   std::printf("tracking-error bound (deg):              ");
   for (int j = 0; j < Model::nq; ++j) std::printf(" %.3f", bound(j) * kDeg);
@@ -220,7 +222,7 @@ TEST_F(HardwareControl, LostServoStopsAndIsNamed) {
   EXPECT_EQ(r.stop_action, StopAction::torque_off);
   EXPECT_NE(r.message.find("servo ID 5 (joint 4 elbow)"), std::string::npos) << r.message;
   EXPECT_FALSE(r.torque_off_confirmed);  // the dead servo cannot confirm
-  rig.expect_safe(5);                     // every other servo is off
+  rig.expect_safe(5);                    // every other servo is off
   expect_log(r, csv);
   // Once it answers again, a safe stop reaches it too.
   rig.virt.set_dead(5, false);
@@ -234,7 +236,8 @@ TEST_F(HardwareControl, HardwareErrorStopsWithItsStatus) {
   ControlOptions o = options();
   o.seconds = 2.0;
   const std::string csv = (dir_ / "alert.csv").string();
-  const ControlResult r = run(rig, traj, csv, o, 0.5, [](Rig& g) { g.virt.set_hardware_error(7, xs::hardware_error::kOverload); });
+  const ControlResult r =
+      run(rig, traj, csv, o, 0.5, [](Rig& g) { g.virt.set_hardware_error(7, xs::hardware_error::kOverload); });
   EXPECT_EQ(r.reason, StopReason::hardware_error) << r.message;
   EXPECT_EQ(r.stop_action, StopAction::torque_off);
   EXPECT_NE(r.message.find("servo ID 7"), std::string::npos) << r.message;
@@ -252,7 +255,8 @@ TEST_F(HardwareControl, ANonFiniteCommandStopsAndIsNamed) {
   // pre-roll call it too): never a silent zero or a saturated command.
   // (From trajectory time 0.5 s on: before torque on, the check of every reference must pass.)
   auto broken = std::make_shared<std::atomic<bool>>(false);
-  o.feedforward = [broken](const Eigen::VectorXd& q, const Eigen::VectorXd&, const Eigen::VectorXd&, Eigen::VectorXd& tau) {
+  o.feedforward = [broken](const Eigen::VectorXd& q, const Eigen::VectorXd&, const Eigen::VectorXd&,
+                           Eigen::VectorXd& tau) {
     tau = Eigen::VectorXd::Zero(q.size());
     if (broken->load()) tau(2) = std::numeric_limits<double>::quiet_NaN();
   };
@@ -343,7 +347,8 @@ TEST_F(HardwareControl, ModelFeedforwardFromAStudysParameters) {
   twin::RunStats st;
   sim.run(traj, ro, &st);
   std::printf("max |q_ref - q| (deg), model feedforward over the bus vs FF+PD alone (twin):\n");
-  for (int j = 0; j < Model::nq; ++j) std::printf("  joint %d: %.3f vs %.3f\n", j + 1, r.max_error(j) * kDeg, st.max_error(j) * kDeg);
+  for (int j = 0; j < Model::nq; ++j)
+    std::printf("  joint %d: %.3f vs %.3f\n", j + 1, r.max_error(j) * kDeg, st.max_error(j) * kDeg);
   EXPECT_LT(r.max_error(1), 0.5 * st.max_error(1));  // shoulder tilt
   EXPECT_LT(r.max_error(3), 0.5 * st.max_error(3));  // elbow
 }
@@ -404,7 +409,8 @@ TEST_F(HardwareControl, ALimitStopHoldsWithoutTheModelsGravity) {
   const ControlResult r = run(rig, traj, (dir_ / "limit_ff.csv").string(), o, -1, {}, js);
   EXPECT_EQ(r.reason, StopReason::velocity_limit) << r.message;
   EXPECT_EQ(r.stop_action, StopAction::hold);
-  EXPECT_NE(r.at_stop.find("(PD (a velocity_limit stop may come from the model feedforward)"), std::string::npos) << r.at_stop;
+  EXPECT_NE(r.at_stop.find("(PD (a velocity_limit stop may come from the model feedforward)"), std::string::npos)
+      << r.at_stop;
   EXPECT_TRUE(r.torque_off_confirmed);
   rig.expect_safe();
 }

@@ -18,8 +18,10 @@ std::vector<JointInfo> limit_crossed(const trajectory::Trajectory& traj, int j, 
   Eigen::VectorXd q0(Model::nq), q1(Model::nq), v(Model::nq), a(Model::nq);
   traj.evaluate(0, q0, v, a);
   traj.evaluate(t, q1, v, a);
-  if (q1(j) > q0(j)) js[j].upper = q1(j) - tolerance;
-  else js[j].lower = q1(j) + tolerance;
+  if (q1(j) > q0(j))
+    js[j].upper = q1(j) - tolerance;
+  else
+    js[j].lower = q1(j) + tolerance;
   return js;
 }
 
@@ -91,7 +93,8 @@ TEST_F(HardwareControl, CurrentLimitStops) {
   // the command saturates at the limit, and the present current passes the trip level.
   std::atomic<double> timeline{-1e9};
   auto* clock = &timeline;
-  o.feedforward = [clock](const Eigen::VectorXd& q, const Eigen::VectorXd&, const Eigen::VectorXd&, Eigen::VectorXd& tau) {
+  o.feedforward = [clock](const Eigen::VectorXd& q, const Eigen::VectorXd&, const Eigen::VectorXd&,
+                          Eigen::VectorXd& tau) {
     tau = Eigen::VectorXd::Zero(q.size());
     if (clock->load() >= 0.5) tau(0) = 100;
   };
@@ -120,8 +123,9 @@ TEST_F(HardwareControl, ALimitIsCheckedWhileAServoDoesNotAnswer) {
   o.seconds = 2.0;
   o.watchdog_cycles = 2000;
   const std::string csv = (dir_ / "stale_limit.csv").string();
-  const ControlResult r = run(rig, traj, csv, o, 0.3, [](Rig& g) { g.virt.set_dead(5, true); },
-                             limit_crossed(traj, j, 0.8, hw_.safety.position_tolerance));
+  const ControlResult r = run(
+      rig, traj, csv, o, 0.3, [](Rig& g) { g.virt.set_dead(5, true); },
+      limit_crossed(traj, j, 0.8, hw_.safety.position_tolerance));
   EXPECT_EQ(r.reason, StopReason::position_limit) << r.message;
   EXPECT_GT(r.timing.max_stale, 100);  // the limit was found while joint 4's state was stale
   rig.expect_safe(5);
@@ -149,7 +153,8 @@ TEST_F(HardwareControl, SigintStopsSafely) {
 // instruction's arrival, so this lets the arm move as its servos' state (torque off) says.
 void let_time_pass(Rig& rig, double seconds) {
   const std::atomic<int> no_stop{0};
-  rig.clock.sleep_until(rig.clock.now() + std::chrono::duration_cast<std::chrono::steady_clock::duration>(std::chrono::duration<double>(seconds)),
+  rig.clock.sleep_until(rig.clock.now() + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+                                              std::chrono::duration<double>(seconds)),
                         no_stop, 0);
   for (int attempt = 0; attempt < 5; ++attempt)
     if (rig.bus.ping(rig.hw.ids()[0], std::chrono::steady_clock::now() + std::chrono::seconds(1)).has_data()) return;
@@ -201,8 +206,8 @@ TEST_F(HardwareControl, HoldKeepsAGravityLoadedArmWhereTorqueOffLetsItFall) {
     const int last = log.samples() - 1;
     // The sag the PD allows at the stop pose, from the twin's true gravity.
     Eigen::Matrix<double, Model::nq, 1> q_stop = log.q.row(last).transpose(), g;
-    Model::inverse_dynamics(q_stop, Eigen::Matrix<double, Model::nq, 1>::Zero(), Eigen::Matrix<double, Model::nq, 1>::Zero(),
-                            rig.backend->truth().phi, g);
+    Model::inverse_dynamics(q_stop, Eigen::Matrix<double, Model::nq, 1>::Zero(),
+                            Eigen::Matrix<double, Model::nq, 1>::Zero(), rig.backend->truth().phi, g);
     double allowed = 0;
     for (int j = 0; j < Model::nq; ++j) {
       const double w = std::sqrt(gains_.kp(j));
@@ -212,9 +217,10 @@ TEST_F(HardwareControl, HoldKeepsAGravityLoadedArmWhereTorqueOffLetsItFall) {
     const double at_torque_off = moved_deg(rig, csv);  // the plant when torque went off
     let_time_pass(rig, 0.4);
     const double later = moved_deg(rig, csv);
-    std::printf("%s: %s; the plant moved %.2f deg from the stop pose by torque off, %.2f deg 0.4 s later (allowed while "
-                "held: %.2f deg)\n",
-                c.name, r.at_stop.c_str(), at_torque_off, later, allowed * kDeg);
+    std::printf(
+        "%s: %s; the plant moved %.2f deg from the stop pose by torque off, %.2f deg 0.4 s later (allowed while "
+        "held: %.2f deg)\n",
+        c.name, r.at_stop.c_str(), at_torque_off, later, allowed * kDeg);
     if (c.action == StopAction::hold) {
       EXPECT_NEAR(r.held, 0.6, 1e-9) << r.at_stop;
       EXPECT_LE(r.hold_deviation, allowed) << r.at_stop;
@@ -255,7 +261,8 @@ TEST_F(HardwareControl, ASecondSigintEndsTheHold) {
 TEST_F(HardwareControl, SignalsMillisecondsApartAreOneStopRequest) {
   const trajectory::Trajectory traj = first_seconds("AG02", 2.0);
   hw_.safety.hold_time = 1.0;
-  for (const auto& [name, second] : {std::pair<const char*, int>{"sigterm_pair", SIGTERM}, {"sigterm_sigint", SIGINT}}) {
+  for (const auto& [name, second] :
+       {std::pair<const char*, int>{"sigterm_pair", SIGTERM}, {"sigterm_sigint", SIGINT}}) {
     Rig rig(twin_, hw_, traj);
     ControlOptions o = options();
     o.seconds = 2.0;
@@ -299,7 +306,8 @@ TEST_F(HardwareControl, ASigtermAfterTheDelayEndsTheHold) {
   // The first signal did not end the hold: it lasted until the second, `delay` later in real
   // time (the rig's clock leaves out the time a loaded host kept the loop waiting, so r.held
   // may be less).
-  EXPECT_GE(ended - std::chrono::steady_clock::time_point(std::chrono::steady_clock::duration(first.load())), delay) << r.at_stop;
+  EXPECT_GE(ended - std::chrono::steady_clock::time_point(std::chrono::steady_clock::duration(first.load())), delay)
+      << r.at_stop;
   EXPECT_GT(r.held, 0.0) << r.at_stop;
   EXPECT_LT(r.held, 20.0) << r.at_stop;
   EXPECT_TRUE(r.torque_off_confirmed);
@@ -329,7 +337,8 @@ TEST_F(HardwareControl, AStopBeforeTheTrajectoryLeavesAnEmptyLogThatSaysWhy) {
 // drops sends SIGHUP, Ctrl-\ SIGQUIT). Without a handler each of these ends the test program.
 TEST_F(HardwareControl, EverySignalThatWouldEndTheProcessStopsLikeSigint) {
   const trajectory::Trajectory traj = first_seconds("AG02", 1.0);
-  for (const auto& [sig, name] : {std::pair<int, const char*>{SIGHUP, "SIGHUP"}, {SIGQUIT, "SIGQUIT"}, {SIGUSR1, "SIGUSR1"}}) {
+  for (const auto& [sig, name] :
+       {std::pair<int, const char*>{SIGHUP, "SIGHUP"}, {SIGQUIT, "SIGQUIT"}, {SIGUSR1, "SIGUSR1"}}) {
     SCOPED_TRACE(name);
     Rig rig(twin_, hw_, traj);
     ControlOptions o = options();
@@ -407,7 +416,8 @@ TEST_F(HardwareControl, ASigkilledControllerLeavesTheServosToTheirBusWatchdog) {
   };
   const std::uint8_t id = hw_.ids().front();
   const auto start = std::chrono::steady_clock::now();
-  while (since(start) < 20 && !(rig.virt.value(id, xs::kTorqueEnable) == 1 && rig.virt.value(id, xs::kBusWatchdog) == 5))
+  while (since(start) < 20 &&
+         !(rig.virt.value(id, xs::kTorqueEnable) == 1 && rig.virt.value(id, xs::kBusWatchdog) == 5))
     std::this_thread::sleep_for(std::chrono::milliseconds(5));
   ASSERT_EQ(rig.virt.value(id, xs::kBusWatchdog), 5) << "the controller never armed the servos' bus watchdog";
   std::this_thread::sleep_for(std::chrono::milliseconds(700));  // the loop runs the trajectory
@@ -419,24 +429,28 @@ TEST_F(HardwareControl, ASigkilledControllerLeavesTheServosToTheirBusWatchdog) {
   // Within the watchdog's 100 ms (and the emulation's 2 ms check) every servo has stopped: its
   // item reads -1, it drives no current, and a new goal is refused until the watchdog is cleared.
   for (std::uint8_t s : hw_.ids()) {
-    while (since(killed) < 2 && rig.virt.value(s, xs::kBusWatchdog) != -1) std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    while (since(killed) < 2 && rig.virt.value(s, xs::kBusWatchdog) != -1)
+      std::this_thread::sleep_for(std::chrono::milliseconds(1));
     EXPECT_EQ(rig.virt.value(s, xs::kBusWatchdog), -1) << "servo " << int(s);
     EXPECT_EQ(rig.virt.value(s, xs::kTorqueEnable), 1) << "servo " << int(s);  // stopped, not switched off
   }
   EXPECT_LT(since(killed), 0.5);
   for (std::uint8_t s : hw_.ids()) {
-    const auto r = rig.bus.read(s, xs::kPresentCurrent, std::chrono::steady_clock::now() + std::chrono::milliseconds(200));
+    const auto r =
+        rig.bus.read(s, xs::kPresentCurrent, std::chrono::steady_clock::now() + std::chrono::milliseconds(200));
     ASSERT_TRUE(r.has_data()) << "servo " << int(s);
     EXPECT_EQ(r.get<std::int16_t>(0), 0) << "servo " << int(s) << " still drives its motor";
   }
-  const auto refused = rig.bus.write(id, xs::kGoalCurrent, 10, std::chrono::steady_clock::now() + std::chrono::milliseconds(200));
+  const auto refused =
+      rig.bus.write(id, xs::kGoalCurrent, 10, std::chrono::steady_clock::now() + std::chrono::milliseconds(200));
   EXPECT_EQ(refused.outcome, dynamixel::Outcome::error_status);
   // Torque off still works on a tripped servo; clearing the watchdog (as the next run's setup
   // does) makes its goal writable again.
   EXPECT_TRUE(safe_stop(rig.bus, hw_));
   for (std::uint8_t s : hw_.ids()) {
     EXPECT_EQ(rig.virt.value(s, xs::kTorqueEnable), 0) << "servo " << int(s);
-    EXPECT_TRUE(rig.bus.write(s, xs::kBusWatchdog, 0, std::chrono::steady_clock::now() + std::chrono::milliseconds(200)).has_data());
+    EXPECT_TRUE(rig.bus.write(s, xs::kBusWatchdog, 0, std::chrono::steady_clock::now() + std::chrono::milliseconds(200))
+                    .has_data());
   }
   EXPECT_TRUE(safe_stop(rig.bus, hw_));
   rig.expect_safe();
@@ -454,8 +468,8 @@ TEST_F(HardwareControl, AStallPastTheBusWatchdogStopsTheRun) {
   std::atomic<double> timeline{-1e9};
   std::atomic<bool> stalled{false};
   const control::FfpdGains g = gains_;
-  o.feedforward = [&timeline, &stalled, g](const Eigen::VectorXd& q, const Eigen::VectorXd& qd, const Eigen::VectorXd& qdd,
-                                           Eigen::VectorXd& tau) {
+  o.feedforward = [&timeline, &stalled, g](const Eigen::VectorXd& q, const Eigen::VectorXd& qd,
+                                           const Eigen::VectorXd& qdd, Eigen::VectorXd& tau) {
     tau = g.inertia.cwiseProduct(qdd) + g.damping.cwiseProduct(qd);  // FF+PD's own realization
     if (timeline.load() >= 0.3 && !stalled.exchange(true)) std::this_thread::sleep_for(std::chrono::milliseconds(150));
     (void)q;

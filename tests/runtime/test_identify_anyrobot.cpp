@@ -59,7 +59,8 @@ class AnyRobotStudy : public ::testing::Test {
     manifest.robot = Model::robot_name;
     const char* names[] = {"R1", "R2", "H1"};
     for (int r = 0; r < 3; ++r) {
-      const io::Log log = test::synthesize<Model>(names[r], truth_, 30.0, 100 + r, kNoise, test::offset_on<Model>(1, kOffset));
+      const io::Log log =
+          test::synthesize<Model>(names[r], truth_, 30.0, 100 + r, kNoise, test::offset_on<Model>(1, kOffset));
       io::write_log(dir_ / "data" / (std::string(names[r]) + ".csv"), log);
       manifest.runs.push_back({names[r], r < 2 ? "F" : "V", 1, std::string(names[r]) + ".csv"});
     }
@@ -243,7 +244,8 @@ TYPED_TEST(AnyRobotStudy, AOneRunStudyWhoseClieDivergedEndsWithAReport) {
   log.qd_ref = log.qd;
   log.qdd_ref = Eigen::MatrixXd::Zero(log.samples(), Model::nq);
   io::write_log(this->dir_ / "data" / "R4.csv", log);
-  std::ofstream(this->dir_ / "data" / "dataset.yaml", std::ios::app) << "  - {trajectory: R4, family: F, trial: 1, file: R4.csv}\n";
+  std::ofstream(this->dir_ / "data" / "dataset.yaml", std::ios::app)
+      << "  - {trajectory: R4, family: F, trial: 1, file: R4.csv}\n";
   study::StudyOptions o = this->options();
   o.trajectories = {"R4"};
   o.intervals = {0.020};
@@ -296,20 +298,23 @@ TYPED_TEST(AnyRobotStudy, ALogOfAnotherRobotOrJointCountIsNamed) {
   for (Eigen::MatrixXd* m : {&fewer.q, &fewer.qd, &fewer.tau}) *m = m->leftCols(n).eval();
   io::write_log(this->dir_ / "data" / "R6.csv", fewer);
   std::ofstream(this->dir_ / "data" / "dataset.yaml", std::ios::app)
-      << "  - {trajectory: R5, family: F, trial: 1, file: R5.csv}\n  - {trajectory: R6, family: F, trial: 1, file: R6.csv}\n";
+      << "  - {trajectory: R5, family: F, trial: 1, file: R5.csv}\n  - {trajectory: R6, family: F, trial: 1, file: "
+         "R6.csv}\n";
   const io::Dataset data = io::read_dataset(this->dir_ / "data");
   try {
     io::read_run_log(data.find("R5", 1), Model::robot_name, Model::nq);
     FAIL() << "another robot's log was accepted";
   } catch (const DataError& e) {
-    EXPECT_NE(std::string(e.what()).find("R5.meta.yaml: error: run R5: the log is of robot 'some_other_arm'"), std::string::npos)
+    EXPECT_NE(std::string(e.what()).find("R5.meta.yaml: error: run R5: the log is of robot 'some_other_arm'"),
+              std::string::npos)
         << e.what();
   }
   try {
     io::read_run_log(data.find("R6", 1), Model::robot_name, Model::nq);
     FAIL() << "a log with another joint count was accepted";
   } catch (const DataError& e) {
-    EXPECT_NE(std::string(e.what()).find(fmt::format("R6.csv: error: run R6: the log has {} joints, the model {}", n, Model::nq)),
+    EXPECT_NE(std::string(e.what()).find(
+                  fmt::format("R6.csv: error: run R6: the log has {} joints, the model {}", n, Model::nq)),
               std::string::npos)
         << e.what();
   }
@@ -338,7 +343,8 @@ Eigen::VectorXd plain_ols(const io::Log& log) {
   Eigen::Matrix<double, Model::nq, Model::np> w;
   for (int i = 1; i + 1 < rows; ++i) {
     const Eigen::Matrix<double, Model::nq, 1> q = log.q.row(i).transpose(), qd = log.qd.row(i).transpose();
-    const Eigen::Matrix<double, Model::nq, 1> qdd = ((log.qd.row(i + 1) - log.qd.row(i - 1)) / (log.time(i + 1) - log.time(i - 1))).transpose();
+    const Eigen::Matrix<double, Model::nq, 1> qdd =
+        ((log.qd.row(i + 1) - log.qd.row(i - 1)) / (log.time(i + 1) - log.time(i - 1))).transpose();
     Model::regressor(q, qd, qdd, w);
     W.middleRows(static_cast<Eigen::Index>(i - 1) * n, n) = w;
     y.segment(static_cast<Eigen::Index>(i - 1) * n, n) = log.tau.row(i).transpose();
@@ -375,8 +381,10 @@ Eigen::VectorXd project_ols(const io::Log& log, double interval, const preproces
 // plain fit. Keeping the stale rows costs the study's fit 4 % on the RX-90.
 TYPED_TEST(AnyRobotStudy, ThePreprocessedOlsBeatsAPlainOlsOnRawTorque) {
   using Model = TypeParam;
-  const io::Log train = test::with_real_sensors(test::synthesize<Model>("T", this->truth_, 30.0, 301, this->kNoise), 1 << 16, 0.3, 80, 1);
-  const io::Log held = test::with_real_sensors(test::synthesize<Model>("V", this->truth_, 15.0, 302, this->kNoise), 1 << 16, 0.3, 80, 2);
+  const io::Log train =
+      test::with_real_sensors(test::synthesize<Model>("T", this->truth_, 30.0, 301, this->kNoise), 1 << 16, 0.3, 80, 1);
+  const io::Log held =
+      test::with_real_sensors(test::synthesize<Model>("V", this->truth_, 15.0, 302, this->kNoise), 1 << 16, 0.3, 80, 2);
   auto score = [&](const Eigen::VectorXd& phi) {
     return study::raw_torque_error(held, &study::open_loop_torque<Model>, phi).error.rmse;
   };
@@ -427,9 +435,11 @@ TYPED_TEST(AnyRobotStudy, ThePriorsWeightIsChosenByHeldOutError) {
   ASSERT_GE(r.selection.run, 0);
   ASSERT_TRUE(r.rescued) << "the representative is consistent: no rescue, no weight to choose";
   ASSERT_EQ(r.rescue_prior_scores.size(), 2u);
-  EXPECT_EQ(r.rescue_prior_weight, 1e-6) << r.rescue_prior_scores[0].second << " vs " << r.rescue_prior_scores[1].second;
+  EXPECT_EQ(r.rescue_prior_weight, 1e-6) << r.rescue_prior_scores[0].second << " vs "
+                                         << r.rescue_prior_scores[1].second;
   EXPECT_LT(r.rescue_prior_scores[0].second, r.rescue_prior_scores[1].second);
   std::string stages;
   for (const auto& st : r.stages) stages += st + "\n";
-  EXPECT_NE(stages.find("rescue prior weight: 1e-06, by held-out open-loop RMSE on 1 other runs"), std::string::npos) << stages;
+  EXPECT_NE(stages.find("rescue prior weight: 1e-06, by held-out open-loop RMSE on 1 other runs"), std::string::npos)
+      << stages;
 }

@@ -270,7 +270,8 @@ double three_point_grid_lambda(const VectorXd& phi, const AuditDomain& d) {
   double worst = std::numeric_limits<double>::infinity();
   VectorXd q(n);
   for (int index = 0, total = static_cast<int>(std::pow(3, n)); index < total; ++index) {
-    for (int j = 0, rest = index; j < n; ++j, rest /= 3) q(j) = d.lower(j) + (d.upper(j) - d.lower(j)) * (rest % 3) / 2.0;
+    for (int j = 0, rest = index; j < n; ++j, rest /= 3)
+      q(j) = d.lower(j) + (d.upper(j) - d.lower(j)) * (rest % 3) / 2.0;
     worst = std::min(worst, lambda_min_at<Crane>(q, phi));
   }
   return worst;

@@ -269,10 +269,12 @@ TEST(ClosedLoopSimulator, ReproducesTheIdealTwin) {
   const double quantization = rms(unquantized.tau - quantized.tau);
   const Channels sim_f = lowpassed(tau, 0.04), quant_f = lowpassed(Channels(quantized.tau), 0.04),
                  unq_f = lowpassed(Channels(unquantized.tau), 0.04);
-  const double vs_quantized_f = rms(Eigen::MatrixXd(sim_f - quant_f)), quantization_f = rms(Eigen::MatrixXd(unq_f - quant_f));
+  const double vs_quantized_f = rms(Eigen::MatrixXd(sim_f - quant_f)),
+               quantization_f = rms(Eigen::MatrixXd(unq_f - quant_f));
   std::cout << "  rms torque difference, N m: unquantized twin " << exact << " (delay 0: " << wrong_delay
-            << ", rows one cycle early: " << wrong_row << "); ideal twin " << vs_quantized << " (its quantization alone: " << quantization
-            << "); after the 10 Hz low-pass " << vs_quantized_f << " (quantization alone " << quantization_f << ")\n";
+            << ", rows one cycle early: " << wrong_row << "); ideal twin " << vs_quantized
+            << " (its quantization alone: " << quantization << "); after the 10 Hz low-pass " << vs_quantized_f
+            << " (quantization alone " << quantization_f << ")\n";
   // A torque changing by ~0.5 mN m per cycle here: 1e-5 N m leaves no room for a timing
   // error beyond a few percent of a cycle.
   EXPECT_LT(exact, 1e-5);
@@ -476,7 +478,9 @@ class LinearCost final : public ceres::CostFunction {
   // The residual variance 2 cost / (m - p) at phi, as the noise floor estimates it.
   double variance(const Eigen::VectorXd& phi) const { return 2 * cost(phi) / static_cast<double>(a_.rows() - 3); }
   // |A (phi1 - phi2)|: how differently two vectors predict the samples.
-  double distance(const Eigen::VectorXd& phi1, const Eigen::VectorXd& phi2) const { return (a_ * (phi1 - phi2)).norm(); }
+  double distance(const Eigen::VectorXd& phi1, const Eigen::VectorXd& phi2) const {
+    return (a_ * (phi1 - phi2)).norm();
+  }
   // The least-squares solution, the parameters in `free` moving and the others at phi's values.
   Eigen::VectorXd least_squares(const Eigen::VectorXd& phi, const std::vector<int>& free) const {
     Eigen::MatrixXd a(a_.rows(), static_cast<Eigen::Index>(free.size()));
@@ -527,8 +531,8 @@ TEST(Clie, HoldingAParameterAtItsBoundEndsTheCreepOfProjectedSteps) {
   identify::ClieOptions o = paper_rule();
   o.hold_at_bounds = true;
   const identify::ClieResult held = solve_linear(cost, start, -0.5, o);
-  std::cout << "  projected: " << creep.iterations << " steps, cost " << cost.cost(creep.phi) << "; held: " << held.iterations
-            << " steps, cost " << cost.cost(held.phi) << "\n";
+  std::cout << "  projected: " << creep.iterations << " steps, cost " << cost.cost(creep.phi)
+            << "; held: " << held.iterations << " steps, cost " << cost.cost(held.phi) << "\n";
   ASSERT_TRUE(creep.success) << creep.termination;
   ASSERT_TRUE(held.success) << held.termination;
   EXPECT_GE(creep.iterations, 20);

@@ -34,9 +34,9 @@ using symoro::test::base_of;
 using symoro::test::diagonal_consistent_standard;
 using symoro::test::expect_consistent;
 using symoro::test::perturbed;
+using symoro::test::pseudo_inertia_by_name;
 using symoro::test::smallest_drive_parameter;
 using symoro::test::smallest_link_eigenvalue;
-using symoro::test::pseudo_inertia_by_name;
 
 // Random consistent s -> phi = B s -> recovered from a prior 30 % off: consistent, and back onto
 // phi to 1e-10.
@@ -262,8 +262,9 @@ TEST(PhysicalConsistency, RejectsBadInput) {
                std::invalid_argument);
   ConsistencyOptions o;
   o.margin = -1;
-  EXPECT_THROW(symoro::identify::consistent_standard_parameters(st, VectorXd::Zero(Crane::np), VectorXd::Zero(Crane::ns), o),
-               std::invalid_argument);
+  EXPECT_THROW(
+      symoro::identify::consistent_standard_parameters(st, VectorXd::Zero(Crane::np), VectorXd::Zero(Crane::ns), o),
+      std::invalid_argument);
 }
 
 }  // namespace

@@ -141,7 +141,8 @@ const bool registered = [] {
 TEST(Determinism, CraneX7ReducedAuditAndProjection) {
   using Model = symoro::crane_x7::reduced::Model;
   const auto tc = symoro::twin::read_twin_config(SYMORO_ROBOTS_DIR "/crane_x7/twin.yaml", symoro::crane_x7::Model::nq);
-  const Eigen::VectorXd truth = Model::base_from_standard(symoro::twin::make_truth(symoro::robot::compiled_model<symoro::crane_x7::Model>(), tc).standard);
+  const Eigen::VectorXd truth = Model::base_from_standard(
+      symoro::twin::make_truth(symoro::robot::compiled_model<symoro::crane_x7::Model>(), tc).standard);
   symoro::test::Random rng(3);
   const Eigen::VectorXd dir = rng.vector<Eigen::VectorXd>(Model::np, -1, 1).cwiseProduct(truth.cwiseAbs());
   same_bits_whatever_the_heap<Model>(truth, dir);

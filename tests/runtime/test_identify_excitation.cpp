@@ -117,7 +117,8 @@ TEST(ExcitationCriterion, TorqueAndWorkspaceJacobiansMatchFiniteDifferences) {
   ExcitationCriterion c(*m, FourierBasis(6, 3, 6.0, 24, start));
   const Eigen::VectorXd x = random_coefficients(c.basis(), start, 0.5, 9);
   const Eigen::VectorXd phi = ur5_nominal();
-  std::vector<HalfSpace> spaces{{"table", 6, Eigen::Vector3d(0, 0, -1), 0.1}, {"wall", 4, Eigen::Vector3d(1, 0.5, 0).normalized(), 0.4}};
+  std::vector<HalfSpace> spaces{{"table", 6, Eigen::Vector3d(0, 0, -1), 0.1},
+                                {"wall", 4, Eigen::Vector3d(1, 0.5, 0).normalized(), 0.4}};
   Eigen::MatrixXd Jt, Jw;
   c.torque(x, phi, &Jt);
   c.workspace(x, spaces, &Jw);
@@ -157,8 +158,8 @@ void expect_limits_hold(const ExcitationDesign& d, const ExcitationDesignOptions
   Eigen::Matrix<double, n, 1> tau;
   for (double time = 0; time <= t.period(); time += 5e-4) {
     t.evaluate(time, q, qd, qdd);
-    Model::inverse_dynamics(Eigen::Matrix<double, n, 1>(q), Eigen::Matrix<double, n, 1>(qd), Eigen::Matrix<double, n, 1>(qdd),
-                            Eigen::Matrix<double, Model::np, 1>(phi), tau);
+    Model::inverse_dynamics(Eigen::Matrix<double, n, 1>(q), Eigen::Matrix<double, n, 1>(qd),
+                            Eigen::Matrix<double, n, 1>(qdd), Eigen::Matrix<double, Model::np, 1>(phi), tau);
     for (int j = 0; j < n; ++j) {
       worst_q = std::min({worst_q, o.limits.upper(j) - q(j), q(j) - o.limits.lower(j)});
       worst_qd = std::min(worst_qd, o.limits.velocity(j) - std::abs(qd(j)));
@@ -167,7 +168,8 @@ void expect_limits_hold(const ExcitationDesign& d, const ExcitationDesignOptions
       moved = std::max(moved, std::abs(q(j) - o.start(j)));
     }
     const auto T = symoro::mdh_poses(frames, q);
-    for (const auto& s : o.workspace) worst_ws = std::min(worst_ws, s.offset - s.normal.dot(T[s.frame - 1].translation()));
+    for (const auto& s : o.workspace)
+      worst_ws = std::min(worst_ws, s.offset - s.normal.dot(T[s.frame - 1].translation()));
   }
   EXPECT_GE(worst_q, 0);
   EXPECT_GE(worst_qd, 0);
@@ -208,8 +210,8 @@ TEST(ExcitationDesign, CraneDesignMeetsEveryLimitAndBeatsAStructuredTrajectory) 
   // structured trajectory, poorly conditioned on its own (every joint moves alone, in one
   // posture). The optimized series of the same length, under the same velocity limits as the
   // design file's speed level 1 (0.25-0.3 of the file's limits) and twice its acceleration.
-  const auto design = symoro::trajectory::TrajectoryDesign::read(std::string(SYMORO_ROBOTS_DIR) + "/crane_x7/trajectories.yaml",
-                                                                 m->description().joints);
+  const auto design = symoro::trajectory::TrajectoryDesign::read(
+      std::string(SYMORO_ROBOTS_DIR) + "/crane_x7/trajectories.yaml", m->description().joints);
   const auto pa01 = design.build("PA01");
   o.period = pa01.duration();
   o.harmonics = 5;

@@ -53,7 +53,9 @@ twin::TwinConfig ideal_config() {
   return c;
 }
 
-Eigen::VectorXd reduced_truth() { return Reduced::from_parent(twin::make_truth(symoro::robot::compiled_model<Full>(), ideal_config()).phi); }
+Eigen::VectorXd reduced_truth() {
+  return Reduced::from_parent(twin::make_truth(symoro::robot::compiled_model<Full>(), ideal_config()).phi);
+}
 
 preprocess::Samples random_samples(int count, unsigned seed) {
   std::mt19937 g(seed);
@@ -81,8 +83,10 @@ TEST(LoadedIdentificationModel, EqualsTheGeneratedModelsBitForBit) {
   EXPECT_EQ(a->open_loop_torque(s, phi), b->open_loop_torque(s, phi));
   for (bool with_fixed : {true, false}) {
     identify::StateDerivatives da, db;
-    a->state_derivatives(s.q.row(3).transpose(), s.qd.row(3).transpose(), s.qdd.row(3).transpose(), phi, with_fixed, da);
-    b->state_derivatives(s.q.row(3).transpose(), s.qd.row(3).transpose(), s.qdd.row(3).transpose(), phi, with_fixed, db);
+    a->state_derivatives(s.q.row(3).transpose(), s.qd.row(3).transpose(), s.qdd.row(3).transpose(), phi, with_fixed,
+                         da);
+    b->state_derivatives(s.q.row(3).transpose(), s.qd.row(3).transpose(), s.qdd.row(3).transpose(), phi, with_fixed,
+                         db);
     EXPECT_EQ(da.tau, db.tau);
     EXPECT_EQ(da.dq, db.dq);
     EXPECT_EQ(da.dqd, db.dqd);
@@ -127,14 +131,15 @@ TEST(LoadedIdentificationModel, LinkedModelIsTheLoadedOneBitForBit) {
   EXPECT_EQ(ra.W, rc.W);
   EXPECT_EQ(ra.y, rc.y);
   EXPECT_EQ(a->open_loop_torque(s, reduced_truth()), c->open_loop_torque(s, reduced_truth()));
-  EXPECT_EQ(a->parent_base_from_standard(twin::make_truth(symoro::robot::compiled_model<Full>(), ideal_config()).standard),
-            c->parent_base_from_standard(twin::make_truth(symoro::robot::compiled_model<Full>(), ideal_config()).standard));
+  EXPECT_EQ(
+      a->parent_base_from_standard(twin::make_truth(symoro::robot::compiled_model<Full>(), ideal_config()).standard),
+      c->parent_base_from_standard(twin::make_truth(symoro::robot::compiled_model<Full>(), ideal_config()).standard));
 }
 
 TEST(LoadedIdentificationModel, ClosedLoopEqualsTheFixedSizeSimulatorBitForBit) {
   const twin::TwinConfig config = ideal_config();
-  const auto design = trajectory::TrajectoryDesign::read(kRobot + "/trajectories.yaml",
-                                                         std::vector<JointInfo>(Full::joints.begin(), Full::joints.end()));
+  const auto design = trajectory::TrajectoryDesign::read(
+      kRobot + "/trajectories.yaml", std::vector<JointInfo>(Full::joints.begin(), Full::joints.end()));
   trajectory::Trajectory v = design.build("V01"), cut = v;
   cut.segments.clear();
   for (const auto& seg : v.segments)
@@ -163,8 +168,8 @@ TEST(LoadedIdentificationModel, ClosedLoopEqualsTheFixedSizeSimulatorBitForBit) 
     // The run-time-size simulator (a robot of 1 or more than 8 joints) gives the same bits.
     robot::LoadOptions o;
     o.cache_dir = SYMORO_TEST_ROBOT_CACHE;
-    const auto d = identify::detail::closed_loop_run_time_sizes(robot::load_robot(kRobot, o)->model("reduced"), setup,
-                                                                reference);
+    const auto d =
+        identify::detail::closed_loop_run_time_sizes(robot::load_robot(kRobot, o)->model("reduced"), setup, reference);
     preprocess::Channels tr, dr;
     ASSERT_TRUE(d->simulate(phi, tr, &dr, &why)) << why.describe();
     EXPECT_EQ(tr, tb);
@@ -175,11 +180,12 @@ TEST(LoadedIdentificationModel, ClosedLoopEqualsTheFixedSizeSimulatorBitForBit) 
     ASSERT_TRUE(a->simulate(phi, tc, nullptr, &why));
     ASSERT_TRUE(b->simulate(phi, tp, nullptr, &why));
     EXPECT_EQ(tc, tp);
-    if (!exact) EXPECT_EQ(tc, tb);
-    else EXPECT_LE((tc - tb).cwiseAbs().maxCoeff(), 1e-9 * tb.cwiseAbs().maxCoeff());
+    if (!exact)
+      EXPECT_EQ(tc, tb);
+    else
+      EXPECT_LE((tc - tb).cwiseAbs().maxCoeff(), 1e-9 * tb.cwiseAbs().maxCoeff());
   }
 }
-
 
 // ---- A log cut in mid-motion (issue 41) ------------------------------------------------------------
 
@@ -252,17 +258,19 @@ TEST(PredictOnALogCutInMotion, GivesTheModelsOwnErrorAndASplitScoresAsTheUncutLo
     const preprocess::Samples all = preprocess::preprocess(log, 0.010, keep);
     const Eigen::MatrixXd e = all.tau - model->open_loop_torque(all, phi);
     bool broken = false;
-    for (int j = 0; j < dof; ++j)
-      broken |= std::sqrt(e.col(j).squaredNorm() / e.rows()) > 0.005 * p.rms(j) + 1e-4;
+    for (int j = 0; j < dof; ++j) broken |= std::sqrt(e.col(j).squaredNorm() / e.rows()) > 0.005 * p.rms(j) + 1e-4;
     EXPECT_TRUE(broken);
 
     // A 70/30 split of the same log in a dataset folder.
-    const auto dir = std::filesystem::temp_directory_path() / ("symoro_split_" + robot_name + std::to_string(::getpid()));
+    const auto dir =
+        std::filesystem::temp_directory_path() / ("symoro_split_" + robot_name + std::to_string(::getpid()));
     std::filesystem::create_directories(dir);
     io::write_log(dir / "run.csv", log);
     const double split = log.time(0) + 0.7 * (log.time(n - 1) - log.time(0));
     const io::DatasetRun held{"run_heldout", "V", 1, dir / "run.csv", split, INFINITY};
-    const auto torque = [&](const preprocess::Samples& s, const Eigen::VectorXd& x) { return model->open_loop_torque(s, x); };
+    const auto torque = [&](const preprocess::Samples& s, const Eigen::VectorXd& x) {
+      return model->open_loop_torque(s, x);
+    };
     const study::RawTorqueScore window = study::raw_torque_error(io::read_run_log(held), torque, phi);
     // The same instants scored inside the uncut log.
     preprocess::Samples uncut = study::raw_torque_samples(log);
@@ -275,10 +283,11 @@ TEST(PredictOnALogCutInMotion, GivesTheModelsOwnErrorAndASplitScoresAsTheUncutLo
     EXPECT_EQ(window.samples, inside.samples);
     EXPECT_NEAR(window.error.rmse, inside.error.rmse, 0.02 * inside.error.rmse + 1e-12);
     std::filesystem::remove_all(dir);
-    std::printf("  %s: predict's largest RMSE / RMS %.2g (%d settling samples left out); held-out raw RMSE %.3g N m, "
-                "inside the uncut log %.3g\n",
-                robot_name.c_str(), (p.rmse.array() / p.rms.array()).maxCoeff(), p.samples.report.edge_samples,
-                window.error.rmse, inside.error.rmse);
+    std::printf(
+        "  %s: predict's largest RMSE / RMS %.2g (%d settling samples left out); held-out raw RMSE %.3g N m, "
+        "inside the uncut log %.3g\n",
+        robot_name.c_str(), (p.rmse.array() / p.rms.array()).maxCoeff(), p.samples.report.edge_samples,
+        window.error.rmse, inside.error.rmse);
   }
 }
 

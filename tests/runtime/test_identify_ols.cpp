@@ -252,8 +252,8 @@ void expect_quality_of_random_motion() {
   Eigen::MatrixXd halves(2 * Model::np, Model::np);
   halves << triangular_factor(W.topRows(half)), triangular_factor(W.bottomRows(W.rows() - half));
   for (const Eigen::MatrixXd& factor : {R, Eigen::MatrixXd(triangular_factor(halves))}) {
-    const ExcitationQuality f = excitation_quality_of_factor(factor, W.rows(), identification_model<Model>()->description().parameters,
-                                                             static_cast<int>(Model::np));
+    const ExcitationQuality f = excitation_quality_of_factor(
+        factor, W.rows(), identification_model<Model>()->description().parameters, static_cast<int>(Model::np));
     EXPECT_EQ(f.rows, W.rows());
     EXPECT_NEAR(f.kappa / (raw(0) / raw(raw.size() - 1)), 1, 1e-9);
     EXPECT_NEAR(f.kappa_scaled / (s(0) / s(s.size() - 1)), 1, 1e-9);

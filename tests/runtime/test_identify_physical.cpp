@@ -47,8 +47,10 @@ int index_of(const std::string& name) {
 template <class Model>
 VectorXd consistent_truth(unsigned seed) {
   test::Random rng(seed);
-  if constexpr (std::is_same_v<Model, Reduced>) return test::diagonal_consistent_standard<Model>(rng);
-  else return test::random_standard_parameters<Model>(rng).s;
+  if constexpr (std::is_same_v<Model, Reduced>)
+    return test::diagonal_consistent_standard<Model>(rng);
+  else
+    return test::random_standard_parameters<Model>(rng).s;
 }
 
 MatrixXd random_metric(int n, unsigned seed) {
@@ -124,14 +126,16 @@ void a_prior_keeps_the_projection_near_the_truth(unsigned seed) {
   for (int k = 0; k < Model::ns; ++k) {
     const std::string family = Model::standard_parameters[static_cast<std::size_t>(k)].family;
     const int j = Model::standard_parameters[static_cast<std::size_t>(k)].joint;
-    prior(k) *= family == "IA" || family == "FV" || family == "FS" ? 1 + rng.uniform(-0.3, 0.3) : link[static_cast<std::size_t>(j)];
+    prior(k) *= family == "IA" || family == "FV" || family == "FS" ? 1 + rng.uniform(-0.3, 0.3)
+                                                                   : link[static_cast<std::size_t>(j)];
   }
   const auto zero = identify::physical_projection<Model>(phi0, {}, A, 1e-6);
   const auto near = identify::physical_projection<Model>(phi0, prior, A, 1e-6);
   ASSERT_TRUE(zero.feasible && near.feasible) << zero.status << " / " << near.status;
-  const double e_zero = (zero.phi - phi_truth).norm() / phi_truth.norm(), e_near = (near.phi - phi_truth).norm() / phi_truth.norm();
-  std::printf("  %s: relative error with the zero prior %.4f, with the 30 %% prior %.4f (phi0 %.4f)\n", Model::description,
-              e_zero, e_near, (phi0 - phi_truth).norm() / phi_truth.norm());
+  const double e_zero = (zero.phi - phi_truth).norm() / phi_truth.norm(),
+               e_near = (near.phi - phi_truth).norm() / phi_truth.norm();
+  std::printf("  %s: relative error with the zero prior %.4f, with the 30 %% prior %.4f (phi0 %.4f)\n",
+              Model::description, e_zero, e_near, (phi0 - phi_truth).norm() / phi_truth.norm());
   EXPECT_LT(e_near, 0.8 * e_zero);
   // Both pay about the same in the metric (what the data see): the choice along d is the prior's.
   EXPECT_LT(near.distance, 2 * zero.distance);
@@ -139,8 +143,12 @@ void a_prior_keeps_the_projection_near_the_truth(unsigned seed) {
   test::expect_consistent<Model>(again, near.phi, 0);
 }
 
-TEST(PhysicalProjection, APriorKeepsTheProjectionNearTheTruthReduced) { a_prior_keeps_the_projection_near_the_truth<Reduced>(21); }
-TEST(PhysicalProjection, APriorKeepsTheProjectionNearTheTruthRx90) { a_prior_keeps_the_projection_near_the_truth<Rx90>(31); }
+TEST(PhysicalProjection, APriorKeepsTheProjectionNearTheTruthReduced) {
+  a_prior_keeps_the_projection_near_the_truth<Reduced>(21);
+}
+TEST(PhysicalProjection, APriorKeepsTheProjectionNearTheTruthRx90) {
+  a_prior_keeps_the_projection_near_the_truth<Rx90>(31);
+}
 
 TEST(PhysicalProjection, ModelsWithEffectsAreRefusedWithTheReason) {
   using Diagnosed = crane_x7::reduced_diagnosed::Model;
@@ -176,7 +184,8 @@ class PhysicalStudy : public ::testing::Test {
     manifest.robot = Model::robot_name;
     const char* names[] = {"R1", "R2", "R3", "H1"};
     for (int r = 0; r < 4; ++r) {
-      const io::Log log = test::synthesize<Model>(names[r], truth_, 12.0, 200 + r, kNoise, test::offset_on<Model>(2, kOffset));
+      const io::Log log =
+          test::synthesize<Model>(names[r], truth_, 12.0, 200 + r, kNoise, test::offset_on<Model>(2, kOffset));
       io::write_log(dir_ / "data" / (std::string(names[r]) + ".csv"), log);
       manifest.runs.push_back({names[r], r < 3 ? "F" : "V", 1, std::string(names[r]) + ".csv"});
     }
@@ -238,7 +247,8 @@ TYPED_TEST(PhysicalStudy, AcceptsAVectorWithAConsistentSetAndValidatesLikeThePdP
   }
   // All-pose PD is necessary, not sufficient: OLS vectors that pass the audit but have no
   // consistent set (measured: 4 of 6 on the CRANE-X7 at 0.3 N m, 4 of 6 on the RX-90 at 1 N m, none of them non-PD).
-  std::printf("  %s: %d of 6 OLS vectors have no consistent set, %d are not PD\n", Model::description, inconsistent, not_pd);
+  std::printf("  %s: %d of 6 OLS vectors have no consistent set, %d are not PD\n", Model::description, inconsistent,
+              not_pd);
   EXPECT_GT(inconsistent, not_pd);
 
   ASSERT_TRUE(phys.accepted) << phys.final_consistency_note;
@@ -258,7 +268,8 @@ TYPED_TEST(PhysicalStudy, AcceptsAVectorWithAConsistentSetAndValidatesLikeThePdP
   // path's open-loop error (the truth itself is consistent).
   ASSERT_EQ(phys.validation.size(), 1u);
   ASSERT_EQ(pd.validation.size(), 1u);
-  std::printf("  held-out RMSE: physical %.5f N m, PD %.5f N m\n", phys.validation[0].rmse_rescue, pd.validation[0].rmse_rescue);
+  std::printf("  held-out RMSE: physical %.5f N m, PD %.5f N m\n", phys.validation[0].rmse_rescue,
+              pd.validation[0].rmse_rescue);
   EXPECT_LT(phys.validation[0].rmse_rescue, 1.05 * pd.validation[0].rmse_rescue);
 }
 

@@ -14,9 +14,12 @@ namespace fs = std::filesystem;
 // --- The report -----------------------------------------------------------------------------
 
 TEST_F(Report, WritesEveryFileAtomicallyAndReturnsThem) {
-  const std::vector<fs::path> expected{*dir_ / "figures" / "routing.svg", *dir_ / "figures" / "pca_clouds.svg",
-                                       *dir_ / "figures" / "validation_V03.svg", *dir_ / "report.md",
-                                       *dir_ / "parameters.yaml", *dir_ / "parameters.csv"};
+  const std::vector<fs::path> expected{*dir_ / "figures" / "routing.svg",
+                                       *dir_ / "figures" / "pca_clouds.svg",
+                                       *dir_ / "figures" / "validation_V03.svg",
+                                       *dir_ / "report.md",
+                                       *dir_ / "parameters.yaml",
+                                       *dir_ / "parameters.csv"};
   EXPECT_EQ(*written_, expected);
   for (const auto& p : expected) EXPECT_TRUE(fs::is_regular_file(p)) << p;
   // No temporary file left behind.
@@ -134,7 +137,8 @@ TEST(ReportMoves, StagesMovesInOlsStandardDeviations) {
   write_report(st, dir);
   const std::string md = read_text(dir / "report.md");
   EXPECT_NE(md.find("moved 1 well-determined parameter by more than 3 σ (largest: MYR2, +10.0 σ)"), std::string::npos);
-  const double e_ols = (ols - st.truth).norm() / st.truth.norm(), e_acc = (st.phi_rescue - st.truth).norm() / st.truth.norm();
+  const double e_ols = (ols - st.truth).norm() / st.truth.norm(),
+               e_acc = (st.phi_rescue - st.truth).norm() / st.truth.norm();
   char text[64];
   std::snprintf(text, sizeof text, "OLS %.2f %%", 100 * e_ols);
   EXPECT_NE(md.find(text), std::string::npos) << text;
@@ -284,7 +288,6 @@ TEST_F(Report, ParametersCsvRowsParseBack) {
   EXPECT_EQ(i, np);
 }
 
-
 // --- Missing data -----------------------------------------------------------------------------
 
 TEST(ReportMissingData, BareStudyRendersWithNotes) {
@@ -304,9 +307,8 @@ TEST(ReportMissingData, BareStudyRendersWithNotes) {
                                        dir / "parameters.csv"};
   EXPECT_EQ(written, expected);
   const std::string md = read_text(dir / "report.md");
-  for (const char* note : {"No representative was selected", "No validation records",
-                           "No PCA scores for the runs", "**Accepted model**: none",
-                           "No CLIE and rescued parameter vectors to compare"})
+  for (const char* note : {"No representative was selected", "No validation records", "No PCA scores for the runs",
+                           "**Accepted model**: none", "No CLIE and rescued parameter vectors to compare"})
     EXPECT_NE(md.find(note), std::string::npos) << note;
   EXPECT_EQ(md.find("pca_clouds.svg"), std::string::npos);
   EXPECT_EQ(md.find("Truth"), std::string::npos);

@@ -20,12 +20,12 @@ TEST(SvgPlot, NiceTicksMatchHandValues) {
     for (std::size_t i = 0; i < values.size(); ++i) EXPECT_DOUBLE_EQ(t.values[i], values[i]) << lo << " " << hi;
   };
   expect(0, 10, 5, 2, 0, {0, 2, 4, 6, 8, 10});
-  expect(-3.2, 7.9, 5, 2, 0, {-4, -2, 0, 2, 4, 6, 8});                          // raw 2.22 -> 2
+  expect(-3.2, 7.9, 5, 2, 0, {-4, -2, 0, 2, 4, 6, 8});  // raw 2.22 -> 2
   expect(0.013, 0.087, 5, 0.01, 2, {0.01, 0.02, 0.03, 0.04, 0.05, 0.06, 0.07, 0.08, 0.09});
-  expect(120, 980, 4, 200, 0, {0, 200, 400, 600, 800, 1000});                 // raw 215 -> 200
-  expect(-1e-4, 3e-4, 5, 1e-4, 4, {-1e-4, 0, 1e-4, 2e-4, 3e-4});              // raw 8e-5 -> 1e-4
-  expect(0.3, 0.7, 4, 0.1, 1, {0.3, 0.4, 0.5, 0.6, 0.7});                     // 0.3/0.1 is 2.99..96
-  expect(7.9, -3.2, 5, 2, 0, {-4, -2, 0, 2, 4, 6, 8});                         // reversed bounds
+  expect(120, 980, 4, 200, 0, {0, 200, 400, 600, 800, 1000});     // raw 215 -> 200
+  expect(-1e-4, 3e-4, 5, 1e-4, 4, {-1e-4, 0, 1e-4, 2e-4, 3e-4});  // raw 8e-5 -> 1e-4
+  expect(0.3, 0.7, 4, 0.1, 1, {0.3, 0.4, 0.5, 0.6, 0.7});         // 0.3/0.1 is 2.99..96
+  expect(7.9, -3.2, 5, 2, 0, {-4, -2, 0, 2, 4, 6, 8});            // reversed bounds
   // Exactly representable: 0.3 must be the double nearest 0.3, not 3 * 0.1.
   EXPECT_EQ(svg::nice_ticks(0.3, 0.7, 4).values[0], 0.3);
 }
@@ -58,8 +58,8 @@ TEST(SvgPlot, RendersOneMarkerPerFinitePointAndEscapesText) {
   s.name = "pts";
   s.x = {0, 1, 2, std::nan(""), 4};
   s.y = {1, -2, 3, 4, 100};
-  for (auto m : {svg::Marker::circle, svg::Marker::square, svg::Marker::triangle, svg::Marker::diamond,
-                 svg::Marker::cross}) {
+  for (auto m :
+       {svg::Marker::circle, svg::Marker::square, svg::Marker::triangle, svg::Marker::diamond, svg::Marker::cross}) {
     s.style.marker = m;
     p.points.push_back(s);
   }
@@ -71,9 +71,9 @@ TEST(SvgPlot, RendersOneMarkerPerFinitePointAndEscapesText) {
   f.panels = {p, p};
   const std::string out = svg::render(f);
   EXPECT_TRUE(balanced(out));
-  EXPECT_EQ(count(out, "class=\"marker\""), 2u * 5 * 4);   // NaN pair left out
-  EXPECT_EQ(count(out, "class=\"legend-marker\""), 1u);    // one entry per name
-  EXPECT_EQ(count(out, "<polyline"), 2u * 2);              // the NaN breaks the line
+  EXPECT_EQ(count(out, "class=\"marker\""), 2u * 5 * 4);  // NaN pair left out
+  EXPECT_EQ(count(out, "class=\"legend-marker\""), 1u);   // one entry per name
+  EXPECT_EQ(count(out, "<polyline"), 2u * 2);             // the NaN breaks the line
   EXPECT_EQ(count(out, "class=\"ring\""), 2u);
   EXPECT_NE(out.find("a &lt;b&gt; &amp; &quot;c&quot;"), std::string::npos);
   EXPECT_NE(out.find(">x&lt;y</text>"), std::string::npos);
@@ -101,7 +101,8 @@ TEST_F(Report, PcaFigureHasOneMarkerPerScoreAndCoveringTicks) {
     for (int i = 0; i < stages[s]->rows(); ++i)
       if (stages[s]->row(i).allFinite()) {
         ++finite;
-        for (int c = 0; c < 2; ++c) lo[c] = std::min(lo[c], (*stages[s])(i, c)), hi[c] = std::max(hi[c], (*stages[s])(i, c));
+        for (int c = 0; c < 2; ++c)
+          lo[c] = std::min(lo[c], (*stages[s])(i, c)), hi[c] = std::max(hi[c], (*stages[s])(i, c));
       }
     EXPECT_EQ(count(ps[s], "class=\"marker\""), finite) << s;
     total += finite;
@@ -151,7 +152,7 @@ TEST_F(Report, ValidationFigureStacksTheChosenJoints) {
     // Every sample is a vertex of the measured line.
     const auto start = ps[k].find("points=\"", ps[k].find("stroke=\"#000000\""));
     const std::string points = ps[k].substr(start + 8, ps[k].find('"', start + 8) - start - 8);
-    EXPECT_EQ(count(points, ",") , static_cast<std::size_t>(v.time.size()));
+    EXPECT_EQ(count(points, ","), static_cast<std::size_t>(v.time.size()));
   }
 }
 
@@ -161,6 +162,5 @@ TEST_F(Report, RoutingFigureHasOneBarPerRouteAndInterval) {
   EXPECT_EQ(count(svg, "class=\"bar\""), 2 * kIntervals.size());
   for (const char* c : {">10 ms<", ">20 ms<", ">40 ms<", ">80 ms<"}) EXPECT_EQ(count(svg, c), 1u) << c;
 }
-
 
 }  // namespace

@@ -64,7 +64,9 @@ struct Studies {
     names.insert(names.end(), kValid.begin(), kValid.end());
     test::write_twin_dataset<Full>(data, twin::read_twin_config(kRobot + "/twin.yaml", Full::nq), design(), names, 1,
                                    kRobot + "/twin.yaml");
-    quiet = study::Study(identify::identification_model<Model>(), options(data, kTmp / ("symoro_repro_a_" + kPid)), design(), setup()).run();
+    quiet = study::Study(identify::identification_model<Model>(), options(data, kTmp / ("symoro_repro_a_" + kPid)),
+                         design(), setup())
+                .run();
     // The same study again while two threads compete for both cores.
     std::atomic<bool> stop{false};
     std::vector<std::thread> load;
@@ -73,7 +75,9 @@ struct Studies {
         volatile double x = 1;
         while (!stop.load(std::memory_order_relaxed)) x = std::sqrt(x + 1);
       });
-    loaded = study::Study(identify::identification_model<Model>(), options(data, kTmp / ("symoro_repro_b_" + kPid)), design(), setup()).run();
+    loaded = study::Study(identify::identification_model<Model>(), options(data, kTmp / ("symoro_repro_b_" + kPid)),
+                          design(), setup())
+                 .run();
     stop = true;
     for (auto& t : load) t.join();
   }
@@ -129,8 +133,7 @@ void rescue_keeps_accuracy() {
     identify::ProjectionOptions po;
     po.eps = 0;
     const auto s = preprocess::preprocess(io::read_log(studies().data / (run.trajectory + "_t1.csv")), run.interval);
-    po.metric = identify::information_metric(
-        identify::least_squares(identify::stack_regression<Model>(s)).information);
+    po.metric = identify::information_metric(identify::least_squares(identify::stack_regression<Model>(s)).information);
     const identify::ProjectionResult p = identify::project_pd(*inertia, run.phi_clie, domain, po);
     ASSERT_TRUE(p.feasible) << run.id() << ": " << p.status;
     // In the closed loop where both vectors can be simulated; a vector that is not PD at the

@@ -213,7 +213,8 @@ double lambda_min_at(const InertiaFunction& m, const Eigen::VectorXd& phi, const
   return smallest_eigenvalue(M);
 }
 
-double lambda_min_over(const InertiaFunction& m, const Eigen::VectorXd& phi, const std::vector<Eigen::VectorXd>& poses) {
+double lambda_min_over(const InertiaFunction& m, const Eigen::VectorXd& phi,
+                       const std::vector<Eigen::VectorXd>& poses) {
   double l = std::numeric_limits<double>::infinity();
   for (const auto& q : poses) l = std::min(l, lambda_min_at(m, phi, q));
   return l;
@@ -267,7 +268,8 @@ Eigen::VectorXd barrier_projection(const InertiaFunction& m, const std::vector<E
           g(i) -= mu * A[i].trace();
         }
         for (int i = 0; i < n; ++i)
-          for (int j = i; j < n; ++j) H(i, j) = H(j, i) = H(i, j) + mu * (A[i].array() * A[j].transpose().array()).sum();
+          for (int j = i; j < n; ++j)
+            H(i, j) = H(j, i) = H(i, j) + mu * (A[i].array() * A[j].transpose().array()).sum();
       }
       const Eigen::VectorXd dx = -H.ldlt().solve(g);
       const double decrement = -g.dot(dx);

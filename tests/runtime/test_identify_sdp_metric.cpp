@@ -33,9 +33,9 @@ double metric_norm(const Eigen::MatrixXd& A, const Eigen::VectorXd& d) { return 
 TEST(SdpMetric, HalfSpaceProjectionMovesParametersOutsideM) {
   // 1 x 1 M = 0.1 + phi_0 - 2 phi_1 >= eps; phi_2 (a friction parameter) is not in M, but the
   // metric couples it to phi_0: d = delta A^-1 a / (a' A^-1 a), a = (1, -2, 0).
-  const AffineInertia m(Eigen::MatrixXd::Constant(1, 1, 0.1),
-                        {Eigen::MatrixXd::Constant(1, 1, 1.0), Eigen::MatrixXd::Constant(1, 1, -2.0),
-                         Eigen::MatrixXd::Zero(1, 1)});
+  const AffineInertia m(
+      Eigen::MatrixXd::Constant(1, 1, 0.1),
+      {Eigen::MatrixXd::Constant(1, 1, 1.0), Eigen::MatrixXd::Constant(1, 1, -2.0), Eigen::MatrixXd::Zero(1, 1)});
   Eigen::MatrixXd A(3, 3);
   A << 4, 0.5, 1.5, 0.5, 2, 0.2, 1.5, 0.2, 1;
   Eigen::VectorXd phi0(3), a(3);
@@ -81,8 +81,8 @@ TEST(SdpMetric, ChangeOfParametersGivesEigenvalueClipping) {
 }
 
 TEST(SdpMetric, RejectsAMetricThatIsNotPositiveDefinite) {
-  const AffineInertia m(Eigen::MatrixXd::Constant(1, 1, 0.1), {Eigen::MatrixXd::Constant(1, 1, 1.0),
-                                                              Eigen::MatrixXd::Constant(1, 1, 1.0)});
+  const AffineInertia m(Eigen::MatrixXd::Constant(1, 1, 0.1),
+                        {Eigen::MatrixXd::Constant(1, 1, 1.0), Eigen::MatrixXd::Constant(1, 1, 1.0)});
   const Eigen::Vector2d phi0(-0.5, 0);
   EXPECT_THROW(project_on_poses(m, phi0, kOnePose, 0.01, {}, Eigen::Matrix2d{{1, 2}, {2, 1}}), std::invalid_argument);
   EXPECT_THROW(project_on_poses(m, phi0, kOnePose, 0.01, {}, Eigen::Matrix3d::Identity()), std::invalid_argument);
@@ -139,7 +139,8 @@ TEST(SdpMetric, CraneX7ReducedEachProjectionIsOptimalInItsMetric) {
   using Model = symoro::crane_x7::reduced::Model;
   const std::string robot = std::string(SYMORO_ROBOTS_DIR) + "/crane_x7";
   const auto tc = symoro::twin::read_twin_config(robot + "/twin.yaml", symoro::crane_x7::Model::nq);
-  const Eigen::VectorXd truth = Model::base_from_standard(symoro::twin::make_truth(symoro::robot::compiled_model<symoro::crane_x7::Model>(), tc).standard);
+  const Eigen::VectorXd truth = Model::base_from_standard(
+      symoro::twin::make_truth(symoro::robot::compiled_model<symoro::crane_x7::Model>(), tc).standard);
   metric_and_euclidean_are_each_optimal<Model>(truth, 3);
 }
 

@@ -149,8 +149,7 @@ void accepted_model_is_positive_definite_by_brute_force() {
   double worst = 1e9;
   for (int k = 0; k < 100000; ++k) {
     Eigen::Matrix<double, Model::nq, 1> q;
-    for (int j = 0; j < Model::nq; ++j)
-      q(j) = std::uniform_real_distribution<double>(dom.lower(j), dom.upper(j))(rng);
+    for (int j = 0; j < Model::nq; ++j) q(j) = std::uniform_real_distribution<double>(dom.lower(j), dom.upper(j))(rng);
     Eigen::Matrix<double, Model::nq, Model::nq> M;
     Model::inertia(q, r.phi_rescue, M);
     worst = std::min(worst, Eigen::SelfAdjointEigenSolver<decltype(M)>(M, Eigen::EigenvaluesOnly).eigenvalues()(0));
@@ -167,7 +166,8 @@ void validation_is_near_the_twins_floor() {
   ASSERT_EQ(r.validation.size(), 1u);
   const auto& v = r.validation.front();
   const auto tc = twin::read_twin_config(kRobot + "/twin.yaml", Full::nq);
-  const Eigen::VectorXd truth = Model::base_from_standard(twin::make_truth(symoro::robot::compiled_model<Full>(), tc).standard);
+  const Eigen::VectorXd truth =
+      Model::base_from_standard(twin::make_truth(symoro::robot::compiled_model<Full>(), tc).standard);
   const identify::ClosedLoopSimulator<Model> sim(setup(), design().build("V02"));
   const auto log = io::read_log(dataset() / "V02_t1.csv");
   const auto s = preprocess::preprocess(log, v.interval);
@@ -262,7 +262,8 @@ TEST(Acceptance, TheVerdictSaysWhyNot) {
   study::Verdict v = study::acceptance_verdict(r);
   EXPECT_FALSE(v.accepted);
   ASSERT_EQ(v.reasons.size(), 1u);
-  EXPECT_EQ(v.reasons[0], "no physically consistent set maps onto it (link 3's pseudo-inertia is not positive definite)");
+  EXPECT_EQ(v.reasons[0],
+            "no physically consistent set maps onto it (link 3's pseudo-inertia is not positive definite)");
   // A failed audit after a failed rescue: both said, the audit first.
   r.final_consistent = true;
   r.final_lambda_min = -2e-4;

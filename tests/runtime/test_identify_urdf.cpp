@@ -60,12 +60,15 @@ std::vector<Eigen::Isometry3d> urdf_frames(const urdf::ModelInterface& m, const 
     if (!j) return T;
     const Eigen::Vector3d axis(j->axis.x, j->axis.y, j->axis.z);
     Eigen::Isometry3d motion = Eigen::Isometry3d::Identity();
-    if (j->type == urdf::Joint::REVOLUTE) motion.rotate(Eigen::AngleAxisd(q(k++), axis));
-    else if (j->type == urdf::Joint::PRISMATIC) motion.translate(q(k++) * axis);
+    if (j->type == urdf::Joint::REVOLUTE)
+      motion.rotate(Eigen::AngleAxisd(q(k++), axis));
+    else if (j->type == urdf::Joint::PRISMATIC)
+      motion.translate(q(k++) * axis);
     const int ant = Model::frames[static_cast<std::size_t>(f - 1)].ant;
     EXPECT_EQ(j->parent_link_name, mx::urdf_link_name(d, ant));
     EXPECT_EQ(j->child_link_name, mx::urdf_link_name(d, f));
-    T[static_cast<std::size_t>(f)] = T[static_cast<std::size_t>(ant)] * pose_of(j->parent_to_joint_origin_transform) * motion;
+    T[static_cast<std::size_t>(f)] =
+        T[static_cast<std::size_t>(ant)] * pose_of(j->parent_to_joint_origin_transform) * motion;
   }
   return T;
 }
@@ -123,8 +126,9 @@ void urdf_round_trip(unsigned seed, int fk_frame) {
     const Eigen::Isometry3d R = pose_of(in.origin);
     EXPECT_TRUE(R.linear().isIdentity(0)) << "frame " << f;
     got.inertia << in.ixx, in.ixy, in.ixz, in.ixy, in.iyy, in.iyz, in.ixz, in.iyz, in.izz;
-    worst_inertial = std::max({worst_inertial, std::abs(got.mass - want.mass), (got.com - want.com).cwiseAbs().maxCoeff(),
-                               (got.inertia - want.inertia).cwiseAbs().maxCoeff()});
+    worst_inertial =
+        std::max({worst_inertial, std::abs(got.mass - want.mass), (got.com - want.com).cwiseAbs().maxCoeff(),
+                  (got.inertia - want.inertia).cwiseAbs().maxCoeff()});
     // Consistent: positive mass, and the inertia about the CoM a PSD tensor with the triangle inequalities.
     EXPECT_GT(got.mass, 0);
     const Eigen::Vector3d ev = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(got.inertia).eigenvalues();
@@ -198,9 +202,10 @@ void urdf_round_trip(unsigned seed, int fk_frame) {
   }
   EXPECT_LE(worst_fk, 1e-12);
   EXPECT_LE(worst_frame, 1e-12);
-  std::printf("  %s seed %u: %d links with inertials, max inertial diff %.3g, max |B s_urdf - phi| %.3g, "
-              "fk diff %.3g, frame diff %.3g, lambda_min %.3g\n",
-              Model::description, seed, with_inertial, worst_inertial, base_error, worst_fk, worst_frame, r.lambda_min);
+  std::printf(
+      "  %s seed %u: %d links with inertials, max inertial diff %.3g, max |B s_urdf - phi| %.3g, "
+      "fk diff %.3g, frame diff %.3g, lambda_min %.3g\n",
+      Model::description, seed, with_inertial, worst_inertial, base_error, worst_fk, worst_frame, r.lambda_min);
 }
 
 TEST(UrdfExport, InertialFormsAreInverse) {
@@ -226,15 +231,17 @@ TEST(UrdfExport, RpyOfRotations) {
   symoro::test::Random rng(2);
   for (int i = 0; i < 100; ++i) {
     Eigen::Matrix3d R = Eigen::Quaterniond::UnitRandom().toRotationMatrix();
-    if (i == 0) R = Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d::UnitY()).toRotationMatrix() *
-                    Eigen::AngleAxisd(0.3, Eigen::Vector3d::UnitX()).toRotationMatrix();
-    if (i == 1) R = Eigen::AngleAxisd(-M_PI / 2, Eigen::Vector3d::UnitY()).toRotationMatrix() *
-                    Eigen::AngleAxisd(0.3, Eigen::Vector3d::UnitX()).toRotationMatrix();
+    if (i == 0)
+      R = Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d::UnitY()).toRotationMatrix() *
+          Eigen::AngleAxisd(0.3, Eigen::Vector3d::UnitX()).toRotationMatrix();
+    if (i == 1)
+      R = Eigen::AngleAxisd(-M_PI / 2, Eigen::Vector3d::UnitY()).toRotationMatrix() *
+          Eigen::AngleAxisd(0.3, Eigen::Vector3d::UnitX()).toRotationMatrix();
     const Eigen::Vector3d rpy = mx::urdf_rpy(R);
-    const Eigen::Matrix3d back = (Eigen::AngleAxisd(rpy(2), Eigen::Vector3d::UnitZ()) *
-                                  Eigen::AngleAxisd(rpy(1), Eigen::Vector3d::UnitY()) *
-                                  Eigen::AngleAxisd(rpy(0), Eigen::Vector3d::UnitX()))
-                                     .toRotationMatrix();
+    const Eigen::Matrix3d back =
+        (Eigen::AngleAxisd(rpy(2), Eigen::Vector3d::UnitZ()) * Eigen::AngleAxisd(rpy(1), Eigen::Vector3d::UnitY()) *
+         Eigen::AngleAxisd(rpy(0), Eigen::Vector3d::UnitX()))
+            .toRotationMatrix();
     EXPECT_LE((back - R).cwiseAbs().maxCoeff(), 1e-14) << i;
   }
 }

@@ -121,7 +121,8 @@ TEST_F(AtomicFiles, TheNextWriteIntoTheFolderRemovesItsDeadWritersTemporaryFiles
   const fs::path no_pid = AtomicFile::temp_path(target, 4294967296L + dead, 0);  // wraps to `dead` as an int
   const fs::path other_living = AtomicFile::temp_path(dir_ / "other.csv", live, 3);
   const fs::path dotted_target = AtomicFile::temp_path(dir_ / "run.2.csv", dead, 1);
-  for (const fs::path& p : {stale, stale_later, mine, living, other_target, other_host, not_ours, no_pid, other_living, dotted_target})
+  for (const fs::path& p :
+       {stale, stale_later, mine, living, other_target, other_host, not_ours, no_pid, other_living, dotted_target})
     touch(p);
   EXPECT_EQ(stale.filename().string().rfind(".big.csv.symoro-tmp.", 0), 0u) << stale;
 
@@ -177,8 +178,7 @@ TEST_F(AtomicFiles, AFullDiskSaysSoAndWhetherAPreviousFileIsKept) {
 
   write_file_atomically(target, "time\n0\n");
   what = error_of([&] { write_file_atomically(target, big); });
-  EXPECT_NE(what.find("writing failed: " + reason + "; the previous file is left as it was"),
-            std::string::npos)
+  EXPECT_NE(what.find("writing failed: " + reason + "; the previous file is left as it was"), std::string::npos)
       << what;
   EXPECT_EQ(read_text(target), "time\n0\n");
   EXPECT_EQ(std::distance(fs::directory_iterator(dir_), fs::directory_iterator()), 1);

@@ -27,7 +27,8 @@ namespace symoro::io {
 namespace {
 
 std::filesystem::path scratch(const std::string& name) {
-  const auto d = std::filesystem::temp_directory_path() / ("symoro_io_files_" + name + "_" + std::to_string(::getpid()));
+  const auto d =
+      std::filesystem::temp_directory_path() / ("symoro_io_files_" + name + "_" + std::to_string(::getpid()));
   std::filesystem::remove_all(d);
   std::filesystem::create_directories(d);
   return d;
@@ -42,7 +43,8 @@ TEST(FolderLock, ASecondHolderIsRefusedWithTheFirstsPid) {
       FAIL() << "two holders of one folder";
     } catch (const DataError& e) {
       const std::string what = e.what();
-      EXPECT_NE(what.find("in use by pid " + std::to_string(::getpid()) + " (dynid identify)"), std::string::npos) << what;
+      EXPECT_NE(what.find("in use by pid " + std::to_string(::getpid()) + " (dynid identify)"), std::string::npos)
+          << what;
       EXPECT_NE(what.find((dir / "study").string()), std::string::npos) << what;
     }
     // Another process is refused too (flock excludes open files, not only processes).
@@ -72,7 +74,8 @@ TEST(Readers, RefuseDevicesAndFifosAtOnce) {
   std::filesystem::create_directories(dir);
   const auto fifo = dir / "fifo";
   ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
-  for (const std::filesystem::path target : {std::filesystem::path("/dev/zero"), std::filesystem::path("/dev/urandom"), fifo}) {
+  for (const std::filesystem::path target :
+       {std::filesystem::path("/dev/zero"), std::filesystem::path("/dev/urandom"), fifo}) {
     SCOPED_TRACE(target.string());
     const auto log = dir / "run.csv", sidecar = dir / "run.meta.yaml", manifest = dir / "dataset.yaml";
     for (const auto& link : {log, sidecar, manifest}) {
@@ -99,11 +102,13 @@ TEST(Readers, RefuseDevicesAndFifosAtOnce) {
 // A 100 MB scalar was echoed whole in the error (100-200 MB of output): a message keeps its head
 // and tail and says how much it left out (issue 42, item 17).
 TEST(Readers, AHugeValueIsNotEchoedWhole) {
-  const std::filesystem::path dir = std::filesystem::temp_directory_path() / ("symoro_huge_" + std::to_string(::getpid()));
+  const std::filesystem::path dir =
+      std::filesystem::temp_directory_path() / ("symoro_huge_" + std::to_string(::getpid()));
   std::filesystem::remove_all(dir);
   std::filesystem::create_directories(dir);
   const std::string key(10 << 20, 'k');
-  std::ofstream(dir / "dataset.yaml") << "robot: arm\n? " << key << "\n: 1\n";  // an explicit key: no 1024-character bound
+  std::ofstream(dir / "dataset.yaml") << "robot: arm\n? " << key
+                                      << "\n: 1\n";  // an explicit key: no 1024-character bound
   try {
     symoro::io::read_dataset(dir);
     ADD_FAILURE() << "a 10 MB unknown key accepted";
@@ -120,18 +125,25 @@ TEST(Readers, AHugeValueIsNotEchoedWhole) {
 
 // --params given a CSV said "operator[] call on a scalar" (issue 42, item 17).
 TEST(Readers, AParametersFileThatIsNoMapIsNamed) {
-  const std::filesystem::path csv = std::filesystem::temp_directory_path() / ("symoro_params_" + std::to_string(::getpid()) + ".csv");
+  const std::filesystem::path csv =
+      std::filesystem::temp_directory_path() / ("symoro_params_" + std::to_string(::getpid()) + ".csv");
   std::ofstream(csv) << "name,value\nXX1,0.1\nXY1,0.2\n";
-  for (const std::function<void()>& read : std::vector<std::function<void()>>{
-           [&] { read_parameters_yaml(csv.string(), {"XX1", "XY1"}); }, [&] { parameters_accepted(csv.string()); },
-           [&] { parameters_integrity(csv.string(), {"XX1", "XY1"}); }}) {
+  for (const std::function<void()>& read :
+       std::vector<std::function<void()>>{[&] {
+                                            read_parameters_yaml(csv.string(), {"XX1", "XY1"});
+                                          },
+                                          [&] { parameters_accepted(csv.string()); },
+                                          [&] {
+                                            parameters_integrity(csv.string(), {"XX1", "XY1"});
+                                          }}) {
     try {
       read();
       ADD_FAILURE() << "a CSV read as parameters";
     } catch (const DataError& e) {
       EXPECT_EQ(std::string(e.what()),
-                csv.string() + ":1: error: not a parameters file: a YAML map with a 'parameters:' list (a study's "
-                               "report/parameters.yaml) was expected; a .csv is not read here");
+                csv.string() +
+                    ":1: error: not a parameters file: a YAML map with a 'parameters:' list (a study's "
+                    "report/parameters.yaml) was expected; a .csv is not read here");
     }
   }
   std::filesystem::remove(csv);
@@ -163,8 +175,9 @@ TEST(ParametersDigest, AnEditedValueOrFlagBreaksIt) {
     std::ofstream f(dir / file);
     f << "robot: \"crane_x7\"\nmodel: \"reduced\"\naccepted: " << (accepted ? "true" : "false") << "\n";
     if (with_digest) f << "digest: " << parameters_digest("crane_x7", "reduced", true, names, phi) << "\n";
-    f << "parameters:\n  - {name: \"ZZR1\", unit: \"kg m^2\", value: 0.0121}\n  - {name: \"MX2\", unit: \"kg m\", value: " << mx2
-      << "}\n";
+    f << "parameters:\n  - {name: \"ZZR1\", unit: \"kg m^2\", value: 0.0121}\n  - {name: \"MX2\", unit: \"kg m\", "
+         "value: "
+      << mx2 << "}\n";
   };
   write("ok.yaml", true, 0.0437, true);
   EXPECT_TRUE(parameters_integrity((dir / "ok.yaml").string(), names).intact);

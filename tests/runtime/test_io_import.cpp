@@ -48,9 +48,8 @@ std::string num(double v) { return io::number_text(v); }
 class Import : public ::testing::Test {
  protected:
   void SetUp() override {
-    dir_ = fs::temp_directory_path() /
-           ("symoro_import_" + std::to_string(::getpid()) + "_" +
-            ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    dir_ = fs::temp_directory_path() / ("symoro_import_" + std::to_string(::getpid()) + "_" +
+                                        ::testing::UnitTest::GetInstance()->current_test_info()->name());
     fs::remove_all(dir_);
     fs::create_directories(dir_);
   }
@@ -62,9 +61,7 @@ class Import : public ::testing::Test {
 
 // ---- The 6-joint export: degrees, milliseconds, mN m, a header, comments, a text column ------
 
-io::ImportTarget six_joints() {
-  return {"arm6", {"j1", "j2", "j3", "j4", "j5", "j6"}, {}};
-}
+io::ImportTarget six_joints() { return {"arm6", {"j1", "j2", "j3", "j4", "j5", "j6"}, {}}; }
 
 io::ImportMapping six_mapping() {
   io::ImportMapping m;
@@ -80,8 +77,8 @@ io::ImportMapping six_mapping() {
 
 // What the exporter wrote (the parsed values of its text), and where.
 struct Export6 {
-  std::vector<double> t_ms;                          // per written log row
-  std::vector<std::vector<double>> pos, vel, eff;    // [row][joint], as written (deg, deg/s, mN m)
+  std::vector<double> t_ms;                        // per written log row
+  std::vector<std::vector<double>> pos, vel, eff;  // [row][joint], as written (deg, deg/s, mN m)
   std::vector<int> stale_lines, duplicate_lines;
 };
 
@@ -211,7 +208,7 @@ TEST_F(Import, SixJointsInDegreesAndMillisecondsReadBackExactly) {
   const io::ImportedLog& imported = r.logs[0];
   EXPECT_EQ(imported.rows, rows + 1);
   EXPECT_EQ(imported.stale_lines, e.stale_lines);
-  EXPECT_EQ(imported.stale_lines.size(), 150u);  // 5 % of 3000
+  EXPECT_EQ(imported.stale_lines.size(), 150u);                 // 5 % of 3000
   EXPECT_EQ(imported.duplicate_lines, std::vector<int>{1005});  // row 1000 is on line 1004
   EXPECT_EQ(imported.columns.at("q1"), "'pos_1' (column 2)");
   EXPECT_EQ(imported.columns.at("qd1"), "'vel_0' (column 14)");
@@ -397,13 +394,16 @@ TEST_F(Import, DatasetWindowsAreChecked) {
   const fs::path manifest = dir_ / "data" / "dataset.yaml";
   std::string text = read_text(manifest);
   const std::size_t runs = text.find("runs:\n");
-  write_text(manifest, text.substr(0, runs) + "runs:\n  - {trajectory: a, family: F, trial: 1, file: a.csv,\n"
-                                              "     window: [2, 1]}\n");
+  write_text(manifest, text.substr(0, runs) +
+                           "runs:\n  - {trajectory: a, family: F, trial: 1, file: a.csv,\n"
+                           "     window: [2, 1]}\n");
   const int window_line = static_cast<int>(std::count(text.begin(), text.begin() + runs, '\n')) + 3;
   expect_error([&] { symoro::io::read_dataset(dir_ / "data"); }, manifest.string(), window_line, "not an interval");
-  write_text(manifest, text.substr(0, runs) + "runs:\n  - {trajectory: a, family: F, trial: 1, file: a.csv, window: [5, 6]}\n");
+  write_text(manifest,
+             text.substr(0, runs) + "runs:\n  - {trajectory: a, family: F, trial: 1, file: a.csv, window: [5, 6]}\n");
   const symoro::io::Dataset d = symoro::io::read_dataset(dir_ / "data");
-  expect_error([&] { symoro::io::read_run_log(d.runs[0]); }, d.runs[0].file.string(), 0, "holds none of the log's samples");
+  expect_error([&] { symoro::io::read_run_log(d.runs[0]); }, d.runs[0].file.string(), 0,
+               "holds none of the log's samples");
 }
 
 // The manifest's one writer against its one reader: every field, awkward names (quotes, a
@@ -415,13 +415,18 @@ TEST_F(Import, ARunFileOutsideTheDatasetFolderIsRefused) {
   write_text(dir_ / "outside.csv", "");
   write_text(dir_ / "data" / "sub" / "in.csv", "");
   const fs::path manifest = dir_ / "data" / "dataset.yaml";
-  for (const std::string& file : std::vector<std::string>{"../outside.csv", (dir_ / "outside.csv").string(), "sub/../../outside.csv"}) {
-    write_text(manifest, "format: symoro-dataset 1\nrobot: arm2\nruns:\n  - trajectory: a\n    family: F\n    trial: 1\n"
-                         "    file: " + file + "\n");
+  for (const std::string& file :
+       std::vector<std::string>{"../outside.csv", (dir_ / "outside.csv").string(), "sub/../../outside.csv"}) {
+    write_text(manifest,
+               "format: symoro-dataset 1\nrobot: arm2\nruns:\n  - trajectory: a\n    family: F\n    trial: 1\n"
+               "    file: " +
+                   file + "\n");
     expect_error([&] { io::read_dataset(dir_ / "data"); }, manifest.string(), 7,
                  "file '" + file + "' is outside the dataset folder: a dataset's logs are in its folder");
   }
-  write_text(manifest, "format: symoro-dataset 1\nrobot: arm2\nruns:\n  - {trajectory: a, family: F, trial: 1, file: sub/../sub/in.csv}\n");
+  write_text(manifest,
+             "format: symoro-dataset 1\nrobot: arm2\nruns:\n  - {trajectory: a, family: F, trial: 1, file: "
+             "sub/../sub/in.csv}\n");
   EXPECT_EQ(io::read_dataset(dir_ / "data").runs.at(0).file, dir_ / "data" / "sub" / "in.csv");
 }
 
@@ -664,10 +669,12 @@ TEST_F(Import, ErrorsNameTheLine) {
     return [m, f] { io::import_log(f, m, two_joints()); };
   };
   const std::string good = "0 0 0 0 0\n0.001 1 1 1 1\n0.002 2 2 2 2\n";
-  expect_error(import(good + "0.0015 3 3 3 3\n"), f.string(), 4, "time goes backwards: 0.0015 s here, 0.002 s on line 3");
+  expect_error(import(good + "0.0015 3 3 3 3\n"), f.string(), 4,
+               "time goes backwards: 0.0015 s here, 0.002 s on line 3");
   expect_error(import(good + "0.002 2 2.5 2 2\n"), f.string(), 4,
                "same time stamp as line 3 (0.002 s) but other values: column 3 is 2.5 here, 2 there");
-  expect_error(import("# c\n" + good + "0.003 3 nan 3 3\n"), f.string(), 5, "column 3 holds 'nan', not a finite number");
+  expect_error(import("# c\n" + good + "0.003 3 nan 3 3\n"), f.string(), 5,
+               "column 3 holds 'nan', not a finite number");
   expect_error(import(good + "0.003 3 3 abc 3\n"), f.string(), 4, "'abc' in column 4 is not a number");
   expect_error(import(good + "0.003 3 3 3\n"), f.string(), 4, "row has 4 fields, the first row (line 1) has 5");
   expect_error(import(good + "0.003 3 inf 3 3\n"), f.string(), 4, "not a finite number");
@@ -678,11 +685,13 @@ TEST_F(Import, ErrorsNameTheLine) {
   named.q = "pos_*";
   named.tau = "eff_*";
   const std::string three = "# comment\n\nt,pos_1,pos_2,pos_3,eff_1,eff_2\n0,1,2,3,4,5\n0.001,1,2,3,4,5\n";
-  expect_error(import(three, named), f.string(), 3, "matches 3 columns numbered 1..3, but the robot 'arm2' has 2 joints");
+  expect_error(import(three, named), f.string(), 3,
+               "matches 3 columns numbered 1..3, but the robot 'arm2' has 2 joints");
   // Numbered from 0 with the 1-based pattern: the 0-based one is named.
   const std::string zero = "t,pos_0,pos_1,eff_1,eff_2\n0,1,2,4,5\n0.001,1,2,4,5\n";
   expect_error(import(zero, named), f.string(), 1,
-               "matches 2 columns numbered 0..1, but the robot 'arm2' has 2 joints (shoulder, elbow); for numbers from 0 write 'pos_%'");
+               "matches 2 columns numbered 0..1, but the robot 'arm2' has 2 joints (shoulder, elbow); for numbers from "
+               "0 write 'pos_%'");
   const std::string one = "t,pos_1,eff_1,eff_2\n0,1,4,5\n0.001,1,4,5\n";
   expect_error(import(one, named), f.string(), 1, "no column 'pos_2' for joint 2");
   io::ImportMapping positions = two_mapping();
@@ -735,8 +744,12 @@ TEST_F(Import, QuotesControlBytesEscaped) {
   named.time = "t";
   named.q = "p1,p2";
   named.tau = "e1,e2";
-  write_text(f, "t,p1,p\x01" "2,e1,e2\n0,0,0,0,0\n0.001,1,x,1,1\n");
-  named.q = "p1,p\x01" "2";
+  write_text(f,
+             "t,p1,p\x01"
+             "2,e1,e2\n0,0,0,0,0\n0.001,1,x,1,1\n");
+  named.q =
+      "p1,p\x01"
+      "2";
   expect_error([&] { io::import_log(f, named, two_joints()); }, f.string(), 3, "'x' in 'p\\x012' (column 3)");
 }
 

@@ -101,8 +101,8 @@ void expect_same_bits(const Eigen::MatrixXd& read, const Eigen::MatrixXd& writte
   ASSERT_EQ(read.cols(), written.cols()) << what;
   for (Eigen::Index j = 0; j < read.cols(); ++j)
     for (Eigen::Index k = 0; k < read.rows(); ++k)
-      ASSERT_EQ(bits(read(k, j)), bits(written(k, j))) << what << "(" << k << ", " << j << "): read " << read(k, j)
-                                                       << ", wrote " << written(k, j);
+      ASSERT_EQ(bits(read(k, j)), bits(written(k, j)))
+          << what << "(" << k << ", " << j << "): read " << read(k, j) << ", wrote " << written(k, j);
 }
 
 void expect_same_metadata(const symoro::io::LogMetadata& read, const symoro::io::LogMetadata& written) {
@@ -123,16 +123,23 @@ std::string sidecar(int samples, const std::string& source = "twin", int joints 
   std::string units = "  time: s\n";
   if (source != "reference") units += "  q: rad\n  qd: rad/s\n  tau: N*m\n";
   units += "  q_ref: rad\n  qd_ref: rad/s\n  qdd_ref: rad/s^2\n";
-  return "format: symoro-log 1\n"          // line 1
-         "robot: crane_x7\n"               // 2
-         "trajectory: AG02\n"              // 3
-         "trial: 1\n"                      // 4
-         "seed: 7\n"                       // 5
-         "source: " + source + "\n"        // 6
-         "sample_time: 0.001\n"            // 7
-         "samples: " + std::to_string(samples) + "\n"  // 8
-         "joints: [" + names + "]\n"       // 9
-         "units:\n" + units +              // 10, then one line per unit
+  return "format: symoro-log 1\n"  // line 1
+         "robot: crane_x7\n"       // 2
+         "trajectory: AG02\n"      // 3
+         "trial: 1\n"              // 4
+         "seed: 7\n"               // 5
+         "source: " +
+         source +
+         "\n"                    // 6
+         "sample_time: 0.001\n"  // 7
+         "samples: " +
+         std::to_string(samples) +
+         "\n"  // 8
+         "joints: [" +
+         names +
+         "]\n"  // 9
+         "units:\n" +
+         units +  // 10, then one line per unit
          "notes: hand written\n";
 }
 
@@ -284,10 +291,11 @@ TEST_F(LogFiles, MetadataThatLooksLikeOtherYamlTypesStaysText) {
 }
 
 TEST_F(LogFiles, ColumnsAreMatchedByName) {
-  const fs::path csv = files("tau2,qd1,time,q2,tau1,q1,qd2\n"
-                             "6,3,0.5,2,5,1,4\n"
-                             "16,13,0.75,12,15,11,14\n",
-                             sidecar(2));
+  const fs::path csv = files(
+      "tau2,qd1,time,q2,tau1,q1,qd2\n"
+      "6,3,0.5,2,5,1,4\n"
+      "16,13,0.75,12,15,11,14\n",
+      sidecar(2));
   const Log log = read_log(csv);
   ASSERT_EQ(log.samples(), 2);
   ASSERT_EQ(log.joints(), 2);
@@ -306,10 +314,11 @@ TEST_F(LogFiles, ColumnsAreMatchedByName) {
 }
 
 TEST_F(LogFiles, AcceptsCrLfSpacesAndByteOrderMark) {
-  const fs::path csv = files("\xEF\xBB\xBFtime, q1,q2 ,qd1,qd2,tau1,tau2\r\n"
-                             "0, 1 ,2,3,4,5,6\r\n"
-                             "1e-3,1,2,3,4,5,-6.5e-1\r\n",
-                             sidecar(2));
+  const fs::path csv = files(
+      "\xEF\xBB\xBFtime, q1,q2 ,qd1,qd2,tau1,tau2\r\n"
+      "0, 1 ,2,3,4,5,6\r\n"
+      "1e-3,1,2,3,4,5,-6.5e-1\r\n",
+      sidecar(2));
   const Log log = read_log(csv);
   ASSERT_EQ(log.samples(), 2);
   EXPECT_EQ(log.time[1], 1e-3);
@@ -335,7 +344,8 @@ TEST_F(LogFiles, OverwritingALogReplacesIt) {
 TEST_F(LogFiles, WriterRejectsInconsistentLogs) {
   const fs::path csv = path("bad.csv");
   const std::vector<std::pair<std::function<void(Log&)>, std::string>> cases = {
-      {[](Log& l) { l.q.conservativeResize(l.q.rows() - 1, Eigen::NoChange); }, "q is 9 x 2 but the log has 10 samples"},
+      {[](Log& l) { l.q.conservativeResize(l.q.rows() - 1, Eigen::NoChange); },
+       "q is 9 x 2 but the log has 10 samples"},
       {[](Log& l) { l.tau.conservativeResize(Eigen::NoChange, 3); }, "tau is 10 x 3"},
       {[](Log& l) { l.meta.joints.push_back("j3"); }, "q is 10 x 2 but the log has 10 samples of 3 joints"},
       {[](Log& l) { l.qd(4, 1) = std::nan(""); }, "qd2 at sample 5 is nan"},
@@ -448,15 +458,16 @@ TEST_F(LogFiles, RejectsSidecarWithMoreJointsThanTheCsv) {
 }
 
 TEST_F(LogFiles, RejectsPartialReferenceGroup) {
-  const fs::path csv = files("time,q1,q2,qd1,qd2,tau1,tau2,q_ref1,q_ref2,qd_ref1,qd_ref2,qdd_ref1\n"
-                             "0,1,2,3,4,5,6,7,8,9,10,11\n",
-                             sidecar(1));
+  const fs::path csv = files(
+      "time,q1,q2,qd1,qd2,tau1,tau2,q_ref1,q_ref2,qd_ref1,qd_ref2,qdd_ref1\n"
+      "0,1,2,3,4,5,6,7,8,9,10,11\n",
+      sidecar(1));
   expect_rejected(csv, csv, 1, "partial reference group: missing column 'qdd_ref2'");
 }
 
 TEST_F(LogFiles, RejectsMeasuredColumnsInAReferenceFile) {
-  const fs::path csv = files("time,q_ref1,q_ref2,qd_ref1,qd_ref2,qdd_ref1,qdd_ref2,q1\n0,1,2,3,4,5,6,7\n",
-                             sidecar(1, "reference"));
+  const fs::path csv =
+      files("time,q_ref1,q_ref2,qd_ref1,qd_ref2,qdd_ref1,qdd_ref2,q1\n0,1,2,3,4,5,6,7\n", sidecar(1, "reference"));
   expect_rejected(csv, csv, 1, "unknown column 'q1' in a reference file");
 }
 
@@ -499,7 +510,8 @@ TEST_F(LogFiles, RejectsALastLineCutWithoutNewline) {
 TEST_F(LogFiles, QuotesControlBytesEscaped) {
   const fs::path csv = files(header2 + "0,1,2,3,4,5,6\n1,1,2,-0." + std::string(1, '\0') + "7x,4,5,6\n", sidecar(2));
   expect_rejected(csv, csv, 3, "'-0.\\07x' in column 'qd1' is not a number");
-  const fs::path header = files("time,q1,q\x01" + std::string(1, '\0') + "2,qd1,qd2,tau1,tau2\n0,1,2,3,4,5,6\n", sidecar(1));
+  const fs::path header =
+      files("time,q1,q\x01" + std::string(1, '\0') + "2,qd1,qd2,tau1,tau2\n0,1,2,3,4,5,6\n", sidecar(1));
   expect_rejected(header, header, 1, "unknown column 'q\\x01\\02'");
 }
 
@@ -565,8 +577,9 @@ TEST_F(LogFiles, RejectsEmptyFile) {
 
 TEST_F(LogFiles, RejectsCsvShorterThanTheSidecarSays) {
   const fs::path csv = files(header2 + "0,1,2,3,4,5,6\n1,1,2,3,4,5,6\n", sidecar(3));
-  expect_rejected(csv, csv, 0, "the CSV has 2 samples but its sidecar (" + metadata_path(csv).string() +
-                                   ":8) says samples: 3 (truncated CSV?)");
+  expect_rejected(
+      csv, csv, 0,
+      "the CSV has 2 samples but its sidecar (" + metadata_path(csv).string() + ":8) says samples: 3 (truncated CSV?)");
 }
 
 TEST_F(LogFiles, RejectsCsvLongerThanTheSidecarSays) {
@@ -607,12 +620,13 @@ TEST_F(LogFiles, RejectsSidecarWithBadYaml) {
     EXPECT_EQ(e.file(), metadata_path(csv).string());
     EXPECT_GE(e.line(), 9) << e.what();  // yaml-cpp notices at the list or just after it
     EXPECT_LE(e.line(), 10) << e.what();
-    EXPECT_NE(std::string(e.what()).find("YAML syntax error: end of sequence flow not found"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("YAML syntax error: end of sequence flow not found"), std::string::npos)
+        << e.what();
   }
 }
 
 TEST_F(LogFiles, RejectsSidecarWithTabIndentation) {
-  const fs::path csv = files(header2 + "0,1,2,3,4,5,6\n", sidecar_with_line(4, "trial: 1\n\tbad: [")); 
+  const fs::path csv = files(header2 + "0,1,2,3,4,5,6\n", sidecar_with_line(4, "trial: 1\n\tbad: ["));
   try {
     read_log(csv);
     FAIL() << "accepted broken YAML";
@@ -629,7 +643,8 @@ TEST_F(LogFiles, RejectsSidecarWithoutAKey) {
 
 TEST_F(LogFiles, RejectsSidecarWithUnknownKey) {
   const fs::path csv = files(header2 + "0,1,2,3,4,5,6\n", sidecar_with_line(3, "trajectroy: AG02"));
-  expect_rejected(csv, metadata_path(csv), 3, "unknown key 'trajectroy' in the metadata sidecar; did you mean 'trajectory'?");
+  expect_rejected(csv, metadata_path(csv), 3,
+                  "unknown key 'trajectroy' in the metadata sidecar; did you mean 'trajectory'?");
 }
 
 TEST_F(LogFiles, RejectsSidecarWithUnknownUnitsKey) {
@@ -648,7 +663,8 @@ TEST_F(LogFiles, RejectsSidecarWithAnUnclosedQuote) {
     FAIL() << "accepted a sidecar with an unclosed quote";
   } catch (const DataError& e) {
     EXPECT_EQ(e.line(), 3) << e.what();
-    EXPECT_EQ(std::string(e.what()).rfind(metadata_path(csv).string() + ":3:13: error: YAML syntax error: ", 0), 0u) << e.what();
+    EXPECT_EQ(std::string(e.what()).rfind(metadata_path(csv).string() + ":3:13: error: YAML syntax error: ", 0), 0u)
+        << e.what();
   }
 }
 
@@ -709,9 +725,8 @@ TEST_F(LogFiles, DISABLED_Speed110000x49) {
   const Log read = read_log(csv);
   const auto t2 = clock::now();
   const double mb = static_cast<double>(fs::file_size(csv)) / 1e6;
-  std::cout << "110000 x 49 log, " << mb << " MB: write "
-            << std::chrono::duration<double>(t1 - t0).count() << " s, read "
-            << std::chrono::duration<double>(t2 - t1).count() << " s\n";
+  std::cout << "110000 x 49 log, " << mb << " MB: write " << std::chrono::duration<double>(t1 - t0).count()
+            << " s, read " << std::chrono::duration<double>(t2 - t1).count() << " s\n";
   expect_same_bits(read.qdd_ref, log.qdd_ref, "qdd_ref");
 }
 

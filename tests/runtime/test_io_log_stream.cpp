@@ -111,7 +111,8 @@ TEST(LogStream, AStalledWriterNeitherBlocksAppendNorLosesAnAcceptedRow) {
   reader.join();
   // The text the pipe carried: header and one line per accepted row, times increasing.
   std::vector<std::string> lines;
-  for (std::size_t a = 0, b; (b = text.find('\n', a)) != std::string::npos; a = b + 1) lines.push_back(text.substr(a, b - a));
+  for (std::size_t a = 0, b; (b = text.find('\n', a)) != std::string::npos; a = b + 1)
+    lines.push_back(text.substr(a, b - a));
   ASSERT_EQ(static_cast<std::int64_t>(lines.size()), accepted + 1);
   double previous = -1;
   for (std::size_t i = 1; i < lines.size(); ++i) {

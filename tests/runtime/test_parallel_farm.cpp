@@ -151,7 +151,8 @@ TEST(Farm, AnIsolatedTaskKilledBySignalFailsWithTheSignalNamedAndTheOthersFinish
     EXPECT_EQ(c.results[i].size(), 2u);
   }
   EXPECT_TRUE(s.tasks[1].failed);
-  EXPECT_NE(s.tasks[1].failure.find("killed by signal " + std::to_string(SIGSEGV)), std::string::npos) << s.tasks[1].failure;
+  EXPECT_NE(s.tasks[1].failure.find("killed by signal " + std::to_string(SIGSEGV)), std::string::npos)
+      << s.tasks[1].failure;
   EXPECT_TRUE(s.tasks[3].failed);
   EXPECT_NE(s.tasks[3].failure.find("out of memory?"), std::string::npos) << s.tasks[3].failure;
   EXPECT_TRUE(s.tasks[4].failed);
@@ -164,7 +165,9 @@ int calls = 0;
 
 TEST(Farm, IsolatedTasksStartFromTheSameStateInProcessOnesDoNot) {
   Farm farm;
-  farm.work = [](const std::string&, const std::function<void(const std::string&)>& emit) { emit(std::to_string(++calls)); };
+  farm.work = [](const std::string&, const std::function<void(const std::string&)>& emit) {
+    emit(std::to_string(++calls));
+  };
   for (bool isolate : {true, false}) {
     calls = 0;
     Collected c;

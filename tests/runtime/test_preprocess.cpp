@@ -52,8 +52,7 @@ double bilinear_butterworth_power(double f, double cutoff, int order, double fs 
 std::complex<double> response(const std::vector<pp::Biquad>& sections, double w) {
   const std::complex<double> z1 = std::polar(1.0, -w), z2 = z1 * z1;
   std::complex<double> h = 1;
-  for (const pp::Biquad& s : sections)
-    h *= (s.b0 + s.b1 * z1 + s.b2 * z2) / (1.0 + s.a1 * z1 + s.a2 * z2);
+  for (const pp::Biquad& s : sections) h *= (s.b0 + s.b1 * z1 + s.b2 * z2) / (1.0 + s.a1 * z1 + s.a2 * z2);
   return h;
 }
 
@@ -110,9 +109,7 @@ std::array<double, 3> impulse_response_l1(double cutoff, int order, double tau_s
 }
 
 // Slowest time constant of the analog Butterworth, s: 1 / (wc sin(pi / 2N)).
-double analog_time_constant(double cutoff, int order) {
-  return 1 / (2 * kPi * cutoff * std::sin(kPi / (2 * order)));
-}
+double analog_time_constant(double cutoff, int order) { return 1 / (2 * kPi * cutoff * std::sin(kPi / (2 * order))); }
 
 // ---- Synthetic motions with exact derivatives ------------------------------------------------
 
@@ -141,10 +138,7 @@ struct Motion {
     for (const Sinusoid& s : sinusoids) {
       const double w = 2 * kPi * s.frequency, g = gain ? gain(s.frequency) : 1.0;
       const double arg = w * t + s.phase;
-      v += g * s.amplitude *
-           (order == 0   ? std::sin(arg)
-            : order == 1 ? w * std::cos(arg)
-                         : -w * w * std::sin(arg));
+      v += g * s.amplitude * (order == 0 ? std::sin(arg) : order == 1 ? w * std::cos(arg) : -w * w * std::sin(arg));
     }
     return v;
   }
@@ -193,8 +187,7 @@ symoro::io::Log record(const std::vector<Motion>& joints, const Recording& r) {
       const double q = joints[j].eval(t - r.start, 0);
       log.q(row, j) = r.quantize ? kEncoderStep * std::round(q / kEncoderStep) : q;
       log.qd(row, j) = joints[j].eval(t - r.start, 1);
-      double tau = torque_motion(j).eval(t - r.start, 0) +
-                   r.backlash * std::sin(2 * kPi * 100 * (t - r.start) + j);
+      double tau = torque_motion(j).eval(t - r.start, 0) + r.backlash * std::sin(2 * kPi * 100 * (t - r.start) + j);
       if (r.quantize) tau = kCurrentStep * std::round((tau + torque_noise(rng)) / kCurrentStep);
       log.tau(row, j) = tau;
     }
@@ -209,9 +202,7 @@ std::vector<Motion> sinusoid_motions(int dof) {
   for (int j = 0; j < dof; ++j) {
     Motion m;
     m.offset = 0.1 * j;
-    m.sinusoids = {{1.0 - 0.1 * j, 0.2 + 0.05 * j, 0.3 * j},
-                   {0.5, 1.0 + 0.1 * j, 1.0},
-                   {0.1, 3.0, 2.0 - 0.2 * j}};
+    m.sinusoids = {{1.0 - 0.1 * j, 0.2 + 0.05 * j, 0.3 * j}, {0.5, 1.0 + 0.1 * j, 1.0}, {0.1, 3.0, 2.0 - 0.2 * j}};
     joints.push_back(m);
   }
   return joints;
@@ -256,14 +247,12 @@ TEST(PreprocessButterworth, MagnitudeMatchesBilinearFormula) {
     for (double cutoff : {5.0, 6.25, 15.0, 100.0, 350.0}) {
       const auto sections = pp::butterworth_lowpass(order, cutoff, fs);
       EXPECT_EQ(static_cast<int>(sections.size()), (order + 1) / 2);
-      for (double f : {0.0, 0.5, 1.0, 3.0, cutoff / 2, cutoff, 1.5 * cutoff, 2 * cutoff, 100.0,
-                       300.0, 499.0}) {
+      for (double f : {0.0, 0.5, 1.0, 3.0, cutoff / 2, cutoff, 1.5 * cutoff, 2 * cutoff, 100.0, 300.0, 499.0}) {
         if (f >= fs / 2) continue;
         const double expected = bilinear_butterworth_power(f, cutoff, order, fs);
         const double actual = std::norm(response(sections, 2 * kPi * f / fs));
         if (expected > 1e-20)
-          EXPECT_NEAR(actual / expected, 1.0, 1e-10)
-              << "order " << order << " cutoff " << cutoff << " f " << f;
+          EXPECT_NEAR(actual / expected, 1.0, 1e-10) << "order " << order << " cutoff " << cutoff << " f " << f;
         else
           EXPECT_LT(actual, 1e-18);
       }
@@ -285,8 +274,7 @@ TEST(PreprocessButterworth, TimeConstantAndPadding) {
   const auto sections = pp::butterworth_lowpass(4, 15.0, 1 / kH);
   const double analog = 1 / (2 * kPi * 15.0 * std::sin(kPi / 8)) / kH;
   EXPECT_NEAR(pp::slowest_time_constant(sections) / analog, 1.0, 0.01);
-  EXPECT_EQ(pp::zero_phase_padding(sections),
-            static_cast<int>(std::ceil(3 * pp::slowest_time_constant(sections))));
+  EXPECT_EQ(pp::zero_phase_padding(sections), static_cast<int>(std::ceil(3 * pp::slowest_time_constant(sections))));
   EXPECT_THROW(pp::butterworth_lowpass(4, 500.0, 1000.0), std::invalid_argument);
   EXPECT_THROW(pp::butterworth_lowpass(0, 15.0, 1000.0), std::invalid_argument);
 }
@@ -318,8 +306,7 @@ TEST(PreprocessZeroPhase, SinusoidIsNotShiftedAndScaledByPowerResponse) {
     basis.row(k - first) << std::sin(2 * kPi * f * k * kH), std::cos(2 * kPi * f * k * kH), 1;
   const double gain = bilinear_butterworth_power(f, cutoff, 4);
   for (int c = 0; c < 2; ++c) {
-    const Eigen::Vector3d fit =
-        basis.colPivHouseholderQr().solve(y.col(c).segment(first, last - first));
+    const Eigen::Vector3d fit = basis.colPivHouseholderQr().solve(y.col(c).segment(first, last - first));
     const double amplitude = c == 0 ? 1.0 : 0.7;
     EXPECT_NEAR(std::atan2(fit[1], fit[0]), 0.0, 1e-6);
     EXPECT_NEAR(std::hypot(fit[0], fit[1]) / amplitude, gain, 1e-6);
@@ -341,8 +328,7 @@ TEST(PreprocessZeroPhase, MatchesScipySosfiltfilt) {
   const auto sections = pp::butterworth_lowpass(4, 15.0, 1000.0);
   ASSERT_EQ(pp::zero_phase_padding(sections), 84);
   pp::Channels x(300, 1);
-  for (int k = 0; k < 300; ++k)
-    x(k, 0) = std::sin(0.01 * k) + 0.5 * std::cos(0.037 * k) + 1e-5 * k * k;
+  for (int k = 0; k < 300; ++k) x(k, 0) = std::sin(0.01 * k) + 0.5 * std::cos(0.037 * k) + 1e-5 * k * k;
   pp::filtfilt(sections, 84, x);
   const std::vector<std::pair<int, double>> scipy{
       {0, 0.4984241762171907},   {1, 0.5034544159119969},   {2, 0.5084626338149228},
@@ -446,8 +432,7 @@ TEST(PreprocessTimeAxis, JitterAloneIsCorrectedWithinTheInterpolationBound) {
   EXPECT_EQ(stamps.pieces[0].grid_samples(), log.samples());
   EXPECT_EQ(stamps.irregular_stamps, 0);  // 80 us at most, under 10 % of 1 ms
   EXPECT_LE(stamps.max_deviation, 2 * r.jitter);
-  const double dt_max =
-      (log.time.tail(log.samples() - 1) - log.time.head(log.samples() - 1)).maxCoeff();
+  const double dt_max = (log.time.tail(log.samples() - 1) - log.time.head(log.samples() - 1)).maxCoeff();
   const pp::GridInterpolation g = pp::grid_interpolation(log.time, stamps, stamps.pieces[0]);
   const pp::Channels grid = g.apply(log.q);
   ASSERT_EQ(grid.rows(), stamps.pieces[0].grid_samples());
@@ -461,8 +446,7 @@ TEST(PreprocessTimeAxis, JitterAloneIsCorrectedWithinTheInterpolationBound) {
     }
     const double bound = qdd_max * dt_max * dt_max / 8;
     EXPECT_LT(worst, bound) << "joint " << j;
-    std::printf("  jitter only, joint %d: max interpolation error %.3g rad, bound %.3g rad\n", j,
-                worst, bound);
+    std::printf("  jitter only, joint %d: max interpolation error %.3g rad, bound %.3g rad\n", j, worst, bound);
   }
 }
 
@@ -551,8 +535,7 @@ TEST(PreprocessResample, KeepsExactlyTheTargetGridSamples) {
     EXPECT_EQ(s.report.kept_samples, expected);
     EXPECT_EQ(s.q.rows(), expected);
     EXPECT_EQ(s.qdd.cols(), 2);
-    for (int i = 0; i < s.time.size(); ++i)
-      EXPECT_NEAR(s.time[i] - log.time[0], i * interval, 1e-12);
+    for (int i = 0; i < s.time.size(); ++i) EXPECT_NEAR(s.time[i] - log.time[0], i * interval, 1e-12);
   }
 }
 
@@ -633,14 +616,12 @@ TEST(PreprocessPipeline, RecoversSinusoidsAndDerivativesAtEveryKeptSample) {
           const double e = estimate[m] - joints[j].eval(t, m, gain);
           (near_edge ? edge[m] : inside[m]).add(e);
           if (near_edge) {
-            const double envelope =
-                2 * qdd_max * std::pow(tau, 2 - m) * std::exp(-d / tau) + bound[m];
+            const double envelope = 2 * qdd_max * std::pow(tau, 2 - m) * std::exp(-d / tau) + bound[m];
             envelope_use = std::max(envelope_use, std::abs(e) / envelope);
           }
         }
         if (!near_edge)
-          (from_gap < 6 * tau ? torque_near_gap : torque)
-              .add(s.tau(i, j) - torque_motion(j).eval(t, 0, gain));
+          (from_gap < 6 * tau ? torque_near_gap : torque).add(s.tau(i, j) - torque_motion(j).eval(t, 0, gain));
       }
     }
     const char* names[3] = {"q", "qd", "qdd"};
@@ -650,24 +631,22 @@ TEST(PreprocessPipeline, RecoversSinusoidsAndDerivativesAtEveryKeptSample) {
       std::printf(
           "  %2.0f ms, %5.2f Hz: %-3s inside rms %.2g (%.2f sigma) max %.2g (%.2f of bound "
           "%.2g); within 6 tau of an end max %.2g\n",
-          interval * 1e3, fc, names[m], inside[m].root_mean_square(),
-          inside[m].root_mean_square() / sigma[m], inside[m].max, inside[m].max / bound[m],
-          bound[m], edge[m].max);
+          interval * 1e3, fc, names[m], inside[m].root_mean_square(), inside[m].root_mean_square() / sigma[m],
+          inside[m].max, inside[m].max / bound[m], bound[m], edge[m].max);
     }
     EXPECT_LT(envelope_use, 1.0) << interval;
     // tau: quantization (0.006 / sqrt(12)) and N(0, 0.01) noise, white, through |H|^4: max of
     // ~5000 samples < 5.5 sigma. Near a bridged gap add the bridge's error through the filter:
     // at most h_max * 4 missing rows * 2 * 0.3 N m, h_max = 2 fc / fs * 1.03 (peak of h).
-    const double sigma_tau =
-        filtered_noise_sigma(std::hypot(kCurrentStep / std::sqrt(12.0), 0.01), fc, 4, 0);
+    const double sigma_tau = filtered_noise_sigma(std::hypot(kCurrentStep / std::sqrt(12.0), 0.01), fc, 4, 0);
     const double bridge = 2 * fc * kH * 1.03 * 4 * 2 * r.backlash;
     EXPECT_LT(torque.max, 5.5 * sigma_tau) << interval;
     EXPECT_LT(torque_near_gap.max, 5.5 * sigma_tau + bridge) << interval;
     std::printf(
         "  %2.0f ms: tau max %.2g N m (%.2f sigma), near gaps %.2g (bound %.2g); "
         "edge envelope used %.2f\n",
-        interval * 1e3, torque.max, torque.max / sigma_tau, torque_near_gap.max,
-        5.5 * sigma_tau + bridge, envelope_use);
+        interval * 1e3, torque.max, torque.max / sigma_tau, torque_near_gap.max, 5.5 * sigma_tau + bridge,
+        envelope_use);
   }
 }
 
@@ -689,8 +668,7 @@ TEST(PreprocessPipeline, RecoversAPolynomial) {
     const double grid_error = kEncoderStep / 2 + 0.32 * 0.005 * 0.005 / 8;  // |qdd| <= 0.32
     ErrorStats inside[3];
     for (int i = 0; i < s.time.size(); ++i) {
-      if (std::min(s.time[i] - s.time[0], s.time[s.time.size() - 1] - s.time[i]) < 6 * tau)
-        continue;
+      if (std::min(s.time[i] - s.time[0], s.time[s.time.size() - 1] - s.time[i]) < 6 * tau) continue;
       const double t = s.time[i] - r.start;
       for (int k = 0; k < 3; ++k)
         inside[k].add((k == 0 ? s.q(i, 0) : k == 1 ? s.qd(i, 0) : s.qdd(i, 0)) - m.eval(t, k));
@@ -726,8 +704,7 @@ TEST(PreprocessPipeline, OneHertzPassesWithin0p1Percent) {
       const double arg = 2 * kPi * (s.time[i] - r.start) + 0.4;
       basis.row(i - skip) << std::sin(arg), std::cos(arg);
     }
-    const Eigen::Vector2d fit =
-        basis.colPivHouseholderQr().solve(s.q.col(0).segment(skip, n - 2 * skip));
+    const Eigen::Vector2d fit = basis.colPivHouseholderQr().solve(s.q.col(0).segment(skip, n - 2 * skip));
     EXPECT_LT(std::abs(std::hypot(fit[0], fit[1]) / 0.8 - 1), 1e-3) << interval;
     EXPECT_LT(std::abs(std::atan2(fit[1], fit[0])), 1e-5) << interval;  // and no delay
   }
@@ -802,8 +779,9 @@ TEST(PreprocessReport, SummaryIsOneLine) {
   EXPECT_NE(line.find("1 gaps bridged (2 samples filled in)"), std::string::npos) << line;
   // 2 s of a motion moving at both ends: the samples within 6 time constants of 15 Hz (0.167 s) of
   // either end, 9 at each, are left out of the 101 on the 20 ms grid.
-  EXPECT_NE(line.find("18 samples within the filter's settling time (0.167 s) of 2 moving ends left out, 83 samples kept"),
-            std::string::npos)
+  EXPECT_NE(
+      line.find("18 samples within the filter's settling time (0.167 s) of 2 moving ends left out, 83 samples kept"),
+      std::string::npos)
       << line;
   std::printf("  %s\n", line.c_str());
 }
@@ -1011,8 +989,8 @@ TEST(PreprocessSpeed, DISABLED_EightJointsHundredTenSeconds) {
       best = std::min(best, std::chrono::duration<double, std::milli>(stop - start).count());
       ASSERT_GT(s.report.kept_samples, 0);
     }
-    std::printf("  %d samples x 8 joints, %2.0f ms interval: %.1f ms (best of 5)\n", log.samples(),
-                interval * 1e3, best);
+    std::printf("  %d samples x 8 joints, %2.0f ms interval: %.1f ms (best of 5)\n", log.samples(), interval * 1e3,
+                best);
   }
 }
 
@@ -1058,7 +1036,8 @@ TEST(PreprocessEdges, MovingEndsLoseTheSettlingTimeAndWhatRemainsIsTheMotion) {
     double worst = 0;
     for (int i = 0; i < s.time.size(); ++i) {
       EXPECT_GE(std::min(s.time[i] - first, last - s.time[i]), s.report.settling_seconds - kH) << interval;
-      for (int j = 0; j < dof; ++j) worst = std::max(worst, std::abs(s.qdd(i, j) - joints[j].eval(s.time[i] - first, 2, gain)));
+      for (int j = 0; j < dof; ++j)
+        worst = std::max(worst, std::abs(s.qdd(i, j) - joints[j].eval(s.time[i] - first, 2, gain)));
     }
     EXPECT_LT(worst, 2e-3 * qdd_max) << interval;
 
@@ -1072,9 +1051,10 @@ TEST(PreprocessEdges, MovingEndsLoseTheSettlingTimeAndWhatRemainsIsTheMotion) {
       for (int j = 0; j < dof; ++j)
         at_ends = std::max(at_ends, std::abs(all.qdd(i, j) - joints[j].eval(all.time[i] - first, 2, gain)));
     EXPECT_GT(at_ends, 0.3 * qdd_max) << interval;
-    std::printf("  %2.0f ms: %d samples in the settling time (%.3f s) left out; qdd error %.2g of its largest "
-                "(%.2g with them)\n",
-                interval * 1e3, s.report.edge_samples, s.report.settling_seconds, worst / qdd_max, at_ends / qdd_max);
+    std::printf(
+        "  %2.0f ms: %d samples in the settling time (%.3f s) left out; qdd error %.2g of its largest "
+        "(%.2g with them)\n",
+        interval * 1e3, s.report.edge_samples, s.report.settling_seconds, worst / qdd_max, at_ends / qdd_max);
   }
 }
 
@@ -1091,7 +1071,8 @@ TEST(PreprocessEdges, EndsAtRestKeepEverySample) {
     for (int j = 0; j < 2; ++j) {
       const double a = 0.4 + 0.3 * j, c = 1 - std::cos(w * t);
       // Half a count of offset and a 37 Hz vibration of 0.3 count: one count toggling at rest.
-      log.q(k, j) = kEncoderStep * std::round((a * c * c + (0.5 + 0.3 * std::sin(2 * kPi * 37 * t)) * kEncoderStep) / kEncoderStep);
+      log.q(k, j) = kEncoderStep *
+                    std::round((a * c * c + (0.5 + 0.3 * std::sin(2 * kPi * 37 * t)) * kEncoderStep) / kEncoderStep);
       log.qd(k, j) = 2 * a * c * w * std::sin(w * t);
       log.tau(k, j) = log.q(k, j);
     }

@@ -216,7 +216,8 @@ TEST(RobotLibrary, Planar2rAndItsEffectsVariantEqualTheInlineHeaders) {
   expect_kernels_equal<symoro::planar2r::Model>(lib->model("full"), 1);
   const ModelHandle effects = lib->model("effects");
   EXPECT_EQ(effects.ne(), symoro::planar2r::effects::Model::ne);
-  EXPECT_EQ(std::string(effects.effect_parameters()[0].name), symoro::planar2r::effects::Model::effect_parameters[0].name);
+  EXPECT_EQ(std::string(effects.effect_parameters()[0].name),
+            symoro::planar2r::effects::Model::effect_parameters[0].name);
   expect_kernels_equal<symoro::planar2r::effects::Model>(effects, 2);
 }
 
@@ -244,7 +245,8 @@ TEST(RobotLibrary, TheCacheIsReusedAndKeyedByTheGeneratedCode) {
   EXPECT_EQ(first.library, again.library);
   EXPECT_EQ(first.code_digest, again.code_digest);
   // Same library object for the same file.
-  EXPECT_EQ(symoro::robot::RobotLibrary::open(first.library).get(), symoro::robot::RobotLibrary::open(again.library).get());
+  EXPECT_EQ(symoro::robot::RobotLibrary::open(first.library).get(),
+            symoro::robot::RobotLibrary::open(again.library).get());
 
   // A change that changes the generated code (a joint limit) is another library.
   const fs::path dir = scratch_copy("planar2r", "limit");
@@ -286,12 +288,15 @@ TEST(RobotLibrary, ItsObjectsAreWhatAProgramLinksStatically) {
     std::ifstream in(listing);
     const std::string symbols((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
     for (const char* model : {"symoro::planar2r::Model", "symoro::planar2r::effects::Model"}) {
-      EXPECT_NE(symbols.find(std::string("symoro::abi_export::model_abi<") + model + ">()"), std::string::npos) << which << " " << model;
-      EXPECT_NE(symbols.find(std::string("symoro::abi_export::inertia_second_derivatives<") + model + ">"), std::string::npos)
+      EXPECT_NE(symbols.find(std::string("symoro::abi_export::model_abi<") + model + ">()"), std::string::npos)
+          << which << " " << model;
+      EXPECT_NE(symbols.find(std::string("symoro::abi_export::inertia_second_derivatives<") + model + ">"),
+                std::string::npos)
           << which << " " << model;
     }
     EXPECT_NE(symbols.find("symoro_planar2r_model_1()"), std::string::npos) << which;
-    EXPECT_EQ(symbols.find("symoro_robot"), std::string::npos) << which << ": the library's entry is not for static linking";
+    EXPECT_EQ(symbols.find("symoro_robot"), std::string::npos)
+        << which << ": the library's entry is not for static linking";
   }
   for (const auto& e : fs::directory_iterator(built.library.parent_path() / "src"))
     if (e.path().extension() == ".o") fs::remove(e.path());
@@ -299,7 +304,8 @@ TEST(RobotLibrary, ItsObjectsAreWhatAProgramLinksStatically) {
     symoro::codegen::build_robot_library(robot_dir("planar2r"), o);
     ADD_FAILURE() << "objects written from a library folder without them";
   } catch (const symoro::codegen::BuildError& e) {
-    EXPECT_NE(std::string(e.what()).find("has no model objects (src/*.o): rebuild it with --force"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("has no model objects (src/*.o): rebuild it with --force"), std::string::npos)
+        << e.what();
   }
 }
 
@@ -312,7 +318,9 @@ TEST(RobotLibraryRefusals, AStaleFolderNamesTheFileAndBothDigests) {
     FAIL() << "a stale folder was accepted";
   } catch (const LoadError& e) {
     const std::string m = e.what();
-    EXPECT_NE(m.find((dir / "robot.yaml").string() + " differs from the robot.yaml the robot library"), std::string::npos) << m;
+    EXPECT_NE(m.find((dir / "robot.yaml").string() + " differs from the robot.yaml the robot library"),
+              std::string::npos)
+        << m;
     EXPECT_NE(m.find("digest "), std::string::npos) << m;
     EXPECT_NE(m.find(", library "), std::string::npos) << m;
   }

@@ -194,9 +194,9 @@ TEST(Profile, RejectsNonPositiveLimits) {
 TEST(Move, TheSlowestJointSetsTheTimingAndNoJointExceedsItsLimits) {
   Eigen::VectorXd from(3), to(3), v(3), a(3);
   from << 0.0, 1.0, -0.5;
-  to << 1.0, 0.5, -0.5;     // joint 3 stays
-  v << 2.0, 0.5, 0.1;       // joint 2: 0.5 rad/s over 0.5 rad is the tighter velocity (1/s)
-  a << 40.0, 4.0, 0.1;      // joint 2: 4 rad/s^2 over 0.5 rad is the tighter acceleration
+  to << 1.0, 0.5, -0.5;  // joint 3 stays
+  v << 2.0, 0.5, 0.1;    // joint 2: 0.5 rad/s over 0.5 rad is the tighter velocity (1/s)
+  a << 40.0, 4.0, 0.1;   // joint 2: 4 rad/s^2 over 0.5 rad is the tighter acceleration
   const Segment seg = plan_move(2.0, from, to, v, a);
   EXPECT_EQ(seg.start, 2.0);
   const Profile expected = Profile::plan(1.0, 8.0);
@@ -452,7 +452,8 @@ TEST(Design, ValidationTrajectoriesMoveManyAxesAtOnce) {
   for (const auto& s : named("V01").segments)
     if (s.label.rfind("waypoint", 0) == 0 && s.profile.moves() && moving_axes(s) == 8) ++v01_all;
   for (const auto& s : named("V02").segments)
-    if (s.label.rfind("waypoint", 0) == 0 && s.profile.moves() && moving_axes(s) == 5 && s.to[7] != s.from[7]) ++v02_groups;
+    if (s.label.rfind("waypoint", 0) == 0 && s.profile.moves() && moving_axes(s) == 5 && s.to[7] != s.from[7])
+      ++v02_groups;
   EXPECT_GE(v01_all, 5);
   EXPECT_GE(v02_groups, 5);
   for (const std::string name : {"V01", "V02", "V03"})
@@ -620,17 +621,18 @@ TEST_F(BrokenDesign, TheSmallDesignIsValid) {
 
 TEST_F(BrokenDesign, UnknownKeysNameTheirLine) {
   expect_read_error(edit("patterns:", "colour: red\npatterns:"), "colour", "unknown key 'colour' in the design");
-  expect_read_error(edit("    center: [0,", "    centre: [0,"), "centre", "unknown key 'centre' in primitives.A; did you mean 'center'?");
-  expect_read_error(edit("{single: [7], posture: A'}", "{single: [7], postur: A'}"), "postur:",
-                    "unknown key 'postur'");
-  expect_read_error(edit("timing: {start_hold", "timing: {start_hld"), "timing", "unknown key 'start_hld' in timing; did you mean 'start_hold'?");
+  expect_read_error(edit("    center: [0,", "    centre: [0,"), "centre",
+                    "unknown key 'centre' in primitives.A; did you mean 'center'?");
+  expect_read_error(edit("{single: [7], posture: A'}", "{single: [7], postur: A'}"), "postur:", "unknown key 'postur'");
+  expect_read_error(edit("timing: {start_hold", "timing: {start_hld"), "timing",
+                    "unknown key 'start_hld' in timing; did you mean 'start_hold'?");
 }
 
 TEST_F(BrokenDesign, WrongSizesNameTheirLine) {
   expect_read_error(edit("  A: [0, 0, 0, -90, 0, 0, 0, 0]", "  A: [0, 0, 0, -90, 0, 0, 0]"), "  A: [0, 0, 0, -90",
                     "must have 8 entries, not 7");
-  expect_read_error(edit("  velocity: [2, 2, 2.5, 2.5, 3, 3, 3, 3]", "  velocity: [2, 2]"), "  velocity:",
-                    "limits.velocity (one value per joint) must have 8 entries, not 2");
+  expect_read_error(edit("  velocity: [2, 2, 2.5, 2.5, 3, 3, 3, 3]", "  velocity: [2, 2]"),
+                    "  velocity:", "limits.velocity (one value per joint) must have 8 entries, not 2");
   expect_read_error(edit("[[10, 10, 10, -80, 10, 10, 10, 10]]", "[[10, 10, 10, -80, 10]]"), "[[10, 10, 10, -80",
                     "must have 8 entries, not 5");
   expect_read_error(edit("signs: [1, -1]", "signs: [1, -1, 1]"), "signs:", "signs must have 2 entries");
@@ -641,11 +643,13 @@ TEST_F(BrokenDesign, UnknownNamesNameTheirLine) {
   expect_read_error(edit("posture: A'}", "posture: D}"), "posture: D", "unknown posture 'D'");
   expect_read_error(edit("{pattern: singles}", "{pattern: doubles}"), "doubles", "unknown pattern 'doubles'");
   expect_read_error(edit("[slow, slow, normal", "[slow, fast, normal"), "joint_class", "unknown speed class 'fast'");
-  expect_read_error(edit("upper_arm_twist, elbow", "upper_arm_twist, knee"), "joints:", "is 'elbow' in the robot, not 'knee'");
+  expect_read_error(edit("upper_arm_twist, elbow", "upper_arm_twist, knee"),
+                    "joints:", "is 'elbow' in the robot, not 'knee'");
 }
 
 TEST_F(BrokenDesign, OutOfRangeValuesNameTheirLine) {
-  expect_read_error(edit("{single: [1, 2, 3]}", "{single: [1, 9, 3]}"), "single: [1, 9", "a joint number must be an integer in 1..8");
+  expect_read_error(edit("{single: [1, 2, 3]}", "{single: [1, 9, 3]}"), "single: [1, 9",
+                    "a joint number must be an integer in 1..8");
   expect_read_error(edit("{pair: [4, 5]", "{pair: [4, 6]"), "pair: [4, 6]", "adjacent joints [j, j+1], not [4, 6]");
   expect_read_error(edit("signs: [1, -1]", "signs: [1, 0]"), "signs:", "a sign must be 1 or -1");
   expect_read_error(edit("speed: 3", "speed: 4"), "speed: 4", "speed (a level) must be an integer in 1..3");
@@ -653,9 +657,10 @@ TEST_F(BrokenDesign, OutOfRangeValuesNameTheirLine) {
   expect_read_error(edit("  A: [0, 0, 0, -90, 0, 0, 0, 0]", "  A: [0, 0, 0, -170, 0, 0, 0, 0]"), "  A: [0, 0, 0, -170",
                     "joint 4 (elbow) at -170 deg is outside");
   expect_read_error(edit("offset: 87", "offset: 89"), "wrist_variant", "the wrist variant A' puts joint 6 at 89 deg");
-  expect_read_error(edit("velocity: [2, 2, 2.5", "velocity: [2, abc, 2.5"), "  velocity:", "must be a number, not 'abc'");
-  expect_read_error(edit("[[10, 10, 10, -80, 10, 10, 10, 10]]", "[[10, 10, 10, -80, 10, 10, 10, -10]]"), "[[10, 10, 10, -80",
-                    "joint 8 (hand) at -10 deg is outside");
+  expect_read_error(edit("velocity: [2, 2, 2.5", "velocity: [2, abc, 2.5"),
+                    "  velocity:", "must be a number, not 'abc'");
+  expect_read_error(edit("[[10, 10, 10, -80, 10, 10, 10, 10]]", "[[10, 10, 10, -80, 10, 10, 10, -10]]"),
+                    "[[10, 10, 10, -80", "joint 8 (hand) at -10 deg is outside");
 }
 
 TEST_F(BrokenDesign, StructuralMistakesNameTheirLine) {
@@ -670,12 +675,14 @@ TEST_F(BrokenDesign, StructuralMistakesNameTheirLine) {
                     "  - {name: PA01", "a trajectory lacks the key 'speed'");
   expect_read_error(edit("postures:\n  A:", "postures:\n  A':"), "  A':", "may not end in '");
   // The parser notices the unclosed list where a mapping key appears inside it.
-  expect_read_error(edit("limits:\n", "limits: [\n"), "  velocity:", "YAML syntax error: end of sequence flow not found");
+  expect_read_error(edit("limits:\n", "limits: [\n"),
+                    "  velocity:", "YAML syntax error: end of sequence flow not found");
 }
 
 TEST_F(BrokenDesign, LimitViolationsAtBuildNameTrajectoryJointAndTime) {
   // Joint 7 swinging 175 deg around 0 passes its stop (-169.8 deg less the 2 deg margin).
-  const std::string text = edit("amplitude: [45, 30, 45, 45, 60, 45, 90, 35]", "amplitude: [45, 30, 45, 45, 60, 45, 175, 35]");
+  const std::string text =
+      edit("amplitude: [45, 30, 45, 45, 60, 45, 90, 35]", "amplitude: [45, 30, 45, 45, 60, 45, 175, 35]");
   const auto d = TrajectoryDesign::read(write(text), crane_joints());
   EXPECT_NO_THROW(d.build("PA01"));  // PA01 does not move joint 7
   try {
@@ -691,16 +698,20 @@ TEST_F(BrokenDesign, LimitViolationsAtBuildNameTrajectoryJointAndTime) {
 
   // Joint 7 at 6 rad/s and 100 rad/s^2 nominal: P7 at factor 0.9 cruises at 5.4 rad/s, over the
   // 4.8171 rad/s of the URDF.
-  const std::string fast = edit("velocity: [2, 2, 2.5, 2.5, 3, 3, 3, 3]\n  acceleration: [10, 10, 15, 15, 20, 20, 20, 20]",
-                                "velocity: [2, 2, 2.5, 2.5, 3, 3, 6, 3]\n  acceleration: [10, 10, 15, 15, 20, 20, 100, 20]");
+  const std::string fast =
+      edit("velocity: [2, 2, 2.5, 2.5, 3, 3, 3, 3]\n  acceleration: [10, 10, 15, 15, 20, 20, 20, 20]",
+           "velocity: [2, 2, 2.5, 2.5, 3, 3, 6, 3]\n  acceleration: [10, 10, 15, 15, 20, 20, 100, 20]");
   const auto f = TrajectoryDesign::read(write(fast), crane_joints());
   try {
     f.build("PA02");
     ADD_FAILURE() << "no velocity error";
   } catch (const DataError& e) {
     const std::string what = e.what();
-    EXPECT_NE(what.find("trajectory PA02: joint 7 (wrist_twist) moves at 5.4 rad/s, over its velocity limit 4.8171 rad/s at t = "),
-              std::string::npos) << what;
+    EXPECT_NE(
+        what.find(
+            "trajectory PA02: joint 7 (wrist_twist) moves at 5.4 rad/s, over its velocity limit 4.8171 rad/s at t = "),
+        std::string::npos)
+        << what;
   }
   EXPECT_THROW(d.build("PA03"), DataError);  // not in the design
 }

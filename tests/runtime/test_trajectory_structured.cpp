@@ -59,7 +59,8 @@ void expect_same_motion(const Trajectory& a, const Trajectory& b) {
   for (double t = 0; t <= a.duration(); t += 0.01) {
     a.evaluate(t, qa, qda, qdda);
     b.evaluate(t, qb, qdb, qddb);
-    ASSERT_LT((qa - qb).cwiseAbs().maxCoeff() + (qda - qdb).cwiseAbs().maxCoeff() + (qdda - qddb).cwiseAbs().maxCoeff(), 1e-9)
+    ASSERT_LT((qa - qb).cwiseAbs().maxCoeff() + (qda - qdb).cwiseAbs().maxCoeff() + (qdda - qddb).cwiseAbs().maxCoeff(),
+              1e-9)
         << a.name << " at t = " << t;
   }
 }
@@ -77,7 +78,8 @@ TEST(StructuredDesign, RebuildsCraneX7sHandWrittenGrid) {
   o.velocity = degrees(f["limits"]["velocity"]) / kDeg;
   o.acceleration = degrees(f["limits"]["acceleration"]) / kDeg;
   o.speed_factors.clear();
-  for (const auto& c : f["speed_factors"]) o.speed_factors[c.first.as<std::string>()] = c.second.as<std::vector<double>>();
+  for (const auto& c : f["speed_factors"])
+    o.speed_factors[c.first.as<std::string>()] = c.second.as<std::vector<double>>();
   o.joint_class = f["joint_class"].as<std::vector<std::string>>();
   const auto hand = TrajectoryDesign::read(kCraneFile, o.joints);
   const auto generated = TrajectoryDesign::read(write_temp("crane.yaml", structured_design_yaml(o)), o.joints);
@@ -118,7 +120,8 @@ void expect_generic_design_builds() {
     }
   }
   // Every joint swings in the singles, by a sizable part of its box (at most 60 deg).
-  for (int j = 0; j < n; ++j) EXPECT_GT(moved(j), std::min(0.3 * (hi(j) - lo(j)), 0.9 * 60 * kDeg)) << "joint " << j + 1;
+  for (int j = 0; j < n; ++j)
+    EXPECT_GT(moved(j), std::min(0.3 * (hi(j) - lo(j)), 0.9 * 60 * kDeg)) << "joint " << j + 1;
 }
 
 TEST(StructuredDesign, GenericDesignsBuildInsideTheLimitsOnTwoRobots) {

@@ -189,7 +189,7 @@ TEST(TwinPlant, ConservesEnergyWithoutFrictionAndControl) {
     swing = std::max(swing, plant.kinetic_energy());
     drift = std::max(drift, std::abs(energy() - e0));
   }
-  EXPECT_GT(swing, 0.5);           // the arm really moved (J of kinetic energy)
+  EXPECT_GT(swing, 0.5);  // the arm really moved (J of kinetic energy)
   // RK4 at the configured 1 ms step: measured 4e-9 of the kinetic energy scale after 2 s.
   EXPECT_LT(drift, 1e-8 * swing);
 }
@@ -460,7 +460,8 @@ TEST(TwinEffects, ActuationDelayShiftsTheTorqueTheLinkReceives) {
     EXPECT_GT(std::abs(base(k + 3, j)), 1e-7) << "joint " << j + 1;
     EXPECT_LT(std::abs(late(k + 3, j)), 1e-3 * std::abs(base(k + 3, j))) << "joint " << j + 1;
     for (int i = 2; i <= 3; ++i)
-      EXPECT_NEAR(late(k + i + 3, j), base(k + i, j), 0.25 * std::abs(base(k + i, j))) << "joint " << j + 1 << " row " << k + i;
+      EXPECT_NEAR(late(k + i + 3, j), base(k + i, j), 0.25 * std::abs(base(k + i, j)))
+          << "joint " << j + 1 << " row " << k + i;
   }
 }
 }  // namespace

@@ -82,7 +82,8 @@ class YamlKeys : public ::testing::Test {
   // `read_file` must refuse `file` at `line` ("file:line: error: unknown key '<key>' ... did you
   // mean '<near>'? (known keys: ...)").
   template <class F>
-  static void expect_unknown(F read_file, const fs::path& file, int line, const std::string& key, const std::string& near) {
+  static void expect_unknown(F read_file, const fs::path& file, int line, const std::string& key,
+                             const std::string& near) {
     try {
       read_file();
       ADD_FAILURE() << "accepted the key '" << key << "' in " << file;
@@ -90,7 +91,8 @@ class YamlKeys : public ::testing::Test {
       const std::string what = e.what();
       EXPECT_EQ(e.file(), file.string()) << what;
       EXPECT_EQ(e.line(), line) << what;
-      EXPECT_EQ(what.rfind(file.string() + ":" + std::to_string(line) + ": error: unknown key '" + key + "' in ", 0), 0u)
+      EXPECT_EQ(what.rfind(file.string() + ":" + std::to_string(line) + ": error: unknown key '" + key + "' in ", 0),
+                0u)
           << what;
       EXPECT_NE(what.find("; did you mean '" + near + "'? (known keys: "), std::string::npos) << what;
     }
@@ -272,13 +274,15 @@ TEST_F(YamlKeys, AnchorsAliasesAndASecondDocumentAreRefusedByEveryReader) {
     std::string text;  // appended to a valid file
     std::string message;
   };
-  const std::vector<Poison> poisons = {{"self-merge", "zz: &s {<<: *s}\n", "a cycle no reader can follow"},
-                                       {"billion laughs", laughs, "YAML aliases expand this document past 1000000 nodes"},
-                                       {"alias", "zz: *nothing\n", "the referenced anchor is not defined"},
-                                       {"second document", "---\nformat: other\n", "a second YAML document"}};
+  const std::vector<Poison> poisons = {
+      {"self-merge", "zz: &s {<<: *s}\n", "a cycle no reader can follow"},
+      {"billion laughs", laughs, "YAML aliases expand this document past 1000000 nodes"},
+      {"alias", "zz: *nothing\n", "the referenced anchor is not defined"},
+      {"second document", "---\nformat: other\n", "a second YAML document"}};
   fs::create_directories(dir_ / "data");
   write(dir_ / "data" / "a.csv", "");
-  const std::string dataset = "format: symoro-dataset 1\nrobot: arm6\nruns:\n  - {trajectory: a, family: F, trial: 1, file: a.csv}\n";
+  const std::string dataset =
+      "format: symoro-dataset 1\nrobot: arm6\nruns:\n  - {trajectory: a, family: F, trial: 1, file: a.csv}\n";
   struct Reader {
     const char* name;
     fs::path file;
@@ -287,8 +291,10 @@ TEST_F(YamlKeys, AnchorsAliasesAndASecondDocumentAreRefusedByEveryReader) {
   };
   const fs::path h = dir_ / "hardware.yaml", c = dir_ / "controller.yaml";
   const std::vector<Reader> readers = {
-      {"hardware.yaml", h, read(kCrane / "hardware.yaml"), [&] { symoro::hardware::read_hardware_config(h, crane_joints()); }},
-      {"controller.yaml", c, read(kCrane / "controller.yaml"), [&] { symoro::control::read_controller_description(c, 8); }},
+      {"hardware.yaml", h, read(kCrane / "hardware.yaml"),
+       [&] { symoro::hardware::read_hardware_config(h, crane_joints()); }},
+      {"controller.yaml", c, read(kCrane / "controller.yaml"),
+       [&] { symoro::control::read_controller_description(c, 8); }},
       {"dataset.yaml", dir_ / "data" / "dataset.yaml", dataset, [&] { symoro::io::read_dataset(dir_ / "data"); }},
       {"YAML text", dir_ / "text.yaml", "format: x\n", [&] { symoro::io::load_yaml_file(dir_ / "text.yaml"); }},
   };
@@ -319,7 +325,8 @@ TEST_F(YamlKeys, AByteOrderMarkIsNoContent) {
   fs::create_directories(dir_ / "data");
   write(dir_ / "data" / "a.csv", "");
   const std::string dataset =
-      "format: \"symoro-dataset 1\"\nrobot: 'arm6'\nruns:\n  - {trajectory: \"a\", family: F, trial: 1, file: 'a.csv'}\n";
+      "format: \"symoro-dataset 1\"\nrobot: 'arm6'\nruns:\n  - {trajectory: \"a\", family: F, trial: 1, file: "
+      "'a.csv'}\n";
   write(dir_ / "data" / "dataset.yaml", "\xEF\xBB\xBF" + dataset);
   const symoro::io::Dataset d = symoro::io::read_dataset(dir_ / "data");
   EXPECT_EQ(d.robot, "arm6");

@@ -44,9 +44,10 @@ void lag_velocity(symoro::io::Log& log, double corner_hz) {
 template <class Model>
 int write(const std::string& file, double seconds, unsigned seed, double velocity_hz) {
   symoro::test::Random rng(23);
-  const Eigen::Matrix<double, Model::np, 1> truth = Model::base_from_standard(symoro::test::random_standard_parameters<Model>(rng).s);
-  symoro::io::Log log =
-      symoro::test::synthesize<Model>("export", truth, seconds, seed, 0.05, symoro::test::offset_on<Model>(Model::nq, -0.06));
+  const Eigen::Matrix<double, Model::np, 1> truth =
+      Model::base_from_standard(symoro::test::random_standard_parameters<Model>(rng).s);
+  symoro::io::Log log = symoro::test::synthesize<Model>("export", truth, seconds, seed, 0.05,
+                                                        symoro::test::offset_on<Model>(Model::nq, -0.06));
   lag_velocity(log, velocity_hz);
   symoro::test::write_export_csv<Model>(log, file);
   return 0;
@@ -56,14 +57,15 @@ int write(const std::string& file, double seconds, unsigned seed, double velocit
 // nominal parameters), with Coulomb friction the URDF does not have (and the offset).
 template <class Model>
 int write_from_nominal(const std::string& file, double seconds, unsigned seed, const std::vector<double>& coulomb) {
-  const YAML::Node nominal = YAML::LoadFile(std::string(SYMORO_ROBOTS_DIR) + "/" + Model::robot_name + "/robot.yaml")["nominal"];
+  const YAML::Node nominal =
+      YAML::LoadFile(std::string(SYMORO_ROBOTS_DIR) + "/" + Model::robot_name + "/robot.yaml")["nominal"];
   Eigen::Matrix<double, Model::ns, 1> s;
   for (int i = 0; i < Model::ns; ++i) {
     const auto& p = Model::standard_parameters[i];
     s(i) = std::string(p.family) == "FS" ? coulomb.at(p.joint - 1) : nominal[p.name].template as<double>();
   }
-  const symoro::io::Log log = symoro::test::synthesize<Model>("export", Model::base_from_standard(s), seconds, seed, 0.05,
-                                                              symoro::test::offset_on<Model>(Model::nq, -0.06));
+  const symoro::io::Log log = symoro::test::synthesize<Model>("export", Model::base_from_standard(s), seconds, seed,
+                                                              0.05, symoro::test::offset_on<Model>(Model::nq, -0.06));
   symoro::test::write_export_csv<Model>(log, file);
   return 0;
 }
@@ -81,7 +83,8 @@ int main(int argc, char** argv) {
   const double velocity_hz = argc == 6 ? std::stod(argv[5]) : 0;
   if (robot == "rx90") return write<symoro::rx90::Model>(argv[2], seconds, seed, velocity_hz);
   if (robot == "stanford_rrp") return write<symoro::stanford_rrp::Model>(argv[2], seconds, seed, velocity_hz);
-  if (robot == "ur5") return write_from_nominal<symoro::ur5::Model>(argv[2], seconds, seed, {1.5, 1.5, 1.0, 0.3, 0.3, 0.3});
+  if (robot == "ur5")
+    return write_from_nominal<symoro::ur5::Model>(argv[2], seconds, seed, {1.5, 1.5, 1.0, 0.3, 0.3, 0.3});
   std::fprintf(stderr, "unknown robot %s\n", robot.c_str());
   return 2;
 }

@@ -27,7 +27,8 @@ detail::DerivativeModel derivative_model(ModelContext& c) {
 }  // namespace
 
 std::string inverse_dynamics_derivatives_header(ModelContext& c) {
-  std::string s = c.banner("Inverse dynamics and its derivatives d tau / d(q, qd), differentiated on the expression graph.");
+  std::string s =
+      c.banner("Inverse dynamics and its derivatives d tau / d(q, qd), differentiated on the expression graph.");
   s += c.kinematic_includes() + c.open();
   s += detail::inverse_dynamics_derivatives_code(derivative_model(c), c.summary->functions);
   s += c.close();

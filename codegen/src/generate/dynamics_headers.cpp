@@ -8,8 +8,9 @@ namespace symoro::codegen::generate {
 std::string inverse_dynamics_header(ModelContext& c) {
   std::string s = c.banner("Inverse dynamics (Newton-Euler, idm.txt).");
   s += c.kinematic_includes() + c.open();
-  s += c.function("// Joint torques tau(q, qd, qdd; phi), friction and rotor inertia included.\n",
-                  "inverse_dynamics", {c.q_in(), c.qd_in(), c.qdd_in(), c.phi_in()}, {"tau", "nq", "1", column(c.plus_effects(c.specialize(c.r.idm)))});
+  s += c.function("// Joint torques tau(q, qd, qdd; phi), friction and rotor inertia included.\n", "inverse_dynamics",
+                  {c.q_in(), c.qd_in(), c.qdd_in(), c.phi_in()},
+                  {"tau", "nq", "1", column(c.plus_effects(c.specialize(c.r.idm)))});
   s += c.close();
   return s;
 }
@@ -18,7 +19,8 @@ std::string nonlinear_effects_header(ModelContext& c) {
   std::string s = c.banner("Coriolis, centrifugal, gravity and friction torques (ccg.txt).");
   s += c.kinematic_includes() + c.open();
   s += c.function("// h(q, qd; phi) = tau(q, qd, 0; phi): Coriolis, centrifugal, gravity and friction.\n",
-                  "nonlinear_effects", {c.q_in(), c.qd_in(), c.phi_in()}, {"h", "nq", "1", column(c.plus_effects(c.specialize(c.r.ccg)))});
+                  "nonlinear_effects", {c.q_in(), c.qd_in(), c.phi_in()},
+                  {"h", "nq", "1", column(c.plus_effects(c.specialize(c.r.ccg)))});
   s += c.close();
   return s;
 }
@@ -33,8 +35,8 @@ std::string forward_dynamics_header(ModelContext& c) {
   const auto qdd = substitute(c.g, c.r.ddm, replacements);
   std::string s = c.banner("Forward dynamics (direct dynamic model, ddm.txt).");
   s += c.kinematic_includes() + c.open();
-  s += c.function("// Joint accelerations qdd(q, qd, tau; phi) = M^-1 (tau - h).\n",
-                  "forward_dynamics", {c.q_in(), c.qd_in(), c.tau_in(), c.phi_in()}, {"qdd", "nq", "1", column(qdd)});
+  s += c.function("// Joint accelerations qdd(q, qd, tau; phi) = M^-1 (tau - h).\n", "forward_dynamics",
+                  {c.q_in(), c.qd_in(), c.tau_in(), c.phi_in()}, {"qdd", "nq", "1", column(qdd)});
   s += c.close();
   return s;
 }

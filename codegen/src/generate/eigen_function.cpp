@@ -12,12 +12,14 @@ std::string ModelContext::function(const std::string& doc, const std::string& na
   std::vector<Assignment> assignments;
   std::vector<NodeId> roots;
   for (const auto& i : in)
-    for (std::size_t k = 0; k < i.symbols.size(); ++k) symbols[i.symbols[k]] = i.name + "[" + str(static_cast<int>(k)) + "]";
+    for (std::size_t k = 0; k < i.symbols.size(); ++k)
+      symbols[i.symbols[k]] = i.name + "[" + str(static_cast<int>(k)) + "]";
   for (std::size_t rr = 0; rr < o.entries.size(); ++rr)
     for (std::size_t c = 0; c < o.entries[rr].size(); ++c) {
       const NodeId v = o.entries[rr][c];
       roots.push_back(v);
-      if (!g.is_constant(v, 0.0)) assignments.push_back({o.name + "(" + str(static_cast<int>(rr)) + ", " + str(static_cast<int>(c)) + ")", v});
+      if (!g.is_constant(v, 0.0))
+        assignments.push_back({o.name + "(" + str(static_cast<int>(rr)) + ", " + str(static_cast<int>(c)) + ")", v});
     }
   summary->functions.push_back({name, count_operations(g, roots)});
 

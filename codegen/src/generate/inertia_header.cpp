@@ -20,10 +20,11 @@ std::string inertia_header(ModelContext& c) {
       for (const auto& [p, v] : fixed) constant = c.g.add(constant, c.g.mul(c.g.constant(v), c.dd[k][j][p]));
       M0[j][k] = M0[k][j] = constant;
     }
-  std::string s = c.banner("Inertia matrix M(q; phi) = d tau / d qdd (idm.txt) and its parameter-linear basis (dim.txt).");
+  std::string s =
+      c.banner("Inertia matrix M(q; phi) = d tau / d qdd (idm.txt) and its parameter-linear basis (dim.txt).");
   s += "#include <array>\n" + c.kinematic_includes() + c.open();
-  s += c.function("// The joint-space inertia matrix M(q; phi), rotor inertias included.\n",
-                  "inertia", {c.q_in(), c.phi_in()}, {"M", "nq", "nq", M});
+  s += c.function("// The joint-space inertia matrix M(q; phi), rotor inertias included.\n", "inertia",
+                  {c.q_in(), c.phi_in()}, {"M", "nq", "nq", M});
   s += "// M(q; phi) = constant(q) + sum_i phi[i] linear[i](q): the structure the SDP projection needs.\n";
   s += "template <class Scalar>\nstruct InertiaBasis {\n";
   s += "  Eigen::Matrix<Scalar, nq, nq> constant;  // from the fixed parameters (zero when they are 0)\n";
@@ -43,7 +44,8 @@ std::string inertia_header(ModelContext& c) {
     for (int k = 0; k <= j; ++k) entry("basis.constant", j, k, M0[j][k]);
   for (std::size_t i = 0; i < c.identified.size(); ++i)
     for (int j = 0; j < n; ++j)
-      for (int k = 0; k <= j; ++k) entry("basis.linear[" + str(static_cast<int>(i)) + "]", j, k, c.dd[k][j][c.identified[i]]);
+      for (int k = 0; k <= j; ++k)
+        entry("basis.linear[" + str(static_cast<int>(i)) + "]", j, k, c.dd[k][j][c.identified[i]]);
   c.summary->functions.push_back({"inertia_basis", count_operations(c.g, roots)});
   s += "template <class Q, class Scalar>\n";
   s += "inline void inertia_basis(const Eigen::MatrixBase<Q>& q, InertiaBasis<Scalar>& basis) {\n";
@@ -67,9 +69,12 @@ DimDerivatives dim_derivatives(RobotModel& r) {
   for (int k = 0; k < r.n; ++k) {
     const auto flat = substitute(r.graph, differentiate(r.graph, all, r.qdd[k]), rest);
     for (const auto& s : free_symbols(r.graph, flat))
-      if (!q.count(s)) throw InputError(r.dir + "/dim.txt", 0, 0, "the inertia matrix depends on " + s + ": the DIM is not linear in the accelerations");
+      if (!q.count(s))
+        throw InputError(r.dir + "/dim.txt", 0, 0,
+                         "the inertia matrix depends on " + s + ": the DIM is not linear in the accelerations");
     dd[k].assign(r.n, {});
-    for (int j = 0; j < r.n; ++j) dd[k][j].assign(flat.begin() + j * r.base.size(), flat.begin() + (j + 1) * r.base.size());
+    for (int j = 0; j < r.n; ++j)
+      dd[k][j].assign(flat.begin() + j * r.base.size(), flat.begin() + (j + 1) * r.base.size());
   }
   return dd;
 }

@@ -21,15 +21,15 @@ using DimDerivatives = std::vector<std::vector<std::vector<NodeId>>>;
 
 // A function input: a template parameter, an argument name and the graph symbols it carries.
 struct Input {
-  std::string type;  // template parameter
-  std::string name;  // argument
+  std::string type;                  // template parameter
+  std::string name;                  // argument
   std::vector<std::string> symbols;  // symbol k is read as name[k]
 };
 
 // An Eigen output of the function and its entries.
 struct Output {
-  std::string name;  // local reference inside the function, e.g. "W"
-  std::string rows, cols;  // C++ constants
+  std::string name;                          // local reference inside the function, e.g. "W"
+  std::string rows, cols;                    // C++ constants
   std::vector<std::vector<NodeId>> entries;  // [row][col]
 };
 
@@ -85,8 +85,7 @@ class ModelContext {
   std::string usings(const std::vector<NodeId>& roots) const;
   // The in-place function and its value-returning form (eigen_function.cpp); its operation
   // count goes to the summary.
-  std::string function(const std::string& doc, const std::string& name, const std::vector<Input>& in,
-                       const Output& o);
+  std::string function(const std::string& doc, const std::string& name, const std::vector<Input>& in, const Output& o);
 
   RobotModel& r;
   ExprGraph& g;
@@ -94,12 +93,12 @@ class ModelContext {
   std::string variant, description;
   std::vector<std::pair<std::string, double>> fixed;
   std::vector<EffectParameter> effects;
-  std::vector<NodeId> effect_terms;  // per effect parameter: its term on its joint's row
-  std::vector<int> identified;       // indices into r.base
+  std::vector<NodeId> effect_terms;                 // per effect parameter: its term on its joint's row
+  std::vector<int> identified;                      // indices into r.base
   std::vector<std::pair<int, double>> fixed_index;  // index into r.base, value
   std::map<std::string, NodeId> replacements;       // fixed base parameter -> its constant
-  std::string ns, dir;                // "symoro::<robot>[::<variant>]", "symoro/<robot>[/<variant>]"
-  ModelSummary* summary = nullptr;    // set while the model's headers are written
+  std::string ns, dir;                              // "symoro::<robot>[::<variant>]", "symoro/<robot>[/<variant>]"
+  ModelSummary* summary = nullptr;                  // set while the model's headers are written
 };
 
 }  // namespace symoro::codegen::generate

@@ -29,7 +29,8 @@ void write_names_and_sizes(const ModelContext& c, std::ostringstream& s) {
   if (c.ne() == 0) {
     s << "inline constexpr int np = " << c.np() << ";  // identified base parameters\n";
   } else {
-    s << "inline constexpr int np = " << c.np() << ";  // identified parameters: base parameters, then effect parameters\n";
+    s << "inline constexpr int np = " << c.np()
+      << ";  // identified parameters: base parameters, then effect parameters\n";
   }
   s << "inline constexpr int ns = " << c.r.standard.size() + c.effects.size() << ";  // standard parameters\n";
   s << "inline constexpr int nf = " << c.r.frames.size() << ";  // frames\n";
@@ -51,7 +52,8 @@ void write_parameter_tables(const ModelContext& c, std::ostringstream& s) {
   for (const auto& e : c.effects)
     s << "    {" << quoted(e.name) << ", " << quoted(e.family) << ", " << e.joint << ", " << quoted(e.unit) << "},\n";
   s << "}};\n\n";
-  s << "// Indices into phi by name: phi[param::" << (c.identified.empty() ? "X" : c.r.base[c.identified[0]].name) << "].\n";
+  s << "// Indices into phi by name: phi[param::" << (c.identified.empty() ? "X" : c.r.base[c.identified[0]].name)
+    << "].\n";
   s << "namespace param {\nenum : int {\n";
   const auto names = c.identified_names();
   for (std::size_t i = 0; i < names.size(); ++i) s << "  " << names[i] << " = " << i << ",\n";
@@ -73,8 +75,10 @@ void write_parameter_tables(const ModelContext& c, std::ostringstream& s) {
          "// base_from_standard.\n";
   }
   s << "inline constexpr std::array<StandardParameterInfo, ns> standard_parameters = {{\n";
-  for (const auto& p : c.r.standard) s << "    {" << quoted(p.name) << ", " << quoted(p.family) << ", " << p.joint << "},\n";
-  for (const auto& e : c.effects) s << "    {" << quoted(e.name) << ", " << quoted(e.family) << ", " << e.joint << "},\n";
+  for (const auto& p : c.r.standard)
+    s << "    {" << quoted(p.name) << ", " << quoted(p.family) << ", " << p.joint << "},\n";
+  for (const auto& e : c.effects)
+    s << "    {" << quoted(e.name) << ", " << quoted(e.family) << ", " << e.joint << "},\n";
   s << "}};\n\n";
   if (c.ne() > 0) {
     s << "// Effect parameters (robot.yaml effects), the last ne entries of phi: name, family, joint,\n"
@@ -94,9 +98,10 @@ void write_geometry(const ModelContext& c, std::ostringstream& s) {
   s << "inline constexpr std::array<JointInfo, nq> joints = {{\n";
   for (int j = 0; j < c.r.n; ++j) {
     const auto& js = c.r.spec.joints[j];
-    s << "    {" << quoted(js.name) << ", " << (c.r.frames[j].sigma == 1 ? "JointType::Prismatic" : "JointType::Revolute")
-      << ", " << cpp_literal(js.lower) << ", " << cpp_literal(js.upper) << ", " << cpp_literal(js.velocity) << ", "
-      << cpp_literal(js.effort) << ", " << cpp_literal(js.audit_lower) << ", " << cpp_literal(js.audit_upper) << "},\n";
+    s << "    {" << quoted(js.name) << ", "
+      << (c.r.frames[j].sigma == 1 ? "JointType::Prismatic" : "JointType::Revolute") << ", " << cpp_literal(js.lower)
+      << ", " << cpp_literal(js.upper) << ", " << cpp_literal(js.velocity) << ", " << cpp_literal(js.effort) << ", "
+      << cpp_literal(js.audit_lower) << ", " << cpp_literal(js.audit_upper) << "},\n";
   }
   s << "}};\n\n";
   s << "// Modified DH frames: ant, sigma, mu, gamma, b, alpha, d, theta, r.\n";

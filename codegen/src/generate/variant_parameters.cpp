@@ -23,7 +23,8 @@ std::vector<std::pair<std::string, double>> resolve_fixed(const RobotModel& r, c
       if (!inserted && it->second != value)
         throw InputError(r.spec.path, v.line, 1, "variant " + v.name + ": " + p.name + " is fixed to two values");
     }
-    if (!matched) throw InputError(r.spec.path, v.line, 1, "variant " + v.name + ": '" + pattern + "' matches no base parameter");
+    if (!matched)
+      throw InputError(r.spec.path, v.line, 1, "variant " + v.name + ": '" + pattern + "' matches no base parameter");
   }
   for (const auto& e : v.effects) {
     if (e.kind != EffectKind::SmoothCoulomb) continue;

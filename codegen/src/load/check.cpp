@@ -42,8 +42,9 @@ void check_structure(const ParReader& pr, const std::string& par_path, RobotMode
   }
   m.n = n;
   if (static_cast<int>(m.spec.joints.size()) != n)
-    throw InputError(m.spec.path, 0, 0, "robot.yaml lists " + std::to_string(m.spec.joints.size()) +
-                                            " joints but " + par_path + " has NJ = " + std::to_string(n));
+    throw InputError(m.spec.path, 0, 0,
+                     "robot.yaml lists " + std::to_string(m.spec.joints.size()) + " joints but " + par_path +
+                         " has NJ = " + std::to_string(n));
   // robot_spec.cpp leaves these to here: only the .par knows the number of joints.
   for (const auto& v : m.spec.variants)
     for (const auto& e : v.effects)
@@ -61,8 +62,8 @@ void check_structure(const ParReader& pr, const std::string& par_path, RobotMode
 void read_frames(const ParReader& pr, const std::string& par_path, RobotModel& m) {
   const int n = m.n;
   const auto &ant = pr.list("ant", n), &sigma = pr.list("sigma", n), &mu = pr.list("mu", n),
-             &gamma = pr.list("gamma", n), &b = pr.list("b", n), &alpha = pr.list("alpha", n),
-             &d = pr.list("d", n), &theta = pr.list("theta", n), &r = pr.list("r", n);
+             &gamma = pr.list("gamma", n), &b = pr.list("b", n), &alpha = pr.list("alpha", n), &d = pr.list("d", n),
+             &theta = pr.list("theta", n), &r = pr.list("r", n);
   for (int j = 0; j < n; ++j) {
     Frame f;
     f.ant = static_cast<int>(pr.value(ant[j]));
@@ -101,7 +102,8 @@ void read_gravity_and_check_rest(const ParReader& pr, const std::string& par_pat
   for (int i = 0; i < 3; ++i) m.gravity[i] = pr.value(g[i]);
   for (const char* zero_list : {"W0", "WP0", "V0", "VP0"})
     for (const auto& e : pr.list(zero_list, 3))
-      if (pr.value(e) != 0.0) fail_at(par_path, e.at, std::string(zero_list) + ": only a fixed base at rest is supported");
+      if (pr.value(e) != 0.0)
+        fail_at(par_path, e.at, std::string(zero_list) + ": only a fixed base at rest is supported");
   for (const char* zero_list : {"eta", "k", "FX", "FY", "FZ", "CX", "CY", "CZ"}) {
     if (!pr.has(zero_list)) continue;
     for (const auto& e : pr.list(zero_list, m.n))
@@ -126,7 +128,8 @@ std::set<std::string> read_standard_parameters(const ParReader& pr, const std::s
     for (const auto& fam : kFamilies) {
       const Expr& e = pr.list(fam, m.n)[j];
       if (e.kind == Expr::Kind::Symbol) {
-        if (!standard_names.insert(e.name).second) fail_at(par_path, e.at, "standard parameter '" + e.name + "' appears twice");
+        if (!standard_names.insert(e.name).second)
+          fail_at(par_path, e.at, "standard parameter '" + e.name + "' appears twice");
         m.standard.push_back({e.name, fam, j + 1, unit_of(m, fam, j + 1)});
       } else if (!is_zero_constant(e)) {
         fail_at(par_path, e.at, "a standard parameter must be a symbol or 0");
@@ -166,11 +169,14 @@ std::set<std::string> read_base_parameters(const grammar::ModelFile& dim, RobotM
     const int col = column_of(t, fam);
     if (col < 0) fail_at(dim.path, t.at, "table '" + t.title + "' has no column " + fam);
     if (static_cast<int>(t.rows.size()) != n)
-      fail_at(dim.path, t.at, "table '" + t.title + "' has " + std::to_string(t.rows.size()) + " rows for " + std::to_string(n) + " joints");
+      fail_at(dim.path, t.at,
+              "table '" + t.title + "' has " + std::to_string(t.rows.size()) + " rows for " + std::to_string(n) +
+                  " joints");
     for (int j = 0; j < n; ++j) {
       const Expr& cell = t.rows[j].cells[col];
       if (cell.kind == Expr::Kind::Symbol) {
-        if (!base_names.insert(cell.name).second) fail_at(dim.path, cell.at, "base parameter '" + cell.name + "' appears twice");
+        if (!base_names.insert(cell.name).second)
+          fail_at(dim.path, cell.at, "base parameter '" + cell.name + "' appears twice");
         by_slot[{fam, j + 1}] = {cell.name, fam, j + 1, unit_of(m, fam, j + 1)};
       } else if (!is_zero_constant(cell)) {
         fail_at(dim.path, cell.at, "a parameter cell must be a symbol or 0");

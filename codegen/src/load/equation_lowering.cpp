@@ -26,8 +26,9 @@ NodeId EquationLowering::leaf(const Expr& e, const std::map<std::string, NodeId>
   if (auto it = env.find(e.name); it != env.end()) return it->second;
   if (inputs.count(e.name)) return g_.symbol(e.name);
   if (auto it = constants_.find(e.name); it != constants_.end()) return it->second;
-  fail_at(path, e.at, "unknown symbol '" + e.name + "': not defined by an earlier equation, not an input of the " +
-                          role + ", and not a constant in robot.yaml");
+  fail_at(path, e.at,
+          "unknown symbol '" + e.name + "': not defined by an earlier equation, not an input of the " + role +
+              ", and not a constant in robot.yaml");
 }
 
 // Post-order walk with an explicit stack: long operator chains make deep trees.
@@ -51,23 +52,41 @@ NodeId EquationLowering::lower(const Expr& root, const std::map<std::string, Nod
     const NodeId* a = values.data() + (values.size() - k);
     NodeId out = -1;
     switch (e->kind) {
-      case Expr::Kind::Number: out = g_.constant(e->number); break;
-      case Expr::Kind::Symbol: out = leaf(*e, env, inputs, path, role); break;
-      case Expr::Kind::Negate: out = g_.neg(a[0]); break;
-      case Expr::Kind::Add: out = g_.add(a[0], a[1]); break;
-      case Expr::Kind::Subtract: out = g_.sub(a[0], a[1]); break;
-      case Expr::Kind::Multiply: out = g_.mul(a[0], a[1]); break;
-      case Expr::Kind::Divide: out = g_.div(a[0], a[1]); break;
+      case Expr::Kind::Number:
+        out = g_.constant(e->number);
+        break;
+      case Expr::Kind::Symbol:
+        out = leaf(*e, env, inputs, path, role);
+        break;
+      case Expr::Kind::Negate:
+        out = g_.neg(a[0]);
+        break;
+      case Expr::Kind::Add:
+        out = g_.add(a[0], a[1]);
+        break;
+      case Expr::Kind::Subtract:
+        out = g_.sub(a[0], a[1]);
+        break;
+      case Expr::Kind::Multiply:
+        out = g_.mul(a[0], a[1]);
+        break;
+      case Expr::Kind::Divide:
+        out = g_.div(a[0], a[1]);
+        break;
       case Expr::Kind::Power:
         if (!g_.is_constant(a[1])) fail_at(path, e->args[1].at, "the exponent must be a constant");
         out = g_.pow(a[0], g_.node(a[1]).value);
         break;
       case Expr::Kind::Call:
         if (k != 1) fail_at(path, e->at, "'" + e->name + "' takes one argument");
-        if (e->name == "sin") out = g_.sin(a[0]);
-        else if (e->name == "cos") out = g_.cos(a[0]);
-        else if (e->name == "sign") out = g_.sign(a[0]);
-        else fail_at(path, e->at, "unknown function '" + e->name + "' (supported: sin, cos, sign)");
+        if (e->name == "sin")
+          out = g_.sin(a[0]);
+        else if (e->name == "cos")
+          out = g_.cos(a[0]);
+        else if (e->name == "sign")
+          out = g_.sign(a[0]);
+        else
+          fail_at(path, e->at, "unknown function '" + e->name + "' (supported: sin, cos, sign)");
         break;
     }
     values.resize(values.size() - k);

@@ -22,10 +22,10 @@ class EquationLowering {
                                     const std::string& role);
 
  private:
-  NodeId leaf(const grammar::Expr& e, const std::map<std::string, NodeId>& env,
-              const std::set<std::string>& inputs, const std::string& path, const std::string& role);
-  NodeId lower(const grammar::Expr& root, const std::map<std::string, NodeId>& env,
-               const std::set<std::string>& inputs, const std::string& path, const std::string& role);
+  NodeId leaf(const grammar::Expr& e, const std::map<std::string, NodeId>& env, const std::set<std::string>& inputs,
+              const std::string& path, const std::string& role);
+  NodeId lower(const grammar::Expr& root, const std::map<std::string, NodeId>& env, const std::set<std::string>& inputs,
+               const std::string& path, const std::string& role);
 
   ExprGraph& g_;
   std::map<std::string, NodeId> constants_;

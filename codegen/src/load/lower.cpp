@@ -56,8 +56,7 @@ void lower_identification_model(EquationLowering& lower, const grammar::ModelFil
 }
 
 // A<i><j> (0 when absent), the lower triangle mirrored.
-void lower_inertia_matrix(EquationLowering& lower, const grammar::ModelFile& inm, const Names& inputs,
-                          RobotModel& m) {
+void lower_inertia_matrix(EquationLowering& lower, const grammar::ModelFile& inm, const Names& inputs, RobotModel& m) {
   const int n = m.n;
   const auto env = lower.run(inm, inputs, "inertia matrix (inm.txt)");
   m.inm.assign(n, std::vector<NodeId>(n, m.graph.zero()));
@@ -67,15 +66,15 @@ void lower_inertia_matrix(EquationLowering& lower, const grammar::ModelFile& inm
 }
 
 // The pose of the highest frame that has a T0T entry: the last arm frame.
-void lower_geometric_model(EquationLowering& lower, const grammar::ModelFile& fgm, const Names& inputs,
-                           RobotModel& m) {
+void lower_geometric_model(EquationLowering& lower, const grammar::ModelFile& fgm, const Names& inputs, RobotModel& m) {
   const auto env = lower.run(fgm, inputs, "geometric model (fgm.txt)");
   auto entry = [](int f, int r, int c) { return "T0T" + std::to_string(f) + std::to_string(r) + std::to_string(c); };
   for (int f = m.n; f >= 1 && m.fgm_frame == 0; --f)
     for (int r = 1; r <= 3; ++r)
       for (int c = 1; c <= 4; ++c)
         if (env.count(entry(f, r, c))) m.fgm_frame = f;
-  if (m.fgm_frame == 0) throw InputError(fgm.path, fgm.equations_at.line, 1, "no equation defines a T0T<frame><row><column> entry");
+  if (m.fgm_frame == 0)
+    throw InputError(fgm.path, fgm.equations_at.line, 1, "no equation defines a T0T<frame><row><column> entry");
   m.fgm.assign(4, std::vector<NodeId>(4, m.graph.zero()));
   for (int r = 1; r <= 3; ++r)
     for (int c = 1; c <= 4; ++c) m.fgm[r - 1][c - 1] = lookup_or_zero(m.graph, env, entry(m.fgm_frame, r, c));

@@ -14,8 +14,7 @@ ParReader::ParReader(const grammar::ParFile& par, const std::map<std::string, do
 
 const grammar::ParEntry& ParReader::entry(const std::string& name) const {
   auto it = entries_.find(name);
-  if (it == entries_.end())
-    throw InputError(par_.path, 0, 0, "missing entry '" + name + "'");
+  if (it == entries_.end()) throw InputError(par_.path, 0, 0, "missing entry '" + name + "'");
   return *it->second;
 }
 
@@ -30,8 +29,8 @@ double ParReader::value(const grammar::Expr& e) const {
   try {
     return grammar::evaluate(e, bindings_);
   } catch (const std::runtime_error& err) {
-    fail_at(par_.path, e.at, std::string(err.what()) +
-                                 " (geometric constants take their values from robot.yaml 'constants')");
+    fail_at(par_.path, e.at,
+            std::string(err.what()) + " (geometric constants take their values from robot.yaml 'constants')");
   }
 }
 

@@ -18,7 +18,8 @@ namespace {
 void check_folder(const fs::path& dir, RobotModel& m) {
   m.dir = dir.string();
   m.name = (dir.has_filename() ? dir.filename() : dir.parent_path().filename()).string();
-  if (const std::string why = robot_name_problem(m.name); !why.empty()) throw InputError(m.dir, 0, 0, why + " (the folder's name)");
+  if (const std::string why = robot_name_problem(m.name); !why.empty())
+    throw InputError(m.dir, 0, 0, why + " (the folder's name)");
   if (!fs::is_directory(dir)) throw InputError(m.dir, 0, 0, "not a directory");
 }
 
@@ -28,9 +29,11 @@ std::pair<std::string, std::string> find_par_files(const fs::path& dir, const Ro
   for (const auto& entry : fs::directory_iterator(dir)) {
     const std::string file = entry.path().filename().string();
     if (entry.path().extension() != ".par") continue;
-    std::string& slot = file.size() > 9 && file.compare(file.size() - 9, 9, "_base.par") == 0
-                            ? base_par_path : par_path;
-    if (!slot.empty()) throw InputError(m.dir, 0, 0, "more than one " + std::string(&slot == &par_path ? "robot" : "base") + " .par file");
+    std::string& slot =
+        file.size() > 9 && file.compare(file.size() - 9, 9, "_base.par") == 0 ? base_par_path : par_path;
+    if (!slot.empty())
+      throw InputError(m.dir, 0, 0,
+                       "more than one " + std::string(&slot == &par_path ? "robot" : "base") + " .par file");
     slot = entry.path().string();
   }
   if (par_path.empty()) throw InputError(m.dir, 0, 0, "no <robot>.par description");
@@ -40,8 +43,7 @@ std::pair<std::string, std::string> find_par_files(const fs::path& dir, const Ro
 
 // The digests source.hpp carries, sorted by file name so that the order of the folder's listing
 // does not matter.
-void digest_sources(const fs::path& dir, const std::string& par_path, const std::string& base_par_path,
-                    RobotModel& m) {
+void digest_sources(const fs::path& dir, const std::string& par_path, const std::string& base_par_path, RobotModel& m) {
   for (const std::string& f : {(dir / "robot.yaml").string(), par_path, base_par_path})
     m.sources.emplace_back(fs::path(f).filename().string(), file_content_digest(f));
   for (const char* f : {"dim.txt", "idm.txt", "ddm.txt", "inm.txt", "ccg.txt", "fgm.txt", "jac.txt", "regp.txt"})

@@ -54,7 +54,9 @@ std::string slot_label(const Candidate& c) {
 }
 
 // A link's slot (0..9 inertial, 10 IA, 11 FV, 12 FS).
-NodeId& slot_of(LinkParameters& l, int slot) { return slot < 10 ? l.inertial[slot] : slot == 10 ? l.ia : slot == 11 ? l.fv : l.fs; }
+NodeId& slot_of(LinkParameters& l, int slot) {
+  return slot < 10 ? l.inertial[slot] : slot == 10 ? l.ia : slot == 11 ? l.fv : l.fs;
+}
 
 // The grouping of a robot's standard parameters into its base parameters, in three steps: the
 // general rules (symbolic), the particular cases (numeric, on the inverse dynamics' columns), and
@@ -81,7 +83,8 @@ class Grouping {
   NodeId name(NodeId value, const char* family, int link) {
     if (g_.is_constant(value) || is_symbol(g_, value)) return value;
     const std::string s = slot_name(family, link);
-    if (taken_.count(s)) throw InputError(d_.path, 0, 0, "the grouped parameter name '" + s + "' is already a symbol of the robot");
+    if (taken_.count(s))
+      throw InputError(d_.path, 0, 0, "the grouped parameter name '" + s + "' is already a symbol of the robot");
     taken_.insert(s);
     out_.definitions.emplace_back(s, value);
     return g_.symbol(s);
@@ -180,7 +183,8 @@ class Grouping {
         if ((W.col(c) - W.col(o)).norm() <= 1e-10 * scale) {
           K_[j - 1].inertial[target] = g_.add(K_[j - 1].inertial[target], K_[j - 1].ia);
           keep_[c] = false;
-          out_.notes.push_back("IA" + std::to_string(j) + " is grouped with " + kInertialFamilies[target] + std::to_string(j));
+          out_.notes.push_back("IA" + std::to_string(j) + " is grouped with " + kInertialFamilies[target] +
+                               std::to_string(j));
         }
       }
     }
@@ -227,7 +231,8 @@ class Grouping {
           // Named already as an intermediate: that definition is this value (the slot did not change since).
           bool same = false;
           for (const auto& [nm, v] : out_.definitions) same = same || (nm == s && v == value);
-          if (!same) throw InputError(d_.path, 0, 0, "the grouped parameter name '" + s + "' is already a symbol of the robot");
+          if (!same)
+            throw InputError(d_.path, 0, 0, "the grouped parameter name '" + s + "' is already a symbol of the robot");
         } else {
           taken_.insert(s);
           out_.definitions.emplace_back(s, value);

@@ -31,11 +31,9 @@ struct BaseParameters {
   // definitions: what regp.txt writes (grouped intermediates such as MR5 included).
   std::vector<std::pair<std::string, NodeId>> definitions;
   std::vector<std::string> names;  // the base parameters in table order (link by link)
-  std::vector<std::string> notes; // what the numeric step decided, for the user
+  std::vector<std::string> notes;  // what the numeric step decided, for the user
 };
 
 BaseParameters base_parameters(ExprGraph& g, const Description& d);
-
-
 
 }  // namespace symoro::codegen::modeling

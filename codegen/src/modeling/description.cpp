@@ -37,13 +37,20 @@ bool quarter_turn(double v, int& k) {
 
 NodeId lower(ExprGraph& g, const Expr& e) {
   switch (e.kind) {
-    case Expr::Kind::Number: return g.constant(e.number);
-    case Expr::Kind::Symbol: return e.name == "pi" ? g.constant(M_PI) : g.symbol(e.name);
-    case Expr::Kind::Negate: return g.neg(lower(g, e.args[0]));
-    case Expr::Kind::Add: return g.add(lower(g, e.args[0]), lower(g, e.args[1]));
-    case Expr::Kind::Subtract: return g.sub(lower(g, e.args[0]), lower(g, e.args[1]));
-    case Expr::Kind::Multiply: return g.mul(lower(g, e.args[0]), lower(g, e.args[1]));
-    case Expr::Kind::Divide: return g.div(lower(g, e.args[0]), lower(g, e.args[1]));
+    case Expr::Kind::Number:
+      return g.constant(e.number);
+    case Expr::Kind::Symbol:
+      return e.name == "pi" ? g.constant(M_PI) : g.symbol(e.name);
+    case Expr::Kind::Negate:
+      return g.neg(lower(g, e.args[0]));
+    case Expr::Kind::Add:
+      return g.add(lower(g, e.args[0]), lower(g, e.args[1]));
+    case Expr::Kind::Subtract:
+      return g.sub(lower(g, e.args[0]), lower(g, e.args[1]));
+    case Expr::Kind::Multiply:
+      return g.mul(lower(g, e.args[0]), lower(g, e.args[1]));
+    case Expr::Kind::Divide:
+      return g.div(lower(g, e.args[0]), lower(g, e.args[1]));
     case Expr::Kind::Power: {
       const NodeId b = lower(g, e.args[0]), p = lower(g, e.args[1]);
       if (!g.is_constant(p)) throw std::runtime_error("the exponent must be a constant");
@@ -84,16 +91,23 @@ std::string to_text(const Expr& e) {
       }
       return buf;
     }
-    case Expr::Kind::Symbol: return e.name;
-    case Expr::Kind::Negate: return "-" + wrap(e.args[0], is_sum(e.args[0]));
-    case Expr::Kind::Add: return to_text(e.args[0]) + " + " + to_text(e.args[1]);
-    case Expr::Kind::Subtract: return to_text(e.args[0]) + " - " + wrap(e.args[1], is_sum(e.args[1]));
-    case Expr::Kind::Multiply: return wrap(e.args[0], is_sum(e.args[0])) + "*" + wrap(e.args[1], is_sum(e.args[1]));
+    case Expr::Kind::Symbol:
+      return e.name;
+    case Expr::Kind::Negate:
+      return "-" + wrap(e.args[0], is_sum(e.args[0]));
+    case Expr::Kind::Add:
+      return to_text(e.args[0]) + " + " + to_text(e.args[1]);
+    case Expr::Kind::Subtract:
+      return to_text(e.args[0]) + " - " + wrap(e.args[1], is_sum(e.args[1]));
+    case Expr::Kind::Multiply:
+      return wrap(e.args[0], is_sum(e.args[0])) + "*" + wrap(e.args[1], is_sum(e.args[1]));
     case Expr::Kind::Divide:
       return wrap(e.args[0], is_sum(e.args[0])) + "/" +
              wrap(e.args[1], e.args[1].kind != Expr::Kind::Number && e.args[1].kind != Expr::Kind::Symbol &&
                                  e.args[1].kind != Expr::Kind::Call);
-    case Expr::Kind::Power: return wrap(e.args[0], e.args[0].kind != Expr::Kind::Symbol && e.args[0].kind != Expr::Kind::Number) + "**" + wrap(e.args[1], e.args[1].kind != Expr::Kind::Number);
+    case Expr::Kind::Power:
+      return wrap(e.args[0], e.args[0].kind != Expr::Kind::Symbol && e.args[0].kind != Expr::Kind::Number) + "**" +
+             wrap(e.args[1], e.args[1].kind != Expr::Kind::Number);
     case Expr::Kind::Call: {
       std::string s = e.name + "(";
       for (std::size_t i = 0; i < e.args.size(); ++i) s += (i ? ", " : "") + to_text(e.args[i]);
@@ -192,7 +206,9 @@ class DescriptionReader {
       if (jd.ant < 0 || jd.ant > j || jd.ant != number(ant[j], "ant"))
         fail(par_.path, ant[j].at, "ant of joint " + std::to_string(j + 1) + " must name an earlier frame");
       if (jd.sigma != 0 && jd.sigma != 1)
-        fail(par_.path, sigma[j].at, "joint " + std::to_string(j + 1) + ": sigma must be 0 (revolute) or 1 (prismatic); fixed joints are not supported");
+        fail(par_.path, sigma[j].at,
+             "joint " + std::to_string(j + 1) +
+                 ": sigma must be 0 (revolute) or 1 (prismatic); fixed joints are not supported");
       jd.gamma = gamma[j];
       jd.b = b[j];
       jd.alpha = alpha[j];
@@ -210,7 +226,8 @@ class DescriptionReader {
         std::set<std::string> used;
         collect_symbols(*e, used);
         for (const auto& s : used)
-          if (names_.count(s)) fail(par_.path, e->at, "the joint variable '" + s + "' appears in a constant geometric parameter");
+          if (names_.count(s))
+            fail(par_.path, e->at, "the joint variable '" + s + "' appears in a constant geometric parameter");
       }
       try {
         jd.gamma_n = lower(g, gamma[j]);
@@ -241,7 +258,8 @@ class DescriptionReader {
     for (const char* zero_list : {"eta", "k", "FX", "FY", "FZ", "CX", "CY", "CZ"}) {
       if (!has(zero_list)) continue;
       for (const auto& e : list(zero_list, n))
-        if (!is_zero(e)) fail(par_.path, e.at, std::string(zero_list) + ": flexible joints and external forces are not supported");
+        if (!is_zero(e))
+          fail(par_.path, e.at, std::string(zero_list) + ": flexible joints and external forces are not supported");
     }
   }
 
@@ -253,7 +271,9 @@ class DescriptionReader {
       const Expr& e = list(family, n)[j];
       if (is_zero(e)) return g_.zero();
       if (e.kind != Expr::Kind::Symbol || e.name == "pi")
-        fail(par_.path, e.at, std::string("a standard parameter must be a symbol or 0 (") + family + " of link " + std::to_string(j + 1) + ")");
+        fail(par_.path, e.at,
+             std::string("a standard parameter must be a symbol or 0 (") + family + " of link " +
+                 std::to_string(j + 1) + ")");
       if (!names_.insert(e.name).second || geometric_.count(e.name))
         fail(par_.path, e.at, "the parameter '" + e.name + "' appears twice");
       d.standard.push_back(e.name);

@@ -15,7 +15,8 @@
 namespace symoro::codegen::modeling {
 
 // Inertial parameter families of a link, in table order.
-inline const std::array<const char*, 10> kInertialFamilies = {"XX", "XY", "XZ", "YY", "YZ", "ZZ", "MX", "MY", "MZ", "M"};
+inline const std::array<const char*, 10> kInertialFamilies = {"XX", "XY", "XZ", "YY", "YZ",
+                                                              "ZZ", "MX", "MY", "MZ", "M"};
 enum Inertial { XX, XY, XZ, YY, YZ, ZZ, MX, MY, MZ, M };
 
 // One link's parameters as graph nodes (a symbol or 0): the ten inertial ones, then the rotor
@@ -41,8 +42,8 @@ struct Description {
   std::string path;
   int n = 0;
   std::vector<JointDescription> joints;
-  std::vector<LinkParameters> links;         // the standard parameters
-  std::vector<grammar::Expr> gravity_expr;   // G, 3 entries
+  std::vector<LinkParameters> links;        // the standard parameters
+  std::vector<grammar::Expr> gravity_expr;  // G, 3 entries
   std::array<NodeId, 3> gravity{};
   std::vector<std::string> geometric_symbols;  // every symbol of the geometry and of G
   std::vector<std::string> standard;           // standard parameter names, link by link

@@ -40,14 +40,20 @@ struct Printer {
     if (names.count(id)) return kAtom;
     const Node& n = g.node(id);
     switch (n.op) {
-      case Op::Constant: return n.value < 0 ? kUnary : kAtom;
+      case Op::Constant:
+        return n.value < 0 ? kUnary : kAtom;
       case Op::Add:
-      case Op::Sub: return kSum;
+      case Op::Sub:
+        return kSum;
       case Op::Mul:
-      case Op::Div: return kProduct;
-      case Op::Neg: return kUnary;
-      case Op::Pow: return kPower;
-      default: return kAtom;
+      case Op::Div:
+        return kProduct;
+      case Op::Neg:
+        return kUnary;
+      case Op::Pow:
+        return kPower;
+      default:
+        return kAtom;
     }
   }
   std::string wrap(NodeId id, bool need) const { return need ? "(" + text(id) + ")" : text(id); }
@@ -56,25 +62,36 @@ struct Printer {
     if (auto it = names.find(id); it != names.end()) return it->second;
     const Node& n = g.node(id);
     switch (n.op) {
-      case Op::Constant: return number_text(n.value);
-      case Op::Symbol: return g.symbol_name(n.symbol);
+      case Op::Constant:
+        return number_text(n.value);
+      case Op::Symbol:
+        return g.symbol_name(n.symbol);
       // Operands keep the graph's grouping (a - (b - c), a*(b*c)): the text reads back to the
       // same expression, rounding included. A negation is always parenthesized as an operand.
-      case Op::Add: return wrap(n.a, prec(n.a) == kUnary) + " + " + wrap(n.b, prec(n.b) == kSum || prec(n.b) == kUnary);
-      case Op::Sub: return wrap(n.a, prec(n.a) == kUnary) + " - " + wrap(n.b, prec(n.b) == kSum || prec(n.b) == kUnary);
+      case Op::Add:
+        return wrap(n.a, prec(n.a) == kUnary) + " + " + wrap(n.b, prec(n.b) == kSum || prec(n.b) == kUnary);
+      case Op::Sub:
+        return wrap(n.a, prec(n.a) == kUnary) + " - " + wrap(n.b, prec(n.b) == kSum || prec(n.b) == kUnary);
       case Op::Mul:
-      case Op::Div: return wrap(n.a, prec(n.a) == kSum || prec(n.a) == kUnary) + (n.op == Op::Mul ? "*" : "/") +
-                           wrap(n.b, prec(n.b) <= kUnary);
-      case Op::Neg: return "-" + wrap(n.a, prec(n.a) <= kSum || prec(n.a) == kUnary);
+      case Op::Div:
+        return wrap(n.a, prec(n.a) == kSum || prec(n.a) == kUnary) + (n.op == Op::Mul ? "*" : "/") +
+               wrap(n.b, prec(n.b) <= kUnary);
+      case Op::Neg:
+        return "-" + wrap(n.a, prec(n.a) <= kSum || prec(n.a) == kUnary);
       case Op::Pow: {
         const double e = n.value;
         return wrap(n.a, prec(n.a) < kAtom) + "**" + (e < 0 ? "(" + number_text(e) + ")" : number_text(e));
       }
-      case Op::Sin: return "sin(" + text(n.a) + ")";
-      case Op::Cos: return "cos(" + text(n.a) + ")";
-      case Op::Sign: return "sign(" + text(n.a) + ")";
-      case Op::Exp: return "exp(" + text(n.a) + ")";
-      case Op::Tanh: return "tanh(" + text(n.a) + ")";
+      case Op::Sin:
+        return "sin(" + text(n.a) + ")";
+      case Op::Cos:
+        return "cos(" + text(n.a) + ")";
+      case Op::Sign:
+        return "sign(" + text(n.a) + ")";
+      case Op::Exp:
+        return "exp(" + text(n.a) + ")";
+      case Op::Tanh:
+        return "tanh(" + text(n.a) + ")";
     }
     return "";
   }
@@ -121,7 +138,8 @@ std::string equations_text(const ExprGraph& g, const std::vector<std::pair<std::
         if (s.rfind(pre, 0) == 0) return true;
       }
     for (const auto& o : outputs)
-      if (o.first.rfind(pre, 0) == 0 && o.first.find_first_not_of("0123456789", pre.size()) == std::string::npos) return true;
+      if (o.first.rfind(pre, 0) == 0 && o.first.find_first_not_of("0123456789", pre.size()) == std::string::npos)
+        return true;
     return false;
   };
   while (clashes(p)) p += "x";

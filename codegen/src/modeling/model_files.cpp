@@ -18,7 +18,9 @@ namespace {
 
 using namespace modeling;
 
-std::string pad(const std::string& s) { return s + std::string(std::max<std::size_t>(1, 8 > s.size() ? 8 - s.size() : 1), ' '); }
+std::string pad(const std::string& s) {
+  return s + std::string(std::max<std::size_t>(1, 8 > s.size() ? 8 - s.size() : 1), ' ');
+}
 
 std::string table(const std::string& title, const std::vector<std::string>& columns,
                   const std::vector<std::vector<std::string>>& rows) {
@@ -56,7 +58,8 @@ struct Tables {
       r.push_back(node_text(g, links[j].ia));
       rows.push_back(r);
     }
-    return table("Dynamic inertia parameters", {"j", "XX", "XY", "XZ", "YY", "YZ", "ZZ", "MX", "MY", "MZ", "M", "IA"}, rows);
+    return table("Dynamic inertia parameters", {"j", "XX", "XY", "XZ", "YY", "YZ", "ZZ", "MX", "MY", "MZ", "M", "IA"},
+                 rows);
   }
   std::string joint(const std::vector<LinkParameters>& links) const {
     std::vector<std::vector<std::string>> rows;
@@ -113,7 +116,8 @@ std::string base_par(const ExprGraph& g, const Description& d, const std::vector
   s += "theta = " + column([&](int j) { return to_text(d.joints[j].theta); }) + "\n";
   s += "\n(* Dynamic parameters and external forces *)\n";
   for (int k = 0; k < 10; ++k)
-    s += std::string(kInertialFamilies[k]) + " = " + column([&](int j) { return node_text(g, links[j].inertial[k]); }) + "\n";
+    s += std::string(kInertialFamilies[k]) + " = " + column([&](int j) { return node_text(g, links[j].inertial[k]); }) +
+         "\n";
   s += "IA = " + column([&](int j) { return node_text(g, links[j].ia); }) + "\n";
   s += "FV = " + column([&](int j) { return node_text(g, links[j].fv); }) + "\n";
   s += "FS = " + column([&](int j) { return node_text(g, links[j].fs); }) + "\n";
@@ -122,10 +126,11 @@ std::string base_par(const ExprGraph& g, const Description& d, const std::vector
   s += "QP = " + column([&](int j) { return d.joints[j].qd; }) + "\n";
   s += "QDP = " + column([&](int j) { return d.joints[j].qdd; }) + "\n";
   s += "GAM = " + column([&](int j) { return d.joints[j].tau; }) + "\n";
-  s += "\n(* Velocity and acceleration of the base *)\nW0 = " + zeros(3) + "\nWP0 = " + zeros(3) + "\nV0 = " + zeros(3) +
-       "\nVP0 = " + zeros(3) + "\n\n(* Acceleration of gravity *)\nG = {" + to_text(d.gravity_expr[0]) + "," +
-       to_text(d.gravity_expr[1]) + "," + to_text(d.gravity_expr[2]) + "}\n";
-  s += "\n(* Transformation of 0 frame position fT0 *)\nZ = {1,0,0,0,0,1,0,0,0,0,1,0,0,0,0,1}\n\n(* End of definition *)\n";
+  s += "\n(* Velocity and acceleration of the base *)\nW0 = " + zeros(3) + "\nWP0 = " + zeros(3) +
+       "\nV0 = " + zeros(3) + "\nVP0 = " + zeros(3) + "\n\n(* Acceleration of gravity *)\nG = {" +
+       to_text(d.gravity_expr[0]) + "," + to_text(d.gravity_expr[1]) + "," + to_text(d.gravity_expr[2]) + "}\n";
+  s += "\n(* Transformation of 0 frame position fT0 *)\nZ = {1,0,0,0,0,1,0,0,0,0,1,0,0,0,0,1}\n\n(* End of definition "
+       "*)\n";
   return s;
 }
 
@@ -135,7 +140,8 @@ namespace {
 // The solution x of A x = b, A symmetric positive definite as symbols, by LDL^T: one division
 // per pivot. b(i) makes the right-hand side's row i when the forward substitution reaches it (the
 // graph's nodes are made in the order the emitted text depends on).
-std::vector<NodeId> ldlt_solve(ExprGraph& g, const std::vector<std::vector<NodeId>>& A, const std::function<NodeId(int)>& b) {
+std::vector<NodeId> ldlt_solve(ExprGraph& g, const std::vector<std::vector<NodeId>>& A,
+                               const std::function<NodeId(int)>& b) {
   const int n = static_cast<int>(A.size());
   std::vector<std::vector<NodeId>> L(n, std::vector<NodeId>(n, g.zero()));
   std::vector<NodeId> D(n), inv_D(n), x(n);
@@ -171,16 +177,18 @@ void add_geometric_files(ExprGraph& g, const Description& d, Tables& t, int fram
     for (int c = 0; c < 4; ++c)
       for (int r = 0; r < 3; ++r)
         o.emplace_back("T0T" + std::to_string(frame) + std::to_string(r + 1) + std::to_string(c + 1), T[r][c]);
-    out.files.push_back({"fgm.txt", model_file({"Direct Geometric model (symoroc model)"}, t.geometric(), equations_text(g, o, q, "T"))});
+    out.files.push_back({"fgm.txt", model_file({"Direct Geometric model (symoroc model)"}, t.geometric(),
+                                               equations_text(g, o, q, "T"))});
   }
   {
     const auto J = frame_jacobian(g, d, frame);
     std::vector<std::pair<std::string, NodeId>> o;
     for (int c = 0; c < n; ++c)
       for (int r = 0; r < 6; ++r) o.emplace_back("J" + std::to_string(r + 1) + std::to_string(c + 1), J[r][c]);
-    out.files.push_back({"jac.txt", model_file({"Jacobian matrix for frame " + std::to_string(frame) + " (symoroc model)",
-                                                "Projection frame 0, intermediate frame " + std::to_string(frame)},
-                                               t.geometric(), equations_text(g, o, q, "T"))});
+    out.files.push_back(
+        {"jac.txt", model_file({"Jacobian matrix for frame " + std::to_string(frame) + " (symoroc model)",
+                                "Projection frame 0, intermediate frame " + std::to_string(frame)},
+                               t.geometric(), equations_text(g, o, q, "T"))});
   }
 }
 
@@ -213,7 +221,9 @@ Modeling model_from_par_file(const grammar::ParFile& par, const ModelingOptions&
   const int n = d.n;
   const int frame = options.frame == 0 ? n : options.frame;
   if (frame < 1 || frame > n)
-    throw InputError(par_path, 0, 0, "frame " + std::to_string(options.frame) + " does not exist (the robot has " + std::to_string(n) + ")");
+    throw InputError(
+        par_path, 0, 0,
+        "frame " + std::to_string(options.frame) + " does not exist (the robot has " + std::to_string(n) + ")");
   Tables t{g, d};
   const std::string tables = t.dynamic(base.links);
   std::vector<std::string> q;
@@ -248,9 +258,10 @@ Modeling model_from_par_file(const grammar::ParFile& par, const ModelingOptions&
     for (const auto& p : base.names) columns.push_back(differentiate(g, tau, p));
     for (int j = 0; j < n; ++j)
       for (std::size_t p = 0; p < base.names.size(); ++p)
-        if (!g.is_constant(columns[p][j], 0.0)) dg.emplace_back("DG" + std::to_string(j + 1) + base.names[p], columns[p][j]);
-    out.files.push_back({"dim.txt", model_file({"Dynamic Identification Model (Newton-Euler method, symoroc model)"}, tables,
-                                               equations_text(g, dg, q, "T"))});
+        if (!g.is_constant(columns[p][j], 0.0))
+          dg.emplace_back("DG" + std::to_string(j + 1) + base.names[p], columns[p][j]);
+    out.files.push_back({"dim.txt", model_file({"Dynamic Identification Model (Newton-Euler method, symoroc model)"},
+                                               tables, equations_text(g, dg, q, "T"))});
   }
 
   // Coriolis, centrifugal, gravity and friction torques: qdd = 0.
@@ -285,9 +296,10 @@ Modeling model_from_par_file(const grammar::ParFile& par, const ModelingOptions&
     const std::vector<NodeId> x = ldlt_solve(g, A, [&](int i) { return g.sub(g.symbol(d.joints[i].tau), h[i]); });
     std::vector<std::pair<std::string, NodeId>> o;
     for (int j = 0; j < n; ++j) o.emplace_back(d.joints[j].qdd, x[j]);
-    out.files.push_back({"ddm.txt", model_file({"Direct Dynamic Model (LDL^T solve of the Newton-Euler model, symoroc model)",
-                                                "Robot with fixed base", ""},
-                                               tables, equations_text(g, o, q, "T"))});
+    out.files.push_back(
+        {"ddm.txt", model_file({"Direct Dynamic Model (LDL^T solve of the Newton-Euler model, symoroc model)",
+                                "Robot with fixed base", ""},
+                               tables, equations_text(g, o, q, "T"))});
   }
 
   add_geometric_files(g, d, t, frame, q, out);

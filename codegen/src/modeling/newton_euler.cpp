@@ -2,8 +2,12 @@
 
 namespace symoro::codegen::modeling {
 
-Vec3 add(ExprGraph& g, const Vec3& a, const Vec3& b) { return {g.add(a[0], b[0]), g.add(a[1], b[1]), g.add(a[2], b[2])}; }
-Vec3 sub(ExprGraph& g, const Vec3& a, const Vec3& b) { return {g.sub(a[0], b[0]), g.sub(a[1], b[1]), g.sub(a[2], b[2])}; }
+Vec3 add(ExprGraph& g, const Vec3& a, const Vec3& b) {
+  return {g.add(a[0], b[0]), g.add(a[1], b[1]), g.add(a[2], b[2])};
+}
+Vec3 sub(ExprGraph& g, const Vec3& a, const Vec3& b) {
+  return {g.sub(a[0], b[0]), g.sub(a[1], b[1]), g.sub(a[2], b[2])};
+}
 Vec3 scale(ExprGraph& g, NodeId s, const Vec3& a) { return {g.mul(s, a[0]), g.mul(s, a[1]), g.mul(s, a[2])}; }
 Vec3 cross(ExprGraph& g, const Vec3& a, const Vec3& b) {
   return {g.sub(g.mul(a[1], b[2]), g.mul(a[2], b[1])), g.sub(g.mul(a[2], b[0]), g.mul(a[0], b[2])),

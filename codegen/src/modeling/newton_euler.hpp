@@ -40,8 +40,8 @@ Vec3 sub(ExprGraph& g, const Vec3& a, const Vec3& b);
 Vec3 scale(ExprGraph& g, NodeId s, const Vec3& a);
 Vec3 cross(ExprGraph& g, const Vec3& a, const Vec3& b);
 NodeId dot(ExprGraph& g, const Vec3& a, const Vec3& b);
-Vec3 times(ExprGraph& g, const Mat3& R, const Vec3& v);             // R v
-Vec3 transpose_times(ExprGraph& g, const Mat3& R, const Vec3& v);   // R^T v
+Vec3 times(ExprGraph& g, const Mat3& R, const Vec3& v);            // R v
+Vec3 transpose_times(ExprGraph& g, const Mat3& R, const Vec3& v);  // R^T v
 Mat3 times(ExprGraph& g, const Mat3& A, const Mat3& B);
 
 }  // namespace symoro::codegen::modeling

@@ -47,8 +47,6 @@ class Capture : public console_bridge::OutputHandler {
   std::string messages;
 };
 
-
-
 Vector3d vec(const urdf::Vector3& v) { return {v.x, v.y, v.z}; }
 
 // A length: 0 below kLengthSnap, else the 12-digit decimal it is within rounding of (the URDF's
@@ -73,8 +71,6 @@ Isometry3d dh_transform(const Dh& p) {
   return T;
 }
 
-
-
 // A URDF is a few elements deep (robot > link > inertial > origin); a file nested far deeper is
 // no URDF, and the XML parser's recursion would overflow the stack on it (a segmentation fault
 // after 18 s at 100,000 levels). The first element past kMaxXmlDepth, or 0 when none is.
@@ -88,12 +84,22 @@ int too_deep_line(const std::string& text) {
     auto skip_to = [&](const char* end) {  // past `end`, counting lines
       const std::size_t at = text.find(end, i);
       const std::size_t stop = at == std::string::npos ? text.size() : at + std::strlen(end);
-      line += static_cast<int>(std::count(text.begin() + static_cast<std::ptrdiff_t>(i), text.begin() + static_cast<std::ptrdiff_t>(stop), '\n'));
+      line += static_cast<int>(std::count(text.begin() + static_cast<std::ptrdiff_t>(i),
+                                          text.begin() + static_cast<std::ptrdiff_t>(stop), '\n'));
       i = stop - 1;
     };
-    if (text.compare(i, 4, "<!--") == 0) { skip_to("-->"); continue; }
-    if (text.compare(i, 9, "<![CDATA[") == 0) { skip_to("]]>"); continue; }
-    if (text.compare(i, 2, "<?") == 0 || text.compare(i, 2, "<!") == 0) { skip_to(">"); continue; }
+    if (text.compare(i, 4, "<!--") == 0) {
+      skip_to("-->");
+      continue;
+    }
+    if (text.compare(i, 9, "<![CDATA[") == 0) {
+      skip_to("]]>");
+      continue;
+    }
+    if (text.compare(i, 2, "<?") == 0 || text.compare(i, 2, "<!") == 0) {
+      skip_to(">");
+      continue;
+    }
     const bool closing = i + 1 < text.size() && text[i + 1] == '/';
     // The tag's end, past quoted attribute values.
     std::size_t k = i + 1;
@@ -109,8 +115,10 @@ int too_deep_line(const std::string& text) {
       }
     }
     const bool self_closing = k < text.size() && k > i && text[k - 1] == '/';
-    if (closing) --depth;
-    else if (!self_closing && ++depth > kMaxXmlDepth) return line;
+    if (closing)
+      --depth;
+    else if (!self_closing && ++depth > kMaxXmlDepth)
+      return line;
     i = k;
   }
   return 0;
@@ -124,7 +132,8 @@ constexpr int kMaxChainJoints = 64;
 // The file read and checked: nesting depth, well-formed XML, values (urdf_checks.hpp), urdfdom's
 // own parse, the number of links.
 UrdfSource read_urdf_source(const std::string& path) {
-  if (const std::string why = ::symoro::detail::not_a_regular_file(path); !why.empty()) throw InputError(path, 0, 0, why);
+  if (const std::string why = ::symoro::detail::not_a_regular_file(path); !why.empty())
+    throw InputError(path, 0, 0, why);
   std::ifstream in(path, std::ios::binary);
   if (!in) throw InputError(path, 0, 0, "cannot read the file");
   std::stringstream buffer;
@@ -139,22 +148,28 @@ UrdfSource read_urdf_source(const std::string& path) {
   {
     TiXmlDocument doc;
     doc.Parse(text.c_str());
-    if (doc.Error()) throw InputError(path, doc.ErrorRow(), doc.ErrorCol(), std::string("malformed XML: ") + doc.ErrorDesc());
+    if (doc.Error())
+      throw InputError(path, doc.ErrorRow(), doc.ErrorCol(), std::string("malformed XML: ") + doc.ErrorDesc());
     check_urdf_values(doc, path);
   }
   {
     Capture capture;
     src.model = urdf::parseURDF(text);
-    if (!src.model) throw InputError(path, 0, 0, "not a valid URDF" + (capture.messages.empty() ? std::string() : ": " + capture.messages));
+    if (!src.model)
+      throw InputError(path, 0, 0,
+                       "not a valid URDF" + (capture.messages.empty() ? std::string() : ": " + capture.messages));
   }
   if (src.model->links_.size() > kMaxUrdfLinks)
-    throw InputError(path, 0, 0, std::to_string(src.model->links_.size()) + " links: more than the " + std::to_string(kMaxUrdfLinks) +
-                                     " a robot description may have here (symoroc models serial arms)");
+    throw InputError(path, 0, 0,
+                     std::to_string(src.model->links_.size()) + " links: more than the " +
+                         std::to_string(kMaxUrdfLinks) +
+                         " a robot description may have here (symoroc models serial arms)");
   return src;
 }
 
 // The tip: --tip-link (below the base), else where the one path of moving joints ends.
-urdf::LinkConstSharedPtr chain_tip(const UrdfSource& src, const urdf::LinkConstSharedPtr& base, const ModelingOptions& options) {
+urdf::LinkConstSharedPtr chain_tip(const UrdfSource& src, const urdf::LinkConstSharedPtr& base,
+                                   const ModelingOptions& options) {
   // The subtree under a joint has a moving joint (the joint itself included).
   std::function<bool(const urdf::Link&)> has_moving = [&](const urdf::Link& l) {
     for (const auto& j : l.child_joints)
@@ -183,8 +198,8 @@ urdf::LinkConstSharedPtr chain_tip(const UrdfSource& src, const urdf::LinkConstS
     if (next.empty()) break;
     if (next.size() > 1)
       throw InputError(src.path, src.line_of("link", tip->name), 0,
-                       "the link '" + tip->name + "' branches into moving joints ('" + next[0]->parent_joint->name + "' and '" +
-                           next[1]->parent_joint->name + "'): name the chain's end with --tip-link");
+                       "the link '" + tip->name + "' branches into moving joints ('" + next[0]->parent_joint->name +
+                           "' and '" + next[1]->parent_joint->name + "'): name the chain's end with --tip-link");
     tip = next[0];
   }
   return tip;
@@ -197,20 +212,29 @@ Chain find_chain(const UrdfSource& src, const ModelingOptions& options) {
   chain.base = options.base_link.empty() ? src.model->getRoot() : src.link(options.base_link, "the base link");
   chain.tip = chain_tip(src, chain.base, options);
   std::vector<urdf::JointConstSharedPtr> path_joints;
-  for (urdf::LinkConstSharedPtr l = chain.tip; l != chain.base; l = l->getParent()) path_joints.insert(path_joints.begin(), l->parent_joint);
+  for (urdf::LinkConstSharedPtr l = chain.tip; l != chain.base; l = l->getParent())
+    path_joints.insert(path_joints.begin(), l->parent_joint);
   for (const auto& j : path_joints) {
     const int line = src.line_of("joint", j->name);
     switch (j->type) {
       case urdf::Joint::REVOLUTE:
       case urdf::Joint::CONTINUOUS:
-      case urdf::Joint::PRISMATIC: break;
-      case urdf::Joint::FIXED: continue;
+      case urdf::Joint::PRISMATIC:
+        break;
+      case urdf::Joint::FIXED:
+        continue;
       default:
-        throw InputError(path, line, 0, "joint '" + j->name + "' on the chain is " +
-                                            (j->type == urdf::Joint::FLOATING ? "floating" : j->type == urdf::Joint::PLANAR ? "planar" : "of an unknown type") +
-                                            ": only revolute, continuous and prismatic joints are supported");
+        throw InputError(path, line, 0,
+                         "joint '" + j->name + "' on the chain is " +
+                             (j->type == urdf::Joint::FLOATING ? "floating"
+                              : j->type == urdf::Joint::PLANAR ? "planar"
+                                                               : "of an unknown type") +
+                             ": only revolute, continuous and prismatic joints are supported");
     }
-    if (j->mimic) throw InputError(path, line, 0, "joint '" + j->name + "' on the chain mimics '" + j->mimic->joint_name + "': a chain joint must be independent");
+    if (j->mimic)
+      throw InputError(path, line, 0,
+                       "joint '" + j->name + "' on the chain mimics '" + j->mimic->joint_name +
+                           "': a chain joint must be independent");
     if (vec(j->axis).norm() < 1e-12) throw InputError(path, line, 0, "joint '" + j->name + "' has a zero axis");
     chain.joints.push_back(j);
     chain.names.insert(j->name);
@@ -230,14 +254,17 @@ void check_locks(const UrdfSource& src, const Chain& chain, const ModelingOption
   for (const auto& [name, value] : options.locked) {
     const auto j = src.model->getJoint(name);
     if (!j || !moving(*j) || chain.names.count(name))
-      throw InputError(src.path, j ? src.line_of("joint", name) : 0, 0, "--lock " + name + ": not a moving joint off the chain");
+      throw InputError(src.path, j ? src.line_of("joint", name) : 0, 0,
+                       "--lock " + name + ": not a moving joint off the chain");
     const std::string lock = "--lock " + name + "=" + number_text(value);
-    if (!std::isfinite(value) || std::abs(value) > 1e3) throw InputError(src.path, src.line_of("joint", name), 0, lock + ": not a position");
+    if (!std::isfinite(value) || std::abs(value) > 1e3)
+      throw InputError(src.path, src.line_of("joint", name), 0, lock + ": not a position");
     const bool bounded = j->type == urdf::Joint::REVOLUTE || j->type == urdf::Joint::PRISMATIC;
     if (bounded && j->limits && j->limits->lower <= j->limits->upper &&
         (value < j->limits->lower || value > j->limits->upper))
       throw InputError(src.path, src.line_of("joint", name), 0,
-                       lock + ": outside the joint's limits " + number_text(j->limits->lower) + " .. " + number_text(j->limits->upper));
+                       lock + ": outside the joint's limits " + number_text(j->limits->lower) + " .. " +
+                           number_text(j->limits->upper));
   }
 }
 
@@ -256,7 +283,8 @@ LinkPlacement place_links(const UrdfSource& src, const Chain& chain, const Model
           if (chain.joints[k]->name == j.name) b = k + 1;
       } else if (moving(j)) {
         if (j.type != urdf::Joint::PRISMATIC && j.type != urdf::Joint::REVOLUTE && j.type != urdf::Joint::CONTINUOUS)
-          throw InputError(src.path, src.line_of("joint", j.name), 0, "joint '" + j.name + "' off the chain is floating or planar: it cannot be locked");
+          throw InputError(src.path, src.line_of("joint", j.name), 0,
+                           "joint '" + j.name + "' off the chain is floating or planar: it cannot be locked");
         const auto it = options.locked.find(j.name);
         const double q = it == options.locked.end() ? 0.0 : it->second;
         motion = urdf_geometry::motion(j, q);
@@ -357,7 +385,8 @@ DhChain dh_chain(const Chain& chain, const LinkPlacement& placed) {
     for (int a = 0; a < 3; ++a)
       for (int bb = 0; bb < 3; ++bb) Tk.linear()(a, bb) = exact(Tk.linear()(a, bb));
     if ((Tk.linear().col(2) - zk).norm() > 1e-6 || (Tk.translation() - Ok).norm() > 1e-6)
-      throw std::logic_error("symoroc model: the DH frame of joint '" + joints[k]->name + "' does not reproduce its axis (an internal error)");
+      throw std::logic_error("symoroc model: the DH frame of joint '" + joints[k]->name +
+                             "' does not reproduce its axis (an internal error)");
     R_prev = Tk.linear();
     O_prev = Tk.translation();
   }
@@ -372,7 +401,8 @@ DhChain dh_chain(const Chain& chain, const LinkPlacement& placed) {
 // Every URDF link's inertial summed into its chain link (body), about the DH frame's origin,
 // in the DH frame: the links without one and those whose inertial is not physically consistent
 // are said in `notes`.
-std::vector<Body> chain_bodies(const UrdfSource& src, const LinkPlacement& placed, const DhChain& frames, std::vector<std::string>& notes) {
+std::vector<Body> chain_bodies(const UrdfSource& src, const LinkPlacement& placed, const DhChain& frames,
+                               std::vector<std::string>& notes) {
   const std::vector<Isometry3d>& F = frames.F;
   const int n = static_cast<int>(frames.dh.size());
   std::vector<Body> bodies(n + 1);
@@ -392,7 +422,7 @@ std::vector<Body> chain_bodies(const UrdfSource& src, const LinkPlacement& place
     const Vector3d e = eig.eigenvalues();
     if (I.mass < 0 || e.minCoeff() < 0 || e(0) + e(1) < e(2) - 1e-12 * e.maxCoeff()) inconsistent.push_back(name);
     if (b == 0) continue;
-    const Isometry3d Tc = Tl * pose(I.origin);  // the inertial frame in base coordinates
+    const Isometry3d Tc = Tl * pose(I.origin);   // the inertial frame in base coordinates
     const Isometry3d inF = F[b].inverse() * Tc;  // ... in DH frame b
     const Vector3d c = inF.translation();
     const Matrix3d Jc = inF.linear() * Ic * inF.linear().transpose();
@@ -407,8 +437,9 @@ std::vector<Body> chain_bodies(const UrdfSource& src, const LinkPlacement& place
     notes.push_back(s);
   }
   for (const auto& name : inconsistent)
-    notes.push_back("warning: the inertial of link '" + name + "' (line " + std::to_string(src.line_of("link", name)) +
-                        ") is not physically consistent (a negative mass or principal moment, or the triangle inequality broken)");
+    notes.push_back(
+        "warning: the inertial of link '" + name + "' (line " + std::to_string(src.line_of("link", name)) +
+        ") is not physically consistent (a negative mass or principal moment, or the triangle inequality broken)");
   return bodies;
 }
 
@@ -430,7 +461,8 @@ UrdfChain read_urdf_chain(const std::string& path, const ModelingOptions& option
   const std::string given_name = options.name.empty() ? src.model->getName() : options.name;
   out.name = identifier(given_name);
   if (out.name != given_name)
-    out.notes.push_back("warning: the robot's name '" + given_name + "' is no C++ identifier: written as '" + out.name + "'");
+    out.notes.push_back("warning: the robot's name '" + given_name + "' is no C++ identifier: written as '" + out.name +
+                        "'");
   out.par_text = par_text(out.name, path, chain, frames, options);
   out.robot_yaml = robot_yaml_text(out.name, src, chain, placed, frames, bodies, options, out.notes);
   return out;

@@ -41,7 +41,8 @@ struct UrdfSource {
     while ((at = text.find("<" + tag, at)) != std::string::npos) {
       const std::size_t end = text.find('>', at);
       const std::size_t n = text.find("name=\"" + name + "\"", at);
-      if (n != std::string::npos && n < end) return static_cast<int>(std::count(text.begin(), text.begin() + at, '\n')) + 1;
+      if (n != std::string::npos && n < end)
+        return static_cast<int>(std::count(text.begin(), text.begin() + at, '\n')) + 1;
       at += 1;
     }
     return 0;
@@ -91,8 +92,8 @@ std::string par_text(const std::string& name, const std::string& path, const Cha
 
 // robot.yaml: the joints' limits, the URDF's inertials as the nominal parameters, and where the
 // model's frames and links are in the URDF. Warnings about the joints go into `notes`.
-std::string robot_yaml_text(const std::string& name, const UrdfSource& src, const Chain& chain, const LinkPlacement& placed,
-                            const DhChain& frames, const std::vector<Body>& bodies, const ModelingOptions& options,
-                            std::vector<std::string>& notes);
+std::string robot_yaml_text(const std::string& name, const UrdfSource& src, const Chain& chain,
+                            const LinkPlacement& placed, const DhChain& frames, const std::vector<Body>& bodies,
+                            const ModelingOptions& options, std::vector<std::string>& notes);
 
 }  // namespace symoro::codegen::modeling::urdf_parts

@@ -19,11 +19,16 @@ std::string angle_text(double a) {
   if (std::abs(a - k * M_PI / 2) <= kAngleSnap) {
     const int q = static_cast<int>(k);
     switch (q) {
-      case 0: return "0";
-      case 1: return "pi/2";
-      case -1: return "-pi/2";
-      case 2: return "pi";
-      case -2: return "-pi";
+      case 0:
+        return "0";
+      case 1:
+        return "pi/2";
+      case -1:
+        return "-pi/2";
+      case 2:
+        return "pi";
+      case -2:
+        return "-pi";
     }
   }
   return number_text(a);
@@ -44,7 +49,8 @@ std::string xyz_rpy(const Isometry3d& T) {
     yaw = std::atan2(-R(0, 1), R(1, 1));
   }
   auto n = [](double x) { return number_text(std::abs(x) < 1e-15 ? 0.0 : x); };
-  return "{xyz: [" + n(p.x()) + ", " + n(p.y()) + ", " + n(p.z()) + "], rpy: [" + n(roll) + ", " + n(pitch) + ", " + n(yaw) + "]}";
+  return "{xyz: [" + n(p.x()) + ", " + n(p.y()) + ", " + n(p.z()) + "], rpy: [" + n(roll) + ", " + n(pitch) + ", " +
+         n(yaw) + "]}";
 }
 
 }  // namespace
@@ -77,41 +83,50 @@ std::string par_text(const std::string& name, const std::string& path, const Cha
     return number_text(v) + "*G3";
   };
   std::string par = "(* Robotname = '" + name + "' *)\n";
-  par += "(* Written by symoroc model from " + path + ", base link " + chain.base->name + ", tip link " + chain.tip->name + " *)\n";
+  par += "(* Written by symoroc model from " + path + ", base link " + chain.base->name + ", tip link " +
+         chain.tip->name + " *)\n";
   par += "NL = " + std::to_string(n) + "\nNJ = " + std::to_string(n) + "\nNF = " + std::to_string(n) +
          "\nType = 0\nis_floating = False\nis_mobile = False\n\n(* Geometric parameters *)\n";
   par += "ant = " + column([&](int k) { return std::to_string(k); }) + "\n";
   par += "sigma = " + column([&](int k) { return std::to_string(dh[k].sigma); }) + "\n";
   par += "b = " + column([&](int k) { return number_text(dh[k].b); }) + "\n";
   par += "d = " + column([&](int k) { return number_text(dh[k].d); }) + "\n";
-  par += "r = " + column([&](int k) { return dh[k].sigma ? "r" + std::to_string(k + 1) : number_text(dh[k].r); }) + "\n";
+  par +=
+      "r = " + column([&](int k) { return dh[k].sigma ? "r" + std::to_string(k + 1) : number_text(dh[k].r); }) + "\n";
   par += "gamma = " + column([&](int k) { return angle_text(dh[k].gamma); }) + "\n";
   par += "alpha = " + column([&](int k) { return angle_text(dh[k].alpha); }) + "\n";
   par += "mu = " + column([&](int) { return std::string("1"); }) + "\n";
-  par += "theta = " + column([&](int k) { return dh[k].sigma ? angle_text(dh[k].theta) : "th" + std::to_string(k + 1); }) + "\n";
+  par +=
+      "theta = " + column([&](int k) { return dh[k].sigma ? angle_text(dh[k].theta) : "th" + std::to_string(k + 1); }) +
+      "\n";
   par += "\n(* Dynamic parameters and external forces *)\n";
-  for (const char* fam : {"XX", "XY", "XZ", "YY", "YZ", "ZZ", "MX", "MY", "MZ", "M"}) par += std::string(fam) + " = " + named(fam, true) + "\n";
-  par += "IA = " + named("IA", options.rotor_inertia) + "\nFV = " + named("FV", options.viscous) + "\nFS = " + named("FS", options.coulomb) + "\n";
+  for (const char* fam : {"XX", "XY", "XZ", "YY", "YZ", "ZZ", "MX", "MY", "MZ", "M"})
+    par += std::string(fam) + " = " + named(fam, true) + "\n";
+  par += "IA = " + named("IA", options.rotor_inertia) + "\nFV = " + named("FV", options.viscous) +
+         "\nFS = " + named("FS", options.coulomb) + "\n";
   for (const char* f : {"FX", "FY", "FZ", "CX", "CY", "CZ"}) par += std::string(f) + " = " + named("", false) + "\n";
   par += "\n(* Joint parameters *)\neta = " + named("", false) + "\nk = " + named("", false) + "\n";
   par += "QP = " + named("QP", true) + "\nQDP = " + named("QDP", true) + "\nGAM = " + named("GAM", true) + "\n";
   par += "\n(* Velocity and acceleration of the base *)\nW0 = {0,0,0}\nWP0 = {0,0,0}\nV0 = {0,0,0}\nVP0 = {0,0,0}\n";
-  par += "\n(* Acceleration of gravity: -z of the URDF's base link, in frame 0 *)\nG = {" + gravity(g0.x()) + "," + gravity(g0.y()) +
-         "," + gravity(g0.z()) + "}\n";
-  par += "\n(* Transformation of 0 frame position fT0 *)\nZ = {1,0,0,0,0,1,0,0,0,0,1,0,0,0,0,1}\n\n(* End of definition *)\n";
+  par += "\n(* Acceleration of gravity: -z of the URDF's base link, in frame 0 *)\nG = {" + gravity(g0.x()) + "," +
+         gravity(g0.y()) + "," + gravity(g0.z()) + "}\n";
+  par +=
+      "\n(* Transformation of 0 frame position fT0 *)\nZ = {1,0,0,0,0,1,0,0,0,0,1,0,0,0,0,1}\n\n(* End of definition "
+      "*)\n";
   return par;
 }
 
-
-std::string robot_yaml_text(const std::string& name, const UrdfSource& src, const Chain& chain, const LinkPlacement& placed,
-                            const DhChain& frames, const std::vector<Body>& bodies, const ModelingOptions& options,
-                            std::vector<std::string>& notes) {
+std::string robot_yaml_text(const std::string& name, const UrdfSource& src, const Chain& chain,
+                            const LinkPlacement& placed, const DhChain& frames, const std::vector<Body>& bodies,
+                            const ModelingOptions& options, std::vector<std::string>& notes) {
   const std::string& path = src.path;
   const urdf::LinkConstSharedPtr &base = chain.base, &tip = chain.tip;
   const std::vector<Isometry3d>& F = frames.F;
   const int n = static_cast<int>(chain.joints.size());
-  std::string y = "# " + name + ": written by symoroc model from " + path + " (base link " + base->name + ", tip link " +
-                  tip->name + ").\n# Review the joint limits; the nominal parameters are the URDF's inertials in the model's frames.\n";
+  std::string y =
+      "# " + name + ": written by symoroc model from " + path + " (base link " + base->name + ", tip link " +
+      tip->name +
+      ").\n# Review the joint limits; the nominal parameters are the URDF's inertials in the model's frames.\n";
   y += "description: " + src.model->getName() + " from its URDF\n\nconstants:\n  G3: 9.81        # m/s^2\n\njoints:\n";
   bool prismatic = false;
   for (int k = 0; k < n; ++k) {
@@ -130,14 +145,15 @@ std::string robot_yaml_text(const std::string& name, const UrdfSource& src, cons
     if (j.type == urdf::Joint::CONTINUOUS) comment += " continuous: +-2 pi written;";
     if (!(lower < upper)) {
       comment += " the URDF's limits are empty: +-pi written;";
-      notes.push_back("warning: joint '" + j.name + "' (line " + std::to_string(src.line_of("joint", j.name)) + ") has empty limits (" +
-                          number_text(lower) + " .. " + number_text(upper) + "): robot.yaml gets -pi .. pi");
+      notes.push_back("warning: joint '" + j.name + "' (line " + std::to_string(src.line_of("joint", j.name)) +
+                      ") has empty limits (" + number_text(lower) + " .. " + number_text(upper) +
+                      "): robot.yaml gets -pi .. pi");
       lower = -M_PI;
       upper = M_PI;
     }
     if (identifier(j.name) != j.name)
       notes.push_back("warning: joint '" + j.name + "' (line " + std::to_string(src.line_of("joint", j.name)) +
-                          ") is no C++ identifier: robot.yaml names it '" + identifier(j.name) + "'");
+                      ") is no C++ identifier: robot.yaml names it '" + identifier(j.name) + "'");
     if (!(velocity > 0)) {
       velocity = 1;
       comment += " no velocity limit in the URDF: 1 written;";
@@ -158,16 +174,18 @@ std::string robot_yaml_text(const std::string& name, const UrdfSource& src, cons
     const Body& B = bodies[k];
     const std::string s = std::to_string(k);
     auto v = [](double x) { return number_text(std::abs(x) < 1e-300 ? 0.0 : x); };
-    y += "  XX" + s + ": " + v(B.J(0, 0)) + "\n  XY" + s + ": " + v(B.J(0, 1)) + "\n  XZ" + s + ": " + v(B.J(0, 2)) + "\n  YY" + s +
-         ": " + v(B.J(1, 1)) + "\n  YZ" + s + ": " + v(B.J(1, 2)) + "\n  ZZ" + s + ": " + v(B.J(2, 2)) + "\n  MX" + s + ": " +
-         v(B.ms.x()) + "\n  MY" + s + ": " + v(B.ms.y()) + "\n  MZ" + s + ": " + v(B.ms.z()) + "\n  M" + s + ": " + v(B.m) + "\n";
+    y += "  XX" + s + ": " + v(B.J(0, 0)) + "\n  XY" + s + ": " + v(B.J(0, 1)) + "\n  XZ" + s + ": " + v(B.J(0, 2)) +
+         "\n  YY" + s + ": " + v(B.J(1, 1)) + "\n  YZ" + s + ": " + v(B.J(1, 2)) + "\n  ZZ" + s + ": " + v(B.J(2, 2)) +
+         "\n  MX" + s + ": " + v(B.ms.x()) + "\n  MY" + s + ": " + v(B.ms.y()) + "\n  MZ" + s + ": " + v(B.ms.z()) +
+         "\n  M" + s + ": " + v(B.m) + "\n";
     const auto& dyn = chain.joints[k - 1]->dynamics;
     if (options.rotor_inertia) y += "  IA" + s + ": 0\n";
     if (options.viscous) y += "  FV" + s + ": " + v(dyn ? dyn->damping : 0.0) + "\n";
     if (options.coulomb) y += "  FS" + s + ": " + v(dyn ? dyn->friction : 0.0) + "\n";
   }
   y += "\n# Where the model's frames are in the URDF, and which URDF links each model link merges.\nurdf:\n";
-  y += "  file: " + std::string(path.substr(path.find_last_of('/') == std::string::npos ? 0 : path.find_last_of('/') + 1)) + "\n";
+  y += "  file: " +
+       std::string(path.substr(path.find_last_of('/') == std::string::npos ? 0 : path.find_last_of('/') + 1)) + "\n";
   y += "  base_link: " + base->name + "\n  tip_link: " + tip->name + "\n";
   y += "  frame0_in_base: " + xyz_rpy(F[0]) + "\n";
   y += "  tip_in_last_frame: " + xyz_rpy(F[n].inverse() * placed.T.at(tip->name)) + "\n";

@@ -43,17 +43,21 @@ class UrdfValueChecker {
   void element(const TiXmlElement& el, const std::string& owner) {
     const std::string tag = el.Value();
     if (tag.rfind("xacro:", 0) == 0)
-      fail(el, "<" + tag + "> is a xacro macro: expand the file with xacro first (xacro robot.urdf.xacro > robot.urdf)");
+      fail(el,
+           "<" + tag + "> is a xacro macro: expand the file with xacro first (xacro robot.urdf.xacro > robot.urdf)");
     for (const TiXmlAttribute* a = el.FirstAttribute(); a; a = a->Next()) {
       const std::string v = a->Value();
       if (v.find("${") != std::string::npos || v.find("$(") != std::string::npos)
-        fail(el, "<" + tag + " " + a->Name() + "=\"" + v + "\"> holds a xacro expression: expand the file with xacro first");
+        fail(el, "<" + tag + " " + a->Name() + "=\"" + v +
+                     "\"> holds a xacro expression: expand the file with xacro first");
     }
     std::string inner = owner;
-    if ((tag == "link" || tag == "joint") && el.Attribute("name")) inner = tag + " '" + std::string(el.Attribute("name")) + "'";
+    if ((tag == "link" || tag == "joint") && el.Attribute("name"))
+      inner = tag + " '" + std::string(el.Attribute("name")) + "'";
     if (tag == "mass") scalar(el, owner, "value", 0, kLargestMass, "kg");
     if (tag == "inertia")
-      for (const char* k : {"ixx", "ixy", "ixz", "iyy", "iyz", "izz"}) scalar(el, owner, k, -kLargestInertia, kLargestInertia, "kg m^2", true);
+      for (const char* k : {"ixx", "ixy", "ixz", "iyy", "iyz", "izz"})
+        scalar(el, owner, k, -kLargestInertia, kLargestInertia, "kg m^2", true);
     if (tag == "origin" && in_dynamics(el)) {
       vector3(el, owner, "xyz", kLargestLength, "m");
       vector3(el, owner, "rpy", kLargestAngle, "rad");
@@ -93,7 +97,8 @@ class UrdfValueChecker {
     return true;
   }
 
-  void vector3(const TiXmlElement& el, const std::string& owner, const char* key, double bound, const char* unit) const {
+  void vector3(const TiXmlElement& el, const std::string& owner, const char* key, double bound,
+               const char* unit) const {
     const char* text = el.Attribute(key);
     if (!text) return;
     std::istringstream in(text);
@@ -104,7 +109,8 @@ class UrdfValueChecker {
     for (const auto& p : parts) {
       double v = 0;
       if (const std::string why = number_problem(p, v); !why.empty()) fail(el, where + ": '" + p + "' " + why);
-      if (std::abs(v) > bound) fail(el, where + ": " + p + " is beyond +-" + text_of(bound) + (*unit ? std::string(" ") + unit : ""));
+      if (std::abs(v) > bound)
+        fail(el, where + ": " + p + " is beyond +-" + text_of(bound) + (*unit ? std::string(" ") + unit : ""));
     }
   }
 
@@ -148,7 +154,8 @@ void add_lock(ModelingOptions& options, const std::string& spec) {
   double q = 0;
   std::string why = modeling::number_problem(spec.substr(eq + 1), q);
   if (why.empty() && std::abs(q) > modeling::kLargestLength) why = "is beyond +-1000 (m or rad)";
-  if (!why.empty()) throw std::invalid_argument("--lock '" + spec + "': the position '" + spec.substr(eq + 1) + "' " + why);
+  if (!why.empty())
+    throw std::invalid_argument("--lock '" + spec + "': the position '" + spec.substr(eq + 1) + "' " + why);
   options.locked[spec.substr(0, eq)] = q;
 }
 

@@ -32,32 +32,32 @@ struct EffectRow {
   std::string_view variant;    // the robot.yaml variant effect it compiles to; "" when it is no model term
   std::string_view twin;       // the twin.yaml effect that simulates it; "" when the twin has none
   EffectScope scope;
-  std::string_view families;   // the parameters' families, space separated ("HS HC": per order)
+  std::string_view families;  // the parameters' families, space separated ("HS HC": per order)
   EffectUnit unit_like;
-  std::string_view unit;       // of the parameters on a revolute joint (with unit_like Own: always)
-  std::string_view unfixes;    // base families a variant un-fixes instead of adding parameters ("FS")
-  bool velocity_scale;         // a variant gives it {joints: [...], velocity: v}
+  std::string_view unit;     // of the parameters on a revolute joint (with unit_like Own: always)
+  std::string_view unfixes;  // base families a variant un-fixes instead of adding parameters ("FS")
+  bool velocity_scale;       // a variant gives it {joints: [...], velocity: v}
   // Physical only with a positive first parameter (a friction level, a play, a mass, a delay):
   // a fit that makes it negative is absorbing another misfit.
   bool positive;
-  std::string_view term;       // the torque on its joint's row, per parameter
+  std::string_view term;  // the torque on its joint's row, per parameter
 };
 
 // The rows, in the twin's order of effects first (its names() and log notes keep that order).
 inline constexpr std::array<EffectRow, 14> kEffectTable{{
-    {"Coulomb friction", "coulomb", "smooth_coulomb", "coulomb", EffectScope::Joint, "FC",
-     EffectUnit::LikeFS, "N*m", "", true, true,
+    {"Coulomb friction", "coulomb", "smooth_coulomb", "coulomb", EffectScope::Joint, "FC", EffectUnit::LikeFS, "N*m",
+     "", true, true,
      "FC tanh(qd / v); the diagnosis: the sign averaged over a velocity spread s (erf), v = s sqrt(pi / 2)"},
     {"Stribeck friction", "stribeck", "stribeck", "stribeck", EffectScope::Joint, "FST", EffectUnit::LikeFS, "N*m", "",
      true, true, "FST sign(qd) exp(-(qd / vs)^2)"},
-    {"constant torque offset", "offset", "offset", "torque_offset", EffectScope::Joint, "OFF", EffectUnit::LikeFS, "N*m",
-     "", false, false, "OFF (the twin's torque_offset t adds t to the drive: OFF = -t)"},
+    {"constant torque offset", "offset", "offset", "torque_offset", EffectScope::Joint, "OFF", EffectUnit::LikeFS,
+     "N*m", "", false, false, "OFF (the twin's torque_offset t adds t to the drive: OFF = -t)"},
     {"backlash", "backlash", "", "backlash", EffectScope::Joint, "BL", EffectUnit::Own, "rad", "", false, true,
      "BL (IA d2s/dt2 + FV ds/dt) / 2, s the smoothed sign of the mesh torque"},
-    {"payload on the last link", "payload", "", "payload", EffectScope::Link, "PM PMX PMY PMZ", EffectUnit::Own, "kg", "",
-     false, true, "W times the last massive link's M, MX, MY, MZ"},
-    {"torque-constant error", "torque_constant", "", "torque_constant_error", EffectScope::Joint, "KTE", EffectUnit::Own,
-     "1", "", false, false, "-KTE tau_model"},
+    {"payload on the last link", "payload", "", "payload", EffectScope::Link, "PM PMX PMY PMZ", EffectUnit::Own, "kg",
+     "", false, true, "W times the last massive link's M, MX, MY, MZ"},
+    {"torque-constant error", "torque_constant", "", "torque_constant_error", EffectScope::Joint, "KTE",
+     EffectUnit::Own, "1", "", false, false, "-KTE tau_model"},
     {"actuation delay", "actuation_delay", "", "actuation_delay", EffectScope::Robot, "DELAY", EffectUnit::Own, "s", "",
      false, true, "DELAY d tau_model / dt"},
     {"encoder and current noise", "", "", "sensor_noise", EffectScope::Robot, "", EffectUnit::Own, "", "", false, false,
@@ -70,10 +70,11 @@ inline constexpr std::array<EffectRow, 14> kEffectTable{{
      EffectUnit::LikeFV, "N*m*s/rad", "", false, false, "FVA |qd|"},
     {"position-dependent torque", "position_harmonics", "position_harmonics", "", EffectScope::Joint, "HS HC",
      EffectUnit::LikeFS, "N*m", "", false, false, "HS_k sin(k q) + HC_k cos(k q)"},
-    {"products of inertia", "inertia_products", "inertia_products", "", EffectScope::Link, "XY XZ YZ", EffectUnit::LikeXY,
-     "kg*m^2", "XY XZ YZ", false, false, "the full model's regressor columns of link j's XY, XZ, YZ"},
-    {"Coulomb friction (OpenSYMORO's sign)", "", "coulomb", "", EffectScope::Joint, "FS", EffectUnit::LikeFS, "N*m", "FS",
-     false, true, "FS sign(qd), already in the files: the variant un-fixes it"},
+    {"products of inertia", "inertia_products", "inertia_products", "", EffectScope::Link, "XY XZ YZ",
+     EffectUnit::LikeXY, "kg*m^2", "XY XZ YZ", false, false,
+     "the full model's regressor columns of link j's XY, XZ, YZ"},
+    {"Coulomb friction (OpenSYMORO's sign)", "", "coulomb", "", EffectScope::Joint, "FS", EffectUnit::LikeFS, "N*m",
+     "FS", false, true, "FS sign(qd), already in the files: the variant un-fixes it"},
 }};
 
 // The row of a name in one of the three columns (&EffectRow::diagnosis, ::variant, ::twin); null
@@ -129,10 +130,12 @@ struct EffectParameterName {
   std::string name, family;
   int order = 0;
 };
-inline std::vector<EffectParameterName> effect_parameter_names(const EffectRow& row, int joint, const std::vector<int>& orders) {
+inline std::vector<EffectParameterName> effect_parameter_names(const EffectRow& row, int joint,
+                                                               const std::vector<int>& orders) {
   std::vector<EffectParameterName> out;
   for (int k : orders.empty() ? std::vector<int>{0} : orders)
-    for (const std::string& family : effect_words(row.families)) out.push_back({effect_parameter_name(family, joint, k), family, k});
+    for (const std::string& family : effect_words(row.families))
+      out.push_back({effect_parameter_name(family, joint, k), family, k});
   return out;
 }
 

@@ -13,8 +13,8 @@ namespace symoro {
 inline std::string bounded_message(const std::string& message) {
   constexpr std::size_t kHead = 2000, kTail = 500;
   if (message.size() <= kHead + kTail + 100) return message;
-  return message.substr(0, kHead) + " [... " + std::to_string(message.size() - kHead - kTail) + " characters left out ...] " +
-         message.substr(message.size() - kTail);
+  return message.substr(0, kHead) + " [... " + std::to_string(message.size() - kHead - kTail) +
+         " characters left out ...] " + message.substr(message.size() - kTail);
 }
 
 class DataError : public std::runtime_error {
@@ -25,8 +25,8 @@ class DataError : public std::runtime_error {
         file_(std::move(file)),
         line_(line) {}
   DataError(std::string file, int line, int column, const std::string& message)
-      : std::runtime_error(bounded_message(file) + ":" + std::to_string(line) + ":" + std::to_string(column) + ": error: " +
-                           bounded_message(message)),
+      : std::runtime_error(bounded_message(file) + ":" + std::to_string(line) + ":" + std::to_string(column) +
+                           ": error: " + bounded_message(message)),
         file_(std::move(file)),
         line_(line) {}
   const std::string& file() const { return file_; }

@@ -32,7 +32,8 @@ inline std::vector<Eigen::Isometry3d> mdh_poses(const std::vector<FrameInfo>& fr
   for (int j = 0; j < n; ++j) {
     const FrameInfo& f = frames[static_cast<std::size_t>(j)];
     const double qj = f.sigma == 2 ? 0.0 : q(k++);
-    const Eigen::Isometry3d parent = f.ant == 0 ? Eigen::Isometry3d::Identity() : T[static_cast<std::size_t>(f.ant - 1)];
+    const Eigen::Isometry3d parent =
+        f.ant == 0 ? Eigen::Isometry3d::Identity() : T[static_cast<std::size_t>(f.ant - 1)];
     T[static_cast<std::size_t>(j)] = parent * mdh_transform(f, qj);
   }
   return T;

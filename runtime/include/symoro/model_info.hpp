@@ -9,11 +9,11 @@ enum class JointType { Revolute = 0, Prismatic = 1 };
 struct JointInfo {
   const char* name;
   JointType type;
-  double lower;         // position limits (rad or m)
+  double lower;  // position limits (rad or m)
   double upper;
-  double velocity;      // |qd| limit (rad/s or m/s)
-  double effort;        // |tau| limit (N m or N)
-  double audit_lower;   // the all-pose PD audit domain for this joint (rad or m)
+  double velocity;     // |qd| limit (rad/s or m/s)
+  double effort;       // |tau| limit (N m or N)
+  double audit_lower;  // the all-pose PD audit domain for this joint (rad or m)
   double audit_upper;
 };
 
@@ -40,7 +40,7 @@ struct EffectParameterInfo {
 
 // A standard (per-link, physical) parameter of the robot description (.par).
 struct StandardParameterInfo {
-  const char* name;    // e.g. "XX2"
+  const char* name;  // e.g. "XX2"
   const char* family;
   int joint;
 };
@@ -54,9 +54,9 @@ struct FixedParameter {
 // One frame of the modified Denavit-Hartenberg (Khalil-Kleinfinger) description, numeric.
 // The joint variable (theta for sigma = 0, r for sigma = 1) is added to `theta` or `r`.
 struct FrameInfo {
-  int ant;     // antecedent frame
-  int sigma;   // 0 revolute, 1 prismatic, 2 fixed
-  int mu;      // 1 actuated
+  int ant;    // antecedent frame
+  int sigma;  // 0 revolute, 1 prismatic, 2 fixed
+  int mu;     // 1 actuated
   double gamma, b, alpha, d, theta, r;
 };
 

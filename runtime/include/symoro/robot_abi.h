@@ -64,17 +64,17 @@ typedef struct symoro_abi_source_file {
 /* One model of the robot (the full model, or a robot.yaml variant). Sizes: q, qd, qdd, tau nq;
  * phi np; s (standard parameters) ns; the full model's phi parent_np. */
 typedef struct symoro_abi_model {
-  const char* variant;     /* "" for the full model */
+  const char* variant; /* "" for the full model */
   const char* description;
   int nq, np, ns, nf, ne, n_fixed, parent_np;
-  const symoro_abi_parameter* parameters;       /* np */
+  const symoro_abi_parameter* parameters;        /* np */
   const symoro_abi_standard_parameter* standard; /* ns */
-  const symoro_abi_effect_parameter* effects;   /* ne: the last ne entries of phi and of s */
-  const symoro_abi_fixed_parameter* fixed;      /* n_fixed */
-  const int* parent_index;                      /* np: entry of the full model's phi, -1 for an effect */
-  const symoro_abi_joint* joints;               /* nq */
-  const symoro_abi_frame* frames;               /* nf */
-  double gravity[3];                            /* in frame 0, m/s^2 */
+  const symoro_abi_effect_parameter* effects;    /* ne: the last ne entries of phi and of s */
+  const symoro_abi_fixed_parameter* fixed;       /* n_fixed */
+  const int* parent_index;                       /* np: entry of the full model's phi, -1 for an effect */
+  const symoro_abi_joint* joints;                /* nq */
+  const symoro_abi_frame* frames;                /* nf */
+  double gravity[3];                             /* in frame 0, m/s^2 */
 
   /* The generated functions, in double. */
   void (*regressor)(const double* q, const double* qd, const double* qdd, double* W /* nq x np */);
@@ -104,9 +104,9 @@ typedef struct symoro_abi_model {
 } symoro_abi_model;
 
 typedef struct symoro_abi_robot {
-  unsigned abi_version;  /* SYMORO_ROBOT_ABI_VERSION */
-  const char* robot;     /* the folder's name, e.g. "crane_x7" */
-  const char* identified; /* the variant robot.yaml names `identified` ("" for the full model) */
+  unsigned abi_version;    /* SYMORO_ROBOT_ABI_VERSION */
+  const char* robot;       /* the folder's name, e.g. "crane_x7" */
+  const char* identified;  /* the variant robot.yaml names `identified` ("" for the full model) */
   const char* code_digest; /* XXH3-128 of the generated code the library was compiled from */
   const char* build;       /* the compiler and flags it was compiled with */
   int n_models;

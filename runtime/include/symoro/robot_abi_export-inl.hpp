@@ -81,7 +81,7 @@ struct Kernels {
     thread_local typename Model::template InertiaBasis<double> b;
     Model::inertia_basis(in<n>(q), b);
     Out<n, n>{constant} = b.constant;
-    for (int i = 0; i < np; ++i) Out<n, n>{linear + static_cast<std::ptrdiff_t>(i) * n * n} = b.linear[i];
+    for (int i = 0; i < np; ++i) Out<n, n>{linear + static_cast<std::ptrdiff_t>(i)* n* n} = b.linear[i];
   }
   static void nonlinear_effects(const double* q, const double* qd, const double* phi, double* h) {
     Out<n> t(h);
@@ -116,7 +116,7 @@ struct Kernels {
     thread_local typename Model::template InertiaDerivatives<double> d;
     Model::inertia_derivatives(in<n>(q), map<np>(phi), d);
     Out<n, n>{m} = d.M;
-    for (int k = 0; k < n; ++k) Out<n, n>{dm + static_cast<std::ptrdiff_t>(k) * n * n} = d.dq[k];
+    for (int k = 0; k < n; ++k) Out<n, n>{dm + static_cast<std::ptrdiff_t>(k)* n* n} = d.dq[k];
   }
   static void forward_kinematics(const double* q, double* t) {
     Out<4, 4> T(t);
@@ -130,9 +130,7 @@ struct Kernels {
     Out<np> p(phi);
     Model::base_from_standard(map<ns>(s), p);
   }
-  static void to_parent(const double* phi, double* parent) {
-    Out<parent_np>{parent} = Model::to_parent(map<np>(phi));
-  }
+  static void to_parent(const double* phi, double* parent) { Out<parent_np>{parent} = Model::to_parent(map<np>(phi)); }
   static void from_parent(const double* parent, double* phi) {
     Out<np>{phi} = Model::from_parent(map<parent_np>(parent));
   }

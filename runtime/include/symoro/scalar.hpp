@@ -26,9 +26,7 @@ struct promote<T> {
 template <class A, class B, class... Rest>
 struct promote<A, B, Rest...> {
   using AB = std::conditional_t<std::is_floating_point_v<A>,
-                                std::conditional_t<std::is_floating_point_v<B>,
-                                                   std::common_type_t<A, B>, B>,
-                                A>;
+                                std::conditional_t<std::is_floating_point_v<B>, std::common_type_t<A, B>, B>, A>;
   using type = typename promote<AB, Rest...>::type;
 };
 template <class... T>

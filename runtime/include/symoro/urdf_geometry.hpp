@@ -46,7 +46,8 @@ inline Eigen::Isometry3d pose(const urdf::Pose& p) {
 inline Eigen::Isometry3d motion(const urdf::Joint& j, double q) {
   Eigen::Isometry3d M = Eigen::Isometry3d::Identity();
   const Eigen::Vector3d axis = Eigen::Vector3d(j.axis.x, j.axis.y, j.axis.z).normalized();
-  if (j.type == urdf::Joint::PRISMATIC) M.translation() = q * axis;
+  if (j.type == urdf::Joint::PRISMATIC)
+    M.translation() = q * axis;
   else if (j.type == urdf::Joint::REVOLUTE || j.type == urdf::Joint::CONTINUOUS)
     M.linear() = Eigen::AngleAxisd(q, axis).toRotationMatrix();
   return M;

@@ -43,7 +43,8 @@ class Reader {
       fail(node, fmt::format("{} must be a number, not '{}'", what, node.Scalar()));
     }
     if (!std::isfinite(v) || v < 0 || (!allow_zero && v == 0))
-      fail(node, fmt::format("{} must be {} (got {})", what, allow_zero ? "finite and >= 0" : "finite and > 0", node.Scalar()));
+      fail(node, fmt::format("{} must be {} (got {})", what, allow_zero ? "finite and >= 0" : "finite and > 0",
+                             node.Scalar()));
     return v;
   }
   Eigen::VectorXd per_joint(const YAML::Node& node, const std::string& what, bool allow_zero) const {
@@ -70,8 +71,10 @@ ControllerDescription read_controller_description(const std::filesystem::path& p
   c.path = path.string();
   try {
     r.keys(root, "the controller description",
-           {"format", "period", "pseudo_derivative_time", "communication_delay", "realization", "bandwidth", "damping_ratio"});
-    if (root["format"].as<std::string>() != "symoro-controller 1") r.fail(root["format"], "format must be 'symoro-controller 1'");
+           {"format", "period", "pseudo_derivative_time", "communication_delay", "realization", "bandwidth",
+            "damping_ratio"});
+    if (root["format"].as<std::string>() != "symoro-controller 1")
+      r.fail(root["format"], "format must be 'symoro-controller 1'");
     c.period = r.number(root["period"], "period", false);
     c.pseudo_derivative_time = r.number(root["pseudo_derivative_time"], "pseudo_derivative_time", false);
     c.communication_delay = r.number(root["communication_delay"], "communication_delay", true);

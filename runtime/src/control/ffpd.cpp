@@ -45,7 +45,8 @@ const Eigen::VectorXd& FfpdController::update(const Eigen::VectorXd& q, const Ei
 }
 
 Eigen::VectorXd ffpd_command(const FfpdGains& g, const Eigen::VectorXd& q, const Eigen::VectorXd& qd_hat,
-                             const Eigen::VectorXd& q_ref, const Eigen::VectorXd& qd_ref, const Eigen::VectorXd& qdd_ref) {
+                             const Eigen::VectorXd& q_ref, const Eigen::VectorXd& qd_ref,
+                             const Eigen::VectorXd& qdd_ref) {
   return g.inertia.cwiseProduct(g.kv.cwiseProduct(qd_ref - qd_hat) + g.kp.cwiseProduct(q_ref - q) + qdd_ref) +
          g.damping.cwiseProduct(qd_ref);
 }

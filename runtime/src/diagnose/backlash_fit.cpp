@@ -38,14 +38,16 @@ twin::TwinConfig with_selected_effects(twin::TwinConfig c, const Selection& s) {
           c.effects.payload_com = Eigen::Vector3d(e.magnitude.values[1], e.magnitude.values[2], e.magnitude.values[3]);
         }
         break;
-      default: break;
+      default:
+        break;
     }
   }
   return c;
 }
 
-BacklashFit fit_backlash(const robot::ModelHandle& full, const io::Log& measured, const trajectory::SampledReference& reference,
-                         twin::TwinConfig nominal, const BacklashFitOptions& options) {
+BacklashFit fit_backlash(const robot::ModelHandle& full, const io::Log& measured,
+                         const trajectory::SampledReference& reference, twin::TwinConfig nominal,
+                         const BacklashFitOptions& options) {
   const int n = full.nq();
   BacklashFit fit;
   fit.measured = high_band_rms(measured, options);
@@ -71,7 +73,8 @@ BacklashFit fit_backlash(const robot::ModelHandle& full, const io::Log& measured
     Eigen::MatrixXd runs(n, options.seeds);
     for (int k = 0; k < options.seeds; ++k) runs.col(k) = simulate(c, options.seed + static_cast<std::uint64_t>(k));
     fit.simulated = runs.rowwise().mean();
-    fit.spread = ((runs.colwise() - fit.simulated).array().square().rowwise().sum() / std::max(1, options.seeds - 1)).sqrt();
+    fit.spread =
+        ((runs.colwise() - fit.simulated).array().square().rowwise().sum() / std::max(1, options.seeds - 1)).sqrt();
   };
   twin::TwinConfig c = nominal;
   if (c.effects.actuation_delay && c.effects.actuation_delay_time > 0) {
@@ -84,7 +87,8 @@ BacklashFit fit_backlash(const robot::ModelHandle& full, const io::Log& measured
       return sum;
     };
     const double g = 0.5 * (std::sqrt(5.0) - 1);
-    double a = c.effects.actuation_delay_time * (1 - options.delay_range), b = c.effects.actuation_delay_time * (1 + options.delay_range);
+    double a = c.effects.actuation_delay_time * (1 - options.delay_range),
+           b = c.effects.actuation_delay_time * (1 + options.delay_range);
     double x1 = b - g * (b - a), x2 = a + g * (b - a), f1 = mismatch(x1), f2 = mismatch(x2);
     for (int k = 0; k < options.delay_steps; ++k) {
       if (f1 < f2) {

@@ -26,52 +26,62 @@ void check_request(const DatasetDiagnosisOptions& options) {
     if (!(std::isfinite(v) && (lo_open ? v > lo : v >= lo) && v <= hi))
       throw DiagnosisRequestError(fmt::format("{} {}: must be {}", option, v, what));
   };
-  if (options.trial < 1 || options.trial > 1'000'000) throw DiagnosisRequestError(fmt::format("--trial {}: must be from 1 to 1000000", options.trial));
+  if (options.trial < 1 || options.trial > 1'000'000)
+    throw DiagnosisRequestError(fmt::format("--trial {}: must be from 1 to 1000000", options.trial));
   range("--interval", options.interval * 1000, 1, 10000, false, "from 1 to 10000 ms");
   range("--cutoff", options.cutoff, 0, 1e5, true, "> 0 and <= 1e5 Hz");
   range("--alpha", options.alpha, 0, 0.5, true, "> 0 and <= 0.5");
   range("--min-gain", options.min_heldout_gain, 0, 1, false, ">= 0 and <= 1");
   range("--min-torque", options.min_effect_torque, 0, 1e6, false, ">= 0 and <= 1e6 N m");
   static const std::regex lower_id("^[a-z][a-z0-9_]*$");
-  if (!options.variant.empty() && (!std::regex_match(options.variant, lower_id) || options.variant == "full" || options.variant == "param"))
-    throw DiagnosisRequestError("--variant '" + options.variant + "' must be a lower-case identifier other than 'full' and 'param' "
+  if (!options.variant.empty() &&
+      (!std::regex_match(options.variant, lower_id) || options.variant == "full" || options.variant == "param"))
+    throw DiagnosisRequestError("--variant '" + options.variant +
+                                "' must be a lower-case identifier other than 'full' and 'param' "
                                 "(symoroc's rule)");
   for (const auto& e : options.only) {
     effect_kind(e);  // unknown names: a clear error first
     if (e == "payload" && options.params.empty())
-      throw DiagnosisRequestError("--only payload needs --params: a refit absorbs a payload into the last link's parameters, "
-                                  "so it is judged against an earlier identification held fixed");
+      throw DiagnosisRequestError(
+          "--only payload needs --params: a refit absorbs a payload into the last link's parameters, "
+          "so it is judged against an earlier identification held fixed");
   }
 }
 
 std::pair<std::vector<std::string>, std::vector<std::string>> diagnosis_runs(const io::Dataset& data,
-                                                                              const DatasetDiagnosisOptions& options) {
+                                                                             const DatasetDiagnosisOptions& options) {
   // Held out: the held-out family (V, as a split at import records it); fitting: every other run
   // of the trial.
   auto pick = [&](bool heldout) {
     std::vector<std::string> v;
     for (const auto& r : data.runs)
-      if (r.trial == options.trial && (r.family == options.heldout_family) == heldout && std::find(v.begin(), v.end(), r.trajectory) == v.end())
+      if (r.trial == options.trial && (r.family == options.heldout_family) == heldout &&
+          std::find(v.begin(), v.end(), r.trajectory) == v.end())
         v.push_back(r.trajectory);
     return v;
   };
-  std::vector<std::string> train = options.train.empty() ? pick(false) : options.train, heldout = options.heldout.empty() ? pick(true) : options.heldout;
+  std::vector<std::string> train = options.train.empty() ? pick(false) : options.train,
+                           heldout = options.heldout.empty() ? pick(true) : options.heldout;
   std::string all;
-  for (const auto& r : data.runs) all += fmt::format("{}{} (family {}, trial {})", all.empty() ? "" : ", ", r.trajectory, r.family, r.trial);
+  for (const auto& r : data.runs)
+    all += fmt::format("{}{} (family {}, trial {})", all.empty() ? "" : ", ", r.trajectory, r.family, r.trial);
   const auto manifest = (data.dir / "dataset.yaml").string();
   if (train.empty())
-    throw DiagnosisRequestError(fmt::format("{}: no fitting run for trial {} (runs: {}); name them with --train", manifest, options.trial, all));
+    throw DiagnosisRequestError(fmt::format("{}: no fitting run for trial {} (runs: {}); name them with --train",
+                                            manifest, options.trial, all));
   if (heldout.empty())
-    throw DiagnosisRequestError(fmt::format("{}: no held-out run (family {}) for trial {} (runs: {}); name them with --heldout, "
-                                            "or split a long run at import (dynid import --split 0.7)",
-                                            manifest, options.heldout_family, options.trial, all));
+    throw DiagnosisRequestError(
+        fmt::format("{}: no held-out run (family {}) for trial {} (runs: {}); name them with --heldout, "
+                    "or split a long run at import (dynid import --split 0.7)",
+                    manifest, options.heldout_family, options.trial, all));
   for (const auto* list : {&train, &heldout})
     for (const auto& name : *list) {
       bool found = false;
       for (const auto& r : data.runs) found = found || (r.trajectory == name && r.trial == options.trial);
       if (!found)
-        throw DiagnosisRequestError(fmt::format("{}: no run {} of trial {} to {} (runs: {}); choose others with --train / --heldout",
-                                                manifest, name, options.trial, list == &train ? "fit" : "hold out", all));
+        throw DiagnosisRequestError(
+            fmt::format("{}: no run {} of trial {} to {} (runs: {}); choose others with --train / --heldout", manifest,
+                        name, options.trial, list == &train ? "fit" : "hold out", all));
     }
   return {train, heldout};
 }
@@ -81,8 +91,9 @@ namespace {
 // The held-out gap against the raw torque at the logs' own rate: the same fits (on the
 // diagnosis grid), evaluated on the raw-torque samples with a stack whose low-pass is above the
 // band (0.4 of the rate).
-void score_raw_torque(const DiagnosisModel& model, const DesignStack& train, const std::vector<std::pair<std::string, io::Log>>& heldout_logs,
-                      const StackOptions& so, const Eigen::VectorXd& held, Diagnosis& d) {
+void score_raw_torque(const DiagnosisModel& model, const DesignStack& train,
+                      const std::vector<std::pair<std::string, io::Log>>& heldout_logs, const StackOptions& so,
+                      const Eigen::VectorXd& held, Diagnosis& d) {
   const study::RawTorqueOptions ro;
   std::vector<NamedSamples> raw_runs;
   for (const auto& [name, log] : heldout_logs) raw_runs.push_back({name, study::raw_torque_samples(log, ro)});
@@ -109,8 +120,8 @@ namespace {
 // Backlash from the closed loop's high band: the robot's digital twin replays the fitting run's
 // own references. A stage that cannot run, or fails, is said in the report (d.backlash_note).
 void backlash_stage(const DiagnosisModel& model, const DatasetDiagnosisOptions& options, const std::string& robot,
-                    const io::Log& first_train, const std::string& first_train_name, const std::function<void()>& check_stop,
-                    Diagnosis& d) {
+                    const io::Log& first_train, const std::string& first_train_name,
+                    const std::function<void()>& check_stop, Diagnosis& d) {
   const identify::ModelDescription& md = model.description();
   const auto twin_path = options.robot_dir / "twin.yaml";
   if (!options.backlash) {
@@ -118,11 +129,14 @@ void backlash_stage(const DiagnosisModel& model, const DatasetDiagnosisOptions& 
   } else if (options.robot_dir.empty()) {
     d.backlash_note = "Not run: the stage simulates the robot's digital twin, and no robot folder was given.";
   } else if (!std::filesystem::exists(twin_path)) {
-    d.backlash_note = fmt::format("Not run: the stage simulates the robot's digital twin, and {} has none ({} not found).",
-                                  robot, twin_path.string());
+    d.backlash_note =
+        fmt::format("Not run: the stage simulates the robot's digital twin, and {} has none ({} not found).", robot,
+                    twin_path.string());
   } else if (!first_train.has_references()) {
-    d.backlash_note = fmt::format("Not run: the log of {} has no reference columns (q_ref, qd_ref, qdd_ref) for the twin to "
-                                  "replay.", first_train_name);
+    d.backlash_note = fmt::format(
+        "Not run: the log of {} has no reference columns (q_ref, qd_ref, qdd_ref) for the twin to "
+        "replay.",
+        first_train_name);
   } else {
     check_stop();
     try {
@@ -138,15 +152,18 @@ void backlash_stage(const DiagnosisModel& model, const DatasetDiagnosisOptions& 
 
 // What the diagnosis named (and dropped), said line by line.
 void say_findings(const Diagnosis& d, const std::function<void(const std::string&)>& say) {
-  for (const auto& e : d.selection.dropped) say(fmt::format("dropped: {}: {} ({})", e.candidate.label(), e.magnitude, e.reason));
+  for (const auto& e : d.selection.dropped)
+    say(fmt::format("dropped: {}: {} ({})", e.candidate.label(), e.magnitude, e.reason));
   for (const auto& e : d.selection.effects)
     say(fmt::format("effect: {}: {} (F {:.1f}, held-out gain {:.1f} %)", e.candidate.label(), e.magnitude.text, e.f,
                     100 * e.heldout_gain));
   for (const auto& f : d.backlash.findings)
-    say(fmt::format("effect: backlash, joint {}: {:.3f} deg of play (high-band torque {:.3f} N m measured, {:.3f} simulated "
-                    "without it, {:.3f} with it)",
-                    f.joint, f.width * 180 / 3.14159265358979323846, f.measured, f.simulated_before, f.simulated_after));
-  if (d.backlash.delay > 0) say(fmt::format("actuation delay refined on the high band: {:.2f} ms", d.backlash.delay * 1e3));
+    say(fmt::format(
+        "effect: backlash, joint {}: {:.3f} deg of play (high-band torque {:.3f} N m measured, {:.3f} simulated "
+        "without it, {:.3f} with it)",
+        f.joint, f.width * 180 / 3.14159265358979323846, f.measured, f.simulated_before, f.simulated_after));
+  if (d.backlash.delay > 0)
+    say(fmt::format("actuation delay refined on the high band: {:.2f} ms", d.backlash.delay * 1e3));
   if (d.selection.effects.empty() && d.backlash.findings.empty())
     say(fmt::format("no missing effect found ({})", d.selection.stop_reason));
 }
@@ -169,7 +186,7 @@ DatasetDiagnosis diagnose_dataset(const DiagnosisModel& model, const DatasetDiag
   so.interval = options.interval;
   so.cutoff = options.cutoff;
   so.candidates.only = options.only;
-  io::Log first_train;  // the backlash stage's run
+  io::Log first_train;                                        // the backlash stage's run
   std::vector<std::pair<std::string, io::Log>> heldout_logs;  // for the raw-torque gap
   auto stack = [&](const std::vector<std::string>& names, bool fitting) {
     std::vector<NamedSamples> runs;
@@ -178,7 +195,8 @@ DatasetDiagnosis diagnose_dataset(const DiagnosisModel& model, const DatasetDiag
       io::Log log = io::read_run_log(data.find(name, options.trial), md.robot, md.nq);
       if (fitting && name == names.front()) first_train = log;
       if (!fitting) heldout_logs.emplace_back(name, log);
-      runs.push_back({name, preprocess::preprocess(log, log.meta.sample_time > 0 ? log.meta.sample_time : 0.001, light_preprocessing())});
+      runs.push_back({name, preprocess::preprocess(log, log.meta.sample_time > 0 ? log.meta.sample_time : 0.001,
+                                                   light_preprocessing())});
     }
     return model.stack_design(runs, so);
   };
@@ -211,7 +229,8 @@ DatasetDiagnosis diagnose_dataset(const DiagnosisModel& model, const DatasetDiag
   check_stop();
   try {
     score_raw_torque(model, train, heldout_logs, so, held, d);
-    say(fmt::format("held-out rms residual against the raw torque: {:.4f} -> {:.4f} N m", d.raw_total_before, d.raw_total_after));
+    say(fmt::format("held-out rms residual against the raw torque: {:.4f} -> {:.4f} N m", d.raw_total_before,
+                    d.raw_total_after));
   } catch (const std::exception& e) {
     d.raw_note = e.what();
   }
@@ -224,7 +243,8 @@ DatasetDiagnosis diagnose_dataset(const DiagnosisModel& model, const DatasetDiag
   d.cutoff = options.cutoff;
   d.held_parameters = options.params.string();
   say_findings(d, say);
-  say(fmt::format("held-out rms residual: {:.4f} -> {:.4f} N m", d.selection.before.heldout_total, d.selection.after.heldout_total));
+  say(fmt::format("held-out rms residual: {:.4f} -> {:.4f} N m", d.selection.before.heldout_total,
+                  d.selection.after.heldout_total));
   check_stop();  // the last chance: from here the report is written whole
   result.files = write_diagnosis_report(d, options.out);
   result.report = options.out / "diagnosis.md";
@@ -233,7 +253,8 @@ DatasetDiagnosis diagnose_dataset(const DiagnosisModel& model, const DatasetDiag
   result.variant_yaml = variant_yaml(d, result.variant_name, base.empty() ? "full" : base);
   if (!result.variant_yaml.empty()) {
     result.variant_file = options.out / "variant.yaml";
-    io::write_file_atomically(result.variant_file, "# Add under `variants:` of robots/" + robot + "/robot.yaml\n" + result.variant_yaml);
+    io::write_file_atomically(result.variant_file,
+                              "# Add under `variants:` of robots/" + robot + "/robot.yaml\n" + result.variant_yaml);
     say(fmt::format("variant: {}", result.variant_file.string()));
   }
   say(fmt::format("report: {} ({} files)", result.report.string(), result.files.size()));
@@ -255,7 +276,8 @@ void add_variant_to_robot_yaml(const std::filesystem::path& yaml, const std::str
   for (auto p = s.find('\n', found); p != std::string::npos && p + 1 < s.size(); p = s.find('\n', p + 1))
     if (s[p + 1] != ' ' && s[p + 1] != '#' && s[p + 1] != '\n')
       throw DiagnosisRequestError(yaml.string() + ": `variants:` must be the last section to add to it");
-  if (s.find("\n  " + name + ":") != std::string::npos) throw DiagnosisRequestError(yaml.string() + ": variant '" + name + "' exists");
+  if (s.find("\n  " + name + ":") != std::string::npos)
+    throw DiagnosisRequestError(yaml.string() + ": variant '" + name + "' exists");
   io::write_file_atomically(yaml, s + variant);
 }
 

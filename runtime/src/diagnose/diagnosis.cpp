@@ -28,7 +28,8 @@ std::vector<ResidualSeries> residual_series(const DesignStack& d, const Eigen::V
     r.qdd = d.qdd.middleRows(a, b - a);
     r.tau_measured = d.tau.middleRows(a, b - a);
     r.tau_model.resize(b - a, n);
-    for (int s = a; s < b; ++s) r.tau_model.row(s - a) = tau_model.segment(static_cast<Eigen::Index>(s) * n, n).transpose();
+    for (int s = a; s < b; ++s)
+      r.tau_model.row(s - a) = tau_model.segment(static_cast<Eigen::Index>(s) * n, n).transpose();
     out.push_back(std::move(r));
     a = b;
   }
@@ -78,8 +79,10 @@ std::string flags(const CandidateTest& t) {
   if (t.absorbed) return "absorbed";
   std::string s;
   s += t.significant ? "significant" : "not significant";
-  if (!t.physical) s += ", non-physical";
-  else if (t.heldout_gain < 0) s += ", worse held out";
+  if (!t.physical)
+    s += ", non-physical";
+  else if (t.heldout_gain < 0)
+    s += ", worse held out";
   return s;
 }
 
@@ -110,20 +113,20 @@ std::string effects_markdown(const Diagnosis& d) {
     m += "\nStopped: " + s.stop_reason + ".\n\n";
     for (const auto& e : s.effects)
       if (e.candidate.kind == EffectKind::ActuationDelay && !e.magnitude.values.empty())
-        m += fmt::format("The actuation delay is not a model term: identify with the logged torque read {0:.2f} ms later "
-                         "(`dynid identify --torque-delay {0:.2f}`, preprocess::Options::torque_delay) and add it to the "
-                         "controller description's communication_delay for the closed loop{1}.\n\n",
-                         e.magnitude.values[0] * 1e3,
-                         d.options.modeled_delay >= 0
-                             ? fmt::format(" (which models {:.2f} ms; the delay named is beyond it)", d.options.modeled_delay * 1e3)
-                             : std::string());
+        m += fmt::format(
+            "The actuation delay is not a model term: identify with the logged torque read {0:.2f} ms later "
+            "(`dynid identify --torque-delay {0:.2f}`, preprocess::Options::torque_delay) and add it to the "
+            "controller description's communication_delay for the closed loop{1}.\n\n",
+            e.magnitude.values[0] * 1e3,
+            d.options.modeled_delay >= 0
+                ? fmt::format(" (which models {:.2f} ms; the delay named is beyond it)", d.options.modeled_delay * 1e3)
+                : std::string());
   }
   if (!s.dropped.empty()) {
     m += "Named by a forward step, then dropped by the backward check (each named effect refitted with all the others "
          "must have a 95 % region that excludes half its size, agree with its physics, and still lower its joints' "
          "held-out residual):\n\n";
-    for (const auto& e : s.dropped)
-      m += fmt::format("- {}: {}; {}.\n", e.candidate.label(), e.magnitude, e.reason);
+    for (const auto& e : s.dropped) m += fmt::format("- {}: {}; {}.\n", e.candidate.label(), e.magnitude, e.reason);
     m += "\n";
   }
   return m;
@@ -137,22 +140,27 @@ std::string backlash_markdown(const Diagnosis& d) {
     m += "## Backlash: the closed loop's high band\n\n";
     m += fmt::format(
         "The fitting run's torque above 40 Hz against a null: the robot's digital twin running the same references in "
-        "closed loop with the effects above (mean and spread over noise seeds), with the log's own floor, which the twin "
+        "closed loop with the effects above (mean and spread over noise seeds), with the log's own floor, which the "
+        "twin "
         "does not model: the encoders' noise estimated from the log ({:.2f} counts) in the loop, and the torque the "
-        "controller's law does not explain (the logged torque less the description's FF+PD command of {} row(s) before, "
-        "from the logged position and velocity) added. A joint whose excess over the null exceeds 6 spreads and 50 % gets "
+        "controller's law does not explain (the logged torque less the description's FF+PD command of {} row(s) "
+        "before, "
+        "from the logged position and velocity) added. A joint whose excess over the null exceeds 6 spreads and 50 % "
+        "gets "
         "the play whose simulation reproduces it, then the others are judged again.",
         b.floor.encoder_noise, b.floor.lag);
     if (b.delay > 0) m += fmt::format(" The selected delay, refined on the high band: {:.2f} ms.", b.delay * 1e3);
-    m += "\n\n| joint | measured (N m) | null (N m) | of which the log's floor (N m) | spread (N m) | play |\n|---|---|---|---|---|---|\n";
+    m += "\n\n| joint | measured (N m) | null (N m) | of which the log's floor (N m) | spread (N m) | play "
+         "|\n|---|---|---|---|---|---|\n";
     for (Eigen::Index j = 0; j < b.measured.size(); ++j) {
       std::string play;
       for (const auto& f : b.findings)
         if (f.joint == j + 1) play = fmt::format("{:.3f} deg", f.width * 180 / 3.14159265358979323846);
-      m += fmt::format("| {} | {:.4f} | {:.4f} | {:.4f} | {:.4f} | {} |\n",
-                       j < static_cast<Eigen::Index>(d.before.joints.size()) ? d.before.joints[j].name : std::to_string(j + 1),
-                       b.measured(j), b.simulated(j), j < b.floor.rms.size() ? b.floor.rms(j) : 0.0, b.spread(j),
-                       play.empty() ? "—" : play);
+      m += fmt::format(
+          "| {} | {:.4f} | {:.4f} | {:.4f} | {:.4f} | {} |\n",
+          j < static_cast<Eigen::Index>(d.before.joints.size()) ? d.before.joints[j].name : std::to_string(j + 1),
+          b.measured(j), b.simulated(j), j < b.floor.rms.size() ? b.floor.rms(j) : 0.0, b.spread(j),
+          play.empty() ? "—" : play);
     }
     m += b.findings.empty() ? "\nNo backlash found.\n\n" : "\n";
     for (const auto& note : b.notes) m += "- " + note + "\n";
@@ -170,7 +178,8 @@ std::string gap_markdown(const Diagnosis& d) {
   m += "| joint | rms before (N m) | rms after (N m) | change |\n|---|---|---|---|\n";
   for (Eigen::Index j = 0; j < s.before.heldout_rmse.size(); ++j) {
     const double b = s.before.heldout_rmse(j), a = s.after.heldout_rmse(j);
-    m += fmt::format("| {} {} | {:.4f} | {:.4f} | {:+.1f} % |\n", j + 1, d.before.joints.size() > static_cast<std::size_t>(j) ? d.before.joints[j].name : "", b, a,
+    m += fmt::format("| {} {} | {:.4f} | {:.4f} | {:+.1f} % |\n", j + 1,
+                     d.before.joints.size() > static_cast<std::size_t>(j) ? d.before.joints[j].name : "", b, a,
                      b > 0 ? 100 * (a / b - 1) : 0.0);
   }
   m += fmt::format("| all | {:.4f} | {:.4f} | {:+.1f} % |\n\n", s.before.heldout_total, s.after.heldout_total,
@@ -195,27 +204,32 @@ std::string stepwise_markdown(const Diagnosis& d) {
   const Selection& s = d.selection;
   std::string m;
   m += "## Stepwise selection\n\n";
-  m += fmt::format("Weights per joint (1/N m): {}. Each step refits the model with each candidate; F is a score test with the "
-                   "residual's autocorrelation (effective sample size per candidate), the level ({:g} per step) is Bonferroni-corrected, "
-                   "and a candidate must also lower the held-out residual of its joints by at least {:.0f} % and matter (at least {:g} N m "
-                   "of torque; a delay at least {:g} log periods); the one removing most of the whole held-out residual is taken, or one "
-                   "with fewer parameters that removes within {:.0f} % as much.\n\n",
-                   [&] {
-                     std::string w;
-                     for (Eigen::Index j = 0; j < s.weights.size(); ++j) w += fmt::format("{}{:.3g}", j ? ", " : "", s.weights(j));
-                     return w;
-                   }(),
-                   d.options.alpha, 100 * d.options.min_heldout_gain, d.options.min_effect_torque, d.options.min_delay_periods,
-                   100 * d.options.parsimony);
+  m += fmt::format(
+      "Weights per joint (1/N m): {}. Each step refits the model with each candidate; F is a score test with the "
+      "residual's autocorrelation (effective sample size per candidate), the level ({:g} per step) is "
+      "Bonferroni-corrected, "
+      "and a candidate must also lower the held-out residual of its joints by at least {:.0f} % and matter (at least "
+      "{:g} N m "
+      "of torque; a delay at least {:g} log periods); the one removing most of the whole held-out residual is taken, "
+      "or one "
+      "with fewer parameters that removes within {:.0f} % as much.\n\n",
+      [&] {
+        std::string w;
+        for (Eigen::Index j = 0; j < s.weights.size(); ++j) w += fmt::format("{}{:.3g}", j ? ", " : "", s.weights(j));
+        return w;
+      }(),
+      d.options.alpha, 100 * d.options.min_heldout_gain, d.options.min_effect_torque, d.options.min_delay_periods,
+      100 * d.options.parsimony);
   for (std::size_t i = 0; i < s.steps.size(); ++i) {
     const auto& st = s.steps[i];
-    m += fmt::format("Step {}: autocorrelation time {:.1f} samples, level {:.1e}; {}.\n\n", i + 1, st.autocorrelation_time,
-                     st.level, st.chosen.empty() ? "nothing taken" : "took `" + st.chosen + "`");
+    m += fmt::format("Step {}: autocorrelation time {:.1f} samples, level {:.1e}; {}.\n\n", i + 1,
+                     st.autocorrelation_time, st.level,
+                     st.chosen.empty() ? "nothing taken" : "took `" + st.chosen + "`");
     m += "| candidate | F | p | held-out gain | effect rms (N m) | verdict |\n|---|---|---|---|---|---|\n";
     for (std::size_t k = 0; k < std::min<std::size_t>(6, st.tests.size()); ++k) {
       const auto& t = st.tests[k];
-      m += fmt::format("| {} | {:.1f} | {:.1e} | {:.2f} % | {:.4f} | {} |\n", t.label, t.f, t.p_value, 100 * t.heldout_gain,
-                       t.effect_rms, flags(t));
+      m += fmt::format("| {} | {:.1f} | {:.1e} | {:.2f} % | {:.4f} | {} |\n", t.label, t.f, t.p_value,
+                       100 * t.heldout_gain, t.effect_rms, flags(t));
     }
     // Candidates the model's own columns already span (e.g. a spring k sin q on a joint whose
     // axis makes it a gravity term): said, not dropped, since the model may hold them already.
@@ -224,7 +238,8 @@ std::string stepwise_markdown(const Diagnosis& d) {
       if (t.absorbed) absorbed += (absorbed.empty() ? "" : ", ") + t.label;
     if (!absorbed.empty())
       m += "\nAbsorbed (its columns lie in the span of the model's own, or are not excited by these data; the model "
-           "can already represent it, and it cannot be judged apart): " + absorbed + ".\n";
+           "can already represent it, and it cannot be judged apart): " +
+           absorbed + ".\n";
     m += "\n";
   }
   return m;
@@ -237,9 +252,10 @@ std::vector<std::filesystem::path> write_diagnosis_report(const Diagnosis& d, co
   std::vector<std::filesystem::path> written;
   const Selection& s = d.selection;
   std::string m = "# Model-gap diagnosis\n\n";
-  m += fmt::format("Robot `{}`, model `{}`. Fitted on {}; judged on the held-out {}. Grid {:g} ms, every column and "
-                   "the torque through the same {:g} Hz zero-phase low-pass (parallel filtering).\n\n",
-                   d.robot, d.model, joined(d.train), joined(d.heldout), d.interval * 1000, d.cutoff);
+  m += fmt::format(
+      "Robot `{}`, model `{}`. Fitted on {}; judged on the held-out {}. Grid {:g} ms, every column and "
+      "the torque through the same {:g} Hz zero-phase low-pass (parallel filtering).\n\n",
+      d.robot, d.model, joined(d.train), joined(d.heldout), d.interval * 1000, d.cutoff);
   if (!d.held_parameters.empty())
     m += "The identified parameters are held at `" + d.held_parameters +
          "` (an earlier identification): only the effects are fitted, so what changed since (a payload) shows.\n\n";
@@ -285,12 +301,18 @@ std::string variant_yaml(const Diagnosis& d, const std::string& name, const std:
       // Coulomb friction smoothed as the diagnosis found the logs' velocity spread: the files'
       // sign(qd) column is biased towards 0 by it at slow motion. The variant's tanh(qd / width)
       // has the slope at rest of the diagnosis's erf (width = spread sqrt(pi / 2)).
-      case EffectKind::Coulomb: scaled[variant_of(c)][c.joint] = variant_velocity(c); break;
+      case EffectKind::Coulomb:
+        scaled[variant_of(c)][c.joint] = variant_velocity(c);
+        break;
       case EffectKind::Offset:
       case EffectKind::ViscousAsymmetry:
-      case EffectKind::InertiaProducts: joints[variant_of(c)].push_back(c.joint); break;
+      case EffectKind::InertiaProducts:
+        joints[variant_of(c)].push_back(c.joint);
+        break;
       // The law itself, sign(qd) exp(-(qd / vs)^2): its level is the law's (effects.hpp).
-      case EffectKind::Stribeck: scaled[variant_of(c)][c.joint] = variant_velocity(c); break;
+      case EffectKind::Stribeck:
+        scaled[variant_of(c)][c.joint] = variant_velocity(c);
+        break;
       case EffectKind::PositionHarmonics: {
         std::string orders;
         for (int k : c.orders) orders += (orders.empty() ? "" : ", ") + std::to_string(k);
@@ -303,16 +325,18 @@ std::string variant_yaml(const Diagnosis& d, const std::string& name, const std:
                  fmt::format("{:.2f}", e.magnitude.values.empty() ? 0.0 : e.magnitude.values[0] * 1e3) + ")\n";
         break;
       case EffectKind::TorqueConstant:
-        notes += fmt::format("    # torque-constant error on joint {} ({}): calibrate the servo's torque constant\n", c.joint,
-                             e.magnitude.text);
+        notes += fmt::format("    # torque-constant error on joint {} ({}): calibrate the servo's torque constant\n",
+                             c.joint, e.magnitude.text);
         break;
       case EffectKind::Backlash:
-        notes += fmt::format("    # backlash on joint {} ({}): not a rigid-body term; leave out samples at mesh-torque reversals\n",
-                             c.joint, e.magnitude.text);
+        notes += fmt::format(
+            "    # backlash on joint {} ({}): not a rigid-body term; leave out samples at mesh-torque reversals\n",
+            c.joint, e.magnitude.text);
         break;
       case EffectKind::Payload:
-        notes += fmt::format("    # payload on link {} ({}): not a new term; identify again with it mounted (dynid identify)\n",
-                             c.joint, e.magnitude.text);
+        notes += fmt::format(
+            "    # payload on link {} ({}): not a new term; identify again with it mounted (dynid identify)\n", c.joint,
+            e.magnitude.text);
         break;
     }
   }
@@ -333,8 +357,8 @@ std::string variant_yaml(const Diagnosis& d, const std::string& name, const std:
       values += fmt::format("{}{:g}", values.empty() ? "" : ", ", v);
       same = same && v == widths.begin()->second;
     }
-    effects += "      " + key + ": {joints: [" + list(js) + "], velocity: " +
-               (same ? fmt::format("{:g}", widths.begin()->second) : "[" + values + "]") + "}\n";
+    effects += "      " + key + ": {joints: [" + list(js) +
+               "], velocity: " + (same ? fmt::format("{:g}", widths.begin()->second) : "[" + values + "]") + "}\n";
   }
   for (auto& [key, groups] : shaped) {
     // A variant holds one entry per effect: the group with the most joints; the others noted.
@@ -349,9 +373,10 @@ std::string variant_yaml(const Diagnosis& d, const std::string& name, const std:
   }
   if (d.backlash_judged)
     for (const auto& f : d.backlash.findings)
-      notes += fmt::format("    # backlash on joint {} ({:.3f} deg of play, from the closed loop's high band): not a rigid-body "
-                           "term; expect chatter where its mesh torque reverses\n",
-                           f.joint, f.width * 180 / 3.14159265358979323846);
+      notes += fmt::format(
+          "    # backlash on joint {} ({:.3f} deg of play, from the closed loop's high band): not a rigid-body "
+          "term; expect chatter where its mesh torque reverses\n",
+          f.joint, f.width * 180 / 3.14159265358979323846);
   if (effects.empty() && notes.empty()) return {};
   std::string y = "  " + name + ":\n";
   y += "    description: " + base + " with the effects dynid diagnose found\n";

@@ -15,7 +15,7 @@ constexpr double kDeg = 180.0 / 3.14159265358979323846;
 
 std::string joint_text(const DesignStack& d, int j) {
   return j >= 1 && j <= static_cast<int>(d.joint_names.size()) ? fmt::format("joint {} ({})", j, d.joint_names[j - 1])
-                                                                : fmt::format("joint {}", j);
+                                                               : fmt::format("joint {}", j);
 }
 
 bool has_parameter(const DesignStack& d, const std::string& name) {
@@ -30,11 +30,12 @@ namespace {
 
 // The diagnosis's effects in EffectKind's order, each a row of the effect table by its name.
 constexpr std::array<std::string_view, 10> kDiagnosisOrder{
-    "coulomb",         "stribeck",        "offset",   "viscous_asymmetry", "position_harmonics",
-    "inertia_products", "torque_constant", "actuation_delay", "backlash",   "payload"};
+    "coulomb",          "stribeck",        "offset",          "viscous_asymmetry", "position_harmonics",
+    "inertia_products", "torque_constant", "actuation_delay", "backlash",          "payload"};
 static_assert(kDiagnosisOrder.size() == static_cast<std::size_t>(EffectKind::Payload) + 1);
 
-static_assert(every_name_has_a_row(&EffectRow::diagnosis, kDiagnosisOrder), "a diagnosis effect without its row in symoro/effect_table.hpp");
+static_assert(every_name_has_a_row(&EffectRow::diagnosis, kDiagnosisOrder),
+              "a diagnosis effect without its row in symoro/effect_table.hpp");
 
 }  // namespace
 
@@ -75,7 +76,8 @@ std::string Candidate::key() const {
 std::string Candidate::label() const {
   const EffectInfo& e = effect_info(kind);
   std::string s = e.title;
-  if (kind == EffectKind::Stribeck) s += fmt::format(" (vs = {:g} rad/s, velocity spread {:g} rad/s)", stribeck_velocity, coulomb_velocity);
+  if (kind == EffectKind::Stribeck)
+    s += fmt::format(" (vs = {:g} rad/s, velocity spread {:g} rad/s)", stribeck_velocity, coulomb_velocity);
   if (kind == EffectKind::Coulomb) s += fmt::format(" (velocity spread {:g} rad/s)", coulomb_velocity);
   if (kind == EffectKind::InertiaProducts || kind == EffectKind::Payload) return s + fmt::format(", link {}", joint);
   if (joint == 0) return s;
@@ -266,7 +268,8 @@ void effect_terms(const Candidate& c, double q, double qd, double* out) {
     case EffectKind::Stribeck: {
       // The product of the two Gaussians (the law's exp(-a v^2), the spread's) is one Gaussian
       // in v, centred at b qd / (a + b), over which the sign's mean is an erf.
-      const double a = 1 / (c.stribeck_velocity * c.stribeck_velocity), b = 1 / (2 * c.coulomb_velocity * c.coulomb_velocity);
+      const double a = 1 / (c.stribeck_velocity * c.stribeck_velocity),
+                   b = 1 / (2 * c.coulomb_velocity * c.coulomb_velocity);
       out[0] = std::sqrt(b / (a + b)) * std::exp(-a * b / (a + b) * qd * qd) * std::erf(b * qd / std::sqrt(a + b));
       break;
     }
@@ -296,7 +299,9 @@ double variant_velocity(const Candidate& c) {
 // The effect table's check: a level, a play, a mass or a delay must be positive. (A torque cannot
 // answer its command before it is sent: a negative delay is another misfit's shape, seen against
 // a study's accepted parameters: -3.39 ms, not a delay.)
-bool physical(const Candidate& c, const Eigen::VectorXd& theta) { return !effect_info(c.kind).row->positive || theta(0) > 0; }
+bool physical(const Candidate& c, const Eigen::VectorXd& theta) {
+  return !effect_info(c.kind).row->positive || theta(0) > 0;
+}
 
 Magnitude magnitude(const Candidate& c, const Eigen::VectorXd& theta, const Eigen::VectorXd& sd) {
   Magnitude m;

@@ -52,8 +52,8 @@ std::string pct(double before, double after) {
   return fmt::format("{:+.1f} %", 100 * (after - before) / before);
 }
 
-svg::Series line(const Eigen::VectorXd& t, const Eigen::MatrixXd& m, int j, const std::string& name,
-                 const char* colour, double width, const char* dash) {
+svg::Series line(const Eigen::VectorXd& t, const Eigen::MatrixXd& m, int j, const std::string& name, const char* colour,
+                 double width, const char* dash) {
   svg::Series s;
   s.name = name;
   s.style.colour = colour;
@@ -101,9 +101,10 @@ std::string torque_figure(const ValidationRecord& before, const ValidationRecord
     p.x_label = "t [s]";
     p.y_label = "τ [N m]";
     p.lines.push_back(line(before.time, before.tau_measured, j, "measured", "#000000", 1.6, ""));
-    p.lines.push_back(line(before.time, before.tau_rescue, j, options.before_label + " (" + c.before_model + ")", "#999999",
-                           1.2, "6 3"));
-    p.lines.push_back(line(after.time, after.tau_rescue, j, options.after_label + " (" + c.after_model + ")", "#d62728", 1.1, ""));
+    p.lines.push_back(line(before.time, before.tau_rescue, j, options.before_label + " (" + c.before_model + ")",
+                           "#999999", 1.2, "6 3"));
+    p.lines.push_back(
+        line(after.time, after.tau_rescue, j, options.after_label + " (" + c.after_model + ")", "#d62728", 1.1, ""));
     f.panels.push_back(p);
     svg::Panel r;
     r.title = fmt::format("J{}: error (measured − simulated)", j + 1);
@@ -169,7 +170,8 @@ std::string localization_section(const StudyValidation& s, const GapComparison& 
 
 GapComparison compare_studies(const StudyValidation& before, const StudyValidation& after) {
   if (before.robot != after.robot)
-    throw std::invalid_argument(fmt::format("the studies are of different robots ('{}' and '{}')", before.robot, after.robot));
+    throw std::invalid_argument(
+        fmt::format("the studies are of different robots ('{}' and '{}')", before.robot, after.robot));
   GapComparison c;
   c.robot = before.robot;
   c.before_model = model_name(before.model);
@@ -191,9 +193,9 @@ GapComparison compare_studies(const StudyValidation& before, const StudyValidati
     if (b.tau_measured.rows() > 0 && (b.tau_measured - a->tau_measured).cwiseAbs().maxCoeff() > 1e-9)
       throw std::invalid_argument(b.trajectory + ": the measured torques differ: the studies used other data");
     if (a->kind != b.kind)
-      throw std::invalid_argument(fmt::format("{} was validated {} before and {} after: the errors are not comparable ({}{})",
-                                              b.trajectory, b.kind, a->kind, b.note.empty() ? a->note : b.note,
-                                              b.note.empty() || a->note.empty() ? "" : "; " + a->note));
+      throw std::invalid_argument(fmt::format(
+          "{} was validated {} before and {} after: the errors are not comparable ({}{})", b.trajectory, b.kind,
+          a->kind, b.note.empty() ? a->note : b.note, b.note.empty() || a->note.empty() ? "" : "; " + a->note));
     GapTrajectory t;
     t.trajectory = b.trajectory;
     t.kind = b.kind;
@@ -216,8 +218,7 @@ GapComparison compare_studies(const StudyValidation& before, const StudyValidati
   }
   for (const auto& a : after.records)
     if (!find(before, a.trajectory)) c.only_after.push_back(a.trajectory);
-  if (c.trajectories.empty())
-    throw std::invalid_argument("the studies have no validation trajectory in common");
+  if (c.trajectories.empty()) throw std::invalid_argument("the studies have no validation trajectory in common");
   c.joint_before = (ss_before / static_cast<double>(std::max(1L, total))).cwiseSqrt();
   c.joint_after = (ss_after / static_cast<double>(std::max(1L, total))).cwiseSqrt();
   c.rmse_before = pooled(c.joint_before);
@@ -233,7 +234,8 @@ GapReportOptions gap_report_options(const std::filesystem::path& before_dir, con
   GapReportOptions ro;
   ro.before_label = before_dir.filename().string();
   ro.after_label = after_dir.filename().string();
-  if (ro.before_label.empty() || ro.before_label == ro.after_label) ro.before_label = "before", ro.after_label = "after";
+  if (ro.before_label.empty() || ro.before_label == ro.after_label)
+    ro.before_label = "before", ro.after_label = "after";
   ro.figure_trajectory = trajectory;
   for (int j : joints) {
     if (j < 1 || j > comparison.joint_before.size())
@@ -248,11 +250,13 @@ std::vector<std::filesystem::path> write_gap_report(const StudyValidation& befor
                                                     const GapReportOptions& options) {
   std::vector<std::filesystem::path> files;
   std::filesystem::create_directories(dir / "figures");
-  const std::string bl = options.before_label + " (" + c.before_model + ")", al = options.after_label + " (" + c.after_model + ")";
+  const std::string bl = options.before_label + " (" + c.before_model + ")",
+                    al = options.after_label + " (" + c.after_model + ")";
 
   std::string md = fmt::format("# Model gap on held-out trajectories: {} → {}\n\n", c.before_model, c.after_model);
   md += fmt::format(
-      "Robot {}. Each model was identified by its own study (OLS, PD audit, conditional SDP, CLIE where the robot has a "
+      "Robot {}. Each model was identified by its own study (OLS, PD audit, conditional SDP, CLIE where the robot has "
+      "a "
       "controller description, rescue) and its accepted parameters give each held-out trajectory's torque: closed loop "
       "(the model under the experiment's FF+PD controller) or open loop (the model's inverse dynamics on the measured "
       "motion), as the table below says; the error is measured minus model torque.\n\n",
@@ -262,12 +266,15 @@ std::vector<std::filesystem::path> write_gap_report(const StudyValidation& befor
     md += fmt::format("| {} | {} | {} | {} | {}{} |\n", s == &before ? options.before_label : options.after_label,
                       model_name(s->model), s->names.size(), s->selected_run, s->accepted ? "PD" : "NOT PD",
                       s->rescued ? " (rescued)" : "");
-  md += fmt::format("\n**Held-out rms torque error: {:.4f} → {:.4f} N m ({})** over {}.\n\n", c.rmse_before, c.rmse_after,
-                    pct(c.rmse_before, c.rmse_after), fmt::join([&] {
-                      std::vector<std::string> v;
-                      for (const auto& t : c.trajectories) v.push_back(t.trajectory);
-                      return v;
-                    }(), ", "));
+  md += fmt::format("\n**Held-out rms torque error: {:.4f} → {:.4f} N m ({})** over {}.\n\n", c.rmse_before,
+                    c.rmse_after, pct(c.rmse_before, c.rmse_after),
+                    fmt::join(
+                        [&] {
+                          std::vector<std::string> v;
+                          for (const auto& t : c.trajectories) v.push_back(t.trajectory);
+                          return v;
+                        }(),
+                        ", "));
   {
     // Against the raw measured torque, open loop, where both studies scored it.
     std::string rows;
@@ -284,17 +291,20 @@ std::vector<std::filesystem::path> write_gap_report(const StudyValidation& befor
   }
   if (!c.only_before.empty() || !c.only_after.empty())
     md += fmt::format("Left out (validated by one study only): {}.\n\n",
-                      fmt::join([&] {
-                        std::vector<std::string> v = c.only_before;
-                        v.insert(v.end(), c.only_after.begin(), c.only_after.end());
-                        return v;
-                      }(), ", "));
+                      fmt::join(
+                          [&] {
+                            std::vector<std::string> v = c.only_before;
+                            v.insert(v.end(), c.only_after.begin(), c.only_after.end());
+                            return v;
+                          }(),
+                          ", "));
 
-  md += "## Per trajectory\n\n| trajectory | kind | interval | samples | rms before [N m] | rms after [N m] | change |\n"
-        "|---|---|---|---|---|---|---|\n";
+  md +=
+      "## Per trajectory\n\n| trajectory | kind | interval | samples | rms before [N m] | rms after [N m] | change |\n"
+      "|---|---|---|---|---|---|---|\n";
   for (const auto& t : c.trajectories)
-    md += fmt::format("| {} | {} | {:g} ms | {} | {:.4f} | {:.4f} | {} |\n", t.trajectory, t.kind, t.interval * 1e3, t.samples,
-                      t.rmse_before, t.rmse_after, pct(t.rmse_before, t.rmse_after));
+    md += fmt::format("| {} | {} | {:g} ms | {} | {:.4f} | {:.4f} | {} |\n", t.trajectory, t.kind, t.interval * 1e3,
+                      t.samples, t.rmse_before, t.rmse_after, pct(t.rmse_before, t.rmse_after));
 
   md += "\n## Per joint\n\n| joint | rms before [N m] | rms after [N m] | change |\n|---|---|---|---|\n";
   for (Eigen::Index j = 0; j < c.joint_before.size(); ++j)
@@ -306,8 +316,9 @@ std::vector<std::filesystem::path> write_gap_report(const StudyValidation& befor
   md += fmt::format("\n![rms error per joint, before and after]({})\n\n", bars);
 
   if (!c.added.empty()) {
-    md += "## Added parameters\n\n| parameter | unit | identified |" + std::string(after.truth.size() ? " twin truth |" : "") +
-          "\n|---|---|---|" + (after.truth.size() ? "---|" : "") + "\n";
+    md += "## Added parameters\n\n| parameter | unit | identified |" +
+          std::string(after.truth.size() ? " twin truth |" : "") + "\n|---|---|---|" +
+          (after.truth.size() ? "---|" : "") + "\n";
     for (const auto& name : c.added) {
       const auto k = std::find(after.names.begin(), after.names.end(), name) - after.names.begin();
       md += fmt::format("| {} | {} | {:.5g} |", name, k < static_cast<long>(after.units.size()) ? after.units[k] : "",
@@ -323,8 +334,7 @@ std::vector<std::filesystem::path> write_gap_report(const StudyValidation& befor
   std::string traj = options.figure_trajectory.empty() ? c.trajectories.back().trajectory : options.figure_trajectory;
   const ValidationRecord* vb = find(before, traj);
   const ValidationRecord* va = find(after, traj);
-  if (!vb || !va)
-    throw std::invalid_argument("figure trajectory " + traj + " is not validated by both studies");
+  if (!vb || !va) throw std::invalid_argument("figure trajectory " + traj + " is not validated by both studies");
   std::vector<int> joints = options.figure_joints;
   if (joints.empty()) {
     std::vector<int> order(static_cast<std::size_t>(c.joint_before.size()));

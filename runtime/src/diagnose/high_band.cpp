@@ -51,18 +51,22 @@ LoopFloor loop_floor(const io::Log& log, const twin::TwinConfig& c, const Backla
   const std::string name = log.meta.trajectory.empty() ? "log" : log.meta.trajectory;
   if (!log.has_references()) throw DataError(name, 0, "the loop's floor needs the log's reference columns");
   if (static_cast<std::size_t>(n) != c.servos.size())
-    throw DataError(name, 0, "the log has " + std::to_string(n) + " joints, the twin description " + std::to_string(c.servos.size()));
+    throw DataError(
+        name, 0,
+        "the log has " + std::to_string(n) + " joints, the twin description " + std::to_string(c.servos.size()));
   const control::FfpdGains g = c.controller.gains();
   const double T = c.controller.period;
   // The law's torque at every row, as the servo realizes it (quantized current, its limit).
   Eigen::MatrixXd command(rows, n);
   for (Eigen::Index k = 0; k < rows; ++k) {
-    const Eigen::VectorXd u = control::ffpd_command(g, log.q.row(k).transpose(), log.qd.row(k).transpose(), log.q_ref.row(k).transpose(),
-                                                    log.qd_ref.row(k).transpose(), log.qdd_ref.row(k).transpose());
+    const Eigen::VectorXd u =
+        control::ffpd_command(g, log.q.row(k).transpose(), log.qd.row(k).transpose(), log.q_ref.row(k).transpose(),
+                              log.qd_ref.row(k).transpose(), log.qdd_ref.row(k).transpose());
     for (Eigen::Index j = 0; j < n; ++j) {
       const auto& s = c.servos[static_cast<std::size_t>(j)];
       const double limit = std::floor(s.current_limit / s.current_unit) * s.current_unit;
-      command(k, j) = s.torque_constant * std::clamp(std::round(u(j) / s.torque_constant / s.current_unit) * s.current_unit, -limit, limit);
+      command(k, j) = s.torque_constant *
+                      std::clamp(std::round(u(j) / s.torque_constant / s.current_unit) * s.current_unit, -limit, limit);
     }
   }
   // The residual at one lag (rows without a command that lag before: 0).
@@ -80,7 +84,8 @@ LoopFloor loop_floor(const io::Log& log, const twin::TwinConfig& c, const Backla
   }
   io::Log residual = log;
   residual.tau = residual_at(f.lag);
-  f.law_rms = (residual.tau.colwise().squaredNorm() / std::max<double>(1.0, static_cast<double>(rows))).cwiseSqrt().transpose();
+  f.law_rms =
+      (residual.tau.colwise().squaredNorm() / std::max<double>(1.0, static_cast<double>(rows))).cwiseSqrt().transpose();
   f.rms = high_band_rms(residual, options);
   // Encoder noise: the position's second difference in counts on 50 ms blocks, its median over
   // blocks (a play's chatter or a fast move raises a few), against the same of the logged

@@ -20,7 +20,9 @@ StackModel stack_model(const ModelHandle& m, const ModelHandle& full) {
   s.full_parameters = full.parameters();
   s.standard = m.standard_parameters();
   s.regressor = [m](const double* q, const double* qd, const double* qdd, double* w) { m.regressor(q, qd, qdd, w); };
-  s.fixed_torque = [m](const double* q, const double* qd, const double* qdd, double* t) { m.fixed_torque(q, qd, qdd, t); };
+  s.fixed_torque = [m](const double* q, const double* qd, const double* qdd, double* t) {
+    m.fixed_torque(q, qd, qdd, t);
+  };
   s.full_regressor = [full](const double* q, const double* qd, const double* qdd, double* w) {
     full.regressor(q, qd, qdd, w);
   };

@@ -189,7 +189,8 @@ Pooled pool(const std::vector<const ResidualSeries*>& series, Index j, Index tot
 
 void check_options(const LocalizeOptions& options) {
   auto bad = [](const std::string& what) { throw std::invalid_argument("localize: " + what); };
-  if (!(options.reversal_window >= 0) || !std::isfinite(options.reversal_window)) bad("reversal_window must be finite and >= 0");
+  if (!(options.reversal_window >= 0) || !std::isfinite(options.reversal_window))
+    bad("reversal_window must be finite and >= 0");
   if (!(options.direction_velocity >= 0) || !std::isfinite(options.direction_velocity))
     bad("direction_velocity must be finite and >= 0");
   if (!(options.high_acceleration_quantile > 0 && options.high_acceleration_quantile < 1))
@@ -197,9 +198,11 @@ void check_options(const LocalizeOptions& options) {
   if (options.position_bands < 1) bad("position_bands must be >= 1");
   if (options.band_edges.empty()) bad("band_edges must not be empty");
   for (std::size_t i = 0; i < options.band_edges.size(); ++i)
-    if (!std::isfinite(options.band_edges[i]) || options.band_edges[i] < 0 || (i > 0 && options.band_edges[i] <= options.band_edges[i - 1]))
+    if (!std::isfinite(options.band_edges[i]) || options.band_edges[i] < 0 ||
+        (i > 0 && options.band_edges[i] <= options.band_edges[i - 1]))
       bad("band_edges must be finite, >= 0 and strictly ascending");
-  if (!(options.segment_seconds > 0) || !std::isfinite(options.segment_seconds)) bad("segment_seconds must be finite and > 0");
+  if (!(options.segment_seconds > 0) || !std::isfinite(options.segment_seconds))
+    bad("segment_seconds must be finite and > 0");
   if (!(options.max_lag >= 0) || !std::isfinite(options.max_lag)) bad("max_lag must be finite and >= 0");
 }
 
@@ -321,7 +324,8 @@ Psd welch(const std::vector<Eigen::MatrixXd>& pieces, double interval, int segme
   out.segment_length = segment_length;
   out.frequency = Eigen::VectorXd::LinSpaced(F, 0, static_cast<double>(F - 1)) / (static_cast<double>(L) * interval);
   Eigen::VectorXd window(L);
-  for (Index i = 0; i < L; ++i) window(i) = 0.5 - 0.5 * std::cos(2 * pi * static_cast<double>(i) / static_cast<double>(L));
+  for (Index i = 0; i < L; ++i)
+    window(i) = 0.5 - 0.5 * std::cos(2 * pi * static_cast<double>(i) / static_cast<double>(L));
   const double s2 = window.squaredNorm();
 
   Eigen::MatrixXd power = Eigen::MatrixXd::Zero(F, columns);
@@ -427,8 +431,7 @@ double torque_lag(const std::vector<Eigen::VectorXd>& measured, const std::vecto
 }
 
 CrossCorrelationPeak cross_correlation_peak(const std::vector<Eigen::VectorXd>& x,
-                                            const std::vector<Eigen::VectorXd>& y, double interval,
-                                            double max_lag) {
+                                            const std::vector<Eigen::VectorXd>& y, double interval, double max_lag) {
   check_pairs(x, y, "cross_correlation_peak");
   const LagRange range = lag_range(interval, max_lag);
   const Index m = range.margin;
@@ -517,13 +520,13 @@ std::vector<ResidualSeries> residual_series(const std::string& name, const prepr
     throw std::invalid_argument(fmt::format("residual_series '{}': tau_model is {} x {}, the samples' tau {} x {}",
                                             name, tau_model.rows(), tau_model.cols(), n, samples.tau.cols()));
   if (!samples.piece.empty() && static_cast<Index>(samples.piece.size()) != n)
-    throw std::invalid_argument(fmt::format("residual_series '{}': piece has {} entries for {} samples", name,
-                                            samples.piece.size(), n));
+    throw std::invalid_argument(
+        fmt::format("residual_series '{}': piece has {} entries for {} samples", name, samples.piece.size(), n));
   std::vector<ResidualSeries> out;
   Index begin = 0;
   for (Index i = 1; i <= n; ++i) {
     const bool split = i == n || (!samples.piece.empty() && samples.piece[static_cast<std::size_t>(i)] !=
-                                                                 samples.piece[static_cast<std::size_t>(i - 1)]);
+                                                                samples.piece[static_cast<std::size_t>(i - 1)]);
     if (!split) continue;
     const Index len = i - begin;
     ResidualSeries s;
@@ -550,8 +553,7 @@ Localization localize(const std::vector<ResidualSeries>& series, const std::vect
   double interval = 0;
   const auto used = checked_series(series, joints, interval);
   if (!joint_names.empty() && static_cast<Index>(joint_names.size()) != joints)
-    throw std::invalid_argument(
-        fmt::format("localize: {} joint names for {} joints", joint_names.size(), joints));
+    throw std::invalid_argument(fmt::format("localize: {} joint names for {} joints", joint_names.size(), joints));
 
   Localization loc;
   loc.interval = interval;
@@ -580,9 +582,8 @@ Localization localize(const std::vector<ResidualSeries>& series, const std::vect
   }
   const auto& edges = options.band_edges;
   for (std::size_t b = 0; b < edges.size(); ++b)
-    loc.bands.push_back(b + 1 < edges.size()
-                            ? fmt::format("[{}, {}) Hz", edge_text(edges[b]), edge_text(edges[b + 1]))
-                            : fmt::format("[{}, {}] Hz", edge_text(edges[b]), edge_text(nyquist)));
+    loc.bands.push_back(b + 1 < edges.size() ? fmt::format("[{}, {}) Hz", edge_text(edges[b]), edge_text(edges[b + 1]))
+                                             : fmt::format("[{}, {}] Hz", edge_text(edges[b]), edge_text(nyquist)));
 
   const double v0 = options.direction_velocity;
   for (Index j = 0; j < joints; ++j) {
@@ -607,9 +608,8 @@ Localization localize(const std::vector<ResidualSeries>& series, const std::vect
     const double threshold =
         quantile(std::vector<double>(abs_qdd.data(), abs_qdd.data() + total), options.high_acceleration_quantile);
     for (Index i = 0; i < total; ++i) mask[static_cast<std::size_t>(i)] = abs_qdd(i) > threshold;
-    jl.regimes.push_back(
-        regime_stat(fmt::format("high acceleration (|qdd| > {} rad/s^2)", sig3(threshold)), p.r, mask, sse,
-                    jl.residual_rms));
+    jl.regimes.push_back(regime_stat(fmt::format("high acceleration (|qdd| > {} rad/s^2)", sig3(threshold)), p.r, mask,
+                                     sse, jl.residual_rms));
 
     const std::vector<double> q_values(p.q.data(), p.q.data() + total);
     const int bands = options.position_bands;
@@ -618,10 +618,11 @@ Localization localize(const std::vector<ResidualSeries>& series, const std::vect
     for (int b = 0; b < bands; ++b) {
       const bool last = b + 1 == bands;
       const double lo = q_edges[static_cast<std::size_t>(b)], hi = q_edges[static_cast<std::size_t>(b) + 1];
-      for (Index i = 0; i < total; ++i) mask[static_cast<std::size_t>(i)] = p.q(i) >= lo && (p.q(i) < hi || (last && p.q(i) <= hi));
+      for (Index i = 0; i < total; ++i)
+        mask[static_cast<std::size_t>(i)] = p.q(i) >= lo && (p.q(i) < hi || (last && p.q(i) <= hi));
       const char close = last ? ']' : ')';
-      jl.regimes.push_back(regime_stat(fmt::format("q in [{:.3f}, {:.3f}{} rad ([{:.1f}, {:.1f}{} deg)", lo, hi,
-                                                   close, lo * deg_per_rad, hi * deg_per_rad, close),
+      jl.regimes.push_back(regime_stat(fmt::format("q in [{:.3f}, {:.3f}{} rad ([{:.1f}, {:.1f}{} deg)", lo, hi, close,
+                                                   lo * deg_per_rad, hi * deg_per_rad, close),
                                        p.r, mask, sse, jl.residual_rms));
     }
 

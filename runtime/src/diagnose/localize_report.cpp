@@ -146,9 +146,9 @@ std::string velocity_figure(const std::vector<ResidualSeries>& series, const Loc
         mean.style = line_style("#d62728", 1.8);
         for (int b = 0; b < bins; ++b) {
           mean.x.push_back(lo + (b + 0.5) * (hi - lo) / bins);
-          mean.y.push_back(count[static_cast<std::size_t>(b)] >= 5 ? sum[static_cast<std::size_t>(b)] /
-                                                                          count[static_cast<std::size_t>(b)]
-                                                                    : nan);
+          mean.y.push_back(count[static_cast<std::size_t>(b)] >= 5
+                               ? sum[static_cast<std::size_t>(b)] / count[static_cast<std::size_t>(b)]
+                               : nan);
         }
         p.lines.push_back(mean);
       }
@@ -235,13 +235,15 @@ std::string localization_markdown(const Localization& loc, const std::vector<std
       "the window around a sign change of qd, or slow. Direction step: (mean r moving + − mean r moving −) / 2 "
       "± its standard error (autocorrelation counted). Torque lag: the shift that best aligns the measured "
       "torque with the model's (+: the measurement lags); a friction misfit biases it, so it is also given with "
-      "an offset, a Coulomb step and a viscous term of the residual fitted at every shift. corr(r, qd): the peak normalized cross-correlation "
+      "an offset, a Coulomb step and a viscous term of the residual fitted at every shift. corr(r, qd): the peak "
+      "normalized cross-correlation "
       "and its lag (+: r lags qd).\n\n",
       loc.samples, loc.series, fixed(loc.interval * 1000, 1));
 
   markdown::Table main({"joint", "residual rms [N m]", "of torque rms", "SSE at reversals", "samples at reversals",
-              "direction step [N m]", "torque lag [ms]", "lag, friction removed [ms]", "peak [Hz]", "dominant band", "corr(r, qd)",
-              "r lag [ms]"}, markdown::Align::first_left);
+                        "direction step [N m]", "torque lag [ms]", "lag, friction removed [ms]", "peak [Hz]",
+                        "dominant band", "corr(r, qd)", "r lag [ms]"},
+                       markdown::Align::first_left);
   for (const auto& jl : loc.joints) {
     const RegimeStat* rev = jl.regimes.empty() ? nullptr : &jl.regimes.front();
     std::string band = "n/a";
@@ -254,9 +256,10 @@ std::string localization_markdown(const Localization& loc, const std::vector<std
     main.row({jl.name, sig3_text(jl.residual_rms),
               percent_text(jl.torque_rms > 0 ? jl.residual_rms / jl.torque_rms : nan),
               rev ? percent_text(rev->sse_share) : "n/a", rev ? percent_text(rev->fraction) : "n/a",
-              std::isfinite(jl.direction_step) ? sig3_text(jl.direction_step) + " ± " + sig3_text(jl.direction_step_se) : "n/a",
-              fixed(jl.torque_lag * 1000, 2), fixed(jl.torque_lag_adjusted * 1000, 2), sig3_text(jl.peak_frequency), band, fixed(jl.velocity_correlation, 2),
-              fixed(jl.velocity_lag * 1000, 1)});
+              std::isfinite(jl.direction_step) ? sig3_text(jl.direction_step) + " ± " + sig3_text(jl.direction_step_se)
+                                               : "n/a",
+              fixed(jl.torque_lag * 1000, 2), fixed(jl.torque_lag_adjusted * 1000, 2), sig3_text(jl.peak_frequency),
+              band, fixed(jl.velocity_correlation, 2), fixed(jl.velocity_lag * 1000, 1)});
   }
   md += main.str() + "\n";
   for (const auto& jl : loc.joints) md += "- " + jl.summary + "\n";
@@ -264,7 +267,8 @@ std::string localization_markdown(const Localization& loc, const std::vector<std
   for (const auto& link : figures) md += fmt::format("![{}]({})\n\n", caption(link), link);
 
   md += heading(heading_level + 1, "Residual by motion regime");
-  markdown::Table regimes({"joint", "regime", "samples", "mean [N m]", "rms [N m]", "rms / overall", "SSE share"}, markdown::Align::first_left);
+  markdown::Table regimes({"joint", "regime", "samples", "mean [N m]", "rms [N m]", "rms / overall", "SSE share"},
+                          markdown::Align::first_left);
   for (const auto& jl : loc.joints)
     for (const auto& r : jl.regimes)
       regimes.row({jl.name, r.regime, fmt::format("{} ({})", r.samples, percent_text(r.fraction)), sig3_text(r.mean),
@@ -277,8 +281,8 @@ std::string localization_markdown(const Localization& loc, const std::vector<std
     return md;
   }
   md += fmt::format("Welch: {} Hann segments of {} samples ({:.2f} s, {:.3f} Hz resolution), 50 % overlap.\n\n",
-                    loc.spectrum.segments, loc.spectrum.segment_length,
-                    loc.spectrum.segment_length * loc.interval, 1 / (loc.spectrum.segment_length * loc.interval));
+                    loc.spectrum.segments, loc.spectrum.segment_length, loc.spectrum.segment_length * loc.interval,
+                    1 / (loc.spectrum.segment_length * loc.interval));
   std::vector<std::string> header{"joint"};
   header.insert(header.end(), loc.bands.begin(), loc.bands.end());
   header.push_back("peak [Hz]");
@@ -294,9 +298,8 @@ std::string localization_markdown(const Localization& loc, const std::vector<std
   return md;
 }
 
-std::vector<std::string> write_localization_figures(const std::vector<ResidualSeries>& series,
-                                                    const Localization& loc, const std::filesystem::path& dir,
-                                                    const std::string& prefix,
+std::vector<std::string> write_localization_figures(const std::vector<ResidualSeries>& series, const Localization& loc,
+                                                    const std::filesystem::path& dir, const std::string& prefix,
                                                     const LocalizationFigureOptions& options) {
   std::filesystem::create_directories(dir);
   std::vector<std::string> written;

@@ -18,7 +18,8 @@ Eigen::VectorXd row_weights(const DesignStack& d, const Eigen::VectorXd& w) {
 
 Eigen::MatrixXd per_sample(const DesignStack& d, const Eigen::VectorXd& stacked) {
   Eigen::MatrixXd m(d.samples(), d.joints);
-  for (int s = 0; s < d.samples(); ++s) m.row(s) = stacked.segment(static_cast<Eigen::Index>(s) * d.joints, d.joints).transpose();
+  for (int s = 0; s < d.samples(); ++s)
+    m.row(s) = stacked.segment(static_cast<Eigen::Index>(s) * d.joints, d.joints).transpose();
   return m;
 }
 
@@ -113,7 +114,6 @@ double heldout_sse(const Fit& f, const Eigen::VectorXd& weights, const std::vect
   return sse;
 }
 
-
 NestedDesign nested_design(const DesignStack& train, const DesignStack& heldout, const std::vector<Candidate>& effects,
                            const Fit& current, const Eigen::VectorXd& weights) {
   NestedDesign d;
@@ -169,9 +169,11 @@ AddedColumns add_columns(const NestedDesign& d, const Eigen::MatrixXd& Ctr, cons
   a.theta_s = a.ZZ.ldlt().solve(a.Cr);
   a.reduction = a.Cr.dot(a.theta_s);
   // Held out: the refit with the columns.
-  const Eigen::VectorXd dbeta = d.empty ? Eigen::VectorXd() : Eigen::VectorXd((-a.K * a.theta_s).cwiseQuotient(d.scale));
+  const Eigen::VectorXd dbeta =
+      d.empty ? Eigen::VectorXd() : Eigen::VectorXd((-a.K * a.theta_s).cwiseQuotient(d.scale));
   a.theta = a.theta_s.cwiseQuotient(a.cs);
-  a.rh1 = d.rh - d.rwh.cwiseProduct(d.empty ? Eigen::VectorXd(Ch * a.theta) : Eigen::VectorXd(d.Ah * dbeta + Ch * a.theta));
+  a.rh1 =
+      d.rh - d.rwh.cwiseProduct(d.empty ? Eigen::VectorXd(Ch * a.theta) : Eigen::VectorXd(d.Ah * dbeta + Ch * a.theta));
   return a;
 }
 
@@ -180,7 +182,8 @@ double joint_sse(const DesignStack& heldout, const Eigen::VectorXd& r, int joint
   const int n = heldout.joints;
   for (int s = 0; s < heldout.samples(); ++s)
     for (int j = 0; j < n; ++j)
-      if (joint == 0 || joint == j + 1) sse += r(static_cast<Eigen::Index>(s) * n + j) * r(static_cast<Eigen::Index>(s) * n + j);
+      if (joint == 0 || joint == j + 1)
+        sse += r(static_cast<Eigen::Index>(s) * n + j) * r(static_cast<Eigen::Index>(s) * n + j);
   return sse;
 }
 

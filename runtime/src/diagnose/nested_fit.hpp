@@ -49,14 +49,14 @@ double heldout_sse(const Fit& f, const Eigen::VectorXd& weights, const std::vect
 struct NestedDesign {
   const DesignStack* train = nullptr;
   const DesignStack* heldout = nullptr;
-  Eigen::MatrixXd A, Ah;        // unweighted designs
-  Eigen::MatrixXd As;           // weighted, unit-norm columns
-  Eigen::VectorXd scale;        // As's column scales
-  Eigen::VectorXd rw, rwh;      // row weights
-  Eigen::VectorXd beta;         // in A's units
-  Eigen::VectorXd r, rh;        // weighted residuals, train and held out
-  Eigen::LDLT<Eigen::MatrixXd> Gf;  // of As'As
-  bool empty = false;           // no column (held parameters, no effect): the residual is y
+  Eigen::MatrixXd A, Ah;                // unweighted designs
+  Eigen::MatrixXd As;                   // weighted, unit-norm columns
+  Eigen::VectorXd scale;                // As's column scales
+  Eigen::VectorXd rw, rwh;              // row weights
+  Eigen::VectorXd beta;                 // in A's units
+  Eigen::VectorXd r, rh;                // weighted residuals, train and held out
+  Eigen::LDLT<Eigen::MatrixXd> Gf;      // of As'As
+  bool empty = false;                   // no column (held parameters, no effect): the residual is y
   FitState train_state, heldout_state;  // its torques, for linearized candidates
 };
 // `effects` evaluated about `current`'s torques (a fit of those same effects).
@@ -66,15 +66,15 @@ NestedDesign nested_design(const DesignStack& train, const DesignStack& heldout,
 // Columns added to a nested design (weighted by its rows, unit norm), solved for together
 // with it.
 struct AddedColumns {
-  bool absorbed = false;  // a zero column, or in the design's span: nothing to solve
-  Eigen::MatrixXd C;      // weighted, unit-norm columns
-  Eigen::VectorXd cs;     // their scales
-  Eigen::MatrixXd K;      // (As'As)^-1 As'C
-  Eigen::MatrixXd ZZ;     // C'C - C'As K: the information of C's part orthogonal to As
-  Eigen::VectorXd Cr;     // C'r
+  bool absorbed = false;           // a zero column, or in the design's span: nothing to solve
+  Eigen::MatrixXd C;               // weighted, unit-norm columns
+  Eigen::VectorXd cs;              // their scales
+  Eigen::MatrixXd K;               // (As'As)^-1 As'C
+  Eigen::MatrixXd ZZ;              // C'C - C'As K: the information of C's part orthogonal to As
+  Eigen::VectorXd Cr;              // C'r
   Eigen::VectorXd theta_s, theta;  // unit-norm and in the columns' units
-  double reduction = 0;   // of the training residual's weighted sum of squares
-  Eigen::VectorXd rh1;    // the held-out weighted residual of the refit with them
+  double reduction = 0;            // of the training residual's weighted sum of squares
+  Eigen::VectorXd rh1;             // the held-out weighted residual of the refit with them
 };
 // Ctr, Ch: the columns on the training and the held-out stacks.
 AddedColumns add_columns(const NestedDesign& d, const Eigen::MatrixXd& Ctr, const Eigen::MatrixXd& Ch);

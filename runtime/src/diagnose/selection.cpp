@@ -46,7 +46,8 @@ std::vector<std::pair<Eigen::Index, Eigen::Index>> segment_ranges(const DesignSt
 }
 
 // sum_s x_s x_{s+k} over the pairs of samples k apart within one segment.
-double lagged_product(const std::vector<std::pair<Eigen::Index, Eigen::Index>>& segments, const Eigen::VectorXd& x, int k) {
+double lagged_product(const std::vector<std::pair<Eigen::Index, Eigen::Index>>& segments, const Eigen::VectorXd& x,
+                      int k) {
   double c = 0;
   for (const auto& [a, b] : segments)
     if (b - a > k) c += x.segment(a, b - a - k).dot(x.segment(a + k, b - a - k));
@@ -77,7 +78,8 @@ std::vector<std::vector<double>> autocovariance(const DesignStack& d, const Eige
 // uncorrelated): sum over joints and lags |k| <= L_j of g_j(k) sum_s z_{s,j} z_{s+k,j}'.
 // With white errors it is sigma^2 Z'Z, the classical F-test's; a slowly varying column (an
 // offset) meets the residual's full autocorrelation, a fast one (a delay) little of it.
-Eigen::MatrixXd score_covariance(const DesignStack& d, const Eigen::MatrixXd& Z, const std::vector<std::vector<double>>& g) {
+Eigen::MatrixXd score_covariance(const DesignStack& d, const Eigen::MatrixXd& Z,
+                                 const std::vector<std::vector<double>>& g) {
   const int n = d.joints, S = d.samples();
   const Eigen::Index m = Z.cols();
   const auto segments = segment_ranges(d);
@@ -92,7 +94,8 @@ Eigen::MatrixXd score_covariance(const DesignStack& d, const Eigen::MatrixXd& Z,
       const auto lag = static_cast<Eigen::Index>(k);
       Ck.setZero();
       for (const auto& [a, b] : segments)
-        if (b - a > lag) Ck.noalias() += Zj.middleRows(a, b - a - lag).transpose() * Zj.middleRows(a + lag, b - a - lag);
+        if (b - a > lag)
+          Ck.noalias() += Zj.middleRows(a, b - a - lag).transpose() * Zj.middleRows(a + lag, b - a - lag);
       V += g[j][k] * (Ck + Ck.transpose());
     }
   }
@@ -142,7 +145,8 @@ void backward_check(const DesignStack& train, const DesignStack& heldout, const 
         std::vector<Candidate> others = chosen;
         others.erase(others.begin() + static_cast<std::ptrdiff_t>(i));
         const Fit without = fit_with_effects(train, heldout, others, weights, options.max_lag);
-        const double s0 = heldout_sse(without, weights, on, heldout.samples()), s1 = heldout_sse(full, weights, on, heldout.samples());
+        const double s0 = heldout_sse(without, weights, on, heldout.samples()),
+                     s1 = heldout_sse(full, weights, on, heldout.samples());
         return s0 > 0 ? 1 - s1 / s0 : 0.0;
       };
       const double gain = size < 1 ? std::numeric_limits<double>::quiet_NaN() : heldout_gain();
@@ -150,16 +154,17 @@ void backward_check(const DesignStack& train, const DesignStack& heldout, const 
       if (!physical(c, theta))
         reason = "refitted with the others, its parameters contradict its physics";
       else if (c.kind == EffectKind::ActuationDelay && options.modeled_delay >= 0 &&
-               std::abs(theta(0) - options.modeled_delay) <=
-                   std::max(1.96 * std::sqrt(std::max(0.0, covs[i](0, 0))), options.min_delay_periods * log_period(train)))
+               std::abs(theta(0) - options.modeled_delay) <= std::max(1.96 * std::sqrt(std::max(0.0, covs[i](0, 0))),
+                                                                      options.min_delay_periods * log_period(train)))
         reason = fmt::format("refitted with the others, it is the {:.2f} ms the controller description already models",
                              1e3 * options.modeled_delay);
       else if (size < 1)
         reason = fmt::format("refitted with the others, its 95 % region reaches {:.0f} % of its size or less",
                              100 * options.smallest_fraction);
       else if (gain < options.min_heldout_gain)
-        reason = fmt::format("refitted with the others, it lowers its joints' held-out residual by {:.1f} % (under {:.0f} %)",
-                             100 * gain, 100 * options.min_heldout_gain);
+        reason = fmt::format(
+            "refitted with the others, it lowers its joints' held-out residual by {:.1f} % (under {:.0f} %)",
+            100 * gain, 100 * options.min_heldout_gain);
       if (reason.empty()) continue;
       // The weakest: the smallest size, held-out gain breaking ties among determined ones.
       const double weakness = size < 1 ? size : 1 + std::max(0.0, gain);
@@ -204,7 +209,8 @@ Eigen::VectorXd autocorrelation_time(const DesignStack& d, const Eigen::MatrixXd
 Fit fit_with_effects(const DesignStack& train, const DesignStack& heldout, const std::vector<Candidate>& effects,
                      const Eigen::VectorXd& weights, int max_lag, std::vector<Eigen::VectorXd>* theta_sd,
                      std::vector<Eigen::MatrixXd>* theta_cov) {
-  if (heldout.held() != train.held()) throw std::invalid_argument("fit_with_effects: parameters held in one stack only");
+  if (heldout.held() != train.held())
+    throw std::invalid_argument("fit_with_effects: parameters held in one stack only");
   const Eigen::Index np = free_parameters(train);
   const Eigen::VectorXd rw = row_weights(train, weights);
   const Eigen::VectorXd y = train.target();
@@ -289,7 +295,8 @@ CandidateTest test_candidate(const Candidate& c, const detail::NestedDesign& nd,
   const Eigen::MatrixXd Z = C - As * ac.K;
   const Eigen::MatrixXd r1 = per_sample(train, Eigen::VectorXd(r - Z * theta_s));
   const Eigen::MatrixXd V = dof * score_covariance(train, Z, autocovariance(train, r1, options.max_lag));
-  const double df2 = static_cast<double>(N) / pooled_time(autocorrelation_time(train, r1, options.max_lag)) - static_cast<double>(p + m);
+  const double df2 = static_cast<double>(N) / pooled_time(autocorrelation_time(train, r1, options.max_lag)) -
+                     static_cast<double>(p + m);
   t.df2 = df2;
   const Eigen::LDLT<Eigen::MatrixXd> Vf(V);
   const double stat = Vf.info() == Eigen::Success ? Cr.dot(Vf.solve(Cr)) : 0.0;

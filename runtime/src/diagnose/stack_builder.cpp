@@ -88,7 +88,8 @@ std::vector<Piece> cut_pieces(const std::vector<NamedSamples>& runs, double base
   std::vector<Piece> pieces;
   for (const auto& r : runs) {
     const auto& s = r.samples;
-    if (std::abs(s.interval - base) > 1e-12) throw std::invalid_argument("stack_design: runs at different base periods");
+    if (std::abs(s.interval - base) > 1e-12)
+      throw std::invalid_argument("stack_design: runs at different base periods");
     const long step = std::lround(interval / base);
     if (step < 1 || std::abs(step * base - interval) > 1e-9)
       throw std::invalid_argument("stack_design: the interval must be a multiple of the base period");
@@ -130,8 +131,8 @@ struct Filters {
 // joint (memory: one joint's columns at the log's rate at a time) every regressor column, the
 // fixed torque, the measured torque and the sample-local effects' terms through the same
 // low-pass, kept at the piece's kept samples.
-void stack_piece(const StackModel& m, const Piece& pc, const std::vector<int>& extra, const std::vector<Candidate>& local,
-                 const Filters& f, Eigen::Index out, DesignStack& d) {
+void stack_piece(const StackModel& m, const Piece& pc, const std::vector<int>& extra,
+                 const std::vector<Candidate>& local, const Filters& f, Eigen::Index out, DesignStack& d) {
   const int n = m.nq, p = m.np, pf = static_cast<int>(m.full_parameters.size());
   const Eigen::Index pe = static_cast<Eigen::Index>(extra.size());
   const auto& s = pc.run->samples;
@@ -234,7 +235,8 @@ DesignStack stack_design(const StackModel& m, const std::vector<NamedSamples>& r
   for (const auto& pc : pieces) total += static_cast<Eigen::Index>(pc.keep.size());
 
   size_stack(d, total, p, pe);
-  for (const auto& c : local) d.effect_terms[c.key()] = Eigen::MatrixXd(total, static_cast<Eigen::Index>(c.parameters.size()));
+  for (const auto& c : local)
+    d.effect_terms[c.key()] = Eigen::MatrixXd(total, static_cast<Eigen::Index>(c.parameters.size()));
   Eigen::Index out = 0;
   for (const auto& pc : pieces) {
     const Eigen::Index L = pc.end - pc.begin, K = static_cast<Eigen::Index>(pc.keep.size());

@@ -15,19 +15,18 @@ constexpr std::size_t kReceiveChunk = 512;
 void check_distinct(ByteView ids, const char* what) {
   for (std::size_t i = 0; i < ids.size(); ++i) {
     if (ids[i] > kMaxId)
-      throw std::invalid_argument(std::string("DYNAMIXEL bus ") + what + ": ID " +
-                                  std::to_string(ids[i]) + " is not 0..252");
+      throw std::invalid_argument(std::string("DYNAMIXEL bus ") + what + ": ID " + std::to_string(ids[i]) +
+                                  " is not 0..252");
     for (std::size_t j = 0; j < i; ++j)
       if (ids[j] == ids[i])  // replies are matched by ID: a duplicate would be ambiguous
-        throw std::invalid_argument(std::string("DYNAMIXEL bus ") + what + ": ID " +
-                                    std::to_string(ids[i]) + " listed twice");
+        throw std::invalid_argument(std::string("DYNAMIXEL bus ") + what + ": ID " + std::to_string(ids[i]) +
+                                    " listed twice");
   }
 }
 
 void check_unicast(std::uint8_t id, const char* what) {
   if (id > kMaxId)
-    throw std::invalid_argument(std::string("DYNAMIXEL bus ") + what + ": ID " +
-                                std::to_string(id) + " is not 0..252");
+    throw std::invalid_argument(std::string("DYNAMIXEL bus ") + what + ": ID " + std::to_string(id) + " is not 0..252");
 }
 
 }  // namespace
@@ -72,9 +71,8 @@ Bus::Clock::duration Bus::attempt_timeout(std::size_t request_bytes, std::size_t
 }
 
 bool Bus::retryable(Outcome outcome) {
-  return outcome == Outcome::timeout || outcome == Outcome::bad_crc ||
-         outcome == Outcome::corrupt || outcome == Outcome::wrong_id ||
-         outcome == Outcome::not_sent;
+  return outcome == Outcome::timeout || outcome == Outcome::bad_crc || outcome == Outcome::corrupt ||
+         outcome == Outcome::wrong_id || outcome == Outcome::not_sent;
 }
 
 void Bus::prepare(std::size_t count) {
@@ -137,8 +135,8 @@ void Bus::handle(const DecodeEvent& event) {
   ++(crc ? stats_.crc_errors : stats_.corrupt);
   const Outcome outcome = crc ? Outcome::bad_crc : Outcome::corrupt;
   std::size_t k = event.raw.size() > 4 ? find_unresolved(event.raw[4]) : kNone;
-  if (k != kNone && (crc || event.error == DecodeError::bad_stuffing ||
-                     event.error == DecodeError::unknown_instruction)) {
+  if (k != kNone &&
+      (crc || event.error == DecodeError::bad_stuffing || event.error == DecodeError::unknown_instruction)) {
     slots_[k].resolved = true;
     --pending_;
     replies_[k].outcome = outcome;
@@ -181,8 +179,7 @@ void Bus::attempt(Clock::time_point until) {
   }
 }
 
-void Bus::transact(Kind kind, std::uint16_t address, std::uint16_t length,
-                   Clock::time_point deadline) {
+void Bus::transact(Kind kind, std::uint16_t address, std::uint16_t length, Clock::time_point deadline) {
   ++stats_.transactions;
   int attempts_left = 1 + std::max(0, options_.retries);
   for (bool first = true;; first = false) {
@@ -222,8 +219,7 @@ void Bus::transact(Kind kind, std::uint16_t address, std::uint16_t length,
       retry_items_.clear();
       for (const Slot& s : slots_)
         if (!s.resolved) retry_items_.push_back(BulkReadItem{s.id, s.address, s.length});
-      encode_bulk_read(Span<const BulkReadItem>(retry_items_.data(), retry_items_.size()),
-                       request_);
+      encode_bulk_read(Span<const BulkReadItem>(retry_items_.data(), retry_items_.size()), request_);
     }  // a single transaction re-sends request_ as it is
   }
   for (const Reply& r : replies_) {
@@ -288,8 +284,7 @@ std::vector<PingReply> Bus::ping_all(std::chrono::microseconds wait) {
   return found;
 }
 
-Reply Bus::read(std::uint8_t id, std::uint16_t address, std::uint16_t length,
-                Clock::time_point deadline) {
+Reply Bus::read(std::uint8_t id, std::uint16_t address, std::uint16_t length, Clock::time_point deadline) {
   check_unicast(id, "read");
   prepare(1);
   slots_[0].id = id;
@@ -302,8 +297,7 @@ Reply Bus::read(std::uint8_t id, std::uint16_t address, std::uint16_t length,
   return replies_[0];
 }
 
-Reply Bus::write(std::uint8_t id, std::uint16_t address, ByteView data,
-                 Clock::time_point deadline) {
+Reply Bus::write(std::uint8_t id, std::uint16_t address, ByteView data, Clock::time_point deadline) {
   encode_write(id, address, data, request_);
   if (id == kBroadcastId) {  // every servo applies it, none answers
     ++stats_.transactions;
@@ -312,9 +306,8 @@ Reply Bus::write(std::uint8_t id, std::uint16_t address, ByteView data,
     const Clock::duration timeout = attempt_timeout(request_.size(), 0, 0);
     Reply r;
     r.id = id;
-    r.outcome = port_.write_all(request_, deadline - now < timeout ? deadline : now + timeout)
-                    ? Outcome::ok
-                    : Outcome::not_sent;
+    r.outcome = port_.write_all(request_, deadline - now < timeout ? deadline : now + timeout) ? Outcome::ok
+                                                                                               : Outcome::not_sent;
     if (r.outcome == Outcome::not_sent) ++stats_.not_sent;
     return r;
   }
@@ -327,8 +320,7 @@ Reply Bus::write(std::uint8_t id, std::uint16_t address, ByteView data,
   return replies_[0];
 }
 
-Reply Bus::write(std::uint8_t id, xseries::Item item, std::int32_t value,
-                 Clock::time_point deadline) {
+Reply Bus::write(std::uint8_t id, xseries::Item item, std::int32_t value, Clock::time_point deadline) {
   std::uint8_t bytes[4];
   store_le(bytes, value);
   return write(id, item.address, ByteView(bytes, item.size), deadline);
@@ -376,11 +368,10 @@ bool Bus::sync_write(ByteView ids, std::uint16_t address, std::uint16_t length, 
   return false;
 }
 
-bool Bus::sync_write(ByteView ids, xseries::Item item, Span<const std::int32_t> values,
-                     Clock::time_point deadline) {
+bool Bus::sync_write(ByteView ids, xseries::Item item, Span<const std::int32_t> values, Clock::time_point deadline) {
   if (values.size() != ids.size())
-    throw std::invalid_argument("DYNAMIXEL bus sync write: " + std::to_string(values.size()) +
-                                " values for " + std::to_string(ids.size()) + " IDs");
+    throw std::invalid_argument("DYNAMIXEL bus sync write: " + std::to_string(values.size()) + " values for " +
+                                std::to_string(ids.size()) + " IDs");
   packed_.resize(ids.size() * item.size);
   for (std::size_t i = 0; i < values.size(); ++i) {
     std::uint8_t bytes[4];
@@ -395,8 +386,7 @@ Span<const Reply> Bus::bulk_read(Span<const BulkReadItem> items, Clock::time_poi
   for (std::size_t i = 0; i < items.size(); ++i) {
     for (std::size_t j = 0; j < i; ++j)
       if (items[j].id == items[i].id)
-        throw std::invalid_argument("DYNAMIXEL bus bulk read: ID " + std::to_string(items[i].id) +
-                                    " listed twice");
+        throw std::invalid_argument("DYNAMIXEL bus bulk read: ID " + std::to_string(items[i].id) + " listed twice");
     total += items[i].length;
   }
   prepare(items.size());

@@ -11,8 +11,7 @@ constexpr std::array<std::uint16_t, 256> make_table() {
   std::array<std::uint16_t, 256> table{};
   for (unsigned i = 0; i < 256; ++i) {
     std::uint16_t r = static_cast<std::uint16_t>(i << 8);
-    for (int bit = 0; bit < 8; ++bit)
-      r = static_cast<std::uint16_t>((r & 0x8000) ? (r << 1) ^ 0x8005 : (r << 1));
+    for (int bit = 0; bit < 8; ++bit) r = static_cast<std::uint16_t>((r & 0x8000) ? (r << 1) ^ 0x8005 : (r << 1));
     table[i] = r;
   }
   return table;

@@ -15,8 +15,7 @@ constexpr std::size_t kMinLength = 3;  // instruction + CRC
 // First index in [from, to) where the 4-byte header starts with all 4 bytes before `to`, or `to`.
 std::size_t find_header(const std::uint8_t* data, std::size_t from, std::size_t to) {
   for (std::size_t i = from; i + 4 <= to; ++i)
-    if (data[i] == 0xFF && data[i + 1] == 0xFF && data[i + 2] == 0xFD && data[i + 3] == 0x00)
-      return i;
+    if (data[i] == 0xFF && data[i + 1] == 0xFF && data[i + 2] == 0xFD && data[i + 3] == 0x00) return i;
   return to;
 }
 
@@ -49,8 +48,7 @@ const char* to_string(DecodeError error) {
 
 Decoder::Decoder(std::size_t max_length) : max_length_(max_length) {
   if (max_length < kMinLength + 1 || max_length > 0xFFFF)
-    throw std::invalid_argument("DYNAMIXEL decoder: max_length " + std::to_string(max_length) +
-                                " is not in 4..65535");
+    throw std::invalid_argument("DYNAMIXEL decoder: max_length " + std::to_string(max_length) + " is not in 4..65535");
   buffer_.reserve(kHeaderSize + max_length + 256);
   region_.reserve(max_length);
 }
@@ -130,8 +128,7 @@ DecodeEvent Decoder::next() {
   const std::uint8_t id = data[frame + 4];
   if (!is_valid_id(id)) return reject(DecodeError::bad_id, frame, kHeaderSize);
   const std::size_t length = load_le<std::uint16_t>(data + frame + 5);
-  if (length < kMinLength || length > max_length_)
-    return reject(DecodeError::bad_length, frame, kHeaderSize);
+  if (length < kMinLength || length > max_length_) return reject(DecodeError::bad_length, frame, kHeaderSize);
   const std::size_t size = kHeaderSize + length;
   const std::size_t region_end = frame + size - kCrcSize;
 

@@ -81,8 +81,7 @@ const char* to_string(ErrorNumber number) {
   return "unknown error number";
 }
 
-PacketWriter::PacketWriter(std::vector<std::uint8_t>& out, std::uint8_t id, Instruction instruction)
-    : out_(out) {
+PacketWriter::PacketWriter(std::vector<std::uint8_t>& out, std::uint8_t id, Instruction instruction) : out_(out) {
   if (!is_valid_id(id))
     throw std::invalid_argument("DYNAMIXEL packet: ID " + std::to_string(id) +
                                 " is not 0..252 or the broadcast ID 254");
@@ -121,8 +120,7 @@ PacketWriter& PacketWriter::bytes(ByteView values) {
 ByteView PacketWriter::finish() {
   const std::size_t length = out_.size() - kHeaderSize + kCrcSize;
   if (length > 0xFFFF)
-    throw std::length_error("DYNAMIXEL packet: Length " + std::to_string(length) +
-                            " does not fit 16 bits");
+    throw std::length_error("DYNAMIXEL packet: Length " + std::to_string(length) + " does not fit 16 bits");
   out_[5] = static_cast<std::uint8_t>(length);
   out_[6] = static_cast<std::uint8_t>(length >> 8);
   const std::uint16_t crc = crc16(out_.data(), out_.size());

@@ -25,8 +25,7 @@ struct Rate {
 // The termios rates a DYNAMIXEL bus can use (X series: 9,600 bps to 4.5 Mbps; 4.5 Mbps has no
 // termios constant). The fast ones are platform extensions, hence the guards.
 constexpr Rate kRates[] = {
-    {9'600, B9600},       {19'200, B19200},     {38'400, B38400},   {57'600, B57600},
-    {115'200, B115200},   {230'400, B230400},
+    {9'600, B9600},        {19'200, B19200}, {38'400, B38400}, {57'600, B57600}, {115'200, B115200}, {230'400, B230400},
 #ifdef B460800
     {460'800, B460800},
 #endif
@@ -167,8 +166,7 @@ void SerialPort::set_baud(std::uint32_t baud) {
   if (fd_ < 0) fail("set baud rate", EBADF);
   termios tio{};
   if (::tcgetattr(fd_, &tio) != 0) fail("tcgetattr", errno);
-  if (::cfsetispeed(&tio, rate->code) != 0 || ::cfsetospeed(&tio, rate->code) != 0)
-    fail("cfsetspeed", errno);
+  if (::cfsetispeed(&tio, rate->code) != 0 || ::cfsetospeed(&tio, rate->code) != 0) fail("cfsetspeed", errno);
   if (::tcsetattr(fd_, TCSANOW, &tio) != 0) fail("tcsetattr (baud rate)", errno);
   baud_ = baud;
 }

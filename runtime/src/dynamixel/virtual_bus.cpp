@@ -83,9 +83,7 @@ void put(std::uint8_t* table, xs::Item item, std::int32_t value) {
   std::copy(bytes, bytes + item.size, table + item.address);
 }
 
-bool is_operating_mode(std::int32_t v) {
-  return v == 0 || v == 1 || v == 3 || v == 4 || v == 5 || v == 16;
-}
+bool is_operating_mode(std::int32_t v) { return v == 0 || v == 1 || v == 3 || v == 4 || v == 5 || v == 16; }
 
 [[noreturn]] void fail(const char* what) {
   throw std::system_error(errno, std::generic_category(), std::string("virtual bus: ") + what);
@@ -104,7 +102,8 @@ std::vector<VirtualServo> crane_x7_servos() {
   return servos;
 }
 
-VirtualBus::VirtualBus(std::vector<VirtualServo> servos, std::unique_ptr<ServoBackend> backend, std::function<double()> plant_clock)
+VirtualBus::VirtualBus(std::vector<VirtualServo> servos, std::unique_ptr<ServoBackend> backend,
+                       std::function<double()> plant_clock)
     : backend_(std::move(backend)), plant_clock_(std::move(plant_clock)) {
   if (!backend_ || backend_->size() != servos.size())
     throw std::invalid_argument("virtual bus: the backend must have one joint per servo");
@@ -231,8 +230,7 @@ VirtualBusStats VirtualBus::stats() const {
 void VirtualBus::update_command(std::size_t index) {
   const std::uint8_t* t = servos_[index].table;
   const bool drive = get(t, xs::kTorqueEnable, false) == 1 &&
-                     get(t, xs::kOperatingMode, false) ==
-                         static_cast<std::int32_t>(xs::OperatingMode::current) &&
+                     get(t, xs::kOperatingMode, false) == static_cast<std::int32_t>(xs::OperatingMode::current) &&
                      get(t, xs::kHardwareErrorStatus, false) == 0 && get(t, xs::kBusWatchdog, true) != -1;
   const double amps = drive ? get(t, xs::kGoalCurrent, true) * xs::kCurrentUnit : 0.0;
   backend_->set_current(index, amps);
@@ -243,8 +241,7 @@ void VirtualBus::refresh_present() {
     const JointState st = backend_->state(i);
     std::uint8_t* t = servos_[i].table;
     const double current = std::clamp(std::round(st.current / xs::kCurrentUnit), -32768.0, 32767.0);
-    const double velocity =
-        std::clamp(std::round(st.velocity / xs::kVelocityUnit), -2147483648.0, 2147483647.0);
+    const double velocity = std::clamp(std::round(st.velocity / xs::kVelocityUnit), -2147483648.0, 2147483647.0);
     put(t, xs::kPresentCurrent, static_cast<std::int32_t>(current));
     put(t, xs::kPresentVelocity, static_cast<std::int32_t>(velocity));
     put(t, xs::kPresentPosition, xs::rad_to_position(st.position));
@@ -262,15 +259,15 @@ ErrorNumber VirtualBus::apply_write(Servo& servo, std::uint16_t address, ByteVie
     const Rule* r = rule_at(a);
     if (!r || r->check == Check::read_only) return ErrorNumber::access_error;
     if (r->item.address != a || r->item.address + r->item.size > end)
-      return ErrorNumber::data_length_error;  // part of a multi-byte item
+      return ErrorNumber::data_length_error;                        // part of a multi-byte item
     if (a < kRamStart && torque) return ErrorNumber::access_error;  // EEPROM is locked
     const std::uint8_t* p = data.data() + (a - address);
-    const std::int32_t v = r->is_signed
-                               ? load_le_signed(p, r->item.size)
-                               : static_cast<std::int32_t>(load_le_unsigned(p, r->item.size));
+    const std::int32_t v =
+        r->is_signed ? load_le_signed(p, r->item.size) : static_cast<std::int32_t>(load_le_unsigned(p, r->item.size));
     bool in_range = true;
     // A tripped bus watchdog makes the goal values read-only: writes get a Data Range Error.
-    const bool goal = r->check == Check::goal_current || r->check == Check::goal_velocity || r->check == Check::goal_position;
+    const bool goal =
+        r->check == Check::goal_current || r->check == Check::goal_velocity || r->check == Check::goal_position;
     if (goal && get(t, xs::kBusWatchdog, true) == -1) return ErrorNumber::data_range_error;
     switch (r->check) {
       case Check::range:
@@ -293,8 +290,7 @@ ErrorNumber VirtualBus::apply_write(Servo& servo, std::uint16_t address, ByteVie
         break;
       }
       case Check::goal_position:
-        in_range = v >= get(t, xs::kMinPositionLimit, false) &&
-                   v <= get(t, xs::kMaxPositionLimit, false);
+        in_range = v >= get(t, xs::kMinPositionLimit, false) && v <= get(t, xs::kMaxPositionLimit, false);
         break;
       case Check::read_only:
         break;
@@ -329,8 +325,8 @@ void VirtualBus::reply(Servo& servo, std::uint8_t error, ByteView params) {
     if (packet_.back() == 0xFF) packet_.back() = 0xFE;
   }
   ++stats_.replies;
-  pending_.push_back(Outgoing{out_.size(), packet_.size(),
-                              get(servo.table, xs::kReturnDelayTime, false) * xs::kReturnDelayUnit});
+  pending_.push_back(
+      Outgoing{out_.size(), packet_.size(), get(servo.table, xs::kReturnDelayTime, false) * xs::kReturnDelayUnit});
   out_.insert(out_.end(), packet_.begin(), packet_.end());
 }
 
@@ -418,10 +414,18 @@ void VirtualBus::process(const DecodeEvent& event, double now) {
   backend_->advance(now);
   const bool broadcast = p.id == kBroadcastId;
   switch (p.instruction) {
-    case Instruction::ping: answer_ping(p, broadcast); break;
-    case Instruction::read: answer_read(p); break;
-    case Instruction::write: answer_write(p, broadcast); break;
-    case Instruction::reboot: answer_reboot(p, broadcast); break;
+    case Instruction::ping:
+      answer_ping(p, broadcast);
+      break;
+    case Instruction::read:
+      answer_read(p);
+      break;
+    case Instruction::write:
+      answer_write(p, broadcast);
+      break;
+    case Instruction::reboot:
+      answer_reboot(p, broadcast);
+      break;
     case Instruction::sync_read:
       if (const auto r = parse_sync_read(p); r && broadcast) {
         refresh_present();

@@ -29,8 +29,10 @@ preprocess::Samples as_samples(const Eigen::MatrixXd& q, const Eigen::MatrixXd& 
 FourierBasis::FourierBasis(int joints, int harmonics, double period, int samples, Eigen::VectorXd start)
     : n_(joints), L_(harmonics), N_(samples), w_(period > 0 ? kTwoPi / period : 0), start_(std::move(start)) {
   if (n_ < 1 || L_ < 2 || N_ < 4 * L_ || !(period > 0) || start_.size() != n_)
-    throw std::invalid_argument("FourierBasis: needs joints >= 1, harmonics >= 2, samples >= 4 harmonics, a positive "
-                                "period and a start pose of " + std::to_string(n_) + " joints");
+    throw std::invalid_argument(
+        "FourierBasis: needs joints >= 1, harmonics >= 2, samples >= 4 harmonics, a positive "
+        "period and a start pose of " +
+        std::to_string(n_) + " joints");
   bq_.resize(N_, 2 * L_);
   bqd_.resize(N_, 2 * L_);
   bqdd_.resize(N_, 2 * L_);
@@ -48,7 +50,8 @@ FourierBasis::FourierBasis(int joints, int harmonics, double period, int samples
 
 double FourierBasis::period() const { return kTwoPi / w_; }
 
-void FourierBasis::states(const Eigen::VectorXd& x, Eigen::MatrixXd& q, Eigen::MatrixXd& qd, Eigen::MatrixXd& qdd) const {
+void FourierBasis::states(const Eigen::VectorXd& x, Eigen::MatrixXd& q, Eigen::MatrixXd& qd,
+                          Eigen::MatrixXd& qdd) const {
   // Column j of X: joint j's coefficients.
   const Eigen::Map<const Eigen::MatrixXd> X(x.data(), 2 * L_, n_);
   q = bq_ * X;
@@ -136,8 +139,8 @@ std::optional<double> ExcitationCriterion::value(const Eigen::VectorXd& x, Eigen
   const int B = basis_.block();
   gradient->resize(basis_.variables());
   for (int j = 0; j < n; ++j)
-    gradient->segment(j * B, B) =
-        -2 * (basis_.bq().transpose() * Hq.col(j) + basis_.bqd().transpose() * Hqd.col(j) + basis_.bqdd().transpose() * Hqdd.col(j));
+    gradient->segment(j * B, B) = -2 * (basis_.bq().transpose() * Hq.col(j) + basis_.bqd().transpose() * Hqd.col(j) +
+                                        basis_.bqdd().transpose() * Hqdd.col(j));
   return f;
 }
 
@@ -170,7 +173,8 @@ Eigen::MatrixXd ExcitationCriterion::workspace(const Eigen::VectorXd& x, const s
   if (jacobian) jacobian->setZero(static_cast<Eigen::Index>(N) * H, basis_.variables());
   Eigen::MatrixXd dq;
   for (int k = 0; k < N; ++k) {
-    out.row(k) = half_space_values(model_.description().frames, q.row(k).transpose(), spaces, jacobian ? &dq : nullptr).transpose();
+    out.row(k) = half_space_values(model_.description().frames, q.row(k).transpose(), spaces, jacobian ? &dq : nullptr)
+                     .transpose();
     if (!jacobian) continue;
     for (int h = 0; h < H; ++h)
       for (int m = 0; m < n; ++m)
@@ -192,8 +196,8 @@ Eigen::VectorXd half_space_values(const std::vector<FrameInfo>& frames, const Ei
   for (std::size_t h = 0; h < spaces.size(); ++h) {
     const HalfSpace& s = spaces[h];
     if (s.frame < 1 || s.frame > nf)
-      throw std::invalid_argument("half-space " + s.name + ": frame " + std::to_string(s.frame) + " is not one of the model's 1.." +
-                                  std::to_string(nf));
+      throw std::invalid_argument("half-space " + s.name + ": frame " + std::to_string(s.frame) +
+                                  " is not one of the model's 1.." + std::to_string(nf));
     const Eigen::Vector3d p = T[static_cast<std::size_t>(s.frame - 1)].translation();
     out(static_cast<Eigen::Index>(h)) = s.normal.dot(p) - s.offset;
     if (!dq) continue;
@@ -202,7 +206,8 @@ Eigen::VectorXd half_space_values(const std::vector<FrameInfo>& frames, const Ei
       if (v < 0) continue;
       const Eigen::Isometry3d& Tf = T[static_cast<std::size_t>(f - 1)];
       const Eigen::Vector3d z = Tf.linear().col(2);
-      const Eigen::Vector3d dp = frames[static_cast<std::size_t>(f - 1)].sigma == 1 ? z : Eigen::Vector3d(z.cross(p - Tf.translation()));
+      const Eigen::Vector3d dp =
+          frames[static_cast<std::size_t>(f - 1)].sigma == 1 ? z : Eigen::Vector3d(z.cross(p - Tf.translation()));
       (*dq)(static_cast<Eigen::Index>(h), v) = s.normal.dot(dp);
     }
   }

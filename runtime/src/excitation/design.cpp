@@ -32,7 +32,9 @@ constexpr double kInfinity = 1e20;  // beyond Ipopt's infinity (1e19)
 
 using Clock = std::chrono::steady_clock;
 
-std::string joint_name(const identify::IdentificationModel& m, int j) { return m.description().joints[static_cast<std::size_t>(j)].name; }
+std::string joint_name(const identify::IdentificationModel& m, int j) {
+  return m.description().joints[static_cast<std::size_t>(j)].name;
+}
 
 // The sampled limits keep the whole motion inside: q - mid, qd and qdd are trigonometric
 // polynomials of degree L, and one sampled at N > 2L equally spaced instants stays within
@@ -98,7 +100,8 @@ class DesignProblem : public Ipopt::TNLP {
     for (int k = 0; k < N_; ++k)
       for (int j = 0; j < n_; ++j) {
         const int r = k * n_ + j;
-        const double mid = (lim.lower(j) + lim.upper(j)) / 2 - o_.start(j), half = (lim.upper(j) - lim.lower(j)) / 2 * s;
+        const double mid = (lim.lower(j) + lim.upper(j)) / 2 - o_.start(j),
+                     half = (lim.upper(j) - lim.lower(j)) / 2 * s;
         g_l[rp_ + r] = mid - half;
         g_u[rp_ + r] = mid + half;
         g_l[rv_ + r] = -lim.velocity(j) * s;
@@ -116,8 +119,8 @@ class DesignProblem : public Ipopt::TNLP {
     return true;
   }
 
-  bool get_starting_point(Ipopt::Index, bool, Ipopt::Number* x, bool, Ipopt::Number*, Ipopt::Number*, Ipopt::Index, bool,
-                          Ipopt::Number*) override {
+  bool get_starting_point(Ipopt::Index, bool, Ipopt::Number* x, bool, Ipopt::Number*, Ipopt::Number*, Ipopt::Index,
+                          bool, Ipopt::Number*) override {
     std::copy(x0_.data(), x0_.data() + V_, x);
     return true;
   }
@@ -164,7 +167,8 @@ class DesignProblem : public Ipopt::TNLP {
     const int B = b.block();
     int e = 0;
     auto put = [&](int row, int col, double v) {
-      if (values) values[e] = v;
+      if (values)
+        values[e] = v;
       else {
         rows[e] = row;
         cols[e] = col;
@@ -283,9 +287,11 @@ Eigen::VectorXd random_start(const FourierBasis& basis, const ExcitationDesignOp
   t.come_to_rest_at(options.start);
   const Eigen::VectorXd pb = t.position_bound(), vb = t.velocity_bound(), ab = t.acceleration_bound();
   for (int j = 0; j < n; ++j) {
-    const double room = std::min(options.limits.upper(j) - options.start(j), options.start(j) - options.limits.lower(j));
+    const double room =
+        std::min(options.limits.upper(j) - options.start(j), options.start(j) - options.limits.lower(j));
     // |q - start| <= 2 sum r / (w l): the series' offset moves with b.
-    const double s = 0.5 * std::min({room / (2 * pb(j)), options.limits.velocity(j) / vb(j), options.limits.acceleration(j) / ab(j)});
+    const double s = 0.5 * std::min({room / (2 * pb(j)), options.limits.velocity(j) / vb(j),
+                                     options.limits.acceleration(j) / ab(j)});
     t.a.row(j) *= s;
     t.b.row(j) *= s;
   }
@@ -296,21 +302,31 @@ Eigen::VectorXd random_start(const FourierBasis& basis, const ExcitationDesignOp
 // at a point it computed normally); the rest (invalid number, restoration failed, infeasible,
 // errors) leave no design.
 bool solved(Ipopt::ApplicationReturnStatus s) {
-  return s == Ipopt::Solve_Succeeded || s == Ipopt::Solved_To_Acceptable_Level || s == Ipopt::Maximum_Iterations_Exceeded ||
-         s == Ipopt::Maximum_CpuTime_Exceeded || s == Ipopt::Search_Direction_Becomes_Too_Small || s == Ipopt::Feasible_Point_Found;
+  return s == Ipopt::Solve_Succeeded || s == Ipopt::Solved_To_Acceptable_Level ||
+         s == Ipopt::Maximum_Iterations_Exceeded || s == Ipopt::Maximum_CpuTime_Exceeded ||
+         s == Ipopt::Search_Direction_Becomes_Too_Small || s == Ipopt::Feasible_Point_Found;
 }
 
 std::string status_name(Ipopt::ApplicationReturnStatus s) {
   switch (s) {
-    case Ipopt::Solve_Succeeded: return "converged";
-    case Ipopt::Solved_To_Acceptable_Level: return "acceptable";
-    case Ipopt::Maximum_Iterations_Exceeded: return "iteration limit";
-    case Ipopt::Infeasible_Problem_Detected: return "infeasible";
-    case Ipopt::Search_Direction_Becomes_Too_Small: return "step too small";
-    case Ipopt::Restoration_Failed: return "restoration failed";
-    case Ipopt::Error_In_Step_Computation: return "step failed";
-    case Ipopt::Invalid_Number_Detected: return "invalid number";
-    default: return fmt::format("Ipopt status {}", static_cast<int>(s));
+    case Ipopt::Solve_Succeeded:
+      return "converged";
+    case Ipopt::Solved_To_Acceptable_Level:
+      return "acceptable";
+    case Ipopt::Maximum_Iterations_Exceeded:
+      return "iteration limit";
+    case Ipopt::Infeasible_Problem_Detected:
+      return "infeasible";
+    case Ipopt::Search_Direction_Becomes_Too_Small:
+      return "step too small";
+    case Ipopt::Restoration_Failed:
+      return "restoration failed";
+    case Ipopt::Error_In_Step_Computation:
+      return "step failed";
+    case Ipopt::Invalid_Number_Detected:
+      return "invalid number";
+    default:
+      return fmt::format("Ipopt status {}", static_cast<int>(s));
   }
 }
 
@@ -319,19 +335,24 @@ void refuse_unmeetable(const identify::IdentificationModel& model, const Excitat
   const int n = d.nq;
   const auto& lim = options.limits;
   auto sized = [n](const Eigen::VectorXd& v) { return v.size() == n; };
-  if (!sized(options.start) || !sized(lim.lower) || !sized(lim.upper) || !sized(lim.velocity) || !sized(lim.acceleration) ||
-      (lim.torque.size() > 0 && !sized(lim.torque)))
+  if (!sized(options.start) || !sized(lim.lower) || !sized(lim.upper) || !sized(lim.velocity) ||
+      !sized(lim.acceleration) || (lim.torque.size() > 0 && !sized(lim.torque)))
     throw std::invalid_argument(fmt::format("design_excitation: the start pose and the limits need {} joints", n));
   if (lim.torque.size() > 0 && options.nominal.size() != d.np)
-    throw std::invalid_argument(fmt::format("design_excitation: torque limits need the nominal model's {} parameters", d.np));
+    throw std::invalid_argument(
+        fmt::format("design_excitation: torque limits need the nominal model's {} parameters", d.np));
   for (int j = 0; j < n; ++j) {
     const std::string name = joint_name(model, j);
-    if (!(lim.velocity(j) > 0)) throw ExcitationInfeasible(fmt::format("velocity limit of joint {} ({}) is {}: it must be > 0", j + 1, name, lim.velocity(j)));
+    if (!(lim.velocity(j) > 0))
+      throw ExcitationInfeasible(
+          fmt::format("velocity limit of joint {} ({}) is {}: it must be > 0", j + 1, name, lim.velocity(j)));
     if (!(lim.acceleration(j) > 0))
-      throw ExcitationInfeasible(fmt::format("acceleration limit of joint {} ({}) is {}: it must be > 0", j + 1, name, lim.acceleration(j)));
+      throw ExcitationInfeasible(
+          fmt::format("acceleration limit of joint {} ({}) is {}: it must be > 0", j + 1, name, lim.acceleration(j)));
     if (!(options.start(j) > lim.lower(j) && options.start(j) < lim.upper(j)))
-      throw ExcitationInfeasible(fmt::format("position limit of joint {} ({}): the start {:.6g} is not inside [{:.6g}, {:.6g}]",
-                                             j + 1, name, options.start(j), lim.lower(j), lim.upper(j)));
+      throw ExcitationInfeasible(
+          fmt::format("position limit of joint {} ({}): the start {:.6g} is not inside [{:.6g}, {:.6g}]", j + 1, name,
+                      options.start(j), lim.lower(j), lim.upper(j)));
   }
   const Eigen::VectorXd zero = Eigen::VectorXd::Zero(n);
   if (lim.torque.size() > 0) {
@@ -340,7 +361,8 @@ void refuse_unmeetable(const identify::IdentificationModel& model, const Excitat
     for (int j = 0; j < n; ++j)
       if (std::abs(rest.tau(j)) > lim.torque(j) * options.torque_margin)
         throw ExcitationInfeasible(fmt::format(
-            "torque limit of joint {} ({}): holding the start pose takes {:.4g} (gravity, nominal model), more than {} % of "
+            "torque limit of joint {} ({}): holding the start pose takes {:.4g} (gravity, nominal model), more than {} "
+            "% of "
             "its limit {:.4g}",
             j + 1, joint_name(model, j), rest.tau(j), std::lround(100 * options.torque_margin), lim.torque(j)));
   }
@@ -348,19 +370,21 @@ void refuse_unmeetable(const identify::IdentificationModel& model, const Excitat
     const Eigen::VectorXd v = half_space_values(d.frames, options.start, options.workspace);
     for (std::size_t h = 0; h < options.workspace.size(); ++h)
       if (v(static_cast<Eigen::Index>(h)) > 0)
-        throw ExcitationInfeasible(fmt::format("workspace half-space {}: frame {}'s origin at the start pose is {:.4g} beyond it",
-                                               options.workspace[h].name, options.workspace[h].frame, v(static_cast<Eigen::Index>(h))));
+        throw ExcitationInfeasible(
+            fmt::format("workspace half-space {}: frame {}'s origin at the start pose is {:.4g} beyond it",
+                        options.workspace[h].name, options.workspace[h].frame, v(static_cast<Eigen::Index>(h))));
   }
 }
 
 }  // namespace
 
-std::vector<ExcitationSlack> check_excitation(const identify::IdentificationModel& model, const trajectory::FourierTrajectory& t,
+std::vector<ExcitationSlack> check_excitation(const identify::IdentificationModel& model,
+                                              const trajectory::FourierTrajectory& t,
                                               const ExcitationDesignOptions& options) {
   const int n = model.description().nq;
   const bool torque = options.limits.torque.size() > 0;
-  std::vector<ExcitationSlack> worst{{"position", "", kInfinity, 0}, {"velocity", "", kInfinity, 0},
-                                     {"acceleration", "", kInfinity, 0}};
+  std::vector<ExcitationSlack> worst{
+      {"position", "", kInfinity, 0}, {"velocity", "", kInfinity, 0}, {"acceleration", "", kInfinity, 0}};
   if (torque) worst.push_back({"torque", "", kInfinity, 0});
   if (!options.workspace.empty()) worst.push_back({"workspace", "", kInfinity, 0});
   // The name is looked up only when a new tightest slack is found (not per joint per millisecond).
@@ -381,12 +405,15 @@ std::vector<ExcitationSlack> check_excitation(const identify::IdentificationMode
     }
     if (torque) {
       model.state_derivatives(q, qd, qdd, options.nominal, true, d);
-      for (int j = 0; j < n; ++j) note(worst[3], options.limits.torque(j) - std::abs(d.tau(j)), [&] { return joint_name(model, j); }, time);
+      for (int j = 0; j < n; ++j)
+        note(
+            worst[3], options.limits.torque(j) - std::abs(d.tau(j)), [&] { return joint_name(model, j); }, time);
     }
     if (!options.workspace.empty()) {
       const Eigen::VectorXd v = half_space_values(model.description().frames, q, options.workspace);
       for (std::size_t h = 0; h < options.workspace.size(); ++h)
-        note(worst.back(), -v(static_cast<Eigen::Index>(h)), [&] { return options.workspace[h].name; }, time);
+        note(
+            worst.back(), -v(static_cast<Eigen::Index>(h)), [&] { return options.workspace[h].name; }, time);
     }
   }
   return worst;
@@ -422,7 +449,8 @@ StartOutcome run_start(const identify::IdentificationModel& model, const Excitat
     // dense aggregated rows (torque, workspace) poorly; AMD halves the time per iteration on a
     // 7-joint arm (Panda, 20 s period, 8 harmonics: 12.4 s -> 6.7 s for 150 iterations).
     ip.SetIntegerValue("mumps_pivot_order", 0);
-    if (app->Initialize("") != Ipopt::Solve_Succeeded) throw std::runtime_error("design_excitation: Ipopt did not initialize");
+    if (app->Initialize("") != Ipopt::Solve_Succeeded)
+      throw std::runtime_error("design_excitation: Ipopt did not initialize");
     const Ipopt::ApplicationReturnStatus status = app->OptimizeTNLP(owner);
     result.status = status_name(status);
     result.solved = solved(status);
@@ -433,8 +461,9 @@ StartOutcome run_start(const identify::IdentificationModel& model, const Excitat
     if (const auto f = criterion.value(problem->solution())) {
       result.criterion = -*f;
       const auto slack = check_excitation(model, basis.trajectory(problem->solution(), options.name), options);
-      result.worst = *std::min_element(slack.begin(), slack.end(),
-                                       [](const ExcitationSlack& a, const ExcitationSlack& b) { return a.slack < b.slack; });
+      result.worst =
+          *std::min_element(slack.begin(), slack.end(),
+                            [](const ExcitationSlack& a, const ExcitationSlack& b) { return a.slack < b.slack; });
       // A start counts only when its solve ended normally and its point passes the dense check:
       // a point Ipopt left after "invalid number" or "restoration failed" is no design, even
       // inside the limits (a NaN torque limit gave one, written with rc 0).
@@ -449,9 +478,9 @@ StartOutcome run_start(const identify::IdentificationModel& model, const Excitat
 // hexadecimal floats (exact).
 std::string outcome_text(const StartOutcome& o) {
   const ExcitationStart& r = o.result;
-  std::string t = fmt::format("{}\n{} {} {} {:a} {:a}\n{}\n{}\n{:a} {:a}\n{}", r.status, int(r.solved), int(r.passed),
-                              r.iterations, r.criterion, r.seconds, r.worst.constraint, r.worst.where, r.worst.slack,
-                              r.worst.time, o.x.size());
+  std::string t =
+      fmt::format("{}\n{} {} {} {:a} {:a}\n{}\n{}\n{:a} {:a}\n{}", r.status, int(r.solved), int(r.passed), r.iterations,
+                  r.criterion, r.seconds, r.worst.constraint, r.worst.where, r.worst.slack, r.worst.time, o.x.size());
   for (Eigen::Index i = 0; i < o.x.size(); ++i) t += fmt::format(" {:a}", o.x(i));
   return t + "\n";
 }
@@ -512,7 +541,8 @@ ExcitationDesign design_excitation(const identify::IdentificationModel& model, c
   const int count = std::max(1, options.starts);
   std::vector<Eigen::VectorXd> x0(static_cast<std::size_t>(count));
   for (int s = 0; s < count; ++s) {
-    x0[static_cast<std::size_t>(s)] = random_start(basis, options, options.seed * 1000003ULL + static_cast<std::uint64_t>(s));
+    x0[static_cast<std::size_t>(s)] =
+        random_start(basis, options, options.seed * 1000003ULL + static_cast<std::uint64_t>(s));
     if (s == 0) {
       criterion.scale_columns_at(x0[0]);
       out.scales = criterion.scales();
@@ -537,7 +567,8 @@ ExcitationDesign design_excitation(const identify::IdentificationModel& model, c
     fo.isolate = true;
     parallel::run_farm(tasks, farm, fo);
   } else {
-    for (int s = 0; s < count; ++s) outcomes[static_cast<std::size_t>(s)] = run_start(model, criterion, options, x0[static_cast<std::size_t>(s)]);
+    for (int s = 0; s < count; ++s)
+      outcomes[static_cast<std::size_t>(s)] = run_start(model, criterion, options, x0[static_cast<std::size_t>(s)]);
   }
   for (int s = 0; s < count; ++s) {
     const StartOutcome& r = outcomes[static_cast<std::size_t>(s)];
@@ -549,19 +580,22 @@ ExcitationDesign design_excitation(const identify::IdentificationModel& model, c
     out.starts.push_back(r.result);
     if (r.result.passed) out.starts.back().trajectory = basis.trajectory(r.x, options.name);
   }
-  if (out.chosen < 0 && std::none_of(out.starts.begin(), out.starts.end(), [](const ExcitationStart& r) { return r.solved; })) {
+  if (out.chosen < 0 &&
+      std::none_of(out.starts.begin(), out.starts.end(), [](const ExcitationStart& r) { return r.solved; })) {
     std::string statuses;
     for (const auto& r : out.starts) statuses += (statuses.empty() ? "" : ", ") + r.status;
     throw ExcitationInfeasible("no start's solve ended normally (Ipopt: " + statuses + ")");
   }
   if (out.chosen < 0) {
-    const auto& w = std::min_element(out.starts.begin(), out.starts.end(), [](const ExcitationStart& a, const ExcitationStart& b) {
-                      return a.worst.slack > b.worst.slack;
-                    })->worst;
-    throw ExcitationInfeasible(w.constraint.empty()
-                                   ? std::string("no start excites every base parameter (the regressor stays rank deficient)")
-                                   : fmt::format("no start met every limit: the closest passes the {} limit of {} by {:.4g} at t = {:.3f} s",
-                                                 w.constraint, w.where, -w.slack, w.time));
+    const auto& w =
+        std::min_element(out.starts.begin(), out.starts.end(), [](const ExcitationStart& a, const ExcitationStart& b) {
+          return a.worst.slack > b.worst.slack;
+        })->worst;
+    throw ExcitationInfeasible(
+        w.constraint.empty()
+            ? std::string("no start excites every base parameter (the regressor stays rank deficient)")
+            : fmt::format("no start met every limit: the closest passes the {} limit of {} by {:.4g} at t = {:.3f} s",
+                          w.constraint, w.where, -w.slack, w.time));
   }
   out.trajectory = basis.trajectory(best_x, options.name);
   out.criterion = best;

@@ -26,8 +26,8 @@ std::vector<std::string> unexcited_columns(const Eigen::VectorXd& norms, const s
 }
 
 // The `top` largest components of a direction in parameter space, named.
-std::vector<std::pair<std::string, double>> largest_components(const Eigen::VectorXd& v, const std::vector<ParameterInfo>& parameters,
-                                                               int top) {
+std::vector<std::pair<std::string, double>> largest_components(const Eigen::VectorXd& v,
+                                                               const std::vector<ParameterInfo>& parameters, int top) {
   std::vector<int> order(static_cast<std::size_t>(v.size()));
   std::iota(order.begin(), order.end(), 0);
   std::sort(order.begin(), order.end(), [&](int a, int b) { return std::abs(v(a)) > std::abs(v(b)); });
@@ -40,8 +40,8 @@ std::vector<std::pair<std::string, double>> largest_components(const Eigen::Vect
 }  // namespace
 
 bool numerically_singular(const Eigen::VectorXd& sigma) {
-  return sigma.size() == 0 || !(sigma(sigma.size() - 1) > static_cast<double>(sigma.size()) *
-                                                               std::numeric_limits<double>::epsilon() * sigma(0));
+  return sigma.size() == 0 || !(sigma(sigma.size() - 1) >
+                                static_cast<double>(sigma.size()) * std::numeric_limits<double>::epsilon() * sigma(0));
 }
 
 ExcitationQuality excitation_quality(const Eigen::MatrixXd& W, const std::vector<ParameterInfo>& parameters, int top,
@@ -136,8 +136,8 @@ preprocess::Samples reference_samples(const trajectory::SampledReference& refere
   return s;
 }
 
-ExcitationQuality excitation_quality(const identify::IdentificationModel& model, const trajectory::SampledReference& reference,
-                                     double interval, int top) {
+ExcitationQuality excitation_quality(const identify::IdentificationModel& model,
+                                     const trajectory::SampledReference& reference, double interval, int top) {
   const identify::ModelDescription& d = model.description();
   if (reference.joints() != d.nq)
     throw std::invalid_argument("excitation_quality: " + reference.name + " has " + std::to_string(reference.joints()) +

@@ -27,7 +27,9 @@ int line_of(const YAML::Node& n) { return n.Mark().is_null() ? 0 : n.Mark().line
 
 struct Reader {
   std::string file;
-  [[noreturn]] void fail(const YAML::Node& at, const std::string& what) const { throw DataError(file, line_of(at), what); }
+  [[noreturn]] void fail(const YAML::Node& at, const std::string& what) const {
+    throw DataError(file, line_of(at), what);
+  }
   YAML::Node need(const YAML::Node& map, const char* key, const std::string& where) const {
     const YAML::Node v = map[key];
     if (!v) fail(map, fmt::format("{}: missing '{}'", where, key));
@@ -54,7 +56,8 @@ struct Reader {
   }
   long long integer(const YAML::Node& n, const std::string& what, long long lo, long long hi) const {
     const double v = number(n, what);
-    if (v != std::floor(v) || v < lo || v > hi) fail(n, fmt::format("{}: expected a whole number in {}..{}, got '{}'", what, lo, hi, n.Scalar()));
+    if (v != std::floor(v) || v < lo || v > hi)
+      fail(n, fmt::format("{}: expected a whole number in {}..{}, got '{}'", what, lo, hi, n.Scalar()));
     return static_cast<long long>(v);
   }
   std::string text(const YAML::Node& n, const std::string& what) const {
@@ -68,11 +71,13 @@ void read_bus(const Reader& r, const YAML::Node& root, HardwareConfig& c) {
   const YAML::Node bus = r.need(root, "bus", "hardware.yaml");
   r.keys(bus, {"baud", "return_delay_time", "period"}, "bus");
   c.baud = static_cast<std::uint32_t>(r.integer(r.need(bus, "baud", "bus"), "bus.baud", 9600, 4'500'000));
-  if (bus["return_delay_time"]) c.return_delay_time = static_cast<int>(r.integer(bus["return_delay_time"], "bus.return_delay_time", 0, 254));
+  if (bus["return_delay_time"])
+    c.return_delay_time = static_cast<int>(r.integer(bus["return_delay_time"], "bus.return_delay_time", 0, 254));
   if (bus["period"]) {
     c.period = r.number(bus["period"], "bus.period");
     if (!(c.period >= 0.0002 && c.period <= 0.02))
-      r.fail(bus["period"], fmt::format("bus.period: {} s is outside [0.0002, 0.02] s: the loop runs at 50 Hz to 5 kHz", c.period));
+      r.fail(bus["period"],
+             fmt::format("bus.period: {} s is outside [0.0002, 0.02] s: the loop runs at 50 Hz to 5 kHz", c.period));
   }
 }
 
@@ -80,13 +85,15 @@ void read_bus(const Reader& r, const YAML::Node& root, HardwareConfig& c) {
 std::map<std::string, ServoModel> read_models(const Reader& r, const YAML::Node& root) {
   std::map<std::string, ServoModel> models;
   const YAML::Node ms = r.need(root, "models", "hardware.yaml");
-  if (!ms.IsMap()) r.fail(ms, "models: expected a map of model name to {model_number, torque_constant, current_unit, current_limit}");
+  if (!ms.IsMap())
+    r.fail(ms, "models: expected a map of model name to {model_number, torque_constant, current_unit, current_limit}");
   for (const auto& kv : ms) {
     ServoModel m;
     m.name = kv.first.as<std::string>();
     const std::string where = "models." + m.name;
     r.keys(kv.second, {"model_number", "torque_constant", "current_unit", "current_limit"}, where);
-    m.model_number = static_cast<std::uint16_t>(r.integer(r.need(kv.second, "model_number", where), where + ".model_number", 0, 65535));
+    m.model_number = static_cast<std::uint16_t>(
+        r.integer(r.need(kv.second, "model_number", where), where + ".model_number", 0, 65535));
     m.torque_constant = r.positive(r.need(kv.second, "torque_constant", where), where + ".torque_constant");
     m.current_unit = r.positive(r.need(kv.second, "current_unit", where), where + ".current_unit");
     m.current_limit = r.positive(r.need(kv.second, "current_limit", where), where + ".current_limit");
@@ -111,12 +118,14 @@ void read_joints(const Reader& r, const YAML::Node& root, const std::map<std::st
     JointHardware h;
     h.name = r.text(r.need(j, "name", where), where + ".name");
     if (h.name != robot_joints[i].name)
-      r.fail(j["name"], fmt::format("{}: joint '{}' here, the robot's joint {} is '{}'", where, h.name, i + 1, robot_joints[i].name));
+      r.fail(j["name"], fmt::format("{}: joint '{}' here, the robot's joint {} is '{}'", where, h.name, i + 1,
+                                    robot_joints[i].name));
     h.id = static_cast<std::uint8_t>(r.integer(r.need(j, "id", where), where + ".id", 0, 252));
     if (!ids.insert(h.id).second) r.fail(j["id"], fmt::format("{}: servo ID {} is used twice", where, int(h.id)));
     const std::string model = r.text(r.need(j, "model", where), where + ".model");
     const auto m = models.find(model);
-    if (m == models.end()) r.fail(j["model"], fmt::format("{}: unknown servo model '{}' (not under models:)", where, model));
+    if (m == models.end())
+      r.fail(j["model"], fmt::format("{}: unknown servo model '{}' (not under models:)", where, model));
     h.model = m->second;
     // Within one revolution of the encoder (4096 pulses): a zero turns away puts every reading
     // that far from the joint's limits.
@@ -127,18 +136,21 @@ void read_joints(const Reader& r, const YAML::Node& root, const std::map<std::st
     }
     h.current_limit = r.positive(r.need(j, "current_limit", where), where + ".current_limit");
     if (h.current_limit > h.model.current_limit)
-      r.fail(j["current_limit"], fmt::format("{}.current_limit: {} A is beyond the {}'s {} A", where, h.current_limit, h.model.name,
-                                             h.model.current_limit));
+      r.fail(j["current_limit"], fmt::format("{}.current_limit: {} A is beyond the {}'s {} A", where, h.current_limit,
+                                             h.model.name, h.model.current_limit));
     c.joints.push_back(h);
   }
 }
 
 // safety: the watchdogs, each limit within the range that keeps it a limit, what a stop does.
 void read_safety(const Reader& r, const YAML::Node& s, HardwareConfig& c) {
-  r.keys(s, {"watchdog_cycles", "position_tolerance", "velocity_factor", "current_trip_factor", "approach_speed", "pre_roll", "at_stop", "hold_time",
-                "bus_watchdog"},
+  r.keys(s,
+         {"watchdog_cycles", "position_tolerance", "velocity_factor", "current_trip_factor", "approach_speed",
+          "pre_roll", "at_stop", "hold_time", "bus_watchdog"},
          "safety");
-  if (s["watchdog_cycles"]) c.safety.watchdog_cycles = static_cast<int>(r.integer(s["watchdog_cycles"], "safety.watchdog_cycles", 1, kMaxWatchdogCycles));
+  if (s["watchdog_cycles"])
+    c.safety.watchdog_cycles =
+        static_cast<int>(r.integer(s["watchdog_cycles"], "safety.watchdog_cycles", 1, kMaxWatchdogCycles));
   // Each limit within a range that keeps it a limit (safety_bound): 1e9 rad of tolerance or
   // 100 times the velocity limit would switch it off.
   const auto bounded = [&](const char* key, double& value) {
@@ -146,8 +158,8 @@ void read_safety(const Reader& r, const YAML::Node& s, HardwareConfig& c) {
     const SafetyBound& b = safety_bound(key);
     const double v = r.number(s[key], std::string("safety.") + key);
     if (!(v >= b.lower && v <= b.upper) || (b.lower_open && v == b.lower))
-      r.fail(s[key], fmt::format("safety.{}: {} is outside {}{}, {}] {}: {}", key, v, b.lower_open ? "(" : "[", b.lower, b.upper,
-                                 b.unit, b.why));
+      r.fail(s[key], fmt::format("safety.{}: {} is outside {}{}, {}] {}: {}", key, v, b.lower_open ? "(" : "[", b.lower,
+                                 b.upper, b.unit, b.why));
     value = v;
   };
   bounded("position_tolerance", c.safety.position_tolerance);
@@ -157,16 +169,20 @@ void read_safety(const Reader& r, const YAML::Node& s, HardwareConfig& c) {
   bounded("pre_roll", c.safety.pre_roll);
   if (s["at_stop"]) {
     const std::string a = r.text(s["at_stop"], "safety.at_stop");
-    if (a == "hold") c.safety.at_stop = StopAction::hold;
-    else if (a == "torque_off") c.safety.at_stop = StopAction::torque_off;
-    else r.fail(s["at_stop"], fmt::format("safety.at_stop: '{}', expected hold or torque_off", a));
+    if (a == "hold")
+      c.safety.at_stop = StopAction::hold;
+    else if (a == "torque_off")
+      c.safety.at_stop = StopAction::torque_off;
+    else
+      r.fail(s["at_stop"], fmt::format("safety.at_stop: '{}', expected hold or torque_off", a));
   }
   bounded("hold_time", c.safety.hold_time);
   if (s["bus_watchdog"]) {
     const double w = r.number(s["bus_watchdog"], "safety.bus_watchdog");
     const double units = std::ceil(w / dynamixel::xseries::kBusWatchdogUnit - 1e-9);
     if (!(w == 0 || (units >= 1 && units <= 127)))
-      r.fail(s["bus_watchdog"], fmt::format("safety.bus_watchdog: {} s; the servos' Bus Watchdog takes 0 (off) or 0.02 to 2.54 s", w));
+      r.fail(s["bus_watchdog"],
+             fmt::format("safety.bus_watchdog: {} s; the servos' Bus Watchdog takes 0 (off) or 0.02 to 2.54 s", w));
     c.safety.bus_watchdog = w;
   }
 }
@@ -196,7 +212,8 @@ HardwareConfig read_hardware_config(const std::filesystem::path& path, const std
   if (!root.IsMap()) throw DataError(c.path, 1, "expected a map of keys");
   r.keys(root, {"format", "bus", "models", "joints", "safety"}, "hardware.yaml");
   const std::string format = r.text(r.need(root, "format", "hardware.yaml"), "format");
-  if (format != "symoro-hardware 1") r.fail(root["format"], "format: expected 'symoro-hardware 1', got '" + format + "'");
+  if (format != "symoro-hardware 1")
+    r.fail(root["format"], "format: expected 'symoro-hardware 1', got '" + format + "'");
   read_bus(r, root, c);
   read_joints(r, root, read_models(r, root), robot_joints, c);
   if (const YAML::Node s = root["safety"]) read_safety(r, s, c);

@@ -44,7 +44,8 @@ class RealtimeScope {
       sched_param p{};
       p.sched_priority = priority;
       on_ = pthread_setschedparam(pthread_self(), SCHED_FIFO, &p) == 0;
-      if (!on_ && verbose) std::fprintf(stderr, "control: SCHED_FIFO %d refused; running at normal priority\n", priority);
+      if (!on_ && verbose)
+        std::fprintf(stderr, "control: SCHED_FIFO %d refused; running at normal priority\n", priority);
     }
     old_slack_ = prctl(PR_GET_TIMERSLACK, 0, 0, 0, 0);
     prctl(PR_SET_TIMERSLACK, 1, 0, 0, 0);
@@ -64,20 +65,32 @@ class RealtimeScope {
 
 }  // namespace
 
-std::string Loop::joint_name(int j) const { return fmt::format("servo ID {} (joint {} {})", int(ids_[j]), j + 1, joints_[j].name); }
+std::string Loop::joint_name(int j) const {
+  return fmt::format("servo ID {} (joint {} {})", int(ids_[j]), j + 1, joints_[j].name);
+}
 
 Loop::Loop(Bus& bus, const HardwareConfig& hw, const std::vector<JointInfo>& joints, const control::FfpdGains& gains,
-     const trajectory::Trajectory& traj, const ControlOptions& options)
-    : bus_(bus), hw_(hw), joints_(joints), gains_(gains), traj_(traj), o_(options), clock_(options.clock ? *options.clock : steady_loop_clock()), n_(static_cast<int>(joints.size())), ids_(hw.ids()) {
-  if (static_cast<int>(hw.joints.size()) != n_) throw std::invalid_argument("run_control: hardware.yaml and the robot differ in joints");
-  if (traj.joints() != n_) throw DataError(traj.name, 0, fmt::format("the trajectory has {} joints, the robot {}", traj.joints(), n_));
+           const trajectory::Trajectory& traj, const ControlOptions& options)
+    : bus_(bus),
+      hw_(hw),
+      joints_(joints),
+      gains_(gains),
+      traj_(traj),
+      o_(options),
+      clock_(options.clock ? *options.clock : steady_loop_clock()),
+      n_(static_cast<int>(joints.size())),
+      ids_(hw.ids()) {
+  if (static_cast<int>(hw.joints.size()) != n_)
+    throw std::invalid_argument("run_control: hardware.yaml and the robot differ in joints");
+  if (traj.joints() != n_)
+    throw DataError(traj.name, 0, fmt::format("the trajectory has {} joints, the robot {}", traj.joints(), n_));
   if (gains.inertia.size() != n_) throw std::invalid_argument("run_control: FF+PD gains for another joint count");
   stop_ = options.stop ? options.stop : &stop_flag();
   stops_seen_ = stop_->load();
   watchdog_ = options.watchdog_cycles > 0 ? options.watchdog_cycles : hw.safety.watchdog_cycles;
   T_ = hw.period;
-  for (Eigen::VectorXd* v : {&q_, &qd_servo_, &current_, &tau_, &qr_, &qdr_, &qddr_, &ff_, &q0_, &qr0_, &kt_, &limit_, &unit_,
-                             &max_error_})
+  for (Eigen::VectorXd* v :
+       {&q_, &qd_servo_, &current_, &tau_, &qr_, &qdr_, &qddr_, &ff_, &q0_, &qr0_, &kt_, &limit_, &unit_, &max_error_})
     v->setZero(n_);
   for (int j = 0; j < n_; ++j) {
     const JointHardware& h = hw.joints[j];
@@ -133,9 +146,11 @@ ControlResult Loop::run(const std::string& csv) {
   if (stop.reason == StopReason::hardware_error && alert_id_ >= 0) {
     try {
       PatientBus patient(bus_);
-      const Reply r = bus_.read(static_cast<std::uint8_t>(alert_id_), xs::kHardwareErrorStatus, Clock::now() + std::chrono::milliseconds(200));
+      const Reply r = bus_.read(static_cast<std::uint8_t>(alert_id_), xs::kHardwareErrorStatus,
+                                Clock::now() + std::chrono::milliseconds(200));
       if (r.has_data())
-        stop.message += fmt::format(": Hardware Error Status 0x{:02x} ({})", r.get<std::uint8_t>(0), error_bits(r.get<std::uint8_t>(0)));
+        stop.message += fmt::format(": Hardware Error Status 0x{:02x} ({})", r.get<std::uint8_t>(0),
+                                    error_bits(r.get<std::uint8_t>(0)));
     } catch (const std::exception&) {
     }
   }
@@ -147,8 +162,8 @@ ControlResult Loop::run(const std::string& csv) {
   result.max_error = max_error_;
   std::string summary = timing_.summary();
   std::replace(summary.begin(), summary.end(), '\n', ';');
-  log.set_notes(fmt::format("{}{}stop: {}: {}; at stop: {}; torque off {}; timing: {}", o_.notes, o_.notes.empty() ? "" : "; ",
-                            to_string(stop.reason), stop.message, result.at_stop,
+  log.set_notes(fmt::format("{}{}stop: {}: {}; at stop: {}; torque off {}; timing: {}", o_.notes,
+                            o_.notes.empty() ? "" : "; ", to_string(stop.reason), stop.message, result.at_stop,
                             result.torque_off_confirmed ? "confirmed" : "NOT confirmed for every servo", summary));
   try {
     log.close();
@@ -165,9 +180,10 @@ ControlResult Loop::run(const std::string& csv) {
   }
   result.rows = log.written();
   if (o_.verbose)
-    std::fprintf(stderr, "stop: %s: %s\nat stop: %s\ntorque off %s; %lld log rows in %s\n%s\n", to_string(result.reason),
-                 result.message.c_str(), result.at_stop.c_str(), result.torque_off_confirmed ? "confirmed" : "NOT confirmed for every servo", static_cast<long long>(result.rows),
-                 csv.c_str(), timing_.summary().c_str());
+    std::fprintf(stderr, "stop: %s: %s\nat stop: %s\ntorque off %s; %lld log rows in %s\n%s\n",
+                 to_string(result.reason), result.message.c_str(), result.at_stop.c_str(),
+                 result.torque_off_confirmed ? "confirmed" : "NOT confirmed for every servo",
+                 static_cast<long long>(result.rows), csv.c_str(), timing_.summary().c_str());
   return result;
 }
 
@@ -178,20 +194,25 @@ void Loop::setup() {
     const JointHardware& h = hw_.joints[j];
     const Reply r = bus_.ping(h.id, wait());
     if (!r.has_data())
-      throw StopNow{StopReason::setup_failed, fmt::format("{} does not answer a ping ({})", joint_name(j), dynamixel::to_string(r.outcome))};
+      throw StopNow{StopReason::setup_failed,
+                    fmt::format("{} does not answer a ping ({})", joint_name(j), dynamixel::to_string(r.outcome))};
     const auto model = r.get<std::uint16_t>(0);
     if (model != h.model.model_number)
-      throw StopNow{StopReason::setup_failed, fmt::format("{} is model number {}, hardware.yaml says {} ({})", joint_name(j), model,
-                                                          h.model.model_number, h.model.name)};
+      throw StopNow{StopReason::setup_failed, fmt::format("{} is model number {}, hardware.yaml says {} ({})",
+                                                          joint_name(j), model, h.model.model_number, h.model.name)};
     if (r.outcome == Outcome::hardware_alert) {
       alert_id_ = h.id;
-      throw StopNow{StopReason::hardware_error, fmt::format("{} reports a hardware error before the start", joint_name(j))};
+      throw StopNow{StopReason::hardware_error,
+                    fmt::format("{} reports a hardware error before the start", joint_name(j))};
     }
   }
   const auto expect_ok = [&](int j, const Reply& r, const char* what) {
     if (!r.has_data())
-      throw StopNow{StopReason::setup_failed, fmt::format("{} refused {}: {}{}", joint_name(j), what, dynamixel::to_string(r.outcome),
-                                                          r.outcome == Outcome::error_status ? std::string(" ") + dynamixel::to_string(r.error.number()) : "")};
+      throw StopNow{
+          StopReason::setup_failed,
+          fmt::format(
+              "{} refused {}: {}{}", joint_name(j), what, dynamixel::to_string(r.outcome),
+              r.outcome == Outcome::error_status ? std::string(" ") + dynamixel::to_string(r.error.number()) : "")};
   };
   for (int j = 0; j < n_; ++j) {
     const std::uint8_t id = ids_[j];
@@ -200,7 +221,8 @@ void Loop::setup() {
     const Reply mode = bus_.read(id, xs::kOperatingMode, wait());
     expect_ok(j, mode, "reading Operating Mode");
     if (mode.get<std::uint8_t>(0) != static_cast<std::uint8_t>(xs::OperatingMode::current))
-      expect_ok(j, bus_.write(id, xs::kOperatingMode, static_cast<std::int32_t>(xs::OperatingMode::current), wait()), "current mode");
+      expect_ok(j, bus_.write(id, xs::kOperatingMode, static_cast<std::int32_t>(xs::OperatingMode::current), wait()),
+                "current mode");
     const Reply delay = bus_.read(id, xs::kReturnDelayTime, wait());
     expect_ok(j, delay, "reading Return Delay Time");
     if (delay.get<std::uint8_t>(0) != hw_.return_delay_time)
@@ -215,8 +237,10 @@ void Loop::setup() {
                                 joint_name(j), dynamixel::to_string(clear.outcome))};
     expect_ok(j, bus_.write(id, xs::kGoalCurrent, 0, wait()), "Goal Current 0");
     if (bus_watchdog_units_ > 0)
-      expect_ok(j, bus_.write(id, xs::kBusWatchdog, bus_watchdog_units_, wait()),
-                fmt::format("Bus Watchdog {} ({} ms, safety.bus_watchdog)", bus_watchdog_units_, bus_watchdog_units_ * 20).c_str());
+      expect_ok(
+          j, bus_.write(id, xs::kBusWatchdog, bus_watchdog_units_, wait()),
+          fmt::format("Bus Watchdog {} ({} ms, safety.bus_watchdog)", bus_watchdog_units_, bus_watchdog_units_ * 20)
+              .c_str());
   }
   // The start pose, before torque is on.
   bool fresh = false;
@@ -234,7 +258,8 @@ void Loop::setup() {
 
 bool Loop::read_state(Clock::time_point deadline, bool setup) {
   const auto t0 = Clock::now();  // the time the bus takes, on the steady clock whatever the loop's
-  const auto replies = bus_.sync_read(ids_, xs::kPresentCurrentVelocityPosition.address, xs::kPresentCurrentVelocityPosition.size, deadline);
+  const auto replies = bus_.sync_read(ids_, xs::kPresentCurrentVelocityPosition.address,
+                                      xs::kPresentCurrentVelocityPosition.size, deadline);
   timing_.read_max = std::max(timing_.read_max, seconds(Clock::now() - t0));
   bool all = true;
   for (int j = 0; j < n_; ++j) {
@@ -265,14 +290,16 @@ bool Loop::read_state(Clock::time_point deadline, bool setup) {
       int count = 0;
       for (int j = 0; j < n_; ++j)
         if (stale_[j] >= watchdog_) {
-          lost += fmt::format("{}{} (last: {})", lost.empty() ? "" : ", ", joint_name(j), dynamixel::to_string(replies[j].outcome));
+          lost += fmt::format("{}{} (last: {})", lost.empty() ? "" : ", ", joint_name(j),
+                              dynamixel::to_string(replies[j].outcome));
           ++count;
         }
       if (count > 0 && count < n_)
         throw StopNow{StopReason::servo_lost,
                       fmt::format("{} stopped answering: {} consecutive failed sync reads", lost, stale_cycles_)};
-      throw StopNow{StopReason::watchdog, fmt::format("{} consecutive failed sync reads: the state is {} cycles old (last: {})",
-                                                      stale_cycles_, stale_cycles_, dynamixel::to_string(replies[0].outcome))};
+      throw StopNow{StopReason::watchdog,
+                    fmt::format("{} consecutive failed sync reads: the state is {} cycles old (last: {})",
+                                stale_cycles_, stale_cycles_, dynamixel::to_string(replies[0].outcome))};
     }
   } else {
     stale_cycles_ = 0;
@@ -286,12 +313,15 @@ void Loop::check_bus_watchdog(Clock::duration away) {
   // Only a gap near the limit can have tripped it: then ask the servos (a read, outside the
   // cycle's budget; the cycle is late anyway).
   if (seconds(away) < limit - 2 * T_) return;
-  const auto replies = bus_.sync_read(ids_, xs::kBusWatchdog.address, xs::kBusWatchdog.size, Clock::now() + std::chrono::milliseconds(50));
+  const auto replies = bus_.sync_read(ids_, xs::kBusWatchdog.address, xs::kBusWatchdog.size,
+                                      Clock::now() + std::chrono::milliseconds(50));
   for (int j = 0; j < n_; ++j)
     if (replies[j].has_data() && replies[j].get<std::int8_t>(0) == -1)
-      throw StopNow{StopReason::bus_watchdog,
-                    fmt::format("{} stopped by its bus watchdog: the loop was away {:.0f} ms, past its {:.0f} ms (safety.bus_watchdog)",
-                                joint_name(j), 1e3 * seconds(away), 1e3 * limit)};
+      throw StopNow{
+          StopReason::bus_watchdog,
+          fmt::format(
+              "{} stopped by its bus watchdog: the loop was away {:.0f} ms, past its {:.0f} ms (safety.bus_watchdog)",
+              joint_name(j), 1e3 * seconds(away), 1e3 * limit)};
 }
 
 void Loop::check_limits() {
@@ -299,11 +329,12 @@ void Loop::check_limits() {
   for (int j = 0; j < n_; ++j) {
     const JointInfo& J = joints_[j];
     if (q_(j) < J.lower - s.position_tolerance || q_(j) > J.upper + s.position_tolerance)
-      throw StopNow{StopReason::position_limit, fmt::format("joint {} {} at {:.4f} rad, beyond its limits [{:.4f}, {:.4f}] (+- {} rad)", j + 1,
-                                                            J.name, q_(j), J.lower, J.upper, s.position_tolerance)};
+      throw StopNow{StopReason::position_limit,
+                    fmt::format("joint {} {} at {:.4f} rad, beyond its limits [{:.4f}, {:.4f}] (+- {} rad)", j + 1,
+                                J.name, q_(j), J.lower, J.upper, s.position_tolerance)};
     if (J.velocity > 0 && std::abs(qd_servo_(j)) > s.velocity_factor * J.velocity)
-      throw StopNow{StopReason::velocity_limit, fmt::format("joint {} {} at {:.3f} rad/s, beyond {:.3f} rad/s", j + 1, J.name, qd_servo_(j),
-                                                            s.velocity_factor * J.velocity)};
+      throw StopNow{StopReason::velocity_limit, fmt::format("joint {} {} at {:.3f} rad/s, beyond {:.3f} rad/s", j + 1,
+                                                            J.name, qd_servo_(j), s.velocity_factor * J.velocity)};
   }
   check_current();
 }
@@ -312,8 +343,8 @@ void Loop::check_current() {
   const double trip = hw_.safety.current_trip_factor;
   for (int j = 0; j < n_; ++j)
     if (std::abs(current_(j)) > trip * limit_(j))
-      throw StopNow{StopReason::current_limit,
-                    fmt::format("joint {} {} draws {:.3f} A, beyond {:.3f} A", j + 1, joints_[j].name, current_(j), trip * limit_(j))};
+      throw StopNow{StopReason::current_limit, fmt::format("joint {} {} draws {:.3f} A, beyond {:.3f} A", j + 1,
+                                                           joints_[j].name, current_(j), trip * limit_(j))};
 }
 
 double Loop::reference(double s) {
@@ -359,9 +390,10 @@ void Loop::command_torque(control::FfpdController& ctrl, double t) {
     // A command that is not a number is a fault upstream (the feedforward model, the
     // controller's state): stopping says so, where a silent 0 or a saturation would not.
     if (!std::isfinite(raw))
-      throw StopNow{StopReason::invalid_command,
-                    fmt::format("joint {} {}: the torque command is {} (feedforward {}) at trajectory time {:.3f} s", j + 1,
-                                joints_[j].name, tau_(j), o_.feedforward ? fmt::format("{}", ff_(j)) : "none", t)};
+      throw StopNow{
+          StopReason::invalid_command,
+          fmt::format("joint {} {}: the torque command is {} (feedforward {}) at trajectory time {:.3f} s", j + 1,
+                      joints_[j].name, tau_(j), o_.feedforward ? fmt::format("{}", ff_(j)) : "none", t)};
     if (std::abs(raw) >= bound) saturated = true;
     command_[j] = static_cast<std::int32_t>(std::clamp(raw, -bound, bound));
   }
@@ -377,7 +409,8 @@ void Loop::log_row(const control::FfpdController& ctrl, double time, double t) {
   log_->append(time, q_.data(), ctrl.velocity().data(), tau_meas_.data(), qr_.data(), qdr_.data(), qddr_.data());
   // A run whose log cannot be written stops (safely): its rows would be lost.
   if (log_->failed())
-    throw StopNow{StopReason::error, fmt::format("{}: {} ({} rows on disk)", log_->path().string(), log_->error(), log_->written())};
+    throw StopNow{StopReason::error,
+                  fmt::format("{}: {} ({} rows on disk)", log_->path().string(), log_->error(), log_->written())};
 }
 
 StopNow Loop::loop() {
@@ -388,8 +421,8 @@ StopNow Loop::loop() {
   control::FfpdController& ctrl = ctrl_.emplace(gains_);
   ctrl.reset(q_);
   if (o_.verbose)
-    std::fprintf(stderr, "control: %s, %.3f s (approach %.2f s over %.3f rad, hold %.2f s), period %.1f ms\n", traj_.name.c_str(), end,
-                 approach_, distance, hw_.safety.pre_roll, T_ * 1e3);
+    std::fprintf(stderr, "control: %s, %.3f s (approach %.2f s over %.3f rad, hold %.2f s), period %.1f ms\n",
+                 traj_.name.c_str(), end, approach_, distance, hw_.safety.pre_roll, T_ * 1e3);
 
   const auto T = std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(T_));
   const auto start = clock_.now() + T;
@@ -456,7 +489,8 @@ void Loop::finish_timing() {
   const double periods = period_stats_[4];
   if (periods > 0) {
     timing_.period_mean = period_stats_[0] / periods;
-    timing_.period_std = std::sqrt(std::max(0.0, period_stats_[1] / periods - timing_.period_mean * timing_.period_mean));
+    timing_.period_std =
+        std::sqrt(std::max(0.0, period_stats_[1] / periods - timing_.period_mean * timing_.period_mean));
   }
   if (timing_.cycles > 0) {
     timing_.latency_mean = period_stats_[2] / timing_.cycles;

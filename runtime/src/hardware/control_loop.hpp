@@ -48,8 +48,8 @@ struct StopNow {
 
 class Loop {
  public:
-  Loop(dynamixel::Bus& bus, const HardwareConfig& hw, const std::vector<JointInfo>& joints, const control::FfpdGains& gains,
-       const trajectory::Trajectory& traj, const ControlOptions& options);
+  Loop(dynamixel::Bus& bus, const HardwareConfig& hw, const std::vector<JointInfo>& joints,
+       const control::FfpdGains& gains, const trajectory::Trajectory& traj, const ControlOptions& options);
   ControlResult run(const std::string& csv);
 
  private:
@@ -97,9 +97,9 @@ class Loop {
   int watchdog_ = 3;
   int bus_watchdog_units_ = 0;  // Bus Watchdog(98) written before torque on (20 ms units; 0: off)
   int alert_id_ = -1;
-  bool torque_on_ = false;  // Torque Enable 1 was written to every servo
-  bool feedforward_checked_ = false;  // the model feedforward passed check_feedforward()
-  std::int64_t k_end_ = 0;            // the last cycle of the run (plan())
+  bool torque_on_ = false;                       // Torque Enable 1 was written to every servo
+  bool feedforward_checked_ = false;             // the model feedforward passed check_feedforward()
+  std::int64_t k_end_ = 0;                       // the last cycle of the run (plan())
   std::optional<control::FfpdController> ctrl_;  // the run's controller: the hold continues it
   TimingStats timing_;
   std::array<double, 5> period_stats_{};

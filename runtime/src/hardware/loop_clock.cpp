@@ -53,7 +53,9 @@ void SteppedClock::sleep_until(time_point t, const std::atomic<int>& stop, int s
   elapsed_ns_.store(ns, std::memory_order_release);
 }
 
-LoopClock::time_point SteppedClock::io_deadline(time_point) const { return std::chrono::steady_clock::now() + io_timeout_; }
+LoopClock::time_point SteppedClock::io_deadline(time_point) const {
+  return std::chrono::steady_clock::now() + io_timeout_;
+}
 
 double SteppedClock::seconds() const { return elapsed_ns_.load(std::memory_order_acquire) * 1e-9; }
 

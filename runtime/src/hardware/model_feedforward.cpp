@@ -10,8 +10,9 @@ namespace {
 
 void check_size(const robot::ModelHandle& model, const Eigen::VectorXd& phi) {
   if (phi.size() != model.np())
-    throw std::invalid_argument("model feedforward: " + std::to_string(phi.size()) + " parameters for model '" + model.label() +
-                                "' of robot '" + model.robot() + "', which has " + std::to_string(model.np()));
+    throw std::invalid_argument("model feedforward: " + std::to_string(phi.size()) + " parameters for model '" +
+                                model.label() + "' of robot '" + model.robot() + "', which has " +
+                                std::to_string(model.np()));
 }
 
 }  // namespace
@@ -19,7 +20,8 @@ void check_size(const robot::ModelHandle& model, const Eigen::VectorXd& phi) {
 std::function<void(const Eigen::VectorXd&, const Eigen::VectorXd&, const Eigen::VectorXd&, Eigen::VectorXd&)>
 model_feedforward(const robot::ModelHandle& model, const Eigen::VectorXd& phi) {
   check_size(model, phi);
-  return [model, phi](const Eigen::VectorXd& q, const Eigen::VectorXd& qd, const Eigen::VectorXd& qdd, Eigen::VectorXd& tau) {
+  return [model, phi](const Eigen::VectorXd& q, const Eigen::VectorXd& qd, const Eigen::VectorXd& qdd,
+                      Eigen::VectorXd& tau) {
     tau.resize(model.nq());
     model.inverse_dynamics(q.data(), qd.data(), qdd.data(), phi.data(), tau.data());
   };

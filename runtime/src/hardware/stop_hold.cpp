@@ -54,7 +54,8 @@ void Loop::at_stop(const StopNow& stop, ControlResult& result) {
   // with the same error: PD alone then.
   Eigen::VectorXd gravity = Eigen::VectorXd::Zero(n_);
   std::string with = "PD";
-  const bool innocent = stop.reason == StopReason::signal || stop.reason == StopReason::completed || stop.reason == StopReason::error;
+  const bool innocent =
+      stop.reason == StopReason::signal || stop.reason == StopReason::completed || stop.reason == StopReason::error;
   if (o_.feedforward && !feedforward_checked_) {
     with = "PD (the model feedforward was not checked)";
   } else if (o_.feedforward && stop.reason == StopReason::invalid_command) {
@@ -76,8 +77,9 @@ void Loop::at_stop(const StopNow& stop, ControlResult& result) {
   }
   result.stop_action = StopAction::hold;
   const std::string ended = hold(gravity, result);
-  result.at_stop = fmt::format("hold {:.3f} s at the stop pose ({}; max deviation {:.3f} deg){}, then torque off", result.held, with,
-                               result.hold_deviation * 180 / 3.14159265358979323846, ended.empty() ? "" : ", ended early: " + ended);
+  result.at_stop =
+      fmt::format("hold {:.3f} s at the stop pose ({}; max deviation {:.3f} deg){}, then torque off", result.held, with,
+                  result.hold_deviation * 180 / 3.14159265358979323846, ended.empty() ? "" : ", ended early: " + ended);
 }
 
 // Holds q at the stop for safety.hold_time; returns why it ended early ("" when it did not).
@@ -100,7 +102,8 @@ std::string Loop::hold(const Eigen::VectorXd& gravity, ControlResult& result) {
     try {
       if (previous_wake != Clock::time_point{}) check_bus_watchdog(wake - previous_wake);
       previous_wake = wake;
-      fresh = read_state(clock_.io_deadline(std::max(deadline + T * 8 / 10, wake + T / 2)), /*setup=*/true);  // counts no watchdog of the run
+      fresh = read_state(clock_.io_deadline(std::max(deadline + T * 8 / 10, wake + T / 2)),
+                         /*setup=*/true);  // counts no watchdog of the run
       if (fresh) check_current();
     } catch (const StopNow& fault) {
       return fault.message;
@@ -111,7 +114,8 @@ std::string Loop::hold(const Eigen::VectorXd& gravity, ControlResult& result) {
     tau_ = ctrl_->update(q_, q_hold, zero, zero) + gravity;
     for (int j = 0; j < n_; ++j) {
       const double raw = std::round(hw_.joints[j].direction * tau_(j) / kt_(j) / unit_(j));
-      if (!std::isfinite(raw)) return fmt::format("joint {} {}: the hold's command is {}", j + 1, joints_[j].name, tau_(j));
+      if (!std::isfinite(raw))
+        return fmt::format("joint {} {}: the hold's command is {}", j + 1, joints_[j].name, tau_(j));
       const double bound = limit_raw_[j];
       command_[j] = static_cast<std::int32_t>(std::clamp(raw, -bound, bound));
     }

@@ -58,7 +58,8 @@ const std::vector<int>& stop_signals() {
     // Every catchable signal whose default action ends the process (signal(7)), but for SIGPIPE
     // (ignored) and the faults a program cannot continue after (SIGSEGV, SIGBUS, SIGFPE, SIGILL,
     // SIGABRT, SIGTRAP, SIGSYS: the servos' bus watchdog covers those, docs/safety.md).
-    std::vector<int> v{SIGINT, SIGTERM, SIGHUP, SIGQUIT, SIGUSR1, SIGUSR2, SIGALRM, SIGVTALRM, SIGPROF, SIGXCPU, SIGXFSZ, SIGIO};
+    std::vector<int> v{SIGINT,  SIGTERM,   SIGHUP,  SIGQUIT, SIGUSR1, SIGUSR2,
+                       SIGALRM, SIGVTALRM, SIGPROF, SIGXCPU, SIGXFSZ, SIGIO};
 #ifdef SIGPWR
     v.push_back(SIGPWR);
 #endif
@@ -80,7 +81,7 @@ StopSignals::StopSignals() : signals_(stop_signals()), previous_(signals_.size()
   sa.sa_sigaction = stop_signal_handler;
   sigemptyset(&sa.sa_mask);
   for (int s : signals_) sigaddset(&sa.sa_mask, s);  // one handler at a time: the check and update stay whole
-  sa.sa_flags = SA_SIGINFO;  // no SA_RESTART: a sleeping loop wakes up at once
+  sa.sa_flags = SA_SIGINFO;                          // no SA_RESTART: a sleeping loop wakes up at once
   for (std::size_t i = 0; i < signals_.size(); ++i) sigaction(signals_[i], &sa, &previous_[i]);
   // A closed stdout or stderr (`dynid control ... | head -1`) must not end the run: a write
   // there fails with EPIPE instead.

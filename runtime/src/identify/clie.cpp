@@ -31,9 +31,9 @@ SampleGrid sample_grid(const preprocess::Samples& measured, double period, int c
     const double cycle = measured.time(s) / period;
     const long long k = std::llround(cycle);
     if (!(std::abs(cycle - static_cast<double>(k)) < 1e-6) || k < 0 || k >= cycles)
-      throw std::invalid_argument(fmt::format(
-          "CLIE: sample {} at t = {} s is not one of the simulation's cycles 0..{} of {} s", s, measured.time(s),
-          cycles - 1, period));
+      throw std::invalid_argument(
+          fmt::format("CLIE: sample {} at t = {} s is not one of the simulation's cycles 0..{} of {} s", s,
+                      measured.time(s), cycles - 1, period));
     grid.rows[static_cast<std::size_t>(s)] = static_cast<Eigen::Index>(k);
   }
   grid.filter = options.filter;
@@ -48,8 +48,8 @@ SampleGrid sample_grid(const preprocess::Samples& measured, double period, int c
                       : o.base_period > 0             ? o.base_period
                                                       : period;
   if (!(std::abs(period - base) <= 1e-9 * period))
-    throw std::invalid_argument(fmt::format("CLIE: the control period {} s differs from the preprocessing base period {} s",
-                                            period, base));
+    throw std::invalid_argument(
+        fmt::format("CLIE: the control period {} s differs from the preprocessing base period {} s", period, base));
   const double cutoff = std::min(o.derivative_cutoff, o.anti_alias_fraction * 0.5 / measured.interval);
   if (measured.report.cutoff > 0 && !(std::abs(measured.report.cutoff - cutoff) <= 1e-9 * cutoff))
     throw std::invalid_argument(fmt::format(
@@ -58,8 +58,9 @@ SampleGrid sample_grid(const preprocess::Samples& measured, double period, int c
   grid.sections = preprocess::butterworth_lowpass(o.filter_order, cutoff, 1 / period);
   grid.padding = preprocess::zero_phase_padding(grid.sections);
   if (grid.padding >= cycles)
-    throw std::invalid_argument(fmt::format("CLIE: {} simulated cycles are too few for the {:.3g} Hz filter's padding of {}",
-                                            cycles, cutoff, grid.padding));
+    throw std::invalid_argument(
+        fmt::format("CLIE: {} simulated cycles are too few for the {:.3g} Hz filter's padding of {}", cycles, cutoff,
+                    grid.padding));
   return grid;
 }
 
@@ -70,11 +71,12 @@ void lowpass(const SampleGrid& grid, preprocess::Channels& signals) {
 Eigen::VectorXd rms_per_joint(const Eigen::VectorXd& residuals, int joints) {
   const Eigen::Index samples = residuals.size() / joints;
   const Eigen::Map<const Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>> r(residuals.data(),
-                                                                                                    samples, joints);
+                                                                                                   samples, joints);
   return (r.colwise().squaredNorm().transpose() / static_cast<double>(std::max<Eigen::Index>(samples, 1))).cwiseSqrt();
 }
 
-Bounds parameter_bounds(const Eigen::VectorXd& phi0, const std::vector<bool>& rotor_inertia, const ClieOptions& options) {
+Bounds parameter_bounds(const Eigen::VectorXd& phi0, const std::vector<bool>& rotor_inertia,
+                        const ClieOptions& options) {
   if (!(options.bound_factor >= 0) || !(options.min_bound > 0) || !(options.min_rotor_inertia >= 0))
     throw std::invalid_argument("CLIE: bound_factor >= 0, min_bound > 0 and min_rotor_inertia >= 0 needed");
   if (!phi0.allFinite()) throw std::invalid_argument("CLIE: the starting phi is not finite");
@@ -82,9 +84,10 @@ Bounds parameter_bounds(const Eigen::VectorXd& phi0, const std::vector<bool>& ro
   if (!(options.noise_floor >= 0) || !std::isfinite(options.noise_floor))
     throw std::invalid_argument("CLIE: noise_floor must be finite and >= 0");
   const bool by_std = options.std_bound > 0;
-  if (by_std && (options.scale.size() != phi0.size() || !(options.scale.array() > 0).all() || !options.scale.allFinite()))
-    throw std::invalid_argument(fmt::format("CLIE: std_bound needs {} positive standard deviations, got {}", phi0.size(),
-                                            options.scale.size()));
+  if (by_std &&
+      (options.scale.size() != phi0.size() || !(options.scale.array() > 0).all() || !options.scale.allFinite()))
+    throw std::invalid_argument(fmt::format("CLIE: std_bound needs {} positive standard deviations, got {}",
+                                            phi0.size(), options.scale.size()));
   Bounds b;
   b.lower.resize(phi0.size());
   b.upper.resize(phi0.size());
@@ -137,7 +140,8 @@ class BoundReached final : public ceres::IterationCallback {
     if (s.iteration == 0 || !s.step_is_successful) return ceres::SOLVER_CONTINUE;
     for (std::size_t i = 0; i < held_.size(); ++i) {
       const auto k = static_cast<Eigen::Index>(i);
-      if (!held_[i] && (phi_[i] <= bounds_.lower(k) || phi_[i] >= bounds_.upper(k))) reached_.push_back(static_cast<int>(i));
+      if (!held_[i] && (phi_[i] <= bounds_.lower(k) || phi_[i] >= bounds_.upper(k)))
+        reached_.push_back(static_cast<int>(i));
     }
     return reached_.empty() ? ceres::SOLVER_CONTINUE : ceres::SOLVER_TERMINATE_SUCCESSFULLY;
   }
@@ -187,7 +191,8 @@ class LastJacobian final : public ceres::CostFunction {
   bool gradient(const Eigen::VectorXd& phi, Eigen::VectorXd& g) const {
     if (!kept_ || phi_ != phi) return false;
     const Eigen::Index n = phi.size(), m = num_residuals();
-    const Eigen::Map<const Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>> j(jacobian_.data(), m, n);
+    const Eigen::Map<const Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>> j(jacobian_.data(),
+                                                                                                     m, n);
     g = j.transpose() * residuals_;
     return true;
   }
@@ -224,7 +229,7 @@ void solve_bounded(ceres::CostFunction& cost, const Bounds& bounds, const ClieOp
     std::vector<int> constant;
     for (int i = 0; i < np; ++i)
       if (held[static_cast<std::size_t>(i)]) constant.push_back(i);
-    if (static_cast<int>(constant.size()) == np) break;  // nothing left to move
+    if (static_cast<int>(constant.size()) == np) break;                                        // nothing left to move
     if (!constant.empty()) problem.SetManifold(phi, new ceres::SubsetManifold(np, constant));  // owned by problem
 
     ceres::Solver::Options so;
@@ -261,9 +266,11 @@ void solve_bounded(ceres::CostFunction& cost, const Bounds& bounds, const ClieOp
     result.iterations += summary.num_successful_steps + summary.num_unsuccessful_steps - (user_stop ? 1 : 0);
     result.jacobian_evaluations += summary.num_jacobian_evaluations;
     result.residual_evaluations += summary.num_residual_evaluations;
-    result.success = summary.termination_type == ceres::CONVERGENCE || summary.termination_type == ceres::NO_CONVERGENCE || user_stop;
-    result.termination = noise_stop ? "CONVERGENCE: " + noise_floor.message()
-                                    : fmt::format("{}: {}", ceres::TerminationTypeToString(summary.termination_type), summary.message);
+    result.success = summary.termination_type == ceres::CONVERGENCE ||
+                     summary.termination_type == ceres::NO_CONVERGENCE || user_stop;
+    result.termination =
+        noise_stop ? "CONVERGENCE: " + noise_floor.message()
+                   : fmt::format("{}: {}", ceres::TerminationTypeToString(summary.termination_type), summary.message);
     for (int i : bound_reached.reached()) held[static_cast<std::size_t>(i)] = true;
     // Release a held parameter whose gradient points into the box (the cost falls moving it off
     // its bound): another round then moves it.
@@ -272,15 +279,16 @@ void solve_bounded(ceres::CostFunction& cost, const Bounds& bounds, const ClieOp
     if (std::find(held.begin(), held.end(), true) != held.end() && kept.gradient(result.phi, g))
       for (int i = 0; i < np; ++i) {
         const auto k = static_cast<std::size_t>(i);
-        if (held[k] && ((result.phi(i) <= bounds.lower(i) && g(i) < 0) || (result.phi(i) >= bounds.upper(i) && g(i) > 0))) {
+        if (held[k] &&
+            ((result.phi(i) <= bounds.lower(i) && g(i) < 0) || (result.phi(i) >= bounds.upper(i) && g(i) > 0))) {
           held[k] = false;
           released = true;
         }
       }
     if (!new_bound && !released) break;
     if (result.iterations >= options.max_iterations) {
-      result.termination = fmt::format("NO_CONVERGENCE: Maximum number of iterations reached. Number of iterations: {}.",
-                                       result.iterations);
+      result.termination = fmt::format(
+          "NO_CONVERGENCE: Maximum number of iterations reached. Number of iterations: {}.", result.iterations);
       break;
     }
   }
@@ -301,7 +309,8 @@ class SampledSensitivities final : public ClosedLoop::SensitivityRows {
     } else {
       order_.resize(grid.rows.size());
       for (std::size_t s = 0; s < order_.size(); ++s) order_[s] = s;
-      std::stable_sort(order_.begin(), order_.end(), [&](std::size_t a, std::size_t b) { return grid.rows[a] < grid.rows[b]; });
+      std::stable_sort(order_.begin(), order_.end(),
+                       [&](std::size_t a, std::size_t b) { return grid.rows[a] < grid.rows[b]; });
       rows_.resize(static_cast<Eigen::Index>(grid.rows.size()), width);
     }
   }
@@ -386,8 +395,7 @@ class ClieCost final : public ceres::CostFunction {
     return slot.ok;
   }
 
-  bool simulate_residuals(const Eigen::VectorXd& phi, double* residuals, double* jacobian,
-                          Divergence* why) const {
+  bool simulate_residuals(const Eigen::VectorXd& phi, double* residuals, double* jacobian, Divergence* why) const {
     std::optional<SampledSensitivities> dtau;
     if (jacobian) {
       dtau.emplace(grid_, sim_.cycles(), static_cast<Eigen::Index>(n_) * np_);
@@ -461,7 +469,8 @@ ClieResult clie(const ClosedLoop& sim, const preprocess::Samples& measured, cons
   detail::ClieCost cost(sim, measured, grid);
   Eigen::VectorXd r;
   if (!cost.residuals(result.phi, r, &result.start_divergence)) {
-    result.termination = "not started: the starting point's simulation diverges (" + result.start_divergence.describe() + ")";
+    result.termination =
+        "not started: the starting point's simulation diverges (" + result.start_divergence.describe() + ")";
     result.wall = elapsed();
     return result;
   }

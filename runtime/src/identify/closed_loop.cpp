@@ -56,7 +56,8 @@ void check_setup(const ClosedLoopSetup& s, int joints) {
     throw std::invalid_argument("closed-loop setup: period and pseudo-derivative time must be positive");
   // The command must take effect within its own cycle: the hold structure assumes it.
   if (!(s.delay >= 0) || !(s.delay < g.period))
-    throw std::invalid_argument(fmt::format("closed-loop setup: delay {} s must be in [0, period = {} s)", s.delay, g.period));
+    throw std::invalid_argument(
+        fmt::format("closed-loop setup: delay {} s must be in [0, period = {} s)", s.delay, g.period));
   if (!(s.pre_roll >= 0) || s.substeps < 1 || !(s.divergence_error > 0))
     throw std::invalid_argument("closed-loop setup: pre_roll >= 0, substeps >= 1 and divergence_error > 0 needed");
 }

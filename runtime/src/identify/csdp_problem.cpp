@@ -80,7 +80,6 @@ struct CsdpWorkspace {
   }
 };
 
-
 // C = -F_k0 per block, exactly symmetric (CSDP checks C(i,j) == C(j,i) bitwise).
 void set_constant(CsdpWorkspace& w, const std::vector<Eigen::MatrixXd>& constant) {
   const int nb = static_cast<int>(constant.size());
@@ -145,8 +144,10 @@ void link_by_block(CsdpWorkspace& w) {
   for (int v = 1; v <= w.k; ++v)
     for (sparseblock* p = w.constraints[v].blocks; p; p = p->next) {
       p->nextbyblock = nullptr;
-      if (last[p->blocknum]) last[p->blocknum]->nextbyblock = p;
-      else w.byblocks[p->blocknum] = p;
+      if (last[p->blocknum])
+        last[p->blocknum]->nextbyblock = p;
+      else
+        w.byblocks[p->blocknum] = p;
       last[p->blocknum] = p;
     }
 }
@@ -222,17 +223,28 @@ int run_csdp(CsdpWorkspace& w, const LmiSettings& settings, double& pobj, double
 
 std::string LmiSolution::message() const {
   switch (code) {
-    case 0: return "ok";
-    case 1: return "CSDP: primal infeasible (the LMI program is unbounded)";
-    case 2: return "CSDP: dual infeasible (the LMI constraints have no solution)";
-    case 3: return "ok (CSDP: reduced accuracy)";
-    case 4: return "CSDP: maximum iterations reached";
-    case 5: return "CSDP: stuck at the edge of primal feasibility";
-    case 6: return "CSDP: stuck at the edge of dual feasibility";
-    case 7: return "CSDP: lack of progress";
-    case 8: return "CSDP: X, Z or O singular";
-    case 9: return "CSDP: NaN or Inf encountered";
-    default: return fmt::format("CSDP: return code {}", code);
+    case 0:
+      return "ok";
+    case 1:
+      return "CSDP: primal infeasible (the LMI program is unbounded)";
+    case 2:
+      return "CSDP: dual infeasible (the LMI constraints have no solution)";
+    case 3:
+      return "ok (CSDP: reduced accuracy)";
+    case 4:
+      return "CSDP: maximum iterations reached";
+    case 5:
+      return "CSDP: stuck at the edge of primal feasibility";
+    case 6:
+      return "CSDP: stuck at the edge of dual feasibility";
+    case 7:
+      return "CSDP: lack of progress";
+    case 8:
+      return "CSDP: X, Z or O singular";
+    case 9:
+      return "CSDP: NaN or Inf encountered";
+    default:
+      return fmt::format("CSDP: return code {}", code);
   }
 }
 

@@ -26,9 +26,9 @@ struct LmiSettings {
 
 struct LmiSolution {
   Eigen::VectorXd y;
-  int code = -1;            // CSDP's return code: 0 solved, 3 solved with reduced accuracy, ...
-  double objective = 0;     // b'y
-  double lower_bound = 0;   // CSDP's primal objective tr(CX), a lower bound on b'y
+  int code = -1;           // CSDP's return code: 0 solved, 3 solved with reduced accuracy, ...
+  double objective = 0;    // b'y
+  double lower_bound = 0;  // CSDP's primal objective tr(CX), a lower bound on b'y
   bool solved() const { return code == 0 || code == 3; }
   std::string message() const;
 };

@@ -37,7 +37,8 @@ Solve solve(const Eigen::MatrixXd& W, const Eigen::VectorXd& y) {
   const Eigen::MatrixXd R = qr.matrixQR().topRows(p).triangularView<Eigen::Upper>();
   for (Eigen::Index i = 0; i < p; ++i)
     if (!(std::abs(R(i, i)) > 1e-12 * std::abs(R(0, 0))))
-      throw std::invalid_argument(fmt::format("the regressor is rank deficient at column {} (parameter not excited)", i));
+      throw std::invalid_argument(
+          fmt::format("the regressor is rank deficient at column {} (parameter not excited)", i));
   Solve s;
   const Eigen::VectorXd qty = (qr.householderQ().transpose() * y).head(p);
   s.phi = R.triangularView<Eigen::Upper>().solve(qty);

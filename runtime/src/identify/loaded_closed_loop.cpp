@@ -18,8 +18,8 @@
 namespace symoro::identify {
 namespace {
 
-using robot::ModelHandle;
 using Eigen::Dynamic;
+using robot::ModelHandle;
 
 // The buffers' types for N joints (Dynamic: the run-time count).
 template <int N>
@@ -85,13 +85,17 @@ class LoadedClosedLoop final : public ClosedLoop {
   // S's q rows and qd rows.
   template <class X>
   auto top(X& S) const {
-    if constexpr (N == Dynamic) return S.topRows(n_);
-    else return S.template topRows<N>();
+    if constexpr (N == Dynamic)
+      return S.topRows(n_);
+    else
+      return S.template topRows<N>();
   }
   template <class X>
   auto bottom(X& S) const {
-    if constexpr (N == Dynamic) return S.bottomRows(n_);
-    else return S.template bottomRows<N>();
+    if constexpr (N == Dynamic)
+      return S.bottomRows(n_);
+    else
+      return S.template bottomRows<N>();
   }
   // Everything a simulation writes per step, sized once.
   struct Work {
@@ -120,8 +124,8 @@ class LoadedClosedLoop final : public ClosedLoop {
   }
 
   // qdd = M^-1 (u - h) at x, and with sens its derivative d qdd / d phi. False on divergence.
-  bool acceleration(bool sens, const Eigen::VectorXd& phi, const State& x, const Vec& u, const Mat& du, double t, Vec& qdd,
-                    Mat& dqdd, Work& w, Divergence& why) const {
+  bool acceleration(bool sens, const Eigen::VectorXd& phi, const State& x, const Vec& u, const Mat& du, double t,
+                    Vec& qdd, Mat& dqdd, Work& w, Divergence& why) const {
     if (!x.q.allFinite() || !x.qd.allFinite()) {
       why = detail::not_finite(t);
       return false;
@@ -191,8 +195,8 @@ class LoadedClosedLoop final : public ClosedLoop {
     return true;
   }
 
-  bool hold_frozen(const Eigen::VectorXd& phi, State& x, const Vec& u, const Mat& du, double length, double t0, double sample_at,
-                   Vec& qs, Mat& dqs, Work& w, Divergence& why) const {
+  bool hold_frozen(const Eigen::VectorXd& phi, State& x, const Vec& u, const Mat& du, double length, double t0,
+                   double sample_at, Vec& qs, Mat& dqs, Work& w, Divergence& why) const {
     const int m = setup_.substeps;
     const double h = length / m;
     State& mid = w.mid;
@@ -234,8 +238,8 @@ class LoadedClosedLoop final : public ClosedLoop {
     return true;
   }
 
-  bool run(bool sens, const Eigen::VectorXd& phi, preprocess::Channels& tau, SensitivityRows* dtau, preprocess::Channels* q_out,
-           Divergence& why) const {
+  bool run(bool sens, const Eigen::VectorXd& phi, preprocess::Channels& tau, SensitivityRows* dtau,
+           preprocess::Channels* q_out, Divergence& why) const {
     const double T = period(), d = setup_.delay;
     const int total = pre_cycles_ + cycles_;
     const bool split = setup_.split_at_sampling;
@@ -251,8 +255,10 @@ class LoadedClosedLoop final : public ClosedLoop {
     x.qd.resize(n_);
     x.qd.setZero();
     x.S.resize(2 * n_, np_);
-    if (sens) controller.template reset<true>(x.q);
-    else controller.template reset<false>(x.q);
+    if (sens)
+      controller.template reset<true>(x.q);
+    else
+      controller.template reset<false>(x.q);
     Vec u_prev, u, qs = x.q;
     u_prev.resize(n_);
     u_prev.setZero();
@@ -293,8 +299,10 @@ class LoadedClosedLoop final : public ClosedLoop {
         }
         if (q_out) q_out->row(k) = qs.transpose();
       }
-      if (sens) controller.template update<true>(qs, dqs, q_ref_.col(k), qd_ref_.col(k), qdd_ref_.col(k), u, du);
-      else controller.template update<false>(qs, dqs, q_ref_.col(k), qd_ref_.col(k), qdd_ref_.col(k), u, du);
+      if (sens)
+        controller.template update<true>(qs, dqs, q_ref_.col(k), qd_ref_.col(k), qdd_ref_.col(k), u, du);
+      else
+        controller.template update<false>(qs, dqs, q_ref_.col(k), qd_ref_.col(k), qdd_ref_.col(k), u, du);
       if (c == total - 1) break;
       if (split) {
         if (!hold(sens, phi, x, u_prev, du_prev, d, t, -1, qs, dqs, w, why)) return false;
@@ -320,14 +328,22 @@ class LoadedClosedLoop final : public ClosedLoop {
 std::unique_ptr<ClosedLoop> closed_loop(const robot::ModelHandle& model, const ClosedLoopSetup& setup,
                                         const trajectory::SampledReference& reference) {
   switch (model.nq()) {
-    case 2: return std::make_unique<LoadedClosedLoop<2>>(model, setup, reference);
-    case 3: return std::make_unique<LoadedClosedLoop<3>>(model, setup, reference);
-    case 4: return std::make_unique<LoadedClosedLoop<4>>(model, setup, reference);
-    case 5: return std::make_unique<LoadedClosedLoop<5>>(model, setup, reference);
-    case 6: return std::make_unique<LoadedClosedLoop<6>>(model, setup, reference);
-    case 7: return std::make_unique<LoadedClosedLoop<7>>(model, setup, reference);
-    case 8: return std::make_unique<LoadedClosedLoop<8>>(model, setup, reference);
-    default: return detail::closed_loop_run_time_sizes(model, setup, reference);
+    case 2:
+      return std::make_unique<LoadedClosedLoop<2>>(model, setup, reference);
+    case 3:
+      return std::make_unique<LoadedClosedLoop<3>>(model, setup, reference);
+    case 4:
+      return std::make_unique<LoadedClosedLoop<4>>(model, setup, reference);
+    case 5:
+      return std::make_unique<LoadedClosedLoop<5>>(model, setup, reference);
+    case 6:
+      return std::make_unique<LoadedClosedLoop<6>>(model, setup, reference);
+    case 7:
+      return std::make_unique<LoadedClosedLoop<7>>(model, setup, reference);
+    case 8:
+      return std::make_unique<LoadedClosedLoop<8>>(model, setup, reference);
+    default:
+      return detail::closed_loop_run_time_sizes(model, setup, reference);
   }
 }
 

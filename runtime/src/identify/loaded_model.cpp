@@ -200,8 +200,10 @@ class LoadedIdentificationModel final : public IdentificationModel {
     PhysicalProjection p;
     p.phi = phi0;
     if (!supports_) {
-      p.status = fmt::format("physical consistency is not available for the {} model: its effect parameters are not "
-                             "standard inertial parameters (use the PD path)", m_.variant());
+      p.status = fmt::format(
+          "physical consistency is not available for the {} model: its effect parameters are not "
+          "standard inertial parameters (use the PD path)",
+          m_.variant());
       return p;
     }
     ConsistencyOptions options;
@@ -225,8 +227,9 @@ class LoadedIdentificationModel final : public IdentificationModel {
       const ConsistencyResult v = check(p.phi, prior);
       p.feasible = v.ok();
       p.margin = v.feasibility;
-      p.status = p.feasible ? fmt::format("projected onto the consistent set (distance {:.4g}); {}", p.distance, v.message)
-                            : fmt::format("the projection has no consistent set after all: {}", v.message);
+      p.status = p.feasible
+                     ? fmt::format("projected onto the consistent set (distance {:.4g}); {}", p.distance, v.message)
+                     : fmt::format("the projection has no consistent set after all: {}", v.message);
       if (!p.feasible) p.phi = phi0;
     } else {
       p.status = p.check.message;
@@ -277,7 +280,8 @@ class LoadedIdentificationModel final : public IdentificationModel {
   }
   std::vector<int> fixed_parent_rows() const {
     std::vector<int> free(static_cast<std::size_t>(full_.np()), 0), held;
-    for (int i = 0; i < m_.np(); ++i) free[static_cast<std::size_t>(m_.parent_index()[static_cast<std::size_t>(i)])] = 1;
+    for (int i = 0; i < m_.np(); ++i)
+      free[static_cast<std::size_t>(m_.parent_index()[static_cast<std::size_t>(i)])] = 1;
     for (int i = 0; i < full_.np(); ++i)
       if (!free[static_cast<std::size_t>(i)]) held.push_back(i);
     return held;

@@ -50,8 +50,8 @@ void require(bool ok, const std::string& message) {
 
 void validate(const InertiaFunction& m, const VectorXd& phi, const AuditDomain& domain) {
   const int n = m.joints();
-  require(phi.size() == m.parameters(), "phi has " + std::to_string(phi.size()) + " entries, the model " +
-                                            std::to_string(m.parameters()));
+  require(phi.size() == m.parameters(),
+          "phi has " + std::to_string(phi.size()) + " entries, the model " + std::to_string(m.parameters()));
   require(domain.lower.size() == n && domain.upper.size() == n,
           "the domain has " + std::to_string(domain.lower.size()) + " lower and " +
               std::to_string(domain.upper.size()) + " upper bounds, the model " + std::to_string(n) + " joints");
@@ -200,8 +200,8 @@ class RayleighProblem : public Ipopt::TNLP {
     return true;
   }
 
-  bool get_starting_point(Ipopt::Index, bool init_x, Ipopt::Number* x, bool init_z, Ipopt::Number*,
-                          Ipopt::Number*, Ipopt::Index, bool init_lambda, Ipopt::Number*) override {
+  bool get_starting_point(Ipopt::Index, bool init_x, Ipopt::Number* x, bool init_z, Ipopt::Number*, Ipopt::Number*,
+                          Ipopt::Index, bool init_lambda, Ipopt::Number*) override {
     if (!init_x || init_z || init_lambda) return false;
     std::copy(start_.data(), start_.data() + start_.size(), x);
     return true;
@@ -269,8 +269,8 @@ class RayleighProblem : public Ipopt::TNLP {
   }
 
   void finalize_solution(Ipopt::SolverReturn, Ipopt::Index n, const Ipopt::Number* x, const Ipopt::Number*,
-                         const Ipopt::Number*, Ipopt::Index, const Ipopt::Number*, const Ipopt::Number*,
-                         Ipopt::Number, const Ipopt::IpoptData*, Ipopt::IpoptCalculatedQuantities*) override {
+                         const Ipopt::Number*, Ipopt::Index, const Ipopt::Number*, const Ipopt::Number*, Ipopt::Number,
+                         const Ipopt::IpoptData*, Ipopt::IpoptCalculatedQuantities*) override {
     // Whatever the status: the caller keeps the start when this pose is no worse.
     if (x != nullptr) solution_ = Eigen::Map<const VectorXd>(x, n);
   }
@@ -405,7 +405,8 @@ std::vector<int> distinct_best(const std::vector<double>& lambda, const std::fun
 }
 
 void finish(AuditResult& r, std::vector<AuditPose> poses, const PoseMetric& metric, Clock::time_point start) {
-  std::sort(poses.begin(), poses.end(), [](const AuditPose& a, const AuditPose& b) { return a.lambda_min < b.lambda_min; });
+  std::sort(poses.begin(), poses.end(),
+            [](const AuditPose& a, const AuditPose& b) { return a.lambda_min < b.lambda_min; });
   for (AuditPose& p : poses) {
     bool distinct = true;
     for (const AuditPose& k : r.minima) distinct = distinct && metric(p.q, k.q) >= kSameMinimum;
@@ -507,8 +508,7 @@ AuditResult audit_pd(const InertiaFunction& m, const VectorXd& phi, const AuditD
   return r;
 }
 
-AuditResult grid_audit(const InertiaFunction& m, const VectorXd& phi, const AuditDomain& domain,
-                       int points_per_joint) {
+AuditResult grid_audit(const InertiaFunction& m, const VectorXd& phi, const AuditDomain& domain, int points_per_joint) {
   const auto start = Clock::now();
   validate(m, phi, domain);
   require(points_per_joint >= 1, "points_per_joint must be at least 1");

@@ -25,15 +25,34 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 Eigen::Matrix4d unit_pseudo_inertia(int slot) {
   Eigen::Matrix4d E = Eigen::Matrix4d::Zero();
   switch (slot) {
-    case 0: E.diagonal().head<3>() << -0.5, 0.5, 0.5; break;
-    case 3: E.diagonal().head<3>() << 0.5, -0.5, 0.5; break;
-    case 5: E.diagonal().head<3>() << 0.5, 0.5, -0.5; break;
-    case 1: E(0, 1) = E(1, 0) = -1; break;
-    case 2: E(0, 2) = E(2, 0) = -1; break;
-    case 4: E(1, 2) = E(2, 1) = -1; break;
-    case 6: case 7: case 8: E(slot - 6, 3) = E(3, slot - 6) = 1; break;
-    case 9: E(3, 3) = 1; break;
-    default: break;
+    case 0:
+      E.diagonal().head<3>() << -0.5, 0.5, 0.5;
+      break;
+    case 3:
+      E.diagonal().head<3>() << 0.5, -0.5, 0.5;
+      break;
+    case 5:
+      E.diagonal().head<3>() << 0.5, 0.5, -0.5;
+      break;
+    case 1:
+      E(0, 1) = E(1, 0) = -1;
+      break;
+    case 2:
+      E(0, 2) = E(2, 0) = -1;
+      break;
+    case 4:
+      E(1, 2) = E(2, 1) = -1;
+      break;
+    case 6:
+    case 7:
+    case 8:
+      E(slot - 6, 3) = E(3, slot - 6) = 1;
+      break;
+    case 9:
+      E(3, 3) = 1;
+      break;
+    default:
+      break;
   }
   return E;
 }
@@ -136,13 +155,14 @@ Constraints add_constraints(detail::LmiProblem& lmi, const Setup& S, const Eigen
       if (!std::isfinite(bound)) continue;
       const double f0 = side * (a(i) - bound) / S.scale(i) - bound_raise;
       if (G.row(i).isZero(0)) {
-        constant(f0, fmt::format("{} {} {:.6g}, fixed by the base vector at {:.6g}", S.st.names[static_cast<std::size_t>(i)],
-                                 side > 0 ? ">=" : "<=", bound, a(i)));
+        constant(f0, fmt::format("{} {} {:.6g}, fixed by the base vector at {:.6g}",
+                                 S.st.names[static_cast<std::size_t>(i)], side > 0 ? ">=" : "<=", bound, a(i)));
         continue;
       }
       const int b = lmi.add_block(Eigen::MatrixXd::Constant(1, 1, f0));
       for (Eigen::Index j = 0; j < ny; ++j)
-        if (G(i, j) != 0) lmi.set_coefficient(b, static_cast<int>(j), Eigen::MatrixXd::Constant(1, 1, side * G(i, j) / S.scale(i)));
+        if (G(i, j) != 0)
+          lmi.set_coefficient(b, static_cast<int>(j), Eigen::MatrixXd::Constant(1, 1, side * G(i, j) / S.scale(i)));
       if (t_var >= 0) lmi.set_coefficient(b, t_var, -Eigen::MatrixXd::Ones(1, 1));
     }
   return c;
@@ -289,8 +309,10 @@ void nearest_consistent(const Setup& S, const ConsistencyOptions& options, Consi
   add_constraints(lmi, S, S.standard(uh), G, target, -1);
   const detail::LmiSolution sol = solve(lmi, r.solves);
   if (!sol.solved()) {
-    r.message = fmt::format("no consistent standard set maps onto phi (phase 1: t = {:.3g}); the search for the nearest "
-                            "base vector that has one failed: {}", r.feasibility, sol.message());
+    r.message = fmt::format(
+        "no consistent standard set maps onto phi (phase 1: t = {:.3g}); the search for the nearest "
+        "base vector that has one failed: {}",
+        r.feasibility, sol.message());
     return;
   }
   const Eigen::VectorXd s = S.standard(uh + sigma * Nh * sol.y.head(nv));
@@ -308,9 +330,12 @@ void nearest_consistent(const Setup& S, const ConsistencyOptions& options, Consi
 
 const char* to_string(ConsistencyStatus s) {
   switch (s) {
-    case ConsistencyStatus::Consistent: return "consistent";
-    case ConsistencyStatus::NoConsistentSet: return "no consistent set";
-    case ConsistencyStatus::SolverFailure: return "solver failure";
+    case ConsistencyStatus::Consistent:
+      return "consistent";
+    case ConsistencyStatus::NoConsistentSet:
+      return "no consistent set";
+    case ConsistencyStatus::SolverFailure:
+      return "solver failure";
   }
   return "?";
 }
@@ -368,15 +393,18 @@ ConsistencyResult consistent_standard_parameters(const ConsistencyStructure& st,
           "names and groups must have one entry per column of B");
   for (const auto& l : st.links)
     for (int k : l.index) require(k >= -1 && k < ns, "a link index is out of range");
-  require(!options.weights.size() || (options.weights.size() == ns && (options.weights.array() > 0).all() && options.weights.allFinite()),
+  require(!options.weights.size() ||
+              (options.weights.size() == ns && (options.weights.array() > 0).all() && options.weights.allFinite()),
           "weights must be positive and finite, one per standard parameter");
   require(!options.lower.size() || options.lower.size() == ns, "lower must have one entry per standard parameter");
   require(!options.upper.size() || options.upper.size() == ns, "upper must have one entry per standard parameter");
-  require(!options.base_weights.size() || (options.base_weights.size() == np && (options.base_weights.array() > 0).all()),
-          "base_weights must be positive, one per base parameter");
-  require(!options.base_metric_root.size() || (options.base_metric_root.cols() == np && options.base_metric_root.allFinite() &&
-                                         options.base_metric_root.rows() > 0),
-          "base_metric_root must have one column per base parameter and finite entries");
+  require(
+      !options.base_weights.size() || (options.base_weights.size() == np && (options.base_weights.array() > 0).all()),
+      "base_weights must be positive, one per base parameter");
+  require(
+      !options.base_metric_root.size() || (options.base_metric_root.cols() == np &&
+                                           options.base_metric_root.allFinite() && options.base_metric_root.rows() > 0),
+      "base_metric_root must have one column per base parameter and finite entries");
   for (int row : options.held_rows) require(row >= 0 && row < np, "a held row is out of range");
   require(std::isfinite(options.margin) && options.margin >= 0, "the margin must be >= 0");
 
@@ -443,8 +471,10 @@ ConsistencyResult consistent_standard_parameters(const ConsistencyStructure& st,
     if (fixed.constant_min < -options.feasibility_tolerance) r.feasibility = fixed.constant_min;
     if (options.feasibility_only) {
       evaluate(S, S.refine(S.standard(S.up + S.N * z1)), phi, r);
-      r.message = fmt::format("no consistent standard set maps onto phi (phase 1: the best smallest-eigenvalue margin is "
-                              "{:.3g} of the links' size)", r.feasibility);
+      r.message = fmt::format(
+          "no consistent standard set maps onto phi (phase 1: the best smallest-eigenvalue margin is "
+          "{:.3g} of the links' size)",
+          r.feasibility);
     } else {
       nearest_consistent(S, options, r);
     }

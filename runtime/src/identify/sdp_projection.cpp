@@ -36,11 +36,13 @@ struct Metric {
     if (diagonal) return linear[static_cast<std::size_t>(j)] / w(j);
     Eigen::MatrixXd C = Eigen::MatrixXd::Zero(linear[0].rows(), linear[0].cols());
     for (int i = 0; i <= j; ++i)  // T is upper triangular
-      if (T(i, j) != 0 && !linear[static_cast<std::size_t>(i)].isZero(0)) C += T(i, j) * linear[static_cast<std::size_t>(i)];
+      if (T(i, j) != 0 && !linear[static_cast<std::size_t>(i)].isZero(0))
+        C += T(i, j) * linear[static_cast<std::size_t>(i)];
     return C;
   }
   // phi0 + s T_{:,j} y_j over the free columns.
-  Eigen::VectorXd step(const Eigen::VectorXd& phi0, const std::vector<int>& free, const Eigen::VectorXd& y, double s) const {
+  Eigen::VectorXd step(const Eigen::VectorXd& phi0, const std::vector<int>& free, const Eigen::VectorXd& y,
+                       double s) const {
     Eigen::VectorXd phi = phi0;
     for (std::size_t j = 0; j < free.size(); ++j) {
       const int c = free[j];
@@ -57,7 +59,8 @@ Metric make_metric(const Eigen::VectorXd& weights, const Eigen::MatrixXd& metric
   Metric m;
   if (metric.size() == 0) {
     m.w = weights.size() == 0 ? Eigen::VectorXd::Ones(n) : weights;
-    if (m.w.size() != n) throw std::invalid_argument(fmt::format("{}: {} weights for {} parameters", who, weights.size(), n));
+    if (m.w.size() != n)
+      throw std::invalid_argument(fmt::format("{}: {} weights for {} parameters", who, weights.size(), n));
     for (int i = 0; i < n; ++i)
       if (!(m.w(i) > 0) || !std::isfinite(m.w(i)))
         throw std::invalid_argument(fmt::format("{}: weight {} must be positive and finite", who, i));
@@ -69,7 +72,8 @@ Metric make_metric(const Eigen::VectorXd& weights, const Eigen::MatrixXd& metric
                                             metric.rows(), metric.cols()));
   const Eigen::MatrixXd sym = 0.5 * (metric + metric.transpose());
   const Eigen::LLT<Eigen::MatrixXd> llt(sym);
-  if (llt.info() != Eigen::Success) throw std::invalid_argument(fmt::format("{}: the metric is not positive definite", who));
+  if (llt.info() != Eigen::Success)
+    throw std::invalid_argument(fmt::format("{}: the metric is not positive definite", who));
   m.diagonal = false;
   m.R = llt.matrixU();
   m.T = m.R.triangularView<Eigen::Upper>().solve(Eigen::MatrixXd::Identity(n, n));
@@ -264,8 +268,9 @@ ProjectionResult project_on_poses(const InertiaFunction& m, const Eigen::VectorX
     break;
   }
   r.feasible = r.lambda_min >= eps - kPoseTolerance;
-  r.status = r.feasible ? sol.lmi.message()
-                        : fmt::format("the solution misses the margin by {:.3g} at a working-set pose", eps - r.lambda_min);
+  r.status = r.feasible
+                 ? sol.lmi.message()
+                 : fmt::format("the solution misses the margin by {:.3g} at a working-set pose", eps - r.lambda_min);
   r.wall = seconds_since(t0);
   return r;
 }
@@ -273,8 +278,8 @@ ProjectionResult project_on_poses(const InertiaFunction& m, const Eigen::VectorX
 }  // namespace
 
 ProjectionResult project_on_poses(const InertiaFunction& m, const Eigen::VectorXd& phi0,
-                                  const std::vector<Eigen::VectorXd>& poses, double eps,
-                                  const Eigen::VectorXd& weights, const Eigen::MatrixXd& metric) {
+                                  const std::vector<Eigen::VectorXd>& poses, double eps, const Eigen::VectorXd& weights,
+                                  const Eigen::MatrixXd& metric) {
   check_phi(m, phi0, "project_on_poses");
   return project_on_poses(m, phi0, poses, eps, make_metric(weights, metric, m.parameters(), "project_on_poses"));
 }
@@ -285,7 +290,8 @@ Eigen::MatrixXd information_metric(const Eigen::MatrixXd& information, double ri
   if (!(ridge >= 0)) throw std::invalid_argument("information_metric: the ridge must be >= 0");
   Eigen::MatrixXd A = 0.5 * (information + information.transpose());
   const double mean_diagonal = A.diagonal().mean();
-  if (!(mean_diagonal > 0)) throw std::invalid_argument("information_metric: the information matrix has no positive diagonal");
+  if (!(mean_diagonal > 0))
+    throw std::invalid_argument("information_metric: the information matrix has no positive diagonal");
   A.diagonal().array() += ridge * mean_diagonal;
   return A;
 }
@@ -405,7 +411,8 @@ ProjectionResult project_pd(const InertiaFunction& m, const Eigen::VectorXd& phi
     r.lambda_min = audit.lambda_min;
     r.worst_pose = audit.worst_pose;
 
-    if (!sol.feasible) return finish(false, fmt::format("round {}: SDP on {} poses: {}", round, set.size(), sol.status));
+    if (!sol.feasible)
+      return finish(false, fmt::format("round {}: SDP on {} poses: {}", round, set.size(), sol.status));
     if (accepted(audit.lambda_min)) return finish(true, "ok");
 
     // The raise anticipates the drift of the working set's basin minima, small against the
@@ -421,8 +428,8 @@ ProjectionResult project_pd(const InertiaFunction& m, const Eigen::VectorXd& phi
       return finish(false, fmt::format("round {}: lambda_min = {:.3g} at a pose equivalent to a working-set pose",
                                        round, audit.lambda_min));
   }
-  return finish(false, fmt::format("not PD-feasible after {} rounds ({} poses): lambda_min = {:.3g}", options.max_rounds,
-                                   set.size(), r.lambda_min));
+  return finish(false, fmt::format("not PD-feasible after {} rounds ({} poses): lambda_min = {:.3g}",
+                                   options.max_rounds, set.size(), r.lambda_min));
 }
 
 ConditionalProjection conditional_projection(const InertiaFunction& m, const Eigen::VectorXd& phi0,

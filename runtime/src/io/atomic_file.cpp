@@ -49,7 +49,8 @@ void remove_stale_temps(const std::filesystem::path& target) {
     if (name.empty() || name[0] != '.' || at == std::string::npos || at < 2) continue;
     const std::string_view rest = std::string_view(name).substr(at + mark.size());  // "<pid>.<n>"
     const std::size_t dot = rest.find('.');
-    if (dot == std::string_view::npos || !all_digits(rest.substr(0, dot)) || !all_digits(rest.substr(dot + 1))) continue;
+    if (dot == std::string_view::npos || !all_digits(rest.substr(0, dot)) || !all_digits(rest.substr(dot + 1)))
+      continue;
     const long pid = std::stol(std::string(rest.substr(0, dot)));
     if (pid <= 0 || pid > INT_MAX || pid == static_cast<long>(::getpid())) continue;  // not a pid, or ours
     if (::kill(static_cast<pid_t>(pid), 0) == 0 || errno != ESRCH) continue;

@@ -18,11 +18,12 @@ namespace {
 
 // The manifest's keys, and its records' (dynid twin dataset: seed, trials, effects; dynid
 // import: split, import, imported): a typo must not pass for one.
-const std::vector<std::string> kManifestKeys = {"format", "robot", "source", "twin", "twin_overrides", "seed", "trials",
-                                                "effects", "split", "import", "imported", "runs"};
+const std::vector<std::string> kManifestKeys = {"format", "robot",   "source", "twin",   "twin_overrides", "seed",
+                                                "trials", "effects", "split",  "import", "imported",       "runs"};
 const std::vector<std::string> kRunKeys = {"trajectory", "family", "trial", "file", "window"};
 const std::vector<std::string> kImportKeys = {"inputs", "rows", "written", "stale_rows", "duplicate_rows"};
-const std::vector<std::string> kImportedKeys = {"file", "rows", "stale_rows", "duplicate_rows", "sample_time", "velocity"};
+const std::vector<std::string> kImportedKeys = {"file",           "rows",        "stale_rows",
+                                                "duplicate_rows", "sample_time", "velocity"};
 
 // The given rows of `m`, in order.
 Eigen::MatrixXd rows_of(const Eigen::MatrixXd& m, const std::vector<Eigen::Index>& rows) {
@@ -43,14 +44,16 @@ const DatasetRun& Dataset::find(const std::string& trajectory, int trial) const 
 Dataset read_dataset(const std::filesystem::path& dir) {
   const auto manifest = dir / "dataset.yaml";
   if (!std::filesystem::exists(manifest))
-    throw DataError(manifest.string(), 0, "not found: a dataset folder holds dataset.yaml (made by dynid twin dataset or dynid import)");
+    throw DataError(manifest.string(), 0,
+                    "not found: a dataset folder holds dataset.yaml (made by dynid twin dataset or dynid import)");
   Dataset d;
   d.dir = std::filesystem::absolute(dir);
   const YAML::Node root = load_yaml_file(manifest);
   auto line = [](const YAML::Node& n) { return n.Mark().line + 1; };
   try {
     check_keys(root, kManifestKeys, manifest.string(), "dataset.yaml");
-    if (!root["runs"] || !root["runs"].IsSequence()) throw DataError(manifest.string(), line(root), "'runs' list missing");
+    if (!root["runs"] || !root["runs"].IsSequence())
+      throw DataError(manifest.string(), line(root), "'runs' list missing");
     d.robot = root["robot"] ? root["robot"].as<std::string>() : "";
     if (root["robot"]) d.robot_line = line(root["robot"]);
     d.twin = root["twin"] ? root["twin"].as<std::string>() : "";
@@ -72,8 +75,11 @@ Dataset read_dataset(const std::filesystem::path& dir) {
     if (const YAML::Node n = root["import"]) {
       check_keys(n, kImportKeys, manifest.string(), "import");
       ImportCounts c;
-      for (auto [key, value] : {std::pair{"inputs", &c.inputs}, {"rows", &c.rows}, {"written", &c.written},
-                                {"stale_rows", &c.stale_rows}, {"duplicate_rows", &c.duplicate_rows}})
+      for (auto [key, value] : {std::pair{"inputs", &c.inputs},
+                                {"rows", &c.rows},
+                                {"written", &c.written},
+                                {"stale_rows", &c.stale_rows},
+                                {"duplicate_rows", &c.duplicate_rows}})
         if (n[key]) *value = n[key].as<int>();
       d.import = c;
     }
@@ -83,7 +89,8 @@ Dataset read_dataset(const std::filesystem::path& dir) {
         check_keys(n, kImportedKeys, manifest.string(), "an imported log");
         ImportedFile f;
         if (n["file"]) f.file = n["file"].as<std::string>();
-        for (auto [key, value] : {std::pair{"rows", &f.rows}, {"stale_rows", &f.stale_rows}, {"duplicate_rows", &f.duplicate_rows}})
+        for (auto [key, value] :
+             {std::pair{"rows", &f.rows}, {"stale_rows", &f.stale_rows}, {"duplicate_rows", &f.duplicate_rows}})
           if (n[key]) *value = n[key].as<int>();
         if (n["sample_time"]) f.sample_time = n["sample_time"].as<double>();
         if (n["velocity"]) f.velocity = n["velocity"].as<std::string>();
@@ -99,10 +106,11 @@ Dataset read_dataset(const std::filesystem::path& dir) {
       const std::filesystem::path listed = std::filesystem::path(r["file"].as<std::string>()).lexically_normal();
       if (listed.empty()) throw DataError(manifest.string(), line(r["file"]), "file: a run needs its log's file name");
       if (listed.is_absolute() || *listed.begin() == "..")
-        throw DataError(manifest.string(), line(r["file"]),
-                        fmt::format("file '{}' is outside the dataset folder: a dataset's logs are in its folder (copy the "
-                                    "log in, or link it there)",
-                                    r["file"].as<std::string>()));
+        throw DataError(
+            manifest.string(), line(r["file"]),
+            fmt::format("file '{}' is outside the dataset folder: a dataset's logs are in its folder (copy the "
+                        "log in, or link it there)",
+                        r["file"].as<std::string>()));
       DatasetRun run{r["trajectory"].as<std::string>(), r["family"].as<std::string>(), r["trial"].as<int>(),
                      d.dir / listed};
       if (!std::filesystem::exists(run.file))
@@ -130,7 +138,8 @@ namespace {
 // A path as the manifest lists it: relative to the folder when it lies inside it.
 std::string listed(const std::filesystem::path& dir, const std::filesystem::path& file) {
   if (!file.is_absolute()) return file.generic_string();
-  const std::filesystem::path rel = file.lexically_normal().lexically_relative(std::filesystem::absolute(dir).lexically_normal());
+  const std::filesystem::path rel =
+      file.lexically_normal().lexically_relative(std::filesystem::absolute(dir).lexically_normal());
   return rel.empty() || *rel.begin() == ".." ? file.generic_string() : rel.generic_string();
 }
 
@@ -144,24 +153,27 @@ void write_dataset(const Dataset& d) {
   if (!d.twin_overrides.empty()) y += "twin_overrides: " + yaml_quoted(listed(d.dir, d.twin_overrides)) + "\n";
   if (d.twin_record) {
     y += fmt::format("seed: {}\ntrials: {}\neffects: [", d.twin_record->seed, d.twin_record->trials);
-    for (std::size_t i = 0; i < d.twin_record->effects.size(); ++i) y += (i ? ", " : "") + yaml_quoted(d.twin_record->effects[i]);
+    for (std::size_t i = 0; i < d.twin_record->effects.size(); ++i)
+      y += (i ? ", " : "") + yaml_quoted(d.twin_record->effects[i]);
     y += "]\n";
   }
   if (d.split > 0) y += "split: " + yaml_number(d.split) + "\n";
   if (d.import)
-    y += fmt::format("import: {{inputs: {}, rows: {}, written: {}, stale_rows: {}, duplicate_rows: {}}}\n", d.import->inputs,
-                     d.import->rows, d.import->written, d.import->stale_rows, d.import->duplicate_rows);
+    y += fmt::format("import: {{inputs: {}, rows: {}, written: {}, stale_rows: {}, duplicate_rows: {}}}\n",
+                     d.import->inputs, d.import->rows, d.import->written, d.import->stale_rows,
+                     d.import->duplicate_rows);
   if (!d.imported.empty()) {
     y += "imported:\n";
     for (const ImportedFile& f : d.imported)
-      y += fmt::format("  - {{file: {}, rows: {}, stale_rows: {}, duplicate_rows: {}, sample_time: {}, velocity: {}}}\n",
-                       yaml_quoted(f.file), f.rows, f.stale_rows, f.duplicate_rows, yaml_number(f.sample_time),
-                       yaml_quoted(f.velocity));
+      y +=
+          fmt::format("  - {{file: {}, rows: {}, stale_rows: {}, duplicate_rows: {}, sample_time: {}, velocity: {}}}\n",
+                      yaml_quoted(f.file), f.rows, f.stale_rows, f.duplicate_rows, yaml_number(f.sample_time),
+                      yaml_quoted(f.velocity));
   }
   y += "runs:\n";
   for (const DatasetRun& r : d.runs) {
-    y += fmt::format("  - {{trajectory: {}, family: {}, trial: {}, file: {}", yaml_quoted(r.trajectory), yaml_quoted(r.family),
-                     r.trial, yaml_quoted(listed(d.dir, r.file)));
+    y += fmt::format("  - {{trajectory: {}, family: {}, trial: {}, file: {}", yaml_quoted(r.trajectory),
+                     yaml_quoted(r.family), r.trial, yaml_quoted(listed(d.dir, r.file)));
     if (std::isfinite(r.window_start) || std::isfinite(r.window_end))
       y += fmt::format(", window: [{}, {}]", yaml_number(r.window_start), yaml_number(r.window_end));
     y += "}\n";
@@ -171,7 +183,8 @@ void write_dataset(const Dataset& d) {
 
 Log read_run_log(const DatasetRun& run) {
   Log log = read_log(run.file);
-  const bool whole = std::isinf(run.window_start) && run.window_start < 0 && std::isinf(run.window_end) && run.window_end > 0;
+  const bool whole =
+      std::isinf(run.window_start) && run.window_start < 0 && std::isinf(run.window_end) && run.window_end > 0;
   log.meta.trajectory = run.trajectory;
   if (whole) return log;
   std::vector<Eigen::Index> rows;
@@ -201,16 +214,19 @@ Log read_run_log(const DatasetRun& run) {
 
 void check_log_robot(const Log& log, const std::filesystem::path& csv, const std::string& robot, int joints) {
   if (!log.meta.robot.empty() && log.meta.robot != robot)
-    throw DataError(metadata_path(csv).string(), 0, fmt::format("the log is of robot '{}', the model of '{}'", log.meta.robot, robot));
+    throw DataError(metadata_path(csv).string(), 0,
+                    fmt::format("the log is of robot '{}', the model of '{}'", log.meta.robot, robot));
   if (log.joints() != joints)
-    throw DataError(csv.string(), 0, fmt::format("the log has {} joints, the model of {} {}", log.joints(), robot, joints));
+    throw DataError(csv.string(), 0,
+                    fmt::format("the log has {} joints, the model of {} {}", log.joints(), robot, joints));
 }
 
 Log read_run_log(const DatasetRun& run, const std::string& robot, int joints) {
   Log log = read_run_log(run);
   if (!log.meta.robot.empty() && log.meta.robot != robot)
-    throw DataError(metadata_path(run.file).string(), 0,
-                    fmt::format("run {}: the log is of robot '{}', the model of '{}'", run.trajectory, log.meta.robot, robot));
+    throw DataError(
+        metadata_path(run.file).string(), 0,
+        fmt::format("run {}: the log is of robot '{}', the model of '{}'", run.trajectory, log.meta.robot, robot));
   if (log.joints() != joints)
     throw DataError(run.file.string(), 0,
                     fmt::format("run {}: the log has {} joints, the model {}", run.trajectory, log.joints(), joints));

@@ -28,7 +28,8 @@ std::string file_digest(const std::filesystem::path& file) {
   XXH3_128bits_reset(state.get());
   std::vector<char> block(1 << 20);
   std::size_t n;
-  while ((n = std::fread(block.data(), 1, block.size(), f.get())) > 0) XXH3_128bits_update(state.get(), block.data(), n);
+  while ((n = std::fread(block.data(), 1, block.size(), f.get())) > 0)
+    XXH3_128bits_update(state.get(), block.data(), n);
   if (std::ferror(f.get())) throw DataError(file.string(), 0, fmt::format("read failed: {}", std::strerror(errno)));
   return hex(XXH3_128bits_digest(state.get()));
 }

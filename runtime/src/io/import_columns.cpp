@@ -118,13 +118,13 @@ std::vector<int> by_number_pattern(const std::string& pattern, std::size_t at_ch
   if (extra || static_cast<int>(found.size()) > count) {
     // Exactly the joints, numbered from the other end (ROS's joint_states exports count from 0).
     const int other = 1 - base;
-    const bool other_base = static_cast<int>(found.size()) == count && *found.begin() == other &&
-                            *found.rbegin() == other + count - 1;
-    at.fail(fmt::format("matches {} column{} numbered {}..{}, but {}{}", found.size(), found.size() == 1 ? "" : "s",
-                        *found.begin(), *found.rbegin(), joints_note(target),
-                        other_base ? fmt::format("; for numbers from {} write '{}{}{}'", other, prefix,
-                                                 other == 0 ? '%' : '*', suffix)
-                                   : std::string()));
+    const bool other_base =
+        static_cast<int>(found.size()) == count && *found.begin() == other && *found.rbegin() == other + count - 1;
+    at.fail(fmt::format(
+        "matches {} column{} numbered {}..{}, but {}{}", found.size(), found.size() == 1 ? "" : "s", *found.begin(),
+        *found.rbegin(), joints_note(target),
+        other_base ? fmt::format("; for numbers from {} write '{}{}{}'", other, prefix, other == 0 ? '%' : '*', suffix)
+                   : std::string()));
   }
   std::vector<int> columns;
   for (int j = 0; j < count; ++j) {

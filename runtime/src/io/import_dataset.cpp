@@ -39,7 +39,8 @@ DatasetImportResult import_dataset(const std::filesystem::path& out, const Datas
   namespace fs = std::filesystem;
   if (import.inputs.empty()) throw DataError(out.string(), 0, "nothing to import: no input files");
   if (!(import.split >= 0 && import.split < 1))
-    throw DataError(import.mapping.origin, 0, fmt::format("split {} is not a fraction in (0, 1) (0: no split)", import.split));
+    throw DataError(import.mapping.origin, 0,
+                    fmt::format("split {} is not a fraction in (0, 1) (0: no split)", import.split));
 
   DatasetImportResult result;
   std::set<std::string> names;
@@ -47,11 +48,13 @@ DatasetImportResult import_dataset(const std::filesystem::path& out, const Datas
     ImportedLog imported = import_log(in.file, import.mapping, import.target);
     if (!import.allow_implausible) check_plausible(imported, import.mapping, import.target);
     const std::string name = in.name.empty() ? in.file.stem().string() : in.name;
-    if (!valid_name(name)) throw DataError(in.file.string(), 0, fmt::format("'{}' cannot name a run (a file name)", name));
+    if (!valid_name(name))
+      throw DataError(in.file.string(), 0, fmt::format("'{}' cannot name a run (a file name)", name));
     imported.log.meta.trajectory = name;
     const fs::path csv = out / (name + ".csv");
     const bool split = import.split > 0 && !in.heldout;
-    for (const std::string& run : split ? std::vector<std::string>{name, name + "_heldout"} : std::vector<std::string>{name})
+    for (const std::string& run :
+         split ? std::vector<std::string>{name, name + "_heldout"} : std::vector<std::string>{name})
       if (!names.insert(run).second)
         throw DataError(in.file.string(), 0, fmt::format("run name '{}' is used twice (name the inputs apart)", run));
     const Log& log = imported.log;
@@ -68,8 +71,9 @@ DatasetImportResult import_dataset(const std::filesystem::path& out, const Datas
       if (fitting < min_part || heldout < min_part)
         throw DataError(in.file.string(), 0,
                         fmt::format("split {} at {} s leaves {} of the {} samples in the {} part; each part needs at "
-                                    "least {}", import.split, number_text(cut), std::min(fitting, heldout),
-                                    log.samples(), fitting < min_part ? "fitting" : "held-out", min_part));
+                                    "least {}",
+                                    import.split, number_text(cut), std::min(fitting, heldout), log.samples(),
+                                    fitting < min_part ? "fitting" : "held-out", min_part));
       result.runs.push_back({name, "F", csv, t0, cut});
       result.runs.push_back({name + "_heldout", kHeldOutFamily, csv, cut, std::numeric_limits<double>::infinity()});
     }
@@ -87,7 +91,8 @@ DatasetImportResult import_dataset(const std::filesystem::path& out, const Datas
     targets.push_back(metadata_path(csv));
   }
   for (const fs::path& t : targets)
-    if (fs::exists(t)) throw DataError(t.string(), 0, "exists already; the importer never replaces a file (choose a new folder)");
+    if (fs::exists(t))
+      throw DataError(t.string(), 0, "exists already; the importer never replaces a file (choose a new folder)");
   std::error_code ec;
   fs::create_directories(out, ec);
   if (ec) throw DataError(out.string(), 0, "cannot create the dataset folder: " + ec.message());
@@ -99,13 +104,16 @@ DatasetImportResult import_dataset(const std::filesystem::path& out, const Datas
   text += fmt::format("imported:\n  robot: {}\n  split: {}\n  inputs:\n", yaml_quoted(import.target.robot),
                       number_text(import.split));
   for (const ImportedLog& l : result.logs) {
-    text += fmt::format("    - input: {}\n      log: {}\n      rows: {}\n      written: {}\n", yaml_quoted(fs::absolute(l.input).string()),
-                        yaml_quoted(l.log.meta.trajectory + ".csv"), l.rows, l.log.samples());
-    text += fmt::format("      stale_rows: {}\n      stale_lines: {}\n", l.stale_lines.size(), line_list(l.stale_lines));
+    text += fmt::format("    - input: {}\n      log: {}\n      rows: {}\n      written: {}\n",
+                        yaml_quoted(fs::absolute(l.input).string()), yaml_quoted(l.log.meta.trajectory + ".csv"),
+                        l.rows, l.log.samples());
+    text +=
+        fmt::format("      stale_rows: {}\n      stale_lines: {}\n", l.stale_lines.size(), line_list(l.stale_lines));
     text += fmt::format("      duplicate_rows: {}\n      duplicate_lines: {}\n", l.duplicate_lines.size(),
                         line_list(l.duplicate_lines));
-    text += fmt::format("      sample_time: {}\n      velocity: {}\n      columns:\n", number_text(l.log.meta.sample_time),
-                        l.log.meta.velocity == Velocity::measured ? "measured" : "differentiated");
+    text +=
+        fmt::format("      sample_time: {}\n      velocity: {}\n      columns:\n", number_text(l.log.meta.sample_time),
+                    l.log.meta.velocity == Velocity::measured ? "measured" : "differentiated");
     for (const auto& [column, source] : l.columns) text += fmt::format("        {}: {}\n", column, yaml_quoted(source));
   }
   write_file_atomically(record, text);

@@ -24,9 +24,9 @@ bool same_bits(const double* a, const double* b, std::size_t count) {
 }
 
 struct Group {
-  std::string key;      // "q", ...
+  std::string key;  // "q", ...
   std::vector<int> columns;
-  std::size_t offset;   // first value of the group in a parsed row
+  std::size_t offset;  // first value of the group in a parsed row
 };
 
 void check_mapping(const ImportMapping& m) {
@@ -47,7 +47,8 @@ void check_mapping(const ImportMapping& m) {
 }  // namespace
 
 double median_sample_time(const Eigen::VectorXd& time, const std::string& source) {
-  if (time.size() < 2) throw DataError(source, 0, fmt::format("{} time stamps: a sample time needs at least 2", time.size()));
+  if (time.size() < 2)
+    throw DataError(source, 0, fmt::format("{} time stamps: a sample time needs at least 2", time.size()));
   std::vector<double> intervals(static_cast<std::size_t>(time.size() - 1));
   for (Eigen::Index k = 1; k < time.size(); ++k) intervals[k - 1] = time[k] - time[k - 1];
   const auto middle = intervals.begin() + static_cast<std::ptrdiff_t>(intervals.size() / 2);
@@ -102,15 +103,21 @@ struct Columns {
   }
 };
 
-Columns select_columns(const detail::TextTable& table, const ImportMapping& mapping, const ImportTarget& target, int n) {
+Columns select_columns(const detail::TextTable& table, const ImportMapping& mapping, const ImportTarget& target,
+                       int n) {
   Columns out;
   std::vector<Group>& groups = out.groups;
   std::vector<int>& columns = out.columns;
-  for (const auto& [key, selector] : std::vector<std::pair<std::string, std::string>>{
-           {"time", mapping.time}, {"q", mapping.q}, {"qd", mapping.qd}, {"tau", mapping.tau},
-           {"q_ref", mapping.q_ref}, {"qd_ref", mapping.qd_ref}, {"qdd_ref", mapping.qdd_ref}}) {
+  for (const auto& [key, selector] : std::vector<std::pair<std::string, std::string>>{{"time", mapping.time},
+                                                                                      {"q", mapping.q},
+                                                                                      {"qd", mapping.qd},
+                                                                                      {"tau", mapping.tau},
+                                                                                      {"q_ref", mapping.q_ref},
+                                                                                      {"qd_ref", mapping.qd_ref},
+                                                                                      {"qdd_ref", mapping.qdd_ref}}) {
     if (selector.empty()) continue;
-    Group g{key, detail::resolve_selector(selector, key, key == "time" ? 1 : n, table, mapping, target), columns.size()};
+    Group g{key, detail::resolve_selector(selector, key, key == "time" ? 1 : n, table, mapping, target),
+            columns.size()};
     for (int c : g.columns) {
       const auto used = std::find(columns.begin(), columns.end(), c);
       if (used != columns.end()) {
@@ -156,8 +163,9 @@ KeptRows keep_rows(const detail::TextTable& table, const std::vector<int>& colum
     const double* previous = values.data() + p * width;
     const double t = row[0] / divisor, t_previous = previous[0] / divisor;
     if (t < t_previous)
-      throw DataError(file, lines[r], fmt::format("time goes backwards: {} s here, {} s on line {}", number_text(t),
-                                                  number_text(t_previous), lines[p]));
+      throw DataError(file, lines[r],
+                      fmt::format("time goes backwards: {} s here, {} s on line {}", number_text(t),
+                                  number_text(t_previous), lines[p]));
     if (t == t_previous) {
       if (same_bits(row + 1, previous + 1, width - 1)) {
         out.duplicate_lines.push_back(lines[r]);
@@ -165,10 +173,10 @@ KeptRows keep_rows(const detail::TextTable& table, const std::vector<int>& colum
       }
       std::size_t c = 1;
       while (c + 1 < width && same_bits(row + c, previous + c, 1)) ++c;
-      throw DataError(file, lines[r],
-                      fmt::format("same time stamp as line {} ({} s) but other values: {} is {} here, {} there",
-                                  lines[p], number_text(t), table.column_label(columns[c]), number_text(row[c]),
-                                  number_text(previous[c])));
+      throw DataError(
+          file, lines[r],
+          fmt::format("same time stamp as line {} ({} s) but other values: {} is {} here, {} there", lines[p],
+                      number_text(t), table.column_label(columns[c]), number_text(row[c]), number_text(previous[c])));
     }
     const bool repeated = same_bits(row + 1, previous + 1, measured_end - 1);
     if (repeated) out.stale_lines.push_back(lines[r]);
@@ -181,15 +189,16 @@ KeptRows keep_rows(const detail::TextTable& table, const std::vector<int>& colum
 // The kept rows' times in s. Stamps far from 0 (1e15 ms since an epoch) hold no 1 ms step in
 // double precision once in s (read as 0.977 ms): then the times count from the first stamp, the
 // difference taken in the file's unit, where it is exact. Returns whether they were rebased.
-bool fill_times(const std::vector<double>& values, std::size_t width, const std::vector<std::size_t>& kept, double divisor,
-                Eigen::VectorXd& time) {
+bool fill_times(const std::vector<double>& values, std::size_t width, const std::vector<std::size_t>& kept,
+                double divisor, Eigen::VectorXd& time) {
   const Eigen::Index rows = static_cast<Eigen::Index>(kept.size());
   time.resize(rows);
   for (Eigen::Index k = 0; k < rows; ++k) time[k] = values[kept[static_cast<std::size_t>(k)] * width] / divisor;
   bool rebased = false;
   if (rows >= 2) {
     std::vector<double> steps;
-    for (std::size_t i = 1; i < kept.size(); ++i) steps.push_back(values[kept[i] * width] - values[kept[i - 1] * width]);
+    for (std::size_t i = 1; i < kept.size(); ++i)
+      steps.push_back(values[kept[i] * width] - values[kept[i - 1] * width]);
     std::nth_element(steps.begin(), steps.begin() + static_cast<std::ptrdiff_t>(steps.size() / 2), steps.end());
     const double step = steps[steps.size() / 2] / divisor;
     const double t_max = std::max(std::abs(time[0]), std::abs(time[rows - 1]));
@@ -197,7 +206,8 @@ bool fill_times(const std::vector<double>& values, std::size_t width, const std:
   }
   if (rebased) {
     const double first = values[kept[0] * width];
-    for (Eigen::Index k = 0; k < rows; ++k) time[k] = (values[kept[static_cast<std::size_t>(k)] * width] - first) / divisor;
+    for (Eigen::Index k = 0; k < rows; ++k)
+      time[k] = (values[kept[static_cast<std::size_t>(k)] * width] - first) / divisor;
   }
   return rebased;
 }
@@ -262,8 +272,9 @@ ImportedLog import_log(const std::filesystem::path& input, const ImportMapping& 
   } else {
     const long fresh = std::count(stale.begin(), stale.end(), false);
     if (fresh < 3)
-      throw DataError(file, lines.back(),
-                      fmt::format("{} distinct samples: differentiating q (the file has no qd) needs at least 3", fresh));
+      throw DataError(
+          file, lines.back(),
+          fmt::format("{} distinct samples: differentiating q (the file has no qd) needs at least 3", fresh));
     log.qd = differentiate_positions(log.time, log.q, stale);
   }
   if (rows < 2) throw DataError(file, lines.back(), "one sample: a log needs at least 2 (with distinct time stamps)");
@@ -276,13 +287,14 @@ ImportedLog import_log(const std::filesystem::path& input, const ImportMapping& 
   meta.joints = target.joints;
   meta.sample_time = median_sample_time(log.time, file);
   meta.velocity = has_qd ? Velocity::measured : Velocity::differentiated;
-  meta.notes = fmt::format("imported from {}: {} rows, {} stale rows kept, {} duplicate rows dropped{}",
-                           input.filename().string(), out.rows, out.stale_lines.size(), out.duplicate_lines.size(),
-                           has_qd ? "" : "; qd differentiated from q") +
-               (rebased ? fmt::format("; time counted from the first stamp ({} {} in the file: too large for the sample "
-                                      "time in double precision)",
-                                      number_text(values[kept[0] * width]), detail::time_unit_name(mapping.time_unit))
-                        : std::string());
+  meta.notes =
+      fmt::format("imported from {}: {} rows, {} stale rows kept, {} duplicate rows dropped{}",
+                  input.filename().string(), out.rows, out.stale_lines.size(), out.duplicate_lines.size(),
+                  has_qd ? "" : "; qd differentiated from q") +
+      (rebased ? fmt::format("; time counted from the first stamp ({} {} in the file: too large for the sample "
+                             "time in double precision)",
+                             number_text(values[kept[0] * width]), detail::time_unit_name(mapping.time_unit))
+               : std::string());
   for (const Group& g : selected.groups)
     for (std::size_t j = 0; j < g.columns.size(); ++j)
       out.columns[g.key == "time" ? "time" : g.key + std::to_string(j + 1)] = table.column_label(g.columns[j]);

@@ -37,10 +37,14 @@ const char* header_name(HeaderRow h) {
 
 const char* delimiter_name(Delimiter d) {
   switch (d) {
-    case Delimiter::comma: return "comma";
-    case Delimiter::semicolon: return "semicolon";
-    case Delimiter::whitespace: return "whitespace";
-    case Delimiter::automatic: break;
+    case Delimiter::comma:
+      return "comma";
+    case Delimiter::semicolon:
+      return "semicolon";
+    case Delimiter::whitespace:
+      return "whitespace";
+    case Delimiter::automatic:
+      break;
   }
   return "auto";
 }
@@ -75,9 +79,12 @@ class MappingReader {
       if (key == "time") {
         m_.time_unit = parse_time_unit(value, e.second);
       } else if (key == "angle") {
-        if (value == "rad") m_.angle_unit = AngleUnit::rad;
-        else if (value == "deg") m_.angle_unit = AngleUnit::deg;
-        else fail(e.second, fmt::format("units.angle: '{}' is neither rad nor deg", value));
+        if (value == "rad")
+          m_.angle_unit = AngleUnit::rad;
+        else if (value == "deg")
+          m_.angle_unit = AngleUnit::deg;
+        else
+          fail(e.second, fmt::format("units.angle: '{}' is neither rad nor deg", value));
       } else if (key == "torque_scale") {
         double v = 0;
         if (parse_number(value, v) != NumberParse::ok || !std::isfinite(v) || v == 0)
@@ -121,10 +128,14 @@ ImportMapping read_import_mapping(const std::filesystem::path& yaml) {
       reader.units(e.second);
     } else if (key == "header") {
       const std::string v = reader.scalar(e.second, key);
-      if (v == "auto") m.header = HeaderRow::automatic;
-      else if (v == "yes" || v == "true") m.header = HeaderRow::present;
-      else if (v == "no" || v == "false") m.header = HeaderRow::absent;
-      else reader.fail(e.second, fmt::format("header: '{}' is not auto, yes or no", v));
+      if (v == "auto")
+        m.header = HeaderRow::automatic;
+      else if (v == "yes" || v == "true")
+        m.header = HeaderRow::present;
+      else if (v == "no" || v == "false")
+        m.header = HeaderRow::absent;
+      else
+        reader.fail(e.second, fmt::format("header: '{}' is not auto, yes or no", v));
     } else if (key == "delimiter") {
       const std::string v = reader.scalar(e.second, key);
       bool known = false;
@@ -133,7 +144,8 @@ ImportMapping read_import_mapping(const std::filesystem::path& yaml) {
       if (!known) reader.fail(e.second, fmt::format("delimiter: '{}' is not auto, comma, semicolon or whitespace", v));
     } else if (key != "imported") {  // import.yaml's record of what was imported
       reader.fail(e.first, fmt::format("unknown key '{}' (time, q, qd, tau, q_ref, qd_ref, qdd_ref, units, header, "
-                                       "delimiter)", key));
+                                       "delimiter)",
+                                       key));
     }
   }
   return m;
@@ -160,20 +172,28 @@ namespace detail {
 
 const char* time_unit_name(TimeUnit u) {
   switch (u) {
-    case TimeUnit::s: return "s";
-    case TimeUnit::ms: return "ms";
-    case TimeUnit::us: return "us";
-    case TimeUnit::ns: return "ns";
+    case TimeUnit::s:
+      return "s";
+    case TimeUnit::ms:
+      return "ms";
+    case TimeUnit::us:
+      return "us";
+    case TimeUnit::ns:
+      return "ns";
   }
   return "s";
 }
 
 double time_divisor(TimeUnit u) {
   switch (u) {
-    case TimeUnit::s: return 1;
-    case TimeUnit::ms: return 1e3;
-    case TimeUnit::us: return 1e6;
-    case TimeUnit::ns: return 1e9;
+    case TimeUnit::s:
+      return 1;
+    case TimeUnit::ms:
+      return 1e3;
+    case TimeUnit::us:
+      return 1e6;
+    case TimeUnit::ns:
+      return 1e9;
   }
   return 1;
 }

@@ -73,7 +73,8 @@ void check_plausible(const ImportedLog& imported, const ImportMapping& mapping, 
   };
   Worst worst = worst_sample(checked ? n : 0, log.samples(), 0, [&](Eigen::Index k, Eigen::Index j) {
     const double lo = target.lower[static_cast<std::size_t>(j)], hi = target.upper[static_cast<std::size_t>(j)];
-    if (!std::isfinite(lo) || !std::isfinite(hi) || !(hi > lo)) return -std::numeric_limits<double>::infinity();  // no limits to judge by
+    if (!std::isfinite(lo) || !std::isfinite(hi) || !(hi > lo))
+      return -std::numeric_limits<double>::infinity();  // no limits to judge by
     return std::max(lo - log.q(k, j), log.q(k, j) - hi) - margin_of(j);
   });
   Eigen::Index worst_row = worst.row, worst_joint = worst.joint;
@@ -88,16 +89,18 @@ void check_plausible(const ImportedLog& imported, const ImportMapping& mapping, 
     const std::string hint = prismatic ? "prismatic positions are read in m: is the file in mm?"
                              : degrees ? "is the angle unit right (--angle, units.angle)?"
                                        : "are the angles in deg, not rad (--angle deg, units.angle: deg)?";
-    throw DataError(file, imported.lines[static_cast<std::size_t>(worst_row)],
-                    fmt::format("joint {} '{}' is at {} {}{}, far outside its limits [{}, {}] {} (by more than {} {}, "
-                                "max({} {}, half its range)): {} {}",
-                                worst_joint + 1, target.joints[j], g(q), unit, as_written, g(lo), g(hi), unit, g(margin),
-                                unit, prismatic ? kPrismaticMargin : kRevoluteMargin, unit, hint, kOverride));
+    throw DataError(
+        file, imported.lines[static_cast<std::size_t>(worst_row)],
+        fmt::format("joint {} '{}' is at {} {}{}, far outside its limits [{}, {}] {} (by more than {} {}, "
+                    "max({} {}, half its range)): {} {}",
+                    worst_joint + 1, target.joints[j], g(q), unit, as_written, g(lo), g(hi), unit, g(margin), unit,
+                    prismatic ? kPrismaticMargin : kRevoluteMargin, unit, hint, kOverride));
   }
 
   // Torques: the sample farthest beyond kEffortFactor times its joint's effort limit.
   worst = worst_sample(log.tau.cols(), log.samples(), 1, [&](Eigen::Index k, Eigen::Index j) {
-    const double effort = target.effort.size() == static_cast<std::size_t>(n) ? target.effort[static_cast<std::size_t>(j)] : 0.0;
+    const double effort =
+        target.effort.size() == static_cast<std::size_t>(n) ? target.effort[static_cast<std::size_t>(j)] : 0.0;
     return std::abs(log.tau(k, j)) / (effort > 0 ? kEffortFactor * effort : kMaxTorque);
   });
   worst_row = worst.row;
@@ -107,12 +110,15 @@ void check_plausible(const ImportedLog& imported, const ImportMapping& mapping, 
     const double effort = target.effort.size() == static_cast<std::size_t>(n) ? target.effort[j] : 0.0;
     const bool prismatic = !target.prismatic.empty() && target.prismatic[j];
     const std::string unit = prismatic ? "N" : "N m";
-    const std::string limit = effort > 0 ? fmt::format("{} times its effort limit {} {}", kEffortFactor, g(effort), unit)
-                                         : fmt::format("{} {}", g(kMaxTorque), unit);
-    throw DataError(file, imported.lines[static_cast<std::size_t>(worst_row)],
-                    fmt::format("joint {} '{}' has a torque of {} {}, beyond {}: is the torque unit right (--torque-scale, "
-                                "units.torque_scale: the factor from the file's unit to {})? {}",
-                                worst_joint + 1, target.joints[j], g(log.tau(worst_row, worst_joint)), unit, limit, unit, kOverride));
+    const std::string limit = effort > 0
+                                  ? fmt::format("{} times its effort limit {} {}", kEffortFactor, g(effort), unit)
+                                  : fmt::format("{} {}", g(kMaxTorque), unit);
+    throw DataError(
+        file, imported.lines[static_cast<std::size_t>(worst_row)],
+        fmt::format("joint {} '{}' has a torque of {} {}, beyond {}: is the torque unit right (--torque-scale, "
+                    "units.torque_scale: the factor from the file's unit to {})? {}",
+                    worst_joint + 1, target.joints[j], g(log.tau(worst_row, worst_joint)), unit, limit, unit,
+                    kOverride));
   }
 
   // Radians declared as degrees: every revolute joint within +-2 pi as written and none moving
@@ -128,10 +134,11 @@ void check_plausible(const ImportedLog& imported, const ImportMapping& mapping, 
       widest = std::max(widest, hi - lo);
     }
     if (revolute > 0 && largest <= 2 * kPi && widest < 2 * kPi)
-      throw DataError(file, 0,
-                      fmt::format("the angles are declared in deg, but every joint stays within +-{} and moves at most {} as "
-                                  "written: these look like radians (--angle rad, units.angle: rad)? {}",
-                                  g(largest), g(widest), kOverride));
+      throw DataError(
+          file, 0,
+          fmt::format("the angles are declared in deg, but every joint stays within +-{} and moves at most {} as "
+                      "written: these look like radians (--angle rad, units.angle: rad)? {}",
+                      g(largest), g(widest), kOverride));
   }
 
   // A gap no recording has (24 h accepted): past kMaxGapSteps median steps and kMaxGap s.
@@ -139,22 +146,24 @@ void check_plausible(const ImportedLog& imported, const ImportMapping& mapping, 
   for (Eigen::Index k = 1; k < log.samples(); ++k) {
     const double gap = log.time[k] - log.time[k - 1];
     if (gap > kMaxGap && gap > kMaxGapSteps * median_step)
-      throw DataError(file, imported.lines[static_cast<std::size_t>(k)],
-                      fmt::format("a gap of {} s since line {} ({} times the median step {} s): a log is one recording; "
-                                  "split the file there, or {}",
-                                  g(gap), imported.lines[static_cast<std::size_t>(k - 1)], g(gap / median_step), g(median_step),
-                                  kOverride));
+      throw DataError(
+          file, imported.lines[static_cast<std::size_t>(k)],
+          fmt::format("a gap of {} s since line {} ({} times the median step {} s): a log is one recording; "
+                      "split the file there, or {}",
+                      g(gap), imported.lines[static_cast<std::size_t>(k - 1)], g(gap / median_step), g(median_step),
+                      kOverride));
   }
 
   const double step = log.meta.sample_time;  // the median interval, to the us
   if (step < kMinStep || step > kMaxStep) {
     const TimeUnit u = mapping.time_unit;
-    const std::string in_seconds = u == TimeUnit::s ? "" : fmt::format(" ({} s read as {})", g(step), detail::time_unit_name(u));
+    const std::string in_seconds =
+        u == TimeUnit::s ? "" : fmt::format(" ({} s read as {})", g(step), detail::time_unit_name(u));
     throw DataError(file, 0,
                     fmt::format("the median time step is {} {} as written{}, outside the plausible [{} s, {} s] of a "
                                 "robot's log: is the time unit right (--time-unit, units.time)? {}",
-                                g(step * detail::time_divisor(u)), detail::time_unit_name(u), in_seconds, g(kMinStep), g(kMaxStep),
-                                kOverride));
+                                g(step * detail::time_divisor(u)), detail::time_unit_name(u), in_seconds, g(kMinStep),
+                                g(kMaxStep), kOverride));
   }
 }
 

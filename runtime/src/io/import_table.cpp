@@ -69,8 +69,7 @@ bool is_number(std::string_view text) {
 
 }  // namespace
 
-TextTable::TextTable(const std::filesystem::path& file, Delimiter delimiter, HeaderRow header)
-    : file_(file.string()) {
+TextTable::TextTable(const std::filesystem::path& file, Delimiter delimiter, HeaderRow header) : file_(file.string()) {
   bytes_ = read_text_file(file, "cannot open the file to import");
   std::size_t start = bytes_.compare(0, 3, "\xEF\xBB\xBF") == 0 ? 3 : 0;  // UTF-8 byte order mark
   // Line ends of CR alone (classic Mac OS, some loggers): the whole file is one line without a
@@ -167,8 +166,8 @@ void TextTable::read(const std::vector<int>& columns, std::vector<double>& value
         throw DataError(file_, line_number,
                         fmt::format("'{}' in {} is not a number", shown_text(text), column_label(c)));
       if (!std::isfinite(v))
-        throw DataError(file_, line_number, fmt::format("{} holds '{}', not a finite number", column_label(c),
-                                                        shown_text(text)));
+        throw DataError(file_, line_number,
+                        fmt::format("{} holds '{}', not a finite number", column_label(c), shown_text(text)));
       values.push_back(v);
     }
     lines.push_back(line_number);

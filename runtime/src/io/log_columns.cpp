@@ -59,13 +59,20 @@ std::string column_name(Column c) {
 
 const Eigen::MatrixXd& group_matrix(const Log& log, Group g) {
   switch (g) {
-    case Group::q: return log.q;
-    case Group::qd: return log.qd;
-    case Group::tau: return log.tau;
-    case Group::q_ref: return log.q_ref;
-    case Group::qd_ref: return log.qd_ref;
-    case Group::qdd_ref: return log.qdd_ref;
-    case Group::time: break;
+    case Group::q:
+      return log.q;
+    case Group::qd:
+      return log.qd;
+    case Group::tau:
+      return log.tau;
+    case Group::q_ref:
+      return log.q_ref;
+    case Group::qd_ref:
+      return log.qd_ref;
+    case Group::qdd_ref:
+      return log.qdd_ref;
+    case Group::time:
+      break;
   }
   throw std::logic_error("group_matrix: time is a vector");
 }
@@ -80,8 +87,7 @@ bool is_known_source(std::string_view source) {
 
 std::vector<Group> groups_of(const Log& log) {
   std::vector<Group> groups{Group::time};
-  if (log.meta.source != reference_source)
-    groups.insert(groups.end(), measured_groups.begin(), measured_groups.end());
+  if (log.meta.source != reference_source) groups.insert(groups.end(), measured_groups.begin(), measured_groups.end());
   if (log.meta.source == reference_source || log.has_references())
     groups.insert(groups.end(), reference_groups.begin(), reference_groups.end());
   return groups;

@@ -15,9 +15,8 @@ namespace symoro::io::detail {
 enum class Group { time, q, qd, tau, q_ref, qd_ref, qdd_ref };
 constexpr int group_count = 7;
 
-constexpr std::array<Group, group_count> all_groups = {Group::time,  Group::q,      Group::qd,
-                                                       Group::tau,   Group::q_ref, Group::qd_ref,
-                                                       Group::qdd_ref};
+constexpr std::array<Group, group_count> all_groups = {Group::time,  Group::q,      Group::qd,     Group::tau,
+                                                       Group::q_ref, Group::qd_ref, Group::qdd_ref};
 constexpr std::array<Group, 3> measured_groups = {Group::q, Group::qd, Group::tau};
 constexpr std::array<Group, 3> reference_groups = {Group::q_ref, Group::qd_ref, Group::qdd_ref};
 

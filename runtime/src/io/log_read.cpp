@@ -91,25 +91,32 @@ std::vector<Column> parse_header(std::string_view header, const detail::Sidecar&
   std::size_t start = 0;
   while (true) {
     const std::size_t comma = header.find(',', start);
-    const std::string_view raw = header.substr(start, comma == std::string_view::npos ? std::string_view::npos : comma - start);
+    const std::string_view raw =
+        header.substr(start, comma == std::string_view::npos ? std::string_view::npos : comma - start);
     const std::string_view raw_name = trim(raw);
     const std::string name = detail::shown_text(raw_name, 80);  // as messages quote it
     const std::size_t position = columns.size() + 1;
     if (name.empty()) throw DataError(file, 1, fmt::format("column {} of the header has no name", position));
     const auto column = detail::parse_column_name(raw_name);
     if (!column)
-      throw DataError(file, 1, fmt::format("unknown column '{}' (a log has time, q<j>, qd<j>, tau<j>, q_ref<j>, "
-                                           "qd_ref<j> and qdd_ref<j> for joints j = 1..{})", name, joints));
+      throw DataError(file, 1,
+                      fmt::format("unknown column '{}' (a log has time, q<j>, qd<j>, tau<j>, q_ref<j>, "
+                                  "qd_ref<j> and qdd_ref<j> for joints j = 1..{})",
+                                  name, joints));
     if (column->joint >= joints)
-      throw DataError(file, 1, fmt::format("unknown column '{}': joint {} does not exist, the sidecar lists {} joints",
-                                           name, column->joint + 1, joints));
+      throw DataError(file, 1,
+                      fmt::format("unknown column '{}': joint {} does not exist, the sidecar lists {} joints", name,
+                                  column->joint + 1, joints));
     if (reference && std::find(detail::measured_groups.begin(), detail::measured_groups.end(), column->group) !=
                          detail::measured_groups.end())
-      throw DataError(file, 1, fmt::format("unknown column '{}' in a reference file (source: reference), which holds "
-                                           "time, q_ref, qd_ref and qdd_ref only", name));
+      throw DataError(file, 1,
+                      fmt::format("unknown column '{}' in a reference file (source: reference), which holds "
+                                  "time, q_ref, qd_ref and qdd_ref only",
+                                  name));
     const auto [previous, inserted] = seen.emplace(std::pair{column->group, column->joint}, position);
     if (!inserted)
-      throw DataError(file, 1, fmt::format("duplicate column '{}' (columns {} and {})", name, previous->second, position));
+      throw DataError(file, 1,
+                      fmt::format("duplicate column '{}' (columns {} and {})", name, previous->second, position));
     columns.push_back(*column);
     if (comma == std::string_view::npos) break;
     start = comma + 1;
@@ -127,19 +134,22 @@ std::vector<Column> parse_header(std::string_view header, const detail::Sidecar&
   if (!reference) {
     const std::vector<std::string> missing = missing_in(detail::measured_groups);
     if (!missing.empty())
-      throw DataError(file, 1, fmt::format("missing column{} {}{}", missing.size() > 1 ? "s" : "", quoted_list(missing),
-                                           joint_count_note));
+      throw DataError(
+          file, 1,
+          fmt::format("missing column{} {}{}", missing.size() > 1 ? "s" : "", quoted_list(missing), joint_count_note));
   }
   const std::vector<std::string> missing_references = missing_in(detail::reference_groups);
   const bool any_reference = missing_references.size() < 3 * static_cast<std::size_t>(joints);
   if (reference && !missing_references.empty())
-    throw DataError(file, 1, fmt::format("missing column{} {} in a reference file{}", missing_references.size() > 1 ? "s" : "",
-                                         quoted_list(missing_references), joint_count_note));
+    throw DataError(file, 1,
+                    fmt::format("missing column{} {} in a reference file{}", missing_references.size() > 1 ? "s" : "",
+                                quoted_list(missing_references), joint_count_note));
   if (any_reference && !missing_references.empty())
-    throw DataError(file, 1, fmt::format("partial reference group: missing column{} {} (q_ref, qd_ref and qdd_ref "
-                                         "come together, for every joint){}",
-                                         missing_references.size() > 1 ? "s" : "", quoted_list(missing_references),
-                                         joint_count_note));
+    throw DataError(
+        file, 1,
+        fmt::format("partial reference group: missing column{} {} (q_ref, qd_ref and qdd_ref "
+                    "come together, for every joint){}",
+                    missing_references.size() > 1 ? "s" : "", quoted_list(missing_references), joint_count_note));
   return columns;
 }
 
@@ -152,8 +162,7 @@ class RowParser {
   // Parses row `row` (0-based) from `line`, which is line `line_number` of the file.
   void parse(std::string_view line, Eigen::Index row, int line_number) {
     line_number_ = line_number;
-    if (trim(line).empty())
-      throw DataError(file_, line_number, "blank line (every line after the header is a sample)");
+    if (trim(line).empty()) throw DataError(file_, line_number, "blank line (every line after the header is a sample)");
     const char* p = line.data();
     const char* const end = line.data() + line.size();
     const std::size_t count = columns_.size();
@@ -187,8 +196,10 @@ class RowParser {
       case NumberParse::not_a_number:
         throw DataError(file_, line_number_, fmt::format("'{}' in column '{}' is not a number", shown, column));
       case NumberParse::out_of_range:
-        throw DataError(file_, line_number_, fmt::format("'{}' in column '{}' is out of the range of a double", shown, column));
-      case NumberParse::ok: break;
+        throw DataError(file_, line_number_,
+                        fmt::format("'{}' in column '{}' is out of the range of a double", shown, column));
+      case NumberParse::ok:
+        break;
     }
     if (!std::isfinite(value))
       throw DataError(file_, line_number_, fmt::format("column '{}' holds '{}', not a finite number", column, shown));
@@ -196,8 +207,9 @@ class RowParser {
   }
 
   [[noreturn]] void fail_field_count(std::size_t fields) const {
-    throw DataError(file_, line_number_,
-                    fmt::format("row has {} field{}, the header has {}", fields, fields == 1 ? "" : "s", columns_.size()));
+    throw DataError(
+        file_, line_number_,
+        fmt::format("row has {} field{}, the header has {}", fields, fields == 1 ? "" : "s", columns_.size()));
   }
 
   const std::string& file_;
@@ -235,9 +247,8 @@ Log read_log(const std::filesystem::path& csv) {
   Log log;
   log.meta = sidecar.meta;
   const bool reference = log.meta.source == detail::reference_source;
-  const bool has_references = reference || std::any_of(columns.begin(), columns.end(), [](const Column& c) {
-                                return c.group == Group::q_ref;
-                              });
+  const bool has_references =
+      reference || std::any_of(columns.begin(), columns.end(), [](const Column& c) { return c.group == Group::q_ref; });
   std::vector<Group> groups{Group::time};
   if (!reference) groups.insert(groups.end(), detail::measured_groups.begin(), detail::measured_groups.end());
   if (has_references) groups.insert(groups.end(), detail::reference_groups.begin(), detail::reference_groups.end());
@@ -247,8 +258,10 @@ Log read_log(const std::filesystem::path& csv) {
   // the matrices exactly.
   const Eigen::Index rows = std::count(text.begin(), text.end(), '\n') - 1;
   if (rows == 0)
-    throw DataError(file, 2, sidecar.meta.notes.empty() ? std::string("no data rows after the header")
-                                                        : "no data rows after the header; the sidecar's notes: " + sidecar.meta.notes);
+    throw DataError(file, 2,
+                    sidecar.meta.notes.empty()
+                        ? std::string("no data rows after the header")
+                        : "no data rows after the header; the sidecar's notes: " + sidecar.meta.notes);
   const Eigen::Index joints = static_cast<Eigen::Index>(log.meta.joints.size());
   log.time.resize(rows);
   for (Group g : groups)
@@ -271,10 +284,10 @@ Log read_log(const std::filesystem::path& csv) {
   }
 
   if (rows != sidecar.samples)
-    throw DataError(file, rows > sidecar.samples ? static_cast<int>(sidecar.samples) + 2 : 0,
-                    fmt::format("the CSV has {} samples but its sidecar ({}:{}) says samples: {}{}", rows, sidecar.file,
-                                sidecar.samples_line, sidecar.samples,
-                                rows < sidecar.samples ? " (truncated CSV?)" : ""));
+    throw DataError(
+        file, rows > sidecar.samples ? static_cast<int>(sidecar.samples) + 2 : 0,
+        fmt::format("the CSV has {} samples but its sidecar ({}:{}) says samples: {}{}", rows, sidecar.file,
+                    sidecar.samples_line, sidecar.samples, rows < sidecar.samples ? " (truncated CSV?)" : ""));
   return log;
 }
 

@@ -20,9 +20,9 @@ namespace symoro::io::detail {
 
 namespace {
 
-constexpr std::array<std::string_view, 12> sidecar_keys = {"format",  "robot",  "trajectory",  "trial",
-                                                           "seed",    "source", "sample_time", "samples",
-                                                           "joints",  "units",  "notes",       "velocity"};
+constexpr std::array<std::string_view, 12> sidecar_keys = {"format", "robot",  "trajectory",  "trial",
+                                                           "seed",   "source", "sample_time", "samples",
+                                                           "joints", "units",  "notes",       "velocity"};
 // Keys a sidecar may leave out (everything else the writer always writes is required).
 // "velocity" is written only when differentiated, so older sidecars stay byte for byte the same.
 constexpr std::array<std::string_view, 2> optional_keys = {"notes", "velocity"};
@@ -53,8 +53,8 @@ class SidecarReader {
     Integer value{};
     const auto [ptr, ec] = std::from_chars(s.data(), s.data() + s.size(), value);
     if (s.empty() || ec != std::errc() || ptr != s.data() + s.size())
-      fail(node, fmt::format("{}: expected a whole number{}, got '{}'", key,
-                             std::is_signed_v<Integer> ? "" : " >= 0", shown_text(s)));
+      fail(node, fmt::format("{}: expected a whole number{}, got '{}'", key, std::is_signed_v<Integer> ? "" : " >= 0",
+                             shown_text(s)));
     return value;
   }
 
@@ -102,7 +102,8 @@ Sidecar read_sidecar(const std::filesystem::path& yaml) {
   const std::string format_text = reader.text(format, "format");
   if (format_text != log_format) {
     if (format_text.rfind("symoro-log ", 0) == 0)
-      reader.fail(format, fmt::format("unsupported log format version '{}' (this reader reads '{}')", format_text, log_format));
+      reader.fail(format,
+                  fmt::format("unsupported log format version '{}' (this reader reads '{}')", format_text, log_format));
     reader.fail(format, fmt::format("format is '{}', not '{}': not a symoro log sidecar", format_text, log_format));
   }
 
@@ -115,7 +116,8 @@ Sidecar read_sidecar(const std::filesystem::path& yaml) {
   meta.seed = reader.integer<std::uint64_t>(value("seed"), "seed");
   meta.source = reader.text(value("source"), "source");
   if (!is_known_source(meta.source))
-    reader.fail(value("source"), fmt::format("source: unknown source '{}' (expected twin, robot or reference)", meta.source));
+    reader.fail(value("source"),
+                fmt::format("source: unknown source '{}' (expected twin, robot or reference)", meta.source));
   meta.sample_time = reader.number(value("sample_time"), "sample_time");
   if (meta.sample_time <= 0)
     reader.fail(value("sample_time"), fmt::format("sample_time: {} s is not positive", number_text(meta.sample_time)));
@@ -137,7 +139,8 @@ Sidecar read_sidecar(const std::filesystem::path& yaml) {
   if (sidecar.samples < 0) reader.fail(samples, fmt::format("samples: {} is negative", sidecar.samples));
 
   const YAML::Node joints = value("joints");
-  if (!joints.IsSequence() || joints.size() == 0) reader.fail(joints, "joints: expected a non-empty list of joint names");
+  if (!joints.IsSequence() || joints.size() == 0)
+    reader.fail(joints, "joints: expected a non-empty list of joint names");
   std::set<std::string> seen;
   for (const YAML::Node& joint : joints) {
     std::string name = reader.text(joint, "joints");
@@ -190,11 +193,11 @@ std::string sidecar_text(const Log& log, const std::string& file) {
   for (const std::string& joint : meta.joints) out << YAML::DoubleQuoted << joint;
   out << YAML::EndSeq;
   out << YAML::Key << "units" << YAML::Value << YAML::BeginMap;
-  for (Group g : groups_of(log)) out << YAML::Key << std::string(group_name(g)) << YAML::Value << std::string(group_unit(g));
+  for (Group g : groups_of(log))
+    out << YAML::Key << std::string(group_name(g)) << YAML::Value << std::string(group_unit(g));
   out << YAML::EndMap;
   out << YAML::Key << "notes" << YAML::Value << YAML::DoubleQuoted << meta.notes;
-  if (meta.velocity == Velocity::differentiated)
-    out << YAML::Key << "velocity" << YAML::Value << "differentiated";
+  if (meta.velocity == Velocity::differentiated) out << YAML::Key << "velocity" << YAML::Value << "differentiated";
   out << YAML::EndMap;
   if (!out.good()) throw DataError(file, 0, "cannot write the metadata sidecar: " + out.GetLastError());
   return std::string(out.c_str()) + "\n";

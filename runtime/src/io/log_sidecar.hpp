@@ -16,10 +16,10 @@ namespace symoro::io::detail {
 constexpr std::string_view log_format = "symoro-log 1";
 
 struct Sidecar {
-  std::string file;    // the sidecar's path, for messages
-  LogMetadata meta;    // checked: known source, robot and joint names non-empty, joints unique
-  long long samples = 0;    // the CSV's row count when it was written
-  int samples_line = 0;     // 1-based line of "samples:" in the sidecar
+  std::string file;                 // the sidecar's path, for messages
+  LogMetadata meta;                 // checked: known source, robot and joint names non-empty, joints unique
+  long long samples = 0;            // the CSV's row count when it was written
+  int samples_line = 0;             // 1-based line of "samples:" in the sidecar
   std::map<Group, int> unit_lines;  // groups the units map names (each with the SI unit), and where
   int units_line = 0;
 };

@@ -236,7 +236,9 @@ std::string LogStream::sidecar_text(std::int64_t samples) const {
   return detail::sidecar_text(log, metadata_path(csv_).string());
 }
 
-void LogStream::write_sidecar(std::int64_t samples) { write_file_atomically(metadata_path(csv_), sidecar_text(samples)); }
+void LogStream::write_sidecar(std::int64_t samples) {
+  write_file_atomically(metadata_path(csv_), sidecar_text(samples));
+}
 
 void LogStream::flush() {
   std::unique_lock<std::mutex> lock(mutex_);

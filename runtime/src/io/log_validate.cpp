@@ -22,7 +22,8 @@ void check_metadata(const LogMetadata& meta, const std::string& file) {
   if (meta.robot.empty()) throw DataError(file, 0, "the robot name is empty");
   if (meta.trial < 0) throw DataError(file, 0, fmt::format("trial {} is negative", meta.trial));
   if (!std::isfinite(meta.sample_time) || meta.sample_time <= 0)
-    throw DataError(file, 0, fmt::format("sample_time {} is not a positive finite number", number_text(meta.sample_time)));
+    throw DataError(file, 0,
+                    fmt::format("sample_time {} is not a positive finite number", number_text(meta.sample_time)));
   if (meta.joints.empty()) throw DataError(file, 0, "the joint list is empty");
   std::set<std::string> seen;
   for (std::size_t j = 0; j < meta.joints.size(); ++j) {
@@ -36,8 +37,9 @@ void check_finite(const Eigen::MatrixXd& m, std::string_view group, const std::s
   for (Eigen::Index j = 0; j < m.cols(); ++j)
     for (Eigen::Index k = 0; k < m.rows(); ++k)
       if (!std::isfinite(m(k, j)))
-        throw DataError(file, 0, fmt::format("{}{} at sample {} is {}, not a finite number", group, j + 1, k + 1,
-                                             number_text(m(k, j))));
+        throw DataError(
+            file, 0,
+            fmt::format("{}{} at sample {} is {}, not a finite number", group, j + 1, k + 1, number_text(m(k, j))));
 }
 
 }  // namespace
@@ -50,14 +52,17 @@ void validate_log(const Log& log, const std::string& file) {
   // A run that stopped before its first row (dynid control) leaves a valid, empty log whose
   // notes say why: the message carries them.
   if (samples == 0)
-    throw DataError(file, 0, meta.notes.empty() ? std::string("the log has no samples") : "the log has no samples; its notes: " + meta.notes);
+    throw DataError(file, 0,
+                    meta.notes.empty() ? std::string("the log has no samples")
+                                       : "the log has no samples; its notes: " + meta.notes);
 
   const bool reference = meta.source == detail::reference_source;
   for (Group g : detail::measured_groups) {
     const Eigen::MatrixXd& m = detail::group_matrix(log, g);
     if (reference && m.cols() != 0)
-      throw DataError(file, 0, fmt::format("a reference log has no {} columns, but {} has {}", detail::group_name(g),
-                                           detail::group_name(g), m.cols()));
+      throw DataError(file, 0,
+                      fmt::format("a reference log has no {} columns, but {} has {}", detail::group_name(g),
+                                  detail::group_name(g), m.cols()));
   }
   const int reference_groups_present =
       static_cast<int>(log.q_ref.cols() > 0) + (log.qd_ref.cols() > 0) + (log.qdd_ref.cols() > 0);
@@ -70,17 +75,20 @@ void validate_log(const Log& log, const std::string& file) {
     if (g == Group::time) continue;
     const Eigen::MatrixXd& m = detail::group_matrix(log, g);
     if (m.rows() != samples || m.cols() != joints)
-      throw DataError(file, 0, fmt::format("{} is {} x {} but the log has {} samples of {} joints (meta.joints)",
-                                           detail::group_name(g), m.rows(), m.cols(), samples, joints));
+      throw DataError(file, 0,
+                      fmt::format("{} is {} x {} but the log has {} samples of {} joints (meta.joints)",
+                                  detail::group_name(g), m.rows(), m.cols(), samples, joints));
     check_finite(m, detail::group_name(g), file);
   }
 
   for (Eigen::Index k = 0; k < samples; ++k) {
     if (!std::isfinite(log.time[k]))
-      throw DataError(file, 0, fmt::format("time at sample {} is {}, not a finite number", k + 1, number_text(log.time[k])));
+      throw DataError(file, 0,
+                      fmt::format("time at sample {} is {}, not a finite number", k + 1, number_text(log.time[k])));
     if (k > 0 && !(log.time[k] > log.time[k - 1]))
-      throw DataError(file, 0, fmt::format("time does not increase strictly: sample {} is at {} s, sample {} at {} s", k,
-                                           number_text(log.time[k - 1]), k + 1, number_text(log.time[k])));
+      throw DataError(file, 0,
+                      fmt::format("time does not increase strictly: sample {} is at {} s, sample {} at {} s", k,
+                                  number_text(log.time[k - 1]), k + 1, number_text(log.time[k])));
   }
 }
 

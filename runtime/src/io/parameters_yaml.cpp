@@ -23,10 +23,12 @@ YAML::Node parameters_root(const std::string& path) {
   if (!std::filesystem::is_regular_file(path)) throw DataError(path, 0, "not found");
   const YAML::Node root = load_yaml_file(path);
   if (!root.IsMap())
-    throw DataError(path, 1, "not a parameters file: a YAML map with a 'parameters:' list (a study's report/parameters.yaml) "
-                             "was expected" + std::string(path.size() > 4 && path.compare(path.size() - 4, 4, ".csv") == 0
-                                                              ? "; a .csv is not read here"
-                                                              : ""));
+    throw DataError(
+        path, 1,
+        "not a parameters file: a YAML map with a 'parameters:' list (a study's report/parameters.yaml) "
+        "was expected" +
+            std::string(path.size() > 4 && path.compare(path.size() - 4, 4, ".csv") == 0 ? "; a .csv is not read here"
+                                                                                         : ""));
   return root;
 }
 
@@ -55,7 +57,8 @@ Eigen::VectorXd read_parameters_yaml(const std::string& path, const std::vector<
   Eigen::VectorXd phi(static_cast<Eigen::Index>(names.size()));
   for (std::size_t i = 0; i < names.size(); ++i) {
     const auto it = values.find(names[i]);
-    if (it == values.end()) throw DataError(path, line(list), fmt::format("parameter '{}' is missing ({} expected)", names[i], names.size()));
+    if (it == values.end())
+      throw DataError(path, line(list), fmt::format("parameter '{}' is missing ({} expected)", names[i], names.size()));
     phi(static_cast<Eigen::Index>(i)) = it->second.first;
   }
   return phi;
@@ -92,9 +95,10 @@ ParametersIntegrity parameters_integrity(const std::string& path, const std::vec
   if (saved.empty()) return {false, "it has no 'digest:' (identify writes one; an edited or hand-made file has none)"};
   const std::string actual = parameters_digest(text("robot"), text("model"), accepted, names, phi);
   if (saved != actual)
-    return {false, fmt::format("its content does not match its digest (file {}, content {}): it was edited after identify "
-                               "wrote it",
-                               saved, actual)};
+    return {false,
+            fmt::format("its content does not match its digest (file {}, content {}): it was edited after identify "
+                        "wrote it",
+                        saved, actual)};
   return {true, ""};
 }
 

@@ -9,7 +9,8 @@
 namespace symoro::io {
 
 void check_regular_file(const std::filesystem::path& path) {
-  if (const std::string why = ::symoro::detail::not_a_regular_file(path); !why.empty()) throw DataError(path.string(), 0, why);
+  if (const std::string why = ::symoro::detail::not_a_regular_file(path); !why.empty())
+    throw DataError(path.string(), 0, why);
 }
 
 std::string read_text_file(const std::filesystem::path& path, const std::string& missing_message) {

@@ -19,11 +19,16 @@ std::string num(double v) { return io::number_text(v == 0 ? 0.0 : v); }  // no "
 std::string xml_escaped(const std::string& t) {
   std::string out;
   for (char c : t) {
-    if (c == '&') out += "&amp;";
-    else if (c == '<') out += "&lt;";
-    else if (c == '>') out += "&gt;";
-    else if (c == '"') out += "&quot;";
-    else out += c;
+    if (c == '&')
+      out += "&amp;";
+    else if (c == '<')
+      out += "&lt;";
+    else if (c == '>')
+      out += "&gt;";
+    else if (c == '"')
+      out += "&quot;";
+    else
+      out += c;
   }
   return out;
 }
@@ -50,7 +55,8 @@ int joint_of_frame(const UrdfDescription& d, int frame) {
 
 void check(const UrdfDescription& d) {
   if (d.s.size() != static_cast<Eigen::Index>(d.names.size()))
-    throw std::invalid_argument(fmt::format("urdf export: {} standard parameters for {} names", d.s.size(), d.names.size()));
+    throw std::invalid_argument(
+        fmt::format("urdf export: {} standard parameters for {} names", d.s.size(), d.names.size()));
   if (!d.s.allFinite()) throw std::invalid_argument("urdf export: a standard parameter is not finite");
   std::size_t movable = 0;
   for (std::size_t i = 0; i < d.frames.size(); ++i) {
@@ -65,7 +71,8 @@ void check(const UrdfDescription& d) {
 
 }  // namespace
 
-UrdfInertial inertial_about_com(const Eigen::Matrix3d& inertia_origin, const Eigen::Vector3d& first_moment, double mass) {
+UrdfInertial inertial_about_com(const Eigen::Matrix3d& inertia_origin, const Eigen::Vector3d& first_moment,
+                                double mass) {
   UrdfInertial u;
   u.present = mass != 0 || !first_moment.isZero(0) || !inertia_origin.isZero(0);
   u.mass = mass;
@@ -93,9 +100,12 @@ UrdfInertial link_inertial(const UrdfDescription& d, int frame) {
     if (d.names[k].joint != frame) continue;
     const int slot = slot_of(d.names[k].family);
     const double v = d.s(static_cast<Eigen::Index>(k));
-    if (slot >= 0 && slot < 6) I(row[slot], col[slot]) = I(col[slot], row[slot]) = v;
-    else if (slot >= 6 && slot < 9) h(slot - 6) = v;
-    else if (slot == 9) m = v;
+    if (slot >= 0 && slot < 6)
+      I(row[slot], col[slot]) = I(col[slot], row[slot]) = v;
+    else if (slot >= 6 && slot < 9)
+      h(slot - 6) = v;
+    else if (slot == 9)
+      m = v;
   }
   return inertial_about_com(I, h, m);
 }
@@ -103,7 +113,8 @@ UrdfInertial link_inertial(const UrdfDescription& d, int frame) {
 std::string urdf_link_name(const UrdfDescription& d, int frame) {
   if (frame == 0) return "base_link";
   const int j = joint_of_frame(d, frame);
-  return j >= 0 ? std::string(d.joints[static_cast<std::size_t>(j)].name) + "_link" : fmt::format("frame{}_link", frame);
+  return j >= 0 ? std::string(d.joints[static_cast<std::size_t>(j)].name) + "_link"
+                : fmt::format("frame{}_link", frame);
 }
 
 std::string urdf_joint_name(const UrdfDescription& d, int frame) {
@@ -151,7 +162,8 @@ std::string urdf_text(const UrdfDescription& d) {
   };
 
   std::string x = "<?xml version=\"1.0\"?>\n";
-  x += "<!-- " + comment_text(d.robot) + ": written by symoro (dynid export, URDF output).\n"
+  x += "<!-- " + comment_text(d.robot) +
+       ": written by symoro (dynid export, URDF output).\n"
        "  Link frames: every link frame is the model's modified Denavit-Hartenberg frame (Khalil-Kleinfinger)\n"
        "  of the same number, frame 0 = base_link: the frame j relative to its antecedent a(j) is\n"
        "    Rot(z, gamma_j) Trans(z, b_j) Rot(x, alpha_j) Trans(x, d_j) Rot(z, theta_j) Trans(z, r_j),\n"
@@ -177,7 +189,8 @@ std::string urdf_text(const UrdfDescription& d) {
     } else {
       x += "  <link name=\"" + xml_escaped(link) + "\">\n";
       x += "    <!-- frame " + std::to_string(f) + " -->\n    <inertial>\n";
-      x += fmt::format("      <origin xyz=\"{} {} {}\" rpy=\"0 0 0\"/>\n", num(in.com.x()), num(in.com.y()), num(in.com.z()));
+      x += fmt::format("      <origin xyz=\"{} {} {}\" rpy=\"0 0 0\"/>\n", num(in.com.x()), num(in.com.y()),
+                       num(in.com.z()));
       x += "      <mass value=\"" + num(in.mass) + "\"/>\n";
       x += fmt::format("      <inertia ixx=\"{}\" ixy=\"{}\" ixz=\"{}\" iyy=\"{}\" iyz=\"{}\" izz=\"{}\"/>\n",
                        num(in.inertia(0, 0)), num(in.inertia(0, 1)), num(in.inertia(0, 2)), num(in.inertia(1, 1)),
@@ -193,18 +206,19 @@ std::string urdf_text(const UrdfDescription& d) {
                      num(fr.alpha), num(fr.d), num(fr.theta), num(fr.r));
     x += "    <parent link=\"" + xml_escaped(urdf_link_name(d, fr.ant)) + "\"/>\n";
     x += "    <child link=\"" + xml_escaped(link) + "\"/>\n";
-    x += fmt::format("    <origin xyz=\"{} {} {}\" rpy=\"{} {} {}\"/>\n", num(p.x()), num(p.y()), num(p.z()), num(rpy(0)),
-                     num(rpy(1)), num(rpy(2)));
+    x += fmt::format("    <origin xyz=\"{} {} {}\" rpy=\"{} {} {}\"/>\n", num(p.x()), num(p.y()), num(p.z()),
+                     num(rpy(0)), num(rpy(1)), num(rpy(2)));
     if (j >= 0) {
       const JointInfo& ji = d.joints[static_cast<std::size_t>(j)];
       x += "    <axis xyz=\"0 0 1\"/>\n";
-      x += fmt::format("    <limit lower=\"{}\" upper=\"{}\" effort=\"{}\" velocity=\"{}\"/>\n", num(ji.lower), num(ji.upper),
-                       num(ji.effort), num(ji.velocity));
+      x += fmt::format("    <limit lower=\"{}\" upper=\"{}\" effort=\"{}\" velocity=\"{}\"/>\n", num(ji.lower),
+                       num(ji.upper), num(ji.effort), num(ji.velocity));
       bool has_fv = false, has_fs = false, has_ia = false;
       const double fv = value_of("FV", f, has_fv), fs = value_of("FS", f, has_fs), ia = value_of("IA", f, has_ia);
       if (has_fv || has_fs) x += fmt::format("    <dynamics damping=\"{}\" friction=\"{}\"/>\n", num(fv), num(fs));
-      if (has_ia) x += "    <!-- rotor inertia IA" + std::to_string(f) + " = " + num(ia) + " " +
-                       standard_unit("IA", fr.sigma == 1) + " (no URDF field; not applied by URDF consumers) -->\n";
+      if (has_ia)
+        x += "    <!-- rotor inertia IA" + std::to_string(f) + " = " + num(ia) + " " +
+             standard_unit("IA", fr.sigma == 1) + " (no URDF field; not applied by URDF consumers) -->\n";
     }
     x += "  </joint>\n";
   }
@@ -216,15 +230,16 @@ std::string standard_parameters_yaml(const UrdfDescription& d, const std::string
   check(d);
   std::string y = header;
   if (!y.empty() && y.back() != '\n') y += '\n';
-  y += "# Frame-origin standard parameters (modified-DH link frames): XX..ZZ about the frame origin, MX MY MZ = M * CoM,\n"
+  y += "# Frame-origin standard parameters (modified-DH link frames): XX..ZZ about the frame origin, MX MY MZ = M * "
+       "CoM,\n"
        "# M, IA (rotor inertia: not representable in URDF, only here), FV (URDF damping), FS (URDF friction).\n";
   y += d.names.empty() ? "parameters: []\n" : "parameters:\n";
   for (std::size_t k = 0; k < d.names.size(); ++k) {
     const auto& p = d.names[k];
     const bool prismatic = p.joint >= 1 && p.joint <= static_cast<int>(d.frames.size()) &&
                            d.frames[static_cast<std::size_t>(p.joint - 1)].sigma == 1;
-    y += fmt::format("  - {{name: \"{}\", frame: {}, family: \"{}\", unit: \"{}\", value: {}}}\n", p.name, p.joint, p.family,
-                     standard_unit(p.family, prismatic), num(d.s(static_cast<Eigen::Index>(k))));
+    y += fmt::format("  - {{name: \"{}\", frame: {}, family: \"{}\", unit: \"{}\", value: {}}}\n", p.name, p.joint,
+                     p.family, standard_unit(p.family, prismatic), num(d.s(static_cast<Eigen::Index>(k))));
   }
   return y;
 }

@@ -153,7 +153,8 @@ TaskEnd run_isolated(const Farm& farm, const std::string& task, const std::funct
 
 }  // namespace
 
-TaskEnd run_task(const Farm& farm, const std::string& task, bool isolate, const std::function<void(const std::string&)>& result) {
+TaskEnd run_task(const Farm& farm, const std::string& task, bool isolate,
+                 const std::function<void(const std::string&)>& result) {
   const auto t0 = std::chrono::steady_clock::now();
   TaskEnd end;
   try {
@@ -189,7 +190,7 @@ FarmSummary run_local(const std::vector<std::string>& tasks, const Farm& farm, c
   FarmSummary summary;
   summary.workers = std::min(detail::worker_count(options, 1), std::max(1, static_cast<int>(tasks.size())));
   summary.tasks.resize(tasks.size());
-  std::mutex m;  // one callback at a time
+  std::mutex m;          // one callback at a time
   std::size_t next = 0;  // under m
   auto worker = [&] {
     for (;;) {

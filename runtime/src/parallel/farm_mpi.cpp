@@ -224,8 +224,9 @@ class Coordinator {
         e.task = static_cast<std::size_t>(t->first);
         e.rank = r;
         e.failed = true;
-        e.failure = fmt::format("rank {} stopped answering for {:g} s while running this task (its process or node was lost)",
-                                r, options_.rank_timeout);
+        e.failure =
+            fmt::format("rank {} stopped answering for {:g} s while running this task (its process or node was lost)",
+                        r, options_.rank_timeout);
         ended(e);
         t = running_.erase(t);
       }
@@ -277,8 +278,8 @@ class Coordinator {
   std::size_t next_ = 0;
   int byes_ = 0;
   std::vector<Clock::time_point> heard_;
-  std::vector<bool> spoke_, done_, lost_;  // done: said bye, or lost
-  std::vector<std::pair<std::int64_t, int>> running_;  // (task, rank) handed to other ranks
+  std::vector<bool> spoke_, done_, lost_;               // done: said bye, or lost
+  std::vector<std::pair<std::int64_t, int> > running_;  // (task, rank) handed to other ranks
 };
 
 void serve(const Farm& farm, const FarmOptions& options) {

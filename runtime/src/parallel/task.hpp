@@ -14,7 +14,8 @@ namespace symoro::parallel::detail {
 // Runs `task`, passing each result it emits to `result` (in the calling thread). The returned
 // end has its failure, wall time and (isolated) peak memory; its task index and rank are the
 // caller's to set.
-TaskEnd run_task(const Farm& farm, const std::string& task, bool isolate, const std::function<void(const std::string&)>& result);
+TaskEnd run_task(const Farm& farm, const std::string& task, bool isolate,
+                 const std::function<void(const std::string&)>& result);
 
 // Worker threads per rank: the option, else the cores this process may run on (its affinity), or
 // this machine's cores shared among the ranks on it when it is not bound.

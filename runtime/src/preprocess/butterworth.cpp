@@ -46,9 +46,8 @@ double pole_radius(const Biquad& s) {
 
 std::vector<Biquad> butterworth_lowpass(int order, double cutoff_hz, double sample_rate_hz) {
   if (order < 1 || !(sample_rate_hz > 0) || !(cutoff_hz > 0) || !(cutoff_hz < sample_rate_hz / 2))
-    throw std::invalid_argument("butterworth_lowpass: need order >= 1 and 0 < cutoff (" +
-                                std::to_string(cutoff_hz) + " Hz) < sample rate / 2 (" +
-                                std::to_string(sample_rate_hz / 2) + " Hz)");
+    throw std::invalid_argument("butterworth_lowpass: need order >= 1 and 0 < cutoff (" + std::to_string(cutoff_hz) +
+                                " Hz) < sample rate / 2 (" + std::to_string(sample_rate_hz / 2) + " Hz)");
   // Prewarping: the analog cutoff whose bilinear image is exactly the digital cutoff.
   const double two_fs = 2 * sample_rate_hz;
   const double warped = two_fs * std::tan(kPi * cutoff_hz / sample_rate_hz);
@@ -60,9 +59,8 @@ std::vector<Biquad> butterworth_lowpass(int order, double cutoff_hz, double samp
     sections.push_back(conjugate_pair_section((two_fs + analog) / (two_fs - analog)));
   }
   if (order % 2 == 1) sections.push_back(real_pole_section((two_fs - warped) / (two_fs + warped)));
-  std::stable_sort(sections.begin(), sections.end(), [](const Biquad& a, const Biquad& b) {
-    return pole_radius(a) < pole_radius(b);
-  });
+  std::stable_sort(sections.begin(), sections.end(),
+                   [](const Biquad& a, const Biquad& b) { return pole_radius(a) < pole_radius(b); });
   return sections;
 }
 

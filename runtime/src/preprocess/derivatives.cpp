@@ -20,8 +20,7 @@ Derivatives finite_differences(const Channels& x, double h, const std::vector<in
       d.second.row(r) = (2 * x.row(0) - 5 * x.row(1) + 4 * x.row(2) - x.row(3)) * inv_h2;
     } else if (k == n - 1) {
       d.first.row(r) = (3 * x.row(k) - 4 * x.row(k - 1) + x.row(k - 2)) * inv_2h;
-      d.second.row(r) =
-          (2 * x.row(k) - 5 * x.row(k - 1) + 4 * x.row(k - 2) - x.row(k - 3)) * inv_h2;
+      d.second.row(r) = (2 * x.row(k) - 5 * x.row(k - 1) + 4 * x.row(k - 2) - x.row(k - 3)) * inv_h2;
     } else {
       d.first.row(r) = (x.row(k + 1) - x.row(k - 1)) * inv_2h;
       d.second.row(r) = (x.row(k + 1) - 2 * x.row(k) + x.row(k - 1)) * inv_h2;

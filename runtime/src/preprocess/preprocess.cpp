@@ -24,9 +24,9 @@ namespace symoro::preprocess {
 namespace {
 
 void validate_options(const Options& options) {
-  if (!(options.base_period >= 0) || !std::isfinite(options.base_period) || !std::isfinite(options.torque_delay) || !(options.max_gap > 0) ||
-      options.filter_order < 1 ||
-      !(options.derivative_cutoff > 0) || !(options.anti_alias_fraction > 0) || !(options.anti_alias_fraction <= 1))
+  if (!(options.base_period >= 0) || !std::isfinite(options.base_period) || !std::isfinite(options.torque_delay) ||
+      !(options.max_gap > 0) || options.filter_order < 1 || !(options.derivative_cutoff > 0) ||
+      !(options.anti_alias_fraction > 0) || !(options.anti_alias_fraction <= 1))
     throw std::invalid_argument(
         "preprocess options: base_period >= 0 (0: the log's), max_gap, derivative_cutoff "
         "positive, filter_order >= 1 and anti_alias_fraction in (0, 1]");
@@ -41,8 +41,8 @@ bool same_row(const Eigen::MatrixXd& m, Eigen::Index k) {
 // Rows that repeat the previous one (Options::drop_stale). qd decides only when measured: a
 // differentiated qd says nothing about the read.
 std::vector<bool> stale_rows(const io::Log& log) {
-  const bool measured_qd = log.meta.velocity == io::Velocity::measured && log.qd.cols() == log.q.cols() &&
-                           log.qd.rows() == log.q.rows();
+  const bool measured_qd =
+      log.meta.velocity == io::Velocity::measured && log.qd.cols() == log.q.cols() && log.qd.rows() == log.q.rows();
   std::vector<bool> stale(static_cast<std::size_t>(log.samples()), false);
   for (Eigen::Index k = 1; k < log.samples(); ++k) {
     if (!same_row(log.q, k) || !same_row(log.tau, k)) continue;
@@ -88,15 +88,11 @@ void shift_later(Channels& x, double shift) {
 
 void validate_signals(const io::Log& log, const std::string& source) {
   const Eigen::Index n = log.time.size();
-  if (log.q.cols() == 0)
-    throw DataError(source, 0, "the log has no measured q (a reference file?)");
+  if (log.q.cols() == 0) throw DataError(source, 0, "the log has no measured q (a reference file?)");
   if (log.tau.cols() != log.q.cols())
-    throw DataError(source, 0,
-                    fmt::format("{} q columns but {} tau columns", log.q.cols(), log.tau.cols()));
+    throw DataError(source, 0, fmt::format("{} q columns but {} tau columns", log.q.cols(), log.tau.cols()));
   if (log.q.rows() != n || log.tau.rows() != n)
-    throw DataError(
-        source, 0,
-        fmt::format("{} time stamps but {} q and {} tau rows", n, log.q.rows(), log.tau.rows()));
+    throw DataError(source, 0, fmt::format("{} time stamps but {} q and {} tau rows", n, log.q.rows(), log.tau.rows()));
   for (const auto& [name, m] : {std::pair{"q", &log.q}, std::pair{"tau", &log.tau}}) {
     if (m->allFinite()) continue;
     Eigen::Index row = 0;
@@ -220,17 +216,19 @@ Samples preprocess_whole(const io::Log& raw, double interval, const Options& opt
   const std::string source = raw.meta.trajectory.empty() ? "log" : raw.meta.trajectory;
   validate_options(options);
   const double period = base_period(raw, options);
-  const std::string origin = options.base_period > 0  ? "set in the options"
+  const std::string origin = options.base_period > 0    ? "set in the options"
                              : raw.meta.sample_time > 0 ? "the log's sample_time"
                                                         : "the log's median stamp interval";
   const int stride = target_stride(interval, period, source, origin);
   validate_signals(raw, source);
   if (options.use_logged_velocity) {
     if (raw.meta.velocity == io::Velocity::differentiated)
-      throw DataError(source, 0, "the log's velocity was differentiated from q at import, not measured: "
-                                 "it cannot stand for a logged velocity (use_logged_velocity)");
+      throw DataError(source, 0,
+                      "the log's velocity was differentiated from q at import, not measured: "
+                      "it cannot stand for a logged velocity (use_logged_velocity)");
     if (raw.qd.cols() != raw.q.cols() || raw.qd.rows() != raw.q.rows() || !raw.qd.allFinite())
-      throw DataError(source, 0, "use_logged_velocity: the log's qd is missing, of another shape than q, or not finite");
+      throw DataError(source, 0,
+                      "use_logged_velocity: the log's qd is missing, of another shape than q, or not finite");
   }
 
   Samples out;
@@ -287,8 +285,7 @@ Samples preprocess_whole(const io::Log& raw, double interval, const Options& opt
     throw DataError(source, 0,
                     fmt::format("log too short for the filter: the longest piece has {} samples "
                                 "of {} s, a {:.3g} Hz order-{} zero-phase filter needs at least {}",
-                                longest, period, report.cutoff, options.filter_order,
-                                min_samples));
+                                longest, period, report.cutoff, options.filter_order, min_samples));
 
   const Eigen::Index total = gather(kept, stamps.t0, stride, interval, joints, out);
   report.kept_samples = static_cast<int>(total);
@@ -307,11 +304,14 @@ const io::Log* source_file(const io::Log& log) {
     return nullptr;
   const double offset = log.time(0) - file->time(first);
   for (Eigen::Index k = 0; k < n; ++k)
-    if (std::abs(file->time(first + k) + offset - log.time(k)) > 1e-9 * std::max(1.0, std::abs(log.time(k)))) return nullptr;
+    if (std::abs(file->time(first + k) + offset - log.time(k)) > 1e-9 * std::max(1.0, std::abs(log.time(k))))
+      return nullptr;
   const auto same = [&](const Eigen::MatrixXd& window, const Eigen::MatrixXd& whole) {
-    return window.rows() == n && whole.rows() == file->samples() && (window.array() == whole.middleRows(first, n).array()).all();
+    return window.rows() == n && whole.rows() == file->samples() &&
+           (window.array() == whole.middleRows(first, n).array()).all();
   };
-  if (!same(log.q, file->q) || !same(log.tau, file->tau) || (log.qd.cols() > 0 && !same(log.qd, file->qd))) return nullptr;
+  if (!same(log.q, file->q) || !same(log.tau, file->tau) || (log.qd.cols() > 0 && !same(log.qd, file->qd)))
+    return nullptr;
   return file;
 }
 
@@ -326,7 +326,8 @@ Samples preprocess(const io::Log& log, double interval, const Options& options) 
   Samples all = preprocess_whole(*file, interval, options, edge_times);
   const double period = all.report.base_period, t0 = file->time(0);
   const auto grid_index = [&](double t) { return std::llround((t - t0) / period); };
-  const long long first = grid_index(file->time(log.file_row)), last = grid_index(file->time(log.file_row + log.samples() - 1));
+  const long long first = grid_index(file->time(log.file_row)),
+                  last = grid_index(file->time(log.file_row + log.samples() - 1));
   std::vector<Eigen::Index> keep;
   for (Eigen::Index k = 0; k < all.time.size(); ++k)
     if (const long long i = grid_index(all.time(k)); first <= i && i <= last) keep.push_back(k);
@@ -341,7 +342,8 @@ Samples preprocess(const io::Log& log, double interval, const Options& options) 
   // file's first stamp, is the origin (they differ by the row's stamp jitter).
   out.time.resize(static_cast<Eigen::Index>(keep.size()));
   for (std::size_t k = 0; k < keep.size(); ++k)
-    out.time(static_cast<Eigen::Index>(k)) = log.time(0) + static_cast<double>(grid_index(all.time(keep[k])) - first) * period;
+    out.time(static_cast<Eigen::Index>(k)) =
+        log.time(0) + static_cast<double>(grid_index(all.time(keep[k])) - first) * period;
   for (auto [to_m, from_m] : {std::pair{&out.q, &all.q}, std::pair{&out.qd, &all.qd}, std::pair{&out.qdd, &all.qdd},
                               std::pair{&out.tau, &all.tau}})
     *to_m = (*from_m)(keep, Eigen::all);
@@ -364,16 +366,15 @@ std::string Report::summary() const {
   std::string line = fmt::format(
       "{} raw samples on a {:.6g} ms grid (stamps within {:.3f} ms of it, {} irregular "
       "intervals), {} stale rows left out, {} gaps bridged ({} samples filled in), {} piece{}",
-      raw_samples, base_period * 1e3, max_stamp_deviation * 1e3, irregular_stamps, stale_rows,
-      gaps_bridged, missing_samples, pieces, pieces == 1 ? "" : "s");
+      raw_samples, base_period * 1e3, max_stamp_deviation * 1e3, irregular_stamps, stale_rows, gaps_bridged,
+      missing_samples, pieces, pieces == 1 ? "" : "s");
   if (dropped_pieces > 0)
-    line += fmt::format(" ({} too short for the filter dropped with {} samples)", dropped_pieces,
-                        dropped_samples);
+    line += fmt::format(" ({} too short for the filter dropped with {} samples)", dropped_pieces, dropped_samples);
   line += fmt::format(", low-pass {:.3g} Hz", cutoff);
   if (context_rows > 0) line += fmt::format(", filtered with the {} rows of its file around it", context_rows);
   if (edge_samples > 0)
-    line += fmt::format(", {} samples within the filter's settling time ({:.3g} s) of {} moving end{} left out", edge_samples,
-                        settling_seconds, moving_ends, moving_ends == 1 ? "" : "s");
+    line += fmt::format(", {} samples within the filter's settling time ({:.3g} s) of {} moving end{} left out",
+                        edge_samples, settling_seconds, moving_ends, moving_ends == 1 ? "" : "s");
   line += fmt::format(", {} samples kept", kept_samples);
   return line;
 }

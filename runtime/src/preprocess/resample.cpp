@@ -9,8 +9,7 @@
 
 namespace symoro::preprocess {
 
-int target_stride(double interval, double base_period, const std::string& source,
-                  const std::string& period_origin) {
+int target_stride(double interval, double base_period, const std::string& source, const std::string& period_origin) {
   const double ratio = interval / base_period;
   const double stride = std::round(ratio);
   if (!(interval > 0) || !std::isfinite(ratio) || stride < 1 || std::abs(ratio - stride) > 1e-9) {
@@ -20,8 +19,7 @@ int target_stride(double interval, double base_period, const std::string& source
     throw DataError(source, 0,
                     fmt::format("interval {:.9g} s is not a positive integer multiple of the base "
                                 "period {:.9g} s{}; nearest valid intervals: {:.9g} s and {:.9g} s",
-                                interval, base_period,
-                                period_origin.empty() ? "" : " (" + period_origin + ")",
+                                interval, base_period, period_origin.empty() ? "" : " (" + period_origin + ")",
                                 below * base_period, above * base_period));
   }
   return static_cast<int>(stride);

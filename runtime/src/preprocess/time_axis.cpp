@@ -14,15 +14,13 @@ namespace symoro::preprocess {
 namespace {
 
 void validate_stamps(const Eigen::VectorXd& time, const std::string& source) {
-  if (time.size() < 2)
-    throw DataError(source, 0, fmt::format("{} time stamps; need at least 2", time.size()));
+  if (time.size() < 2) throw DataError(source, 0, fmt::format("{} time stamps; need at least 2", time.size()));
   for (Eigen::Index i = 0; i < time.size(); ++i) {
-    if (!std::isfinite(time[i]))
-      throw DataError(source, 0, fmt::format("time stamp of sample {} is not finite", i));
+    if (!std::isfinite(time[i])) throw DataError(source, 0, fmt::format("time stamp of sample {} is not finite", i));
     if (i > 0 && !(time[i] > time[i - 1]))
-      throw DataError(source, 0,
-                      fmt::format("time does not increase strictly at sample {} ({} s after {} s)",
-                                  i, time[i], time[i - 1]));
+      throw DataError(
+          source, 0,
+          fmt::format("time does not increase strictly at sample {} ({} s after {} s)", i, time[i], time[i - 1]));
   }
 }
 
@@ -36,8 +34,7 @@ double median_interval(const Eigen::VectorXd& time) {
 
 }  // namespace
 
-StampAnalysis analyse_stamps(const Eigen::VectorXd& time, double period, double max_gap,
-                             const std::string& source) {
+StampAnalysis analyse_stamps(const Eigen::VectorXd& time, double period, double max_gap, const std::string& source) {
   if (!(period > 0) || !(max_gap > 0))
     throw std::invalid_argument("analyse_stamps: period and max_gap must be positive");
   validate_stamps(time, source);
@@ -81,8 +78,7 @@ StampAnalysis analyse_stamps(const Eigen::VectorXd& time, double period, double 
 
 GridInterpolation grid_interpolation(const Eigen::VectorXd& time, const StampAnalysis& stamps,
                                      const StampPiece& piece) {
-  if (piece.raw_samples() < 2)
-    throw std::invalid_argument("grid_interpolation: a piece needs at least 2 stamps");
+  if (piece.raw_samples() < 2) throw std::invalid_argument("grid_interpolation: a piece needs at least 2 stamps");
   GridInterpolation g;
   const int n = piece.grid_samples();
   g.left_row.resize(n);
@@ -107,8 +103,7 @@ Channels GridInterpolation::apply(const Eigen::MatrixXd& signal) const {
   for (Eigen::Index k = 0; k < n; ++k, target += channels) {
     const double w = weight[k];
     const double* left = source + left_row[k];
-    for (Eigen::Index c = 0; c < channels; ++c)
-      target[c] = (1 - w) * left[c * stride] + w * left[c * stride + 1];
+    for (Eigen::Index c = 0; c < channels; ++c) target[c] = (1 - w) * left[c * stride] + w * left[c * stride + 1];
   }
   return out;
 }

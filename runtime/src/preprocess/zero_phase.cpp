@@ -100,8 +100,7 @@ void filtfilt(const std::vector<Biquad>& sections, int padding, Channels& signal
   cascade.run(signals.data(), n, 1);
   cascade.run(after.data(), padding, 1);
   // Backward from the end of the forward output, through `after` back to the first sample.
-  double* last =
-      padding > 0 ? after.data() + (padding - 1) * channels : signals.data() + (n - 1) * channels;
+  double* last = padding > 0 ? after.data() + (padding - 1) * channels : signals.data() + (n - 1) * channels;
   cascade.start_at_rest(last);
   cascade.run(last, padding, -1);
   cascade.run(signals.data() + (n - 1) * channels, n, -1);
@@ -114,8 +113,8 @@ struct SampledZeroPhase::State {
   int padding;
   Eigen::Index rows, channels, pushed = 0;
   Cascade forward;
-  Channels head, ring;          // the first padding + 1 rows; the last padding + 1 rows (raw)
-  Eigen::ArrayXd tmp;           // one row through the forward pass
+  Channels head, ring;                       // the first padding + 1 rows; the last padding + 1 rows (raw)
+  Eigen::ArrayXd tmp;                        // one row through the forward pass
   std::vector<Eigen::Index> wanted, unique;  // as asked; sorted without repeats
   // The backward cascade as z <- A z + B u, y = c z + d u; at rest on u: z = rest u.
   Eigen::MatrixXd A;
@@ -242,7 +241,8 @@ void SampledZeroPhase::finish(Channels& out) {
       y.row(i) = s.c.transpose() * z + s.d * s.at_row.row(i);
       if (i == 0) break;
       Eigen::MatrixXd a = Eigen::MatrixXd::Identity(dim, dim);
-      for (Eigen::Index p = 0; p < s.unique[static_cast<std::size_t>(i)] - s.unique[static_cast<std::size_t>(i - 1)]; ++p)
+      for (Eigen::Index p = 0; p < s.unique[static_cast<std::size_t>(i)] - s.unique[static_cast<std::size_t>(i - 1)];
+           ++p)
         a = s.A * a;
       z = a * z + s.blocks.middleRows((i - 1) * dim, dim);
     }

@@ -19,9 +19,12 @@ bool numeric_cell(const std::string& c) {
 std::string cell(const std::string& text) {
   std::string out;
   for (char c : text) {
-    if (c == '|') out += "\\|";
-    else if (c == '\n' || c == '\r') out += ' ';
-    else out += c;
+    if (c == '|')
+      out += "\\|";
+    else if (c == '\n' || c == '\r')
+      out += ' ';
+    else
+      out += c;
   }
   return out;
 }
@@ -41,8 +44,9 @@ std::string Table::str() const {
   };
   std::string out = line(header_) + "|";
   for (std::size_t i = 0; i < header_.size(); ++i) {
-    const bool right = i > 0 && (align_ == Align::first_left ||
-                                 std::all_of(rows_.begin(), rows_.end(), [&](const auto& r) { return numeric_cell(r[i]); }));
+    const bool right =
+        i > 0 && (align_ == Align::first_left ||
+                  std::all_of(rows_.begin(), rows_.end(), [&](const auto& r) { return numeric_cell(r[i]); }));
     out += right ? "---:|" : ":---|";
   }
   out += "\n";

@@ -74,33 +74,40 @@ void append_marker(std::string& out, const Style& s, double cx, double cy, const
   const std::string paint = fmt::format(R"(fill="{}" fill-opacity="{}" stroke="{}" stroke-width="0.6")",
                                         xml_escape(s.colour), s.opacity, xml_escape(s.colour));
   auto path = [&](const std::string& d) {
-    fmt::format_to(std::back_inserter(out), R"(<path class="{}" d="{}" {}/>)"
-                   "\n", cls, d, paint);
+    fmt::format_to(std::back_inserter(out),
+                   R"(<path class="{}" d="{}" {}/>)"
+                   "\n",
+                   cls, d, paint);
   };
   switch (s.marker) {
     case Marker::circle:
-      fmt::format_to(std::back_inserter(out), R"(<circle class="{}" cx="{}" cy="{}" r="{}" {}/>)"
-                     "\n", cls, num(cx), num(cy), num(r), paint);
+      fmt::format_to(std::back_inserter(out),
+                     R"(<circle class="{}" cx="{}" cy="{}" r="{}" {}/>)"
+                     "\n",
+                     cls, num(cx), num(cy), num(r), paint);
       break;
     case Marker::square: {
       const double h = 0.9 * r;
-      fmt::format_to(std::back_inserter(out), R"(<rect class="{}" x="{}" y="{}" width="{}" height="{}" {}/>)"
-                     "\n", cls, num(cx - h), num(cy - h), num(2 * h), num(2 * h), paint);
+      fmt::format_to(std::back_inserter(out),
+                     R"(<rect class="{}" x="{}" y="{}" width="{}" height="{}" {}/>)"
+                     "\n",
+                     cls, num(cx - h), num(cy - h), num(2 * h), num(2 * h), paint);
       break;
     }
     case Marker::triangle:
-      path(fmt::format("M{} {}L{} {}L{} {}Z", num(cx), num(cy - 1.25 * r), num(cx + 1.1 * r),
-                       num(cy + 0.7 * r), num(cx - 1.1 * r), num(cy + 0.7 * r)));
+      path(fmt::format("M{} {}L{} {}L{} {}Z", num(cx), num(cy - 1.25 * r), num(cx + 1.1 * r), num(cy + 0.7 * r),
+                       num(cx - 1.1 * r), num(cy + 0.7 * r)));
       break;
     case Marker::diamond:
-      path(fmt::format("M{} {}L{} {}L{} {}L{} {}Z", num(cx), num(cy - 1.3 * r), num(cx + 1.3 * r),
-                       num(cy), num(cx), num(cy + 1.3 * r), num(cx - 1.3 * r), num(cy)));
+      path(fmt::format("M{} {}L{} {}L{} {}L{} {}Z", num(cx), num(cy - 1.3 * r), num(cx + 1.3 * r), num(cy), num(cx),
+                       num(cy + 1.3 * r), num(cx - 1.3 * r), num(cy)));
       break;
     case Marker::cross:
       fmt::format_to(std::back_inserter(out),
                      R"(<path class="{}" d="M{} {}L{} {}M{} {}L{} {}" fill="none" stroke="{}" stroke-width="1.6"/>)"
-                     "\n", cls, num(cx - r), num(cy - r), num(cx + r), num(cy + r), num(cx - r), num(cy + r),
-                     num(cx + r), num(cy - r), xml_escape(s.colour));
+                     "\n",
+                     cls, num(cx - r), num(cy - r), num(cx + r), num(cy + r), num(cx - r), num(cy + r), num(cx + r),
+                     num(cy - r), xml_escape(s.colour));
       break;
   }
 }
@@ -162,8 +169,8 @@ LegendLayout layout_legend(const std::vector<LegendEntry>& entries, double width
   return l;
 }
 
-void append_legend(std::string& out, const std::vector<LegendEntry>& entries, const LegendLayout& layout,
-                   double left, double top) {
+void append_legend(std::string& out, const std::vector<LegendEntry>& entries, const LegendLayout& layout, double left,
+                   double top) {
   out += "<g class=\"legend\">\n";
   for (std::size_t i = 0; i < entries.size(); ++i) {
     const auto& e = entries[i];
@@ -173,23 +180,27 @@ void append_legend(std::string& out, const std::vector<LegendEntry>& entries, co
         append_marker(out, e.style, x + 12, y, "legend-marker");
         break;
       case Kind::line:
-        fmt::format_to(std::back_inserter(out), R"(<line x1="{}" y1="{}" x2="{}" y2="{}" {}/>)"
-                       "\n", num(x), num(y), num(x + 26), num(y), line_paint(e.style));
+        fmt::format_to(std::back_inserter(out),
+                       R"(<line x1="{}" y1="{}" x2="{}" y2="{}" {}/>)"
+                       "\n",
+                       num(x), num(y), num(x + 26), num(y), line_paint(e.style));
         break;
       case Kind::bar:
         fmt::format_to(std::back_inserter(out),
                        R"(<rect x="{}" y="{}" width="16" height="10" fill="{}" fill-opacity="{}"/>)"
-                       "\n", num(x + 4), num(y - 5), xml_escape(e.style.colour), e.style.opacity);
+                       "\n",
+                       num(x + 4), num(y - 5), xml_escape(e.style.colour), e.style.opacity);
         break;
     }
-    fmt::format_to(std::back_inserter(out), R"(<text x="{}" y="{}" dominant-baseline="middle">{}</text>)"
-                   "\n", num(x + 32), num(y), xml_escape(e.name));
+    fmt::format_to(std::back_inserter(out),
+                   R"(<text x="{}" y="{}" dominant-baseline="middle">{}</text>)"
+                   "\n",
+                   num(x + 32), num(y), xml_escape(e.name));
   }
   out += "</g>\n";
 }
 
-void append_panel(std::string& out, const Panel& p, int index, double left, double top, double width,
-                  double height) {
+void append_panel(std::string& out, const Panel& p, int index, double left, double top, double width, double height) {
   const double x0 = left + margin_left, y0 = top + margin_top;
   const double w = std::max(20.0, width - margin_left - margin_right);
   const double h = std::max(20.0, height - margin_top - margin_bottom);
@@ -236,41 +247,60 @@ void append_panel(std::string& out, const Panel& p, int index, double left, doub
 
   auto out_it = std::back_inserter(out);
   fmt::format_to(out_it, "<g class=\"panel\">\n");
-  fmt::format_to(out_it, R"(<clipPath id="clip{}"><rect x="{}" y="{}" width="{}" height="{}"/></clipPath>)"
-                 "\n", index, num(x0), num(y0), num(w), num(h));
+  fmt::format_to(out_it,
+                 R"(<clipPath id="clip{}"><rect x="{}" y="{}" width="{}" height="{}"/></clipPath>)"
+                 "\n",
+                 index, num(x0), num(y0), num(w), num(h));
   if (!p.title.empty())
-    fmt::format_to(out_it, R"(<text class="panel-title" x="{}" y="{}" text-anchor="middle" font-weight="bold">{}</text>)"
-                   "\n", num(x0 + w / 2), num(top + 18), xml_escape(p.title));
+    fmt::format_to(out_it,
+                   R"(<text class="panel-title" x="{}" y="{}" text-anchor="middle" font-weight="bold">{}</text>)"
+                   "\n",
+                   num(x0 + w / 2), num(top + 18), xml_escape(p.title));
 
   // Grid and tick labels.
   fmt::format_to(out_it, "<g stroke=\"#e3e3e3\" stroke-width=\"1\">\n");
   for (double t : ya.ticks.values)
-    fmt::format_to(out_it, R"(<line x1="{}" y1="{}" x2="{}" y2="{}"/>)"
-                   "\n", num(x0), num(sy(t)), num(x0 + w), num(sy(t)));
+    fmt::format_to(out_it,
+                   R"(<line x1="{}" y1="{}" x2="{}" y2="{}"/>)"
+                   "\n",
+                   num(x0), num(sy(t)), num(x0 + w), num(sy(t)));
   if (!bars)
     for (double t : xa.ticks.values)
-      fmt::format_to(out_it, R"(<line x1="{}" y1="{}" x2="{}" y2="{}"/>)"
-                     "\n", num(sx(t)), num(y0), num(sx(t)), num(y0 + h));
+      fmt::format_to(out_it,
+                     R"(<line x1="{}" y1="{}" x2="{}" y2="{}"/>)"
+                     "\n",
+                     num(sx(t)), num(y0), num(sx(t)), num(y0 + h));
   out += "</g>\n";
   for (double t : ya.ticks.values)
-    fmt::format_to(out_it, R"(<text class="ytick" x="{}" y="{}" text-anchor="end" dominant-baseline="middle">{}</text>)"
-                   "\n", num(x0 - 5), num(sy(t)), tick_text(t, ya.ticks.decimals));
+    fmt::format_to(out_it,
+                   R"(<text class="ytick" x="{}" y="{}" text-anchor="end" dominant-baseline="middle">{}</text>)"
+                   "\n",
+                   num(x0 - 5), num(sy(t)), tick_text(t, ya.ticks.decimals));
   if (bars) {
     for (std::size_t c = 0; c < p.categories.size(); ++c)
-      fmt::format_to(out_it, R"(<text class="category" x="{}" y="{}" text-anchor="middle">{}</text>)"
-                     "\n", num(sx(static_cast<double>(c))), num(y0 + h + 15), xml_escape(p.categories[c]));
+      fmt::format_to(out_it,
+                     R"(<text class="category" x="{}" y="{}" text-anchor="middle">{}</text>)"
+                     "\n",
+                     num(sx(static_cast<double>(c))), num(y0 + h + 15), xml_escape(p.categories[c]));
   } else {
     for (double t : xa.ticks.values)
-      fmt::format_to(out_it, R"(<text class="xtick" x="{}" y="{}" text-anchor="middle">{}</text>)"
-                     "\n", num(sx(t)), num(y0 + h + 15), tick_text(t, xa.ticks.decimals));
+      fmt::format_to(out_it,
+                     R"(<text class="xtick" x="{}" y="{}" text-anchor="middle">{}</text>)"
+                     "\n",
+                     num(sx(t)), num(y0 + h + 15), tick_text(t, xa.ticks.decimals));
   }
   if (!p.x_label.empty())
-    fmt::format_to(out_it, R"(<text class="x-label" x="{}" y="{}" text-anchor="middle">{}</text>)"
-                   "\n", num(x0 + w / 2), num(y0 + h + 34), xml_escape(p.x_label));
+    fmt::format_to(out_it,
+                   R"(<text class="x-label" x="{}" y="{}" text-anchor="middle">{}</text>)"
+                   "\n",
+                   num(x0 + w / 2), num(y0 + h + 34), xml_escape(p.x_label));
   if (!p.y_label.empty()) {
     const double lx = left + 14, ly_ = y0 + h / 2;
-    fmt::format_to(out_it, R"~(<text class="y-label" x="{}" y="{}" text-anchor="middle" transform="rotate(-90 {} {})">{}</text>)~"
-                   "\n", num(lx), num(ly_), num(lx), num(ly_), xml_escape(p.y_label));
+    fmt::format_to(
+        out_it,
+        R"~(<text class="y-label" x="{}" y="{}" text-anchor="middle" transform="rotate(-90 {} {})">{}</text>)~"
+        "\n",
+        num(lx), num(ly_), num(lx), num(ly_), xml_escape(p.y_label));
   }
 
   // Data, clipped to the plot area.
@@ -284,9 +314,12 @@ void append_panel(std::string& out, const Panel& p, int index, double left, doub
         if (!std::isfinite(v)) continue;
         const double xl = static_cast<double>(c) - group / 2 + bar * static_cast<double>(s);
         const double top_y = std::min(sy(v), sy(0)), bottom_y = std::max(sy(v), sy(0));
-        fmt::format_to(out_it, R"(<rect class="bar" x="{}" y="{}" width="{}" height="{}" fill="{}" fill-opacity="{}"><title>{}: {}</title></rect>)"
-                       "\n", num(sx(xl)), num(top_y), num(sx(xl + bar) - sx(xl)), num(bottom_y - top_y),
-                       xml_escape(series.style.colour), series.style.opacity, xml_escape(series.name), v);
+        fmt::format_to(
+            out_it,
+            R"(<rect class="bar" x="{}" y="{}" width="{}" height="{}" fill="{}" fill-opacity="{}"><title>{}: {}</title></rect>)"
+            "\n",
+            num(sx(xl)), num(top_y), num(sx(xl + bar) - sx(xl)), num(bottom_y - top_y), xml_escape(series.style.colour),
+            series.style.opacity, xml_escape(series.name), v);
       }
     }
   }
@@ -295,8 +328,10 @@ void append_panel(std::string& out, const Panel& p, int index, double left, doub
     int count = 0;
     auto flush = [&] {
       if (count >= 2)
-        fmt::format_to(out_it, R"(<polyline class="line" {} points="{}"/>)"
-                       "\n", line_paint(s.style), points);
+        fmt::format_to(out_it,
+                       R"(<polyline class="line" {} points="{}"/>)"
+                       "\n",
+                       line_paint(s.style), points);
       points.clear();
       count = 0;
     };
@@ -315,8 +350,10 @@ void append_panel(std::string& out, const Panel& p, int index, double left, doub
       if (std::isfinite(s.x[i]) && std::isfinite(s.y[i])) append_marker(out, s.style, sx(s.x[i]), sy(s.y[i]), "marker");
   for (const auto& l : p.labels)
     if (l.ring && std::isfinite(l.x) && std::isfinite(l.y))
-      fmt::format_to(out_it, R"(<circle class="ring" cx="{}" cy="{}" r="8" fill="none" stroke="{}" stroke-width="1.8"/>)"
-                     "\n", num(sx(l.x)), num(sy(l.y)), xml_escape(l.colour));
+      fmt::format_to(out_it,
+                     R"(<circle class="ring" cx="{}" cy="{}" r="8" fill="none" stroke="{}" stroke-width="1.8"/>)"
+                     "\n",
+                     num(sx(l.x)), num(sy(l.y)), xml_escape(l.colour));
   out += "</g>\n";
 
   // Labels beside their points, turned to the left near the right edge to stay readable.
@@ -324,12 +361,16 @@ void append_panel(std::string& out, const Panel& p, int index, double left, doub
     if (!std::isfinite(l.x) || !std::isfinite(l.y) || l.text.empty()) continue;
     const double px_ = sx(l.x), py_ = sy(l.y);
     const bool left_side = px_ > x0 + 0.7 * w;
-    fmt::format_to(out_it, R"(<text class="point-label" x="{}" y="{}" text-anchor="{}" fill="{}">{}</text>)"
-                   "\n", num(left_side ? px_ - 9 : px_ + 9), num(py_ - 7), left_side ? "end" : "start",
-                   xml_escape(l.colour), xml_escape(l.text));
+    fmt::format_to(out_it,
+                   R"(<text class="point-label" x="{}" y="{}" text-anchor="{}" fill="{}">{}</text>)"
+                   "\n",
+                   num(left_side ? px_ - 9 : px_ + 9), num(py_ - 7), left_side ? "end" : "start", xml_escape(l.colour),
+                   xml_escape(l.text));
   }
-  fmt::format_to(out_it, R"(<rect x="{}" y="{}" width="{}" height="{}" fill="none" stroke="#444" stroke-width="1"/>)"
-                 "\n", num(x0), num(y0), num(w), num(h));
+  fmt::format_to(out_it,
+                 R"(<rect x="{}" y="{}" width="{}" height="{}" fill="none" stroke="#444" stroke-width="1"/>)"
+                 "\n",
+                 num(x0), num(y0), num(w), num(h));
   out += "</g>\n";
 }
 
@@ -375,12 +416,23 @@ std::string xml_escape(const std::string& text) {
   out.reserve(text.size());
   for (char c : text) {
     switch (c) {
-      case '&': out += "&amp;"; break;
-      case '<': out += "&lt;"; break;
-      case '>': out += "&gt;"; break;
-      case '"': out += "&quot;"; break;
-      case '\'': out += "&apos;"; break;
-      default: out += c;
+      case '&':
+        out += "&amp;";
+        break;
+      case '<':
+        out += "&lt;";
+        break;
+      case '>':
+        out += "&gt;";
+        break;
+      case '"':
+        out += "&quot;";
+        break;
+      case '\'':
+        out += "&apos;";
+        break;
+      default:
+        out += c;
     }
   }
   return out;
@@ -398,14 +450,21 @@ std::string render(const Figure& figure) {
   const double height = title + rows * figure.panel_height + legend_height;
 
   std::string out;
+  fmt::format_to(
+      std::back_inserter(out),
+      R"(<svg xmlns="http://www.w3.org/2000/svg" width="{0}" height="{1}" viewBox="0 0 {0} {1}" font-family="Helvetica, Arial, sans-serif" font-size="11">)"
+      "\n",
+      num(width), num(height));
   fmt::format_to(std::back_inserter(out),
-                 R"(<svg xmlns="http://www.w3.org/2000/svg" width="{0}" height="{1}" viewBox="0 0 {0} {1}" font-family="Helvetica, Arial, sans-serif" font-size="11">)"
-                 "\n", num(width), num(height));
-  fmt::format_to(std::back_inserter(out), R"(<rect width="{}" height="{}" fill="white"/>)"
-                 "\n", num(width), num(height));
+                 R"(<rect width="{}" height="{}" fill="white"/>)"
+                 "\n",
+                 num(width), num(height));
   if (!figure.title.empty())
-    fmt::format_to(std::back_inserter(out), R"(<text class="title" x="{}" y="20" text-anchor="middle" font-size="14" font-weight="bold">{}</text>)"
-                   "\n", num(width / 2), xml_escape(figure.title));
+    fmt::format_to(
+        std::back_inserter(out),
+        R"(<text class="title" x="{}" y="20" text-anchor="middle" font-size="14" font-weight="bold">{}</text>)"
+        "\n",
+        num(width / 2), xml_escape(figure.title));
   for (int i = 0; i < count; ++i) {
     const double left = (i % columns) * figure.panel_width, top = title + (i / columns) * figure.panel_height;
     append_panel(out, figure.panels[i], i, left, top, figure.panel_width, figure.panel_height);

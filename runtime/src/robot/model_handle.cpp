@@ -30,7 +30,8 @@ ModelHandle::ModelHandle(std::string robot, const symoro_abi_model* model)
     parameters_.push_back({p.name, p.family, p.joint, p.unit});
     parent_index_.push_back(m_->parent_index[i]);
   }
-  for (int i = 0; i < m_->ns; ++i) standard_.push_back({m_->standard[i].name, m_->standard[i].family, m_->standard[i].joint});
+  for (int i = 0; i < m_->ns; ++i)
+    standard_.push_back({m_->standard[i].name, m_->standard[i].family, m_->standard[i].joint});
   for (int i = 0; i < m_->ne; ++i) {
     const auto& e = m_->effects[i];
     effects_.push_back({e.name, e.family, e.joint, e.order, e.velocity});

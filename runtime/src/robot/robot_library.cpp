@@ -22,7 +22,9 @@ std::map<std::string, std::shared_ptr<const RobotLibrary>>& registry() {
 }  // namespace
 
 RobotLibrary::RobotLibrary(fs::path path, const symoro_abi_robot* abi)
-    : path_(std::move(path)), abi_(abi), robot_(abi->robot ? abi->robot : ""),
+    : path_(std::move(path)),
+      abi_(abi),
+      robot_(abi->robot ? abi->robot : ""),
       code_digest_(abi->code_digest ? abi->code_digest : "") {}
 
 std::shared_ptr<const RobotLibrary> RobotLibrary::open(const fs::path& library) {
@@ -60,12 +62,14 @@ std::shared_ptr<const RobotLibrary> RobotLibrary::open(const fs::path& library) 
 }
 
 void RobotLibrary::check_folder(const fs::path& robot_dir) const {
-  if (!fs::is_directory(robot_dir)) throw LoadError("robot '" + robot_ + "': " + robot_dir.string() + " is not a folder");
+  if (!fs::is_directory(robot_dir))
+    throw LoadError("robot '" + robot_ + "': " + robot_dir.string() + " is not a folder");
   for (int i = 0; i < abi_->n_sources; ++i) {
     const symoro_abi_source_file& f = abi_->sources[i];
     const fs::path file = robot_dir / f.name;
     if (!fs::exists(file))
-      throw LoadError(file.string() + " is missing: the robot library " + path_.string() + " was compiled from a folder "
+      throw LoadError(file.string() + " is missing: the robot library " + path_.string() +
+                      " was compiled from a folder "
                       "that has it");
     const std::string now = io::file_digest(file);
     if (now != f.digest)

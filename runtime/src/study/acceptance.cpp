@@ -47,7 +47,8 @@ PriorWeightChoice choose_prior_weight(const std::vector<double>& weights, double
   return out;
 }
 
-identify::AuditOptions final_audit_options(const identify::AuditOptions& pipeline, const FinalAuditOptions& final_audit) {
+identify::AuditOptions final_audit_options(const identify::AuditOptions& pipeline,
+                                           const FinalAuditOptions& final_audit) {
   identify::AuditOptions a = pipeline;
   a.samples *= final_audit.sample_factor;
   a.starts *= final_audit.start_factor;
@@ -62,7 +63,8 @@ std::string describe(const identify::AuditOptions& a) {
 Verdict acceptance_verdict(const StudyResult& r) {
   Verdict v;
   if (r.selection.run < 0) {
-    v.reasons.push_back("no representative run: " + (r.selection.rule.empty() ? "no run produced a final vector" : r.selection.rule));
+    v.reasons.push_back("no representative run: " +
+                        (r.selection.rule.empty() ? "no run produced a final vector" : r.selection.rule));
     return v;
   }
   const bool positive_definite = r.final_lambda_min > 0;  // AuditResult::positive_definite()
@@ -70,7 +72,8 @@ Verdict acceptance_verdict(const StudyResult& r) {
   v.accepted = positive_definite && consistent;
   if (v.accepted) return v;
   if (!positive_definite)
-    v.reasons.push_back(fmt::format("the final audit found M(q) not positive definite (lambda_min {:.4g})", r.final_lambda_min));
+    v.reasons.push_back(
+        fmt::format("the final audit found M(q) not positive definite (lambda_min {:.4g})", r.final_lambda_min));
   if (!consistent)
     v.reasons.push_back("no physically consistent set maps onto it" +
                         (r.final_consistency_note.empty() ? std::string() : " (" + r.final_consistency_note + ")"));

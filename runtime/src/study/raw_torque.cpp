@@ -18,9 +18,10 @@ preprocess::Samples raw_torque_samples(const io::Log& log, const RawTorqueOption
 }
 
 std::string raw_torque_filter_text(const RawTorqueOptions& options) {
-  return fmt::format("raw torque (stale rows out, on the log's own-period grid, unfiltered); the model on the logged position "
-                     "through a zero-phase order-4 Butterworth low-pass at {:g} Hz, qd and qdd its central differences",
-                     options.cutoff);
+  return fmt::format(
+      "raw torque (stale rows out, on the log's own-period grid, unfiltered); the model on the logged position "
+      "through a zero-phase order-4 Butterworth low-pass at {:g} Hz, qd and qdd its central differences",
+      options.cutoff);
 }
 
 RawTorqueScore raw_torque_error(const io::Log& log, const OpenLoopTorque& model, const Eigen::VectorXd& phi,

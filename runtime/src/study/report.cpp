@@ -41,8 +41,7 @@ svg::Style interval_style(std::size_t k) {
 
 std::string degrees(const Eigen::VectorXd& pose) {
   std::string out = "[";
-  for (Eigen::Index i = 0; i < pose.size(); ++i)
-    out += (i ? ", " : "") + fixed(pose(i) * deg_per_rad, 1);
+  for (Eigen::Index i = 0; i < pose.size(); ++i) out += (i ? ", " : "") + fixed(pose(i) * deg_per_rad, 1);
   return out + "]";
 }
 
@@ -137,8 +136,8 @@ std::string pca_figure(const StudyResult& study, const ReportOptions& options) {
     for (int i = 0; i < static_cast<int>(study.runs.size()); ++i) {
       const auto& run = study.runs[i];
       const bool selected = i == study.selection.run;
-      const bool example = std::find(options.examples.begin(), options.examples.end(), run.trajectory) !=
-                           options.examples.end();
+      const bool example =
+          std::find(options.examples.begin(), options.examples.end(), run.trajectory) != options.examples.end();
       if (!selected && !example) continue;
       svg::PointLabel l;
       l.x = x_of(*stages[s], i);
@@ -201,27 +200,32 @@ std::string summary(const StudyResult& study) {
   std::string out = "## Summary\n\n";
   const RunRecord* sel = selected_run(study);
   if (sel) {
-    out += fmt::format("- **Accepted model**: {}, {}; final all-pose audit{} λ_min = {} at the worst pose {} deg: {}.\n",
-                       sel->id(),
-                       study.rescued ? (study.rescue_feasible ? (study.consistency == "physical"
-                                                                     ? fmt::format("rescued onto the physically consistent set (clearance {} of each link's size)", sig(study.rescue_eps, 3))
-                                                                     : fmt::format("PD-rescued (ε = {})", sig(study.rescue_eps, 3)))
-                                                              : "the rescue's projection FAILED (" + study.rescue_status + ")")
-                                     : std::string("the run's final vector as is (no rescue needed)"),
-                       study.final_audit.empty() ? "" : " (" + study.final_audit + ")", sig(study.final_lambda_min, 4),
-                       degrees(study.final_worst_pose),
-                       study.accepted ? "**accepted**"
-                                      : fmt::format("**not accepted** ({})", fmt::join(acceptance_verdict(study).reasons, "; ")));
+    out += fmt::format(
+        "- **Accepted model**: {}, {}; final all-pose audit{} λ_min = {} at the worst pose {} deg: {}.\n", sel->id(),
+        study.rescued
+            ? (study.rescue_feasible
+                   ? (study.consistency == "physical"
+                          ? fmt::format("rescued onto the physically consistent set (clearance {} of each link's size)",
+                                        sig(study.rescue_eps, 3))
+                          : fmt::format("PD-rescued (ε = {})", sig(study.rescue_eps, 3)))
+                   : "the rescue's projection FAILED (" + study.rescue_status + ")")
+            : std::string("the run's final vector as is (no rescue needed)"),
+        study.final_audit.empty() ? "" : " (" + study.final_audit + ")", sig(study.final_lambda_min, 4),
+        degrees(study.final_worst_pose),
+        study.accepted ? "**accepted**"
+                       : fmt::format("**not accepted** ({})", fmt::join(acceptance_verdict(study).reasons, "; ")));
     out += fmt::format("- **Physical consistency** of the accepted vector ({} path): {}.\n",
                        study.consistency == "physical" ? "the physical" : "the paper's PD",
                        study.final_consistency_note.empty() ? std::string("not checked")
                        : study.final_consistent
                            ? fmt::format("a consistent set of link inertials maps onto it ({}): `dynid export --urdf` "
-                                         "reproduces it exactly", study.final_consistency_note)
+                                         "reproduces it exactly",
+                                         study.final_consistency_note)
                            : study.final_consistency_note);
-    out += fmt::format("- **Selection**: {}{}.\n", study.selection.rule.empty() ? "by centrality" : study.selection.rule,
-                       study.selection.components > 0 ? fmt::format(" ({} PCA components)", study.selection.components)
-                                                      : std::string());
+    out +=
+        fmt::format("- **Selection**: {}{}.\n", study.selection.rule.empty() ? "by centrality" : study.selection.rule,
+                    study.selection.components > 0 ? fmt::format(" ({} PCA components)", study.selection.components)
+                                                   : std::string());
   } else {
     out += fmt::format("- **Accepted model**: none; no representative was selected ({}).\n",
                        study.selection.rule.empty() ? "no run produced a final vector" : study.selection.rule);
@@ -241,8 +245,9 @@ std::string summary(const StudyResult& study) {
     std::string kinds;
     for (const auto& v : study.validation)
       if (kinds.find(v.kind) == std::string::npos) kinds += (kinds.empty() ? "" : " and ") + v.kind;
-    out += fmt::format("- **Validation** ({}; mean over {}): RMSE {} N m (final) / {} N m (accepted); MNE {} / {}.\n", kinds,
-                       names, sig(sums[0] / n, 5), sig(sums[1] / n, 5), sig(sums[2] / n, 5), sig(sums[3] / n, 5));
+    out +=
+        fmt::format("- **Validation** ({}; mean over {}): RMSE {} N m (final) / {} N m (accepted); MNE {} / {}.\n",
+                    kinds, names, sig(sums[0] / n, 5), sig(sums[1] / n, 5), sig(sums[2] / n, 5), sig(sums[3] / n, 5));
     for (const auto& v : study.validation)
       if (!v.note.empty()) out += fmt::format("  - {}: {}\n", v.trajectory, v.note);
   } else {
@@ -261,9 +266,10 @@ std::string summary(const StudyResult& study) {
   }
   std::string ms;
   for (double i : intervals(study)) ms += (ms.empty() ? "" : ", ") + std::to_string(interval_ms(i));
-  out += fmt::format("- **Runs**: {} ({} trajectories × intervals {} ms); CLIE converged in {}, PD after CLIE in {}{}.\n",
-                     study.runs.size(), trajectories.size(), ms.empty() ? "none" : ms, converged, pd,
-                     failed.empty() ? std::string() : fmt::format("; CLIE failed for {}", fmt::join(failed, ", ")));
+  out +=
+      fmt::format("- **Runs**: {} ({} trajectories × intervals {} ms); CLIE converged in {}, PD after CLIE in {}{}.\n",
+                  study.runs.size(), trajectories.size(), ms.empty() ? "none" : ms, converged, pd,
+                  failed.empty() ? std::string() : fmt::format("; CLIE failed for {}", fmt::join(failed, ", ")));
   int checked = 0, ols_pd = 0, ols_consistent = 0, final_pd = 0, final_consistent = 0;
   for (const auto& r : study.runs) {
     if (r.failed || !r.physical) continue;
@@ -272,17 +278,19 @@ std::string summary(const StudyResult& study) {
     final_pd += r.phi_clie.size() > 0 && r.clie_pd, final_consistent += r.phi_clie.size() > 0 && r.clie_consistent;
   }
   if (checked > 0)
-    out += fmt::format("- **Physical consistency of the runs** (a consistent set of link inertials maps onto the vector; "
-                       "all-pose PD is necessary, not sufficient): OLS {} of {} (PD {}), final vectors {} (PD {}).\n",
-                       ols_consistent, checked, ols_pd, final_consistent, final_pd);
-  out += fmt::format("- **Wall time**: {} s for this invocation on {}{} thread{}; run stages sum to {} s "
-                     "(OLS {}, audit {}, SDP {}, CLIE {}){}.\n\n",
-                     fixed(study.wall, 1), study.ranks > 1 ? fmt::format("{} MPI ranks x ", study.ranks) : "", study.threads,
-                     study.threads == 1 ? "" : "s", fixed(study.wall_runs, 1), fixed(t[0], 1), fixed(t[1], 1), fixed(t[2], 1),
-                     fixed(t[3], 1),
-                     study.worker_peak_mb > 0 ? fmt::format("; peak memory of a trajectory's process {} MB ({})", fixed(study.worker_peak_mb, 0),
-                                                            study.worker_peak_trajectory)
-                                              : "");
+    out += fmt::format(
+        "- **Physical consistency of the runs** (a consistent set of link inertials maps onto the vector; "
+        "all-pose PD is necessary, not sufficient): OLS {} of {} (PD {}), final vectors {} (PD {}).\n",
+        ols_consistent, checked, ols_pd, final_consistent, final_pd);
+  out += fmt::format(
+      "- **Wall time**: {} s for this invocation on {}{} thread{}; run stages sum to {} s "
+      "(OLS {}, audit {}, SDP {}, CLIE {}){}.\n\n",
+      fixed(study.wall, 1), study.ranks > 1 ? fmt::format("{} MPI ranks x ", study.ranks) : "", study.threads,
+      study.threads == 1 ? "" : "s", fixed(study.wall_runs, 1), fixed(t[0], 1), fixed(t[1], 1), fixed(t[2], 1),
+      fixed(t[3], 1),
+      study.worker_peak_mb > 0 ? fmt::format("; peak memory of a trajectory's process {} MB ({})",
+                                             fixed(study.worker_peak_mb, 0), study.worker_peak_trajectory)
+                               : "");
   return out;
 }
 
@@ -292,10 +300,11 @@ std::string reproduction_section(const StudyResult& study) {
   MarkdownTable table({"Finding", "Paper (CRANE-X7, real arm)", "This study", "Verdict", "Note"});
   for (const Finding& f : paper_findings(study)) table.row({f.name, f.paper, f.study, f.verdict, f.note});
   out += table.str();
-  out += "\ntr Σ_z: the trace of the sample covariance of the standardized parameters (the cloud figure's "
-         "standardization; smaller is tighter). The paper's values are from its tables; this study's are computed from "
-         "its run records; the clouds are drawn under Parameter clouds. docs/identification.md explains the findings "
-         "that differ.\n\n";
+  out +=
+      "\ntr Σ_z: the trace of the sample covariance of the standardized parameters (the cloud figure's "
+      "standardization; smaller is tighter). The paper's values are from its tables; this study's are computed from "
+      "its run records; the clouds are drawn under Parameter clouds. docs/identification.md explains the findings "
+      "that differ.\n\n";
   return out;
 }
 
@@ -320,8 +329,8 @@ std::string clouds_section(const StudyResult& study, bool figure) {
 const Eigen::VectorXd& accepted_vector(const StudyResult& study) {
   const auto np = static_cast<Eigen::Index>(study.names.size());
   if (study.phi_rescue.size() != 0 && !study.names.empty() && study.phi_rescue.size() != np)
-    throw std::invalid_argument(fmt::format("the accepted parameter vector has {} entries for {} names",
-                                            study.phi_rescue.size(), np));
+    throw std::invalid_argument(
+        fmt::format("the accepted parameter vector has {} entries for {} names", study.phi_rescue.size(), np));
   return study.phi_rescue;
 }
 
@@ -374,8 +383,8 @@ void write_parameters_csv(const StudyResult& study, const std::filesystem::path&
   };
   std::string csv = sel ? "name,unit,value,ols,sdp,clie\n" : "name,unit,value\n";
   for (Eigen::Index i = 0; i < phi.size(); ++i) {
-    csv += csv_field(name_of(study, static_cast<int>(i))) + "," + csv_field(unit_of(study, static_cast<int>(i))) +
-           "," + io::number_text(phi(i));
+    csv += csv_field(name_of(study, static_cast<int>(i))) + "," + csv_field(unit_of(study, static_cast<int>(i))) + "," +
+           io::number_text(phi(i));
     if (sel) csv += "," + column(sel->phi_ols, i) + "," + column(sel->phi_sdp, i) + "," + column(sel->phi_clie, i);
     csv += "\n";
   }

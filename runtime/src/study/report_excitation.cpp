@@ -25,7 +25,8 @@ std::string excitation_section(const StudyResult& study) {
   std::map<std::string, std::vector<const RunRecord*>> by_family;
   for (const RunRecord& r : study.runs)
     if (!r.failed && r.interval == interval) by_family[family(r.trajectory)].push_back(&r);
-  MarkdownTable table({"Family", "Trajectories", "κ", "κ scaled", "log det", "Best", "its κ scaled", "its weakest direction"});
+  MarkdownTable table(
+      {"Family", "Trajectories", "κ", "κ scaled", "log det", "Best", "its κ scaled", "its weakest direction"});
   for (const auto& [fam, runs] : by_family) {
     std::vector<double> kappa, scaled, log_det;
     const RunRecord* best = runs.front();
@@ -35,8 +36,8 @@ std::string excitation_section(const StudyResult& study) {
       log_det.push_back(r->log_det_scaled);
       if (r->kappa_scaled < best->kappa_scaled) best = r;
     }
-    table.row({fam, std::to_string(runs.size()), sig(median(kappa), 4), sig(median(scaled), 4), fixed(median(log_det), 2),
-               best->trajectory, sig(best->kappa_scaled, 4), cell(best->weakest)});
+    table.row({fam, std::to_string(runs.size()), sig(median(kappa), 4), sig(median(scaled), 4),
+               fixed(median(log_det), 2), best->trajectory, sig(best->kappa_scaled, 4), cell(best->weakest)});
   }
   return out + table.str() + "\n";
 }

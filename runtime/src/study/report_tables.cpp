@@ -21,7 +21,6 @@ double median(std::vector<double> v) {
   return v.size() % 2 ? v[m] : 0.5 * (v[m - 1] + v[m]);
 }
 
-
 namespace {
 
 using symoro::detail::nan;
@@ -166,8 +165,8 @@ std::vector<Dispersion> dispersion_by_interval(const StudyResult& study) {
 std::string routing_table(const StudyResult& study) {
   std::string out = "## Table III: routing summary before CLIE\n\n";
   if (study.runs.empty()) return out + "No runs.\n\n";
-  const bool any_other = std::any_of(study.runs.begin(), study.runs.end(),
-                                     [](const RunRecord& r) { return !is_o_c(r) && !is_o_s_c(r); });
+  const bool any_other =
+      std::any_of(study.runs.begin(), study.runs.end(), [](const RunRecord& r) { return !is_o_c(r) && !is_o_s_c(r); });
   std::vector<std::string> header{"T_s [ms]", "PD-OLS → CLIE", "NPD-OLS → SDP → CLIE"};
   if (any_other) header.push_back("Other route");
   for (const char* h : {"Total", "SDP infeasible", "CLIE converged", "CLIE PD"}) header.push_back(h);
@@ -177,9 +176,12 @@ std::string routing_table(const StudyResult& study) {
     for (const auto& r : study.runs) {
       if (!all && interval_ms(r.interval) != interval_ms(interval)) continue;
       ++total;
-      if (is_o_c(r)) ++oc;
-      else if (is_o_s_c(r)) ++osc;
-      else ++other;
+      if (is_o_c(r))
+        ++oc;
+      else if (is_o_s_c(r))
+        ++osc;
+      else
+        ++other;
       if (is_o_s_c(r) && !r.sdp_feasible) ++infeasible;
       if (r.clie_success) ++converged;
       if (r.clie_ran && r.clie_pd) ++pd;
@@ -232,28 +234,33 @@ std::string transition_table(const StudyResult& study) {
   if (!r) return "## Table V: stage-wise evolution of the representative\n\nNo representative was selected.\n\n";
   std::string out = fmt::format("## Table V: stage-wise evolution of the representative {}\n\n", r->id());
   MarkdownTable table({"Stage", "PD", "Route", "ε_PD", "λ_min", "Remark"});
-  table.row({"OLS", yes_no(r->ols_pd), "--", "--", sig(r->ols_lambda_min, 4),
-             fmt::format("Initial estimate, κ = {}, residual RMS {} N m", fixed(r->kappa, 1), sig(r->residual_rms, 4))});
+  table.row(
+      {"OLS", yes_no(r->ols_pd), "--", "--", sig(r->ols_lambda_min, 4),
+       fmt::format("Initial estimate, κ = {}, residual RMS {} N m", fixed(r->kappa, 1), sig(r->residual_rms, 4))});
   std::string sdp_remark = is_o_c(*r)        ? "Skipped: the OLS estimate was already PD"
                            : r->sdp_feasible ? "Feasible projection before CLIE"
                                              : "No margin gave a PD projection; CLIE started from the last";
-  table.row({"SDP", is_o_s_c(*r) ? yes_no(r->sdp_feasible) : "--", r->route.empty() ? "n/a" : r->route,
-             eps_text(*r), "--", sdp_remark});
-  std::string clie_remark = !r->clie_ran    ? "CLIE " + termination(*r) + "; the SDP (or PD OLS) vector is the final one"
-                            : r->clie_success ? fmt::format("Converged ({} iterations, cost {} lower)", r->clie_iterations, cost_reduction(*r))
+  table.row({"SDP", is_o_s_c(*r) ? yes_no(r->sdp_feasible) : "--", r->route.empty() ? "n/a" : r->route, eps_text(*r),
+             "--", sdp_remark});
+  std::string clie_remark = !r->clie_ran ? "CLIE " + termination(*r) + "; the SDP (or PD OLS) vector is the final one"
+                            : r->clie_success ? fmt::format("Converged ({} iterations, cost {} lower)",
+                                                            r->clie_iterations, cost_reduction(*r))
                                               : "CLIE failed: " + termination(*r);
   if (r->clie_success && !r->clie_pd) clie_remark += "; statistically central but non-PD";
   table.row({"CLIE", yes_no(r->clie_pd), "--", "--", sig(r->clie_lambda_min, 4), clie_remark});
   const bool physical = study.consistency == "physical";
   std::string final_remark =
-      study.rescued ? (study.accepted ? (physical ? "Projected onto the physically consistent set; final accepted model"
-                                                  : "Final accepted model")
-                                      : (physical ? "Rescued, but the final checks failed" : "Rescued, but the final audit failed"))
-                    : (study.accepted ? (physical ? "Not needed: the CLIE candidate has a consistent set and is accepted as is"
-                                                  : "Not needed: the CLIE candidate was PD and is accepted as is")
-                                      : (physical ? "Not rescued; the final checks failed" : "Not rescued; the final audit failed"));
-  table.row({physical ? "Physical rescue" : "PD-rescue", yes_no(study.accepted), "--", study.rescued ? sig(study.rescue_eps, 3) : "--",
-             sig(study.final_lambda_min, 4), final_remark});
+      study.rescued
+          ? (study.accepted
+                 ? (physical ? "Projected onto the physically consistent set; final accepted model"
+                             : "Final accepted model")
+                 : (physical ? "Rescued, but the final checks failed" : "Rescued, but the final audit failed"))
+          : (study.accepted
+                 ? (physical ? "Not needed: the CLIE candidate has a consistent set and is accepted as is"
+                             : "Not needed: the CLIE candidate was PD and is accepted as is")
+                 : (physical ? "Not rescued; the final checks failed" : "Not rescued; the final audit failed"));
+  table.row({physical ? "Physical rescue" : "PD-rescue", yes_no(study.accepted), "--",
+             study.rescued ? sig(study.rescue_eps, 3) : "--", sig(study.final_lambda_min, 4), final_remark});
   return out + table.str() + "\nλ_min: smallest eigenvalue of M(θ; φ) found by the all-pose audit.\n\n";
 }
 
@@ -266,8 +273,9 @@ std::string rescue_delta_table(const StudyResult& study, int count) {
   if (!r || r->phi_clie.size() != np || study.phi_rescue.size() != np || np == 0)
     return out + "No CLIE and rescued parameter vectors to compare.\n\n";
   if (!study.rescued)
-    return out + (study.consistency == "physical" ? "The CLIE candidate passed the final checks and was accepted unchanged: no rescue.\n\n"
-                                                  : "The CLIE candidate passed the final audit and was accepted unchanged: no rescue.\n\n");
+    return out + (study.consistency == "physical"
+                      ? "The CLIE candidate passed the final checks and was accepted unchanged: no rescue.\n\n"
+                      : "The CLIE candidate passed the final audit and was accepted unchanged: no rescue.\n\n");
   std::vector<int> order(np);
   std::iota(order.begin(), order.end(), 0);
   const Eigen::VectorXd delta = study.phi_rescue - r->phi_clie;
@@ -276,8 +284,8 @@ std::string rescue_delta_table(const StudyResult& study, int count) {
                        "Δ = rescue − CLIE"});
   for (int k = 0; k < std::min(count, np); ++k) {
     const int i = order[k];
-    table.row({name_of(study, i), unit_of(study, i), sig(r->phi_clie(i), 6), sig(study.phi_rescue(i), 6),
-               sig(delta(i), 4)});
+    table.row(
+        {name_of(study, i), unit_of(study, i), sig(r->phi_clie(i), 6), sig(study.phi_rescue(i), 6), sig(delta(i), 4)});
   }
   return out + table.str() +
          fmt::format("\n‖Δ‖₂ = {}, ‖Δ‖₂ / ‖φ_CLIE‖₂ = {}.\n\n", sig(delta.norm(), 4),
@@ -290,17 +298,19 @@ std::string raw_validation_table(const StudyResult& study) {
   for (const auto& v : study.validation)
     if (std::isfinite(v.raw_rmse_rescue)) filter = v.raw_filter;
   if (filter.empty()) return "";
-  MarkdownTable table({"Trajectory", "Final RMSE [N m]", "Accepted RMSE [N m]", "Accepted, mean of the joints' RMSE [N m]",
-                        "Accepted, per joint [N m]"});
+  MarkdownTable table({"Trajectory", "Final RMSE [N m]", "Accepted RMSE [N m]",
+                       "Accepted, mean of the joints' RMSE [N m]", "Accepted, per joint [N m]"});
   for (const auto& v : study.validation) {
     if (!std::isfinite(v.raw_rmse_rescue)) continue;
     std::string joints;
-    for (Eigen::Index j = 0; j < v.raw_rmse_joint_rescue.size(); ++j) joints += (j ? ", " : "") + sig(v.raw_rmse_joint_rescue(j), 3);
+    for (Eigen::Index j = 0; j < v.raw_rmse_joint_rescue.size(); ++j)
+      joints += (j ? ", " : "") + sig(v.raw_rmse_joint_rescue(j), 3);
     const double mean = v.raw_rmse_joint_rescue.size() > 0 ? v.raw_rmse_joint_rescue.mean() : std::nan("");
     table.row({v.trajectory, sig(v.raw_rmse_clie, 6), sig(v.raw_rmse_rescue, 6), sig(mean, 6), joints});
   }
   return "\nAgainst the raw measured torque, open loop at the log's own rate: " + filter +
-         ". RMSE: over all joints and samples together, sqrt(sum e^2 / (samples x joints)); mean of the joints' RMSE: the "
+         ". RMSE: over all joints and samples together, sqrt(sum e^2 / (samples x joints)); mean of the joints' RMSE: "
+         "the "
          "average over joints of sqrt(sum_k e_j(k)^2 / samples) (docs/identification.md, \"Validation against the raw "
          "torque\", rescores it with NumPy).\n\n" +
          table.str() + "\n";
@@ -310,12 +320,16 @@ std::string raw_validation_table(const StudyResult& study) {
 std::string edge_note(const StudyResult& study) {
   std::string runs, held;
   for (const auto& r : study.runs)
-    if (r.edge_samples > 0) runs += fmt::format("{}{} at {} ms: {}", runs.empty() ? "" : ", ", r.trajectory, interval_ms(r.interval), r.edge_samples);
+    if (r.edge_samples > 0)
+      runs += fmt::format("{}{} at {} ms: {}", runs.empty() ? "" : ", ", r.trajectory, interval_ms(r.interval),
+                          r.edge_samples);
   for (const auto& v : study.validation)
     if (v.edge_samples > 0) held += fmt::format("{}{}: {}", held.empty() ? "" : ", ", v.trajectory, v.edge_samples);
   if (runs.empty() && held.empty()) return "";
-  return "\nLeft out of fitting and scoring: the samples within the low-pass's settling time (6 time constants) of a log "
-         "end where the arm moves, whose acceleration the filter's end padding gets wrong (docs/identification.md, \"The "
+  return "\nLeft out of fitting and scoring: the samples within the low-pass's settling time (6 time constants) of a "
+         "log "
+         "end where the arm moves, whose acceleration the filter's end padding gets wrong (docs/identification.md, "
+         "\"The "
          "ends of a log\"). " +
          (runs.empty() ? std::string() : "Identification runs: " + runs + ". ") +
          (held.empty() ? std::string() : "Held out: " + held + ".") + "\n";
@@ -324,7 +338,8 @@ std::string edge_note(const StudyResult& study) {
 std::string validation_table(const StudyResult& study) {
   std::string out = "## Table VII: validation on held-out trajectories\n\n";
   if (study.validation.empty()) return out + "No validation records.\n\n";
-  MarkdownTable table({"Trajectory", "T_s [ms]", "Kind", "Final RMSE [N m]", "Accepted RMSE [N m]", "Final MNE", "Accepted MNE"});
+  MarkdownTable table(
+      {"Trajectory", "T_s [ms]", "Kind", "Final RMSE [N m]", "Accepted RMSE [N m]", "Final MNE", "Accepted MNE"});
   double sums[4] = {0, 0, 0, 0};
   for (const auto& v : study.validation) {
     const double values[4] = {v.rmse_clie, v.rmse_rescue, v.mne_clie, v.mne_rescue};
@@ -337,10 +352,12 @@ std::string validation_table(const StudyResult& study) {
   }
   const double n = static_cast<double>(study.validation.size());
   table.row({"Mean", "", "", sig(sums[0] / n, 6), sig(sums[1] / n, 6), sig(sums[2] / n, 6), sig(sums[3] / n, 6)});
-  out += table.str() +
-         "\nFinal: the representative run's last stage (CLIE, or SDP where CLIE did not run); accepted: after the rescue. "
-         "Closed loop: the model under the experiment's controller; open loop: the model's inverse dynamics on the measured "
-         "motion. RMSE over all joints and samples; MNE: mean over joints of ‖e_j‖ / ‖τ_m,j‖.\n\n";
+  out +=
+      table.str() +
+      "\nFinal: the representative run's last stage (CLIE, or SDP where CLIE did not run); accepted: after the rescue. "
+      "Closed loop: the model under the experiment's controller; open loop: the model's inverse dynamics on the "
+      "measured "
+      "motion. RMSE over all joints and samples; MNE: mean over joints of ‖e_j‖ / ‖τ_m,j‖.\n\n";
   for (const auto& v : study.validation)
     if (!v.note.empty()) out += fmt::format("- {}: {}\n", v.trajectory, v.note);
   out += raw_validation_table(study);
@@ -355,8 +372,9 @@ std::string validation_table(const StudyResult& study) {
   for (int j = 0; j < joints; ++j) header.push_back(fmt::format("J{}", j + 1));
   MarkdownTable per_joint(header);
   for (const auto& v : study.validation)
-    for (const auto& [model, rmse] : {std::pair{"final RMSE [N m]", &v.rmse_joint_clie}, std::pair{"accepted RMSE [N m]", &v.rmse_joint_rescue},
-                                      std::pair{"accepted NRMSE", &v.nrmse_joint_rescue}}) {
+    for (const auto& [model, rmse] :
+         {std::pair{"final RMSE [N m]", &v.rmse_joint_clie}, std::pair{"accepted RMSE [N m]", &v.rmse_joint_rescue},
+          std::pair{"accepted NRMSE", &v.nrmse_joint_rescue}}) {
       if (rmse->size() == 0) continue;
       std::vector<std::string> row{v.trajectory, model};
       for (int j = 0; j < joints; ++j) row.push_back(j < rmse->size() ? sig((*rmse)(j), 4) : "--");
@@ -402,9 +420,10 @@ std::string central_runs_table(const StudyResult& study, int count) {
 std::string appendix_record(const StudyResult& study) {
   std::string out = "## Appendix A: run record\n\n";
   if (study.runs.empty()) return out + "No runs.\n\n";
-  out += "κ: σ_max/σ_min of the stacked regressor W; κ scaled: the same with unit-norm columns. "
-         "OLS PD and λ_min: the all-pose audit of the OLS estimate. Cost reduction: 1 − final/initial "
-         "CLIE cost. Times in s.\n\n";
+  out +=
+      "κ: σ_max/σ_min of the stacked regressor W; κ scaled: the same with unit-norm columns. "
+      "OLS PD and λ_min: the all-pose audit of the OLS estimate. Cost reduction: 1 − final/initial "
+      "CLIE cost. Times in s.\n\n";
   std::vector<int> order(study.runs.size());
   std::iota(order.begin(), order.end(), 0);
   std::stable_sort(order.begin(), order.end(), [&](int a, int b) {
@@ -413,9 +432,9 @@ std::string appendix_record(const StudyResult& study) {
     const auto kb = std::make_tuple(family(rb.trajectory), rb.trajectory, rb.interval);
     return ka < kb;
   });
-  const std::vector<std::string> header{"Trajectory", "T_s [ms]", "κ", "κ scaled", "OLS PD", "OLS λ_min", "Route",
-                                        "ε_PD", "CLIE", "Cost reduction", "CLIE PD", "CLIE λ_min",
-                                        "t_OLS", "t_audit", "t_SDP", "t_CLIE"};
+  const std::vector<std::string> header{"Trajectory", "T_s [ms]", "κ",     "κ scaled",       "OLS PD",  "OLS λ_min",
+                                        "Route",      "ε_PD",     "CLIE",  "Cost reduction", "CLIE PD", "CLIE λ_min",
+                                        "t_OLS",      "t_audit",  "t_SDP", "t_CLIE"};
   std::size_t k = 0;
   while (k < order.size()) {
     const std::string fam = family(study.runs[order[k]].trajectory);
@@ -424,8 +443,8 @@ std::string appendix_record(const StudyResult& study) {
       const RunRecord& r = study.runs[order[k]];
       table.row({r.trajectory, std::to_string(interval_ms(r.interval)), fixed(r.kappa, 1), fixed(r.kappa_scaled, 1),
                  r.ols_pd ? "Y" : "N", sig(r.ols_lambda_min, 3), r.route.empty() ? "n/a" : r.route, eps_text(r),
-                 clie_status(r), cost_reduction(r), r.clie_pd ? "Y" : "N", sig(r.clie_lambda_min, 3),
-                 fixed(r.t_ols, 2), fixed(r.t_audit, 2), fixed(r.t_sdp, 2), fixed(r.t_clie, 1)});
+                 clie_status(r), cost_reduction(r), r.clie_pd ? "Y" : "N", sig(r.clie_lambda_min, 3), fixed(r.t_ols, 2),
+                 fixed(r.t_audit, 2), fixed(r.t_sdp, 2), fixed(r.t_clie, 1)});
     }
     out += "### " + fam + "\n\n" + table.str() + "\n";
   }
@@ -447,9 +466,13 @@ std::string parameter_table(const StudyResult& study) {
   if (truth) header.insert(header.end(), {"Truth", "Error", "Rel. error"});
   MarkdownTable table(header);
   for (int i = 0; i < np; ++i) {
-    std::vector<std::string> row{name_of(study, i), unit_of(study, i), value_or_dash(ols, i, np),
-                                 value_or_dash(std_ols, i, np), value_or_dash(sdp, i, np),
-                                 value_or_dash(clie, i, np), value_or_dash(study.phi_rescue, i, np)};
+    std::vector<std::string> row{name_of(study, i),
+                                 unit_of(study, i),
+                                 value_or_dash(ols, i, np),
+                                 value_or_dash(std_ols, i, np),
+                                 value_or_dash(sdp, i, np),
+                                 value_or_dash(clie, i, np),
+                                 value_or_dash(study.phi_rescue, i, np)};
     if (truth) {
       row.push_back(sig(study.truth(i), 6));
       if (study.phi_rescue.size() == np) {

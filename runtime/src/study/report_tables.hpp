@@ -16,9 +16,9 @@ namespace symoro::study::report_detail {
 std::string fixed(double value, int decimals);  // "n/a" when not finite
 std::string sig(double value, int digits);      // significant digits, "n/a" when not finite
 std::string yes_no(bool value);
-long interval_ms(double interval);               // s -> whole ms
-double median(std::vector<double> v);            // NaN when empty
-using markdown::cell;                            // '|' and newlines made table-safe (md_cell before)
+long interval_ms(double interval);     // s -> whole ms
+double median(std::vector<double> v);  // NaN when empty
+using markdown::cell;                  // '|' and newlines made table-safe (md_cell before)
 
 using MarkdownTable = markdown::Table;  // numbers right, the first column and text left
 
@@ -36,19 +36,19 @@ std::string name_of(const StudyResult& study, int i);
 // standardized parameters (pca.hpp's cloud_dispersion in the PCA's standardization, else in the
 // pooled one of all stages, which the PCA would use).
 struct Dispersion {
-  double interval = 0;  // s; NaN for all intervals pooled
+  double interval = 0;          // s; NaN for all intervals pooled
   double trace[3] = {0, 0, 0};  // OLS, SDP, CLIE (NaN with fewer than two vectors)
   int count[3] = {0, 0, 0};     // vectors used (finite, of the right size)
 };
 std::vector<Dispersion> dispersion_by_interval(const StudyResult& study);  // last: all pooled
 
 // --- Sections -----------------------------------------------------------------------------
-std::string routing_table(const StudyResult& study);                                  // Table III
+std::string routing_table(const StudyResult& study);                                       // Table III
 std::string route_examples_table(const StudyResult& study, const ReportOptions& options);  // IV
-std::string transition_table(const StudyResult& study);                               // Table V
-std::string rescue_delta_table(const StudyResult& study, int count = 5);              // Table VI
-std::string validation_table(const StudyResult& study);                               // Table VII
-std::string excitation_section(const StudyResult& study);  // report_excitation.cpp
+std::string transition_table(const StudyResult& study);                                    // Table V
+std::string rescue_delta_table(const StudyResult& study, int count = 5);                   // Table VI
+std::string validation_table(const StudyResult& study);                                    // Table VII
+std::string excitation_section(const StudyResult& study);                                  // report_excitation.cpp
 // Every parameter the accepted vector moved from CLIE by more than 3 OLS std while its OLS
 // relative std is under 5 %, and the `count` largest such moves (report_moves.cpp).
 std::string moves_table(const StudyResult& study, int count = 10);

@@ -37,8 +37,10 @@ FindingValues finding_values(const StudyResult& study) {
   f.selected_interval = sel ? sel->interval : 0;
   for (const Dispersion& d : dispersion_by_interval(study)) {
     for (int s = 0; s < 3; ++s) {
-      if (std::isnan(d.interval)) f.all[s] = d.trace[s];
-      else if (sel && interval_ms(d.interval) == interval_ms(sel->interval)) f.at_selected[s] = d.trace[s];
+      if (std::isnan(d.interval))
+        f.all[s] = d.trace[s];
+      else if (sel && interval_ms(d.interval) == interval_ms(sel->interval))
+        f.at_selected[s] = d.trace[s];
     }
   }
 
@@ -88,7 +90,8 @@ namespace {
 // Sec. VI-A: the clouds contract, OLS -> SDP -> CLIE.
 Finding clouds_finding(const FindingValues& f, const std::string& at) {
   using namespace report_detail;
-  Finding c{"clouds contract OLS → SDP → CLIE (Sec. VI-A, Fig. 5)", "yes: progressively more concentrated", "", "n/a", ""};
+  Finding c{"clouds contract OLS → SDP → CLIE (Sec. VI-A, Fig. 5)", "yes: progressively more concentrated", "", "n/a",
+            ""};
   c.study = fmt::format("tr Σ_z at {}: {} → {} → {}; all intervals: {} → {} → {}", at, num(f.at_selected[0]),
                         num(f.at_selected[1]), num(f.at_selected[2]), num(f.all[0]), num(f.all[1]), num(f.all[2]));
   if (f.clie_ran == 0) {
@@ -113,11 +116,13 @@ Finding rescue_finding(const FindingValues& f, const StudyResult& study) {
   if (f.validations == 0) {
     r.study = "no validation";
   } else if (!study.rescued) {
-    r.study = fmt::format("no rescue needed (the representative's CLIE vector is PD); mean RMSE {} N m", num(f.rmse_final, 5));
+    r.study = fmt::format("no rescue needed (the representative's CLIE vector is PD); mean RMSE {} N m",
+                          num(f.rmse_final, 5));
     r.note = "nothing to compare";
   } else {
     const double change = f.rmse_accepted / f.rmse_final - 1;
-    r.study = fmt::format("mean RMSE {} → {} N m ({:+.2f} %)", num(f.rmse_final, 5), num(f.rmse_accepted, 5), 100 * change);
+    r.study =
+        fmt::format("mean RMSE {} → {} N m ({:+.2f} %)", num(f.rmse_final, 5), num(f.rmse_accepted, 5), 100 * change);
     r.verdict = verdict(change < 0.05);
     r.note = "kept: at most 5 % worse (an improvement also keeps it)";
   }
@@ -129,7 +134,8 @@ Finding validation_finding(const FindingValues& f, const StudyResult& study) {
   using namespace report_detail;
   Finding v{"the model validates on V01–V03 (Table VII)", "all three, closed loop", "", "n/a", ""};
   if (f.validations > 0) {
-    v.study = fmt::format("{} of {} finite, {} closed loop", f.validations_finite, f.validations, f.validations_closed_loop);
+    v.study =
+        fmt::format("{} of {} finite, {} closed loop", f.validations_finite, f.validations, f.validations_closed_loop);
     // Open loop by design (no controller description or reference) is not a failed finding.
     bool by_design = f.validations_closed_loop == 0;
     for (const ValidationRecord& r : study.validation) by_design = by_design && r.note.rfind("open loop:", 0) == 0;
@@ -175,18 +181,19 @@ Finding representative_finding(const RunRecord* sel) {
 Finding kappa_finding(const FindingValues& f) {
   using namespace report_detail;
   Finding k{"regressor condition number κ (Table IV, Appendix A)",
-            fmt::format("σ_max / σ_min of W: {}–{} (AG02 33.2–34.1, AP01 46.1–47.2)", kPaperKappaMin, kPaperKappaMax), "",
-            "n/a", ""};
+            fmt::format("σ_max / σ_min of W: {}–{} (AG02 33.2–34.1, AP01 46.1–47.2)", kPaperKappaMin, kPaperKappaMax),
+            "", "n/a", ""};
   k.study = fmt::format("raw: median {}, {}–{}; unit-norm columns: median {}, {}–{}", num(f.kappa_median, 3),
-                        num(f.kappa_min, 3), num(f.kappa_max, 3), num(f.kappa_scaled_median, 3), num(f.kappa_scaled_min, 3),
-                        num(f.kappa_scaled_max, 3));
+                        num(f.kappa_min, 3), num(f.kappa_max, 3), num(f.kappa_scaled_median, 3),
+                        num(f.kappa_scaled_min, 3), num(f.kappa_scaled_max, 3));
   const auto inside = [](double v) { return v >= 0.5 * kPaperKappaMin && v <= 2 * kPaperKappaMax; };
   if (std::isfinite(f.kappa_median)) {
     const bool raw = inside(f.kappa_median), scaled = inside(f.kappa_scaled_median);
     k.verdict = raw || scaled ? "reproduced" : "not reproduced";
     k.note = raw ? "the raw κ matches the paper's range"
-             : scaled ? "the column-scaled κ matches the paper's range, the raw one does not (units; docs/identification.md)"
-                      : "neither κ matches the paper's range";
+             : scaled
+                 ? "the column-scaled κ matches the paper's range, the raw one does not (units; docs/identification.md)"
+                 : "neither κ matches the paper's range";
   }
   return k;
 }
@@ -204,7 +211,8 @@ Finding routing_finding(const FindingValues& f) {
     ms += fmt::format("{}{}", k ? "/" : "", interval_ms(f.intervals[k]));
     if (k > 0 && f.pd_ols[k] < f.pd_ols[k - 1]) rising = false;
   }
-  t.study = f.intervals.empty() ? "no runs" : fmt::format("PD OLS at {} ms: {} of {}", ms, counts, f.runs.empty() ? 0 : f.runs[0]);
+  t.study = f.intervals.empty() ? "no runs"
+                                : fmt::format("PD OLS at {} ms: {} of {}", ms, counts, f.runs.empty() ? 0 : f.runs[0]);
   if (f.intervals.size() > 1) t.verdict = verdict(rising);
   return t;
 }

@@ -31,12 +31,14 @@ void check_request(const StudyRequest& r) {
   check_count("--clie-iterations", r.clie_iterations, 0, 100000);
   check_range("--clie-std-bound", r.clie_std_bound, 0, 1e6, false, ">= 0 and <= 1e6");
   check_range("--clie-noise-floor", r.clie_noise_floor, 0, 1e6, false, ">= 0 and <= 1e6");
-  if (r.validation_ms != 0) check_range("--validation-interval", r.validation_ms, 1, 10000, false, "from 1 to 10000 ms");
+  if (r.validation_ms != 0)
+    check_range("--validation-interval", r.validation_ms, 1, 10000, false, "from 1 to 10000 ms");
   check_range("--rescue-prior-weight", r.rescue_prior_weight, 0, 1e6, true, "> 0 and <= 1e6");
   for (double w : r.rescue_prior_weights) check_range("--rescue-prior-weights", w, 0, 1e6, true, "> 0 and <= 1e6");
 }
 
-StudyOptions study_options(const StudyRequest& r, const identify::ModelDescription& d, const std::filesystem::path& robot_dir) {
+StudyOptions study_options(const StudyRequest& r, const identify::ModelDescription& d,
+                           const std::filesystem::path& robot_dir) {
   check_request(r);
   StudyOptions so;
   so.data = r.data;

@@ -25,8 +25,8 @@ ClosedLoopSource closed_loop_source(const std::filesystem::path& robot_dir, cons
   return loop;
 }
 
-bool nominal_standard_parameters(const std::filesystem::path& robot_dir, const std::vector<StandardParameterInfo>& standard,
-                                 std::vector<double>& values) {
+bool nominal_standard_parameters(const std::filesystem::path& robot_dir,
+                                 const std::vector<StandardParameterInfo>& standard, std::vector<double>& values) {
   const std::filesystem::path yaml = robot_dir / "robot.yaml";
   YAML::Node nominal;
   try {
@@ -44,8 +44,10 @@ bool nominal_standard_parameters(const std::filesystem::path& robot_dir, const s
   std::string missing;
   try {
     for (std::size_t i = 0; i < standard.size(); ++i) {
-      if (const YAML::Node v = nominal[standard[i].name]) values[i] = v.as<double>();
-      else if (rigid(standard[i].family)) missing += std::string(missing.empty() ? "" : ", ") + standard[i].name;
+      if (const YAML::Node v = nominal[standard[i].name])
+        values[i] = v.as<double>();
+      else if (rigid(standard[i].family))
+        missing += std::string(missing.empty() ? "" : ", ") + standard[i].name;
     }
   } catch (const YAML::Exception& e) {
     throw DataError(yaml.string(), e.mark.line + 1, e.msg);

@@ -16,11 +16,12 @@ namespace symoro::study::detail {
 
 // The paper's pre-CLIE step (Algorithm 1, lines 4-15): the all-pose audit of the OLS estimate
 // and, when it is not PD, the conditional SDP projection. Fills the record's audit and route.
-ClieStart pd_start(const identify::LeastSquaresResult& ls, const StudyOptions& options, const identify::InertiaFunction& inertia,
-                          const identify::AuditDomain& domain, RunRecord& r) {
+ClieStart pd_start(const identify::LeastSquaresResult& ls, const StudyOptions& options,
+                   const identify::InertiaFunction& inertia, const identify::AuditDomain& domain, RunRecord& r) {
   const auto t = std::chrono::steady_clock::now();
   identify::ProjectionOptions po = options.projection;
-  if (options.projection_metric == ProjectionMetric::information) po.metric = identify::information_metric(ls.information, options.information_ridge);
+  if (options.projection_metric == ProjectionMetric::information)
+    po.metric = identify::information_metric(ls.information, options.information_ridge);
   const identify::ConditionalProjection cp = conditional_projection(inertia, ls.phi, domain, options.margins, po);
   const double conditional_wall = seconds_since(t);
   r.ols_lambda_min = cp.audit.lambda_min;
@@ -46,14 +47,16 @@ ClieStart pd_start(const identify::LeastSquaresResult& ls, const StudyOptions& o
 // The physical path's pre-CLIE step when asked (StudyOptions::physical_start): the all-pose audit
 // (for the record) and, when the OLS estimate has no consistent standard set, the nearest base
 // vector that has one in the run's predicted-torque metric (physical_projection.hpp).
-ClieStart physical_start(const identify::IdentificationModel& model, const identify::LeastSquaresResult& ls, const StudyOptions& options,
-                         const identify::InertiaFunction& inertia, const identify::AuditDomain& domain, RunRecord& r) {
+ClieStart physical_start(const identify::IdentificationModel& model, const identify::LeastSquaresResult& ls,
+                         const StudyOptions& options, const identify::InertiaFunction& inertia,
+                         const identify::AuditDomain& domain, RunRecord& r) {
   const identify::AuditResult a = audit_pd(inertia, ls.phi, domain, options.audit);
   r.ols_lambda_min = a.lambda_min;
   r.ols_worst_pose = a.worst_pose;
   r.ols_pd = a.positive_definite();
   r.t_audit = a.wall;
-  const identify::PhysicalProjection p = model.physical_projection(ls.phi, torque_metric(ls, options.information_ridge), options.physical_clearance);
+  const identify::PhysicalProjection p =
+      model.physical_projection(ls.phi, torque_metric(ls, options.information_ridge), options.physical_clearance);
   r.physical = true;
   r.ols_consistent = p.consistent;
   r.ols_consistency = p.check.feasibility;
@@ -96,9 +99,11 @@ RunRecord identify_run(const identify::IdentificationModel& model, const io::Log
   }
   r.kappa = ls.kappa;
   r.kappa_scaled = ls.kappa_scaled;
-  const excitation::ExcitationQuality q = excitation::excitation_quality(reg.W, model.description().parameters, 3, false);
+  const excitation::ExcitationQuality q =
+      excitation::excitation_quality(reg.W, model.description().parameters, 3, false);
   r.log_det_scaled = q.log_det_scaled;
-  for (const auto& [name, v] : q.weakest) r.weakest += fmt::format("{}{} {:+.2f}", r.weakest.empty() ? "" : ", ", name, v);
+  for (const auto& [name, v] : q.weakest)
+    r.weakest += fmt::format("{}{} {:+.2f}", r.weakest.empty() ? "" : ", ", name, v);
   r.phi_ols = ls.phi;
   r.std_ols = ls.std_dev;
   r.residual_rms = ls.residual_rms;
@@ -107,7 +112,7 @@ RunRecord identify_run(const identify::IdentificationModel& model, const io::Log
 
   const bool physical = options.consistency == Consistency::physical;
   const ClieStart start = physical && options.physical_start ? physical_start(model, ls, options, inertia, domain, r)
-                                                       : pd_start(ls, options, inertia, domain, r);
+                                                             : pd_start(ls, options, inertia, domain, r);
   // Whether a vector has a consistent set (the physical path; its time counts as the SDP's).
   auto check = [&](const Eigen::VectorXd& phi, bool& consistent, double& margin) {
     const auto tc = std::chrono::steady_clock::now();

@@ -163,7 +163,8 @@ std::optional<RunRecord> load_run(const std::filesystem::path& file, const std::
   try {
     const YAML::Node n = io::load_yaml_file(file);
     if (n["fingerprint"].as<std::string>() != fingerprint) return std::nullopt;
-    if (!n["failed"].as<bool>(false) && !n["log_det_scaled"]) return std::nullopt;  // a record before issue 29: done again
+    if (!n["failed"].as<bool>(false) && !n["log_det_scaled"])
+      return std::nullopt;  // a record before issue 29: done again
     return parse(n);
   } catch (const YAML::Exception&) {
     return std::nullopt;  // unreadable: the run is done again

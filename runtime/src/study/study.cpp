@@ -44,14 +44,20 @@ using io::DatasetRun;
 class StudyRun {
  public:
   StudyRun(const identify::IdentificationModel& model, const StudyOptions& options, const ClosedLoopSource& closed_loop)
-      : model_(model), d_(model.description()), o_(options), loop_(closed_loop), inertia_(model.inertia_function()),
+      : model_(model),
+        d_(model.description()),
+        o_(options),
+        loop_(closed_loop),
+        inertia_(model.inertia_function()),
         domain_(identify::audit_domain(d_.joints)) {}
 
   StudyResult run() {
     const auto t0 = std::chrono::steady_clock::now();
     if (o_.consistency == Consistency::physical && !model_.supports_physical_consistency())
-      throw std::invalid_argument(fmt::format("--consistency physical: the {} model has effect parameters (not standard "
-                                              "inertial parameters); identify it with the PD path", d_.variant));
+      throw std::invalid_argument(
+          fmt::format("--consistency physical: the {} model has effect parameters (not standard "
+                      "inertial parameters); identify it with the PD path",
+                      d_.variant));
     const Dataset data = io::read_dataset(o_.data);
     io::check_dataset_robot(data, d_.robot);
     StudyResult out = described(data);
@@ -138,9 +144,11 @@ class StudyRun {
         }
     // Longest first (the log's size stands for its duration), so no thread ends on a long one.
     std::stable_sort(todo.begin(), todo.end(), [&](const std::string& a, const std::string& b) {
-      return std::filesystem::file_size(data.find(a, o_.trial).file) > std::filesystem::file_size(data.find(b, o_.trial).file);
+      return std::filesystem::file_size(data.find(a, o_.trial).file) >
+             std::filesystem::file_size(data.find(b, o_.trial).file);
     });
-    const int skipped = static_cast<int>(std::count_if(slots.begin(), slots.end(), [](const Slot& s) { return s.record.has_value(); }));
+    const int skipped =
+        static_cast<int>(std::count_if(slots.begin(), slots.end(), [](const Slot& s) { return s.record.has_value(); }));
     if (o_.on_start && parallel::place().coordinator()) o_.on_start(static_cast<int>(slots.size()), skipped);
 
     // One task per trajectory (its log read once, its missing intervals in order), on the
@@ -206,9 +214,10 @@ class StudyRun {
     fo.rank_timeout = o_.rank_timeout;
     const parallel::FarmSummary farmed = parallel::run_farm(tasks, farm, fo);
     if (farmed.stopped) {
-      const auto saved = std::count_if(slots.begin(), slots.end(), [](const Slot& s) { return s.record && !s.record->failed; });
-      throw StudyStopped(fmt::format("the study was stopped: {} of {} runs are saved in {}; run it again to resume", saved,
-                                     slots.size(), (o_.out / "runs").string()));
+      const auto saved =
+          std::count_if(slots.begin(), slots.end(), [](const Slot& s) { return s.record && !s.record->failed; });
+      throw StudyStopped(fmt::format("the study was stopped: {} of {} runs are saved in {}; run it again to resume",
+                                     saved, slots.size(), (o_.out / "runs").string()));
     }
     return farmed;
   }
@@ -245,7 +254,8 @@ class StudyRun {
 
   // The closed loop of one run, or nullptr with the reason: the log's reference columns first,
   // else the design's trajectory of that name.
-  std::unique_ptr<identify::ClosedLoop> closed_loop(const std::string& name, const io::Log& log, std::string& why) const {
+  std::unique_ptr<identify::ClosedLoop> closed_loop(const std::string& name, const io::Log& log,
+                                                    std::string& why) const {
     if (!loop_.setup) {
       why = loop_.why.empty() ? "no controller description" : loop_.why;
       return nullptr;
@@ -255,10 +265,12 @@ class StudyRun {
     if (loop_.design) {
       const auto names = loop_.design->names();
       if (std::find(names.begin(), names.end(), name) != names.end())
-        return model_.closed_loop(*loop_.setup, trajectory::sample(loop_.design->build(name), loop_.setup->gains.period));
+        return model_.closed_loop(*loop_.setup,
+                                  trajectory::sample(loop_.design->build(name), loop_.setup->gains.period));
     }
     why = fmt::format("the log of {} has no reference columns{}", name,
-                      loop_.design ? " and the trajectory design has no trajectory of that name" : " and the robot has no trajectory design");
+                      loop_.design ? " and the trajectory design has no trajectory of that name"
+                                   : " and the robot has no trajectory design");
     return nullptr;
   }
 
@@ -274,8 +286,8 @@ class StudyRun {
         if (why.empty()) why = r.clie_termination;
       }
     }
-    out.stages.push_back(fmt::format("OLS{}, all-pose PD audit, conditional SDP projection: {} runs", o_.least_squares.weighted ? " (WLS)" : "",
-                                     out.runs.size() - failures));
+    out.stages.push_back(fmt::format("OLS{}, all-pose PD audit, conditional SDP projection: {} runs",
+                                     o_.least_squares.weighted ? " (WLS)" : "", out.runs.size() - failures));
     if (o_.consistency == Consistency::physical)
       out.stages.push_back(fmt::format(
           "physical consistency (per-link pseudo-inertia LMIs, IA, FV, FS >= 0): every run's OLS and final vectors "
@@ -283,21 +295,26 @@ class StudyRun {
           "predicted on {} (clearance {:g} of each link's size), leaning along what that metric barely sees towards "
           "{} (weight {}); acceptance needs a consistent set and the final audit",
           o_.physical_start ? fmt::format("CLIE's start projected onto that set (clearance {:g}) instead of the PD "
-                                          "projection; ", o_.physical_clearance)
+                                          "projection; ",
+                                          o_.physical_clearance)
                             : "CLIE's start the paper's (conditional PD projection); ",
           o_.rescue_metric_all_runs ? "every identification trajectory at the representative's interval"
                                     : "the representative's run",
           o_.physical_rescue_clearance,
-          o_.rescue_prior.size() > 0 ? o_.rescue_prior_source : std::string("zero inertia (no prior: the links shrink towards line-like "
-                                                                         "mass distributions; give --rescue-prior)"),
+          o_.rescue_prior.size() > 0 ? o_.rescue_prior_source
+                                     : std::string("zero inertia (no prior: the links shrink towards line-like "
+                                                   "mass distributions; give --rescue-prior)"),
           o_.rescue_prior_weights.empty() ? fmt::format("{:g}", o_.rescue_prior_weight)
-                                        : "chosen by held-out error, below"));
+                                          : "chosen by held-out error, below"));
     if (o_.consistency == Consistency::pd || !o_.physical_start)
-      out.stages.push_back(fmt::format("SDP projection{} in the {} metric{}", o_.consistency == Consistency::pd ? " and rescue" : "",
-                                       to_string(o_.projection_metric),
-                                       o_.projection_metric == ProjectionMetric::information ? " (the run's W'W / sigma^2)" : ""));
+      out.stages.push_back(
+          fmt::format("SDP projection{} in the {} metric{}", o_.consistency == Consistency::pd ? " and rescue" : "",
+                      to_string(o_.projection_metric),
+                      o_.projection_metric == ProjectionMetric::information ? " (the run's W'W / sigma^2)" : ""));
     const std::string bounds =
-        o_.clie.std_bound > 0 ? fmt::format(" (bounds: +-{:g} OLS standard deviations around the start)", o_.clie.std_bound) : "";
+        o_.clie.std_bound > 0
+            ? fmt::format(" (bounds: +-{:g} OLS standard deviations around the start)", o_.clie.std_bound)
+            : "";
     if (skipped == 0)
       out.stages.push_back(fmt::format("CLIE: {} runs{}", clie, bounds));
     else
@@ -328,12 +345,13 @@ class StudyRun {
     in.loop = "open";
     if (loop_.setup) {
       const identify::ClosedLoopSetup& c = *loop_.setup;
-      in.loop = fmt::format("{} {} {} {} {} | {} {} {} {}", c.gains.period, c.gains.pseudo_derivative_time, c.delay, c.pre_roll,
-                            c.substeps, fmt::join(c.gains.inertia, " "), fmt::join(c.gains.damping, " "),
+      in.loop = fmt::format("{} {} {} {} {} | {} {} {} {}", c.gains.period, c.gains.pseudo_derivative_time, c.delay,
+                            c.pre_roll, c.substeps, fmt::join(c.gains.inertia, " "), fmt::join(c.gains.damping, " "),
                             fmt::join(c.gains.kp, " "), fmt::join(c.gains.kv, " "));
       // The design's bytes (an unreadable design is an error, not an empty fingerprint).
       if (loop_.design)
-        in.loop += " | " + fingerprint_of(io::read_text_file(loop_.design->path(), "cannot read the trajectory design"));
+        in.loop +=
+            " | " + fingerprint_of(io::read_text_file(loop_.design->path(), "cannot read the trajectory design"));
     }
     return in;
   }
@@ -343,15 +361,17 @@ class StudyRun {
     if (std::filesystem::exists(sidecar)) d += " " + io::file_digest(sidecar);
     return d;
   }
-  std::string run_inputs(const StudyInputs& in, const DatasetRun& run, const io::LogMetadata& meta, const std::string& content,
-                         double interval) const {
-    return fmt::format("{}| {} {} {} {} {} [{}, {}] | {} | {} | {}", in.model, run.file.filename().string(), content, meta.seed,
-                       meta.notes, meta.trial, run.window_start, run.window_end, interval, o_.describe(), in.loop);
+  std::string run_inputs(const StudyInputs& in, const DatasetRun& run, const io::LogMetadata& meta,
+                         const std::string& content, double interval) const {
+    return fmt::format("{}| {} {} {} {} {} [{}, {}] | {} | {} | {}", in.model, run.file.filename().string(), content,
+                       meta.seed, meta.notes, meta.trial, run.window_start, run.window_end, interval, o_.describe(),
+                       in.loop);
   }
 
   // A run's least squares again (the rescue's metric: its information matrix).
   identify::LeastSquaresResult refit(const Dataset& data, const RunRecord& r) const {
-    const preprocess::Samples s = preprocess::preprocess(load_log(data.find(r.trajectory, o_.trial)), r.interval, o_.preprocess);
+    const preprocess::Samples s =
+        preprocess::preprocess(load_log(data.find(r.trajectory, o_.trial)), r.interval, o_.preprocess);
     return least_squares(model_.stack_regression(s), o_.least_squares);
   }
 
@@ -363,7 +383,8 @@ class StudyRun {
     double rows = 0;
     for (const auto& name : identification_names(data)) {
       try {
-        const preprocess::Samples s = preprocess::preprocess(load_log(data.find(name, o_.trial)), interval, o_.preprocess);
+        const preprocess::Samples s =
+            preprocess::preprocess(load_log(data.find(name, o_.trial)), interval, o_.preprocess);
         const identify::Regression reg = model_.stack_regression(s);
         A.selfadjointView<Eigen::Lower>().rankUpdate(reg.W.transpose());
         rows += static_cast<double>(reg.W.rows());
@@ -371,7 +392,8 @@ class StudyRun {
         continue;
       }
     }
-    if (rows == 0) throw std::runtime_error("the rescue's metric: no identification log could be read at this interval");
+    if (rows == 0)
+      throw std::runtime_error("the rescue's metric: no identification log could be read at this interval");
     A = A.selfadjointView<Eigen::Lower>();
     return identify::information_metric(A / rows, o_.information_ridge);
   }
@@ -395,8 +417,9 @@ class StudyRun {
   // The rescue over standard parameters: the nearest base vector with a consistent set, in the
   // predicted-torque metric, towards the prior (its weight chosen by held-out error when several).
   void rescue_physical(const Dataset& data, const RunRecord& sel, StudyResult& out) const {
-    const Eigen::MatrixXd metric = o_.rescue_metric_all_runs ? pooled_torque_metric(data, sel.interval)
-                                                             : detail::torque_metric(refit(data, sel), o_.information_ridge);
+    const Eigen::MatrixXd metric = o_.rescue_metric_all_runs
+                                       ? pooled_torque_metric(data, sel.interval)
+                                       : detail::torque_metric(refit(data, sel), o_.information_ridge);
     auto rescue = [&](double weight) {
       return model_.physical_projection(sel.phi_clie, metric, o_.physical_rescue_clearance, o_.rescue_prior, weight);
     };
@@ -415,14 +438,17 @@ class StudyRun {
         }
         return count > 0 ? std::sqrt(sq / count) : 0.0;
       };
-      PriorWeightChoice choice = choose_prior_weight(o_.rescue_prior_weights, o_.rescue_prior_weight, rescue, heldout_rmse);
+      PriorWeightChoice choice =
+          choose_prior_weight(o_.rescue_prior_weights, o_.rescue_prior_weight, rescue, heldout_rmse);
       p = std::move(choice.projection);
       out.rescue_prior_weight = choice.weight;
       out.rescue_prior_scores = choice.scores;
       std::string scores;
-      for (const auto& [w, e] : out.rescue_prior_scores) scores += fmt::format("{}{:g}: {:.6g}", scores.empty() ? "" : ", ", w, e);
-      out.stages.push_back(fmt::format("rescue prior weight: {:g}, by held-out open-loop RMSE on {} other runs (N m; {})",
-                                       out.rescue_prior_weight, others.size(), scores));
+      for (const auto& [w, e] : out.rescue_prior_scores)
+        scores += fmt::format("{}{:g}: {:.6g}", scores.empty() ? "" : ", ", w, e);
+      out.stages.push_back(
+          fmt::format("rescue prior weight: {:g}, by held-out open-loop RMSE on {} other runs (N m; {})",
+                      out.rescue_prior_weight, others.size(), scores));
     }
     out.phi_rescue = p.phi;
     out.rescued = true;
@@ -433,12 +459,14 @@ class StudyRun {
 
   // Held out for the prior's weight: the other identification runs at the representative's
   // interval, preprocessed (a log that cannot be read is left out).
-  std::vector<preprocess::Samples> other_runs_at_interval(const Dataset& data, const RunRecord& sel, const StudyResult& out) const {
+  std::vector<preprocess::Samples> other_runs_at_interval(const Dataset& data, const RunRecord& sel,
+                                                          const StudyResult& out) const {
     std::vector<preprocess::Samples> others;
     for (const RunRecord& r : out.runs)
       if (&r != &sel && !r.failed && std::abs(r.interval - sel.interval) < 1e-12) {
         try {
-          others.push_back(preprocess::preprocess(load_log(data.find(r.trajectory, o_.trial)), r.interval, o_.preprocess));
+          others.push_back(
+              preprocess::preprocess(load_log(data.find(r.trajectory, o_.trial)), r.interval, o_.preprocess));
         } catch (const std::exception&) {
         }
       }
@@ -514,10 +542,10 @@ class StudyRun {
   identify::AuditDomain domain_;
 };
 
-
 }  // namespace
 
-Study::Study(std::shared_ptr<const identify::IdentificationModel> model, StudyOptions options, ClosedLoopSource closed_loop)
+Study::Study(std::shared_ptr<const identify::IdentificationModel> model, StudyOptions options,
+             ClosedLoopSource closed_loop)
     : model_(std::move(model)), o_(std::move(options)), loop_(std::move(closed_loop)) {
   if (!model_) throw std::invalid_argument("Study: no model");
 }
@@ -527,12 +555,13 @@ StudyResult Study::run() { return StudyRun(*model_, o_, loop_).run(); }
 void require_identified(const StudyResult& r) {
   const auto failed = std::count_if(r.runs.begin(), r.runs.end(), [](const RunRecord& run) { return run.failed; });
   if (r.runs.empty() || failed == static_cast<long>(r.runs.size()))
-    throw std::runtime_error(fmt::format("no run of the study succeeded ({} of {} failed{}): no model was identified",
-                                         failed, r.runs.size(),
-                                         r.runs.empty() ? "" : "; the first: " + r.runs.front().id() + ": " + r.runs.front().failure));
+    throw std::runtime_error(
+        fmt::format("no run of the study succeeded ({} of {} failed{}): no model was identified", failed, r.runs.size(),
+                    r.runs.empty() ? "" : "; the first: " + r.runs.front().id() + ": " + r.runs.front().failure));
   if (r.selection.run < 0)
-    throw std::runtime_error(fmt::format("no representative run: {}; no model was identified",
-                                         r.selection.rule.empty() ? "no run produced a final vector" : r.selection.rule));
+    throw std::runtime_error(
+        fmt::format("no representative run: {}; no model was identified",
+                    r.selection.rule.empty() ? "no run produced a final vector" : r.selection.rule));
 }
 
 }  // namespace symoro::study

@@ -31,8 +31,8 @@ ValidationRecord validate_trajectory(const identify::ClosedLoop* sim, const Open
     if (!sim || !simulated_samples(*sim, measured, phi, options, tau, &why)) {
       if (sim) {
         v.kind = "open-loop";
-        v.note += fmt::format("{}the closed loop of the {} vector {}; open-loop values", v.note.empty() ? "" : "; ", which,
-                              why.describe());
+        v.note += fmt::format("{}the closed loop of the {} vector {}; open-loop values", v.note.empty() ? "" : "; ",
+                              which, why.describe());
       }
       tau = open_loop(measured, phi);
     }
@@ -44,11 +44,11 @@ ValidationRecord validate_trajectory(const identify::ClosedLoop* sim, const Open
   run("final", phi_clie, v.tau_clie, v.rmse_clie, v.mne_clie, v.rmse_joint_clie);
   run("accepted", phi_rescue, v.tau_rescue, v.rmse_rescue, v.mne_rescue, v.rmse_joint_rescue);
   if (v.rmse_joint_rescue.size() == n) {
-    const Eigen::VectorXd rms = (measured.tau.colwise().squaredNorm() / std::max<double>(1, measured.tau.rows())).cwiseSqrt().transpose();
+    const Eigen::VectorXd rms =
+        (measured.tau.colwise().squaredNorm() / std::max<double>(1, measured.tau.rows())).cwiseSqrt().transpose();
     v.nrmse_joint_rescue = v.rmse_joint_rescue.cwiseQuotient(rms.cwiseMax(1e-300));
   }
   return v;
 }
-
 
 }  // namespace symoro::study

@@ -72,8 +72,9 @@ void read_series(const std::filesystem::path& file, int joints, ValidationRecord
       start = comma + 1;
     }
     if (row.size() != columns)
-      throw DataError(file.string(), number, fmt::format("{} columns, expected {} (time and {} x {} joints)", row.size(),
-                                                         columns, kPerJoint, joints));
+      throw DataError(
+          file.string(), number,
+          fmt::format("{} columns, expected {} (time and {} x {} joints)", row.size(), columns, kPerJoint, joints));
     rows.push_back(std::move(row));
   }
   const Eigen::Index r = static_cast<Eigen::Index>(rows.size());
@@ -108,7 +109,8 @@ T as(const YAML::Node& n, const char* key, const std::string& file) {
 Eigen::VectorXd vec(const YAML::Node& map, const char* key, const std::string& file, bool optional = false) {
   const YAML::Node n = map[key];
   if (!n && optional) return {};
-  if (!n || !n.IsSequence()) throw DataError(file, line_of(n ? n : map), fmt::format("'{}' must be a list of numbers", key));
+  if (!n || !n.IsSequence())
+    throw DataError(file, line_of(n ? n : map), fmt::format("'{}' must be a list of numbers", key));
   Eigen::VectorXd v(static_cast<Eigen::Index>(n.size()));
   for (std::size_t i = 0; i < n.size(); ++i) {
     try {
@@ -181,8 +183,9 @@ StudyValidation read_validation(const std::filesystem::path& study_dir) {
   const auto path = study_dir / "validation.yaml";
   const std::string file = path.string();
   if (!std::filesystem::exists(path))
-    throw DataError(file, 0, "not found: is this an identification study folder (dynid identify -o) with held-out "
-                             "validation trajectories?");
+    throw DataError(file, 0,
+                    "not found: is this an identification study folder (dynid identify -o) with held-out "
+                    "validation trajectories?");
   YAML::Node root;
   try {
     root = io::load_yaml_file(file);  // anchors, aliases and a second document refused
@@ -215,7 +218,8 @@ StudyValidation read_validation(const std::filesystem::path& study_dir) {
     v.kind = t["kind"] ? as<std::string>(t, "kind", file) : "closed-loop";  // studies before open-loop validation
     v.note = t["note"] ? as<std::string>(t, "note", file) : "";
     if (v.kind != "closed-loop" && v.kind != "open-loop")
-      throw DataError(file, line_of(t["kind"]), fmt::format("'kind' must be closed-loop or open-loop, not '{}'", v.kind));
+      throw DataError(file, line_of(t["kind"]),
+                      fmt::format("'kind' must be closed-loop or open-loop, not '{}'", v.kind));
     const int joints = as<int>(t, "joints", file);
     if (joints < 1) throw DataError(file, line_of(t["joints"]), "'joints' must be positive");
     v.rmse_clie = as<double>(t, "rmse_clie", file);

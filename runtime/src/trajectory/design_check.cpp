@@ -38,9 +38,9 @@ void check_limits(const Design& design, const TrajectorySpec& spec, const Trajec
       const JointInfo& joint = design.joints[j];
       const double low = joint.lower + design.position_margin, high = joint.upper - design.position_margin;
       if (q[j] < low || q[j] > high)
-        fail(j, time, "reaches " + text(q[j] / kDeg) + " deg, outside [" + text(low / kDeg) + ", " +
-                          text(high / kDeg) + "] deg (its limits less the " + text(design.position_margin / kDeg) +
-                          " deg margin)");
+        fail(j, time,
+             "reaches " + text(q[j] / kDeg) + " deg, outside [" + text(low / kDeg) + ", " + text(high / kDeg) +
+                 "] deg (its limits less the " + text(design.position_margin / kDeg) + " deg margin)");
     }
   };
   if (trajectory.segments.empty()) throw DataError(file, spec.line, "trajectory " + spec.name + " is empty");
@@ -56,7 +56,8 @@ void check_limits(const Design& design, const TrajectorySpec& spec, const Trajec
         for (std::size_t j = 0; j < design.joints.size(); ++j)
           if (std::abs(qd[j]) > design.joints[j].velocity)
             fail(j, s.start + k * 1e-3,
-                 "moves at " + text(std::abs(qd[j])) + " rad/s, over its velocity limit " + text(design.joints[j].velocity) + " rad/s");
+                 "moves at " + text(std::abs(qd[j])) + " rad/s, over its velocity limit " +
+                     text(design.joints[j].velocity) + " rad/s");
       }
       continue;
     }
@@ -66,7 +67,8 @@ void check_limits(const Design& design, const TrajectorySpec& spec, const Trajec
       const double speed = std::abs(s.to[j] - s.from[j]) * peak;
       if (speed > design.joints[j].velocity)
         fail(j, s.start + s.profile.ramp,
-             "moves at " + text(speed) + " rad/s, over its velocity limit " + text(design.joints[j].velocity) + " rad/s");
+             "moves at " + text(speed) + " rad/s, over its velocity limit " + text(design.joints[j].velocity) +
+                 " rad/s");
     }
   }
 }

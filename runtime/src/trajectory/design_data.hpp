@@ -26,14 +26,14 @@ struct PrimitiveSpec {
 struct ItemSpec {
   enum class Kind { Primitives, Waypoints, Fourier };
   Kind kind = Kind::Primitives;
-  std::vector<PrimitiveSpec> primitives;   // Kind::Primitives, in order
-  std::vector<Eigen::VectorXd> waypoints;  // Kind::Waypoints, rad
+  std::vector<PrimitiveSpec> primitives;             // Kind::Primitives, in order
+  std::vector<Eigen::VectorXd> waypoints;            // Kind::Waypoints, rad
   std::shared_ptr<const FourierTrajectory> fourier;  // Kind::Fourier: w, a, b (q0 from where it starts)
-  int periods = 1;                         // Kind::Fourier
-  std::string posture;                     // e.g. "A" or "C'"
-  int speed = 1;                           // level, 1-based
-  std::string speed_class;                 // empty: the slowest class of the moving joints
-  std::string summary;                     // for the trajectory's description
+  int periods = 1;                                   // Kind::Fourier
+  std::string posture;                               // e.g. "A" or "C'"
+  int speed = 1;                                     // level, 1-based
+  std::string speed_class;                           // empty: the slowest class of the moving joints
+  std::string summary;                               // for the trajectory's description
   int line = 0;
 };
 
@@ -55,17 +55,17 @@ struct Design {
   std::vector<JointInfo> joints;
   std::vector<std::string> joint_names;  // owned copies of joints[j].name
 
-  double position_margin = 0;            // rad
-  Eigen::VectorXd velocity, acceleration;  // at speed factor 1
+  double position_margin = 0;                                // rad
+  Eigen::VectorXd velocity, acceleration;                    // at speed factor 1
   std::map<std::string, std::vector<double>> speed_factors;  // class -> factor per level
-  std::vector<std::string> joint_class;  // per joint
+  std::vector<std::string> joint_class;                      // per joint
 
   double start_hold = 0, end_hold = 0, waypoint_dwell = 0, primitive_dwell = 0;
 
-  std::map<std::string, Eigen::VectorXd> postures;  // the file's postures and their wrist variants
-  std::map<std::string, std::string> base_posture;  // "A'" -> "A", "A" -> "A"
+  std::map<std::string, Eigen::VectorXd> postures;                  // the file's postures and their wrist variants
+  std::map<std::string, std::string> base_posture;                  // "A'" -> "A", "A" -> "A"
   std::map<std::string, PrimitiveParameters> primitive_parameters;  // by base posture
-  std::vector<TrajectorySpec> trajectories;        // in file order
+  std::vector<TrajectorySpec> trajectories;                         // in file order
 
   int levels() const;  // speed levels per class
 };

@@ -16,7 +16,9 @@
 
 namespace symoro::trajectory {
 
-int Design::levels() const { return speed_factors.empty() ? 0 : static_cast<int>(speed_factors.begin()->second.size()); }
+int Design::levels() const {
+  return speed_factors.empty() ? 0 : static_cast<int>(speed_factors.begin()->second.size());
+}
 
 namespace {
 
@@ -91,8 +93,8 @@ class Reader {
   int integer(const YAML::Node& node, const std::string& what, int lowest, int highest) const {
     const double value = number(node, what);
     if (value != std::floor(value) || value < lowest || value > highest)
-      fail(node, what + " must be an integer in " + std::to_string(lowest) + ".." + std::to_string(highest) +
-                     ", not " + scalar(node, what));
+      fail(node, what + " must be an integer in " + std::to_string(lowest) + ".." + std::to_string(highest) + ", not " +
+                     scalar(node, what));
     return static_cast<int>(value);
   }
 
@@ -156,12 +158,14 @@ class DesignReader {
     for (int j = 0; j < n_; ++j) {
       const std::string name = r_.scalar(node[j], "joint name");
       if (name != d_.joint_names[j])
-        r_.fail(node[j], "joint " + std::to_string(j + 1) + " is '" + d_.joint_names[j] + "' in the robot, not '" + name + "'");
+        r_.fail(node[j],
+                "joint " + std::to_string(j + 1) + " is '" + d_.joint_names[j] + "' in the robot, not '" + name + "'");
     }
   }
 
   void limits(const YAML::Node& node) {
-    r_.keys(node, "limits", {"position_margin", "velocity", "acceleration"}, {"position_margin", "velocity", "acceleration"});
+    r_.keys(node, "limits", {"position_margin", "velocity", "acceleration"},
+            {"position_margin", "velocity", "acceleration"});
     d_.position_margin = r_.at_least(node["position_margin"], "limits.position_margin", 0) * kDeg;
     d_.velocity = r_.per_joint(node["velocity"], "limits.velocity");
     d_.acceleration = r_.per_joint(node["acceleration"], "limits.acceleration");
@@ -177,8 +181,8 @@ class DesignReader {
       r_.sequence(list, "speed_factors." + name);
       if (levels == 0) levels = list.size();
       if (list.size() != levels)
-        r_.fail(list, "speed_factors." + name + " has " + std::to_string(list.size()) + " levels; the first class has " +
-                          std::to_string(levels));
+        r_.fail(list, "speed_factors." + name + " has " + std::to_string(list.size()) +
+                          " levels; the first class has " + std::to_string(levels));
       std::vector<double> factors;
       for (const auto& f : list) {
         const double factor = r_.positive(f, "a speed factor");
@@ -338,9 +342,11 @@ class DesignReader {
   }
 
   ItemSpec item(const YAML::Node& node, const TrajectorySpec& t) const {
-    r_.keys(node, "an item of " + t.name, {"pattern", "single", "pair", "signs", "waypoints", "fourier", "posture", "speed", "class"}, {});
+    r_.keys(node, "an item of " + t.name,
+            {"pattern", "single", "pair", "signs", "waypoints", "fourier", "posture", "speed", "class"}, {});
     const int kinds = !!node["pattern"] + !!node["single"] + !!node["pair"] + !!node["waypoints"] + !!node["fourier"];
-    if (kinds != 1) r_.fail(node, "an item of " + t.name + " needs exactly one of pattern, single, pair, waypoints and fourier");
+    if (kinds != 1)
+      r_.fail(node, "an item of " + t.name + " needs exactly one of pattern, single, pair, waypoints and fourier");
     ItemSpec item;
     item.line = static_cast<int>(node.Mark().line) + 1;
     item.posture = node["posture"] ? posture_name(node["posture"]) : t.posture;
@@ -348,7 +354,9 @@ class DesignReader {
     if (node["class"]) item.speed_class = speed_class(node["class"]);
     if (node["fourier"]) {
       for (const char* key : {"signs", "posture", "speed", "class"})
-        if (node[key]) r_.fail(node[key], std::string("a fourier item starts where the arm is and keeps its own timing: it takes no ") + key);
+        if (node[key])
+          r_.fail(node[key],
+                  std::string("a fourier item starts where the arm is and keeps its own timing: it takes no ") + key);
       item.kind = ItemSpec::Kind::Fourier;
       fourier(node["fourier"], t.name, item);
     } else if (node["waypoints"]) {
@@ -388,18 +396,22 @@ class DesignReader {
     series->w = 2 * 3.14159265358979323846 / r_.positive(node["period"], "fourier.period");
     item.periods = node["periods"] ? r_.integer(node["periods"], "fourier.periods", 1, 1000) : 1;
     auto matrix = [&](const YAML::Node& m, const char* key, Eigen::MatrixXd& out) {
-      r_.sequence(m, std::string("fourier.") + key + " (one list of harmonics per joint)", static_cast<std::size_t>(n_));
+      r_.sequence(m, std::string("fourier.") + key + " (one list of harmonics per joint)",
+                  static_cast<std::size_t>(n_));
       const std::size_t L = r_.sequence(m[0], std::string("fourier.") + key + " of joint 1").size();
       if (L < 2) r_.fail(m[0], "fourier needs at least 2 harmonics");
       out.resize(n_, static_cast<Eigen::Index>(L));
       for (int j = 0; j < n_; ++j) {
-        const YAML::Node row = r_.sequence(m[j], std::string("fourier.") + key + " of joint " + std::to_string(j + 1), L);
-        for (std::size_t l = 0; l < L; ++l) out(j, static_cast<Eigen::Index>(l)) = r_.number(row[l], std::string("fourier.") + key);
+        const YAML::Node row =
+            r_.sequence(m[j], std::string("fourier.") + key + " of joint " + std::to_string(j + 1), L);
+        for (std::size_t l = 0; l < L; ++l)
+          out(j, static_cast<Eigen::Index>(l)) = r_.number(row[l], std::string("fourier.") + key);
       }
     };
     matrix(node["a"], "a", series->a);
     matrix(node["b"], "b", series->b);
-    if (series->a.cols() != series->b.cols()) r_.fail(node["b"], "fourier.a and fourier.b need the same number of harmonics");
+    if (series->a.cols() != series->b.cols())
+      r_.fail(node["b"], "fourier.a and fourier.b need the same number of harmonics");
     for (int j = 0; j < n_; ++j) {
       double sa = 0, sb = 0, scale = 1e-300;
       for (Eigen::Index l = 0; l < series->a.cols(); ++l) {
@@ -409,27 +421,33 @@ class DesignReader {
       }
       if (std::abs(sa) > 1e-9 * scale || std::abs(sb) > 1e-9 * scale)
         r_.fail(node, "fourier of " + name + ": joint " + std::to_string(j + 1) + " (" + d_.joint_names[j] +
-                          ") is not at rest at t = 0 (sum a = " + Reader::format(sa) + ", sum l b = " + Reader::format(sb) + ", both must be 0)");
+                          ") is not at rest at t = 0 (sum a = " + Reader::format(sa) +
+                          ", sum l b = " + Reader::format(sb) + ", both must be 0)");
     }
     item.fourier = std::move(series);
-    item.summary = "fourier " + std::to_string(item.fourier->harmonics()) + " harmonics, " + Reader::format(item.fourier->period()) +
-                   " s x " + std::to_string(item.periods);
+    item.summary = "fourier " + std::to_string(item.fourier->harmonics()) + " harmonics, " +
+                   Reader::format(item.fourier->period()) + " s x " + std::to_string(item.periods);
   }
 
   void trajectories(const YAML::Node& node) {
     std::set<std::string> names;
     for (const auto& entry : r_.sequence(node, "trajectories")) {
-      r_.keys(entry, "a trajectory", {"name", "description", "posture", "speed", "sequence"}, {"name", "posture", "speed", "sequence"});
+      r_.keys(entry, "a trajectory", {"name", "description", "posture", "speed", "sequence"},
+              {"name", "posture", "speed", "sequence"});
       TrajectorySpec t;
       t.line = static_cast<int>(entry.Mark().line) + 1;
       t.name = r_.scalar(entry["name"], "a trajectory name");
       // The family is the name's letters (PA01 -> PA, V03 -> V).
-      const auto digits = std::find_if(t.name.begin(), t.name.end(), [](char c) { return std::isdigit(static_cast<unsigned char>(c)); });
+      const auto digits = std::find_if(t.name.begin(), t.name.end(),
+                                       [](char c) { return std::isdigit(static_cast<unsigned char>(c)); });
       t.family.assign(t.name.begin(), digits);
-      const bool letters = std::all_of(t.name.begin(), digits, [](char c) { return std::isupper(static_cast<unsigned char>(c)); });
-      const bool numbers = std::all_of(digits, t.name.end(), [](char c) { return std::isdigit(static_cast<unsigned char>(c)); });
+      const bool letters =
+          std::all_of(t.name.begin(), digits, [](char c) { return std::isupper(static_cast<unsigned char>(c)); });
+      const bool numbers =
+          std::all_of(digits, t.name.end(), [](char c) { return std::isdigit(static_cast<unsigned char>(c)); });
       if (t.family.empty() || digits == t.name.end() || !letters || !numbers)
-        r_.fail(entry["name"], "a trajectory name is its family's capital letters and a number (e.g. PA01), not '" + t.name + "'");
+        r_.fail(entry["name"],
+                "a trajectory name is its family's capital letters and a number (e.g. PA01), not '" + t.name + "'");
       if (!names.insert(t.name).second) r_.fail(entry["name"], "duplicate trajectory name '" + t.name + "'");
       t.posture = posture_name(entry["posture"]);
       t.speed = r_.integer(entry["speed"], "speed (a level)", 1, d_.levels());
@@ -462,9 +480,11 @@ Design read_design(const std::filesystem::path& yaml, const std::vector<JointInf
     d.joint_names.emplace_back(joint.name);
     // Angles in the file are in degrees; a prismatic joint has no unit in this format.
     if (joint.type != JointType::Revolute)
-      throw DataError(file, 0, "joint " + d.joint_names.back() + " is prismatic; trajectory designs cover revolute joints");
+      throw DataError(file, 0,
+                      "joint " + d.joint_names.back() + " is prismatic; trajectory designs cover revolute joints");
   }
-  if (!std::filesystem::is_regular_file(yaml)) throw DataError(file, 0, "cannot read the trajectory design: no such file");
+  if (!std::filesystem::is_regular_file(yaml))
+    throw DataError(file, 0, "cannot read the trajectory design: no such file");
   const YAML::Node root = io::load_yaml_file(yaml);
   const Reader reader(file, static_cast<int>(joints.size()));
   DesignReader(d, reader).read(root);

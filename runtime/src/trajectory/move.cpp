@@ -8,8 +8,8 @@
 
 namespace symoro::trajectory {
 
-Segment plan_move(double start, const Eigen::VectorXd& from, const Eigen::VectorXd& to,
-                  const Eigen::VectorXd& velocity, const Eigen::VectorXd& acceleration) {
+Segment plan_move(double start, const Eigen::VectorXd& from, const Eigen::VectorXd& to, const Eigen::VectorXd& velocity,
+                  const Eigen::VectorXd& acceleration) {
   const Eigen::Index n = from.size();
   if (to.size() != n || velocity.size() != n || acceleration.size() != n)
     throw std::invalid_argument("plan_move: waypoints and limits differ in size");

@@ -18,8 +18,7 @@ namespace {
 constexpr double kPi = 3.14159265358979323846;
 
 // The first ramp at time u from its start.
-void first_ramp(double u, double ramp, double peak_acceleration, double& s, double& sd,
-                double& sdd) {
+void first_ramp(double u, double ramp, double peak_acceleration, double& s, double& sd, double& sdd) {
   const double phase = kPi * u / ramp;
   const double sine = std::sin(phase);
   s = peak_acceleration * (0.25 * u * u - ramp * ramp / (4 * kPi * kPi) * sine * sine);
@@ -29,8 +28,7 @@ void first_ramp(double u, double ramp, double peak_acceleration, double& s, doub
 }  // namespace
 
 Profile Profile::plan(double velocity, double acceleration) {
-  if (!(velocity > 0) || !(acceleration > 0) || !std::isfinite(velocity) ||
-      !std::isfinite(acceleration))
+  if (!(velocity > 0) || !(acceleration > 0) || !std::isfinite(velocity) || !std::isfinite(acceleration))
     throw std::invalid_argument("Profile::plan: velocity and acceleration limits must be positive");
   Profile p;
   // Two full ramps at the velocity limit cover V * r = 2 V^2 / A.

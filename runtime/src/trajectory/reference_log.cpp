@@ -13,8 +13,8 @@ io::Log reference_log(const Trajectory& t, double period, const std::string& rob
     throw std::invalid_argument("reference_log: the period must be positive");
   if (static_cast<int>(joint_names.size()) != t.joints())
     throw std::invalid_argument("reference_log: " + std::to_string(joint_names.size()) +
-                                " joint names for trajectory " + t.name + " with " +
-                                std::to_string(t.joints()) + " joints");
+                                " joint names for trajectory " + t.name + " with " + std::to_string(t.joints()) +
+                                " joints");
   const double duration = t.duration();
   if (!(duration > 0)) throw std::invalid_argument("reference_log: trajectory " + t.name + " is empty");
   // k * period for k < steps, and the end itself last (the final interval absorbs the rest).

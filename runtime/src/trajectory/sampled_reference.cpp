@@ -35,7 +35,8 @@ SampledReference sampled_reference(const io::Log& log, double period) {
   const std::string source = log.meta.trajectory.empty() ? "log" : log.meta.trajectory;
   if (!(period > 0)) throw std::invalid_argument("sampled reference: the period must be positive");
   if (!log.has_references())
-    throw DataError(source, 0, "the log has no reference columns (q_ref, qd_ref, qdd_ref): the closed loop cannot be simulated");
+    throw DataError(source, 0,
+                    "the log has no reference columns (q_ref, qd_ref, qdd_ref): the closed loop cannot be simulated");
   const Eigen::Index rows = log.samples();
   if (rows < 2) throw DataError(source, 0, "a reference needs at least 2 rows");
   std::vector<double> steps(static_cast<std::size_t>(rows - 1));
@@ -43,8 +44,10 @@ SampledReference sampled_reference(const io::Log& log, double period) {
   std::nth_element(steps.begin(), steps.begin() + steps.size() / 2, steps.end());
   const double median = steps[steps.size() / 2];
   if (!(std::abs(median - period) <= 0.1 * period))
-    throw DataError(source, 0, fmt::format("rows are {:.6g} s apart (median), the controller's period is {:.6g} s: the "
-                                           "log's references are not the controller's cycles", median, period));
+    throw DataError(source, 0,
+                    fmt::format("rows are {:.6g} s apart (median), the controller's period is {:.6g} s: the "
+                                "log's references are not the controller's cycles",
+                                median, period));
   // A controller steps through its references by cycle: each row belongs to its nearest cycle
   // (stamp jitter moves the stamp, not the reference); cycles without a row (a dropped read)
   // are interpolated linearly between their neighbours.

@@ -46,8 +46,10 @@ void structured_box(const StructuredDesignOptions& options, Eigen::VectorXd& low
   upper.resize(n);
   for (int j = 0; j < n; ++j) {
     const JointInfo& J = options.joints[static_cast<std::size_t>(j)];
-    double lo = std::max(J.lower + options.position_margin, J.audit_lower), hi = std::min(J.upper - options.position_margin, J.audit_upper);
-    if (!(hi > lo)) lo = J.lower + options.position_margin, hi = J.upper - options.position_margin;  // an audit box beside the range
+    double lo = std::max(J.lower + options.position_margin, J.audit_lower),
+           hi = std::min(J.upper - options.position_margin, J.audit_upper);
+    if (!(hi > lo))
+      lo = J.lower + options.position_margin, hi = J.upper - options.position_margin;  // an audit box beside the range
     const double mid = (lo + hi) / 2;
     lower(j) = std::max(lo, mid - kMaxHalfBox);
     upper(j) = std::min(hi, mid + kMaxHalfBox);
@@ -58,8 +60,8 @@ namespace {
 
 // The postures given, or three about the box's middle: A at it, B and C a quarter of the box up
 // and down on joints 2 and 3.
-std::map<std::string, Eigen::VectorXd> design_postures(const StructuredDesignOptions& options, const Eigen::VectorXd& mid,
-                                                       const Eigen::VectorXd& width) {
+std::map<std::string, Eigen::VectorXd> design_postures(const StructuredDesignOptions& options,
+                                                       const Eigen::VectorXd& mid, const Eigen::VectorXd& width) {
   const int n = static_cast<int>(mid.size());
   std::map<std::string, Eigen::VectorXd> postures = options.postures;
   if (postures.empty()) {
@@ -77,8 +79,9 @@ std::map<std::string, Eigen::VectorXd> design_postures(const StructuredDesignOpt
 
 // The primitives' amplitude and center offset per posture: given, or the largest swing inside
 // the box (about the box's middle for a posture at its edge).
-std::string primitives_yaml(const StructuredDesignOptions& options, const std::map<std::string, Eigen::VectorXd>& postures,
-                            const Eigen::VectorXd& lo, const Eigen::VectorXd& hi) {
+std::string primitives_yaml(const StructuredDesignOptions& options,
+                            const std::map<std::string, Eigen::VectorXd>& postures, const Eigen::VectorXd& lo,
+                            const Eigen::VectorXd& hi) {
   const int n = static_cast<int>(lo.size());
   const Eigen::VectorXd width = hi - lo, mid = (lo + hi) / 2;
   std::string y;
@@ -97,7 +100,8 @@ std::string primitives_yaml(const StructuredDesignOptions& options, const std::m
           r.center(j) = mid(j) - q(j), r.amplitude(j) = std::min(width(j) / 3, kMaxAmplitude);
       }
     }
-    y += fmt::format("  {}:\n    amplitude: {}\n    center:    {}\n", name, list(r.amplitude, kDeg), list(r.center, kDeg));
+    y += fmt::format("  {}:\n    amplitude: {}\n    center:    {}\n", name, list(r.amplitude, kDeg),
+                     list(r.center, kDeg));
   }
 
   return y;
@@ -111,8 +115,10 @@ std::string patterns_yaml(int n, bool& has_pairs) {
   std::vector<std::string> singles_list, in_phase, opposite, pairs_in, pairs_opp;
   for (int j = 1; j <= n; ++j) singles_list.push_back(std::to_string(j));
   for (int j = 1; j <= n; j += 3) {
-    if (j + 1 <= n) in_phase.push_back(pair(j, false));
-    else in_phase.push_back(single(j));
+    if (j + 1 <= n)
+      in_phase.push_back(pair(j, false));
+    else
+      in_phase.push_back(single(j));
     if (j + 2 <= n) in_phase.push_back(single(j + 2));
   }
   opposite.push_back(single(1));
@@ -134,8 +140,9 @@ std::string patterns_yaml(int n, bool& has_pairs) {
 
 // The trajectories: each posture x single pattern x speed level, the adjacent pairs, and the
 // held-out validation waypoints (six each, inside the middle 70 % of the box).
-std::string trajectories_yaml(const StructuredDesignOptions& options, const std::map<std::string, Eigen::VectorXd>& postures,
-                              bool has_pairs, const Eigen::VectorXd& mid, const Eigen::VectorXd& width) {
+std::string trajectories_yaml(const StructuredDesignOptions& options,
+                              const std::map<std::string, Eigen::VectorXd>& postures, bool has_pairs,
+                              const Eigen::VectorXd& mid, const Eigen::VectorXd& width) {
   const int n = static_cast<int>(mid.size());
   std::string y;
   y += "\ntrajectories:\n";
@@ -143,17 +150,19 @@ std::string trajectories_yaml(const StructuredDesignOptions& options, const std:
   for (const auto& [name, q] : postures) {
     for (int p = 0; p < 3; ++p)
       for (int level = 1; level <= 3; ++level)
-        y += fmt::format("  - {{name: P{}{:02d}, posture: {}, speed: {}, sequence: [{{pattern: {}}}]}}\n", name, 3 * p + level, name,
-                         level, patterns[p]);
+        y += fmt::format("  - {{name: P{}{:02d}, posture: {}, speed: {}, sequence: [{{pattern: {}}}]}}\n", name,
+                         3 * p + level, name, level, patterns[p]);
     y += "\n";
   }
   if (has_pairs) {
     int k = 0;
     for (const auto& [name, q] : postures)
-      y += fmt::format("  - {{name: AP{:02d}, posture: {}, speed: 3, sequence: [{{pattern: adjacent_pairs}}]}}\n", ++k, name);
+      y += fmt::format("  - {{name: AP{:02d}, posture: {}, speed: 3, sequence: [{{pattern: adjacent_pairs}}]}}\n", ++k,
+                       name);
     const std::string last = postures.rbegin()->first;
     for (int level = 1; level <= 2; ++level)
-      y += fmt::format("  - {{name: AP{:02d}, posture: {}, speed: {}, sequence: [{{pattern: adjacent_pairs}}]}}\n", ++k, last, level);
+      y += fmt::format("  - {{name: AP{:02d}, posture: {}, speed: {}, sequence: [{{pattern: adjacent_pairs}}]}}\n", ++k,
+                       last, level);
     y += "\n";
   }
   // Held-out validation: six multi-axis waypoints each, drawn inside the middle 70 % of the box.
@@ -178,21 +187,25 @@ std::string structured_design_yaml(const StructuredDesignOptions& options) {
   const int n = static_cast<int>(options.joints.size());
   for (const JointInfo& j : options.joints)
     if (j.type != JointType::Revolute)
-      throw std::invalid_argument(std::string("structured design: joint ") + j.name + " is prismatic; the design format covers revolute joints");
+      throw std::invalid_argument(std::string("structured design: joint ") + j.name +
+                                  " is prismatic; the design format covers revolute joints");
   auto sized = [n](const Eigen::VectorXd& v) { return v.size() == 0 || v.size() == n; };
-  if (!sized(options.velocity) || !sized(options.acceleration) || (!options.joint_class.empty() && static_cast<int>(options.joint_class.size()) != n))
+  if (!sized(options.velocity) || !sized(options.acceleration) ||
+      (!options.joint_class.empty() && static_cast<int>(options.joint_class.size()) != n))
     throw std::invalid_argument(fmt::format("structured design: limits and classes need {} joints", n));
   Eigen::VectorXd lo, hi;
   structured_box(options, lo, hi);
   for (int j = 0; j < n; ++j)
     if (!(hi(j) > lo(j)))
-      throw std::invalid_argument(fmt::format("structured design: joint {} ({}) has no room inside its limits less the margin", j + 1,
-                                              options.joints[static_cast<std::size_t>(j)].name));
+      throw std::invalid_argument(
+          fmt::format("structured design: joint {} ({}) has no room inside its limits less the margin", j + 1,
+                      options.joints[static_cast<std::size_t>(j)].name));
   const Eigen::VectorXd width = hi - lo, mid = (lo + hi) / 2;
 
   const std::map<std::string, Eigen::VectorXd> postures = design_postures(options, mid, width);
   for (const auto& [name, q] : postures)
-    if (q.size() != n) throw std::invalid_argument(fmt::format("structured design: posture {} needs {} joints", name, n));
+    if (q.size() != n)
+      throw std::invalid_argument(fmt::format("structured design: posture {} needs {} joints", name, n));
   Eigen::VectorXd velocity = options.velocity, acceleration = options.acceleration;
   if (velocity.size() == 0) {
     velocity.resize(n);
@@ -204,7 +217,8 @@ std::string structured_design_yaml(const StructuredDesignOptions& options) {
     for (int j = 0; j < n; ++j) classes.push_back(j < 2 ? "proximal" : "normal");
 
   std::string y;
-  y += fmt::format("# {} identification and validation trajectories: the paper's structured families (single-joint\n", options.robot);
+  y += fmt::format("# {} identification and validation trajectories: the paper's structured families (single-joint\n",
+                   options.robot);
   y += "# and adjacent-pair primitives on a posture x pattern x speed grid), written by `dynid excite`\n";
   y += "# (symoro/trajectory/structured_design.hpp). Units: deg, rad/s and rad/s^2 at speed factor 1, s.\n";
   y += "# Review the postures and amplitudes: they are derived from the joint limits, not from the arm's\n";
@@ -223,8 +237,9 @@ std::string structured_design_yaml(const StructuredDesignOptions& options) {
   y += "joint_class: [";
   for (int j = 0; j < n; ++j) y += (j ? ", " : "") + classes[static_cast<std::size_t>(j)];
   y += "]\n\n";
-  y += fmt::format("timing:\n  start_hold: {:.6g}\n  end_hold: {:.6g}\n  waypoint_dwell: {:.6g}\n  primitive_dwell: {:.6g}\n\n",
-                   options.start_hold, options.end_hold, options.waypoint_dwell, options.primitive_dwell);
+  y += fmt::format(
+      "timing:\n  start_hold: {:.6g}\n  end_hold: {:.6g}\n  waypoint_dwell: {:.6g}\n  primitive_dwell: {:.6g}\n\n",
+      options.start_hold, options.end_hold, options.waypoint_dwell, options.primitive_dwell);
   y += "postures:\n";
   for (const auto& [name, q] : postures) y += fmt::format("  {}: {}\n", name, list(q, kDeg));
   y += primitives_yaml(options, postures, lo, hi);

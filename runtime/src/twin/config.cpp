@@ -72,7 +72,8 @@ class Reader {
     Eigen::VectorXd v = per_joint(node, what);
     for (int i = 0; i < n_; ++i)
       if (v(i) < 0 || (!allow_zero && v(i) == 0))
-        fail(node[i], what + " of joint " + std::to_string(i + 1) + " must be " + (allow_zero ? "non-negative" : "positive"));
+        fail(node[i],
+             what + " of joint " + std::to_string(i + 1) + " must be " + (allow_zero ? "non-negative" : "positive"));
     return v;
   }
 
@@ -121,8 +122,8 @@ class Reader {
   static Eigen::Matrix3d rotation_rpy(const Eigen::Vector3d& rpy) {
     // URDF: fixed-axis roll about x, then pitch about y, then yaw about z.
     return (Eigen::AngleAxisd(rpy.z(), Eigen::Vector3d::UnitZ()) *
-            Eigen::AngleAxisd(rpy.y(), Eigen::Vector3d::UnitY()) *
-            Eigen::AngleAxisd(rpy.x(), Eigen::Vector3d::UnitX())).toRotationMatrix();
+            Eigen::AngleAxisd(rpy.y(), Eigen::Vector3d::UnitY()) * Eigen::AngleAxisd(rpy.x(), Eigen::Vector3d::UnitX()))
+        .toRotationMatrix();
   }
 
   void urdf(const YAML::Node& node, UrdfChain& chain) const {
@@ -148,7 +149,8 @@ class Reader {
           u.model_joint = static_cast<int>(jn);
           if (u.model_joint != jn || u.model_joint < 1 || u.model_joint > n_)
             fail(j["joint"], "joint of " + u.name + " must be a model joint 1.." + std::to_string(n_));
-          if (!seen.insert(u.model_joint).second) fail(j["joint"], "model joint " + std::to_string(u.model_joint) + " appears twice");
+          if (!seen.insert(u.model_joint).second)
+            fail(j["joint"], "model joint " + std::to_string(u.model_joint) + " appears twice");
           u.axis = vector(need(j, "axis", "urdf joint " + u.name), "axis of " + u.name, 3);
           if (u.axis.norm() < 1e-9) fail(j["axis"], "axis of " + u.name + " is zero");
           u.axis.normalize();
@@ -176,7 +178,9 @@ class Reader {
         Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(u.inertia);
         const Eigen::Vector3d l = eig.eigenvalues();
         if (l(0) < 0 || l(0) + l(1) < l(2) * (1 - 1e-9))
-          fail(b["inertia"], "inertia of " + u.name + " is not physical (principal moments must be non-negative and satisfy the triangle inequality)");
+          fail(b["inertia"],
+               "inertia of " + u.name +
+                   " is not physical (principal moments must be non-negative and satisfy the triangle inequality)");
         chain.inertials.push_back(u);
       }
     });
@@ -191,22 +195,31 @@ class Reader {
     s.current_limit = positive(need(node, "current_limit", "servo " + s.model), "current_limit");
     const double counts = positive(need(node, "encoder_counts", "servo " + s.model), "encoder_counts");
     s.encoder_counts = static_cast<int>(counts);
-    if (s.encoder_counts != counts || s.encoder_counts < 2) fail(node["encoder_counts"], "encoder_counts must be an integer >= 2");
+    if (s.encoder_counts != counts || s.encoder_counts < 2)
+      fail(node["encoder_counts"], "encoder_counts must be an integer >= 2");
     return s;
   }
 
   void controller(const YAML::Node& node, ControllerConfig& c) const {
-    check_keys(node, "controller", {"period", "pseudo_derivative_time", "communication_delay", "realization", "bandwidth", "damping_ratio"});
+    check_keys(
+        node, "controller",
+        {"period", "pseudo_derivative_time", "communication_delay", "realization", "bandwidth", "damping_ratio"});
     field(node, "period", "controller", [&](const YAML::Node& v) { c.period = positive(v, "period"); });
-    field(node, "pseudo_derivative_time", "controller", [&](const YAML::Node& v) { c.pseudo_derivative_time = positive(v, "pseudo_derivative_time"); });
-    field(node, "communication_delay", "controller", [&](const YAML::Node& v) { c.communication_delay = positive(v, "communication_delay", true); });
+    field(node, "pseudo_derivative_time", "controller",
+          [&](const YAML::Node& v) { c.pseudo_derivative_time = positive(v, "pseudo_derivative_time"); });
+    field(node, "communication_delay", "controller",
+          [&](const YAML::Node& v) { c.communication_delay = positive(v, "communication_delay", true); });
     field(node, "realization", "controller", [&](const YAML::Node& r) {
       check_keys(r, "realization", {"inertia", "damping"});
-      field(r, "inertia", "realization", [&](const YAML::Node& v) { c.realization_inertia = positive_per_joint(v, "realization inertia", false); });
-      field(r, "damping", "realization", [&](const YAML::Node& v) { c.realization_damping = positive_per_joint(v, "realization damping", true); });
+      field(r, "inertia", "realization",
+            [&](const YAML::Node& v) { c.realization_inertia = positive_per_joint(v, "realization inertia", false); });
+      field(r, "damping", "realization",
+            [&](const YAML::Node& v) { c.realization_damping = positive_per_joint(v, "realization damping", true); });
     });
-    field(node, "bandwidth", "controller", [&](const YAML::Node& v) { c.bandwidth = positive_per_joint(v, "bandwidth", false); });
-    field(node, "damping_ratio", "controller", [&](const YAML::Node& v) { c.damping_ratio = positive_per_joint(v, "damping_ratio", false); });
+    field(node, "bandwidth", "controller",
+          [&](const YAML::Node& v) { c.bandwidth = positive_per_joint(v, "bandwidth", false); });
+    field(node, "damping_ratio", "controller",
+          [&](const YAML::Node& v) { c.damping_ratio = positive_per_joint(v, "damping_ratio", false); });
   }
 
   void effects(const YAML::Node& node, Effects& e) const {
@@ -224,34 +237,47 @@ class Reader {
       body(s);
     };
     section("coulomb", {"torque", "smoothing_velocity"}, e.coulomb, [&](const YAML::Node& s) {
-      field(s, "torque", "coulomb", [&](const YAML::Node& v) { e.coulomb_torque = positive_per_joint(v, "coulomb torque", true); });
-      field(s, "smoothing_velocity", "coulomb", [&](const YAML::Node& v) { e.coulomb_smoothing_velocity = positive(v, "smoothing_velocity"); });
+      field(s, "torque", "coulomb",
+            [&](const YAML::Node& v) { e.coulomb_torque = positive_per_joint(v, "coulomb torque", true); });
+      field(s, "smoothing_velocity", "coulomb",
+            [&](const YAML::Node& v) { e.coulomb_smoothing_velocity = positive(v, "smoothing_velocity"); });
     });
     section("stribeck", {"torque", "velocity"}, e.stribeck, [&](const YAML::Node& s) {
-      field(s, "torque", "stribeck", [&](const YAML::Node& v) { e.stribeck_torque = positive_per_joint(v, "stribeck torque", true); });
-      field(s, "velocity", "stribeck", [&](const YAML::Node& v) { e.stribeck_velocity = positive(v, "stribeck velocity"); });
+      field(s, "torque", "stribeck",
+            [&](const YAML::Node& v) { e.stribeck_torque = positive_per_joint(v, "stribeck torque", true); });
+      field(s, "velocity", "stribeck",
+            [&](const YAML::Node& v) { e.stribeck_velocity = positive(v, "stribeck velocity"); });
     });
     section("torque_offset", {"torque"}, e.torque_offset, [&](const YAML::Node& s) {
-      field(s, "torque", "torque_offset", [&](const YAML::Node& v) { e.offset_torque = per_joint(v, "offset torque"); });
+      field(s, "torque", "torque_offset",
+            [&](const YAML::Node& v) { e.offset_torque = per_joint(v, "offset torque"); });
     });
     section("backlash", {"width", "frequency", "damping_ratio"}, e.backlash, [&](const YAML::Node& s) {
-      field(s, "width", "backlash", [&](const YAML::Node& v) { e.backlash_width = positive_per_joint(v, "backlash width", true); });
-      field(s, "frequency", "backlash", [&](const YAML::Node& v) { e.backlash_frequency = positive(v, "backlash frequency"); });
-      field(s, "damping_ratio", "backlash", [&](const YAML::Node& v) { e.backlash_damping_ratio = positive(v, "backlash damping_ratio", true); });
+      field(s, "width", "backlash",
+            [&](const YAML::Node& v) { e.backlash_width = positive_per_joint(v, "backlash width", true); });
+      field(s, "frequency", "backlash",
+            [&](const YAML::Node& v) { e.backlash_frequency = positive(v, "backlash frequency"); });
+      field(s, "damping_ratio", "backlash",
+            [&](const YAML::Node& v) { e.backlash_damping_ratio = positive(v, "backlash damping_ratio", true); });
     });
     section("payload", {"mass", "com"}, e.payload, [&](const YAML::Node& s) {
       field(s, "mass", "payload", [&](const YAML::Node& v) { e.payload_mass = positive(v, "payload mass", true); });
       field(s, "com", "payload", [&](const YAML::Node& v) { e.payload_com = vector(v, "payload com", 3); });
     });
     section("torque_constant_error", {"scale"}, e.torque_constant_error, [&](const YAML::Node& s) {
-      field(s, "scale", "torque_constant_error", [&](const YAML::Node& v) { e.torque_constant_scale = positive_per_joint(v, "torque constant scale", false); });
+      field(s, "scale", "torque_constant_error", [&](const YAML::Node& v) {
+        e.torque_constant_scale = positive_per_joint(v, "torque constant scale", false);
+      });
     });
     section("actuation_delay", {"delay"}, e.actuation_delay, [&](const YAML::Node& s) {
-      field(s, "delay", "actuation_delay", [&](const YAML::Node& v) { e.actuation_delay_time = positive(v, "actuation delay", true); });
+      field(s, "delay", "actuation_delay",
+            [&](const YAML::Node& v) { e.actuation_delay_time = positive(v, "actuation delay", true); });
     });
     section("sensor_noise", {"encoder", "current"}, e.sensor_noise, [&](const YAML::Node& s) {
-      field(s, "encoder", "sensor_noise", [&](const YAML::Node& v) { e.encoder_noise = positive(v, "encoder noise", true); });
-      field(s, "current", "sensor_noise", [&](const YAML::Node& v) { e.current_noise = positive(v, "current noise", true); });
+      field(s, "encoder", "sensor_noise",
+            [&](const YAML::Node& v) { e.encoder_noise = positive(v, "encoder noise", true); });
+      field(s, "current", "sensor_noise",
+            [&](const YAML::Node& v) { e.current_noise = positive(v, "current noise", true); });
     });
     section("timestamp_jitter", {"std", "max"}, e.timestamp_jitter, [&](const YAML::Node& s) {
       field(s, "std", "timestamp_jitter", [&](const YAML::Node& v) { e.jitter_std = positive(v, "jitter std", true); });
@@ -271,14 +297,16 @@ class Reader {
   }
 
   void apply(const YAML::Node& root, TwinConfig& c) const {
-    check_keys(root, "the twin configuration", {"format", "urdf", "drives", "servos", "controller", "integration", "effects"});
+    check_keys(root, "the twin configuration",
+               {"format", "urdf", "drives", "servos", "controller", "integration", "effects"});
     field(root, "format", "the twin configuration", [&](const YAML::Node& v) {
       if (v.as<std::string>() != "symoro-twin 1") fail(v, "format must be 'symoro-twin 1'");
     });
     field(root, "urdf", "the twin configuration", [&](const YAML::Node& v) { urdf(v, c.chain); });
     field(root, "drives", "the twin configuration", [&](const YAML::Node& d) {
       check_keys(d, "drives", {"rotor_inertia", "viscous"});
-      field(d, "rotor_inertia", "drives", [&](const YAML::Node& v) { c.rotor_inertia = positive_per_joint(v, "rotor_inertia", true); });
+      field(d, "rotor_inertia", "drives",
+            [&](const YAML::Node& v) { c.rotor_inertia = positive_per_joint(v, "rotor_inertia", true); });
       field(d, "viscous", "drives", [&](const YAML::Node& v) { c.viscous = positive_per_joint(v, "viscous", true); });
     });
     field(root, "servos", "the twin configuration", [&](const YAML::Node& list) {
@@ -306,7 +334,8 @@ YAML::Node load(const std::filesystem::path& path) {
   YAML::Node root = io::load_yaml_file(path);
   // A scalar or a list: the first lookup threw yaml-cpp's BadSubscript past every handler (fuzz_yaml).
   if (!root.IsMap() && !root.IsNull())
-    throw DataError(path.string(), root.Mark().is_null() ? 1 : root.Mark().line + 1, "expected a YAML map of sections (twin.yaml)");
+    throw DataError(path.string(), root.Mark().is_null() ? 1 : root.Mark().line + 1,
+                    "expected a YAML map of sections (twin.yaml)");
   return root;
 }
 
@@ -325,10 +354,12 @@ const std::vector<std::string>& Effects::names() {
 }
 
 void Effects::set(const std::string& name, bool on) {
-  bool* flags[] = {&coulomb, &stribeck, &torque_offset, &backlash, &payload,
-                   &torque_constant_error, &actuation_delay, &sensor_noise, &timestamp_jitter, &dropped_samples};
+  bool* flags[] = {
+      &coulomb,         &stribeck,     &torque_offset,    &backlash,       &payload, &torque_constant_error,
+      &actuation_delay, &sensor_noise, &timestamp_jitter, &dropped_samples};
   const auto& n = names();
-  if (n.size() != std::size(flags)) throw std::logic_error("the twin's effect flags and the effect table's twin names differ");
+  if (n.size() != std::size(flags))
+    throw std::logic_error("the twin's effect flags and the effect table's twin names differ");
   for (size_t i = 0; i < n.size(); ++i)
     if (n[i] == name) {
       *flags[i] = on;
@@ -344,8 +375,8 @@ void Effects::disable_all() {
 }
 
 std::vector<std::string> Effects::enabled() const {
-  const bool flags[] = {coulomb, stribeck, torque_offset, backlash, payload,
-                        torque_constant_error, actuation_delay, sensor_noise, timestamp_jitter, dropped_samples};
+  const bool flags[] = {coulomb,         stribeck,     torque_offset,    backlash,       payload, torque_constant_error,
+                        actuation_delay, sensor_noise, timestamp_jitter, dropped_samples};
   std::vector<std::string> out;
   for (size_t i = 0; i < std::size(flags) && i < names().size(); ++i)
     if (flags[i]) out.push_back(names()[i]);
@@ -373,7 +404,8 @@ TwinConfig read_twin_config(const std::filesystem::path& path, int joints, const
   if (!root["controller"].IsDefined()) {
     const auto description = path.parent_path() / control::controller_file_name();
     if (!std::filesystem::exists(description))
-      throw DataError(path.string(), 0, fmt::format("no 'controller' section and no controller description ({})", description.string()));
+      throw DataError(path.string(), 0,
+                      fmt::format("no 'controller' section and no controller description ({})", description.string()));
     c.controller = control::read_controller_description(description, joints);
     files.push_back(description);
   }

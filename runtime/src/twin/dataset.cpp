@@ -29,7 +29,9 @@ bool finished(const std::filesystem::path& csv, std::uint64_t seed, int trial, c
 
 }  // namespace
 
-std::string run_file_name(const std::string& trajectory, int trial) { return fmt::format("{}_t{}.csv", trajectory, trial); }
+std::string run_file_name(const std::string& trajectory, int trial) {
+  return fmt::format("{}_t{}.csv", trajectory, trial);
+}
 
 std::string describe_run(const RunStats& s) {
   return fmt::format("{:.1f} s simulated in {:.2f} s ({:.0f}x), max |error| {:.2f} deg, {} dropped, {} saturated",
@@ -37,29 +39,37 @@ std::string describe_run(const RunStats& s) {
                      s.max_error.maxCoeff() * 180 / 3.14159265358979323846, s.dropped, s.saturated);
 }
 
-TwinDatasetSummary make_twin_dataset(const ClosedLoopTwin& twin, const std::vector<trajectory::Trajectory>& trajectories,
+TwinDatasetSummary make_twin_dataset(const ClosedLoopTwin& twin,
+                                     const std::vector<trajectory::Trajectory>& trajectories,
                                      const TwinDatasetOptions& options) {
-  return make_twin_dataset([&twin](const trajectory::Trajectory& t, const RunOptions& ro, RunStats* st) { return twin.run(t, ro, st); },
-                           twin.notes(), twin.config(), trajectories, options);
+  return make_twin_dataset(
+      [&twin](const trajectory::Trajectory& t, const RunOptions& ro, RunStats* st) { return twin.run(t, ro, st); },
+      twin.notes(), twin.config(), trajectories, options);
 }
 
 TwinDatasetSummary make_twin_dataset(const RunTwin& run, const std::string& notes, const TwinConfig& config,
-                                     const std::vector<trajectory::Trajectory>& trajs, const TwinDatasetOptions& options) {
+                                     const std::vector<trajectory::Trajectory>& trajs,
+                                     const TwinDatasetOptions& options) {
   std::filesystem::create_directories(options.out);
   TwinDatasetSummary summary;
   summary.runs = static_cast<int>(trajs.size()) * options.trials;
 
-  struct Job { int traj, trial; };
+  struct Job {
+    int traj, trial;
+  };
   std::vector<Job> jobs;
   for (int t = 0; t < static_cast<int>(trajs.size()); ++t)
     for (int k = 1; k <= options.trials; ++k) {
       const auto file = options.out / run_file_name(trajs[t].name, k);
-      if (finished(file, run_seed(options.seed, trajs[t].name, k), k, notes)) ++summary.skipped;
-      else jobs.push_back({t, k});
+      if (finished(file, run_seed(options.seed, trajs[t].name, k), k, notes))
+        ++summary.skipped;
+      else
+        jobs.push_back({t, k});
     }
   summary.made = static_cast<int>(jobs.size());
   // Longest runs first: better load balance across workers.
-  std::stable_sort(jobs.begin(), jobs.end(), [&](const Job& a, const Job& b) { return trajs[a.traj].duration() > trajs[b.traj].duration(); });
+  std::stable_sort(jobs.begin(), jobs.end(),
+                   [&](const Job& a, const Job& b) { return trajs[a.traj].duration() > trajs[b.traj].duration(); });
   summary.coordinator = parallel::place().coordinator();
   if (summary.coordinator && options.on_start) options.on_start(summary.made, summary.skipped);
   auto name_of = [&](const Job& j) { return fmt::format("{} t{}", trajs[j.traj].name, j.trial); };

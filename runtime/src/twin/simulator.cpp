@@ -16,8 +16,9 @@ ClosedLoopTwin::ClosedLoopTwin(robot::ModelHandle model, TwinConfig config)
   const int n = model_.nq();
   if (static_cast<int>(c_.servos.size()) != n) throw DataError(c_.path, 0, "servos: one per joint needed");
   if (c_.rotor_inertia.size() != n || c_.viscous.size() != n)
-    throw DataError(c_.path, 0, "the twin is read for " + std::to_string(c_.rotor_inertia.size()) + " joints, robot '" +
-                                    model_.robot() + "' has " + std::to_string(n));
+    throw DataError(c_.path, 0,
+                    "the twin is read for " + std::to_string(c_.rotor_inertia.size()) + " joints, robot '" +
+                        model_.robot() + "' has " + std::to_string(n));
   truth_ = make_truth(model_, c_);
   for (const auto& j : model_.joints()) names_.push_back(j.name);
 }
@@ -25,13 +26,15 @@ ClosedLoopTwin::ClosedLoopTwin(robot::ModelHandle model, TwinConfig config)
 std::string ClosedLoopTwin::notes() const {
   std::string enabled;
   for (const auto& s : c_.effects.enabled()) enabled += (enabled.empty() ? "" : ", ") + s;
-  return "digital twin (" + c_.path + ", config " + c_.fingerprint + "); effects: " + (enabled.empty() ? "none" : enabled);
+  return "digital twin (" + c_.path + ", config " + c_.fingerprint +
+         "); effects: " + (enabled.empty() ? "none" : enabled);
 }
 
 io::Log ClosedLoopTwin::run(const trajectory::Trajectory& traj, const RunOptions& opt, RunStats* stats) const {
   const int n = joints();
   if (traj.joints() != n)
-    throw DataError(traj.name, 0, "the trajectory has " + std::to_string(traj.joints()) + " joints, the robot " + std::to_string(n));
+    throw DataError(traj.name, 0,
+                    "the trajectory has " + std::to_string(traj.joints()) + " joints, the robot " + std::to_string(n));
   return run(trajectory::sample(traj, c_.controller.period), opt, stats);
 }
 
@@ -91,8 +94,13 @@ struct Servos {
 // delay, the commands in the order they went out, each taking effect `lag` after it.
 struct Actuation {
   Actuation(Plant& plant, const Vec& kt_true, double lag, double clock)
-      : plant(plant), kt_true(kt_true), lag(lag), clock(clock), current(Vec::Zero(kt_true.size())),
-        applied(Vec::Zero(kt_true.size())), torque(kt_true.size()) {}
+      : plant(plant),
+        kt_true(kt_true),
+        lag(lag),
+        clock(clock),
+        current(Vec::Zero(kt_true.size())),
+        applied(Vec::Zero(kt_true.size())),
+        torque(kt_true.size()) {}
   // Advances the plant by dt, applying each pending command when it takes effect.
   void drive(double dt) {
     const double end = clock + dt;
@@ -124,8 +132,8 @@ struct Actuation {
 };
 
 // A log of up to `rows` cycles of the twin, described as the run's.
-io::Log empty_log(const trajectory::SampledReference& ref, const RunOptions& opt, const std::vector<std::string>& joints,
-                  const std::string& notes, double sample_time, int rows) {
+io::Log empty_log(const trajectory::SampledReference& ref, const RunOptions& opt,
+                  const std::vector<std::string>& joints, const std::string& notes, double sample_time, int rows) {
   io::Log log;
   log.meta.robot = opt.robot;
   log.meta.trajectory = ref.name;
@@ -147,10 +155,12 @@ io::Log ClosedLoopTwin::run(const trajectory::SampledReference& ref, const RunOp
   const auto wall0 = std::chrono::steady_clock::now();
   const int n = joints();
   if (ref.joints() != n)
-    throw DataError(ref.name, 0, "the reference has " + std::to_string(ref.joints()) + " joints, the robot " + std::to_string(n));
+    throw DataError(ref.name, 0,
+                    "the reference has " + std::to_string(ref.joints()) + " joints, the robot " + std::to_string(n));
   if (!(std::abs(ref.period - c_.controller.period) <= 1e-9 * c_.controller.period) || ref.cycles() < 1)
-    throw DataError(ref.name, 0, "the reference is sampled every " + std::to_string(ref.period) + " s, the controller runs every " +
-                                     std::to_string(c_.controller.period) + " s");
+    throw DataError(ref.name, 0,
+                    "the reference is sampled every " + std::to_string(ref.period) + " s, the controller runs every " +
+                        std::to_string(c_.controller.period) + " s");
   const Effects& e = c_.effects;
   const double T = c_.controller.period, d = c_.controller.communication_delay;
   const int K = ref.cycles() - 1;
@@ -203,7 +213,8 @@ io::Log ClosedLoopTwin::run(const trajectory::SampledReference& ref, const RunOp
 
     bool dropped = false;
     if (e.dropped_samples && k > 0 && k < K) {
-      if (drop_left == 0 && rng.uniform() < e.drop_probability) drop_left = 1 + static_cast<int>(rng.uniform() * e.drop_max_burst);
+      if (drop_left == 0 && rng.uniform() < e.drop_probability)
+        drop_left = 1 + static_cast<int>(rng.uniform() * e.drop_max_burst);
       if (drop_left > 0) {
         dropped = true;
         --drop_left;
@@ -234,7 +245,8 @@ io::Log ClosedLoopTwin::run(const trajectory::SampledReference& ref, const RunOp
     t_start_next = t_now + 1e-6;
   }
   log.time.conservativeResize(rows);
-  for (Eigen::MatrixXd* m : {&log.q, &log.qd, &log.tau, &log.q_ref, &log.qd_ref, &log.qdd_ref}) m->conservativeResize(rows, n);
+  for (Eigen::MatrixXd* m : {&log.q, &log.qd, &log.tau, &log.q_ref, &log.qd_ref, &log.qdd_ref})
+    m->conservativeResize(rows, n);
 
   st.cycles = K + 1;
   st.rms_error = (st.rms_error / double(K + 1)).cwiseSqrt();

@@ -36,8 +36,9 @@ std::vector<LinkInertial> model_link_inertials(const UrdfChain& chain, const std
   const int nu = static_cast<int>(chain.joints.size());
   for (const auto& j : chain.joints)
     if (!j.fixed && j.model_joint > nq)
-      throw DataError(file, 0, fmt::format("urdf joint {} drives model joint {}, but the model has {} joints",
-                                           j.name, j.model_joint, nq));
+      throw DataError(
+          file, 0,
+          fmt::format("urdf joint {} drives model joint {}, but the model has {} joints", j.name, j.model_joint, nq));
 
   // The model joint that carries each URDF link: the last movable URDF joint up to it.
   std::vector<int> carrier(nu, 0);
@@ -68,10 +69,13 @@ std::vector<LinkInertial> model_link_inertials(const UrdfChain& chain, const std
       const double dr = (Xi.linear() - X[i].linear()).cwiseAbs().maxCoeff();
       const double dp = (Xi.translation() - X[i].translation()).norm();
       if (dr > 1e-9 || dp > 1e-9)
-        throw DataError(file, 0, fmt::format(
-            "the child link of urdf joint {} does not move with model frame {} (rotation differs by {:.3g}, "
-            "position by {:.3g} m at some pose): check base_in_urdf, the joint axes and that joint angles have the "
-            "same zero and direction in both descriptions", chain.joints[i].name, frame[carrier[i] - 1] + 1, dr, dp));
+        throw DataError(
+            file, 0,
+            fmt::format(
+                "the child link of urdf joint {} does not move with model frame {} (rotation differs by {:.3g}, "
+                "position by {:.3g} m at some pose): check base_in_urdf, the joint axes and that joint angles have the "
+                "same zero and direction in both descriptions",
+                chain.joints[i].name, frame[carrier[i] - 1] + 1, dr, dp));
     }
   }
 
@@ -82,8 +86,8 @@ std::vector<LinkInertial> model_link_inertials(const UrdfChain& chain, const std
     if (carrier[i] == 0) continue;  // fixed to the base: it never moves
     LinkInertial& L = links[frame[carrier[i] - 1]];
     const Eigen::Isometry3d Xinv = X[i].inverse();
-    const Eigen::Vector3d c = Xinv * (b.origin + b.com);                  // CoM in the model frame
-    const Eigen::Matrix3d R = Xinv.linear() * rotation_from_rpy(b.rpy);   // inertia axes in it
+    const Eigen::Vector3d c = Xinv * (b.origin + b.com);                 // CoM in the model frame
+    const Eigen::Matrix3d R = Xinv.linear() * rotation_from_rpy(b.rpy);  // inertia axes in it
     const Eigen::Matrix3d Ic = R * b.inertia * R.transpose();
     L.J += Ic + b.mass * (c.squaredNorm() * Eigen::Matrix3d::Identity() - c * c.transpose());
     L.ms += b.mass * c;
@@ -137,9 +141,10 @@ Eigen::VectorXd standard_vector(const std::vector<StandardParameterInfo>& names,
       if (j > joints && (std::string(f) == "IA" || std::string(f) == "FV" || std::string(f) == "FS")) continue;
       const double v = value(f, j);
       if (v != 0 && !present(f, j))
-        throw DataError(file, 0, fmt::format("the twin has {}{} = {:.6g} but the model has no such parameter "
-                                             "(it is 0 in the robot's .par): the model cannot represent this robot",
-                                             f, j, v));
+        throw DataError(file, 0,
+                        fmt::format("the twin has {}{} = {:.6g} but the model has no such parameter "
+                                    "(it is 0 in the robot's .par): the model cannot represent this robot",
+                                    f, j, v));
     }
   return s;
 }

@@ -23,7 +23,15 @@
 namespace symoro::codegen {
 
 // In catalogue order, which is also the order of the parameters the effects add.
-enum class EffectKind { Coulomb, InertiaProducts, Offset, Stribeck, ViscousAsymmetry, PositionHarmonics, SmoothCoulomb };
+enum class EffectKind {
+  Coulomb,
+  InertiaProducts,
+  Offset,
+  Stribeck,
+  ViscousAsymmetry,
+  PositionHarmonics,
+  SmoothCoulomb
+};
 
 // The robot.yaml key of an effect ("coulomb", "inertia_products", ...) and back.
 const std::string& effect_name(EffectKind kind);
@@ -54,9 +62,9 @@ struct EffectSpec {
 
 // A parameter an effect adds: identified, appended after the base parameters.
 struct EffectParameter {
-  std::string name;     // OFF2, FST2, FVA1, HS3_1, HC3_1
-  std::string family;   // OFF, FST, FVA, HS, HC
-  int joint = 0;        // 1-based
+  std::string name;    // OFF2, FST2, FVA1, HS3_1, HC3_1
+  std::string family;  // OFF, FST, FVA, HS, HC
+  int joint = 0;       // 1-based
   std::string unit;
   int order = 0;        // HS, HC: the harmonic order
   double velocity = 0;  // FST: the Stribeck velocity; FC: the tanh velocity scale
@@ -66,8 +74,8 @@ struct EffectParameter {
 // ascending, order ascending, HS before HC for one order. `unit(family, joint)` is the unit of
 // the base family FS or FV on that joint (prismatic joints have their own); the torque-like
 // parameters take the FS unit, FVA the FV unit.
-std::vector<EffectParameter> effect_parameters(
-    const std::vector<EffectSpec>& effects, const std::function<std::string(const std::string&, int)>& unit);
+std::vector<EffectParameter> effect_parameters(const std::vector<EffectSpec>& effects,
+                                               const std::function<std::string(const std::string&, int)>& unit);
 
 // The term a parameter multiplies on its joint's row (its regressor entry there), over the
 // nodes of that joint's position q and velocity qd.

@@ -24,9 +24,9 @@ enum class Op : std::uint8_t {
   Pow,       // a ** value, value a constant exponent
   Sin,
   Cos,
-  Sign,      // -1, 0, +1
-  Exp,       // e ** a
-  Tanh,      // hyperbolic tangent (smooth Coulomb friction)
+  Sign,  // -1, 0, +1
+  Exp,   // e ** a
+  Tanh,  // hyperbolic tangent (smooth Coulomb friction)
 };
 
 struct Node {
@@ -61,9 +61,7 @@ class ExprGraph {
   const Node& node(NodeId id) const { return nodes_[static_cast<std::size_t>(id)]; }
   std::size_t size() const { return nodes_.size(); }
   bool is_constant(NodeId id) const { return node(id).op == Op::Constant; }
-  bool is_constant(NodeId id, double v) const {
-    return is_constant(id) && node(id).value == v;
-  }
+  bool is_constant(NodeId id, double v) const { return is_constant(id) && node(id).value == v; }
   const std::string& symbol_name(int symbol) const { return symbols_[symbol]; }
   // The node of a symbol if it was ever made, else -1.
   NodeId find_symbol(const std::string& name) const;

@@ -30,13 +30,13 @@ struct ModelingOptions {
   // An arm with a gripper joint may want the wrist's (CRANE-X7: 7 of 8).
   int frame = 0;
   // URDF input only.
-  std::string name;       // the robot's name; default: the URDF's
-  std::string base_link;  // default: the root link
-  std::string tip_link;   // default: the end of the moving joints, when it is unique
+  std::string name;                      // the robot's name; default: the URDF's
+  std::string base_link;                 // default: the root link
+  std::string tip_link;                  // default: the end of the moving joints, when it is unique
   std::map<std::string, double> locked;  // off-chain moving joints' positions (default 0)
-  bool rotor_inertia = true;  // each joint gets IA
-  bool viscous = true;        // ... FV
-  bool coulomb = true;        // ... FS
+  bool rotor_inertia = true;             // each joint gets IA
+  bool viscous = true;                   // ... FV
+  bool coulomb = true;                   // ... FS
 };
 
 // "joint=position" (symoroc model --lock) into `options.locked`; throws std::invalid_argument

@@ -17,8 +17,7 @@ std::vector<NodeId> substitute(ExprGraph& g, const std::vector<NodeId>& roots,
 
 // Symbolic differentiation of every root with respect to one symbol (d sign / dx = 0,
 // d exp(a) / dx = exp(a) da / dx, d tanh(a) / dx = (1 - tanh(a)^2) da / dx).
-std::vector<NodeId> differentiate(ExprGraph& g, const std::vector<NodeId>& roots,
-                                  const std::string& symbol);
+std::vector<NodeId> differentiate(ExprGraph& g, const std::vector<NodeId>& roots, const std::string& symbol);
 
 // Dead-code elimination: the nodes the roots need, in increasing id (topological) order.
 std::vector<NodeId> reachable(const ExprGraph& g, const std::vector<NodeId>& roots);
@@ -32,8 +31,8 @@ struct OperationCount {
   int mul = 0;
   int div = 0;
   int neg = 0;
-  int pow = 0;  // x**k, emitted as k-1 multiplications for small integers
-  int trig = 0; // sin and cos
+  int pow = 0;   // x**k, emitted as k-1 multiplications for small integers
+  int trig = 0;  // sin and cos
   int sign = 0;
   int exp = 0;  // exp and tanh
   int total() const { return add + mul + div + neg + pow + trig + sign + exp; }

@@ -43,7 +43,7 @@ struct RobotLibraryBuild {
   std::filesystem::path library;  // <cache>/<robot>-<key>/lib<robot>.so
   std::string robot, code_digest, key;
   int models = 0;
-  bool built = false;          // false: taken from the cache
+  bool built = false;  // false: taken from the cache
   double generate_seconds = 0, compile_seconds = 0;
 };
 

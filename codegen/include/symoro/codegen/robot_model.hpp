@@ -53,7 +53,7 @@ struct RobotModel {
   std::vector<std::vector<NodeId>> inm;  // A[i][j], full symmetric
   std::vector<std::vector<NodeId>> fgm;  // 4 x 4
   int fgm_frame = 0;
-  std::vector<std::vector<NodeId>> jac;  // 6 x n
+  std::vector<std::vector<NodeId>> jac;    // 6 x n
   std::vector<NodeId> base_from_standard;  // per base parameter, over standard symbols
 
   // The files of the folder the model was read from, with their content digests (file name,

@@ -23,9 +23,9 @@ class InputError : public std::runtime_error {
 
 struct JointSpec {
   std::string name;
-  double lower = 0, upper = 0;  // rad or m
-  double velocity = 0;          // rad/s or m/s
-  double effort = 0;            // N m or N
+  double lower = 0, upper = 0;              // rad or m
+  double velocity = 0;                      // rad/s or m/s
+  double effort = 0;                        // N m or N
   double audit_lower = 0, audit_upper = 0;  // the all-pose PD audit domain
 };
 

@@ -46,7 +46,8 @@ void check_quotes(const YAML::Node& n, const std::string& text, const Fail& fail
     if (m.is_null() || m.pos < 0 || static_cast<std::size_t>(m.pos) >= text.size()) return;
     const char c = text[static_cast<std::size_t>(m.pos)];
     if ((c == '"' || c == '\'') && quoted_end(text, static_cast<std::size_t>(m.pos)) == std::string::npos)
-      fail(m.line + 1, m.column + 1, std::string("YAML syntax error: the quoted value opened here by ") + c + " has no closing quote");
+      fail(m.line + 1, m.column + 1,
+           std::string("YAML syntax error: the quoted value opened here by ") + c + " has no closing quote");
   } else if (n.IsMap()) {
     for (const auto& e : n) {
       check_quotes(e.first, text, fail);
@@ -65,7 +66,8 @@ inline std::size_t edits(const std::string& a, const std::string& b) {
   for (std::size_t i = 1; i <= a.size(); ++i)
     for (std::size_t j = 1; j <= b.size(); ++j) {
       d[i][j] = std::min({d[i - 1][j] + 1, d[i][j - 1] + 1, d[i - 1][j - 1] + (a[i - 1] == b[j - 1] ? 0 : 1)});
-      if (i > 1 && j > 1 && a[i - 1] == b[j - 2] && a[i - 2] == b[j - 1]) d[i][j] = std::min(d[i][j], d[i - 2][j - 2] + 1);
+      if (i > 1 && j > 1 && a[i - 1] == b[j - 2] && a[i - 2] == b[j - 1])
+        d[i][j] = std::min(d[i][j], d[i - 2][j - 2] + 1);
     }
   return d[a.size()][b.size()];
 }
@@ -83,7 +85,8 @@ inline std::string nearest_name(const std::string& name, const std::vector<std::
   for (const std::string& k : known) {
     const std::size_t e = edits(lower(name), lower(k));
     if (e > 2 || 2 * e > std::max(name.size(), k.size())) continue;
-    const std::pair<std::size_t, std::size_t> score{e, std::max(name.size(), k.size()) - std::min(name.size(), k.size())};
+    const std::pair<std::size_t, std::size_t> score{e,
+                                                    std::max(name.size(), k.size()) - std::min(name.size(), k.size())};
     if (best.empty() || score < best_score) best = k, best_score = score;
   }
   return best;
@@ -92,7 +95,8 @@ inline std::string nearest_name(const std::string& name, const std::vector<std::
 // Every key of `map` is one of `known`, once: else fail(line, column, message) with the nearest
 // known key and the list. `where` names the map ("a run", "robot.yaml").
 template <class Fail>
-void check_keys(const YAML::Node& map, const std::vector<std::string>& known, const std::string& where, const Fail& fail) {
+void check_keys(const YAML::Node& map, const std::vector<std::string>& known, const std::string& where,
+                const Fail& fail) {
   if (!map.IsMap()) return;
   std::map<std::string, int> seen;  // key -> its line
   for (const auto& e : map) {
@@ -105,11 +109,13 @@ void check_keys(const YAML::Node& map, const std::vector<std::string>& known, co
       std::string list;
       for (const auto& k : known) list += (list.empty() ? "" : ", ") + k;
       fail(line, column,
-           "unknown key '" + key + "' in " + where + (near.empty() ? "" : "; did you mean '" + near + "'?") + " (known keys: " +
-               list + ")");
+           "unknown key '" + key + "' in " + where + (near.empty() ? "" : "; did you mean '" + near + "'?") +
+               " (known keys: " + list + ")");
     }
     const auto [at, fresh] = seen.emplace(key, line);
-    if (!fresh) fail(line, column, "key '" + key + "' appears twice in " + where + " (first on line " + std::to_string(at->second) + ")");
+    if (!fresh)
+      fail(line, column,
+           "key '" + key + "' appears twice in " + where + " (first on line " + std::to_string(at->second) + ")");
   }
 }
 
@@ -127,9 +133,9 @@ void check_yaml_structure(const std::string& text, const Fail& fail) {
     explicit Events(const Fail& f) : fail(f) {}
     const Fail& fail;
     int documents = 0;
-    long long nodes = 0;                                       // after expanding the aliases so far
-    std::vector<std::pair<YAML::anchor_t, long long>> open;    // anchored containers being read
-    std::map<YAML::anchor_t, long long> size;                  // each anchored node's expanded size
+    long long nodes = 0;                                     // after expanding the aliases so far
+    std::vector<std::pair<YAML::anchor_t, long long>> open;  // anchored containers being read
+    std::map<YAML::anchor_t, long long> size;                // each anchored node's expanded size
     void node(const YAML::Mark& mark, long long count) {
       nodes += count;
       if (nodes > kMaxYamlNodes)
@@ -151,25 +157,29 @@ void check_yaml_structure(const std::string& text, const Fail& fail) {
       if (anchor != YAML::NullAnchor) size[anchor] = nodes - first;
     }
     void OnDocumentStart(const YAML::Mark& mark) override {
-      if (++documents > 1) fail(mark.line + 1, mark.column + 1, "a second YAML document ('---'): one document per file");
+      if (++documents > 1)
+        fail(mark.line + 1, mark.column + 1, "a second YAML document ('---'): one document per file");
     }
     void OnDocumentEnd() override {}
     void OnNull(const YAML::Mark& mark, YAML::anchor_t anchor) override { leaf(mark, anchor); }
     void OnAlias(const YAML::Mark& mark, YAML::anchor_t anchor) override {
       for (const auto& o : open)
         if (o.first == anchor)
-          fail(mark.line + 1, mark.column + 1, "a YAML alias inside the node its anchor names: a cycle no reader can follow");
+          fail(mark.line + 1, mark.column + 1,
+               "a YAML alias inside the node its anchor names: a cycle no reader can follow");
       const auto it = size.find(anchor);
       node(mark, it == size.end() ? 1 : it->second);
     }
     void OnScalar(const YAML::Mark& mark, const std::string&, YAML::anchor_t anchor, const std::string&) override {
       leaf(mark, anchor);
     }
-    void OnSequenceStart(const YAML::Mark& mark, const std::string&, YAML::anchor_t anchor, YAML::EmitterStyle::value) override {
+    void OnSequenceStart(const YAML::Mark& mark, const std::string&, YAML::anchor_t anchor,
+                         YAML::EmitterStyle::value) override {
       start(mark, anchor);
     }
     void OnSequenceEnd() override { end(); }
-    void OnMapStart(const YAML::Mark& mark, const std::string&, YAML::anchor_t anchor, YAML::EmitterStyle::value) override {
+    void OnMapStart(const YAML::Mark& mark, const std::string&, YAML::anchor_t anchor,
+                    YAML::EmitterStyle::value) override {
       start(mark, anchor);
     }
     void OnMapEnd() override { end(); }

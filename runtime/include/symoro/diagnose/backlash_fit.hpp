@@ -34,21 +34,21 @@
 namespace symoro::diagnose {
 
 struct BacklashFinding {
-  int joint = 0;                  // 1-based
-  double width = 0;               // rad, total play
-  double measured = 0;            // N m, high-band torque rms of the data
-  double simulated_before = 0;    // N m, of the simulation without this joint's play (mean over seeds)
-  double spread = 0;              // N m, its standard deviation over seeds
-  double simulated_after = 0;     // N m, with the fitted play
+  int joint = 0;                // 1-based
+  double width = 0;             // rad, total play
+  double measured = 0;          // N m, high-band torque rms of the data
+  double simulated_before = 0;  // N m, of the simulation without this joint's play (mean over seeds)
+  double spread = 0;            // N m, its standard deviation over seeds
+  double simulated_after = 0;   // N m, with the fitted play
 };
 
 struct BacklashFit {
   Eigen::VectorXd measured, simulated, spread;  // per joint, the final judgement (N m); simulated: the null
-  LoopFloor floor;                // the log's own floor, in the null
+  LoopFloor floor;                              // the log's own floor, in the null
   std::vector<BacklashFinding> findings;
-  double delay = 0;               // s, the refined actuation delay (0: none was selected)
+  double delay = 0;  // s, the refined actuation delay (0: none was selected)
   int simulations = 0;
-  std::vector<std::string> notes; // joints the twin cannot give play (said in the report)
+  std::vector<std::string> notes;  // joints the twin cannot give play (said in the report)
 };
 
 // The twin description with the effects the selection named that the twin can play: Coulomb
@@ -59,7 +59,8 @@ twin::TwinConfig with_selected_effects(twin::TwinConfig c, const Selection& s);
 // with the effects already diagnosed switched on and every unknown one off (backlash off);
 // `measured` the fitting run and `reference` its reference at every cycle (the log's own
 // references: the motion that was logged).
-BacklashFit fit_backlash(const robot::ModelHandle& full, const io::Log& measured, const trajectory::SampledReference& reference,
-                         twin::TwinConfig nominal, const BacklashFitOptions& options = {});
+BacklashFit fit_backlash(const robot::ModelHandle& full, const io::Log& measured,
+                         const trajectory::SampledReference& reference, twin::TwinConfig nominal,
+                         const BacklashFitOptions& options = {});
 
 }  // namespace symoro::diagnose

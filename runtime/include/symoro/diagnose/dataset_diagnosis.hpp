@@ -19,24 +19,24 @@
 namespace symoro::diagnose {
 
 struct DatasetDiagnosisOptions {
-  std::filesystem::path data;       // the dataset folder (dataset.yaml and logs)
-  std::filesystem::path out;        // the report folder
-  std::filesystem::path robot_dir;  // twin.yaml, controller.yaml; empty: none (no backlash stage)
+  std::filesystem::path data;               // the dataset folder (dataset.yaml and logs)
+  std::filesystem::path out;                // the report folder
+  std::filesystem::path robot_dir;          // twin.yaml, controller.yaml; empty: none (no backlash stage)
   std::vector<std::string> train, heldout;  // empty: the dataset's (held out: heldout_family)
   std::string heldout_family = io::kHeldOutFamily;
   int trial = 1;
-  double interval = 0.01;  // s, the diagnosis grid
-  double cutoff = 5;       // Hz, the low-pass on every column and the torque
+  double interval = 0.01;         // s, the diagnosis grid
+  double cutoff = 5;              // Hz, the low-pass on every column and the torque
   std::vector<std::string> only;  // effect names (effects.hpp); empty: every candidate
   // The selection's thresholds, with SelectionOptions' defaults (selection.hpp says what each is).
   double alpha = SelectionOptions{}.alpha;
   double min_heldout_gain = SelectionOptions{}.min_heldout_gain;
   double min_effect_torque = SelectionOptions{}.min_effect_torque;
-  bool backlash = true;           // the closed-loop high-band stage
-  std::filesystem::path params;   // an earlier identification's parameters, held (empty: refit)
-  std::string variant;            // the variant's name (empty: <model>_diagnosed, or diagnosed)
+  bool backlash = true;                         // the closed-loop high-band stage
+  std::filesystem::path params;                 // an earlier identification's parameters, held (empty: refit)
+  std::string variant;                          // the variant's name (empty: <model>_diagnosed, or diagnosed)
   std::function<void(const std::string&)> say;  // a line of progress, as each stage ends
-  std::function<bool()> stop;                    // asked between stages: true stops (DiagnosisStopped)
+  std::function<bool()> stop;                   // asked between stages: true stops (DiagnosisStopped)
 };
 
 // Options that cannot be met by this dataset (no fitting or held-out run, a run it lacks), or a
@@ -65,7 +65,7 @@ void check_request(const DatasetDiagnosisOptions& options);
 
 // The fitting and held-out runs of `o.trial`: as named, else the dataset's.
 std::pair<std::vector<std::string>, std::vector<std::string>> diagnosis_runs(const io::Dataset& data,
-                                                                              const DatasetDiagnosisOptions& options);
+                                                                             const DatasetDiagnosisOptions& options);
 
 DatasetDiagnosis diagnose_dataset(const DiagnosisModel& model, const DatasetDiagnosisOptions& options);
 

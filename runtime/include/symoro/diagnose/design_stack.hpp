@@ -12,27 +12,26 @@
 
 #include <Eigen/Core>
 
-
 namespace symoro::diagnose {
 
 struct DesignStack {
   int joints = 0;
   std::vector<std::string> joint_names;
-  double interval = 0;                  // s, the grid of every trajectory
+  double interval = 0;  // s, the grid of every trajectory
   // What every column went through (stack_builder.hpp): the logs' period and the zero-phase
   // Butterworth low-pass; 0 when unknown. Columns computed later from the fit (backlash) are
   // re-made at this rate and through this filter, as the data were.
   double base_interval = 0, cutoff = 0;
   int filter_order = 0;
-  Eigen::MatrixXd q, qd, qdd, tau;      // samples x joints
-  Eigen::VectorXd time;                 // s, within its trajectory
-  std::vector<int> segment;             // per sample: a contiguous piece (trajectory x log piece)
+  Eigen::MatrixXd q, qd, qdd, tau;              // samples x joints
+  Eigen::VectorXd time;                         // s, within its trajectory
+  std::vector<int> segment;                     // per sample: a contiguous piece (trajectory x log piece)
   std::vector<std::string> segment_trajectory;  // per segment
-  Eigen::MatrixXd W;                    // identified model, (samples * joints) x np
-  Eigen::VectorXd tau0;                 // its fixed parameters' torque, same rows
-  std::vector<std::string> parameters;  // identified parameter names
-  Eigen::VectorXd rotor_inertia_index;  // per joint: index of IA<j> in `parameters`, -1 if none
-  Eigen::VectorXd viscous_index;        // per joint: index of FV<j>, -1 if none
+  Eigen::MatrixXd W;                            // identified model, (samples * joints) x np
+  Eigen::VectorXd tau0;                         // its fixed parameters' torque, same rows
+  std::vector<std::string> parameters;          // identified parameter names
+  Eigen::VectorXd rotor_inertia_index;          // per joint: index of IA<j> in `parameters`, -1 if none
+  Eigen::VectorXd viscous_index;                // per joint: index of FV<j>, -1 if none
   // Full-model columns that are not identified parameters (name, family, joint).
   Eigen::MatrixXd full_extra;
   std::vector<std::string> full_extra_names, full_extra_families;

@@ -57,7 +57,7 @@ enum class EffectKind {
 struct EffectInfo {
   EffectKind kind;
   const EffectRow* row;
-  const char* name;  // row->diagnosis, e.g. "coulomb"
+  const char* name;   // row->diagnosis, e.g. "coulomb"
   const char* title;  // row->title, "Coulomb friction"
 };
 
@@ -76,11 +76,11 @@ struct Candidate {
   // under it (a sharp sign gave a Stribeck level a third of its size), and the magnitudes are
   // the law's own.
   double coulomb_velocity = 0.01;
-  std::vector<int> orders;          // position_harmonics
-  std::vector<int> full_columns;    // inertia_products: columns of DesignStack::full_extra
+  std::vector<int> orders;        // position_harmonics
+  std::vector<int> full_columns;  // inertia_products: columns of DesignStack::full_extra
   std::vector<std::string> parameters, units;
-  std::string label() const;        // "coulomb friction, joint 2 (shoulder_tilt)" style
-  std::string key() const;          // "coulomb:2", unique per candidate
+  std::string label() const;  // "coulomb friction, joint 2 (shoulder_tilt)" style
+  std::string key() const;    // "coulomb:2", unique per candidate
 };
 
 struct CandidateOptions {

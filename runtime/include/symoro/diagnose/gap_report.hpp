@@ -17,8 +17,8 @@ namespace symoro::diagnose {
 // One held-out trajectory in both studies.
 struct GapTrajectory {
   std::string trajectory;
-  std::string kind;          // closed-loop or open-loop (the same in both studies)
-  double interval = 0;                     // s
+  std::string kind;     // closed-loop or open-loop (the same in both studies)
+  double interval = 0;  // s
   int samples = 0;
   double rmse_before = 0, rmse_after = 0;  // N m, accepted parameters, all joints
   Eigen::VectorXd joint_before, joint_after;
@@ -26,7 +26,7 @@ struct GapTrajectory {
 
 struct GapComparison {
   std::string robot, before_model, after_model;
-  std::vector<GapTrajectory> trajectories;  // those both studies validated, in the before order
+  std::vector<GapTrajectory> trajectories;           // those both studies validated, in the before order
   std::vector<std::string> only_before, only_after;  // validated by one study alone (left out)
   // Pooled over the compared trajectories' samples: per joint and over all joints.
   Eigen::VectorXd joint_before, joint_after;
@@ -41,7 +41,7 @@ GapComparison compare_studies(const study::StudyValidation& before, const study:
 
 struct GapReportOptions {
   std::string before_label = "before", after_label = "after";  // e.g. the study folders
-  std::string figure_trajectory;  // trajectory whose torques are plotted (default: the last compared)
+  std::string figure_trajectory;   // trajectory whose torques are plotted (default: the last compared)
   std::vector<int> figure_joints;  // 0-based (default: the 3 joints whose error changed most)
 };
 

@@ -21,10 +21,10 @@
 namespace symoro::diagnose {
 
 struct BacklashFitOptions {
-  double band_hz = 40;        // the high band starts here (the low band ends at the stack's 5 Hz)
-  double light_hz = 150;      // the 1 kHz preprocessing's low-pass (the band's top)
-  int seeds = 3;              // simulations of the twin: the spread of the high-band rms
-  double sigmas = 6;          // an excess must exceed this many spreads ...
+  double band_hz = 40;    // the high band starts here (the low band ends at the stack's 5 Hz)
+  double light_hz = 150;  // the 1 kHz preprocessing's low-pass (the band's top)
+  int seeds = 3;          // simulations of the twin: the spread of the high-band rms
+  double sigmas = 6;      // an excess must exceed this many spreads ...
   // ... and this fraction of the null's rms: the loop's chatter is heavy-tailed from run to
   // run (clean twin runs of V01: joint 2 at 0.76-0.79 N m for five seeds, 0.98 for another),
   // which the spread of a few seeds does not show.
@@ -44,10 +44,10 @@ struct BacklashFitOptions {
 Eigen::VectorXd high_band_rms(const io::Log& log, const BacklashFitOptions& options = {});
 
 struct LoopFloor {
-  Eigen::VectorXd rms;         // N m per joint: the high band of what the law does not explain
-  Eigen::VectorXd law_rms;     // N m per joint: that residual over all frequencies
-  int lag = 0;                 // rows from the command to the logged torque that shows it
-  double encoder_noise = 0;    // counts (std), the median over joints (for the report)
+  Eigen::VectorXd rms;       // N m per joint: the high band of what the law does not explain
+  Eigen::VectorXd law_rms;   // N m per joint: that residual over all frequencies
+  int lag = 0;               // rows from the command to the logged torque that shows it
+  double encoder_noise = 0;  // counts (std), the median over joints (for the report)
   Eigen::VectorXd encoder_noise_per_joint;
 };
 

@@ -22,9 +22,9 @@ namespace symoro::diagnose {
 // One trajectory (or one piece of it) on a uniform grid. qd is the preprocessed (zero-phase
 // low-passed) velocity, so its sign changes are reversals of the motion, not sensor noise.
 struct ResidualSeries {
-  std::string name;   // trajectory name (pieces of one trajectory share it)
-  double interval = 0;  // s
-  Eigen::VectorXd time;  // s
+  std::string name;                                     // trajectory name (pieces of one trajectory share it)
+  double interval = 0;                                  // s
+  Eigen::VectorXd time;                                 // s
   Eigen::MatrixXd q, qd, qdd, tau_measured, tau_model;  // samples x joints
 };
 
@@ -51,12 +51,12 @@ struct LocalizeOptions {
 
 // The residual over the samples of one regime. Shares are relative to the joint's all samples.
 struct RegimeStat {
-  std::string regime;    // e.g. "velocity reversal", "q in [-0.52, 0.31] rad ([-29.8, 17.8] deg)"
+  std::string regime;  // e.g. "velocity reversal", "q in [-0.52, 0.31] rad ([-29.8, 17.8] deg)"
   int samples = 0;
-  double fraction = 0;   // of the joint's samples
+  double fraction = 0;       // of the joint's samples
   double mean = 0, rms = 0;  // N m (NaN without samples)
-  double rms_ratio = 0;  // rms / the joint's overall residual rms
-  double sse_share = 0;  // share of the joint's residual sum of squares
+  double rms_ratio = 0;      // rms / the joint's overall residual rms
+  double sse_share = 0;      // share of the joint's residual sum of squares
 };
 
 struct JointLocalization {
@@ -90,8 +90,8 @@ struct JointLocalization {
 // 0 Hz, so integrating the residual PSD gives its mean square (residual_rms^2), the quantity
 // the regime shares split.
 struct Spectrum {
-  Eigen::VectorXd frequency;           // Hz, 0 .. Nyquist
-  Eigen::MatrixXd residual, measured;  // frequencies x joints
+  Eigen::VectorXd frequency;             // Hz, 0 .. Nyquist
+  Eigen::MatrixXd residual, measured;    // frequencies x joints
   int segments = 0, segment_length = 0;  // averaged over all series
 };
 
@@ -147,8 +147,7 @@ struct CrossCorrelationPeak {
 // delta (as torque_lag; pooled over pieces, each signal's pooled mean removed); the delta with the
 // largest |c| over |delta| <= max_lag, refined by a parabola through its neighbours.
 CrossCorrelationPeak cross_correlation_peak(const std::vector<Eigen::VectorXd>& x,
-                                            const std::vector<Eigen::VectorXd>& y, double interval,
-                                            double max_lag);
+                                            const std::vector<Eigen::VectorXd>& y, double interval, double max_lag);
 
 // N_eff = N / (1 + 2 sum_{k>=1} rho_k) of the pooled pieces, rho_k the lag-k autocorrelation
 // (products only within a piece, pooled mean removed; FFT), the sum stopped before the first

@@ -31,8 +31,8 @@ struct LocalizationFigureOptions {
 // (without "<prefix>_" when prefix is empty). A figure without data (no spectrum, no series of
 // that name) is not written. Returns the file names written, relative to `dir`.
 std::vector<std::string> write_localization_figures(const std::vector<ResidualSeries>& series,
-                                                    const Localization& localization,
-                                                    const std::filesystem::path& dir, const std::string& prefix,
+                                                    const Localization& localization, const std::filesystem::path& dir,
+                                                    const std::string& prefix,
                                                     const LocalizationFigureOptions& options = {});
 
 }  // namespace symoro::diagnose

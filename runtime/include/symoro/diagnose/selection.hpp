@@ -48,7 +48,7 @@ struct SelectionOptions {
   // not a shift one could apply to the torque.
   double min_delay_periods = 1.0;
   int max_effects = 10;
-  int max_lag = 400;               // samples, for the autocorrelation time
+  int max_lag = 400;  // samples, for the autocorrelation time
   // The backward check: a named effect whose 95 % region reaches this fraction of its own
   // size (or less) is not determined by the data.
   double smallest_fraction = 0.5;
@@ -76,8 +76,8 @@ struct CandidateTest {
 };
 
 struct SelectionStep {
-  double autocorrelation_time = 1;  // samples per independent sample (pooled over joints)
-  double level = 0;                 // alpha / candidates
+  double autocorrelation_time = 1;   // samples per independent sample (pooled over joints)
+  double level = 0;                  // alpha / candidates
   std::vector<CandidateTest> tests;  // sorted by held-out reduction, best first
   std::string chosen;                // key, empty when the selection stopped here
 };
@@ -90,29 +90,29 @@ struct SelectedEffect {
 };
 
 struct Fit {
-  Eigen::VectorXd phi;              // identified parameters
-  std::vector<Eigen::VectorXd> theta;  // per selected effect
-  Eigen::VectorXd train_rmse, heldout_rmse;  // per joint, N m
+  Eigen::VectorXd phi;                        // identified parameters
+  std::vector<Eigen::VectorXd> theta;         // per selected effect
+  Eigen::VectorXd train_rmse, heldout_rmse;   // per joint, N m
   double train_total = 0, heldout_total = 0;  // over all joints and samples
-  Eigen::VectorXd train_tau, heldout_tau;  // stacked model torques (with the effects)
+  Eigen::VectorXd train_tau, heldout_tau;     // stacked model torques (with the effects)
 };
 
 // An effect the forward steps named and the backward check dropped, with why.
 struct DroppedEffect {
   Candidate candidate;
-  std::string magnitude;  // as refitted with the others, e.g. "-0.0126 +- 0.0238 N m"
-  double size = 0;        // its Wald statistic over the region's bound (< 1: undetermined)
+  std::string magnitude;    // as refitted with the others, e.g. "-0.0126 +- 0.0238 N m"
+  double size = 0;          // its Wald statistic over the region's bound (< 1: undetermined)
   double heldout_gain = 0;  // what dropping it from the full model costs its joints, held out (NaN: not
                             // asked, its region already failed)
   std::string reason;
 };
 
 struct Selection {
-  Eigen::VectorXd weights;          // per joint, 1 / residual std of the base fit
+  Eigen::VectorXd weights;  // per joint, 1 / residual std of the base fit
   std::vector<SelectionStep> steps;
   std::vector<SelectedEffect> effects;
   std::vector<DroppedEffect> dropped;  // by the backward check, in the order dropped
-  Fit before, after;                // base model alone, and with the selected effects
+  Fit before, after;                   // base model alone, and with the selected effects
   std::string stop_reason;
 };
 

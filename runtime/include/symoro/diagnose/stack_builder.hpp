@@ -70,7 +70,8 @@ struct StackModel {
 };
 
 // The design stack of `runs` (stack_builder.cpp, compiled once for every robot).
-DesignStack stack_design(const StackModel& model, const std::vector<NamedSamples>& runs, const StackOptions& options = {});
+DesignStack stack_design(const StackModel& model, const std::vector<NamedSamples>& runs,
+                         const StackOptions& options = {});
 
 // A generated model and its full model as a StackModel.
 template <class Full, class Identified>

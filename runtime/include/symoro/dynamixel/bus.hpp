@@ -99,17 +99,14 @@ class Bus {
   Reply ping(std::uint8_t id, Clock::time_point deadline = kNoDeadline);
   // Every servo that answers a broadcast ping within `wait` (there is no count to wait for).
   std::vector<PingReply> ping_all(std::chrono::microseconds wait = std::chrono::milliseconds(20));
-  Reply read(std::uint8_t id, std::uint16_t address, std::uint16_t length,
-             Clock::time_point deadline = kNoDeadline);
+  Reply read(std::uint8_t id, std::uint16_t address, std::uint16_t length, Clock::time_point deadline = kNoDeadline);
   Reply read(std::uint8_t id, xseries::Item item, Clock::time_point deadline = kNoDeadline) {
     return read(id, item.address, item.size, deadline);
   }
   // To the broadcast ID: no reply; the outcome is ok when the request was written.
-  Reply write(std::uint8_t id, std::uint16_t address, ByteView data,
-              Clock::time_point deadline = kNoDeadline);
+  Reply write(std::uint8_t id, std::uint16_t address, ByteView data, Clock::time_point deadline = kNoDeadline);
   // The value's low item.size bytes (two's complement for signed items).
-  Reply write(std::uint8_t id, xseries::Item item, std::int32_t value,
-              Clock::time_point deadline = kNoDeadline);
+  Reply write(std::uint8_t id, xseries::Item item, std::int32_t value, Clock::time_point deadline = kNoDeadline);
   // Clears a hardware error (the servo restarts with torque off).
   Reply reboot(std::uint8_t id, Clock::time_point deadline = kNoDeadline);
 
@@ -123,13 +120,11 @@ class Bus {
   bool sync_write(ByteView ids, xseries::Item item, Span<const std::int32_t> values,
                   Clock::time_point deadline = kNoDeadline);
   // One reply per item, in order (distinct IDs).
-  Span<const Reply> bulk_read(Span<const BulkReadItem> items,
-                              Clock::time_point deadline = kNoDeadline);
+  Span<const Reply> bulk_read(Span<const BulkReadItem> items, Clock::time_point deadline = kNoDeadline);
 
   // The timeout of one attempt that writes `request_bytes` and expects `replies` status packets
   // with `reply_params` parameter bytes in all.
-  Clock::duration attempt_timeout(std::size_t request_bytes, std::size_t replies,
-                                  std::size_t reply_params) const;
+  Clock::duration attempt_timeout(std::size_t request_bytes, std::size_t replies, std::size_t reply_params) const;
 
   const BusStats& stats() const { return stats_; }
   void reset_stats() { stats_ = BusStats{}; }
@@ -150,8 +145,7 @@ class Bus {
 
   // Runs attempts for slots_/replies_ (prepared by the caller) until every slot is resolved with
   // a final answer, the retries are used up or the deadline leaves no room.
-  void transact(Kind kind, std::uint16_t address, std::uint16_t length,
-                Clock::time_point deadline);
+  void transact(Kind kind, std::uint16_t address, std::uint16_t length, Clock::time_point deadline);
   // One attempt: writes request_ and collects replies for the unresolved slots until `until`.
   void attempt(Clock::time_point until);
   void handle(const DecodeEvent& event);

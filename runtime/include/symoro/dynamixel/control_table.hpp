@@ -41,7 +41,7 @@ inline constexpr Item kHardwareErrorStatus{70, 1};
 // the servo stopped and its goal values refuse writes (Data Range Error) until it is cleared.
 inline constexpr Item kBusWatchdog{98, 1};
 inline constexpr double kBusWatchdogUnit = 0.020;  // s
-inline constexpr Item kGoalCurrent{102, 2};  // signed
+inline constexpr Item kGoalCurrent{102, 2};        // signed
 inline constexpr Item kGoalVelocity{104, 4};
 inline constexpr Item kGoalPosition{116, 4};
 inline constexpr Item kPresentCurrent{126, 2};   // signed
@@ -92,16 +92,15 @@ constexpr const Model* find_model(std::uint16_t number) {
 
 // Baud Rate(8) value -> bit/s (0 for a value the X430/X540 series do not define).
 constexpr std::uint32_t baud_rate_bps(std::uint8_t value) {
-  constexpr std::uint32_t kRates[] = {9'600,     57'600,    115'200,   1'000'000,
-                                      2'000'000, 3'000'000, 4'000'000, 4'500'000};
+  constexpr std::uint32_t kRates[] = {9'600, 57'600, 115'200, 1'000'000, 2'000'000, 3'000'000, 4'000'000, 4'500'000};
   return value < 8 ? kRates[value] : 0;
 }
 
 // ---- Units --------------------------------------------------------------------------------------
 inline constexpr double kPi = 3.14159265358979323846;
-inline constexpr double kCurrentUnit = 2.69e-3;                  // A per unit ("about 2.69 mA")
-inline constexpr double kVelocityUnit = 0.229 * 2.0 * kPi / 60;  // rad/s per unit (0.229 rev/min)
-inline constexpr std::int32_t kPulsesPerRevolution = 4096;       // 0..4,095 per turn, CCW positive
+inline constexpr double kCurrentUnit = 2.69e-3;                            // A per unit ("about 2.69 mA")
+inline constexpr double kVelocityUnit = 0.229 * 2.0 * kPi / 60;            // rad/s per unit (0.229 rev/min)
+inline constexpr std::int32_t kPulsesPerRevolution = 4096;                 // 0..4,095 per turn, CCW positive
 inline constexpr double kPositionUnit = 2.0 * kPi / kPulsesPerRevolution;  // rad per pulse
 // The pulse count taken as 0 rad: the middle of 0..4,095. The e-manual defines no angle origin;
 // this is the convention of CRANE-X7's drivers, to be confirmed per joint when homing.

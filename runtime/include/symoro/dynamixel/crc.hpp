@@ -15,8 +15,6 @@ namespace symoro::dynamixel {
 
 // Continues `crc` over `size` bytes (pass the previous result to checksum a message in pieces).
 std::uint16_t crc16(const std::uint8_t* data, std::size_t size, std::uint16_t crc = 0);
-inline std::uint16_t crc16(ByteView bytes, std::uint16_t crc = 0) {
-  return crc16(bytes.data(), bytes.size(), crc);
-}
+inline std::uint16_t crc16(ByteView bytes, std::uint16_t crc = 0) { return crc16(bytes.data(), bytes.size(), crc); }
 
 }  // namespace symoro::dynamixel

@@ -32,8 +32,7 @@ ByteView encode_write(std::uint8_t id, std::uint16_t address, ByteView data, Buf
 // The same item of every listed servo; each answers with its own status packet, in list order.
 ByteView encode_sync_read(std::uint16_t address, std::uint16_t length, ByteView ids, Buffer& out);
 // `data` holds ids.size() records of `length` bytes, in the order of `ids`.
-ByteView encode_sync_write(std::uint16_t address, std::uint16_t length, ByteView ids, ByteView data,
-                           Buffer& out);
+ByteView encode_sync_write(std::uint16_t address, std::uint16_t length, ByteView ids, ByteView data, Buffer& out);
 
 struct BulkReadItem {
   std::uint8_t id = 0;
@@ -45,8 +44,8 @@ ByteView encode_bulk_read(Span<const BulkReadItem> items, Buffer& out);
 // ---- Servo side: status packets ----------------------------------------------------------------
 
 ByteView encode_status(std::uint8_t id, std::uint8_t error, ByteView params, Buffer& out);
-ByteView encode_ping_reply(std::uint8_t id, std::uint16_t model_number, std::uint8_t firmware,
-                           Buffer& out, std::uint8_t error = 0);
+ByteView encode_ping_reply(std::uint8_t id, std::uint16_t model_number, std::uint8_t firmware, Buffer& out,
+                           std::uint8_t error = 0);
 
 // ---- Parsing requests (servo side) -------------------------------------------------------------
 
@@ -76,9 +75,7 @@ struct SyncWriteRequest {
 
   std::size_t count() const { return records.size() / (std::size_t{length} + 1); }
   std::uint8_t id(std::size_t i) const { return records[i * (std::size_t{length} + 1)]; }
-  ByteView data(std::size_t i) const {
-    return records.subspan(i * (std::size_t{length} + 1) + 1, length);
-  }
+  ByteView data(std::size_t i) const { return records.subspan(i * (std::size_t{length} + 1) + 1, length); }
 };
 // Requires at least one record and no partial one.
 std::optional<SyncWriteRequest> parse_sync_write(const Packet& packet);

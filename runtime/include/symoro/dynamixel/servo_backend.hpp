@@ -38,17 +38,16 @@ class ServoBackend {
 class RotorBackend : public ServoBackend {
  public:
   struct Rotor {
-    double inertia = 0.01;          // J, kg m^2 (> 0)
-    double damping = 0.02;          // b, N m s/rad (>= 0)
+    double inertia = 0.01;            // J, kg m^2 (> 0)
+    double damping = 0.02;            // b, N m s/rad (>= 0)
     double torque_constant = 2.3179;  // kt, N m/A (XM430-W350; XM540-W270: 3.1317)
-    double position = 0;            // initial q, rad
+    double position = 0;              // initial q, rad
   };
 
   explicit RotorBackend(std::vector<Rotor> rotors) : rotors_(std::move(rotors)) {
     for (std::size_t i = 0; i < rotors_.size(); ++i) {
       if (!(rotors_[i].inertia > 0) || !(rotors_[i].damping >= 0))
-        throw std::invalid_argument("RotorBackend: rotor " + std::to_string(i) +
-                                    " needs inertia > 0 and damping >= 0");
+        throw std::invalid_argument("RotorBackend: rotor " + std::to_string(i) + " needs inertia > 0 and damping >= 0");
       states_.push_back(JointState{rotors_[i].position, 0, 0});
     }
   }
@@ -74,8 +73,8 @@ class RotorBackend : public ServoBackend {
         s.velocity += a * h;
         continue;
       }
-      const double tau = r.inertia / r.damping;  // time constant
-      const double w_end = torque / r.damping;   // steady velocity
+      const double tau = r.inertia / r.damping;    // time constant
+      const double w_end = torque / r.damping;     // steady velocity
       const double decay = -std::expm1(-h / tau);  // 1 - exp(-h/tau), exact for small h too
       s.position += w_end * h + (s.velocity - w_end) * tau * decay;
       s.velocity += (w_end - s.velocity) * decay;

@@ -70,7 +70,8 @@ class VirtualBus {
   // `plant_clock`: the time (s) the backend integrates to at each instruction, called on the
   // bus's thread; empty: the wall clock since construction. A test that steps the controller's
   // clock (hardware::SteppedClock) gives that clock's seconds, so the arm moves on the loop's time.
-  VirtualBus(std::vector<VirtualServo> servos, std::unique_ptr<ServoBackend> backend, std::function<double()> plant_clock = {});
+  VirtualBus(std::vector<VirtualServo> servos, std::unique_ptr<ServoBackend> backend,
+             std::function<double()> plant_clock = {});
   ~VirtualBus();
   VirtualBus(const VirtualBus&) = delete;
   VirtualBus& operator=(const VirtualBus&) = delete;
@@ -129,9 +130,7 @@ class VirtualBus {
   void update_command(std::size_t index);
   void refresh_present();
   Servo* find(std::uint8_t id);
-  std::size_t index_of(const Servo& servo) const {
-    return static_cast<std::size_t>(&servo - servos_.data());
-  }
+  std::size_t index_of(const Servo& servo) const { return static_cast<std::size_t>(&servo - servos_.data()); }
   void send_pending();
   double clock() const;
   // Bus Watchdog(98): a servo with torque on whose limit has passed since the last instruction

@@ -84,7 +84,8 @@ class ExcitationCriterion {
 
   // The nominal torque ID(q, qd, qdd; phi) at the instants: N x joints; with `jacobian`, row
   // k * joints + j holds d tau_j(t_k) / dx.
-  Eigen::MatrixXd torque(const Eigen::VectorXd& x, const Eigen::VectorXd& phi, Eigen::MatrixXd* jacobian = nullptr) const;
+  Eigen::MatrixXd torque(const Eigen::VectorXd& x, const Eigen::VectorXd& phi,
+                         Eigen::MatrixXd* jacobian = nullptr) const;
 
   // normal . p - offset per half-space h at the instants: N x spaces; with `jacobian`, row
   // k * spaces + h holds its derivative along x.

@@ -40,10 +40,10 @@ struct ExcitationDesignOptions {
   std::string name = "OF01";
   double period = 10;  // s, one period of the series
   int harmonics = 5;
-  int samples = 0;     // design instants per period; 0: 20 per harmonic, at least 100
+  int samples = 0;        // design instants per period; 0: 20 per harmonic, at least 100
   Eigen::VectorXd start;  // the rest pose at the start and the end
   ExcitationLimits limits;
-  Eigen::VectorXd nominal;     // phi of the nominal model (required with limits.torque)
+  Eigen::VectorXd nominal;      // phi of the nominal model (required with limits.torque)
   double torque_margin = 0.95;  // of the torque limit at the design instants
   std::vector<HalfSpace> workspace;
   double workspace_margin = 0.01;  // m inside the half-spaces at the design instants
@@ -52,9 +52,9 @@ struct ExcitationDesignOptions {
   // other, in this process). The design is the same either way.
   int workers = 0;
   std::uint64_t seed = 1;
-  int max_iterations = 150;     // per start
-  double tolerance = 1e-5;      // Ipopt's relative tolerance
-  double check_period = 1e-3;   // s
+  int max_iterations = 150;    // per start
+  double tolerance = 1e-5;     // Ipopt's relative tolerance
+  double check_period = 1e-3;  // s
 };
 
 // A limit the motion comes nearest to (or passes) in the dense check.
@@ -70,17 +70,17 @@ struct ExcitationStart {
   std::string status;    // Ipopt's return status
   int iterations = 0;
   double seconds = 0;
-  bool solved = false;   // Ipopt's status: a normal end (converged, acceptable, a limit reached)
-  bool passed = false;   // solved, and the dense check passed
-  ExcitationSlack worst; // the tightest limit of the dense check
+  bool solved = false;                       // Ipopt's status: a normal end (converged, acceptable, a limit reached)
+  bool passed = false;                       // solved, and the dense check passed
+  ExcitationSlack worst;                     // the tightest limit of the dense check
   trajectory::FourierTrajectory trajectory;  // the start's design, when it passed
 };
 
 struct ExcitationDesign {
   trajectory::FourierTrajectory trajectory;
-  Eigen::VectorXd scales;   // S of the criterion (the first start's column norms)
-  double criterion = 0;     // log det(S W'W S / N) at the design instants
-  int chosen = -1;          // index into starts
+  Eigen::VectorXd scales;  // S of the criterion (the first start's column norms)
+  double criterion = 0;    // log det(S W'W S / N) at the design instants
+  int chosen = -1;         // index into starts
   std::vector<ExcitationStart> starts;
   std::vector<ExcitationSlack> slack;  // per constraint kind, the tightest of the chosen design
   double seconds = 0;
@@ -99,7 +99,8 @@ ExcitationDesign design_excitation(const identify::IdentificationModel& model, c
 
 // The dense check of a series against the options' limits: the tightest slack per constraint
 // kind (position, velocity, acceleration, then torque and workspace when constrained).
-std::vector<ExcitationSlack> check_excitation(const identify::IdentificationModel& model, const trajectory::FourierTrajectory& t,
+std::vector<ExcitationSlack> check_excitation(const identify::IdentificationModel& model,
+                                              const trajectory::FourierTrajectory& t,
                                               const ExcitationDesignOptions& options);
 
 }  // namespace symoro::excitation

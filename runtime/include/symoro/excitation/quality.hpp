@@ -33,14 +33,14 @@ struct ExcitationQuality {
   double log_det_scaled = -std::numeric_limits<double>::infinity();  // of W_s'W_s, unit columns
   double sigma_min_scaled = 0;
   std::vector<std::pair<std::string, double>> weakest;  // name, component of the weakest direction
-  std::vector<std::string> unexcited;                  // parameters whose column is zero
+  std::vector<std::string> unexcited;                   // parameters whose column is zero
 };
 
 // From a stacked regressor (rows x parameters). `top`: how many components of the weakest
 // direction to name. Throws std::invalid_argument when the names do not match W's columns.
 // raw_kappa false: kappa is left infinite (a caller that has it already saves an SVD of W).
-ExcitationQuality excitation_quality(const Eigen::MatrixXd& W, const std::vector<ParameterInfo>& parameters, int top = 3,
-                                     bool raw_kappa = true);
+ExcitationQuality excitation_quality(const Eigen::MatrixXd& W, const std::vector<ParameterInfo>& parameters,
+                                     int top = 3, bool raw_kappa = true);
 
 // W's triangular factor: the p x p upper triangular R of W = Q R (fewer rows when W has fewer than
 // p), by Householder QR of blocks of rows in turn (R of [R; next block]: each block stays in
@@ -64,7 +64,7 @@ ExcitationQuality excitation_quality_of_factor(const Eigen::MatrixXd& R, Eigen::
 preprocess::Samples reference_samples(const trajectory::SampledReference& reference, double interval);
 
 // The regression of a reference motion (reference_samples) judged as above.
-ExcitationQuality excitation_quality(const identify::IdentificationModel& model, const trajectory::SampledReference& reference,
-                                     double interval, int top = 3);
+ExcitationQuality excitation_quality(const identify::IdentificationModel& model,
+                                     const trajectory::SampledReference& reference, double interval, int top = 3);
 
 }  // namespace symoro::excitation

@@ -17,16 +17,16 @@
 namespace symoro::hardware {
 
 struct ServoModel {
-  std::string name;                 // "XM430-W350"
-  std::uint16_t model_number = 0;   // Model Number(0), checked by ping at start
-  double torque_constant = 0;       // N m / A
-  double current_unit = 0;          // A per Goal/Present Current unit
-  double current_limit = 0;         // A, the model's maximum
+  std::string name;                // "XM430-W350"
+  std::uint16_t model_number = 0;  // Model Number(0), checked by ping at start
+  double torque_constant = 0;      // N m / A
+  double current_unit = 0;         // A per Goal/Present Current unit
+  double current_limit = 0;        // A, the model's maximum
 };
 
 struct JointHardware {
-  std::string name;       // the model's joint name (checked against the robot's joints)
-  std::uint8_t id = 0;    // servo ID
+  std::string name;     // the model's joint name (checked against the robot's joints)
+  std::uint8_t id = 0;  // servo ID
   ServoModel model;
   std::int32_t zero = 2048;  // pulses at q = 0
   int direction = 1;         // +1 or -1
@@ -46,14 +46,14 @@ enum class StopAction { hold, torque_off };
 const char* to_string(StopAction action);
 
 struct Safety {
-  int watchdog_cycles = 3;            // consecutive failed sync reads that stop the arm
-  double position_tolerance = 0.05;   // rad a joint may pass its robot.yaml limit by
-  double velocity_factor = 1.0;       // stop beyond factor * robot.yaml velocity limit
-  double current_trip_factor = 1.5;   // stop when |present current| > factor * current_limit
-  double approach_speed = 0.3;        // rad/s, the move to the trajectory's start posture
-  double pre_roll = 0.5;              // s holding the start posture before the trajectory
+  int watchdog_cycles = 3;                // consecutive failed sync reads that stop the arm
+  double position_tolerance = 0.05;       // rad a joint may pass its robot.yaml limit by
+  double velocity_factor = 1.0;           // stop beyond factor * robot.yaml velocity limit
+  double current_trip_factor = 1.5;       // stop when |present current| > factor * current_limit
+  double approach_speed = 0.3;            // rad/s, the move to the trajectory's start posture
+  double pre_roll = 0.5;                  // s holding the start posture before the trajectory
   StopAction at_stop = StopAction::hold;  // safety.at_stop: hold | torque_off
-  double hold_time = 2.0;             // s of hold before torque off (safety.hold_time, > 0)
+  double hold_time = 2.0;                 // s of hold before torque off (safety.hold_time, > 0)
   // The servos' own Bus Watchdog(98), set before torque on: a servo that hears no instruction
   // packet for this long (the controller crashed, was killed with SIGKILL, or stalled) stops
   // driving its motor by itself. s, rounded up to 20 ms units, 0.02..2.54; 0: off.

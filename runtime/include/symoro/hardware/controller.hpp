@@ -55,27 +55,27 @@ enum class StopReason {
   velocity_limit,
   current_limit,
   invalid_command,  // a torque or current command not finite (NaN, inf): named, never zeroed
-  setup_failed,    // a servo missing, of the wrong model, or refusing the configuration
-  error,           // an exception (serial port failure, log write failure)
+  setup_failed,     // a servo missing, of the wrong model, or refusing the configuration
+  error,            // an exception (serial port failure, log write failure)
 };
 const char* to_string(StopReason reason);
 
 // Per-cycle timing, in seconds unless named otherwise.
 struct TimingStats {
-  std::int64_t cycles = 0;          // control cycles run (all phases)
-  std::int64_t overruns = 0;        // cycles whose work ended after the next deadline
-  std::int64_t skipped = 0;         // deadlines skipped after an overrun
+  std::int64_t cycles = 0;    // control cycles run (all phases)
+  std::int64_t overruns = 0;  // cycles whose work ended after the next deadline
+  std::int64_t skipped = 0;   // deadlines skipped after an overrun
   double period_mean = 0, period_std = 0, period_min = 0, period_max = 0;  // between wake-ups
-  double jitter_max = 0;            // max |period - T|
-  double latency_mean = 0, latency_max = 0;  // wake-up after the deadline
-  double work_mean = 0, work_max = 0;        // wake-up to the end of the cycle's work
-  double read_max = 0;              // the longest sync read
+  double jitter_max = 0;                                                   // max |period - T|
+  double latency_mean = 0, latency_max = 0;                                // wake-up after the deadline
+  double work_mean = 0, work_max = 0;                                      // wake-up to the end of the cycle's work
+  double read_max = 0;                                                     // the longest sync read
   std::int64_t read_failures = 0;   // cycles whose sync read lacked a servo's data
   std::int64_t write_failures = 0;  // sync writes not sent in time
   std::int64_t max_stale = 0;       // most consecutive failed reads
   std::int64_t saturated = 0;       // cycles with a command at its current limit
   dynamixel::BusStats bus;
-  std::string summary() const;      // several lines, for people and the log's notes
+  std::string summary() const;  // several lines, for people and the log's notes
 };
 
 struct ControlOptions {
@@ -87,8 +87,8 @@ struct ControlOptions {
   // Extra joint torque added to FF+PD (N m), from the references: e.g. model_feedforward.
   // When set, the FF+PD's own realization feedforward (M-hat qdd_ref + D-hat qd_ref) is
   // replaced by it (the PD part remains).
-  std::function<void(const Eigen::VectorXd& q_ref, const Eigen::VectorXd& qd_ref,
-                     const Eigen::VectorXd& qdd_ref, Eigen::VectorXd& tau)>
+  std::function<void(const Eigen::VectorXd& q_ref, const Eigen::VectorXd& qd_ref, const Eigen::VectorXd& qdd_ref,
+                     Eigen::VectorXd& tau)>
       feedforward;
   // The model behind `feedforward`: its mass matrix M(q) (nq x nq; model_inertia<Model>(phi)).
   // A feedforward is checked before torque is enabled (else the run stops as setup_failed, torque
@@ -120,17 +120,17 @@ struct ControlOptions {
 
 struct ControlResult {
   StopReason reason = StopReason::error;
-  std::string message;         // one line: what stopped the run and where
+  std::string message;  // one line: what stopped the run and where
   TimingStats timing;
-  std::int64_t rows = 0;        // log rows written
-  double trajectory_time = 0;  // s of the trajectory run
-  Eigen::VectorXd max_error;   // max |q_ref - q| per joint over the logged rows, rad
+  std::int64_t rows = 0;              // log rows written
+  double trajectory_time = 0;         // s of the trajectory run
+  Eigen::VectorXd max_error;          // max |q_ref - q| per joint over the logged rows, rad
   bool torque_off_confirmed = false;  // every answering servo read back Torque Enable 0
   // What the arm did between the stop and torque off (hardware.yaml safety.at_stop):
   StopAction stop_action = StopAction::torque_off;  // hold: the stop pose was held first
-  double held = 0;            // s of hold (less than safety.hold_time when a fault ended it)
-  double hold_deviation = 0;  // max |q - q_stop| over the hold, rad, from the servos' positions
-  std::string at_stop;        // one line: what was done and why (also in the log's notes)
+  double held = 0;                                  // s of hold (less than safety.hold_time when a fault ended it)
+  double hold_deviation = 0;                        // max |q - q_stop| over the hold, rad, from the servos' positions
+  std::string at_stop;                              // one line: what was done and why (also in the log's notes)
 };
 
 // The process-wide count of stop requests, raised by the signal handler of StopSignals.

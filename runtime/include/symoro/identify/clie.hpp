@@ -24,7 +24,7 @@ namespace symoro::identify {
 
 struct ClieOptions {
   int max_iterations = 30;
-  double function_tolerance = 1e-7;   // Ceres: relative change of the cost
+  double function_tolerance = 1e-7;  // Ceres: relative change of the cost
   // The noise-floor stop (docs/identification.md): the solve also ends after a step that lowered
   // the cost by less than noise_floor sigma^2, sigma^2 = 2 cost / (m - p) the residual variance
   // at the new point (m residuals, p parameters). A Gauss-Newton step that lowers the cost by
@@ -37,9 +37,9 @@ struct ClieOptions {
   double noise_floor = 0;
   double parameter_tolerance = 1e-8;
   double gradient_tolerance = 1e-10;
-  double bound_factor = 100;          // bounds phi0_i -+ bound_factor |phi0_i|
-  double min_bound = 1e-4;            // bound half-width floor for phi0_i near 0 (in the parameter's unit)
-  double min_rotor_inertia = 1e-6;    // kg m^2: lower bound of IA parameters
+  double bound_factor = 100;        // bounds phi0_i -+ bound_factor |phi0_i|
+  double min_bound = 1e-4;          // bound half-width floor for phi0_i near 0 (in the parameter's unit)
+  double min_rotor_inertia = 1e-6;  // kg m^2: lower bound of IA parameters
   // A parameter that a step puts on its bound is held there: Ceres is restarted with it
   // constant, and released (another restart) when the gradient at the end of a round pulls it
   // back into the box. Ceres' bounded Levenberg-Marquardt computes each step as if there were no
@@ -52,22 +52,22 @@ struct ClieOptions {
   // deviations): bounds phi0_i -+ std_bound scale_i as well, the tighter of the two applying.
   double std_bound = 0;
   Eigen::VectorXd scale;
-  bool filter = true;                 // the measurement's low-pass on tau_s (off: raw samples)
-  preprocess::Options preprocess;     // must be the options that produced the measured samples
+  bool filter = true;              // the measurement's low-pass on tau_s (off: raw samples)
+  preprocess::Options preprocess;  // must be the options that produced the measured samples
 };
 
 struct ClieResult {
   Eigen::VectorXd phi;
-  bool success = false;             // Ceres converged or hit max_iterations from a valid start
-  Divergence start_divergence;      // set when the starting point's simulation diverges
-  std::string termination;          // Ceres' termination type and message
+  bool success = false;                     // Ceres converged or hit max_iterations from a valid start
+  Divergence start_divergence;              // set when the starting point's simulation diverges
+  std::string termination;                  // Ceres' termination type and message
   double initial_cost = 0, final_cost = 0;  // 0.5 sum of squares, N^2 m^2
   int iterations = 0;
   int jacobian_evaluations = 0, residual_evaluations = 0, rejected_divergent = 0;
   Eigen::VectorXd rms_initial, rms_final;  // per joint torque error at the samples, N m
-  std::vector<int> at_bound;        // parameters ending on a bound
-  std::vector<int> held;            // of those, the ones held there (ClieOptions::hold_at_bounds)
-  double wall = 0;                  // s
+  std::vector<int> at_bound;               // parameters ending on a bound
+  std::vector<int> held;                   // of those, the ones held there (ClieOptions::hold_at_bounds)
+  double wall = 0;                         // s
 };
 
 // The simulated torque at the samples' grid (filtered as the measurement when options.filter):

@@ -48,9 +48,9 @@ ClosedLoopSetup closed_loop_setup(const control::ControllerDescription& controll
 // Why a simulation stopped early.
 struct Divergence {
   bool diverged = false;
-  double time = 0;      // s
-  int joint = -1;       // 0-based, -1 when not joint-specific
-  std::string reason;   // e.g. "tracking error 0.62 rad", "M not positive definite", "not finite"
+  double time = 0;               // s
+  int joint = -1;                // 0-based, -1 when not joint-specific
+  std::string reason;            // e.g. "tracking error 0.62 rad", "M not positive definite", "not finite"
   std::string describe() const;  // one line for reports
 };
 

@@ -30,8 +30,8 @@ struct ModelDescription {
   int nq = 0, np = 0;
   std::vector<ParameterInfo> parameters;  // phi's entries
   std::vector<JointInfo> joints;
-  std::vector<StandardParameterInfo> standard;  // the argument of base_from_standard
-  std::vector<FrameInfo> frames;                // the modified-DH frames (symoro/mdh.hpp)
+  std::vector<StandardParameterInfo> standard;        // the argument of base_from_standard
+  std::vector<FrameInfo> frames;                      // the modified-DH frames (symoro/mdh.hpp)
   Eigen::Vector3d gravity = Eigen::Vector3d::Zero();  // in frame 0 (m/s^2): which way is down
 };
 

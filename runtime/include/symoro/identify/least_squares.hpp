@@ -21,11 +21,11 @@ struct LeastSquaresResult {
   Eigen::VectorXd std_dev;
   // W'W / sigma^2 (weighted rows for WLS): the inverse of the estimate's covariance.
   Eigen::MatrixXd information;
-  double kappa = 0;          // sigma_max / sigma_min of W (unweighted, as the paper reports it)
-  double kappa_scaled = 0;   // the same with unit-norm columns
-  double residual_rms = 0;   // N m, of y - W phi over all rows
-  Eigen::VectorXd joint_rms; // per joint residual rms
-  Eigen::VectorXd weights;   // per joint row weight (all 1 for OLS)
+  double kappa = 0;           // sigma_max / sigma_min of W (unweighted, as the paper reports it)
+  double kappa_scaled = 0;    // the same with unit-norm columns
+  double residual_rms = 0;    // N m, of y - W phi over all rows
+  Eigen::VectorXd joint_rms;  // per joint residual rms
+  Eigen::VectorXd weights;    // per joint row weight (all 1 for OLS)
   int rows = 0;
   bool weighted = false;
 };

@@ -29,12 +29,12 @@ struct AuditPose {
 };
 
 struct AuditResult {
-  double lambda_min = 0;        // the smallest eigenvalue found over the box
-  Eigen::VectorXd worst_pose;   // where
+  double lambda_min = 0;          // the smallest eigenvalue found over the box
+  Eigen::VectorXd worst_pose;     // where
   std::vector<AuditPose> minima;  // distinct local minima (and best samples), worst first
-  int sampled = 0;              // poses evaluated by sampling
-  int local_searches = 0;       // Ipopt runs
-  double wall = 0;              // s
+  int sampled = 0;                // poses evaluated by sampling
+  int local_searches = 0;         // Ipopt runs
+  double wall = 0;                // s
   bool positive_definite(double margin = 0) const { return lambda_min > margin; }
 };
 

@@ -31,11 +31,11 @@ struct LinkInertialIndices {
 enum class StandardGroup { Mass, FirstMoment, Inertia, RotorInertia, Viscous, Coulomb, Other };
 
 struct ConsistencyStructure {
-  Eigen::MatrixXd B;                        // np x ns: phi = B s
-  std::vector<std::string> names;           // ns standard parameter names (messages)
-  std::vector<StandardGroup> group;         // ns
-  std::vector<LinkInertialIndices> links;   // links with at least one inertial parameter
-  std::vector<int> nonnegative;             // IA, FV, FS: lower bound 0 unless options say otherwise
+  Eigen::MatrixXd B;                       // np x ns: phi = B s
+  std::vector<std::string> names;          // ns standard parameter names (messages)
+  std::vector<StandardGroup> group;        // ns
+  std::vector<LinkInertialIndices> links;  // links with at least one inertial parameter
+  std::vector<int> nonnegative;            // IA, FV, FS: lower bound 0 unless options say otherwise
 };
 
 struct ConsistencyOptions {
@@ -84,7 +84,7 @@ enum class ConsistencyStatus {
 
 struct ConsistencyResult {
   ConsistencyStatus status = ConsistencyStatus::SolverFailure;
-  std::string message;              // one sentence: why this status
+  std::string message;  // one sentence: why this status
   bool ok() const { return status == ConsistencyStatus::Consistent; }
 
   Eigen::VectorXd s;                // Consistent: the answer; NoConsistentSet: a consistent set for phi_consistent
@@ -102,8 +102,8 @@ struct ConsistencyResult {
   Eigen::VectorXd phi_consistent;
   double base_distance = 0;
 
-  int solves = 0;                   // CSDP solves
-  double wall = 0;                  // s
+  int solves = 0;   // CSDP solves
+  double wall = 0;  // s
 };
 
 const char* to_string(ConsistencyStatus s);
@@ -121,7 +121,6 @@ Eigen::Matrix4d pseudo_inertia(const Eigen::VectorXd& s, const LinkInertialIndic
 
 // Throws std::invalid_argument on inconsistent sizes or non-finite input.
 ConsistencyResult consistent_standard_parameters(const ConsistencyStructure& structure, const Eigen::VectorXd& phi,
-                                                 const Eigen::VectorXd& prior,
-                                                 const ConsistencyOptions& options = {});
+                                                 const Eigen::VectorXd& prior, const ConsistencyOptions& options = {});
 
 }  // namespace symoro::identify

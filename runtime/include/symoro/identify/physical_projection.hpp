@@ -26,25 +26,26 @@
 namespace symoro::identify {
 
 struct PhysicalProjection {
-  ConsistencyResult check;    // of phi0 (with the projection's search when it has no consistent set)
-  bool consistent = false;    // phi0 has a consistent standard set: phi = phi0
-  bool projected = false;     // it had none: phi is the nearest base vector that has one
-  bool feasible = false;      // phi has a consistent standard set (verified by its own solve)
-  Eigen::VectorXd phi;        // the model's base vector (phi0 when not projected or when it failed)
+  ConsistencyResult check;  // of phi0 (with the projection's search when it has no consistent set)
+  bool consistent = false;  // phi0 has a consistent standard set: phi = phi0
+  bool projected = false;   // it had none: phi is the nearest base vector that has one
+  bool feasible = false;    // phi has a consistent standard set (verified by its own solve)
+  Eigen::VectorXd phi;      // the model's base vector (phi0 when not projected or when it failed)
   // The smallest pseudo-inertia eigenvalue margin of phi relative to the links' size (phase 1's
   // t of physical_consistency.hpp; < 0: no consistent set). NaN when the prior's own projection
   // onto phi was consistent (phase 1 not needed).
   double margin = std::numeric_limits<double>::quiet_NaN();
-  double distance = 0;        // |R (phi - phi0)| in the caller's metric (0 when not projected)
-  std::string status;         // one sentence
-  double wall = 0;            // s
+  double distance = 0;  // |R (phi - phi0)| in the caller's metric (0 when not projected)
+  std::string status;   // one sentence
+  double wall = 0;      // s
 };
 
 // The parent's base rows a variant fixes (empty for a full model), 0-based.
 template <class Model>
 std::vector<int> fixed_parent_rows() {
   std::vector<int> free(Model::Parent::np, 0), held;
-  for (int i = 0; i < Model::np; ++i) free[static_cast<std::size_t>(Model::parent_index[static_cast<std::size_t>(i)])] = 1;
+  for (int i = 0; i < Model::np; ++i)
+    free[static_cast<std::size_t>(Model::parent_index[static_cast<std::size_t>(i)])] = 1;
   for (int i = 0; i < Model::Parent::np; ++i)
     if (!free[static_cast<std::size_t>(i)]) held.push_back(i);
   return held;
@@ -88,13 +89,16 @@ ConsistencyResult physical_check(const Eigen::VectorXd& phi, Eigen::VectorXd pri
 // (prior regularization, tolerances); its held rows, metric and clearance are set here.
 template <class Model>
 PhysicalProjection physical_projection(const Eigen::VectorXd& phi0, Eigen::VectorXd prior,
-                                       const Eigen::MatrixXd& metric, double clearance, ConsistencyOptions options = {}) {
+                                       const Eigen::MatrixXd& metric, double clearance,
+                                       ConsistencyOptions options = {}) {
   const auto t0 = std::chrono::steady_clock::now();
   PhysicalProjection p;
   p.phi = phi0;
   if constexpr (!supports_physical_consistency<Model>()) {
-    p.status = fmt::format("physical consistency is not available for the {} model: its effect parameters are not "
-                           "standard inertial parameters (use the PD path)", Model::variant_name);
+    p.status = fmt::format(
+        "physical consistency is not available for the {} model: its effect parameters are not "
+        "standard inertial parameters (use the PD path)",
+        Model::variant_name);
     return p;
   } else {
     if (metric.rows() != Model::np || metric.cols() != Model::np)
@@ -108,18 +112,20 @@ PhysicalProjection physical_projection(const Eigen::VectorXd& phi0, Eigen::Vecto
     if (p.check.ok()) {
       p.consistent = p.feasible = true;
       p.status = "consistent: " + p.check.message;
-    } else if (p.check.status == ConsistencyStatus::NoConsistentSet && p.check.phi_consistent.size() == Model::Parent::np) {
+    } else if (p.check.status == ConsistencyStatus::NoConsistentSet &&
+               p.check.phi_consistent.size() == Model::Parent::np) {
       p.projected = true;
       const Eigen::Matrix<double, Model::Parent::np, 1> full = p.check.phi_consistent;
       p.phi = Model::from_parent(full).template cast<double>();
-      p.distance = (options.base_metric_root * (Model::to_parent(Eigen::Matrix<double, Model::np, 1>(p.phi)) -
-                                                 consistency_target<Model>(phi0)))
+      p.distance = (options.base_metric_root *
+                    (Model::to_parent(Eigen::Matrix<double, Model::np, 1>(p.phi)) - consistency_target<Model>(phi0)))
                        .norm();
       const ConsistencyResult v = physical_check<Model>(p.phi, prior);
       p.feasible = v.ok();
       p.margin = v.feasibility;
-      p.status = p.feasible ? fmt::format("projected onto the consistent set (distance {:.4g}); {}", p.distance, v.message)
-                            : fmt::format("the projection has no consistent set after all: {}", v.message);
+      p.status = p.feasible
+                     ? fmt::format("projected onto the consistent set (distance {:.4g}); {}", p.distance, v.message)
+                     : fmt::format("the projection has no consistent set after all: {}", v.message);
       if (!p.feasible) p.phi = phi0;
     } else {
       p.status = p.check.message;

@@ -10,8 +10,8 @@
 namespace symoro::identify {
 
 struct Regression {
-  Eigen::MatrixXd W;   // (samples * joints) x parameters; row s * joints + j
-  Eigen::VectorXd y;   // measured tau minus fixed_torque, same rows
+  Eigen::MatrixXd W;  // (samples * joints) x parameters; row s * joints + j
+  Eigen::VectorXd y;  // measured tau minus fixed_torque, same rows
   int joints = 0, samples = 0;
 };
 

@@ -20,13 +20,13 @@
 namespace symoro::identify {
 
 struct ProjectionOptions {
-  double eps = 0.001;          // margin, in M's units (kg m^2)
+  double eps = 0.001;  // margin, in M's units (kg m^2)
   // The audit's verdict accepts lambda_min >= eps - accept_slack; for eps = 0 (the post-CLIE
   // rescue) the SDP itself uses rescue_floor so that the strict test lambda_min > 0 holds.
   double accept_slack = 1e-9;
   double rescue_floor = 1e-7;
-  int max_rounds = 30;         // exchange rounds
-  int poses_per_round = 4;     // worst distinct audit minima added per round
+  int max_rounds = 30;      // exchange rounds
+  int poses_per_round = 4;  // worst distinct audit minima added per round
   // The exchange ends slowly: each new pose's basin minimum drifts a little as phi moves, so the
   // audit's shortfall shrinks by a small factor per round. When > 0, each round also raises the
   // SDP's margin by this fraction of the audit's shortfall (accumulated): fewer rounds for a
@@ -34,7 +34,7 @@ struct ProjectionOptions {
   // the distance about 1e-4 larger in relative terms). The raise stays below max(eps, 1 % of
   // phi0's violation): a large shortfall is a new basin, not drift. 0: the plain exchange.
   double shortfall_raise = 0;
-  AuditOptions audit;          // the audit run after each solve
+  AuditOptions audit;  // the audit run after each solve
   // Diagonal weights of the distance (empty: the paper's plain Euclidean norm).
   Eigen::VectorXd weights;
   // A symmetric positive definite np x np metric A: the distance is sqrt(d' A d), d = phi - phi0
@@ -50,15 +50,15 @@ Eigen::MatrixXd information_metric(const Eigen::MatrixXd& information, double ri
 
 struct ProjectionResult {
   Eigen::VectorXd phi;
-  bool feasible = false;       // the final all-pose audit passed at the margin
-  double eps = 0;              // the margin asked for
-  double lambda_min = 0;       // from the final audit
+  bool feasible = false;  // the final all-pose audit passed at the margin
+  double eps = 0;         // the margin asked for
+  double lambda_min = 0;  // from the final audit
   Eigen::VectorXd worst_pose;
-  double distance = 0;         // |phi - phi0| (weighted when weights are given)
-  int rounds = 0;              // exchange rounds, one SDP each (project_on_poses: CSDP solves)
-  int poses = 0;               // working-set size at the end
-  std::string status;          // "ok", or CSDP's failure / why the loop stopped
-  double wall = 0;             // s
+  double distance = 0;  // |phi - phi0| (weighted when weights are given)
+  int rounds = 0;       // exchange rounds, one SDP each (project_on_poses: CSDP solves)
+  int poses = 0;        // working-set size at the end
+  std::string status;   // "ok", or CSDP's failure / why the loop stopped
+  double wall = 0;      // s
 };
 
 // The working set starts with the domain's centre and the worst minima of phi0's audit; round r
@@ -86,11 +86,11 @@ ProjectionResult project_on_poses(const InertiaFunction& m, const Eigen::VectorX
 // the all-pose audit. When none does: feasible = false, phi = phi0 and eps = 0 (a failed
 // projection is never handed on); the attempts keep what each margin reached.
 struct ConditionalProjection {
-  AuditResult audit;            // of phi0
-  bool projected = false;       // false: phi0 was PD and is returned unchanged
-  bool feasible = false;        // phi is PD over the box
-  double eps = 0;               // the adopted margin (0 when not projected)
-  Eigen::VectorXd phi;          // the CLIE starting point (phi0 when not feasible)
+  AuditResult audit;                       // of phi0
+  bool projected = false;                  // false: phi0 was PD and is returned unchanged
+  bool feasible = false;                   // phi is PD over the box
+  double eps = 0;                          // the adopted margin (0 when not projected)
+  Eigen::VectorXd phi;                     // the CLIE starting point (phi0 when not feasible)
   std::vector<ProjectionResult> attempts;  // one per margin tried
 };
 

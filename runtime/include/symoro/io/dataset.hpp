@@ -50,13 +50,13 @@ struct ImportedFile {
 struct Dataset {
   std::filesystem::path dir;
   std::string robot;
-  std::string twin;             // the twin configuration that made it ("" for measured data)
-  std::string twin_overrides;   // the overrides it was made with, a file in the folder (absolute
-                                // when read; when written, absolute or relative to the folder), or ""
-  std::string source;           // "imported" (dynid import), or "" (not recorded)
-  int robot_line = 0;           // line of "robot:" in dataset.yaml (0: none; set when read)
+  std::string twin;            // the twin configuration that made it ("" for measured data)
+  std::string twin_overrides;  // the overrides it was made with, a file in the folder (absolute
+                               // when read; when written, absolute or relative to the folder), or ""
+  std::string source;          // "imported" (dynid import), or "" (not recorded)
+  int robot_line = 0;          // line of "robot:" in dataset.yaml (0: none; set when read)
   std::optional<TwinDatasetRecord> twin_record;
-  double split = 0;             // dynid import --split (a record; the windows are what counts)
+  double split = 0;  // dynid import --split (a record; the windows are what counts)
   std::optional<ImportCounts> import;
   std::vector<ImportedFile> imported;
   std::vector<DatasetRun> runs;

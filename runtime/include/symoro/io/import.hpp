@@ -36,7 +36,7 @@ namespace symoro::io {
 
 enum class TimeUnit { s, ms, us, ns };
 enum class AngleUnit { rad, deg };
-enum class HeaderRow { automatic, present, absent };  // automatic: a first row with a non-number
+enum class HeaderRow { automatic, present, absent };               // automatic: a first row with a non-number
 enum class Delimiter { automatic, comma, semicolon, whitespace };  // automatic: ',' then ';' then blanks
 
 struct ImportMapping {
@@ -64,8 +64,8 @@ std::string import_mapping_yaml(const ImportMapping& mapping);
 // The robot the logs are of.
 struct ImportTarget {
   std::string robot;
-  std::vector<std::string> joints;  // names, in the model's order
-  std::vector<bool> prismatic;      // per joint (empty: all revolute)
+  std::vector<std::string> joints;   // names, in the model's order
+  std::vector<bool> prismatic;       // per joint (empty: all revolute)
   std::vector<double> lower, upper;  // position limits per joint, rad or m (empty: not checked)
   std::vector<double> effort;        // torque (force) limits per joint, N m or N (empty or 0: not checked)
 };
@@ -77,10 +77,10 @@ ImportTarget import_target(const std::string& robot, const std::vector<JointInfo
 // "" (0 for torque_scale) leaves a setting as the mapping has it.
 struct MappingSettings {
   std::string time, q, qd, tau, q_ref, qd_ref, qdd_ref;  // column selectors
-  std::string time_unit;  // s | ms | us | ns
-  std::string angle;      // rad | deg
-  std::string header;     // auto | yes | no
-  std::string delimiter;  // auto | comma | semicolon | whitespace
+  std::string time_unit;                                 // s | ms | us | ns
+  std::string angle;                                     // rad | deg
+  std::string header;                                    // auto | yes | no
+  std::string delimiter;                                 // auto | comma | semicolon | whitespace
   double torque_scale = 0;
 };
 // std::invalid_argument naming the setting and its choices for a word not among them.
@@ -89,12 +89,12 @@ void apply_settings(ImportMapping& mapping, const MappingSettings& settings);
 // One input file, converted.
 struct ImportedLog {
   std::filesystem::path input;
-  Log log;                           // meta: robot, trajectory (the file's stem), source "robot",
-                                     // sample_time (median interval to the us), velocity
-  int rows = 0;                      // data rows in the input
-  std::vector<int> lines;            // 1-based input line of each written row
-  std::vector<int> stale_lines;      // 1-based input lines of stale rows (kept)
-  std::vector<int> duplicate_lines;  // 1-based input lines of duplicates (dropped)
+  Log log;                                     // meta: robot, trajectory (the file's stem), source "robot",
+                                               // sample_time (median interval to the us), velocity
+  int rows = 0;                                // data rows in the input
+  std::vector<int> lines;                      // 1-based input line of each written row
+  std::vector<int> stale_lines;                // 1-based input lines of stale rows (kept)
+  std::vector<int> duplicate_lines;            // 1-based input lines of duplicates (dropped)
   std::map<std::string, std::string> columns;  // log column -> input column ("q1" -> "pos_1 (column 3)")
 };
 

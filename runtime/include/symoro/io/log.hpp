@@ -41,22 +41,22 @@ namespace symoro::io {
 enum class Velocity { measured, differentiated };
 
 struct LogMetadata {
-  std::string robot;        // robots/<robot>
-  std::string trajectory;   // e.g. "AG02"
-  int trial = 0;            // repetition number, 1-based (0: not a repeated trial)
-  std::uint64_t seed = 0;   // the twin's seed (0 for a real arm)
-  std::string source;       // "twin", "robot" or "reference"
-  double sample_time = 0;   // nominal control period, s (e.g. 0.001)
-  std::vector<std::string> joints;  // joint names, in column order 1..n
-  std::string notes;        // free text (e.g. the twin configuration used)
+  std::string robot;                       // robots/<robot>
+  std::string trajectory;                  // e.g. "AG02"
+  int trial = 0;                           // repetition number, 1-based (0: not a repeated trial)
+  std::uint64_t seed = 0;                  // the twin's seed (0 for a real arm)
+  std::string source;                      // "twin", "robot" or "reference"
+  double sample_time = 0;                  // nominal control period, s (e.g. 0.001)
+  std::vector<std::string> joints;         // joint names, in column order 1..n
+  std::string notes;                       // free text (e.g. the twin configuration used)
   Velocity velocity = Velocity::measured;  // sidecar key written only when differentiated
 };
 
 // Samples are rows: time(k), q(k, j). Reference matrices have 0 columns when the log has none.
 struct Log {
   LogMetadata meta;
-  Eigen::VectorXd time;                 // s
-  Eigen::MatrixXd q, qd, tau;           // samples x joints
+  Eigen::VectorXd time;        // s
+  Eigen::MatrixXd q, qd, tau;  // samples x joints
   Eigen::MatrixXd q_ref, qd_ref, qdd_ref;
   // A window of a longer file (a dataset run's window, io::read_run_log): that file as read, and
   // the row of it where this log's rows begin. Preprocessing filters the whole file and keeps

@@ -39,17 +39,15 @@ namespace symoro::io {
 class LogStream {
  public:
   LogStream(std::filesystem::path csv, LogMetadata meta, bool references,
-            std::chrono::milliseconds flush_every = std::chrono::milliseconds(100),
-            std::size_t capacity = 1 << 14);
+            std::chrono::milliseconds flush_every = std::chrono::milliseconds(100), std::size_t capacity = 1 << 14);
   ~LogStream();
   LogStream(const LogStream&) = delete;
   LogStream& operator=(const LogStream&) = delete;
 
   // One row; each pointer holds joints() values (the reference ones are ignored without
   // references). False when the row was dropped (not finite, time not increasing, overflow).
-  bool append(double time, const double* q, const double* qd, const double* tau,
-              const double* q_ref = nullptr, const double* qd_ref = nullptr,
-              const double* qdd_ref = nullptr);
+  bool append(double time, const double* q, const double* qd, const double* tau, const double* q_ref = nullptr,
+              const double* qd_ref = nullptr, const double* qdd_ref = nullptr);
   // Notes for the sidecar (written at the next flush and by close()).
   void set_notes(std::string notes);
   // Writes what is buffered now and waits until it is on disk (CSV and sidecar).

@@ -12,6 +12,7 @@ void check_regular_file(const std::filesystem::path& path);
 
 // The file's bytes; DataError(path, 0, missing_message) when it cannot be opened or is no
 // regular file.
-std::string read_text_file(const std::filesystem::path& path, const std::string& missing_message = "cannot read the file");
+std::string read_text_file(const std::filesystem::path& path,
+                           const std::string& missing_message = "cannot read the file");
 
 }  // namespace symoro::io

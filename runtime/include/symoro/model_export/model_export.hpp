@@ -17,10 +17,10 @@
 namespace symoro::model_export {
 
 struct ModelExportOptions {
-  Eigen::VectorXd prior;      // standard parameters (description().standard's order) the inertials lean to
-  std::string prior_what;     // what the prior is, for the notes
-  std::string study;          // the study folder, for the notes
-  bool accepted = true;       // whether the study's final audit accepted phi (said in the notes)
+  Eigen::VectorXd prior;   // standard parameters (description().standard's order) the inertials lean to
+  std::string prior_what;  // what the prior is, for the notes
+  std::string study;       // the study folder, for the notes
+  bool accepted = true;    // whether the study's final audit accepted phi (said in the notes)
   // Every link's pseudo-inertia >= margin I: strictly inside the consistent set, above rounding
   // (a singular pseudo-inertia is a body some simulators reject).
   double margin = 1e-9;
@@ -34,22 +34,24 @@ struct ModelExportOptions {
 
 struct ModelExport {
   identify::ConsistencyResult consistency;
-  bool nearest = false;     // the nearest consistent base vector was exported, not phi
-  double residual = 0;      // max |B s - phi| (phi in the full model's base)
-  std::string cost;         // ModelExportOptions::cost's sentence, when there is no consistent set
+  bool nearest = false;         // the nearest consistent base vector was exported, not phi
+  double residual = 0;          // max |B s - phi| (phi in the full model's base)
+  std::string cost;             // ModelExportOptions::cost's sentence, when there is no consistent set
   UrdfDescription description;  // s and the provenance notes
-  std::string header;       // the standard-parameter YAML's header
+  std::string header;           // the standard-parameter YAML's header
 };
 
 // Throws std::runtime_error ("no URDF written: ...") when no consistent set reproduces phi and
 // not options.nearest, or the solve fails; std::logic_error for a model with effect parameters.
-ModelExport export_model(const identify::IdentificationModel& model, const Eigen::VectorXd& phi, const ModelExportOptions& options);
+ModelExport export_model(const identify::IdentificationModel& model, const Eigen::VectorXd& phi,
+                         const ModelExportOptions& options);
 
 // Writes `urdf_text` to `urdf` and the standard parameters to <urdf stem>.standard.yaml and
 // .standard.csv (each atomically, folders created); returns the three paths.
 struct ModelExportFiles {
   std::filesystem::path urdf, yaml, csv;
 };
-ModelExportFiles write_model_export(const ModelExport& e, const std::filesystem::path& urdf, const std::string& urdf_text);
+ModelExportFiles write_model_export(const ModelExport& e, const std::filesystem::path& urdf,
+                                    const std::string& urdf_text);
 
 }  // namespace symoro::model_export

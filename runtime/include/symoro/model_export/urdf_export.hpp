@@ -19,12 +19,12 @@
 namespace symoro::model_export {
 
 struct UrdfDescription {
-  std::string robot;                          // <robot name="...">
-  std::vector<FrameInfo> frames;              // frames 1..nf (entry i: frame i + 1)
-  std::vector<JointInfo> joints;              // the movable frames, in frame order
-  std::vector<StandardParameterInfo> names;   // the entries of s
-  Eigen::VectorXd s;                          // standard parameters
-  std::vector<std::string> notes;             // comment lines after the convention (provenance)
+  std::string robot;                         // <robot name="...">
+  std::vector<FrameInfo> frames;             // frames 1..nf (entry i: frame i + 1)
+  std::vector<JointInfo> joints;             // the movable frames, in frame order
+  std::vector<StandardParameterInfo> names;  // the entries of s
+  Eigen::VectorXd s;                         // standard parameters
+  std::vector<std::string> notes;            // comment lines after the convention (provenance)
 };
 
 // One link's inertial as URDF has it. `present` is false when the model has no inertial
@@ -33,13 +33,14 @@ struct UrdfDescription {
 struct UrdfInertial {
   bool present = false;
   double mass = 0;
-  Eigen::Vector3d com = Eigen::Vector3d::Zero();           // in the link (model) frame
-  Eigen::Matrix3d inertia = Eigen::Matrix3d::Zero();       // about the CoM, link-frame axes
+  Eigen::Vector3d com = Eigen::Vector3d::Zero();      // in the link (model) frame
+  Eigen::Matrix3d inertia = Eigen::Matrix3d::Zero();  // about the CoM, link-frame axes
 };
 
 // Frame-origin parameters (inertia I about the frame origin, first moments h = m c, mass m) to
 // URDF's CoM form: c = h / m (0 when m = 0), I_c = I - m (|c|^2 1 - c c'). And back.
-UrdfInertial inertial_about_com(const Eigen::Matrix3d& inertia_origin, const Eigen::Vector3d& first_moment, double mass);
+UrdfInertial inertial_about_com(const Eigen::Matrix3d& inertia_origin, const Eigen::Vector3d& first_moment,
+                                double mass);
 void inertial_about_origin(const UrdfInertial& in, Eigen::Matrix3d& inertia_origin, Eigen::Vector3d& first_moment,
                            double& mass);
 

@@ -54,11 +54,11 @@ struct FarmOptions {
 // What became of one task, on rank 0.
 struct TaskEnd {
   std::size_t task = 0;
-  int rank = 0;                // the rank that ran it
+  int rank = 0;  // the rank that ran it
   bool failed = false;
-  std::string failure;         // why: the exception's message, or the signal that killed it
-  double wall = 0;             // s
-  double peak_memory_mb = 0;   // the task's process's peak resident memory (isolated tasks only)
+  std::string failure;        // why: the exception's message, or the signal that killed it
+  double wall = 0;            // s
+  double peak_memory_mb = 0;  // the task's process's peak resident memory (isolated tasks only)
 };
 
 struct Farm {
@@ -78,7 +78,7 @@ struct Farm {
 
 struct FarmSummary {
   int ranks = 1;
-  int workers = 1;  // worker threads per rank (on rank 0)
+  int workers = 1;             // worker threads per rank (on rank 0)
   std::vector<TaskEnd> tasks;  // rank 0: one per task, in list order
   bool stopped = false;        // Farm::stop said so: some tasks did not run
 };

@@ -22,7 +22,7 @@ struct Options {
   int filter_order = 4;   // Butterworth order, applied forward and backward (zero phase)
   // One low-pass is applied to q and tau alike (so that the regressor and the torque see the
   // same filter): cutoff = min(derivative_cutoff, anti_alias_fraction * target Nyquist).
-  double derivative_cutoff = 15.0;    // Hz
+  double derivative_cutoff = 15.0;  // Hz
   double anti_alias_fraction = 0.8;
   // Rows whose q, qd and tau repeat the previous row bit for bit (qd compared only when it
   // was measured) are the logger reading one state twice: their stamp is not the state's
@@ -53,18 +53,18 @@ double base_period(const io::Log& log, const Options& options);
 
 struct Report {
   int raw_samples = 0;
-  double base_period = 0;     // s, the grid used (see base_period())
-  int stale_rows = 0;         // repeated rows left out (Options::drop_stale)
-  int irregular_stamps = 0;   // intervals deviating from base_period by more than 10 %
-  int gaps_bridged = 0;       // gaps longer than 1.5 base periods and up to max_gap
-  int missing_samples = 0;    // base-grid samples filled in across bridged gaps
-  int pieces = 0;             // independent pieces after splitting at long gaps
+  double base_period = 0;          // s, the grid used (see base_period())
+  int stale_rows = 0;              // repeated rows left out (Options::drop_stale)
+  int irregular_stamps = 0;        // intervals deviating from base_period by more than 10 %
+  int gaps_bridged = 0;            // gaps longer than 1.5 base periods and up to max_gap
+  int missing_samples = 0;         // base-grid samples filled in across bridged gaps
+  int pieces = 0;                  // independent pieces after splitting at long gaps
   double max_stamp_deviation = 0;  // s, largest distance of a stamp from its base-grid point
   // Pieces shorter than the filter's edge padding cannot be filtered; they are left out and
   // counted here (the log as a whole is rejected when no piece is long enough).
   int dropped_pieces = 0;
-  int dropped_samples = 0;    // raw samples in the dropped pieces
-  double cutoff = 0;          // Hz, the low-pass actually used
+  int dropped_samples = 0;  // raw samples in the dropped pieces
+  double cutoff = 0;        // Hz, the low-pass actually used
   // Target samples within the filter's settling time (settling_seconds) of a piece's end where
   // the arm moves, left out (edges.hpp), and how many such ends there were.
   int edge_samples = 0;
@@ -73,16 +73,16 @@ struct Report {
   // A window of a longer file (io::Log::file: a dataset run's window): the file's rows around
   // it that were filtered through and not returned. 0 for a whole log.
   int context_rows = 0;
-  int kept_samples = 0;       // target-grid samples returned
+  int kept_samples = 0;         // target-grid samples returned
   std::string summary() const;  // one line for logs and reports
 };
 
 // Regression-ready samples at one interval: rows are samples on the target grid.
 struct Samples {
-  double interval = 0;         // s
-  Eigen::VectorXd time;        // s, multiples of `interval` from the log's first stamp
+  double interval = 0;              // s
+  Eigen::VectorXd time;             // s, multiples of `interval` from the log's first stamp
   Eigen::MatrixXd q, qd, qdd, tau;  // samples x joints
-  std::vector<int> piece;      // which piece of the log each sample came from
+  std::vector<int> piece;           // which piece of the log each sample came from
   Report report;
 };
 

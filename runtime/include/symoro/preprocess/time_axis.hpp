@@ -36,8 +36,7 @@ struct StampAnalysis {
 // Validates and segments the stamps. Throws DataError(source, 0, ...) when a stamp is not
 // finite, time does not increase strictly, there are fewer than 2 stamps, or the median
 // interval is more than 10 % off `period` (the grid would resample the log, not correct it).
-StampAnalysis analyse_stamps(const Eigen::VectorXd& time, double period, double max_gap,
-                             const std::string& source);
+StampAnalysis analyse_stamps(const Eigen::VectorXd& time, double period, double max_gap, const std::string& source);
 
 // Linear interpolation of raw rows onto a piece's grid points: grid sample k is
 // (1 - weight[k]) * row left_row[k] + weight[k] * row left_row[k] + 1.
@@ -60,7 +59,6 @@ struct GridInterpolation {
 };
 
 // Needs a piece of at least 2 stamps.
-GridInterpolation grid_interpolation(const Eigen::VectorXd& time, const StampAnalysis& stamps,
-                                     const StampPiece& piece);
+GridInterpolation grid_interpolation(const Eigen::VectorXd& time, const StampAnalysis& stamps, const StampPiece& piece);
 
 }  // namespace symoro::preprocess

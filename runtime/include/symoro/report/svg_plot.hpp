@@ -71,7 +71,7 @@ struct Panel {
 struct Figure {
   std::string title;
   std::vector<Panel> panels;
-  int columns = 0;  // panels per row; 0: all in one row
+  int columns = 0;                               // panels per row; 0: all in one row
   double panel_width = 340, panel_height = 280;  // px, each panel including its axes' margins
   bool legend = true;
 };

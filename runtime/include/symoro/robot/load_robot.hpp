@@ -14,8 +14,8 @@
 namespace symoro::robot {
 
 struct LoadOptions {
-  std::filesystem::path cache_dir;  // empty: the default robot cache
-  int jobs = 0;                     // parallel compiles of a build; 0: the machine's cores
+  std::filesystem::path cache_dir;                   // empty: the default robot cache
+  int jobs = 0;                                      // parallel compiles of a build; 0: the machine's cores
   std::function<void(const std::string&)> progress;  // build progress, when set
 };
 

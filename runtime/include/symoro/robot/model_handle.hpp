@@ -45,7 +45,9 @@ class ModelHandle {
   const symoro_abi_model& abi() const { return *m_; }
 
   // The generated functions; sizes as in symoro/robot_abi.h. One indirect call each.
-  void regressor(const double* q, const double* qd, const double* qdd, double* W) const { m_->regressor(q, qd, qdd, W); }
+  void regressor(const double* q, const double* qd, const double* qdd, double* W) const {
+    m_->regressor(q, qd, qdd, W);
+  }
   void fixed_torque(const double* q, const double* qd, const double* qdd, double* tau) const {
     m_->fixed_torque(q, qd, qdd, tau);
   }
@@ -53,7 +55,9 @@ class ModelHandle {
     m_->inverse_dynamics(q, qd, qdd, phi, tau);
   }
   void inertia(const double* q, const double* phi, double* M) const { m_->inertia(q, phi, M); }
-  void inertia_basis(const double* q, double* constant, double* linear) const { m_->inertia_basis(q, constant, linear); }
+  void inertia_basis(const double* q, double* constant, double* linear) const {
+    m_->inertia_basis(q, constant, linear);
+  }
   void nonlinear_effects(const double* q, const double* qd, const double* phi, double* h) const {
     m_->nonlinear_effects(q, qd, phi, h);
   }

@@ -57,7 +57,8 @@ struct FinalAuditOptions {
   int start_factor = 2;              // times its local minimizations
   std::uint64_t seed_offset = 7919;  // added to its seed: another scrambling, poses it never saw
 };
-identify::AuditOptions final_audit_options(const identify::AuditOptions& pipeline, const FinalAuditOptions& final_audit);
+identify::AuditOptions final_audit_options(const identify::AuditOptions& pipeline,
+                                           const FinalAuditOptions& final_audit);
 // One line for the report: the settings as numbers.
 std::string describe(const identify::AuditOptions& final_audit);
 

@@ -38,15 +38,15 @@ const char* to_string(Consistency c);
 Consistency consistency_from_string(const std::string& s);
 
 struct StudyOptions {
-  std::filesystem::path data;   // dataset folder (dataset.yaml and its logs)
-  std::filesystem::path out;    // study folder: runs/ (one file per run) and the report
-  int trial = 1;                // which repetition of each trajectory
+  std::filesystem::path data;             // dataset folder (dataset.yaml and its logs)
+  std::filesystem::path out;              // study folder: runs/ (one file per run) and the report
+  int trial = 1;                          // which repetition of each trajectory
   std::vector<std::string> trajectories;  // identification set (empty: every family but V)
   std::vector<std::string> validation;    // held-out set (empty: family V)
   std::string validation_family = io::kHeldOutFamily;
   std::vector<double> intervals = preprocess::paper_intervals();
-  int threads = 0;              // 0: every core
-  bool fresh = false;           // redo every run, even those finished (benchmarks)
+  int threads = 0;     // 0: every core
+  bool fresh = false;  // redo every run, even those finished (benchmarks)
   // Each trajectory's runs in a process of their own (symoro/parallel/farm.hpp): a crash or an
   // out-of-memory kill fails those runs only, and every run starts from the same solver state,
   // so the records do not depend on the thread or rank count or on which runs went before.

@@ -32,8 +32,8 @@ struct RawTorqueScore {
 RawTorqueScore raw_torque_error(const io::Log& log, const OpenLoopTorque& model, const Eigen::VectorXd& phi,
                                 const RawTorqueOptions& options = {});
 // The same on samples raw_torque_samples made (several vectors on one log: preprocessed once).
-RawTorqueScore raw_torque_error(const preprocess::Samples& samples, const OpenLoopTorque& model, const Eigen::VectorXd& phi,
-                                const RawTorqueOptions& options = {});
+RawTorqueScore raw_torque_error(const preprocess::Samples& samples, const OpenLoopTorque& model,
+                                const Eigen::VectorXd& phi, const RawTorqueOptions& options = {});
 
 // The motion and raw torque raw_torque_error scores on (Samples at the log's base period).
 preprocess::Samples raw_torque_samples(const io::Log& log, const RawTorqueOptions& options = {});

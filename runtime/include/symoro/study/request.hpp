@@ -14,8 +14,8 @@
 namespace symoro::study {
 
 struct StudyRequest {
-  std::string data, out;            // the dataset and the study folder
-  std::vector<double> intervals_ms;  // empty: StudyOptions' (the paper's)
+  std::string data, out;                      // the dataset and the study folder
+  std::vector<double> intervals_ms;           // empty: StudyOptions' (the paper's)
   std::vector<std::string> only, validation;  // empty: every family but V; family V
   int threads = StudyOptions{}.threads;
   int trial = StudyOptions{}.trial;

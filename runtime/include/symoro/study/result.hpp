@@ -13,26 +13,26 @@ namespace symoro::study {
 
 // One trajectory at one sampling interval: OLS -> audit -> (SDP) -> CLIE.
 struct RunRecord {
-  std::string trajectory;    // e.g. "AG02"
+  std::string trajectory;  // e.g. "AG02"
   // A run that could not be done (its log too short at this interval, a solver's exception):
   // recorded with the reason, left out of the clouds and the selection; the study goes on.
   bool failed = false;
   std::string failure;
-  double interval = 0;       // s
-  int samples = 0;           // target-grid samples (rows of W are samples x joints)
+  double interval = 0;  // s
+  int samples = 0;      // target-grid samples (rows of W are samples x joints)
   // Target samples left out within the filter's settling time of a log end where the arm moves
   // (preprocess/edges.hpp); recorded only when there are some.
   int edge_samples = 0;
   // OLS
-  double kappa = 0;          // sigma_max / sigma_min of the stacked W (paper's kappa)
-  double kappa_scaled = 0;   // the same with unit-norm columns (conditioning, not units)
+  double kappa = 0;         // sigma_max / sigma_min of the stacked W (paper's kappa)
+  double kappa_scaled = 0;  // the same with unit-norm columns (conditioning, not units)
   // excitation/quality.hpp of W: log det of W'W with unit columns (<= 0) and the weakest
   // direction's largest components ("MX3 +0.71, MX2 -0.70, XXR4 -0.05")
   double log_det_scaled = 0;
   std::string weakest;
   Eigen::VectorXd phi_ols, std_ols;  // estimate and standard deviations
-  double residual_rms = 0;   // N m, of tau - W phi_ols
-  bool weighted = false;     // WLS (per-joint weights) instead of OLS
+  double residual_rms = 0;           // N m, of tau - W phi_ols
+  bool weighted = false;             // WLS (per-joint weights) instead of OLS
   // All-pose audit of the OLS estimate
   double ols_lambda_min = 0;
   Eigen::VectorXd ols_worst_pose;
@@ -49,11 +49,11 @@ struct RunRecord {
   bool clie_ran = true;
   Eigen::VectorXd phi_clie;
   bool clie_success = false;
-  std::string clie_termination;   // Ceres' termination, or the start's divergence
+  std::string clie_termination;  // Ceres' termination, or the start's divergence
   double clie_cost_initial = 0, clie_cost_final = 0;
   int clie_iterations = 0;
-  Eigen::VectorXd clie_rms;       // per joint, N m, at the samples
-  double clie_lambda_min = 0;     // all-pose audit of phi_clie
+  Eigen::VectorXd clie_rms;    // per joint, N m, at the samples
+  double clie_lambda_min = 0;  // all-pose audit of phi_clie
   bool clie_pd = false;
   // Consistency::physical only (physical = true): whether the OLS and CLIE vectors have a
   // physically consistent standard set, and phase 1's margin of each (relative to the links'
@@ -67,15 +67,15 @@ struct RunRecord {
   // Wall times, s
   double t_ols = 0, t_audit = 0, t_sdp = 0, t_clie = 0;
 
-  std::string id() const;         // "AG02@40ms"
+  std::string id() const;  // "AG02@40ms"
 };
 
 // The parameter clouds in one PCA basis (standardized parameters of all three stages).
 struct PcaClouds {
-  Eigen::VectorXd mean, scale;    // standardization: z = (phi - mean) / scale
-  Eigen::MatrixXd components;     // np x k, orthonormal columns
-  Eigen::VectorXd explained;      // fraction of variance per component
-  Eigen::MatrixXd ols, sdp, clie; // runs x k scores
+  Eigen::VectorXd mean, scale;     // standardization: z = (phi - mean) / scale
+  Eigen::MatrixXd components;      // np x k, orthonormal columns
+  Eigen::VectorXd explained;       // fraction of variance per component
+  Eigen::MatrixXd ols, sdp, clie;  // runs x k scores
 };
 
 // Representative selection by centrality in the CLIE cloud.
@@ -98,12 +98,13 @@ struct ValidationRecord {
   int edge_samples = 0;  // as RunRecord's, of the held-out log at `interval`
   // Per joint rmse_j / rms(tau_m,j) of the accepted (rescue) vector: comparable across joints.
   Eigen::VectorXd nrmse_joint_rescue;
-  double rmse_clie = 0, rmse_rescue = 0;   // N m, over all joints and samples
-  double mne_clie = 0, mne_rescue = 0;     // mean over joints of |e_j| / |tau_m,j| (2-norms)
+  double rmse_clie = 0, rmse_rescue = 0;  // N m, over all joints and samples
+  double mne_clie = 0, mne_rescue = 0;    // mean over joints of |e_j| / |tau_m,j| (2-norms)
   Eigen::VectorXd rmse_joint_clie, rmse_joint_rescue;
   // Open loop against the raw measured torque at the log's own rate (raw_torque.hpp), beside the
   // filtered numbers above: what a plain least-squares fit would be compared with. NaN: not scored.
-  double raw_rmse_clie = std::numeric_limits<double>::quiet_NaN(), raw_rmse_rescue = std::numeric_limits<double>::quiet_NaN();
+  double raw_rmse_clie = std::numeric_limits<double>::quiet_NaN(),
+         raw_rmse_rescue = std::numeric_limits<double>::quiet_NaN();
   Eigen::VectorXd raw_rmse_joint_rescue;
   std::string raw_filter;  // the evaluation's own filter, one sentence
   // The series (for the torque figure and the closed-loop localization): samples x joints; the
@@ -121,21 +122,21 @@ struct StudyResult {
   Selection selection;
   // Post-CLIE rescue of the selected candidate and the final audit
   Eigen::VectorXd phi_rescue;
-  bool rescued = false;                   // false: the CLIE candidate was PD, accepted as is
+  bool rescued = false;  // false: the CLIE candidate was PD, accepted as is
   double rescue_eps = 0;
-  bool rescue_feasible = true;            // false: the rescue's projection failed (rescue_status says why)
+  bool rescue_feasible = true;  // false: the rescue's projection failed (rescue_status says why)
   std::string rescue_status;
   // The physical rescue's prior weight, and when it was chosen by held-out error, each
   // candidate's open-loop RMSE on the other identification runs (N m).
   double rescue_prior_weight = 0;
   std::vector<std::pair<double, double>> rescue_prior_scores;
-  std::string final_audit;                // its settings (acceptance.hpp's describe)
+  std::string final_audit;  // its settings (acceptance.hpp's describe)
   double final_lambda_min = 0;
   Eigen::VectorXd final_worst_pose;
   // Final audit passed (physical: and a consistent set exists); acceptance_verdict
   // (acceptance.hpp) says why not.
   bool accepted = false;
-  std::string consistency = "pd";         // the path: pd (the paper's) or physical
+  std::string consistency = "pd";  // the path: pd (the paper's) or physical
   // The accepted vector's physical consistency, checked on both paths where the model allows
   // (physical_projection.hpp): a consistent standard set maps onto it, phase 1's margin (NaN: not
   // needed), or why it was not checked.
@@ -143,20 +144,20 @@ struct StudyResult {
   double final_consistency = std::numeric_limits<double>::quiet_NaN();
   std::string final_consistency_note;
   std::vector<ValidationRecord> validation;
-  Eigen::VectorXd truth;                  // the twin's true parameters (empty for real data)
-  std::string data_source;                // e.g. "twin (robots/crane_x7/twin.yaml, config ...)"
+  Eigen::VectorXd truth;                       // the twin's true parameters (empty for real data)
+  std::string data_source;                     // e.g. "twin (robots/crane_x7/twin.yaml, config ...)"
   std::string data_twin, data_twin_overrides;  // the dataset's twin and overrides ("" for real data)
   // What the chain did and skipped, one line each (e.g. "CLIE: not run: no controller
   // description (robots/x/controller.yaml)"), for the report.
   std::vector<std::string> stages;
-  int threads = 1;                        // worker threads per rank
-  int ranks = 1;                          // MPI ranks (1: this machine alone)
+  int threads = 1;  // worker threads per rank
+  int ranks = 1;    // MPI ranks (1: this machine alone)
   // The largest peak resident memory of a trajectory's process (isolated runs; 0 otherwise) and
   // that trajectory: what one worker needs.
   double worker_peak_mb = 0;
   std::string worker_peak_trajectory;
-  double wall = 0;                        // s, whole study (runs done in this invocation)
-  double wall_runs = 0;                   // s, sum of the runs' stage times
+  double wall = 0;       // s, whole study (runs done in this invocation)
+  double wall_runs = 0;  // s, sum of the runs' stage times
 };
 
 }  // namespace symoro::study

@@ -21,7 +21,7 @@ ClosedLoopSource closed_loop_source(const std::filesystem::path& robot_dir, cons
 // robot.yaml's `nominal:` standard parameters (symoroc model writes a URDF's there) in the order
 // of `standard`, a variant's effect parameters 0; false when robot.yaml has none. DataError
 // naming robot.yaml when it is malformed or lacks a rigid-body parameter.
-bool nominal_standard_parameters(const std::filesystem::path& robot_dir, const std::vector<StandardParameterInfo>& standard,
-                                 std::vector<double>& values);
+bool nominal_standard_parameters(const std::filesystem::path& robot_dir,
+                                 const std::vector<StandardParameterInfo>& standard, std::vector<double>& values);
 
 }  // namespace symoro::study

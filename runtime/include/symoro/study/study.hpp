@@ -60,8 +60,8 @@ void require_identified(const StudyResult& result);
 class Study {
  public:
   Study(std::shared_ptr<const identify::IdentificationModel> model, StudyOptions options, ClosedLoopSource closed_loop);
-  Study(std::shared_ptr<const identify::IdentificationModel> model, StudyOptions options, trajectory::TrajectoryDesign design,
-        identify::ClosedLoopSetup setup)
+  Study(std::shared_ptr<const identify::IdentificationModel> model, StudyOptions options,
+        trajectory::TrajectoryDesign design, identify::ClosedLoopSetup setup)
       : Study(std::move(model), std::move(options), ClosedLoopSource{std::move(setup), std::move(design), ""}) {}
 
   StudyResult run();

@@ -46,7 +46,8 @@ Eigen::MatrixXd open_loop_torque(const preprocess::Samples& s, const Eigen::Vect
   Eigen::MatrixXd tau(s.q.rows(), Model::nq);
   Vec out;
   for (Eigen::Index i = 0; i < s.q.rows(); ++i) {
-    Model::inverse_dynamics(Vec(s.q.row(i).transpose()), Vec(s.qd.row(i).transpose()), Vec(s.qdd.row(i).transpose()), p, out);
+    Model::inverse_dynamics(Vec(s.q.row(i).transpose()), Vec(s.qd.row(i).transpose()), Vec(s.qdd.row(i).transpose()), p,
+                            out);
     tau.row(i) = out.transpose();
   }
   return tau;
@@ -67,9 +68,10 @@ ValidationRecord validate_trajectory(const identify::ClosedLoop* sim, const Open
 
 // The same for a generated Model.
 template <class Model>
-ValidationRecord validate_trajectory(const identify::ClosedLoopSimulator<Model>* sim, const preprocess::Samples& measured,
-                                     const Eigen::VectorXd& phi_clie, const Eigen::VectorXd& phi_rescue,
-                                     const identify::ClieOptions& options, const std::string& why_open = "") {
+ValidationRecord validate_trajectory(const identify::ClosedLoopSimulator<Model>* sim,
+                                     const preprocess::Samples& measured, const Eigen::VectorXd& phi_clie,
+                                     const Eigen::VectorXd& phi_rescue, const identify::ClieOptions& options,
+                                     const std::string& why_open = "") {
   return validate_trajectory(sim, &open_loop_torque<Model>, measured, phi_clie, phi_rescue, options, why_open);
 }
 

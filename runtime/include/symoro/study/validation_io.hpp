@@ -16,9 +16,9 @@
 namespace symoro::study {
 
 struct StudyValidation {
-  std::string robot, model;               // model: the variant's name ("" for the full model)
-  std::string selected_run;               // e.g. "AG02@10ms"
-  bool accepted = false;                  // final all-pose audit passed
+  std::string robot, model;  // model: the variant's name ("" for the full model)
+  std::string selected_run;  // e.g. "AG02@10ms"
+  bool accepted = false;     // final all-pose audit passed
   bool rescued = false;
   std::vector<std::string> names, units;  // accepted parameters
   Eigen::VectorXd phi;                    // accepted parameters (rescue, or CLIE when PD)

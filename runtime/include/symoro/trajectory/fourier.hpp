@@ -22,9 +22,9 @@ namespace symoro::trajectory {
 
 struct FourierTrajectory {
   std::string name;
-  double w = 0;              // rad/s
-  Eigen::VectorXd q0;        // per joint: the series' offset
-  Eigen::MatrixXd a, b;      // joints x harmonics
+  double w = 0;          // rad/s
+  Eigen::VectorXd q0;    // per joint: the series' offset
+  Eigen::MatrixXd a, b;  // joints x harmonics
 
   int joints() const { return static_cast<int>(a.rows()); }
   int harmonics() const { return static_cast<int>(a.cols()); }

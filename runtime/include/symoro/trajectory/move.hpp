@@ -12,8 +12,8 @@ namespace symoro::trajectory {
 
 // The move from `from` to `to` starting at `start`, with per-joint limits |qd_j| <= velocity_j
 // and |qdd_j| <= acceleration_j (both > 0). A move with from == to has a 0 duration.
-Segment plan_move(double start, const Eigen::VectorXd& from, const Eigen::VectorXd& to,
-                  const Eigen::VectorXd& velocity, const Eigen::VectorXd& acceleration);
+Segment plan_move(double start, const Eigen::VectorXd& from, const Eigen::VectorXd& to, const Eigen::VectorXd& velocity,
+                  const Eigen::VectorXd& acceleration);
 
 // Standing at `at` from `start` for `duration` seconds.
 Segment plan_hold(double start, const Eigen::VectorXd& at, double duration);

@@ -35,15 +35,15 @@ struct PrimitiveRanges {
 struct StructuredDesignOptions {
   std::string robot;
   std::vector<JointInfo> joints;
-  double position_margin = 0.034906585039886591;  // rad (2 deg)
-  std::map<std::string, Eigen::VectorXd> postures;         // rad; empty: A, B, C as above
-  std::map<std::string, PrimitiveRanges> primitives;       // by posture; missing: as above
-  Eigen::VectorXd velocity, acceleration;                  // at speed factor 1; empty: as above
+  double position_margin = 0.034906585039886591;      // rad (2 deg)
+  std::map<std::string, Eigen::VectorXd> postures;    // rad; empty: A, B, C as above
+  std::map<std::string, PrimitiveRanges> primitives;  // by posture; missing: as above
+  Eigen::VectorXd velocity, acceleration;             // at speed factor 1; empty: as above
   std::map<std::string, std::vector<double>> speed_factors{
       {"normal", {0.30, 0.60, 0.90}}, {"proximal", {0.25, 0.50, 0.75}}, {"large", {0.20, 0.40, 0.60}}};
   std::vector<std::string> joint_class;  // per joint; empty: joints 1, 2 proximal, the rest normal
   double start_hold = 1.5, end_hold = 1.5, waypoint_dwell = 0.25, primitive_dwell = 0.5;  // s
-  int validation = 3;  // V trajectories
+  int validation = 3;                                                                     // V trajectories
   std::uint64_t seed = 1;
 };
 

@@ -35,11 +35,11 @@ struct Profile {
 };
 
 struct Segment {
-  double start = 0;        // s from the trajectory start
+  double start = 0;          // s from the trajectory start
   Eigen::VectorXd from, to;  // waypoints (rad or m), one entry per joint; equal for a hold
   Profile profile;
-  std::string label;       // what the segment belongs to: "hold", "dwell", "transition",
-                           // a primitive such as "P4@B'" or "P2,3(+,-)@C", "waypoint 3", "fourier"
+  std::string label;  // what the segment belongs to: "hold", "dwell", "transition",
+                      // a primitive such as "P4@B'" or "P2,3(+,-)@C", "waypoint 3", "fourier"
   // A periodic excitation (its whole periods, from rest at `from` back to rest there): set, the
   // segment follows this series from its start instead of the profile (which only holds the
   // duration).
@@ -49,9 +49,9 @@ struct Segment {
 
 class Trajectory {
  public:
-  std::string name;         // e.g. "PA01"
-  std::string family;       // PA PB PC AP AG V
-  std::string description;  // one line: posture, primitives, speed
+  std::string name;               // e.g. "PA01"
+  std::string family;             // PA PB PC AP AG V
+  std::string description;        // one line: posture, primitives, speed
   std::vector<Segment> segments;  // contiguous, in time order, from t = 0
 
   int joints() const { return segments.empty() ? 0 : static_cast<int>(segments.front().from.size()); }

@@ -18,7 +18,7 @@ namespace symoro::twin {
 struct UrdfJoint {
   std::string name;
   bool fixed = false;
-  int model_joint = 0;                 // 1-based joint of the model; 0 when fixed
+  int model_joint = 0;  // 1-based joint of the model; 0 when fixed
   Eigen::Vector3d xyz = Eigen::Vector3d::Zero(), rpy = Eigen::Vector3d::Zero();
   Eigen::Vector3d axis = Eigen::Vector3d::UnitZ();
 };
@@ -61,8 +61,8 @@ struct Effects {
   bool torque_offset = false;
   Eigen::VectorXd offset_torque;
   bool backlash = false;
-  Eigen::VectorXd backlash_width;       // rad, total play; 0 = rigid joint
-  double backlash_frequency = 100;      // Hz
+  Eigen::VectorXd backlash_width;   // rad, total play; 0 = rigid joint
+  double backlash_frequency = 100;  // Hz
   double backlash_damping_ratio = 0.1;
   bool payload = false;
   double payload_mass = 0;
@@ -74,10 +74,10 @@ struct Effects {
   bool actuation_delay = false;
   double actuation_delay_time = 0;  // s
   bool sensor_noise = false;
-  double encoder_noise = 0;   // counts
+  double encoder_noise = 0;  // counts
   // Per joint (counts), when given: replaces encoder_noise (the diagnosis estimates it per joint).
   Eigen::VectorXd encoder_noise_per_joint;
-  double current_noise = 0;   // A
+  double current_noise = 0;  // A
   bool timestamp_jitter = false;
   double jitter_std = 0, jitter_max = 0;
   bool dropped_samples = false;

@@ -17,13 +17,13 @@
 namespace symoro::twin {
 
 struct TwinDatasetOptions {
-  std::filesystem::path out;          // the dataset folder (created)
+  std::filesystem::path out;  // the dataset folder (created)
   std::string robot;
-  std::uint64_t seed = 1;             // the dataset's seed (run_seed derives each run's)
+  std::uint64_t seed = 1;  // the dataset's seed (run_seed derives each run's)
   int trials = 3;
-  int workers = 0;                    // per rank, as parallel::FarmOptions::workers
-  std::filesystem::path overrides;    // the twin.yaml overrides the twin was made with, or "":
-                                      // copied into the folder, so the truth travels with the data
+  int workers = 0;                  // per rank, as parallel::FarmOptions::workers
+  std::filesystem::path overrides;  // the twin.yaml overrides the twin was made with, or "":
+                                    // copied into the folder, so the truth travels with the data
   // On the coordinator: before the runs (how many will run, how many are finished already), and
   // after each ("AG02 t2", describe_run's text).
   std::function<void(int to_run, int skipped)> on_start;
@@ -44,10 +44,12 @@ using RunTwin = std::function<io::Log(const trajectory::Trajectory&, const RunOp
 // ::config). Throws std::runtime_error naming the failed runs, after the others are written (a
 // rerun does only the failed ones); the manifest is then not written.
 TwinDatasetSummary make_twin_dataset(const RunTwin& run, const std::string& notes, const TwinConfig& config,
-                                     const std::vector<trajectory::Trajectory>& trajectories, const TwinDatasetOptions& options);
+                                     const std::vector<trajectory::Trajectory>& trajectories,
+                                     const TwinDatasetOptions& options);
 
 // The same with the twin's own runs.
-TwinDatasetSummary make_twin_dataset(const ClosedLoopTwin& twin, const std::vector<trajectory::Trajectory>& trajectories,
+TwinDatasetSummary make_twin_dataset(const ClosedLoopTwin& twin,
+                                     const std::vector<trajectory::Trajectory>& trajectories,
                                      const TwinDatasetOptions& options);
 
 // A run's log file in a dataset: <trajectory>_t<trial>.csv.

@@ -36,13 +36,13 @@ namespace symoro::twin {
 struct RunOptions {
   std::string robot;
   int trial = 1;
-  std::uint64_t seed = 1;   // the run's own seed (see run_seed)
-  double pre_roll = 0.5;    // s of holding the start posture before logging
+  std::uint64_t seed = 1;  // the run's own seed (see run_seed)
+  double pre_roll = 0.5;   // s of holding the start posture before logging
 };
 
 struct RunStats {
-  double simulated = 0;     // s of logged motion
-  double wall = 0;          // s of computation
+  double simulated = 0;                        // s of logged motion
+  double wall = 0;                             // s of computation
   int cycles = 0, dropped = 0, saturated = 0;  // saturated: cycles with a current at its limit
   Eigen::VectorXd max_error, rms_error;        // true q_ref - q, rad, per joint
   Eigen::VectorXd max_torque;                  // |applied motor torque|, N m, per joint

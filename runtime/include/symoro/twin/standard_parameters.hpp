@@ -37,9 +37,8 @@ void add_point_mass(LinkInertial& link, double mass, const Eigen::Vector3d& com)
 // does not have (zero in its .par) must be zero in the truth, else DataError: the model could
 // not represent the twin. Drive values are per joint (size = joints). A variant's effect
 // parameters (OFF, FST, FVA, HS, HC) are 0: the twin applies its own effects.
-Eigen::VectorXd standard_vector(const std::vector<StandardParameterInfo>& names,
-                                const std::vector<LinkInertial>& links, const Eigen::VectorXd& rotor_inertia,
-                                const Eigen::VectorXd& viscous, const Eigen::VectorXd& coulomb,
-                                const std::string& file);
+Eigen::VectorXd standard_vector(const std::vector<StandardParameterInfo>& names, const std::vector<LinkInertial>& links,
+                                const Eigen::VectorXd& rotor_inertia, const Eigen::VectorXd& viscous,
+                                const Eigen::VectorXd& coulomb, const std::string& file);
 
 }  // namespace symoro::twin

@@ -41,8 +41,8 @@ Eigen::VectorXd unmodeled_torque(const TwinConfig& c, const trajectory::Trajecto
   for (int k = 0; k <= K; ++k) {
     t.evaluate(k * step, q, qd, qdd);
     const Eigen::VectorXd tau = needed(q, qd, qdd);
-    const Eigen::VectorXd w = tau - c.controller.realization_inertia.cwiseProduct(qdd) -
-                              c.controller.realization_damping.cwiseProduct(qd);
+    const Eigen::VectorXd w =
+        tau - c.controller.realization_inertia.cwiseProduct(qdd) - c.controller.realization_damping.cwiseProduct(qd);
     worst = worst.cwiseMax(w.cwiseAbs());
   }
   const Effects& e = c.effects;

@@ -43,7 +43,9 @@ inline std::vector<dynamixel::VirtualServo> virtual_servos(const hardware::Hardw
     dynamixel::VirtualServo s;
     s.id = j.id;
     const dynamixel::xseries::Model* m = dynamixel::xseries::find_model(j.model.model_number);
-    if (!m) throw std::invalid_argument("virtual_servos: model number " + std::to_string(j.model.model_number) + " is not emulated");
+    if (!m)
+      throw std::invalid_argument("virtual_servos: model number " + std::to_string(j.model.model_number) +
+                                  " is not emulated");
     s.model = *m;
     s.return_delay = static_cast<std::uint8_t>(hw.return_delay_time);
     out.push_back(s);

@@ -41,7 +41,8 @@ struct Bounds {
   Eigen::VectorXd lower, upper;
 };
 // phi0_i -+ max(bound_factor |phi0_i|, min_bound); rotor inertias at least min_rotor_inertia.
-Bounds parameter_bounds(const Eigen::VectorXd& phi0, const std::vector<bool>& rotor_inertia, const ClieOptions& options);
+Bounds parameter_bounds(const Eigen::VectorXd& phi0, const std::vector<bool>& rotor_inertia,
+                        const ClieOptions& options);
 
 // Ceres' bounded Levenberg-Marquardt on `cost` from result.phi (inside the bounds) to its
 // end point; fills the solver fields of `result` (phi, success, termination, iterations,
@@ -59,8 +60,8 @@ bool simulated_samples(const ClosedLoopSimulator<Model>& sim, const preprocess::
 }
 
 template <class Model>
-ClieResult clie(const ClosedLoopSimulator<Model>& sim, const preprocess::Samples& measured,
-                const Eigen::VectorXd& phi0, const ClieOptions& options = {}) {
+ClieResult clie(const ClosedLoopSimulator<Model>& sim, const preprocess::Samples& measured, const Eigen::VectorXd& phi0,
+                const ClieOptions& options = {}) {
   return clie(static_cast<const ClosedLoop&>(sim), measured, phi0, options);
 }
 

@@ -242,8 +242,8 @@ class ClosedLoopSimulator final : public ClosedLoop {
     return simulate(phi, tau, dtau, why, nullptr);
   }
   // The same, also giving the sampled q (cycles() x nq, row k = q(t_k), what the controller saw).
-  bool simulate(const Eigen::VectorXd& phi, preprocess::Channels& tau, preprocess::Channels* dtau,
-                Divergence* why, preprocess::Channels* q) const override {
+  bool simulate(const Eigen::VectorXd& phi, preprocess::Channels& tau, preprocess::Channels* dtau, Divergence* why,
+                preprocess::Channels* q) const override {
     if (!dtau) return simulate_into(phi, tau, nullptr, why, q);
     // Rows into the matrix.
     struct Store final : SensitivityRows {
@@ -264,8 +264,8 @@ class ClosedLoopSimulator final : public ClosedLoop {
   bool simulate_into(const Eigen::VectorXd& phi, preprocess::Channels& tau, SensitivityRows* dtau, Divergence* why,
                      preprocess::Channels* q) const {
     if (phi.size() != np)
-      throw std::invalid_argument("closed-loop simulation: phi has " + std::to_string(phi.size()) + " entries, the model " +
-                                  std::to_string(np));
+      throw std::invalid_argument("closed-loop simulation: phi has " + std::to_string(phi.size()) +
+                                  " entries, the model " + std::to_string(np));
     Divergence stop;
     const Phi p = phi;
     const bool ok = dtau ? run<true>(p, tau, dtau, q, stop) : run<false>(p, tau, nullptr, q, stop);
@@ -282,8 +282,8 @@ class ClosedLoopSimulator final : public ClosedLoop {
 
   // qdd = M^-1 (u - h) at x, and with Sens its derivative d qdd / d phi. False on divergence.
   template <bool Sens>
-  bool acceleration(const Phi& phi, const State& x, const Vec& u, const SensQ& du, double t, Vec& qdd,
-                    SensQ& dqdd, Divergence& why) const {
+  bool acceleration(const Phi& phi, const State& x, const Vec& u, const SensQ& du, double t, Vec& qdd, SensQ& dqdd,
+                    Divergence& why) const {
     if (!x.q.allFinite() || !x.qd.allFinite()) {
       why = detail::not_finite(t);
       return false;
@@ -331,8 +331,7 @@ class ClosedLoopSimulator final : public ClosedLoop {
             Vec& qs, SensQ& dqs, Divergence& why) const {
     if (!(length > 0)) return true;
     if constexpr (Sens)
-      if (!setup_.exact_sensitivities)
-        return hold_frozen(phi, x, u, du, length, t0, sample_at, qs, dqs, why);
+      if (!setup_.exact_sensitivities) return hold_frozen(phi, x, u, du, length, t0, sample_at, qs, dqs, why);
     const int m = setup_.substeps;
     const double h = length / m;
     Vec qdd1, qdd2;

@@ -39,8 +39,7 @@ class ModelInertiaFunction final : public InertiaFunction {
     Model::inertia(q, phi, M);
   }
 
-  void basis(const Eigen::VectorXd& q, Eigen::MatrixXd& constant,
-             std::vector<Eigen::MatrixXd>& linear) const override {
+  void basis(const Eigen::VectorXd& q, Eigen::MatrixXd& constant, std::vector<Eigen::MatrixXd>& linear) const override {
     detail::check_size("q", q.size(), n);
     // np fixed n x n matrices (33 kB for the full CRANE-X7): kept off a worker thread's stack.
     auto b = std::make_unique<typename Model::template InertiaBasis<double>>();

@@ -47,7 +47,8 @@ inline StandardGroup standard_group(const std::string& family) {
 // The structure of a model whose standard parameters are `standard`, B its full model's
 // base_from_standard (np x ns, column k the image of unit vector k). For a generated Model
 // (below) and a loaded one (loaded_model.cpp) alike.
-inline ConsistencyStructure consistency_structure(const std::vector<StandardParameterInfo>& standard, Eigen::MatrixXd B) {
+inline ConsistencyStructure consistency_structure(const std::vector<StandardParameterInfo>& standard,
+                                                  Eigen::MatrixXd B) {
   ConsistencyStructure c;
   c.B = std::move(B);
   for (std::size_t k = 0; k < standard.size(); ++k) {
@@ -77,7 +78,8 @@ ConsistencyStructure consistency_structure() {
   // parent's does not have: not supported yet.
   static_assert(!detail::HasEffects<Model>::value, "consistency_structure: variants with effects are not supported");
   using Parent = typename Model::Parent;
-  static_assert(Parent::ns == Model::ns, "consistency_structure: the variant's standard vector differs from its parent's");
+  static_assert(Parent::ns == Model::ns,
+                "consistency_structure: the variant's standard vector differs from its parent's");
   Eigen::MatrixXd B(Parent::np, Parent::ns);
   for (int k = 0; k < Parent::ns; ++k)
     B.col(k) = Parent::base_from_standard(Eigen::Matrix<double, Parent::ns, 1>::Unit(k));

@@ -42,14 +42,15 @@ struct ClieStart {
 
 // The paper's pre-CLIE step (Algorithm 1, lines 4-15): the all-pose audit of the OLS estimate
 // and, when it is not PD, the conditional SDP projection. Fills the record's audit and route.
-ClieStart pd_start(const identify::LeastSquaresResult& ls, const StudyOptions& options, const identify::InertiaFunction& inertia,
-                   const identify::AuditDomain& domain, RunRecord& r);
+ClieStart pd_start(const identify::LeastSquaresResult& ls, const StudyOptions& options,
+                   const identify::InertiaFunction& inertia, const identify::AuditDomain& domain, RunRecord& r);
 
 // The physical path's pre-CLIE step when asked (StudyOptions::physical_start): the all-pose audit
 // (for the record) and, when the OLS estimate has no consistent standard set, the nearest base
 // vector that has one in the run's predicted-torque metric (physical_projection.hpp).
-ClieStart physical_start(const identify::IdentificationModel& model, const identify::LeastSquaresResult& ls, const StudyOptions& options,
-                         const identify::InertiaFunction& inertia, const identify::AuditDomain& domain, RunRecord& r);
+ClieStart physical_start(const identify::IdentificationModel& model, const identify::LeastSquaresResult& ls,
+                         const StudyOptions& options, const identify::InertiaFunction& inertia,
+                         const identify::AuditDomain& domain, RunRecord& r);
 
 // One trajectory at one interval, from its log.
 // sim: the run's closed loop, or nullptr (CLIE is skipped; `no_clie` says why).
