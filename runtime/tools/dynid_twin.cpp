@@ -155,8 +155,10 @@ void add_twin_commands(CLI::App& app, Common& common) {
   auto* data = twin->add_subcommand("dataset", "Run every trajectory for several trials (resumable, parallel)");
   add_config_options(data, common, *o);
   data->add_option("-o,--output", o->out, "Output directory")->required();
-  data->add_option("--trials", o->trials, "Repeated trials per trajectory")->check(numbers::count(1, 1e4));
-  data->add_option("--seed", o->seed, "Dataset seed")->check(numbers::seed());
+  data->add_option("--trials", o->trials, "Repeated trials per trajectory")
+      ->check(numbers::count(1, 1e4))
+      ->capture_default_str();
+  data->add_option("--seed", o->seed, "Dataset seed")->check(numbers::seed())->capture_default_str();
   data->add_option("--jobs", o->jobs,
                    "Worker threads per rank (default: the cores, shared among the MPI ranks on a machine)")
       ->check(numbers::count(1, 1024));

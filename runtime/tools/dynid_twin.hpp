@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "dynid_common.hpp"
+#include "symoro/twin/dataset.hpp"
 
 namespace symoro::dynid {
 
@@ -19,8 +20,9 @@ struct TwinOptions {
   std::string out;
   std::string trajectory = "AG02";
   std::vector<std::string> only;
-  int trial = 1, trials = 3, jobs = 0;
-  std::uint64_t seed = 1;
+  int trial = 1, jobs = 0;
+  int trials = twin::TwinDatasetOptions{}.trials;
+  std::uint64_t seed = twin::TwinDatasetOptions{}.seed;
   double repeat_seconds = 3;
 };
 
