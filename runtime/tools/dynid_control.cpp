@@ -101,28 +101,33 @@ hardware::HardwareConfig read_hardware(const Common& common, const ControlCliOpt
   return hw;
 }
 
-// The gains are the lab's controller description's, on the real arm and the virtual one alike;
-// twin.yaml (and --config, --ideal) shape only the emulated arm behind --virtual, whose twin
-// this returns (none without --virtual).
-std::optional<twin::TwinConfig> read_gains_and_twin(const Common& common, const ControlCliOptions& options, int nq,
-                                                    const hardware::HardwareConfig& hw, control::FfpdGains& gains) {
+// The gains are the lab's controller description's, on the real arm and the virtual one alike,
+// at hardware.yaml's period.
+control::FfpdGains read_gains(const Common& common, int nq, double period) {
   const auto controller_path = common.robot_dir() / control::controller_file_name();
   if (!std::filesystem::exists(controller_path))
     throw UsageError(fmt::format("robot '{}' has no controller description ({} not found): it holds the FF+PD gains",
                                  common.robot, controller_path.string()));
-  gains = control::read_controller_description(controller_path, nq).gains();
-  gains.period = hw.period;
-  if (!options.virtual_bus && (!options.twin_config.empty() || options.ideal))
-    throw UsageError("--config and --ideal change the emulated arm of --virtual only; the real arm's gains come from " +
-                     controller_path.string());
-  std::optional<twin::TwinConfig> tc;
-  if (options.virtual_bus) {
-    const auto twin_path = common.robot_dir() / "twin.yaml";
-    if (!std::filesystem::exists(twin_path))
-      throw UsageError(fmt::format("--virtual needs the robot's digital twin ({} not found)", twin_path.string()));
-    tc = twin::read_twin_config(twin_path, nq, options.twin_config);
-    if (options.ideal) tc->effects.disable_all();
+  control::FfpdGains gains = control::read_controller_description(controller_path, nq).gains();
+  gains.period = period;
+  return gains;
+}
+
+// twin.yaml (and --config, --ideal) shape only the emulated arm behind --virtual: its twin, none
+// without --virtual.
+std::optional<twin::TwinConfig> read_virtual_twin(const Common& common, const ControlCliOptions& options, int nq) {
+  if (!options.virtual_bus) {
+    if (!options.twin_config.empty() || options.ideal)
+      throw UsageError(
+          "--config and --ideal change the emulated arm of --virtual only; the real arm's gains come from " +
+          (common.robot_dir() / control::controller_file_name()).string());
+    return std::nullopt;
   }
+  const auto twin_path = common.robot_dir() / "twin.yaml";
+  if (!std::filesystem::exists(twin_path))
+    throw UsageError(fmt::format("--virtual needs the robot's digital twin ({} not found)", twin_path.string()));
+  twin::TwinConfig tc = twin::read_twin_config(twin_path, nq, options.twin_config);
+  if (options.ideal) tc.effects.disable_all();
   return tc;
 }
 
@@ -196,8 +201,8 @@ void run_control_command(const Common& common, const ControlCliOptions& options)
   const std::vector<JointInfo>& joints = full.joints();
   std::string stop_override;
   const hardware::HardwareConfig hw = read_hardware(common, options, joints, stop_override);
-  control::FfpdGains gains;
-  const std::optional<twin::TwinConfig> tc = read_gains_and_twin(common, options, full.nq(), hw, gains);
+  const control::FfpdGains gains = read_gains(common, full.nq(), hw.period);
+  const std::optional<twin::TwinConfig> tc = read_virtual_twin(common, options, full.nq());
   const trajectory::Trajectory traj = read_design(common, joints).build(options.trajectory);
 
   hardware::ControlOptions co;
