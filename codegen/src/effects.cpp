@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <stdexcept>
 #include <tuple>
 
@@ -13,7 +14,8 @@ namespace symoro::codegen {
 namespace {
 
 // The variant effects in canonical order (EffectKind's, which orders the parameters they add),
-// each a row of the effect table by its variant name.
+// each a row of the effect table by its variant name. A row added to the table after these
+// follows them, in the table's order.
 constexpr std::array<std::string_view, 7> kVariantOrder{
     "coulomb", "inertia_products", "offset", "stribeck", "viscous_asymmetry", "position_harmonics", "smooth_coulomb"};
 static_assert(kVariantOrder.size() == static_cast<std::size_t>(EffectKind::SmoothCoulomb) + 1);
@@ -30,11 +32,13 @@ struct Entry {
 
 const std::vector<Entry>& catalogue() {
   static const std::vector<Entry> entries = [] {
+    std::vector<const EffectRow*> rows;
+    for (std::string_view name : kVariantOrder) rows.push_back(find_effect(&EffectRow::variant, name));
+    for (const EffectRow& row : kEffectTable)
+      if (!row.variant.empty() && std::find(rows.begin(), rows.end(), &row) == rows.end()) rows.push_back(&row);
     std::vector<Entry> out;
-    for (std::size_t k = 0; k < kVariantOrder.size(); ++k) {
-      const EffectRow* row = find_effect(&EffectRow::variant, kVariantOrder[k]);
-      out.push_back({static_cast<EffectKind>(k), row, std::string(row->variant), effect_words(row->unfixes)});
-    }
+    for (const EffectRow* row : rows)
+      out.push_back({static_cast<EffectKind>(out.size()), row, std::string(row->variant), effect_words(row->unfixes)});
     return out;
   }();
   return entries;
@@ -60,7 +64,9 @@ std::string effect_names() {
 
 bool effect_on_links(EffectKind kind) { return entry(kind).row->scope == EffectScope::Link; }
 
-bool effect_has_velocity(EffectKind kind) { return entry(kind).row->velocity_scale; }
+bool effect_has_velocity(EffectKind kind) { return !entry(kind).row->velocity_scale.empty(); }
+
+const EffectRow& effect_row(EffectKind kind) { return *entry(kind).row; }
 
 const std::vector<std::string>& unfixed_families(EffectKind kind) { return entry(kind).unfixes; }
 
@@ -80,7 +86,7 @@ std::vector<EffectParameter> effect_parameters(const std::vector<EffectSpec>& ef
     const std::string u = row.unit_like == EffectUnit::LikeFV   ? unit("FV", j)
                           : row.unit_like == EffectUnit::LikeFS ? unit("FS", j)
                                                                 : std::string(row.unit);
-    const double velocity = row.velocity_scale ? e->velocity : 0.0;
+    const double velocity = row.velocity_scale.empty() ? 0.0 : e->velocity;
     std::vector<int> orders = e->orders;
     std::sort(orders.begin(), orders.end());
     for (const EffectParameterName& p : effect_parameter_names(row, j, orders))
@@ -89,34 +95,100 @@ std::vector<EffectParameter> effect_parameters(const std::vector<EffectSpec>& ef
   return out;
 }
 
-// Nodes are made one statement at a time: the order of evaluation of a call's arguments is
-// unspecified, and node ids (hence the emitted text) must not depend on the compiler.
+namespace {
+
+// A joint law's nodes in the expression graph. |a| is a sign(a): the generated code has no abs.
+class GraphLaw final : public LawAlgebra {
+ public:
+  explicit GraphLaw(ExprGraph& g) : g_(g) {}
+  Value constant(double c) override { return g_.constant(c); }
+  Value add(Value a, Value b) override { return g_.add(a, b); }
+  Value sub(Value a, Value b) override { return g_.sub(a, b); }
+  Value mul(Value a, Value b) override { return g_.mul(a, b); }
+  Value div(Value a, Value b) override { return g_.div(a, b); }
+  Value neg(Value a) override { return g_.neg(a); }
+  Value square(Value a) override { return g_.pow(a, 2.0); }
+  Value abs(Value a) override {
+    const NodeId sign = g_.sign(a);
+    return g_.mul(a, sign);
+  }
+  Value sign(Value a) override { return g_.sign(a); }
+  Value exp(Value a) override { return g_.exp(a); }
+  Value tanh(Value a) override { return g_.tanh(a); }
+  Value sin(Value a) override { return g_.sin(a); }
+  Value cos(Value a) override { return g_.cos(a); }
+
+ private:
+  ExprGraph& g_;
+};
+
+// A joint law as text for `symoroc info`, e.g. "sign(QP2)*exp(-(QP2/0.05)^2)": each value with
+// the precedence of its outer operation, parenthesized where an operation binds tighter.
+class TextLaw final : public LawAlgebra {
+ public:
+  enum Prec { kSum, kProduct, kUnary, kPower, kAtom };
+  Value atom(std::string s) { return put(std::move(s), kAtom); }
+  const std::string& text(Value v) const { return parts_.at(static_cast<std::size_t>(v)).s; }
+
+  Value constant(double c) override {
+    const bool integer = c == std::floor(c) && std::abs(c) < 1e15;
+    return put(integer ? std::to_string(static_cast<long long>(c)) : cpp_literal(c), c < 0 ? kUnary : kAtom);
+  }
+  Value add(Value a, Value b) override { return put(wrap(a, kSum) + " + " + wrap(b, kSum), kSum); }
+  Value sub(Value a, Value b) override { return put(wrap(a, kSum) + " - " + wrap(b, kProduct), kSum); }
+  Value mul(Value a, Value b) override {
+    if (text(a) == "1") return b;
+    if (text(b) == "1") return a;
+    return put(wrap(a, kProduct) + "*" + wrap(b, kPower), kProduct);
+  }
+  Value div(Value a, Value b) override { return put(wrap(a, kProduct) + "/" + wrap(b, kPower), kProduct); }
+  Value neg(Value a) override { return put("-" + wrap(a, kPower), kUnary); }
+  Value square(Value a) override { return put(wrap(a, kAtom) + "^2", kPower); }
+  Value abs(Value a) override { return atom("|" + text(a) + "|"); }
+  Value sign(Value a) override { return call("sign", a); }
+  Value exp(Value a) override { return call("exp", a); }
+  Value tanh(Value a) override { return call("tanh", a); }
+  Value sin(Value a) override { return call("sin", a); }
+  Value cos(Value a) override { return call("cos", a); }
+
+ private:
+  struct Part {
+    std::string s;
+    int prec;
+  };
+  Value put(std::string s, int prec) {
+    parts_.push_back({std::move(s), prec});
+    return static_cast<Value>(parts_.size() - 1);
+  }
+  std::string wrap(Value v, int min_prec) const {
+    const Part& p = parts_.at(static_cast<std::size_t>(v));
+    return p.prec >= min_prec ? p.s : "(" + p.s + ")";
+  }
+  Value call(const char* f, Value a) { return atom(std::string(f) + "(" + text(a) + ")"); }
+
+  std::vector<Part> parts_;
+};
+
+// The row whose law gives the parameter's term, and the law's inputs but for q and qd.
+FamilyLaw law_of(const EffectParameter& p) {
+  const FamilyLaw law = family_law(p.family);
+  if (!law.row) throw std::logic_error("no term for effect parameter family " + p.family);
+  return law;
+}
+
+}  // namespace
+
 NodeId effect_term(ExprGraph& g, const EffectParameter& p, NodeId q, NodeId qd) {
-  if (p.family == "OFF") return g.one();
-  if (p.family == "FST") {  // sign(qd) exp(-(qd / v)^2)
-    const NodeId sign = g.sign(qd);
-    const NodeId exp = g.exp(g.neg(g.pow(g.div(qd, g.constant(p.velocity)), 2.0)));
-    return g.mul(sign, exp);
-  }
-  if (p.family == "FVA") {  // |qd|
-    const NodeId sign = g.sign(qd);
-    return g.mul(qd, sign);
-  }
-  if (p.family == "FC") return g.tanh(g.div(qd, g.constant(p.velocity)));
-  if (p.family == "HS") return g.sin(g.mul(g.constant(p.order), q));
-  if (p.family == "HC") return g.cos(g.mul(g.constant(p.order), q));
-  throw std::logic_error("no term for effect parameter family " + p.family);
+  const FamilyLaw law = law_of(p);
+  GraphLaw a(g);
+  return law.row->law(a, {q, qd, law.family, p.velocity, p.order});
 }
 
 std::string effect_term_text(const EffectParameter& p, const std::string& q, const std::string& qd) {
-  const std::string kq = p.order == 1 ? q : std::to_string(p.order) + "*" + q;
-  if (p.family == "OFF") return "1";
-  if (p.family == "FST") return "sign(" + qd + ")*exp(-(" + qd + "/" + cpp_literal(p.velocity) + ")^2)";
-  if (p.family == "FVA") return "|" + qd + "|";
-  if (p.family == "FC") return "tanh(" + qd + "/" + cpp_literal(p.velocity) + ")";
-  if (p.family == "HS") return "sin(" + kq + ")";
-  if (p.family == "HC") return "cos(" + kq + ")";
-  throw std::logic_error("no term for effect parameter family " + p.family);
+  const FamilyLaw law = law_of(p);
+  TextLaw a;
+  const LawAlgebra::Value vq = a.atom(q), vqd = a.atom(qd);
+  return a.text(law.row->law(a, {vq, vqd, law.family, p.velocity, p.order}));
 }
 
 }  // namespace symoro::codegen

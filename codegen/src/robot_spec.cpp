@@ -124,8 +124,7 @@ std::vector<EffectSpec> read_effects(const Reader& r, const YAML::Node& effects,
     std::vector<int> orders;
     if (effect_has_velocity(*kind) || *kind == EffectKind::PositionHarmonics) {
       const bool stribeck = effect_has_velocity(*kind);
-      const std::string what_velocity =
-          *kind == EffectKind::Stribeck ? "the Stribeck velocity" : "the velocity scale of tanh(qd/v)";
+      const std::string what_velocity(effect_row(*kind).velocity_scale);
       const std::string form = stribeck ? "{joints: [...], velocity: <rad/s>}" : "{joints: [...], orders: [...]}";
       if (!kv.second.IsMap()) r.fail(kv.second, effect + " takes " + form);
       r.only_keys(
@@ -135,7 +134,7 @@ std::vector<EffectSpec> read_effects(const Reader& r, const YAML::Node& effects,
       list.reset(kv.second["joints"]);
       if (!list) r.fail(kv.second, effect + " needs 'joints': " + form);
       if (stribeck) {
-        velocity = *kind == EffectKind::Stribeck ? kDefaultStribeckVelocity : kDefaultSmoothCoulombVelocity;
+        velocity = effect_row(*kind).default_velocity;
         if (const auto vel = kv.second["velocity"]) {
           // A number for every joint, or a list with one per joint (dynid diagnose selects a
           // tanh width per joint).

@@ -5,13 +5,14 @@
 #include <map>
 #include <set>
 
+#include "symoro/effect_table.hpp"
 #include "variant_parameters.hpp"
 
 namespace symoro::codegen::generate {
 
 // Resolves a variant's patterns to base parameters; every pattern must match something. The
-// base parameters its effects un-fix (coulomb, inertia_products) stay identified; smooth_coulomb
-// fixes its joint's FS to 0 (its tanh term replaces the files' sign term).
+// base parameters its effects un-fix (coulomb, inertia_products) stay identified; those an
+// effect's term replaces are fixed to 0 (smooth_coulomb's tanh replaces the files' FS sign).
 std::vector<std::pair<std::string, double>> resolve_fixed(const RobotModel& r, const VariantSpec& v) {
   std::map<std::string, double> fixed;
   for (const auto& [pattern, value] : v.fixed) {
@@ -26,15 +27,27 @@ std::vector<std::pair<std::string, double>> resolve_fixed(const RobotModel& r, c
     if (!matched)
       throw InputError(r.spec.path, v.line, 1, "variant " + v.name + ": '" + pattern + "' matches no base parameter");
   }
+  // An effect whose term replaces base families on its joint (the effect table's `replaces`)
+  // fixes them to 0, and cannot share the joint with an effect that un-fixes or replaces them.
   for (const auto& e : v.effects) {
-    if (e.kind != EffectKind::SmoothCoulomb) continue;
-    for (const auto& other : v.effects)
-      if (other.kind == EffectKind::Coulomb && other.index == e.index)
-        throw InputError(r.spec.path, e.line, e.column,
-                         "variant " + v.name + ": joint " + std::to_string(e.index) +
-                             " has both coulomb and smooth_coulomb (one Coulomb friction term per joint)");
+    const EffectRow& row = effect_row(e.kind);
+    const std::vector<std::string> replaced = effect_words(row.replaces);
+    if (replaced.empty()) continue;
+    for (const auto& other : v.effects) {
+      if (&other == &e || other.index != e.index) continue;
+      std::vector<std::string> theirs = unfixed_families(other.kind);
+      for (const std::string& f : effect_words(effect_row(other.kind).replaces)) theirs.push_back(f);
+      for (const std::string& f : replaced)
+        if (std::find(theirs.begin(), theirs.end(), f) != theirs.end())
+          throw InputError(r.spec.path, e.line, e.column,
+                           "variant " + v.name + ": joint " + std::to_string(e.index) + " has both " +
+                               effect_name(std::min(e.kind, other.kind)) + " and " +
+                               effect_name(std::max(e.kind, other.kind)) + " (one " + std::string(row.title) +
+                               " term per joint)");
+    }
     for (const auto& p : r.base)
-      if (p.joint == e.index && p.family == "FS") fixed[p.name] = 0.0;
+      if (p.joint == e.index && std::find(replaced.begin(), replaced.end(), p.family) != replaced.end())
+        fixed[p.name] = 0.0;
   }
   for (const auto& e : v.effects) {
     const auto& families = unfixed_families(e.kind);

@@ -2,13 +2,13 @@
 // compiles (`effects:`), and what the twin simulates, one row per physical effect with its name
 // in each of the three. The diagnosis (diagnose/effects.cpp), the compiler (codegen/src/effects.cpp)
 // and the twin's configuration (twin/config.cpp) take their names, titles, parameter families,
-// units and physical checks from here; tests/runtime/test_diagnose_effects.cpp checks, row by row,
-// that the three evaluate the same term. Header-only and free of other headers of the project:
-// symoroc reads it without linking the runtime.
+// units, physical checks and joint laws from here; tests/runtime/test_diagnose_effects.cpp checks,
+// row by row, that the three evaluate the same term. Header-only, with no other header of the
+// project than effect_law.hpp: symoroc reads it without linking the runtime.
 //
-// Adding a friction model: a row here, its term in the diagnosis (effect_terms, effect_columns)
-// and, if a variant can carry it, in the compiler (effect_term, effect_term_text); see
-// docs/architecture.md, "Where to add an effect".
+// Adding a friction model (any term of a joint's q and qd): its law in effect_laws and its row in
+// kEffectTable, both here. The diagnosis then looks for it on every joint, a robot.yaml variant
+// compiles it, `symoroc info` prints it; see docs/architecture.md, "Where to add an effect".
 #pragma once
 
 #include <algorithm>
@@ -16,6 +16,8 @@
 #include <string>
 #include <string_view>
 #include <vector>
+
+#include "symoro/effect_law.hpp"
 
 namespace symoro {
 
@@ -36,45 +38,88 @@ struct EffectRow {
   EffectUnit unit_like;
   std::string_view unit;     // of the parameters on a revolute joint (with unit_like Own: always)
   std::string_view unfixes;  // base families a variant un-fixes instead of adding parameters ("FS")
-  bool velocity_scale;       // a variant gives it {joints: [...], velocity: v}
+  // Base families its term replaces on its joint: a variant fixes them to 0 and refuses an
+  // effect that un-fixes them on the same joint (smooth Coulomb friction replaces FS sign(qd)).
+  std::string_view replaces;
+  // What its velocity scale is called, when a variant gives it {joints: [...], velocity: v}
+  // ("the Stribeck velocity"); "" for none. default_velocity: v when robot.yaml gives none.
+  std::string_view velocity_scale;
+  double default_velocity;
   // Physical only with a positive first parameter (a friction level, a play, a mass, a delay):
   // a fit that makes it negative is absorbing another misfit.
   bool positive;
-  std::string_view term;  // the torque on its joint's row, per parameter
+  std::string_view term;  // the torque on its joint's row, per parameter, in words
+  // The term as a law of (q, qd) (symoro/effect_law.hpp): what the compiler compiles and the
+  // diagnosis fits. Null for an effect that is no function of its joint's q and qd alone.
+  JointLaw law;
 };
 
+// Each joint law (symoro/effect_law.hpp): the term its parameter multiplies on its joint's row.
+namespace effect_laws {
+using V = LawAlgebra::Value;
+// FC tanh(qd / v): Coulomb friction smoothed over a velocity scale v.
+inline V smooth_coulomb(LawAlgebra& a, const LawInputs& x) { return a.tanh(a.div(x.qd, a.constant(x.velocity))); }
+// FST sign(qd) exp(-(qd / vs)^2): friction above Coulomb's at rest, fading with speed.
+inline V stribeck(LawAlgebra& a, const LawInputs& x) {
+  const V sign = a.sign(x.qd);
+  const V fade = a.exp(a.neg(a.square(a.div(x.qd, a.constant(x.velocity)))));
+  return a.mul(sign, fade);
+}
+// OFF: a constant torque.
+inline V offset(LawAlgebra& a, const LawInputs&) { return a.constant(1.0); }
+// FVA |qd|: viscous friction FV + FVA forward, FV - FVA backward.
+inline V viscous_asymmetry(LawAlgebra& a, const LawInputs& x) { return a.abs(x.qd); }
+// HS_k sin(k q), HC_k cos(k q): torque that repeats with the joint's position.
+inline V position_harmonic(LawAlgebra& a, const LawInputs& x) {
+  const V kq = a.mul(a.constant(x.order), x.q);
+  return x.family == 0 ? a.sin(kq) : a.cos(kq);
+}
+}  // namespace effect_laws
+
 // The rows, in the twin's order of effects first (its names() and log notes keep that order).
+// Each row: title; its names in the diagnosis, a variant, the twin; scope; parameter families,
+// their unit (like a base family's, or its own); the base families a variant un-fixes and those
+// its term replaces; the name of its velocity scale and its default; the physical check; the
+// term in words; the joint law.
 inline constexpr std::array<EffectRow, 14> kEffectTable{{
-    {"Coulomb friction", "coulomb", "smooth_coulomb", "coulomb", EffectScope::Joint, "FC", EffectUnit::LikeFS, "N*m",
-     "", true, true,
-     "FC tanh(qd / v); the diagnosis: the sign averaged over a velocity spread s (erf), v = s sqrt(pi / 2)"},
-    {"Stribeck friction", "stribeck", "stribeck", "stribeck", EffectScope::Joint, "FST", EffectUnit::LikeFS, "N*m", "",
-     true, true, "FST sign(qd) exp(-(qd / vs)^2)"},
-    {"constant torque offset", "offset", "offset", "torque_offset", EffectScope::Joint, "OFF", EffectUnit::LikeFS,
-     "N*m", "", false, false, "OFF (the twin's torque_offset t adds t to the drive: OFF = -t)"},
-    {"backlash", "backlash", "", "backlash", EffectScope::Joint, "BL", EffectUnit::Own, "rad", "", false, true,
-     "BL (IA d2s/dt2 + FV ds/dt) / 2, s the smoothed sign of the mesh torque"},
-    {"payload on the last link", "payload", "", "payload", EffectScope::Link, "PM PMX PMY PMZ", EffectUnit::Own, "kg",
-     "", false, true, "W times the last massive link's M, MX, MY, MZ"},
-    {"torque-constant error", "torque_constant", "", "torque_constant_error", EffectScope::Joint, "KTE",
-     EffectUnit::Own, "1", "", false, false, "-KTE tau_model"},
-    {"actuation delay", "actuation_delay", "", "actuation_delay", EffectScope::Robot, "DELAY", EffectUnit::Own, "s", "",
-     false, true, "DELAY d tau_model / dt"},
-    {"encoder and current noise", "", "", "sensor_noise", EffectScope::Robot, "", EffectUnit::Own, "", "", false, false,
-     "none: a measurement effect"},
-    {"timestamp jitter", "", "", "timestamp_jitter", EffectScope::Robot, "", EffectUnit::Own, "", "", false, false,
-     "none: a measurement effect"},
-    {"dropped samples", "", "", "dropped_samples", EffectScope::Robot, "", EffectUnit::Own, "", "", false, false,
-     "none: a measurement effect"},
-    {"direction-dependent viscous friction", "viscous_asymmetry", "viscous_asymmetry", "", EffectScope::Joint, "FVA",
-     EffectUnit::LikeFV, "N*m*s/rad", "", false, false, "FVA |qd|"},
-    {"position-dependent torque", "position_harmonics", "position_harmonics", "", EffectScope::Joint, "HS HC",
-     EffectUnit::LikeFS, "N*m", "", false, false, "HS_k sin(k q) + HC_k cos(k q)"},
-    {"products of inertia", "inertia_products", "inertia_products", "", EffectScope::Link, "XY XZ YZ",
-     EffectUnit::LikeXY, "kg*m^2", "XY XZ YZ", false, false,
-     "the full model's regressor columns of link j's XY, XZ, YZ"},
-    {"Coulomb friction (OpenSYMORO's sign)", "", "coulomb", "", EffectScope::Joint, "FS", EffectUnit::LikeFS, "N*m",
-     "FS", false, true, "FS sign(qd), already in the files: the variant un-fixes it"},
+    {"Coulomb friction", "coulomb", "smooth_coulomb", "coulomb",  //
+     EffectScope::Joint, "FC", EffectUnit::LikeFS, "N*m", "", "FS", "the velocity scale of tanh(qd/v)", 0.03, true,
+     "FC tanh(qd / v); the diagnosis: the sign averaged over a velocity spread s (erf), v = s sqrt(pi / 2)",
+     effect_laws::smooth_coulomb},
+    {"Stribeck friction", "stribeck", "stribeck", "stribeck",  //
+     EffectScope::Joint, "FST", EffectUnit::LikeFS, "N*m", "", "", "the Stribeck velocity", 0.05, true,
+     "FST sign(qd) exp(-(qd / vs)^2); the diagnosis: averaged over a velocity spread", effect_laws::stribeck},
+    {"constant torque offset", "offset", "offset", "torque_offset",  //
+     EffectScope::Joint, "OFF", EffectUnit::LikeFS, "N*m", "", "", "", 0, false,
+     "OFF (the twin's torque_offset t adds t to the drive: OFF = -t)", effect_laws::offset},
+    {"backlash", "backlash", "", "backlash",  //
+     EffectScope::Joint, "BL", EffectUnit::Own, "rad", "", "", "", 0, true,
+     "BL (IA d2s/dt2 + FV ds/dt) / 2, s the smoothed sign of the mesh torque", nullptr},
+    {"payload on the last link", "payload", "", "payload",  //
+     EffectScope::Link, "PM PMX PMY PMZ", EffectUnit::Own, "kg", "", "", "", 0, true,
+     "W times the last massive link's M, MX, MY, MZ", nullptr},
+    {"torque-constant error", "torque_constant", "", "torque_constant_error",  //
+     EffectScope::Joint, "KTE", EffectUnit::Own, "1", "", "", "", 0, false, "-KTE tau_model", nullptr},
+    {"actuation delay", "actuation_delay", "", "actuation_delay",  //
+     EffectScope::Robot, "DELAY", EffectUnit::Own, "s", "", "", "", 0, true, "DELAY d tau_model / dt", nullptr},
+    {"encoder and current noise", "", "", "sensor_noise",  //
+     EffectScope::Robot, "", EffectUnit::Own, "", "", "", "", 0, false, "none: a measurement effect", nullptr},
+    {"timestamp jitter", "", "", "timestamp_jitter",  //
+     EffectScope::Robot, "", EffectUnit::Own, "", "", "", "", 0, false, "none: a measurement effect", nullptr},
+    {"dropped samples", "", "", "dropped_samples",  //
+     EffectScope::Robot, "", EffectUnit::Own, "", "", "", "", 0, false, "none: a measurement effect", nullptr},
+    {"direction-dependent viscous friction", "viscous_asymmetry", "viscous_asymmetry", "",  //
+     EffectScope::Joint, "FVA", EffectUnit::LikeFV, "N*m*s/rad", "", "", "", 0, false, "FVA |qd|",
+     effect_laws::viscous_asymmetry},
+    {"position-dependent torque", "position_harmonics", "position_harmonics", "",  //
+     EffectScope::Joint, "HS HC", EffectUnit::LikeFS, "N*m", "", "", "", 0, false, "HS_k sin(k q) + HC_k cos(k q)",
+     effect_laws::position_harmonic},
+    {"products of inertia", "inertia_products", "inertia_products", "",  //
+     EffectScope::Link, "XY XZ YZ", EffectUnit::LikeXY, "kg*m^2", "XY XZ YZ", "", "", 0, false,
+     "the full model's regressor columns of link j's XY, XZ, YZ", nullptr},
+    {"Coulomb friction (OpenSYMORO's sign)", "", "coulomb", "",  //
+     EffectScope::Joint, "FS", EffectUnit::LikeFS, "N*m", "FS", "", "", 0, true,
+     "FS sign(qd), already in the files: the variant un-fixes it", nullptr},
 }};
 
 // The row of a name in one of the three columns (&EffectRow::diagnosis, ::variant, ::twin); null
@@ -106,6 +151,13 @@ inline std::vector<std::string> effect_words(std::string_view text) {
   return words;
 }
 
+// How many words a space-separated column has, without making them.
+constexpr int effect_word_count(std::string_view text) {
+  int n = 0;
+  for (std::size_t at = 0; at < text.size(); ++at) n += text[at] != ' ' && (at == 0 || text[at - 1] == ' ');
+  return n;
+}
+
 // Whether a variant effect adds parameters of this family (OFF, FST, FVA, HS, HC, FC): a family
 // of the effects, not of the rigid body or the drives.
 inline bool variant_adds_family(std::string_view family) {
@@ -114,6 +166,22 @@ inline bool variant_adds_family(std::string_view family) {
       for (const std::string& f : effect_words(row.families))
         if (f == family) return true;
   return false;
+}
+
+// The row whose joint law gives a parameter family's term (OFF, FST, FC, HS, ...), with the
+// family's place among the row's families; a null row when no law gives it.
+struct FamilyLaw {
+  const EffectRow* row = nullptr;
+  int family = 0;
+};
+inline FamilyLaw family_law(std::string_view family) {
+  for (const EffectRow& row : kEffectTable)
+    if (row.law) {
+      const std::vector<std::string> words = effect_words(row.families);
+      for (std::size_t k = 0; k < words.size(); ++k)
+        if (words[k] == family) return {&row, static_cast<int>(k)};
+    }
+  return {};
 }
 
 // The name of an effect's parameter on a joint: the family, the joint, and the order of a

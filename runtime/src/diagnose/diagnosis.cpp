@@ -338,6 +338,14 @@ std::string variant_yaml(const Diagnosis& d, const std::string& name, const std:
             "    # payload on link {} ({}): not a new term; identify again with it mounted (dynid identify)\n", c.joint,
             e.magnitude.text);
         break;
+      default:  // a row added to the effect table: its variant effect, with the velocity it was found at
+        if (variant_of(c).empty())
+          notes += fmt::format("    # {} ({}): no variant effect carries it\n", c.label(), e.magnitude.text);
+        else if (variant_velocity(c) > 0)
+          scaled[variant_of(c)][c.joint] = variant_velocity(c);
+        else
+          joints[variant_of(c)].push_back(c.joint);
+        break;
     }
   }
   auto list = [](std::vector<int> js) {

@@ -18,6 +18,9 @@ std::string joint_text(const DesignStack& d, int j) {
                                                                : fmt::format("joint {}", j);
 }
 
+// A row added to the table past the diagnosis's named kinds, with a joint law: handled by its row.
+bool added_law(EffectKind kind) { return kind > EffectKind::Payload && effect_info(kind).row->law; }
+
 bool has_parameter(const DesignStack& d, const std::string& name) {
   for (const auto& p : d.parameters)
     if (p == name) return true;
@@ -39,13 +42,16 @@ static_assert(every_name_has_a_row(&EffectRow::diagnosis, kDiagnosisOrder),
 
 }  // namespace
 
+// The diagnosis's effects: kDiagnosisOrder's, then the table's further rows with a diagnosis name.
 const std::vector<EffectInfo>& effect_catalogue() {
   static const std::vector<EffectInfo> v = [] {
+    std::vector<const EffectRow*> rows;
+    for (std::string_view name : kDiagnosisOrder) rows.push_back(find_effect(&EffectRow::diagnosis, name));
+    for (const EffectRow& row : kEffectTable)
+      if (!row.diagnosis.empty() && std::find(rows.begin(), rows.end(), &row) == rows.end()) rows.push_back(&row);
     std::vector<EffectInfo> out;
-    for (std::size_t k = 0; k < kDiagnosisOrder.size(); ++k) {
-      const EffectRow* row = find_effect(&EffectRow::diagnosis, kDiagnosisOrder[k]);
-      out.push_back({static_cast<EffectKind>(k), row, row->diagnosis.data(), row->title.data()});
-    }
+    for (const EffectRow* row : rows)
+      out.push_back({static_cast<EffectKind>(out.size()), row, row->diagnosis.data(), row->title.data()});
     return out;
   }();
   return v;
@@ -70,6 +76,7 @@ std::string Candidate::key() const {
   std::string k = std::string(effect_info(kind).name) + ":" + std::to_string(joint);
   if (kind == EffectKind::Stribeck) k += fmt::format("@{:g}~{:g}", stribeck_velocity, coulomb_velocity);
   if (kind == EffectKind::Coulomb) k += fmt::format("@{:g}", coulomb_velocity);
+  if (added_law(kind) && velocity > 0) k += fmt::format("@{:g}", velocity);
   return k;
 }
 
@@ -79,6 +86,7 @@ std::string Candidate::label() const {
   if (kind == EffectKind::Stribeck)
     s += fmt::format(" (vs = {:g} rad/s, velocity spread {:g} rad/s)", stribeck_velocity, coulomb_velocity);
   if (kind == EffectKind::Coulomb) s += fmt::format(" (velocity spread {:g} rad/s)", coulomb_velocity);
+  if (added_law(kind) && velocity > 0) s += fmt::format(" (v = {:g} rad/s)", velocity);
   if (kind == EffectKind::InertiaProducts || kind == EffectKind::Payload) return s + fmt::format(", link {}", joint);
   if (joint == 0) return s;
   return s + fmt::format(", joint {}", joint);
@@ -90,6 +98,7 @@ Candidate joint_candidate(EffectKind kind, int j, const std::vector<int>& orders
   c.kind = kind;
   c.joint = j;
   c.orders = orders;
+  if (added_law(kind)) c.velocity = row.default_velocity;
   for (const EffectParameterName& p : effect_parameter_names(row, j, orders)) {
     c.parameters.push_back(p.name);
     c.units.emplace_back(row.unit);
@@ -156,6 +165,8 @@ std::vector<Candidate> candidates(const DesignStack& d, const CandidateOptions& 
     const bool drive = d.rotor_inertia_index(j - 1) >= 0 && d.viscous_index(j - 1) >= 0;
     add(EffectKind::TorqueConstant);
     if (drive) add(EffectKind::Backlash);
+    for (const EffectInfo& e : effect_catalogue())
+      if (added_law(e.kind) && e.row->scope == EffectScope::Joint) add(e.kind);
     // Products of inertia of link j from the full model.
     if (wanted(options, EffectKind::InertiaProducts)) {
       const EffectRow& row = *effect_info(EffectKind::InertiaProducts).row;
@@ -254,10 +265,8 @@ Eigen::MatrixXd effect_columns(const Candidate& c, const DesignStack& d, const F
   return X;
 }
 
-bool sample_local(EffectKind kind) {
-  return kind == EffectKind::Coulomb || kind == EffectKind::Stribeck || kind == EffectKind::Offset ||
-         kind == EffectKind::ViscousAsymmetry || kind == EffectKind::PositionHarmonics;
-}
+// Every joint law is; Coulomb's and Stribeck's are the diagnosis's own (averaged over a spread).
+bool sample_local(EffectKind kind) { return effect_info(kind).row->law != nullptr; }
 
 void effect_terms(const Candidate& c, double q, double qd, double* out) {
   switch (c.kind) {
@@ -273,27 +282,23 @@ void effect_terms(const Candidate& c, double q, double qd, double* out) {
       out[0] = std::sqrt(b / (a + b)) * std::exp(-a * b / (a + b) * qd * qd) * std::erf(b * qd / std::sqrt(a + b));
       break;
     }
-    case EffectKind::Offset:
-      out[0] = 1.0;
-      break;
-    case EffectKind::ViscousAsymmetry:
-      out[0] = std::abs(qd);
-      break;
-    case EffectKind::PositionHarmonics:
-      for (std::size_t i = 0; i < c.orders.size(); ++i) {
-        out[2 * i] = std::sin(c.orders[i] * q);
-        out[2 * i + 1] = std::cos(c.orders[i] * q);
-      }
-      break;
-    default:
-      throw std::logic_error("effect_terms: not a sample-local effect");
+    default: {
+      // The row's joint law, per parameter in the order they are named: per order, each family.
+      const EffectRow& row = *effect_info(c.kind).row;
+      if (!row.law) throw std::logic_error("effect_terms: not a sample-local effect");
+      const int families = effect_word_count(row.families);
+      const std::size_t orders = std::max<std::size_t>(c.orders.size(), 1);
+      for (std::size_t o = 0; o < orders; ++o)
+        for (int f = 0; f < families; ++f)
+          *out++ = LawValues::evaluate(row.law, q, qd, f, c.velocity, c.orders.empty() ? 0 : c.orders[o]);
+    }
   }
 }
 
 double variant_velocity(const Candidate& c) {
   if (c.kind == EffectKind::Coulomb) return c.coulomb_velocity * std::sqrt(std::acos(-1.0) / 2);
   if (c.kind == EffectKind::Stribeck) return c.stribeck_velocity;
-  return 0;
+  return c.velocity;
 }
 
 // The effect table's check: a level, a play, a mass or a delay must be positive. (A torque cannot
@@ -309,15 +314,16 @@ Magnitude magnitude(const Candidate& c, const Eigen::VectorXd& theta, const Eige
     return fmt::format("{:.{}f} +- {:.{}f} {}", v * scale, digits, e * scale, digits, unit);
   };
   switch (c.kind) {
-    case EffectKind::Coulomb:
-    case EffectKind::Stribeck:
-    case EffectKind::Offset:
-    case EffectKind::ViscousAsymmetry: {  // one parameter, in the table's unit ("N*m" read "N m")
+    default: {  // each parameter, in the table's unit ("N*m" read "N m")
       std::string unit(effect_info(c.kind).row->unit);
       std::replace(unit.begin(), unit.end(), '*', ' ');
-      m.values = {theta(0)};
-      m.names = {c.parameters[0]};
-      m.text = pm(theta(0), sd(0), unit.c_str(), 1, 4);
+      for (Eigen::Index i = 0; i < theta.size(); ++i) {
+        m.values.push_back(theta(i));
+        m.names.push_back(c.parameters[i]);
+        const std::string value = pm(theta(i), sd(i), unit.c_str(), 1, 4);
+        m.text +=
+            theta.size() == 1 ? value : fmt::format("{}{} = {}", m.text.empty() ? "" : ", ", c.parameters[i], value);
+      }
       break;
     }
     case EffectKind::PositionHarmonics:

@@ -20,9 +20,14 @@
 
 #include "symoro/codegen/expr_graph.hpp"
 
+namespace symoro {
+struct EffectRow;
+}
+
 namespace symoro::codegen {
 
-// In catalogue order, which is also the order of the parameters the effects add.
+// In catalogue order, which is also the order of the parameters the effects add. A kind past
+// SmoothCoulomb is a variant effect added to the table after these (effect_row tells it).
 enum class EffectKind {
   Coulomb,
   InertiaProducts,
@@ -45,11 +50,11 @@ bool effect_on_links(EffectKind kind);
 // {"XY", "XZ", "YZ"} for inertia_products, none for the effects that add parameters.
 const std::vector<std::string>& unfixed_families(EffectKind kind);
 
-inline constexpr double kDefaultStribeckVelocity = 0.05;  // rad/s (m/s for a prismatic joint)
-// The velocity scale of smooth Coulomb friction tanh(qd / v) when robot.yaml gives none.
-inline constexpr double kDefaultSmoothCoulombVelocity = 0.03;  // rad/s (m/s for a prismatic joint)
-// Whether an effect takes {joints: [...], velocity: v} (stribeck, smooth_coulomb).
+// Whether an effect takes {joints: [...], velocity: v} (stribeck, smooth_coulomb); the row says
+// what the velocity is called and its default when robot.yaml gives none.
 bool effect_has_velocity(EffectKind kind);
+// The effect's row of the effect table.
+const EffectRow& effect_row(EffectKind kind);
 
 // One effect on one joint (or link) of a variant, as robot.yaml states it.
 struct EffectSpec {
@@ -78,7 +83,7 @@ std::vector<EffectParameter> effect_parameters(const std::vector<EffectSpec>& ef
                                                const std::function<std::string(const std::string&, int)>& unit);
 
 // The term a parameter multiplies on its joint's row (its regressor entry there), over the
-// nodes of that joint's position q and velocity qd.
+// nodes of that joint's position q and velocity qd: its row's joint law, in the graph.
 NodeId effect_term(ExprGraph& g, const EffectParameter& p, NodeId q, NodeId qd);
 
 // The same term as text for `symoroc info`, e.g. "sign(QP2)*exp(-(QP2/0.05)^2)".

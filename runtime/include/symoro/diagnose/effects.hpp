@@ -23,10 +23,13 @@
 //                                                       torque): column (IA d2s/dt2 + FV ds/dt) / 2,
 //                                                       s made at the logs' rate and low-passed as
 //                                                       the data were (DesignStack::filtered)
+//   (a row added to the effect table with a diagnosis name and a joint law: its law, on every joint)
 // The last three are linearizations about the current fit (their columns use its torque), so
-// the selection re-evaluates them after every step. Names, families, units, the physical check
-// and the variant effect each compiles to (coulomb -> smooth_coulomb) are the effect table's
-// (symoro/effect_table.hpp); what is here is each effect's term.
+// the selection re-evaluates them after every step. Names, families, units, the physical check,
+// the variant effect each compiles to (coulomb -> smooth_coulomb) and the laws of the joint
+// effects are the effect table's (symoro/effect_table.hpp); what is here is how the diagnosis
+// looks for each: Coulomb and Stribeck friction averaged over the logs' velocity spread, the
+// linearized effects' columns, the payload's.
 #pragma once
 
 #include <string>
@@ -39,6 +42,8 @@
 
 namespace symoro::diagnose {
 
+// A kind past Payload is a row added to the effect table with a diagnosis name and a joint law:
+// the diagnosis knows it by its row alone (effect_info(kind).row).
 enum class EffectKind {
   Coulomb,
   Stribeck,
@@ -76,6 +81,7 @@ struct Candidate {
   // under it (a sharp sign gave a Stribeck level a third of its size), and the magnitudes are
   // the law's own.
   double coulomb_velocity = 0.01;
+  double velocity = 0;            // rad/s: the velocity scale of an added row's law that has one
   std::vector<int> orders;        // position_harmonics
   std::vector<int> full_columns;  // inertia_products: columns of DesignStack::full_extra
   std::vector<std::string> parameters, units;
