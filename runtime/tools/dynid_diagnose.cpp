@@ -10,11 +10,22 @@
 #include "dynid_robots.hpp"
 #include "dynid_numbers.hpp"
 #include "symoro/diagnose/dataset_diagnosis.hpp"
+#include "symoro/diagnose/effects.hpp"
 #include "symoro/diagnose/loaded_model.hpp"
 
 namespace symoro::dynid {
 
 namespace {
+
+// --only's help: the diagnosis's effects, and the effect table's rows it looks for when named.
+std::string only_help() {
+  std::string own, asked;
+  for (const auto& e : symoro::diagnose::effect_catalogue()) {
+    std::string& list = symoro::diagnose::only_when_named(e.kind) ? asked : own;
+    list += (list.empty() ? "" : ", ") + std::string(e.name);
+  }
+  return "Only these effects (" + own + ")" + (asked.empty() ? "" : "; these only when named: " + asked);
+}
 
 diagnose::DatasetDiagnosisOptions library_options(const Common& common, const DiagnoseOptions& options) {
   diagnose::DatasetDiagnosisOptions d;
@@ -92,10 +103,7 @@ void add_diagnose_commands(CLI::App& app, Common& common) {
   cmd->add_option("--interval", o->interval_ms, "Diagnosis grid, ms")->check(numbers::interval_ms());
   cmd->add_option("--cutoff", o->cutoff, "Low-pass on every column and the torque, Hz")
       ->check(numbers::positive(1e5, "> 0 and <= 1e5 Hz"));
-  cmd->add_option("--only", o->only,
-                  "Only these effects (coulomb, stribeck, offset, viscous_asymmetry, "
-                  "position_harmonics, inertia_products, torque_constant, actuation_delay, backlash, payload)")
-      ->delimiter(',');
+  cmd->add_option("--only", o->only, only_help())->delimiter(',');
   cmd->add_option("--alpha", o->alpha, "Family-wise level of each step")
       ->check(numbers::checked(0, 0.5, true, false, "> 0 and <= 0.5"));
   cmd->add_option("--min-gain", o->min_gain, "Least relative fall of the held-out residual")

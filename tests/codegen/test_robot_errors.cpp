@@ -205,16 +205,18 @@ TEST_F(BrokenRobot, EffectsUnfixAndAppendParametersInCanonicalOrder) {
   ASSERT_EQ(gen.models.size(), 2u);
   const ModelSummary& m = gen.models[1];
   EXPECT_EQ(m.name, "arm::effects");
-  EXPECT_EQ(names_of(m.identified),
-            (std::vector<std::string>{"ZZR1", "MXR1", "MY1", "ZZ2", "MX2", "MY2", "IA2", "FV1", "FV2", "FS1", "OFF1",
-                                      "OFF2", "FST2", "FVA2", "HS1_1", "HC1_1", "HS1_2", "HC1_2", "FC2"}));
+  EXPECT_EQ(
+      names_of(m.identified),
+      (std::vector<std::string>{"ZZR1", "MXR1", "MY1",  "ZZ2",  "MX2",   "MY2",   "IA2",   "FV1",   "FV2", "FS1",
+                                "OFF1", "OFF2", "FST2", "FVA2", "HS1_1", "HC1_1", "HS1_2", "HC1_2", "FC2", "FSE2"}));
   ASSERT_EQ(m.fixed.size(), 1u);  // "FS*" matches FS1 and FS2; coulomb [1] un-fixes FS1
   EXPECT_EQ(m.fixed[0].first, "FS2");
   EXPECT_EQ(m.identified[13].unit, "N*m*s/rad");
-  ASSERT_EQ(m.effects.size(), 9u);
+  ASSERT_EQ(m.effects.size(), 10u);
   EXPECT_EQ(m.effects[2], (std::pair<std::string, std::string>{"FST2", "sign(QP2)*exp(-(QP2/0.05)^2)"}));
   EXPECT_EQ(m.effects[6], (std::pair<std::string, std::string>{"HS1_2", "sin(2*th1)"}));
   EXPECT_EQ(m.effects[8], (std::pair<std::string, std::string>{"FC2", "tanh(QP2/0.04)"}));
+  EXPECT_EQ(m.effects[9], (std::pair<std::string, std::string>{"FSE2", "sign(QP2)*exp(-(|QP2|/0.08))"}));
 }
 
 TEST_F(BrokenRobot, BaseVariantChainsFixedPatternsAndEffects) {
@@ -234,9 +236,9 @@ TEST_F(BrokenRobot, BaseVariantChainsFixedPatternsAndEffects) {
     const ModelSummary& m = gen.models[k];
     SCOPED_TRACE(m.name);
     EXPECT_EQ(names_of(m.identified),
-              (std::vector<std::string>{"ZZR1",  "MXR1",  "MY1",   "ZZ2",   "MX2",   "MY2",   "IA2",
-                                        "FV1",   "FS1",   "OFF1",  "OFF2",  "FST1",  "FST2",  "FVA2",
-                                        "HS1_1", "HC1_1", "HS1_2", "HC1_2", "HS2_3", "HC2_3", "FC2"}));
+              (std::vector<std::string>{"ZZR1",  "MXR1",  "MY1",   "ZZ2",   "MX2",  "MY2",  "IA2",   "FV1",
+                                        "FS1",   "OFF1",  "OFF2",  "FST1",  "FST2", "FVA2", "HS1_1", "HC1_1",
+                                        "HS1_2", "HC1_2", "HS2_3", "HC2_3", "FC2",  "FSE2"}));
     EXPECT_EQ(m.fixed, (std::vector<std::pair<std::string, double>>{{"FV2", 0.0}, {"FS2", 0.0}}));
     EXPECT_EQ(m.effects[2].second, "sign(QP1)*exp(-(QP1/0.05)^2)");  // the default Stribeck velocity
   }
@@ -261,7 +263,8 @@ TEST_F(BrokenRobot, PrismaticJointsTakePrismaticUnits) {
 TEST_F(BrokenRobot, UnknownEffect) {
   add_variants("  bad:\n    effects:\n      backlash: [1]\n");
   expect_error(R"(robot\.yaml:31:7: error: variant bad: unknown effect 'backlash' \(known effects: coulomb, )"
-               R"(inertia_products, offset, stribeck, viscous_asymmetry, position_harmonics, smooth_coulomb\))");
+               R"(inertia_products, offset, stribeck, viscous_asymmetry, position_harmonics, smooth_coulomb, )"
+               R"(tustin_stribeck\))");
 }
 
 TEST_F(BrokenRobot, EffectJointOutOfRange) {
@@ -376,7 +379,7 @@ TEST_F(BrokenRobot, EffectsMustBeAMap) {
 TEST_F(BrokenRobot, EffectParameterNameClashes) {
   // A geometric constant named like the parameter an offset of joint 2 adds.
   replace("robot.yaml", "  G3: 9.80665     # m/s^2\n", "  G3: 9.80665     # m/s^2\n  OFF2: 1.0\n");
-  expect_error(R"(robot\.yaml:20:1: error: variant effects: the effect parameter OFF2 is already a name of the model)");
+  expect_error(R"(robot\.yaml:19:1: error: variant effects: the effect parameter OFF2 is already a name of the model)");
 }
 
 TEST(Generation, IsReproducible) {

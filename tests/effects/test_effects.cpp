@@ -1,7 +1,8 @@
 // Model-gap effects compiled into a variant (robot.yaml `effects`), on planar2r::effects:
 //   coulomb [1] (FS1 un-fixed while "FS*" fixes the rest), offset [1, 2], stribeck joint 2 at
 //   0.05 rad/s, viscous_asymmetry [2], position_harmonics joint 1, orders 1 and 2,
-//   smooth_coulomb joint 2 at 0.04 rad/s (FS2 stays fixed to 0).
+//   smooth_coulomb joint 2 at 0.04 rad/s (FS2 stays fixed to 0), tustin_stribeck joint 2 at
+//   0.08 rad/s (a row of the effect table that only its law describes).
 // Every regressor column is checked against its term written out here, then the functions
 // against each other and against the robot's full model, and the Jet derivatives of the new
 // terms against finite differences.
@@ -28,6 +29,7 @@ using V2 = Eigen::Vector2d;
 
 constexpr double kStribeckVelocity = 0.05;  // robot.yaml
 constexpr double kCoulombVelocity = 0.04;   // robot.yaml, smooth_coulomb
+constexpr double kTustinVelocity = 0.08;    // robot.yaml, tustin_stribeck
 constexpr double kTight = 1e-13;
 constexpr double kRelTol = 1e-9;
 constexpr int kStates = 40;
@@ -42,7 +44,8 @@ V2 effect_torque_by_hand(const V2& q, const V2& qd, const ParameterVector<Effect
   tau(0) = phi(OFF1) + phi(HS1_1) * std::sin(q(0)) + phi(HC1_1) * std::cos(q(0)) + phi(HS1_2) * std::sin(2 * q(0)) +
            phi(HC1_2) * std::cos(2 * q(0));
   tau(1) = phi(OFF2) + phi(FST2) * sgn(qd(1)) * std::exp(-std::pow(qd(1) / v, 2)) + phi(FVA2) * std::fabs(qd(1)) +
-           phi(FC2) * std::tanh(qd(1) / kCoulombVelocity);
+           phi(FC2) * std::tanh(qd(1) / kCoulombVelocity) +
+           phi(FSE2) * sgn(qd(1)) * std::exp(-std::fabs(qd(1)) / kTustinVelocity);
   return tau;
 }
 
@@ -63,14 +66,15 @@ class PlanarEffects : public ::testing::Test {
 };
 
 TEST_F(PlanarEffects, ParametersAreAppendedInCanonicalOrderWithUnits) {
-  static_assert(Effects::np == 19 && Effects::ne == 9 && Effects::ns == Full::ns + 9);
-  const std::array<const char*, 19> names = {"ZZR1",  "MXR1",  "MY1",   "ZZ2",   "MX2",  "MY2",  "IA2",
+  static_assert(Effects::np == 20 && Effects::ne == 10 && Effects::ns == Full::ns + 10);
+  const std::array<const char*, 20> names = {"ZZR1",  "MXR1",  "MY1",   "ZZ2",   "MX2",  "MY2",  "IA2",
                                              "FV1",   "FV2",   "FS1",   "OFF1",  "OFF2", "FST2", "FVA2",
-                                             "HS1_1", "HC1_1", "HS1_2", "HC1_2", "FC2"};
-  const std::array<const char*, 9> units = {"N*m", "N*m", "N*m", "N*m*s/rad", "N*m", "N*m", "N*m", "N*m", "N*m"};
-  const std::array<int, 9> joints = {1, 2, 2, 2, 1, 1, 1, 1, 2};
+                                             "HS1_1", "HC1_1", "HS1_2", "HC1_2", "FC2",  "FSE2"};
+  const std::array<const char*, 10> units = {"N*m", "N*m", "N*m", "N*m*s/rad", "N*m",
+                                             "N*m", "N*m", "N*m", "N*m",       "N*m"};
+  const std::array<int, 10> joints = {1, 2, 2, 2, 1, 1, 1, 1, 2, 2};
   for (int i = 0; i < Effects::np; ++i) EXPECT_EQ(std::string(Effects::parameters[i].name), names[i]) << i;
-  for (int k = 0; k < 9; ++k) {
+  for (int k = 0; k < 10; ++k) {
     const auto& p = Effects::parameters[10 + k];
     EXPECT_EQ(std::string(p.unit), units[k]) << p.name;
     EXPECT_EQ(p.joint, joints[k]) << p.name;
@@ -81,6 +85,8 @@ TEST_F(PlanarEffects, ParametersAreAppendedInCanonicalOrderWithUnits) {
   EXPECT_EQ(Effects::effect_parameters[6].order, 2);
   EXPECT_EQ(Effects::effect_parameters[8].velocity, kCoulombVelocity);
   EXPECT_EQ(std::string(Effects::effect_parameters[8].family), "FC");
+  EXPECT_EQ(Effects::effect_parameters[9].velocity, kTustinVelocity);
+  EXPECT_EQ(std::string(Effects::effect_parameters[9].family), "FSE");
   // coulomb [1]: FS1 is identified although "FS*" fixes FS2 (which smooth_coulomb fixes too).
   ASSERT_EQ(Effects::fixed_parameters.size(), 1u);
   EXPECT_EQ(std::string(Effects::fixed_parameters[0].name), "FS2");
@@ -108,6 +114,7 @@ TEST_F(PlanarEffects, RegressorColumnsAreTheTerms) {
     expect_column(HS1_2, std::sin(2 * q1), 0.0);
     expect_column(HC1_2, std::cos(2 * q1), 0.0);
     expect_column(FC2, 0.0, std::tanh(qd2 / kCoulombVelocity));
+    expect_column(FSE2, 0.0, sgn(qd2) * std::exp(-std::fabs(qd2) / kTustinVelocity));
     // The base parameters' columns are the full model's.
     const auto Wf = Full::regressor(s.q, s.qd, s.qdd);
     for (int i = 0; i < Effects::np - Effects::ne; ++i)
@@ -150,11 +157,11 @@ TEST_F(PlanarEffects, ForwardDynamicsInvertsInverseDynamics) {
 TEST_F(PlanarEffects, BaseFromStandardMapsEffectParametersIdentically) {
   const auto standard = standard_parameters_of_variant<Effects>(rng_);  // FS2 = 0, as fixed
   const ParameterVector<Effects> phi = Effects::base_from_standard(standard.s);
-  EXPECT_TRUE((phi.tail<9>().array() == standard.s.tail<9>().array()).all());
+  EXPECT_TRUE((phi.tail<10>().array() == standard.s.tail<10>().array()).all());
   EXPECT_TRUE(close(Effects::to_parent(phi), Full::base_from_standard(standard.s.head<Full::ns>()), kTight));
-  for (int k = 0; k < 9; ++k)
+  for (int k = 0; k < 10; ++k)
     EXPECT_EQ(std::string(Effects::standard_parameters[Full::ns + k].name), Effects::effect_parameters[k].name);
-  EXPECT_TRUE(Effects::from_parent(Effects::to_parent(phi)).tail<9>().isZero(0.0));
+  EXPECT_TRUE(Effects::from_parent(Effects::to_parent(phi)).tail<10>().isZero(0.0));
 }
 
 // Derivatives in q and qd (Jets seeded on both) of every regressor column and of the torque,
@@ -180,7 +187,7 @@ TEST_F(PlanarEffects, JetDerivativesOfTheTermsMatchFiniteDifferences) {
     };
     const Eigen::MatrixXd W_jet = jet_jacobian(Effects::regressor(q, qd, s.qdd));
     const Eigen::MatrixXd W_fd = finite_difference_jacobian(regressor_at, x, 1e-7);
-    // Rows of d vec(W) / dx for the 9 effect columns (column-major: entry (r, c) is row 2c + r):
+    // Rows of d vec(W) / dx for the 10 effect columns (column-major: entry (r, c) is row 2c + r):
     // relative 1e-6, or 1e-8 absolute where the derivative is below the central difference's
     // round-off (eps |W| / h ~ 1e-9: saturated tanh and Stribeck terms).
     for (int c = Effects::np - Effects::ne; c < Effects::np; ++c) {
@@ -195,6 +202,8 @@ TEST_F(PlanarEffects, JetDerivativesOfTheTermsMatchFiniteDifferences) {
     EXPECT_NEAR(W_jet(2 * fx::param::FVA2 + 1, 3), sgn(qd2), 1e-15);
     const double th = std::tanh(qd2 / kCoulombVelocity), dfc = (1 - th * th) / kCoulombVelocity;
     EXPECT_NEAR(W_jet(2 * fx::param::FC2 + 1, 3), dfc, 1e-12 * (1 + std::fabs(dfc)));
+    const double dfse = -std::exp(-std::fabs(qd2) / kTustinVelocity) / kTustinVelocity;
+    EXPECT_NEAR(W_jet(2 * fx::param::FSE2 + 1, 3), dfse, 1e-12 * (1 + std::fabs(dfse)));
     EXPECT_TRUE(close(jet_jacobian(Effects::inverse_dynamics(q, qd, s.qdd, phi)),
                       finite_difference_jacobian(tau_at, x, 1e-7), 1e-6));
   }

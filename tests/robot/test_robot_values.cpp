@@ -416,7 +416,7 @@ TEST_P(RobotValues, InertiaFirstAndSecondDerivativesAreTheFiniteDifferences) {
 
 TEST_P(RobotValues, ParameterMetadataIsWellFormed) {
   static const std::set<std::string> families = {"XX", "XY", "XZ", "YY",  "YZ",  "ZZ",  "MX", "MY", "MZ", "M",
-                                                 "IA", "FV", "FS", "OFF", "FST", "FVA", "HS", "HC", "FC"};
+                                                 "IA", "FV", "FS", "OFF", "FST", "FVA", "HS", "HC", "FC", "FSE"};
   for_models([&](const ModelHandle& m, const ModelHandle&) {
     std::set<std::string> seen;
     const int np = m.np(), ne = m.ne();
@@ -444,7 +444,7 @@ TEST_P(RobotValues, ParameterMetadataIsWellFormed) {
       EXPECT_EQ(std::string(m.standard_parameters()[m.ns() - ne + k].name), e.name);
       const std::string family = e.family;
       EXPECT_EQ(e.order >= 1, family == "HS" || family == "HC");
-      EXPECT_EQ(e.velocity > 0, family == "FST" || family == "FC");
+      EXPECT_EQ(e.velocity > 0, family == "FST" || family == "FC" || family == "FSE");
     }
   });
 }

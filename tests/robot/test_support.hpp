@@ -153,7 +153,8 @@ template <class Model>
 inline constexpr int effect_count = EffectCount<Model>::value;
 
 inline bool is_effect_family(const std::string& family) {
-  return family == "OFF" || family == "FST" || family == "FVA" || family == "HS" || family == "HC" || family == "FC";
+  return family == "OFF" || family == "FST" || family == "FVA" || family == "HS" || family == "HC" || family == "FC" ||
+         family == "FSE";
 }
 
 // The term an effect parameter multiplies in its joint's torque, at that joint's q and qd.
@@ -164,6 +165,7 @@ inline double effect_term(const std::string& family, int order, double velocity,
   if (family == "HS") return std::sin(order * q);
   if (family == "HC") return std::cos(order * q);
   if (family == "FC") return std::tanh(qd / velocity);
+  if (family == "FSE") return sign_of(qd) * std::exp(-std::abs(qd) / velocity);
   throw std::invalid_argument("unknown effect family '" + family + "'");
 }
 

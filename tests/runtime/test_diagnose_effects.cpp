@@ -328,8 +328,9 @@ TEST(DiagnoseTwin, PayloadAgainstAnEarlierIdentification) {
 namespace {
 
 // The diagnosis's effect terms are the compiler's: planar2r's variant `effects` compiles
-// offsets, Stribeck (0.05 rad/s), direction-dependent viscous friction and position
-// harmonics; each compiled regressor column equals effect_terms() of the same candidate.
+// offsets, Stribeck (0.05 rad/s), direction-dependent viscous friction, position harmonics and
+// Tustin's Stribeck friction; each compiled regressor column equals effect_terms() of the same
+// candidate.
 TEST(DiagnoseEffects, TermsMatchTheCompiledVariant) {
   using E = symoro::planar2r::effects::Model;
   auto column = [](const char* name) {
@@ -365,6 +366,14 @@ TEST(DiagnoseEffects, TermsMatchTheCompiledVariant) {
     check(EffectKind::Stribeck, 2, {"FST2"});
     check(EffectKind::ViscousAsymmetry, 2, {"FVA2"});
     check(EffectKind::PositionHarmonics, 1, {"HS1_1", "HC1_1", "HS1_2", "HC1_2"}, {1, 2});
+    // Tustin's Stribeck friction, a row known by its law alone: at no spread, the compiled law.
+    Candidate tustin = joint_candidate(effect_kind("tustin_stribeck"), 2);
+    tustin.velocity = 0.08;  // planar2r's robot.yaml
+    tustin.coulomb_velocity = 0;
+    double fse = 0;
+    effect_terms(tustin, q(1), qd(1), &fse);
+    EXPECT_NEAR(W(1, column("FSE2")), fse, 1e-14);
+    EXPECT_EQ(W(0, column("FSE2")), 0.0);
     // Coulomb: the compiled FS1 is OpenSYMORO's sign(qd), the diagnosis's erf tends to it.
     Candidate c;
     c.kind = EffectKind::Coulomb;
@@ -439,12 +448,11 @@ TEST(EffectTable, TheDiagnosisTheCompilerAndTheTwinAgreeOnEveryRow) {
     }
     if (row.diagnosis.empty() || !compiled || !row.unfixes.empty()) continue;
     // The same candidate as the diagnosis makes it and as a variant compiles it, on joint 2.
-    Candidate c;
-    c.kind = effect_kind(std::string(row.diagnosis));
-    c.joint = 2;
+    const EffectKind kind = effect_kind(std::string(row.diagnosis));
+    Candidate c =
+        joint_candidate(kind, 2, kind == EffectKind::PositionHarmonics ? std::vector<int>{1, 3} : std::vector<int>{});
     c.coulomb_velocity = 1e-7;  // the spread's effect on Stribeck's law: (spread / vs)^2 relative
     c.stribeck_velocity = 0.05;
-    if (c.kind == EffectKind::PositionHarmonics) c.orders = {1, 3};
     cg::EffectSpec spec;
     spec.kind = *compiled;
     spec.index = 2;
@@ -467,7 +475,7 @@ TEST(EffectTable, TheDiagnosisTheCompilerAndTheTwinAgreeOnEveryRow) {
       }
     ++compared;
   }
-  EXPECT_EQ(compared, 5);  // coulomb, stribeck, offset, viscous_asymmetry, position_harmonics
+  EXPECT_EQ(compared, 6);  // coulomb, stribeck, offset, viscous_asymmetry, position_harmonics, tustin_stribeck
 
   // The twin's friction rows: its plant's torque beyond viscous friction is the compiled term
   // times the twin's level (coulomb: smooth_coulomb at the twin's smoothing velocity; stribeck:
@@ -510,6 +518,39 @@ TEST(EffectTable, TheDiagnosisTheCompilerAndTheTwinAgreeOnEveryRow) {
              }())
                 .norm(),
             1e-3);
+}
+
+}  // namespace
+
+namespace {
+
+// A row added to the effect table with its law alone (Tustin's Stribeck friction) is averaged by
+// the diagnosis over the velocity spread by quadrature: against the average derived by hand,
+// E[sign(v) exp(-|v| / a)] over v ~ N(m, s^2)
+//   = exp(s^2 / (2 a^2)) (exp(-m / a) Phi((m - s^2 / a) / s) - exp(m / a) Phi(-(m + s^2 / a) / s)),
+// at rest, near it (the two pieces of the quadrature) and far from it; and with no spread, the law.
+TEST(DiagnoseEffects, AnAddedLawIsAveragedOverTheVelocitySpread) {
+  const EffectKind kind = effect_kind("tustin_stribeck");
+  const auto Phi = [](double x) { return 0.5 * std::erfc(-x / std::sqrt(2.0)); };
+  for (double a : {0.03, 0.06, 0.15})
+    for (double s : {0.005, 0.02, 0.05}) {
+      Candidate c = joint_candidate(kind, 1);
+      c.velocity = a;
+      c.coulomb_velocity = s;
+      for (double m : {0.0, 1e-4, -0.004, 0.01, -0.03, 0.08, 0.3, -1.2}) {
+        const double expected = std::exp(s * s / (2 * a * a)) * (std::exp(-m / a) * Phi((m - s * s / a) / s) -
+                                                                 std::exp(m / a) * Phi(-(m + s * s / a) / s));
+        double got = 0;
+        effect_terms(c, 0.4, m, &got);
+        EXPECT_NEAR(got, expected, 1e-7) << "a " << a << ", s " << s << ", qd " << m;
+      }
+    }
+  Candidate sharp = joint_candidate(kind, 1);
+  sharp.velocity = 0.06;
+  sharp.coulomb_velocity = 0;
+  double got = 0;
+  effect_terms(sharp, 0.4, -0.09, &got);
+  EXPECT_DOUBLE_EQ(got, -std::exp(-0.09 / 0.06));
 }
 
 }  // namespace

@@ -74,6 +74,12 @@ inline V position_harmonic(LawAlgebra& a, const LawInputs& x) {
   const V kq = a.mul(a.constant(x.order), x.q);
   return x.family == 0 ? a.sin(kq) : a.cos(kq);
 }
+// FSE sign(qd) exp(-|qd| / vs): Tustin's Stribeck friction, fading exponentially with speed.
+inline V tustin_stribeck(LawAlgebra& a, const LawInputs& x) {
+  const V sign = a.sign(x.qd);
+  const V fade = a.exp(a.neg(a.div(a.abs(x.qd), a.constant(x.velocity))));
+  return a.mul(sign, fade);
+}
 }  // namespace effect_laws
 
 // The rows, in the twin's order of effects first (its names() and log notes keep that order).
@@ -81,7 +87,7 @@ inline V position_harmonic(LawAlgebra& a, const LawInputs& x) {
 // their unit (like a base family's, or its own); the base families a variant un-fixes and those
 // its term replaces; the name of its velocity scale and its default; the physical check; the
 // term in words; the joint law.
-inline constexpr std::array<EffectRow, 14> kEffectTable{{
+inline constexpr std::array<EffectRow, 15> kEffectTable{{
     {"Coulomb friction", "coulomb", "smooth_coulomb", "coulomb",  //
      EffectScope::Joint, "FC", EffectUnit::LikeFS, "N*m", "", "FS", "the velocity scale of tanh(qd/v)", 0.03, true,
      "FC tanh(qd / v); the diagnosis: the sign averaged over a velocity spread s (erf), v = s sqrt(pi / 2)",
@@ -120,6 +126,9 @@ inline constexpr std::array<EffectRow, 14> kEffectTable{{
     {"Coulomb friction (OpenSYMORO's sign)", "", "coulomb", "",  //
      EffectScope::Joint, "FS", EffectUnit::LikeFS, "N*m", "FS", "", "", 0, true,
      "FS sign(qd), already in the files: the variant un-fixes it", nullptr},
+    {"Tustin's Stribeck friction", "tustin_stribeck", "tustin_stribeck", "",  //
+     EffectScope::Joint, "FSE", EffectUnit::LikeFS, "N*m", "", "", "the Stribeck velocity", 0.05, true,
+     "FSE sign(qd) exp(-|qd| / vs)", effect_laws::tustin_stribeck},
 }};
 
 // The row of a name in one of the three columns (&EffectRow::diagnosis, ::variant, ::twin); null

@@ -14,7 +14,7 @@ namespace symoro::diagnose::detail {
 
 namespace {
 
-bool friction(const Candidate& c) { return c.kind == EffectKind::Coulomb || c.kind == EffectKind::Stribeck; }
+bool friction(const Candidate& c) { return friction_law(c.kind); }
 
 // One way to describe a joint's friction: one or two candidates.
 struct Option {
@@ -22,14 +22,15 @@ struct Option {
   double sse = std::numeric_limits<double>::infinity();  // the joint's held-out weighted SSE
 };
 
-// Every option among a joint's friction candidates: each alone, and each Coulomb and Stribeck
-// pair at the same velocity spread.
+// Every option among a joint's friction candidates: each alone, and Coulomb friction beside each
+// Stribeck term or added row's friction law at the same velocity spread.
 std::vector<Option> options(const std::vector<Candidate>& friction) {
   std::vector<Option> out;
   for (const auto& c : friction) out.push_back({{&c}});
   for (const auto& c : friction)
     for (const auto& s : friction)
-      if (c.kind == EffectKind::Coulomb && s.kind == EffectKind::Stribeck && c.coulomb_velocity == s.coulomb_velocity)
+      if (c.kind == EffectKind::Coulomb && (s.kind == EffectKind::Stribeck || s.kind > EffectKind::Payload) &&
+          c.coulomb_velocity == s.coulomb_velocity)
         out.push_back({{&c, &s}});
   return out;
 }

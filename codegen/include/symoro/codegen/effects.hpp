@@ -11,6 +11,8 @@
 //   position_harmonics  HS<j>_<k>, HC<j>_<k> [N*m | N]  HSj_k*sin(k*qj), HCj_k*cos(k*qj)
 //   smooth_coulomb      FC<j>     [N*m | N]           FCj * tanh(QPj/v); fixes FSj to 0 (the
 //                       files' FSj*sign(QPj) would be the same effect with a noise-biased column)
+//   tustin_stribeck     FSE<j>    [N*m | N]           FSEj * sign(QPj) * exp(-|QPj|/v)
+// A row added to the table compiles from its row alone: its law gives the term.
 #pragma once
 
 #include <functional>

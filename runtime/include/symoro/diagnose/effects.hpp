@@ -23,7 +23,9 @@
 //                                                       torque): column (IA d2s/dt2 + FV ds/dt) / 2,
 //                                                       s made at the logs' rate and low-passed as
 //                                                       the data were (DesignStack::filtered)
-//   (a row added to the effect table with a diagnosis name and a joint law: its law, on every joint)
+//   tustin_stribeck    FSE<j> (N m), vs fixed           FSE sign(qd) exp(-|qd|/vs), averaged over the spread:
+//                                                       a row added to the effect table, known by its law
+//                                                       alone and looked for only when --only names it
 // The last three are linearizations about the current fit (their columns use its torque), so
 // the selection re-evaluates them after every step. Names, families, units, the physical check,
 // the variant effect each compiles to (coulomb -> smooth_coulomb) and the laws of the joint
@@ -67,6 +69,10 @@ struct EffectInfo {
 };
 
 const std::vector<EffectInfo>& effect_catalogue();
+// Whether the diagnosis looks for an effect only when CandidateOptions::only names it: a row added
+// to the effect table, known by its law alone (a law close to one the diagnosis tries already
+// would split the effect between the two).
+bool only_when_named(EffectKind kind);
 const EffectInfo& effect_info(EffectKind kind);
 // By name; throws std::invalid_argument listing the known names.
 EffectKind effect_kind(const std::string& name);
@@ -99,7 +105,13 @@ struct CandidateOptions {
   std::vector<double> refined_spreads{0.005, 0.01, 0.02, 0.03, 0.04, 0.06, 0.1};
   std::vector<double> refined_stribeck_velocities{0.02, 0.05, 0.07, 0.1, 0.15};
   std::vector<int> harmonic_orders{1, 2};
-  std::vector<std::string> only;  // effect names to consider (empty: all)
+  // rad/s: the velocity scales an added row's law that has one is tried at, one candidate each,
+  // and those a friction law of an added row is chosen from again (friction_options).
+  std::vector<double> law_velocities{0.02, 0.05, 0.1};
+  std::vector<double> refined_law_velocities{0.02, 0.03, 0.05, 0.07, 0.1, 0.15};
+  // Effect names to consider (empty: the diagnosis's own; a row added to the effect table is
+  // considered only when named here).
+  std::vector<std::string> only;
 };
 
 // A joint's candidate with its parameters named and united as the effect table says (one per
@@ -110,8 +122,11 @@ Candidate joint_candidate(EffectKind kind, int joint, const std::vector<int>& or
 // (a parameter of the same name), inertia products only for links whose full-model columns
 // exist in the stack, torque-constant and backlash only where IA and FV are identified.
 std::vector<Candidate> candidates(const DesignStack& d, const CandidateOptions& options = {});
-// Joint j's Coulomb and Stribeck candidates over the refined spreads and velocities (when the
-// options allow those effects): what the joint's friction is chosen from once named.
+// Whether an effect is one of a joint's friction terms, chosen again as a whole once named:
+// Coulomb, Stribeck, or an added row's law with a velocity scale and a positive level.
+bool friction_law(EffectKind kind);
+// Joint j's friction candidates over the refined spreads and velocities (when the options allow
+// those effects): what the joint's friction is chosen from once named.
 std::vector<Candidate> friction_options(const DesignStack& d, const CandidateOptions& options, int joint);
 
 // What a linearized candidate needs from the current fit.

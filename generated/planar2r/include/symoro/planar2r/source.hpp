@@ -22,7 +22,7 @@ inline constexpr File files[] = {
     {"planar2r.par", "5bedaac409c4c7b65a0cf4670adf379d"},
     {"planar2r_base.par", "a65e7b4cc1a0841391c87ea87c2168ae"},
     {"regp.txt", "e8b8629c3e466b794ef980c07a8011c3"},
-    {"robot.yaml", "37493b14c3d6a6145d86459b2e234a37"},
+    {"robot.yaml", "ba9839ced2f6c1d11972c6b76558c6d7"},
 };
 
 }  // namespace symoro::planar2r::source

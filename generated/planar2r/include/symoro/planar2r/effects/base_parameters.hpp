@@ -20,7 +20,7 @@ inline void base_from_standard(const Eigen::MatrixBase<S>& s, const Eigen::Matri
   using std::pow;
   using std::sin;
   using ::symoro::sign;
-  eigen_assert(s.size() == 35);
+  eigen_assert(s.size() == 36);
   static_cast<void>(s);
   Eigen::MatrixBase<Out>& phi = const_cast<Eigen::MatrixBase<Out>&>(out);
   phi.derived().resize(np, 1);
@@ -46,6 +46,7 @@ inline void base_from_standard(const Eigen::MatrixBase<S>& s, const Eigen::Matri
   const Scalar HS1_2(s[32]);
   const Scalar HC1_2(s[33]);
   const Scalar FC2(s[34]);
+  const Scalar FSE2(s[35]);
   phi(0, 0) = 0.25 * M2 + IA1 + ZZ1;
   phi(1, 0) = 0.5 * M2 + MX1;
   phi(2, 0) = MY1;
@@ -65,6 +66,7 @@ inline void base_from_standard(const Eigen::MatrixBase<S>& s, const Eigen::Matri
   phi(16, 0) = HS1_2;
   phi(17, 0) = HC1_2;
   phi(18, 0) = FC2;
+  phi(19, 0) = FSE2;
 }
 
 template <class S>

@@ -24,7 +24,7 @@ inline void forward_dynamics(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixB
   eigen_assert(q.size() == 2);
   eigen_assert(qd.size() == 2);
   eigen_assert(tau.size() == 2);
-  eigen_assert(phi.size() == 19);
+  eigen_assert(phi.size() == 20);
   static_cast<void>(q);
   static_cast<void>(qd);
   static_cast<void>(tau);
@@ -77,7 +77,8 @@ inline void forward_dynamics(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixB
   const Scalar GAM1(tau[0]);
   const Scalar t27 = 1.0 / (ZZR1 + t26);
   const Scalar t28 = 20.0 * QP2;
-  const Scalar t29 = 2.0 * th1;
+  const Scalar t29 = QP2 * t9;
+  const Scalar t30 = 2.0 * th1;
   const Scalar OFF1(phi[10]);
   const Scalar OFF2(phi[11]);
   const Scalar FST2(phi[12]);
@@ -87,13 +88,15 @@ inline void forward_dynamics(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixB
   const Scalar HS1_2(phi[16]);
   const Scalar HC1_2(phi[17]);
   const Scalar FC2(phi[18]);
-  const Scalar t30 = GAM2 - (OFF2 + t9 * exp(-(t28 * t28)) * FST2 + QP2 * t9 * FVA2 + tanh(25.0 * QP2) * FC2) - QP2 * FV2;
-  const Scalar t31 = t10 * (t13 * t21 - t12 * t18 - t15 * t30 - t8 * MX2) + t11 * (t12 * t19 - t13 * t22 + t16 * t30 - t8 * MY2);
-  const Scalar t32 = GAM1 - (OFF1 + t1 * HS1_1 + t0 * HC1_1 + sin(t29) * HS1_2 + cos(t29) * HC1_2) - (QP1 * FV1 + (sign(QP1) * FS1 + (t12 * t20 + t13 * t23 + t17 * t30 + t31)));
-  const Scalar t33 = t27 * t32 - (t5 * ((t2 * t24 - t3 * t25 - MY1) * t27) + t6 * ((MXR1 + (t2 * t25 + t3 * t24)) * t27));
-  const Scalar t34 = t16 * (t13 + (t2 * t6 + t11 * t33) - t3 * t5) - t15 * (t3 * t6 + (t12 + (t2 * t5 + t10 * t33)));
-  qdd(0, 0) = t33;
-  qdd(1, 0) = t14 * t30 - (t34 + t17 * t33);
+  const Scalar FSE2(phi[19]);
+  const Scalar t31 = OFF2 + t9 * exp(-(t28 * t28)) * FST2 + t29 * FVA2 + tanh(25.0 * QP2) * FC2 + t9 * exp(-(12.5 * t29)) * FSE2;
+  const Scalar t32 = GAM2 - t31 - QP2 * FV2;
+  const Scalar t33 = t10 * (t13 * t21 - t12 * t18 - t15 * t32 - t8 * MX2) + t11 * (t12 * t19 - t13 * t22 + t16 * t32 - t8 * MY2);
+  const Scalar t34 = GAM1 - (OFF1 + t1 * HS1_1 + t0 * HC1_1 + sin(t30) * HS1_2 + cos(t30) * HC1_2) - (QP1 * FV1 + (sign(QP1) * FS1 + (t12 * t20 + t13 * t23 + t17 * t32 + t33)));
+  const Scalar t35 = t27 * t34 - (t5 * ((t2 * t24 - t3 * t25 - MY1) * t27) + t6 * ((MXR1 + (t2 * t25 + t3 * t24)) * t27));
+  const Scalar t36 = t16 * (t13 + (t2 * t6 + t11 * t35) - t3 * t5) - t15 * (t3 * t6 + (t12 + (t2 * t5 + t10 * t35)));
+  qdd(0, 0) = t35;
+  qdd(1, 0) = t14 * t32 - (t36 + t17 * t35);
 }
 
 template <class Q, class QD, class Tau, class Phi>

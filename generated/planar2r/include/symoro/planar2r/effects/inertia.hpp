@@ -21,7 +21,7 @@ inline void inertia(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<Phi>&
   using std::sin;
   using ::symoro::sign;
   eigen_assert(q.size() == 2);
-  eigen_assert(phi.size() == 19);
+  eigen_assert(phi.size() == 20);
   static_cast<void>(q);
   static_cast<void>(phi);
   Eigen::MatrixBase<Out>& M = const_cast<Eigen::MatrixBase<Out>&>(out);

@@ -28,7 +28,7 @@ inline void inertia_derivatives(const Eigen::MatrixBase<Q>& q, const Eigen::Matr
   using std::sin;
   using ::symoro::sign;
   eigen_assert(q.size() == 2);
-  eigen_assert(phi.size() == 19);
+  eigen_assert(phi.size() == 20);
   static_cast<void>(q);
   static_cast<void>(phi);
   d.M.setZero();

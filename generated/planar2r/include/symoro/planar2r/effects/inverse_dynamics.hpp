@@ -24,7 +24,7 @@ inline void inverse_dynamics(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixB
   eigen_assert(q.size() == 2);
   eigen_assert(qd.size() == 2);
   eigen_assert(qdd.size() == 2);
-  eigen_assert(phi.size() == 19);
+  eigen_assert(phi.size() == 20);
   static_cast<void>(q);
   static_cast<void>(qd);
   static_cast<void>(qdd);
@@ -63,7 +63,8 @@ inline void inverse_dynamics(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixB
   const Scalar FV2(phi[8]);
   const Scalar IA2(phi[6]);
   const Scalar t14 = 20.0 * QP2;
-  const Scalar t15 = 2.0 * th1;
+  const Scalar t15 = QP2 * t11;
+  const Scalar t16 = 2.0 * th1;
   const Scalar OFF1(phi[10]);
   const Scalar OFF2(phi[11]);
   const Scalar FST2(phi[12]);
@@ -73,10 +74,11 @@ inline void inverse_dynamics(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixB
   const Scalar HS1_2(phi[16]);
   const Scalar HC1_2(phi[17]);
   const Scalar FC2(phi[18]);
-  const Scalar t16 = QDP1 * ZZR1 + t13 + (sign(QP1) * FS1 + QP1 * FV1) + (OFF1 + t1 * HS1_1 + t0 * HC1_1 + sin(t15) * HS1_2 + cos(t15) * HC1_2);
-  const Scalar t17 = t12 + (QP2 * FV2 + QDP2 * IA2) + (OFF2 + t11 * exp(-(t14 * t14)) * FST2 + QP2 * t11 * FVA2 + tanh(25.0 * QP2) * FC2);
-  tau(0, 0) = t16;
-  tau(1, 0) = t17;
+  const Scalar FSE2(phi[19]);
+  const Scalar t17 = QDP1 * ZZR1 + t13 + (sign(QP1) * FS1 + QP1 * FV1) + (OFF1 + t1 * HS1_1 + t0 * HC1_1 + sin(t16) * HS1_2 + cos(t16) * HC1_2);
+  const Scalar t18 = OFF2 + t11 * exp(-(t14 * t14)) * FST2 + t15 * FVA2 + tanh(25.0 * QP2) * FC2 + t11 * exp(-(12.5 * t15)) * FSE2;
+  tau(0, 0) = t17;
+  tau(1, 0) = t12 + (QP2 * FV2 + QDP2 * IA2) + t18;
 }
 
 template <class Q, class QD, class QDD, class Phi>

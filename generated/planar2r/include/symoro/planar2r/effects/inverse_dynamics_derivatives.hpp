@@ -33,7 +33,7 @@ inline void inverse_dynamics_derivatives(const Eigen::MatrixBase<Q>& q, const Ei
   eigen_assert(q.size() == 2);
   eigen_assert(qd.size() == 2);
   eigen_assert(qdd.size() == 2);
-  eigen_assert(phi.size() == 19);
+  eigen_assert(phi.size() == 20);
   static_cast<void>(q);
   static_cast<void>(qd);
   static_cast<void>(qdd);
@@ -83,10 +83,12 @@ inline void inverse_dynamics_derivatives(const Eigen::MatrixBase<Q>& q, const Ei
   const Scalar t23 = t2 * (MY2 * t18) + t3 * (MX2 * t18);
   const Scalar t24 = 20.0 * QP2;
   const Scalar t25 = exp(-(t24 * t24));
-  const Scalar t26 = 2.0 * th1;
-  const Scalar t27 = sin(t26);
-  const Scalar t28 = cos(t26);
-  const Scalar t29 = tanh(25.0 * QP2);
+  const Scalar t26 = QP2 * t13;
+  const Scalar t27 = 2.0 * th1;
+  const Scalar t28 = sin(t27);
+  const Scalar t29 = cos(t27);
+  const Scalar t30 = tanh(25.0 * QP2);
+  const Scalar t31 = exp(-(12.5 * t26));
   const Scalar OFF1(phi[10]);
   const Scalar OFF2(phi[11]);
   const Scalar FST2(phi[12]);
@@ -96,18 +98,20 @@ inline void inverse_dynamics_derivatives(const Eigen::MatrixBase<Q>& q, const Ei
   const Scalar HS1_2(phi[16]);
   const Scalar HC1_2(phi[17]);
   const Scalar FC2(phi[18]);
-  const Scalar t30 = t20 + (MXR1 * t19 - t5 * MY1) + (t0 * HS1_1 - t1 * HC1_1 + HS1_2 * (2.0 * t28) - HC1_2 * (2.0 * t27));
-  const Scalar t31 = FV2 + (t13 * FVA2 - FST2 * (t13 * (t25 * (800.0 * QP2))) + FC2 * (25.0 * (1.0 - t29 * t29)));
-  d.tau(0) = t17 + (OFF1 + t1 * HS1_1 + t0 * HC1_1 + t27 * HS1_2 + t28 * HC1_2);
-  d.tau(1) = t16 + (QP2 * FV2 + QDP2 * IA2) + (OFF2 + t13 * t25 * FST2 + QP2 * t13 * FVA2 + t29 * FC2);
-  d.dq(0, 0) = t30;
+  const Scalar FSE2(phi[19]);
+  const Scalar t32 = t16 + (QP2 * FV2 + QDP2 * IA2) + (OFF2 + t13 * t25 * FST2 + t26 * FVA2 + t30 * FC2 + t13 * t31 * FSE2);
+  const Scalar t33 = t20 + (MXR1 * t19 - t5 * MY1) + (t0 * HS1_1 - t1 * HC1_1 + HS1_2 * (2.0 * t29) - HC1_2 * (2.0 * t28));
+  const Scalar t34 = t13 * FVA2 - FST2 * (t13 * (t25 * (800.0 * QP2))) + FC2 * (25.0 * (1.0 - t30 * t30)) - FSE2 * (t13 * (t31 * (12.5 * t13)));
+  d.tau(0) = t17 + (OFF1 + t1 * HS1_1 + t0 * HC1_1 + t28 * HS1_2 + t29 * HC1_2);
+  d.tau(1) = t32;
+  d.dq(0, 0) = t33;
   d.dq(1, 0) = t20;
   d.dq(0, 1) = -0.5 * (t2 * t14 + t3 * t15) - t21;
   d.dq(1, 1) = -t21;
   d.dqd(0, 0) = FV1 + (t22 - 0.5 * t23);
   d.dqd(1, 0) = t22;
   d.dqd(0, 1) = -0.5 * t23;
-  d.dqd(1, 1) = t31;
+  d.dqd(1, 1) = FV2 + t34;
 }
 
 }  // namespace symoro::planar2r::effects

@@ -12,12 +12,12 @@ namespace symoro::planar2r::effects {
 inline constexpr const char* robot_name = "planar2r";
 // The variant's name; empty for the robot's full model.
 inline constexpr const char* variant_name = "effects";
-inline constexpr const char* description = "every model-gap effect (offsets, Stribeck, asymmetric viscous friction, position harmonics, smooth Coulomb)";
+inline constexpr const char* description = "every model-gap effect (offsets, Stribeck, asymmetric viscous friction, position harmonics, smooth Coulomb, Tustin's Stribeck)";
 inline constexpr int nq = 2;  // joints
-inline constexpr int np = 19;  // identified parameters: base parameters, then effect parameters
-inline constexpr int ns = 35;  // standard parameters
+inline constexpr int np = 20;  // identified parameters: base parameters, then effect parameters
+inline constexpr int ns = 36;  // standard parameters
 inline constexpr int nf = 2;  // frames
-inline constexpr int ne = 9;  // effect parameters (robot.yaml effects): the last ne entries of phi and of s
+inline constexpr int ne = 10;  // effect parameters (robot.yaml effects): the last ne entries of phi and of s
 
 // Identified base parameters: the columns of the regressor and the entries of phi.
 inline constexpr std::array<ParameterInfo, np> parameters = {{
@@ -40,6 +40,7 @@ inline constexpr std::array<ParameterInfo, np> parameters = {{
     {"HS1_2", "HS", 1, "N*m"},
     {"HC1_2", "HC", 1, "N*m"},
     {"FC2", "FC", 2, "N*m"},
+    {"FSE2", "FSE", 2, "N*m"},
 }};
 
 // Indices into phi by name: phi[param::ZZR1].
@@ -64,6 +65,7 @@ enum : int {
   HS1_2 = 16,
   HC1_2 = 17,
   FC2 = 18,
+  FSE2 = 19,
 };
 }  // namespace param
 
@@ -74,7 +76,7 @@ inline constexpr std::array<FixedParameter, 1> fixed_parameters = {{
 
 // Index of each identified parameter in the robot's full parameter vector (-1 for the effect
 // parameters, which the full model does not have).
-inline constexpr std::array<int, np> parent_index = {{0, 1, 2, 3, 4, 5, 6, 7, 8, 9, -1, -1, -1, -1, -1, -1, -1, -1, -1}};
+inline constexpr std::array<int, np> parent_index = {{0, 1, 2, 3, 4, 5, 6, 7, 8, 9, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1}};
 
 // Standard parameters (the .par's symbols, then the effect parameters): the argument of
 // base_from_standard.
@@ -114,6 +116,7 @@ inline constexpr std::array<StandardParameterInfo, ns> standard_parameters = {{
     {"HS1_2", "HS", 1},
     {"HC1_2", "HC", 1},
     {"FC2", "FC", 2},
+    {"FSE2", "FSE", 2},
 }};
 
 // Effect parameters (robot.yaml effects), the last ne entries of phi: name, family, joint,
@@ -129,6 +132,7 @@ inline constexpr std::array<EffectParameterInfo, ne> effect_parameters = {{
     {"HS1_2", "HS", 1, 2, 0.0},
     {"HC1_2", "HC", 1, 2, 0.0},
     {"FC2", "FC", 2, 0, 0.04},
+    {"FSE2", "FSE", 2, 0, 0.08},
 }};
 
 // name, type, position limits, velocity limit, effort limit, PD-audit domain.

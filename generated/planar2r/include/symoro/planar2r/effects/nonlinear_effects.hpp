@@ -23,7 +23,7 @@ inline void nonlinear_effects(const Eigen::MatrixBase<Q>& q, const Eigen::Matrix
   using ::symoro::sign;
   eigen_assert(q.size() == 2);
   eigen_assert(qd.size() == 2);
-  eigen_assert(phi.size() == 19);
+  eigen_assert(phi.size() == 20);
   static_cast<void>(q);
   static_cast<void>(qd);
   static_cast<void>(phi);
@@ -54,7 +54,8 @@ inline void nonlinear_effects(const Eigen::MatrixBase<Q>& q, const Eigen::Matrix
   const Scalar t10 = MX2 * (t2 * t5 - t3 * t8) - MY2 * (t2 * t8 + t3 * t5);
   const Scalar t11 = sign(QP1) * FS1 + QP1 * FV1 + (t10 + (t5 * MXR1 - 0.5 * (t2 * (t7 * MY2) + t3 * (t7 * MX2)) - t4 * MY1));
   const Scalar t12 = 20.0 * QP2;
-  const Scalar t13 = 2.0 * th1;
+  const Scalar t13 = QP2 * t9;
+  const Scalar t14 = 2.0 * th1;
   const Scalar OFF1(phi[10]);
   const Scalar OFF2(phi[11]);
   const Scalar FST2(phi[12]);
@@ -64,9 +65,10 @@ inline void nonlinear_effects(const Eigen::MatrixBase<Q>& q, const Eigen::Matrix
   const Scalar HS1_2(phi[16]);
   const Scalar HC1_2(phi[17]);
   const Scalar FC2(phi[18]);
-  const Scalar t14 = OFF2 + t9 * exp(-(t12 * t12)) * FST2 + QP2 * t9 * FVA2 + tanh(25.0 * QP2) * FC2 + (QP2 * FV2 + t10);
-  h(0, 0) = t11 + (OFF1 + t1 * HS1_1 + t0 * HC1_1 + sin(t13) * HS1_2 + cos(t13) * HC1_2);
-  h(1, 0) = t14;
+  const Scalar FSE2(phi[19]);
+  const Scalar t15 = OFF2 + t9 * exp(-(t12 * t12)) * FST2 + t13 * FVA2 + tanh(25.0 * QP2) * FC2 + t9 * exp(-(12.5 * t13)) * FSE2;
+  h(0, 0) = t11 + (OFF1 + t1 * HS1_1 + t0 * HC1_1 + sin(t14) * HS1_2 + cos(t14) * HC1_2);
+  h(1, 0) = t15 + (QP2 * FV2 + t10);
 }
 
 template <class Q, class QD, class Phi>

@@ -51,7 +51,8 @@ inline void regressor(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<QD>
   const Scalar t12 = t2 * t10 - t3 * t9;
   const Scalar t13 = sign(QP2);
   const Scalar t14 = 20.0 * QP2;
-  const Scalar t15 = 2.0 * th1;
+  const Scalar t15 = QP2 * t13;
+  const Scalar t16 = 2.0 * th1;
   W(0, 0) = QDP1;
   W(0, 1) = t5;
   W(0, 2) = -t4;
@@ -63,8 +64,8 @@ inline void regressor(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<QD>
   W(0, 10) = Scalar(1.0);
   W(0, 14) = t1;
   W(0, 15) = t0;
-  W(0, 16) = sin(t15);
-  W(0, 17) = cos(t15);
+  W(0, 16) = sin(t16);
+  W(0, 17) = cos(t16);
   W(1, 3) = t7;
   W(1, 4) = t12;
   W(1, 5) = -t11;
@@ -72,8 +73,9 @@ inline void regressor(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<QD>
   W(1, 8) = QP2;
   W(1, 11) = Scalar(1.0);
   W(1, 12) = t13 * exp(-(t14 * t14));
-  W(1, 13) = QP2 * t13;
+  W(1, 13) = t15;
   W(1, 18) = tanh(25.0 * QP2);
+  W(1, 19) = t13 * exp(-(12.5 * t15));
 }
 
 template <class Q, class QD, class QDD>
