@@ -285,9 +285,15 @@ namespace {
 // The robot.yaml variant effect a selected effect compiles to (the effect table's).
 std::string variant_of(const Candidate& c) { return std::string(effect_info(c.kind).row->variant); }
 
-}  // namespace
+std::string joint_list(std::vector<int> js) {
+  std::sort(js.begin(), js.end());
+  std::string out;
+  for (int j : js) out += (out.empty() ? "" : ", ") + std::to_string(j);
+  return out;
+}
 
-std::string variant_yaml(const Diagnosis& d, const std::string& name, const std::string& base) {
+// The selected effects as a variant's entries, and notes on those no variant effect carries.
+struct VariantEntries {
   std::map<std::string, std::vector<int>> joints;
   // Effects written {joints: [...], <parameter>}: joints grouped by (effect, parameter text).
   std::map<std::string, std::map<std::string, std::vector<int>>> shaped;
@@ -295,7 +301,8 @@ std::string variant_yaml(const Diagnosis& d, const std::string& name, const std:
   // selected joint keeps the width it was selected with.
   std::map<std::string, std::map<int, double>> scaled;
   std::string notes;
-  for (const auto& e : d.selection.effects) {
+
+  void add(const SelectedEffect& e) {
     const Candidate& c = e.candidate;
     switch (c.kind) {
       // Coulomb friction smoothed as the diagnosis found the logs' velocity spread: the files'
@@ -348,37 +355,45 @@ std::string variant_yaml(const Diagnosis& d, const std::string& name, const std:
         break;
     }
   }
-  auto list = [](std::vector<int> js) {
-    std::sort(js.begin(), js.end());
-    std::string out;
-    for (int j : js) out += (out.empty() ? "" : ", ") + std::to_string(j);
-    return out;
-  };
-  std::string effects;
-  for (auto& [key, js] : joints) effects += "      " + key + ": [" + list(js) + "]\n";
-  for (const auto& [key, widths] : scaled) {
-    std::vector<int> js;
-    std::string values;
-    bool same = true;
-    for (const auto& [j, v] : widths) {
-      js.push_back(j);
-      values += fmt::format("{}{:g}", values.empty() ? "" : ", ", v);
-      same = same && v == widths.begin()->second;
+
+  // The `effects:` lines; a shaped effect's other groups go into the notes.
+  std::string effects() {
+    std::string effects;
+    for (auto& [key, js] : joints) effects += "      " + key + ": [" + joint_list(js) + "]\n";
+    for (const auto& [key, widths] : scaled) {
+      std::vector<int> js;
+      std::string values;
+      bool same = true;
+      for (const auto& [j, v] : widths) {
+        js.push_back(j);
+        values += fmt::format("{}{:g}", values.empty() ? "" : ", ", v);
+        same = same && v == widths.begin()->second;
+      }
+      effects += "      " + key + ": {joints: [" + joint_list(js) +
+                 "], velocity: " + (same ? fmt::format("{:g}", widths.begin()->second) : "[" + values + "]") + "}\n";
     }
-    effects += "      " + key + ": {joints: [" + list(js) +
-               "], velocity: " + (same ? fmt::format("{:g}", widths.begin()->second) : "[" + values + "]") + "}\n";
+    for (auto& [key, groups] : shaped) {
+      // A variant holds one entry per effect: the group with the most joints; the others noted.
+      auto best = groups.begin();
+      for (auto it = groups.begin(); it != groups.end(); ++it)
+        if (it->second.size() > best->second.size()) best = it;
+      effects += "      " + key + ": {joints: [" + joint_list(best->second) + "], " + best->first + "}\n";
+      for (auto it = groups.begin(); it != groups.end(); ++it)
+        if (it != best)
+          notes += "    # also " + key + " on joints [" + joint_list(it->second) + "] with " + it->first +
+                   " (one entry per effect in a variant: the joints above use " + best->first + ")\n";
+    }
+    return effects;
   }
-  for (auto& [key, groups] : shaped) {
-    // A variant holds one entry per effect: the group with the most joints; the others noted.
-    auto best = groups.begin();
-    for (auto it = groups.begin(); it != groups.end(); ++it)
-      if (it->second.size() > best->second.size()) best = it;
-    effects += "      " + key + ": {joints: [" + list(best->second) + "], " + best->first + "}\n";
-    for (auto it = groups.begin(); it != groups.end(); ++it)
-      if (it != best)
-        notes += "    # also " + key + " on joints [" + list(it->second) + "] with " + it->first +
-                 " (one entry per effect in a variant: the joints above use " + best->first + ")\n";
-  }
+};
+
+}  // namespace
+
+std::string variant_yaml(const Diagnosis& d, const std::string& name, const std::string& base) {
+  VariantEntries v;
+  for (const auto& e : d.selection.effects) v.add(e);
+  const std::string effects = v.effects();
+  std::string notes = v.notes;
   if (d.backlash_judged)
     for (const auto& f : d.backlash.findings)
       notes += fmt::format(

@@ -33,15 +33,10 @@ bool valid_name(const std::string& name) {
   return true;
 }
 
-}  // namespace
+namespace fs = std::filesystem;
 
-DatasetImportResult import_dataset(const std::filesystem::path& out, const DatasetImport& import) {
-  namespace fs = std::filesystem;
-  if (import.inputs.empty()) throw DataError(out.string(), 0, "nothing to import: no input files");
-  if (!(import.split >= 0 && import.split < 1))
-    throw DataError(import.mapping.origin, 0,
-                    fmt::format("split {} is not a fraction in (0, 1) (0: no split)", import.split));
-
+// Every input read, checked and named, split into fitting and held-out runs when asked.
+DatasetImportResult read_inputs(const fs::path& out, const DatasetImport& import) {
   DatasetImportResult result;
   std::set<std::string> names;
   for (const ImportInput& in : import.inputs) {
@@ -79,6 +74,61 @@ DatasetImportResult import_dataset(const std::filesystem::path& out, const Datas
     }
     result.logs.push_back(std::move(imported));
   }
+  return result;
+}
+
+// import.yaml: the mapping (reusable as --mapping) and what each input gave.
+std::string import_record(const DatasetImport& import, const DatasetImportResult& result) {
+  std::string text = import_mapping_yaml(import.mapping);
+  text += fmt::format("imported:\n  robot: {}\n  split: {}\n  inputs:\n", yaml_quoted(import.target.robot),
+                      number_text(import.split));
+  for (const ImportedLog& l : result.logs) {
+    text += fmt::format("    - input: {}\n      log: {}\n      rows: {}\n      written: {}\n",
+                        yaml_quoted(fs::absolute(l.input).string()), yaml_quoted(l.log.meta.trajectory + ".csv"),
+                        l.rows, l.log.samples());
+    text +=
+        fmt::format("      stale_rows: {}\n      stale_lines: {}\n", l.stale_lines.size(), line_list(l.stale_lines));
+    text += fmt::format("      duplicate_rows: {}\n      duplicate_lines: {}\n", l.duplicate_lines.size(),
+                        line_list(l.duplicate_lines));
+    text +=
+        fmt::format("      sample_time: {}\n      velocity: {}\n      columns:\n", number_text(l.log.meta.sample_time),
+                    l.log.meta.velocity == Velocity::measured ? "measured" : "differentiated");
+    for (const auto& [column, source] : l.columns) text += fmt::format("        {}: {}\n", column, yaml_quoted(source));
+  }
+  return text;
+}
+
+// dataset.yaml's content: the runs and what the import read.
+Dataset imported_dataset(const fs::path& out, const DatasetImport& import, const DatasetImportResult& result) {
+  Dataset d;
+  d.dir = out;
+  d.robot = import.target.robot;
+  d.source = "imported";
+  d.split = import.split;
+  d.import.emplace();
+  d.import->inputs = static_cast<int>(result.logs.size());
+  for (const ImportedLog& l : result.logs) {
+    d.import->rows += l.rows;
+    d.import->written += l.log.samples();
+    d.import->stale_rows += static_cast<int>(l.stale_lines.size());
+    d.import->duplicate_rows += static_cast<int>(l.duplicate_lines.size());
+    d.imported.push_back({l.log.meta.trajectory + ".csv", l.rows, static_cast<int>(l.stale_lines.size()),
+                          static_cast<int>(l.duplicate_lines.size()), l.log.meta.sample_time,
+                          l.log.meta.velocity == Velocity::measured ? "measured" : "differentiated"});
+  }
+  for (const DatasetImportResult::Run& r : result.runs)
+    d.runs.push_back({r.trajectory, r.family, 1, r.file.filename(), r.window_start, r.window_end});
+  return d;
+}
+
+}  // namespace
+
+DatasetImportResult import_dataset(const std::filesystem::path& out, const DatasetImport& import) {
+  if (import.inputs.empty()) throw DataError(out.string(), 0, "nothing to import: no input files");
+  if (!(import.split >= 0 && import.split < 1))
+    throw DataError(import.mapping.origin, 0,
+                    fmt::format("split {} is not a fraction in (0, 1) (0: no split)", import.split));
+  DatasetImportResult result = read_inputs(out, import);
 
   // One import into a folder at a time (two at once both passed the check below and one input
   // was lost), then never replace a file: an earlier import or recording stays as it was.
@@ -99,45 +149,9 @@ DatasetImportResult import_dataset(const std::filesystem::path& out, const Datas
 
   for (const ImportedLog& l : result.logs) write_log(out / (l.log.meta.trajectory + ".csv"), l.log);
 
-  // import.yaml: the mapping (reusable as --mapping) and what each input gave.
-  std::string text = import_mapping_yaml(import.mapping);
-  text += fmt::format("imported:\n  robot: {}\n  split: {}\n  inputs:\n", yaml_quoted(import.target.robot),
-                      number_text(import.split));
-  for (const ImportedLog& l : result.logs) {
-    text += fmt::format("    - input: {}\n      log: {}\n      rows: {}\n      written: {}\n",
-                        yaml_quoted(fs::absolute(l.input).string()), yaml_quoted(l.log.meta.trajectory + ".csv"),
-                        l.rows, l.log.samples());
-    text +=
-        fmt::format("      stale_rows: {}\n      stale_lines: {}\n", l.stale_lines.size(), line_list(l.stale_lines));
-    text += fmt::format("      duplicate_rows: {}\n      duplicate_lines: {}\n", l.duplicate_lines.size(),
-                        line_list(l.duplicate_lines));
-    text +=
-        fmt::format("      sample_time: {}\n      velocity: {}\n      columns:\n", number_text(l.log.meta.sample_time),
-                    l.log.meta.velocity == Velocity::measured ? "measured" : "differentiated");
-    for (const auto& [column, source] : l.columns) text += fmt::format("        {}: {}\n", column, yaml_quoted(source));
-  }
-  write_file_atomically(record, text);
-
+  write_file_atomically(record, import_record(import, result));
   // dataset.yaml last: it lists only files already in place.
-  Dataset d;
-  d.dir = out;
-  d.robot = import.target.robot;
-  d.source = "imported";
-  d.split = import.split;
-  d.import.emplace();
-  d.import->inputs = static_cast<int>(result.logs.size());
-  for (const ImportedLog& l : result.logs) {
-    d.import->rows += l.rows;
-    d.import->written += l.log.samples();
-    d.import->stale_rows += static_cast<int>(l.stale_lines.size());
-    d.import->duplicate_rows += static_cast<int>(l.duplicate_lines.size());
-    d.imported.push_back({l.log.meta.trajectory + ".csv", l.rows, static_cast<int>(l.stale_lines.size()),
-                          static_cast<int>(l.duplicate_lines.size()), l.log.meta.sample_time,
-                          l.log.meta.velocity == Velocity::measured ? "measured" : "differentiated"});
-  }
-  for (const DatasetImportResult::Run& r : result.runs)
-    d.runs.push_back({r.trajectory, r.family, 1, r.file.filename(), r.window_start, r.window_end});
-  write_dataset(d);
+  write_dataset(imported_dataset(out, import, result));
   result.dataset = manifest;
   return result;
 }

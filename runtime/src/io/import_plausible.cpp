@@ -57,27 +57,24 @@ Worst worst_sample(Eigen::Index joints, Eigen::Index rows, double floor, Score s
 // 3 significant digits are enough evidence; number_text would print 58.70000000000001.
 std::string g(double v) { return fmt::format("{:.6g}", v); }
 
-}  // namespace
-
-void check_plausible(const ImportedLog& imported, const ImportMapping& mapping, const ImportTarget& target) {
+// Positions: the sample farthest beyond its joint's margin, over all joints.
+void check_positions(const ImportedLog& imported, const ImportMapping& mapping, const ImportTarget& target) {
   const Log& log = imported.log;
   const std::string file = imported.input.string();
   const Eigen::Index n = log.q.cols();
   const bool checked = target.lower.size() == static_cast<std::size_t>(n) && target.upper.size() == target.lower.size();
-
-  // The sample farthest beyond its joint's margin, over all joints.
   const auto margin_of = [&](Eigen::Index j) {
     const double lo = target.lower[static_cast<std::size_t>(j)], hi = target.upper[static_cast<std::size_t>(j)];
     const bool prismatic = !target.prismatic.empty() && target.prismatic[static_cast<std::size_t>(j)];
     return std::max(prismatic ? kPrismaticMargin : kRevoluteMargin, 0.5 * (hi - lo));
   };
-  Worst worst = worst_sample(checked ? n : 0, log.samples(), 0, [&](Eigen::Index k, Eigen::Index j) {
+  const Worst worst = worst_sample(checked ? n : 0, log.samples(), 0, [&](Eigen::Index k, Eigen::Index j) {
     const double lo = target.lower[static_cast<std::size_t>(j)], hi = target.upper[static_cast<std::size_t>(j)];
     if (!std::isfinite(lo) || !std::isfinite(hi) || !(hi > lo))
       return -std::numeric_limits<double>::infinity();  // no limits to judge by
     return std::max(lo - log.q(k, j), log.q(k, j) - hi) - margin_of(j);
   });
-  Eigen::Index worst_row = worst.row, worst_joint = worst.joint;
+  const Eigen::Index worst_row = worst.row, worst_joint = worst.joint;
   if (worst_row >= 0) {
     const std::size_t j = static_cast<std::size_t>(worst_joint);
     const bool prismatic = !target.prismatic.empty() && target.prismatic[j];
@@ -96,15 +93,19 @@ void check_plausible(const ImportedLog& imported, const ImportMapping& mapping, 
                     worst_joint + 1, target.joints[j], g(q), unit, as_written, g(lo), g(hi), unit, g(margin), unit,
                     prismatic ? kPrismaticMargin : kRevoluteMargin, unit, hint, kOverride));
   }
+}
 
-  // Torques: the sample farthest beyond kEffortFactor times its joint's effort limit.
-  worst = worst_sample(log.tau.cols(), log.samples(), 1, [&](Eigen::Index k, Eigen::Index j) {
+// Torques: the sample farthest beyond kEffortFactor times its joint's effort limit.
+void check_torques(const ImportedLog& imported, const ImportTarget& target) {
+  const Log& log = imported.log;
+  const std::string file = imported.input.string();
+  const Eigen::Index n = log.q.cols();
+  const Worst worst = worst_sample(log.tau.cols(), log.samples(), 1, [&](Eigen::Index k, Eigen::Index j) {
     const double effort =
         target.effort.size() == static_cast<std::size_t>(n) ? target.effort[static_cast<std::size_t>(j)] : 0.0;
     return std::abs(log.tau(k, j)) / (effort > 0 ? kEffortFactor * effort : kMaxTorque);
   });
-  worst_row = worst.row;
-  worst_joint = worst.joint;
+  const Eigen::Index worst_row = worst.row, worst_joint = worst.joint;
   if (worst_row >= 0) {
     const std::size_t j = static_cast<std::size_t>(worst_joint);
     const double effort = target.effort.size() == static_cast<std::size_t>(n) ? target.effort[j] : 0.0;
@@ -120,9 +121,14 @@ void check_plausible(const ImportedLog& imported, const ImportMapping& mapping, 
                     worst_joint + 1, target.joints[j], g(log.tau(worst_row, worst_joint)), unit, limit, unit,
                     kOverride));
   }
+}
 
-  // Radians declared as degrees: every revolute joint within +-2 pi as written and none moving
-  // 2 pi (6 "degrees") over the whole log, which no identification log does.
+// Radians declared as degrees: every revolute joint within +-2 pi as written and none moving
+// 2 pi (6 "degrees") over the whole log, which no identification log does.
+void check_angle_unit(const ImportedLog& imported, const ImportMapping& mapping, const ImportTarget& target) {
+  const Log& log = imported.log;
+  const std::string file = imported.input.string();
+  const Eigen::Index n = log.q.cols();
   if (mapping.angle_unit == AngleUnit::deg && log.samples() > 1) {
     double largest = 0, widest = 0;
     int revolute = 0;
@@ -140,8 +146,13 @@ void check_plausible(const ImportedLog& imported, const ImportMapping& mapping, 
                       "written: these look like radians (--angle rad, units.angle: rad)? {}",
                       g(largest), g(widest), kOverride));
   }
+}
 
-  // A gap no recording has (24 h accepted): past kMaxGapSteps median steps and kMaxGap s.
+// Time: a gap no recording has (24 h accepted): past kMaxGapSteps median steps and kMaxGap s;
+// a median step outside a robot log's.
+void check_time(const ImportedLog& imported, const ImportMapping& mapping) {
+  const Log& log = imported.log;
+  const std::string file = imported.input.string();
   const double median_step = log.meta.sample_time;
   for (Eigen::Index k = 1; k < log.samples(); ++k) {
     const double gap = log.time[k] - log.time[k - 1];
@@ -165,6 +176,15 @@ void check_plausible(const ImportedLog& imported, const ImportMapping& mapping, 
                                 g(step * detail::time_divisor(u)), detail::time_unit_name(u), in_seconds, g(kMinStep),
                                 g(kMaxStep), kOverride));
   }
+}
+
+}  // namespace
+
+void check_plausible(const ImportedLog& imported, const ImportMapping& mapping, const ImportTarget& target) {
+  check_positions(imported, mapping, target);
+  check_torques(imported, target);
+  check_angle_unit(imported, mapping, target);
+  check_time(imported, mapping);
 }
 
 }  // namespace symoro::io

@@ -200,14 +200,18 @@ void append_legend(std::string& out, const std::vector<LegendEntry>& entries, co
   out += "</g>\n";
 }
 
-void append_panel(std::string& out, const Panel& p, int index, double left, double top, double width, double height) {
-  const double x0 = left + margin_left, y0 = top + margin_top;
-  const double w = std::max(20.0, width - margin_left - margin_right);
-  const double h = std::max(20.0, height - margin_top - margin_bottom);
-  const bool bars = !p.bars.empty();
+// A panel's plot area in the figure and its axes: where a data point is drawn.
+struct PanelFrame {
+  double left, top;     // the panel's corner in the figure
+  double x0, y0, w, h;  // the plot area
+  Axis xa, ya;
+  double sx(double x) const { return x0 + (x - xa.lo) / (xa.hi - xa.lo) * w; }
+  double sy(double y) const { return y0 + h - (y - ya.lo) / (ya.hi - ya.lo) * h; }
+};
 
-  // Data extents: points and labels padded on both axes, lines only vertically (a time axis
-  // should start and end at the data), bars always from zero.
+// The data's extents: points and labels padded on both axes, lines only vertically (a time axis
+// should start and end at the data), bars always from zero.
+std::pair<Extent, Extent> data_extents(const Panel& p) {
   Extent xe, ye, px, py;
   for (const auto& s : p.points)
     for (std::size_t i = 0; i < std::min(s.x.size(), s.y.size()); ++i)
@@ -221,7 +225,7 @@ void append_panel(std::string& out, const Panel& p, int index, double left, doub
     for (std::size_t i = 0; i < std::min(s.x.size(), s.y.size()); ++i)
       if (std::isfinite(s.x[i]) && std::isfinite(s.y[i])) xe.add(s.x[i]), ly.add(s.y[i]);
   ye.merge(ly.padded(0.04));
-  if (bars) {
+  if (!p.bars.empty()) {
     Extent be;
     be.add(0);
     for (const auto& s : p.bars)
@@ -231,26 +235,36 @@ void append_panel(std::string& out, const Panel& p, int index, double left, doub
     ye.add(be.lo < 0 ? padded.lo : 0);
     ye.add(be.hi > 0 ? padded.hi : 0);
   }
+  return {xe, ye};
+}
 
-  const int x_intervals = std::max(2, static_cast<int>(w / 75));
-  const int y_intervals = std::max(2, static_cast<int>(h / 45));
-  Axis xa;
-  if (bars) {
-    xa.lo = -0.5;
-    xa.hi = std::max<double>(1, static_cast<double>(p.categories.size())) - 0.5;
+PanelFrame panel_frame(const Panel& p, double left, double top, double width, double height) {
+  PanelFrame f;
+  f.left = left, f.top = top;
+  f.x0 = left + margin_left, f.y0 = top + margin_top;
+  f.w = std::max(20.0, width - margin_left - margin_right);
+  f.h = std::max(20.0, height - margin_top - margin_bottom);
+  const auto [xe, ye] = data_extents(p);
+  const int x_intervals = std::max(2, static_cast<int>(f.w / 75));
+  const int y_intervals = std::max(2, static_cast<int>(f.h / 45));
+  if (!p.bars.empty()) {
+    f.xa.lo = -0.5;
+    f.xa.hi = std::max<double>(1, static_cast<double>(p.categories.size())) - 0.5;
   } else {
-    xa = make_axis(p.x_range, xe, x_intervals);
+    f.xa = make_axis(p.x_range, xe, x_intervals);
   }
-  const Axis ya = make_axis(p.y_range, ye, y_intervals);
-  auto sx = [&](double x) { return x0 + (x - xa.lo) / (xa.hi - xa.lo) * w; };
-  auto sy = [&](double y) { return y0 + h - (y - ya.lo) / (ya.hi - ya.lo) * h; };
+  f.ya = make_axis(p.y_range, ye, y_intervals);
+  return f;
+}
 
+// The title, grid, tick labels and axis labels.
+void append_frame(std::string& out, const Panel& p, const PanelFrame& f) {
+  const double x0 = f.x0, y0 = f.y0, w = f.w, h = f.h, left = f.left, top = f.top;
+  const Axis &xa = f.xa, &ya = f.ya;
+  const bool bars = !p.bars.empty();
+  const auto sx = [&f](double x) { return f.sx(x); };
+  const auto sy = [&f](double y) { return f.sy(y); };
   auto out_it = std::back_inserter(out);
-  fmt::format_to(out_it, "<g class=\"panel\">\n");
-  fmt::format_to(out_it,
-                 R"(<clipPath id="clip{}"><rect x="{}" y="{}" width="{}" height="{}"/></clipPath>)"
-                 "\n",
-                 index, num(x0), num(y0), num(w), num(h));
   if (!p.title.empty())
     fmt::format_to(out_it,
                    R"(<text class="panel-title" x="{}" y="{}" text-anchor="middle" font-weight="bold">{}</text>)"
@@ -302,7 +316,14 @@ void append_panel(std::string& out, const Panel& p, int index, double left, doub
         "\n",
         num(lx), num(ly_), num(lx), num(ly_), xml_escape(p.y_label));
   }
+}
 
+// The bars, lines, markers and rings, clipped to the plot area.
+void append_data(std::string& out, const Panel& p, const PanelFrame& f, int index) {
+  const auto sx = [&f](double x) { return f.sx(x); };
+  const auto sy = [&f](double y) { return f.sy(y); };
+  const bool bars = !p.bars.empty();
+  auto out_it = std::back_inserter(out);
   // Data, clipped to the plot area.
   fmt::format_to(out_it, "<g clip-path=\"url(#clip{})\">\n", index);
   if (bars) {
@@ -355,22 +376,38 @@ void append_panel(std::string& out, const Panel& p, int index, double left, doub
                      "\n",
                      num(sx(l.x)), num(sy(l.y)), xml_escape(l.colour));
   out += "</g>\n";
+}
 
-  // Labels beside their points, turned to the left near the right edge to stay readable.
+// Labels beside their points, turned to the left near the right edge to stay readable.
+void append_point_labels(std::string& out, const Panel& p, const PanelFrame& f) {
+  auto out_it = std::back_inserter(out);
   for (const auto& l : p.labels) {
     if (!std::isfinite(l.x) || !std::isfinite(l.y) || l.text.empty()) continue;
-    const double px_ = sx(l.x), py_ = sy(l.y);
-    const bool left_side = px_ > x0 + 0.7 * w;
+    const double px_ = f.sx(l.x), py_ = f.sy(l.y);
+    const bool left_side = px_ > f.x0 + 0.7 * f.w;
     fmt::format_to(out_it,
                    R"(<text class="point-label" x="{}" y="{}" text-anchor="{}" fill="{}">{}</text>)"
                    "\n",
                    num(left_side ? px_ - 9 : px_ + 9), num(py_ - 7), left_side ? "end" : "start", xml_escape(l.colour),
                    xml_escape(l.text));
   }
+}
+
+void append_panel(std::string& out, const Panel& p, int index, double left, double top, double width, double height) {
+  const PanelFrame f = panel_frame(p, left, top, width, height);
+  auto out_it = std::back_inserter(out);
+  fmt::format_to(out_it, "<g class=\"panel\">\n");
+  fmt::format_to(out_it,
+                 R"(<clipPath id="clip{}"><rect x="{}" y="{}" width="{}" height="{}"/></clipPath>)"
+                 "\n",
+                 index, num(f.x0), num(f.y0), num(f.w), num(f.h));
+  append_frame(out, p, f);
+  append_data(out, p, f, index);
+  append_point_labels(out, p, f);
   fmt::format_to(out_it,
                  R"(<rect x="{}" y="{}" width="{}" height="{}" fill="none" stroke="#444" stroke-width="1"/>)"
                  "\n",
-                 num(x0), num(y0), num(w), num(h));
+                 num(f.x0), num(f.y0), num(f.w), num(f.h));
   out += "</g>\n";
 }
 

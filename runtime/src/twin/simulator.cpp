@@ -149,18 +149,43 @@ io::Log empty_log(const trajectory::SampledReference& ref, const RunOptions& opt
   return log;
 }
 
+// The reference must have the robot's joints and the controller's period.
+void check_reference(const trajectory::SampledReference& ref, int n, double period) {
+  if (ref.joints() != n)
+    throw DataError(ref.name, 0,
+                    "the reference has " + std::to_string(ref.joints()) + " joints, the robot " + std::to_string(n));
+  if (!(std::abs(ref.period - period) <= 1e-9 * period) || ref.cycles() < 1)
+    throw DataError(ref.name, 0,
+                    "the reference is sampled every " + std::to_string(ref.period) + " s, the controller runs every " +
+                        std::to_string(period) + " s");
+}
+
+// Whether this cycle's sample is lost: a burst of 1 to drop_max_burst starts with probability
+// drop_probability; `left` counts the burst's samples still to drop.
+bool drops(const Effects& e, Random& rng, int& left) {
+  if (left == 0 && rng.uniform() < e.drop_probability) left = 1 + static_cast<int>(rng.uniform() * e.drop_max_burst);
+  if (left == 0) return false;
+  --left;
+  return true;
+}
+
+void log_row(io::Log& log, int row, double t, const Vec& q, const Vec& qd, const Vec& tau, const Vec& qr,
+             const Vec& qdr, const Vec& qddr) {
+  log.time(row) = t;
+  log.q.row(row) = q.transpose();
+  log.qd.row(row) = qd.transpose();
+  log.tau.row(row) = tau.transpose();
+  log.q_ref.row(row) = qr.transpose();
+  log.qd_ref.row(row) = qdr.transpose();
+  log.qdd_ref.row(row) = qddr.transpose();
+}
+
 }  // namespace
 
 io::Log ClosedLoopTwin::run(const trajectory::SampledReference& ref, const RunOptions& opt, RunStats* stats) const {
   const auto wall0 = std::chrono::steady_clock::now();
   const int n = joints();
-  if (ref.joints() != n)
-    throw DataError(ref.name, 0,
-                    "the reference has " + std::to_string(ref.joints()) + " joints, the robot " + std::to_string(n));
-  if (!(std::abs(ref.period - c_.controller.period) <= 1e-9 * c_.controller.period) || ref.cycles() < 1)
-    throw DataError(ref.name, 0,
-                    "the reference is sampled every " + std::to_string(ref.period) + " s, the controller runs every " +
-                        std::to_string(c_.controller.period) + " s");
+  check_reference(ref, n, c_.controller.period);
   const Effects& e = c_.effects;
   const double T = c_.controller.period, d = c_.controller.communication_delay;
   const int K = ref.cycles() - 1;
@@ -211,15 +236,7 @@ io::Log ClosedLoopTwin::run(const trajectory::SampledReference& ref, const RunOp
     st.rms_error += err.cwiseAbs2();
     st.max_torque = st.max_torque.cwiseMax(servos.kt_true.cwiseProduct(act.applied).cwiseAbs());
 
-    bool dropped = false;
-    if (e.dropped_samples && k > 0 && k < K) {
-      if (drop_left == 0 && rng.uniform() < e.drop_probability)
-        drop_left = 1 + static_cast<int>(rng.uniform() * e.drop_max_burst);
-      if (drop_left > 0) {
-        dropped = true;
-        --drop_left;
-      }
-    }
+    const bool dropped = e.dropped_samples && k > 0 && k < K && drops(e, rng, drop_left);
     if (!dropped) {
       servos.encoder(q_true, q_meas);
       servos.logged_torque(act.current, tau_logged);
@@ -229,16 +246,7 @@ io::Log ClosedLoopTwin::run(const trajectory::SampledReference& ref, const RunOp
     bool cycle_sat = false;
     servos.current_command(ctrl.update(q_meas, qr, qdr, qddr), cmd, cycle_sat);
     st.saturated += cycle_sat;
-    if (!dropped) {
-      log.time(rows) = t_k;
-      log.q.row(rows) = q_meas.transpose();
-      log.qd.row(rows) = ctrl.velocity().transpose();
-      log.tau.row(rows) = tau_logged.transpose();
-      log.q_ref.row(rows) = qr.transpose();
-      log.qd_ref.row(rows) = qdr.transpose();
-      log.qdd_ref.row(rows) = qddr.transpose();
-      ++rows;
-    }
+    if (!dropped) log_row(log, rows++, t_k, q_meas, ctrl.velocity(), tau_logged, qr, qdr, qddr);
     act.drive(d);
     t_now = t_k + d;
     act.command(cmd);
