@@ -8,6 +8,7 @@
 #include <regex>
 #include <set>
 
+#include "symoro/effect_table.hpp"
 #include "yaml_check.hpp"
 
 namespace symoro::codegen {
