@@ -29,7 +29,7 @@ std::vector<Option> options(const std::vector<Candidate>& friction) {
   for (const auto& c : friction) out.push_back({{&c}});
   for (const auto& c : friction)
     for (const auto& s : friction)
-      if (c.kind == EffectKind::Coulomb && (s.kind == EffectKind::Stribeck || s.kind > EffectKind::Payload) &&
+      if (c.kind == EffectKind::Coulomb && (s.kind == EffectKind::Stribeck || only_when_named(s.kind)) &&
           c.coulomb_velocity == s.coulomb_velocity)
         out.push_back({{&c, &s}});
   return out;
