@@ -24,11 +24,18 @@ std::string joint_text(const DesignStack& d, int j) {
 bool added_law(EffectKind kind) { return kind > EffectKind::Payload && effect_info(kind).row->law; }
 
 // Whether an added law is averaged over the velocity spread: a law of qd alone (a law of q is
-// blurred by no spread).
+// blurred by no spread). Traced once per kind: effect_terms asks it at every sample.
 bool averaged(EffectKind kind) {
-  if (!added_law(kind)) return false;
-  const detail::LawDependence on = detail::law_dependence(effect_info(kind).row->law);
-  return on.qd && !on.q;
+  static const std::vector<bool> by_kind = [] {
+    std::vector<bool> out;
+    for (const EffectInfo& e : effect_catalogue()) {
+      const bool added = added_law(e.kind);
+      const detail::LawDependence on = added ? detail::law_dependence(e.row->law) : detail::LawDependence{};
+      out.push_back(added && on.qd && !on.q);
+    }
+    return out;
+  }();
+  return by_kind.at(static_cast<std::size_t>(kind));
 }
 
 bool has_parameter(const DesignStack& d, const std::string& name) {
