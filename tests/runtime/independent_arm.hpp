@@ -9,14 +9,18 @@
 //   loop    1 kHz FF+PD with the controller description's gains, but the velocity is a backward
 //           difference through a 80 Hz first-order low-pass (the twin: Tustin's pseudo-derivative
 //           with Tf); the command takes effect after the bus delay and is held;
+//   contact optional external torque pulses on the links, which nothing in the log records (the
+//           momentum observer's tests);
 //   sensors the encoder is quantized with 0.3 counts of noise; the logged torque is the current
 //           the servo *measures*: the applied current plus 1.5 current units of noise, quantized
 //           (the twin logs the commanded current).
 #pragma once
 
+#include <algorithm>
 #include <cmath>
 #include <random>
 #include <string>
+#include <vector>
 
 #include <Eigen/Core>
 
@@ -27,6 +31,18 @@
 #include "symoro/twin/truth.hpp"
 
 namespace symoro::test {
+
+// An external torque on one joint's link (a contact): `torque` N m from `start` for `duration` s
+// of log time, with 2 ms linear ramps inside that span.
+struct TorquePulse {
+  int joint = 0;  // 0-based
+  double start = 0, duration = 0, torque = 0;
+  double at(double t) const {
+    const double ramp = 0.002, in = t - start, left = start + duration - t;
+    if (in <= 0 || left <= 0) return 0;
+    return torque * std::min({1.0, in / ramp, left / ramp});
+  }
+};
 
 struct IndependentArmOptions {
   Eigen::VectorXd play;     // rad, total play per joint (empty or 0: rigid)
@@ -41,6 +57,7 @@ struct IndependentArmOptions {
   double step = 1e-4;           // s
   double pre_roll = 0.5;        // s holding the first reference, not logged
   unsigned seed = 1;
+  std::vector<TorquePulse> pulses;
 };
 
 // Runs `ref` on the arm that `c` describes (its chain, drives, servos and controller gains;
@@ -91,10 +108,11 @@ io::Log run_independent_arm(const twin::TwinConfig& c, const trajectory::Sampled
       damping(j) = 2 * o.mesh_damping * std::sqrt(stiffness(j) * reduced);
     }
   }
+  double now = -o.pre_roll;  // log time
   auto advance = [&](double dt, const Vec& motor) {
     const int steps = std::max(1, static_cast<int>(std::ceil(dt / o.step - 1e-9)));
     const double h = dt / steps;
-    for (int s = 0; s < steps; ++s) {
+    for (int s = 0; s < steps; ++s, now += h) {
       Vec tau = motor, tm = Vec::Zero();
       for (int j = 0; j < n; ++j) {
         tau(j) -= friction(j, qd(j));
@@ -108,6 +126,7 @@ io::Log run_independent_arm(const twin::TwinConfig& c, const trajectory::Sampled
         tm(j) = motor(j) - fv(j) * qdm(j) - mesh;
         tau(j) = mesh - friction(j, qd(j));
       }
+      for (const TorquePulse& p : o.pulses) tau(p.joint) += p.at(now + 0.5 * h);
       Vec qdd;
       Model::forward_dynamics(q, qd, tau, phi, qdd);
       qd += h * qdd;
@@ -157,7 +176,10 @@ io::Log run_independent_arm(const twin::TwinConfig& c, const trajectory::Sampled
     applied = cmd;
     advance(T - d, kt.cwiseProduct(applied));
   };
-  for (int k = 0; k < static_cast<int>(std::llround(o.pre_roll / T)); ++k) cycle(0, nullptr, 0);
+  const int pre_roll = static_cast<int>(std::llround(o.pre_roll / T));
+  now = -pre_roll * T;
+  for (int k = 0; k < pre_roll; ++k) cycle(0, nullptr, 0);
+  now = 0;  // round-off of the pre-roll's steps
   io::Log log;
   log.meta.robot = Model::robot_name;
   log.meta.trajectory = ref.name;

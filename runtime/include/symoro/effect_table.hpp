@@ -87,7 +87,7 @@ inline V tustin_stribeck(LawAlgebra& a, const LawInputs& x) {
 // their unit (like a base family's, or its own); the base families a variant un-fixes and those
 // its term replaces; the name of its velocity scale and its default; the physical check; the
 // term in words; the joint law.
-inline constexpr std::array<EffectRow, 15> kEffectTable{{
+inline constexpr std::array<EffectRow, 16> kEffectTable{{
     {"Coulomb friction", "coulomb", "smooth_coulomb", "coulomb",  //
      EffectScope::Joint, "FC", EffectUnit::LikeFS, "N*m", "", "FS", "the velocity scale of tanh(qd/v)", 0.03, true,
      "FC tanh(qd / v); the diagnosis: the sign averaged over a velocity spread s (erf), v = s sqrt(pi / 2)",
@@ -114,6 +114,9 @@ inline constexpr std::array<EffectRow, 15> kEffectTable{{
      EffectScope::Robot, "", EffectUnit::Own, "", "", "", "", 0, false, "none: a measurement effect", nullptr},
     {"dropped samples", "", "", "dropped_samples",  //
      EffectScope::Robot, "", EffectUnit::Own, "", "", "", "", 0, false, "none: a measurement effect", nullptr},
+    {"external contact torque", "", "", "contact",  //
+     EffectScope::Joint, "", EffectUnit::Own, "N*m", "", "", "", 0, false,
+     "none: an external torque on a link for a while (a collision), which the log does not show", nullptr},
     {"direction-dependent viscous friction", "viscous_asymmetry", "viscous_asymmetry", "",  //
      EffectScope::Joint, "FVA", EffectUnit::LikeFV, "N*m*s/rad", "", "", "", 0, false, "FVA |qd|",
      effect_laws::viscous_asymmetry},

@@ -1,5 +1,6 @@
 #include "symoro/twin/config.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
@@ -227,7 +228,7 @@ class Reader {
     auto section = [&](const char* name, const std::vector<std::string>& keys, bool& enabled, auto&& body) {
       const YAML::Node s = node[name];
       if (!s.IsDefined()) {
-        if (partial_) return;
+        if (partial_ || std::string(name) == "contact") return;  // a contact is an experiment's, not the arm's
         fail(node, std::string("effects lacks '") + name + "'");
       }
       std::vector<std::string> allowed{"enabled"};
@@ -294,6 +295,18 @@ class Reader {
         if (e.drop_max_burst != b) fail(v, "max_burst must be an integer");
       });
     });
+    section("contact", {"joint", "start", "duration", "torque"}, e.contact, [&](const YAML::Node& s) {
+      field(s, "joint", "contact", [&](const YAML::Node& v) {
+        const double j = positive(v, "contact joint");
+        e.contact_joint = static_cast<int>(j);
+        if (e.contact_joint != j || e.contact_joint > n_)
+          fail(v, fmt::format("contact joint must be a joint number from 1 to {}", n_));
+      });
+      field(s, "start", "contact", [&](const YAML::Node& v) { e.contact_start = number(v, "contact start"); });
+      field(s, "duration", "contact",
+            [&](const YAML::Node& v) { e.contact_duration = positive(v, "contact duration", true); });
+      field(s, "torque", "contact", [&](const YAML::Node& v) { e.contact_torque = number(v, "contact torque"); });
+    });
   }
 
   void apply(const YAML::Node& root, TwinConfig& c) const {
@@ -355,8 +368,8 @@ const std::vector<std::string>& Effects::names() {
 
 void Effects::set(const std::string& name, bool on) {
   bool* flags[] = {
-      &coulomb,         &stribeck,     &torque_offset,    &backlash,       &payload, &torque_constant_error,
-      &actuation_delay, &sensor_noise, &timestamp_jitter, &dropped_samples};
+      &coulomb,         &stribeck,     &torque_offset,    &backlash,        &payload, &torque_constant_error,
+      &actuation_delay, &sensor_noise, &timestamp_jitter, &dropped_samples, &contact};
   const auto& n = names();
   if (n.size() != std::size(flags))
     throw std::logic_error("the twin's effect flags and the effect table's twin names differ");
@@ -370,13 +383,20 @@ void Effects::set(const std::string& name, bool on) {
   throw std::invalid_argument("unknown twin effect '" + name + "' (known: " + all + ")");
 }
 
+double Effects::contact_at(double t) const {
+  const double ramp = 0.002, in = t - contact_start, left = contact_start + contact_duration - t;
+  if (!contact || in <= 0 || left <= 0) return 0;
+  return contact_torque * std::min({1.0, in / ramp, left / ramp});
+}
+
 void Effects::disable_all() {
   for (const auto& n : names()) set(n, false);
 }
 
 std::vector<std::string> Effects::enabled() const {
-  const bool flags[] = {coulomb,         stribeck,     torque_offset,    backlash,       payload, torque_constant_error,
-                        actuation_delay, sensor_noise, timestamp_jitter, dropped_samples};
+  const bool flags[] = {
+      coulomb,         stribeck,     torque_offset,    backlash,        payload, torque_constant_error,
+      actuation_delay, sensor_noise, timestamp_jitter, dropped_samples, contact};
   std::vector<std::string> out;
   for (size_t i = 0; i < std::size(flags) && i < names().size(); ++i)
     if (flags[i]) out.push_back(names()[i]);

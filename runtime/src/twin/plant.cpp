@@ -17,6 +17,7 @@ Plant::Plant(robot::ModelHandle model, const Truth& truth, const TwinConfig& c, 
   if (q0.size() != n || phi_.size() != model_.np() || phi_links_.size() != model_.np())
     throw DataError(c.path, 0, "the twin's plant: start posture or truth not sized for robot '" + model_.robot() + "'");
   const Effects& e = c.effects;
+  effects_ = e;
   const Eigen::VectorXd zero = Eigen::VectorXd::Zero(n);
   fv_ = c.viscous;
   ia_ = c.rotor_inertia;
@@ -63,15 +64,17 @@ void Plant::advance(double dt, const Eigen::VectorXd& motor_torque) {
   const int steps = static_cast<int>(std::ceil(dt / max_step_ - 1e-9));
   const double h = dt / steps;
   for (int s = 0; s < steps; ++s) {
-    derivative(x_, motor_torque, k1_);
+    const double t = time_ + s * h;
+    derivative(x_, motor_torque, k1_, t);
     xt_ = x_ + (h / 2) * k1_;
-    derivative(xt_, motor_torque, k2_);
+    derivative(xt_, motor_torque, k2_, t + h / 2);
     xt_ = x_ + (h / 2) * k2_;
-    derivative(xt_, motor_torque, k3_);
+    derivative(xt_, motor_torque, k3_, t + h / 2);
     xt_ = x_ + h * k3_;
-    derivative(xt_, motor_torque, k4_);
+    derivative(xt_, motor_torque, k4_, t + h);
     x_ += (h / 6) * (k1_ + 2 * k2_ + 2 * k3_ + k4_);
   }
+  time_ += dt;
 }
 
 double Plant::extra_friction(int j, double v) const {
@@ -80,7 +83,8 @@ double Plant::extra_friction(int j, double v) const {
   return level * std::tanh(v / v_eps_);
 }
 
-void Plant::derivative(const Eigen::VectorXd& x, const Eigen::VectorXd& motor_torque, Eigen::VectorXd& dx) const {
+void Plant::derivative(const Eigen::VectorXd& x, const Eigen::VectorXd& motor_torque, Eigen::VectorXd& dx,
+                       double t) const {
   const int n = n_;
   const double* q = x.data();
   const double* qd = x.data() + n;
@@ -104,6 +108,7 @@ void Plant::derivative(const Eigen::VectorXd& x, const Eigen::VectorXd& motor_to
       tau_(j) = drive - extra_friction(j, qd[j]);
     }
   }
+  if (effects_.contact) tau_(effects_.contact_joint - 1) += effects_.contact_at(t);  // on the link
   model_.forward_dynamics(q, qd, tau_.data(), (backlash_ ? phi_links_ : phi_).data(), dx.data() + n);
   dx.head(n) = x.segment(n, n);
 }

@@ -195,6 +195,7 @@ io::Log ClosedLoopTwin::run(const trajectory::SampledReference& ref, const RunOp
   // References per cycle (the controller steps through them by cycle count).
   Vec qr = ref.q.col(0), qdr = ref.qd.col(0), qddr = ref.qdd.col(0);
   Plant plant(model_, truth_, c_, qr);
+  plant.set_time(-static_cast<double>(std::llround(opt.pre_roll / T)) * T);  // log time: the pre-roll's start
   control::FfpdController ctrl(controller_gains(c_));
   Vec q_meas(n), q_true(n), u_cmd(n);
   servos.encoder(plant.q(), q_meas);

@@ -83,6 +83,14 @@ struct Effects {
   bool dropped_samples = false;
   double drop_probability = 0;
   int drop_max_burst = 1;
+  // An external torque on one joint's link (a collision; the momentum observer's test input):
+  // contact_torque N m (N) from contact_start for contact_duration s of log time, with 2 ms
+  // linear ramps inside that span. Optional in twin.yaml (off when absent).
+  bool contact = false;
+  int contact_joint = 1;  // 1-based
+  double contact_start = 0, contact_duration = 0, contact_torque = 0;
+  // The contact's torque on its joint at log time t.
+  double contact_at(double t) const;
 
   // Turns every effect off (the ideal twin: only the servos' quantization and the delay).
   void disable_all();

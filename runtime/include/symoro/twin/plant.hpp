@@ -4,7 +4,8 @@
 // ModelHandle (one indirect call of its generated forward dynamics per derivative).
 //
 // Effects on the mechanics: smooth Coulomb and Stribeck friction, a constant unmeasured torque
-// offset, and backlash. With backlash a joint's rotor becomes its own body: the rotor (rotor
+// offset, backlash, and a contact (an external torque on one link for a while, at the plant's
+// clock: log time). With backlash a joint's rotor becomes its own body: the rotor (rotor
 // inertia, viscous and Coulomb friction) drives the link through a dead zone of the given width
 // and a stiff, lightly damped gear mesh beyond it; the link side uses the model without that
 // joint's rotor inertia and viscous friction.
@@ -35,12 +36,16 @@ class Plant {
 
   // Advances by dt with the motor torques held, in equal RK4 steps no longer than max_step.
   void advance(double dt, const Eigen::VectorXd& motor_torque);
+  // The plant's clock (log time; the simulator starts it at the pre-roll's start).
+  double time() const { return time_; }
+  void set_time(double t) { time_ = t; }
 
   // The friction beyond viscous: smooth Coulomb plus Stribeck, odd in the velocity.
   double extra_friction(int j, double v) const;
 
-  // dx/dt at x (4 joints-long vectors; dx sized by the caller).
-  void derivative(const Eigen::VectorXd& x, const Eigen::VectorXd& motor_torque, Eigen::VectorXd& dx) const;
+  // dx/dt at x (4 joints-long vectors; dx sized by the caller), the contact's torque at time t.
+  void derivative(const Eigen::VectorXd& x, const Eigen::VectorXd& motor_torque, Eigen::VectorXd& dx,
+                  double t = 0) const;
 
   // Mechanical energy of the rigid plant (no backlash): kinetic 1/2 qd' M qd.
   double kinetic_energy() const;
@@ -52,6 +57,8 @@ class Plant {
   double max_step_;
   Eigen::VectorXd fv_, ia_, fc_, fs_, offset_, half_width_, stiffness_, mesh_damping_;
   double v_eps_ = 0.01, v_s_ = 0.05;
+  Effects effects_;  // the contact's
+  double time_ = 0;
   bool friction_ = false, backlash_ = false;
   Eigen::VectorXd x_;
   Eigen::VectorXd k1_, k2_, k3_, k4_, xt_;  // RK4's stages (no allocation per step)

@@ -50,6 +50,7 @@ Eigen::VectorXd unmodeled_torque(const TwinConfig& c, const trajectory::Trajecto
     if (e.coulomb) worst(j) += e.coulomb_torque(j);
     if (e.stribeck) worst(j) += e.stribeck_torque(j);
     if (e.torque_offset) worst(j) += std::abs(e.offset_torque(j));
+    if (e.contact && j == e.contact_joint - 1) worst(j) += std::abs(e.contact_torque);
     // Half a current step of quantization and a 5-sigma current noise act like torque.
     const Servo& s = c.servos[j];
     worst(j) += s.torque_constant * (s.current_unit / 2 + (e.sensor_noise ? 5 * e.current_noise : 0.0));

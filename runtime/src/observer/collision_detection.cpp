@@ -1,0 +1,196 @@
+#include "symoro/observer/collision_detection.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+#include <boost/math/distributions/normal.hpp>
+#include <fmt/format.h>
+#include <yaml-cpp/yaml.h>
+
+#include "symoro/error.hpp"
+#include "symoro/io/number_text.hpp"
+#include "symoro/io/yaml_keys.hpp"
+
+namespace symoro::observer {
+
+Eigen::MatrixXd observe_log(MomentumObserver& observer, const io::Log& log) {
+  const int n = observer.nq();
+  if (log.joints() != n)
+    throw std::invalid_argument(
+        fmt::format("observe_log: the log has {} joints, the observer's model {}", log.joints(), n));
+  Eigen::MatrixXd r = Eigen::MatrixXd::Zero(log.samples(), n);
+  // Row-major copies of one sample: the log's matrices are column-major.
+  Eigen::VectorXd q(n), qd(n), tau(n);
+  Eigen::Index last = 0;  // the last row stepped
+  for (Eigen::Index k = 0; k < log.samples(); ++k) {
+    // A stale row (a logger repeating the row before under a new stamp) is no new sample: r holds,
+    // and the next new row steps over both intervals.
+    if (k > 0 && log.q.row(k) == log.q.row(k - 1) && log.qd.row(k) == log.qd.row(k - 1) &&
+        log.tau.row(k) == log.tau.row(k - 1)) {
+      r.row(k) = r.row(k - 1);
+      continue;
+    }
+    q = log.q.row(k).transpose();
+    qd = log.qd.row(k).transpose();
+    tau = log.tau.row(k).transpose();
+    if (k == 0) {
+      observer.reset(q.data(), qd.data(), tau.data());
+      continue;
+    }
+    r.row(k) = observer.update(q.data(), qd.data(), tau.data(), log.time(k) - log.time(last)).transpose();
+    last = k;
+  }
+  return r;
+}
+
+ObserverThresholds observer_thresholds(const std::vector<Eigen::MatrixXd>& residuals,
+                                       const std::vector<Eigen::VectorXd>& times, const Eigen::VectorXd& gain,
+                                       const ThresholdOptions& options) {
+  if (residuals.empty() || residuals.size() != times.size())
+    throw std::invalid_argument("observer_thresholds: no calibration residuals (or times and residuals differ)");
+  if (!(options.false_alarms_per_hour > 0))
+    throw std::invalid_argument("observer_thresholds: the false-alarm rate must be positive");
+  const Eigen::Index n = residuals.front().cols();
+  const double settle = options.settle_time_constants / gain.minCoeff();
+  ObserverThresholds t;
+  Eigen::VectorXd sum = Eigen::VectorXd::Zero(n), sq = Eigen::VectorXd::Zero(n);
+  std::vector<std::pair<std::size_t, Eigen::Index>> used;  // (run, first row)
+  for (std::size_t i = 0; i < residuals.size(); ++i) {
+    const Eigen::VectorXd& time = times[i];
+    Eigen::Index first = 0;
+    while (first < time.size() && time(first) - time(0) < settle) ++first;
+    used.emplace_back(i, first);
+    for (Eigen::Index k = first; k < time.size(); ++k) {
+      sum += residuals[i].row(k).transpose();
+      sq += residuals[i].row(k).transpose().cwiseAbs2();
+      ++t.samples;
+    }
+    if (time.size() > first) t.seconds += time(time.size() - 1) - time(first);
+  }
+  if (t.samples < 100)
+    throw std::invalid_argument(fmt::format(
+        "observer_thresholds: {} calibration samples after the residual settles ({:.3g} s per run): too few", t.samples,
+        settle));
+  t.center = sum / t.samples;
+  t.spread = (sq / t.samples - t.center.cwiseAbs2()).cwiseMax(0).cwiseSqrt();
+  // Independent samples per hour over all joints, and the tail each may take.
+  const double independent = 3600 * 0.5 * gain.mean() * static_cast<double>(n);
+  const double tail = std::min(0.5, options.false_alarms_per_hour / independent);
+  t.z = boost::math::quantile(boost::math::complement(boost::math::normal(), tail / 2));
+  t.gaussian = t.threshold = t.z * t.spread;
+  t.false_alarms_per_hour = options.false_alarms_per_hour;
+  t.peak_margin = options.peak_margin;
+  t.peak = Eigen::VectorXd::Zero(n);
+  for (const auto& [i, first] : used) {
+    const Eigen::Index rows = residuals[i].rows() - first;
+    const Eigen::MatrixXd centered = residuals[i].bottomRows(rows).rowwise() - t.center.transpose();
+    t.peak = t.peak.cwiseMax(centered.cwiseAbs().colwise().maxCoeff().transpose());
+    t.gaussian_alarms +=
+        static_cast<int>(collision_events(times[i].tail(rows), residuals[i].bottomRows(rows), t).size());
+  }
+  t.threshold = t.gaussian.cwiseMax(options.peak_margin * t.peak);
+  return t;
+}
+
+std::vector<CollisionEvent> collision_events(const Eigen::VectorXd& time, const Eigen::MatrixXd& residual,
+                                             const ObserverThresholds& thresholds) {
+  std::vector<CollisionEvent> out;
+  for (Eigen::Index j = 0; j < residual.cols(); ++j) {
+    bool open = false;
+    CollisionEvent e;
+    for (Eigen::Index k = 0; k < residual.rows(); ++k) {
+      const double d = residual(k, j) - thresholds.center(j);
+      if (std::abs(d) > thresholds.threshold(j)) {
+        if (!open) e = CollisionEvent{static_cast<int>(j), time(k), time(k), 0, time(k)}, open = true;
+        e.end = time(k);
+        if (std::abs(d) > std::abs(e.peak)) e.peak = d, e.peak_time = time(k);
+      } else if (open) {
+        out.push_back(e), open = false;
+      }
+    }
+    if (open) out.push_back(e);
+  }
+  std::stable_sort(out.begin(), out.end(), [](const CollisionEvent& a, const CollisionEvent& b) {
+    return a.start < b.start || (a.start == b.start && a.joint < b.joint);
+  });
+  return out;
+}
+
+namespace {
+
+std::string list(const Eigen::VectorXd& v) {
+  std::string s;
+  for (Eigen::Index i = 0; i < v.size(); ++i) s += (i ? ", " : "") + io::number_text(v(i));
+  return "[" + s + "]";
+}
+
+}  // namespace
+
+std::string thresholds_yaml(const ObserverThresholds& t, const std::vector<std::string>& joints,
+                            const std::string& robot, const std::string& model, const Eigen::VectorXd& gain,
+                            const std::string& calibrated_on) {
+  std::string names;
+  for (const auto& j : joints) names += (names.empty() ? "" : ", ") + fmt::format("\"{}\"", j);
+  return fmt::format(
+      "# The momentum observer's band per joint: an event when |r - center| > threshold (dynid observer).\n"
+      "# threshold = max(z * spread, peak_margin * calibration peak); z from a Gaussian tail at\n"
+      "# false_alarms_per_hour (all joints together), the residual counted as gain / 2 independent\n"
+      "# samples per second. Units: N m (revolute), N (prismatic).\n"
+      "robot: \"{}\"\nmodel: \"{}\"\njoints: [{}]\ngain: {}  # K, 1/s\n"
+      "false_alarms_per_hour: {}\nz: {}\npeak_margin: {}\ncenter: {}\nspread: {}\nthreshold: {}\n"
+      "calibration:\n  on: \"{}\"\n  samples: {}\n  seconds: {}\n  peak: {}  # max |r - center|\n"
+      "  gaussian: {}  # z * spread\n"
+      "  gaussian_alarms: {}  # events the Gaussian band alone raises on the calibration runs\n",
+      robot, model, names, list(gain), io::number_text(t.false_alarms_per_hour), io::number_text(t.z),
+      io::number_text(t.peak_margin), list(t.center), list(t.spread), list(t.threshold), calibrated_on, t.samples,
+      io::number_text(t.seconds), list(t.peak), list(t.gaussian), t.gaussian_alarms);
+}
+
+ThresholdsFile read_thresholds_yaml(const std::string& file, const std::vector<std::string>& joints) {
+  const YAML::Node root = io::load_yaml_file(file);
+  if (!root.IsMap()) throw DataError(file, 1, "a thresholds file is a mapping (dynid observer writes one)");
+  io::check_keys(root,
+                 {"robot", "model", "joints", "gain", "false_alarms_per_hour", "z", "peak_margin", "center", "spread",
+                  "threshold", "calibration"},
+                 file, "a thresholds file");
+  const auto line = [](const YAML::Node& n) { return n.Mark().line + 1; };
+  const auto vector = [&](const char* key) {
+    const YAML::Node n = root[key];
+    if (!n || !n.IsSequence() || n.size() != joints.size())
+      throw DataError(file, n ? line(n) : 0, fmt::format("{} must list {} numbers, one per joint", key, joints.size()));
+    Eigen::VectorXd v(static_cast<Eigen::Index>(joints.size()));
+    for (std::size_t i = 0; i < joints.size(); ++i) {
+      double x = 0;
+      if (!YAML::convert<double>::decode(n[i], x) || !std::isfinite(x))
+        throw DataError(file, line(n[i]), fmt::format("{}[{}] is not a finite number", key, i));
+      v(static_cast<Eigen::Index>(i)) = x;
+    }
+    return v;
+  };
+  const YAML::Node names = root["joints"];
+  if (!names || !names.IsSequence() || names.size() != joints.size())
+    throw DataError(file, names ? line(names) : 0, fmt::format("joints must list the model's {}", joints.size()));
+  for (std::size_t i = 0; i < joints.size(); ++i)
+    if (!names[i].IsScalar() || names[i].Scalar() != joints[i])
+      throw DataError(file, line(names[i]),
+                      fmt::format("joint {} is '{}', the model's is '{}'", i + 1,
+                                  names[i].IsScalar() ? names[i].Scalar() : "?", joints[i]));
+  ThresholdsFile out;
+  out.robot = root["robot"] && root["robot"].IsScalar() ? root["robot"].Scalar() : "";
+  out.model = root["model"] && root["model"].IsScalar() ? root["model"].Scalar() : "";
+  out.gain = vector("gain");
+  out.thresholds.center = vector("center");
+  out.thresholds.spread = vector("spread");
+  out.thresholds.threshold = vector("threshold");
+  for (Eigen::Index j = 0; j < out.gain.size(); ++j) {
+    if (!(out.gain(j) > 0)) throw DataError(file, line(root["gain"]), "every gain must be positive");
+    if (!(out.thresholds.threshold(j) > 0))
+      throw DataError(file, line(root["threshold"]), "every threshold must be positive");
+  }
+  if (root["false_alarms_per_hour"]) out.thresholds.false_alarms_per_hour = root["false_alarms_per_hour"].as<double>(0);
+  if (root["z"]) out.thresholds.z = root["z"].as<double>(0);
+  return out;
+}
+
+}  // namespace symoro::observer
