@@ -43,6 +43,7 @@ ModelKernels handle_kernels(const robot::ModelHandle& model) {
   const robot::ModelHandle m = model;
   const int nq = m.nq(), np = m.np(), ns = m.ns();
   ModelKernels k;
+  k.handle = std::make_shared<const robot::ModelHandle>(m);
   k.nq = nq;
   k.np = np;
   k.ns = ns;

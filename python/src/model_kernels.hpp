@@ -28,6 +28,7 @@ struct ModelKernels {
   std::function<std::shared_ptr<const identify::IdentificationModel>()> identification;
   std::function<std::shared_ptr<const diagnose::DiagnosisModel>()> diagnosis;
   int nq = 0, np = 0, ns = 0;
+  std::shared_ptr<const robot::ModelHandle> handle;  // the handle itself (the momentum observer)
 
   // (n, nq, np)
   std::function<void(const double* q, const double* qd, const double* qdd, double* w, Batch b)> regressor;

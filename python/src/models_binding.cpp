@@ -348,6 +348,9 @@ std::shared_ptr<const identify::IdentificationModel> identification_of(py::handl
   return model.cast<const Model&>().id;
 }
 
+// Its robot handle (symoro.MomentumObserver).
+const robot::ModelHandle& handle_of(py::handle model) { return *model.cast<const Model&>().k.handle; }
+
 // robot_dir as given, else a loaded model's own folder: the workflow then reads its robot.yaml
 // (the nominal prior, the controller description) as dynid does from --robot.
 std::optional<std::filesystem::path> robot_dir_of(py::handle model, const std::optional<std::filesystem::path>& given) {

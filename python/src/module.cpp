@@ -14,6 +14,7 @@ void bind_workflow(py::module_& m);
 void bind_results(py::module_& m);
 void bind_export(py::module_& m);
 void bind_diagnose(py::module_& m);
+void bind_observer(py::module_& m);
 
 }  // namespace symoro::python
 
@@ -40,4 +41,5 @@ PYBIND11_MODULE(_symoro, m) {
   symoro::python::bind_results(m);
   symoro::python::bind_export(m);
   symoro::python::bind_diagnose(m);
+  symoro::python::bind_observer(m);
 }

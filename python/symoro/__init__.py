@@ -10,13 +10,15 @@
     found = symoro.diagnose(arm, "data", "diagnosis", robot_dir="robots/crane_x7")  # missing effects
     gap = symoro.compare("study", "study-diagnosed", "gap")   # two studies on their held-out runs
     symoro.export_urdf(arm, "study-physical", "arm.urdf", prior="zero")  # consistent inertials
+    obs = symoro.MomentumObserver(arm, study["phi"])          # collision detection (docs/observer.md)
 
 See docs/python.md.
 """
 
-from ._symoro import DataError, Model, StudyStopped, compare, diagnose, export_urdf, identify, import_logs, predict
+from ._symoro import (DataError, Model, MomentumObserver, StudyStopped, collision_events, compare, diagnose, export_urdf,
+                      identify, import_logs, observer_thresholds, predict)
 from . import models
 from .models import load
 
-__all__ = ["DataError", "Model", "StudyStopped", "compare", "diagnose", "export_urdf", "identify", "import_logs", "load",
-           "models", "predict"]
+__all__ = ["DataError", "Model", "MomentumObserver", "StudyStopped", "collision_events", "compare", "diagnose",
+           "export_urdf", "identify", "import_logs", "load", "models", "observer_thresholds", "predict"]

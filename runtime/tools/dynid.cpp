@@ -35,6 +35,7 @@ int main(int argc, char** argv) {
   add_control_commands(app, common);
   add_export_commands(app, common);
   add_predict_commands(app, common);
+  add_observer_commands(app, common);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -39,30 +39,6 @@ struct PredictOptions {
   bool force = false;
 };
 
-// The model label a parameters file was identified with (its `model:`; "" the full model).
-std::string file_model(const std::string& file) {
-  if (!std::filesystem::exists(file)) throw UsageError(file + ": not found");
-  try {
-    const YAML::Node root = io::load_yaml_file(file);
-    const std::string m = root["model"] ? root["model"].as<std::string>() : std::string();
-    return m.empty() ? "full" : m;
-  } catch (const YAML::BadFile&) {
-    throw UsageError(file + ": not found");
-  } catch (const YAML::Exception& e) {
-    throw UsageError(file + ": invalid YAML: " + e.what());
-  }
-}
-
-// phi from robot.yaml's nominal standard parameters.
-Eigen::VectorXd nominal_phi(const Common& common, const identify::IdentificationModel& model) {
-  std::vector<double> s;
-  if (!nominal_standard_parameters(common, model.description().standard, s))
-    throw UsageError((common.robot_dir() / "robot.yaml").string() +
-                     " has no nominal parameters (symoroc model writes them from a URDF): give --params "
-                     "<study>/report/parameters.yaml");
-  return model.base_from_standard(Eigen::Map<const Eigen::VectorXd>(s.data(), static_cast<Eigen::Index>(s.size())));
-}
-
 // The prediction of one log, its samples written to `csv`.
 study::Prediction predict_log(const io::Log& log, const identify::IdentificationModel& model,
                               const Eigen::VectorXd& phi, const PredictOptions& options, const fs::path& csv) {
@@ -86,26 +62,10 @@ study::Prediction predict_log(const io::Log& log, const identify::Identification
 }
 
 void run(const Common& common, const PredictOptions& options) {
-  std::string label = options.model;
-  if (options.params != "nominal") {
-    const std::string in_file = file_model(options.params);
-    if (!label.empty() && label != in_file)
-      throw UsageError(
-          fmt::format("--model {}, but {} holds the parameters of model {}", label, options.params, in_file));
-    label = in_file;
-  }
-  const auto model = identification_model(common, label);
+  const auto model = identification_model(common, parameters_model(options.params, options.model));
   const identify::ModelDescription& d = model->description();
-  Eigen::VectorXd phi;
-  if (options.params == "nominal") {
-    phi = nominal_phi(common, *model);
-  } else {
-    std::vector<std::string> names;
-    for (const auto& p : d.parameters) names.push_back(p.name);
-    const io::ParametersIntegrity integrity = io::parameters_integrity(options.params, names);
-    if (!integrity.intact) fmt::print(stderr, "warning: {}: {}\n", options.params, integrity.why);
-    phi = io::read_parameters_yaml(options.params, names);
-  }
+  const Eigen::VectorXd phi =
+      parameters_phi(common, robot_model(common, d.variant.empty() ? "full" : d.variant), options.params);
 
   // What to predict: one log, or every run of a dataset's trial.
   std::vector<std::pair<std::string, io::Log>> logs;

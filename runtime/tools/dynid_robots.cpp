@@ -6,8 +6,11 @@
 #include <set>
 
 #include <fmt/format.h>
+#include <yaml-cpp/yaml.h>
 
 #include "symoro/identify/loaded_model.hpp"
+#include "symoro/io/parameters_yaml.hpp"
+#include "symoro/io/yaml_keys.hpp"
 #include "symoro/robot/load_robot.hpp"
 
 namespace symoro::dynid {
@@ -93,6 +96,38 @@ robot::ModelHandle robot_model(const Common& common, const std::string& label) {
 std::shared_ptr<const identify::IdentificationModel> identification_model(const Common& common,
                                                                           const std::string& label) {
   return identify::identification_model(robot_model(common, label), full_model(common));
+}
+
+std::string parameters_model(const std::string& params, const std::string& model) {
+  if (params == "nominal") return model;
+  if (!std::filesystem::exists(params)) throw UsageError(params + ": not found");
+  std::string in_file;
+  try {
+    const YAML::Node root = io::load_yaml_file(params);
+    in_file = root["model"] ? root["model"].as<std::string>() : std::string();
+  } catch (const YAML::Exception& e) {
+    throw UsageError(params + ": invalid YAML: " + e.what());
+  }
+  if (in_file.empty()) in_file = "full";
+  if (!model.empty() && model != in_file)
+    throw UsageError(fmt::format("--model {}, but {} holds the parameters of model {}", model, params, in_file));
+  return in_file;
+}
+
+Eigen::VectorXd parameters_phi(const Common& common, const robot::ModelHandle& model, const std::string& params) {
+  if (params == "nominal") {
+    std::vector<double> s;
+    if (!nominal_standard_parameters(common, model.standard_parameters(), s))
+      throw UsageError((common.robot_dir() / "robot.yaml").string() +
+                       " has no nominal parameters (symoroc model writes them from a URDF): give --params "
+                       "<study>/report/parameters.yaml");
+    return model.base_from_standard(Eigen::Map<const Eigen::VectorXd>(s.data(), static_cast<Eigen::Index>(s.size())));
+  }
+  std::vector<std::string> names;
+  for (const auto& p : model.parameters()) names.push_back(p.name);
+  const io::ParametersIntegrity integrity = io::parameters_integrity(params, names);
+  if (!integrity.intact) fmt::print(stderr, "warning: {}: {}\n", params, integrity.why);
+  return io::read_parameters_yaml(params, names);
 }
 
 }  // namespace symoro::dynid

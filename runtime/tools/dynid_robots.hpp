@@ -52,6 +52,16 @@ inline robot::ModelHandle full_model(const Common& common) { return robot_model(
 std::shared_ptr<const identify::IdentificationModel> identification_model(const Common& common,
                                                                           const std::string& label);
 
+// The model a --params argument is for: a parameters file's `model:` ("full" when it names
+// none; --model, when given, must agree), or `model` itself for `nominal`. UsageError naming the
+// file when it is missing or no YAML.
+std::string parameters_model(const std::string& params, const std::string& model);
+
+// phi of `model` from --params: a study's report/parameters.yaml (its integrity checked, a warning
+// when edited), or `nominal`: robot.yaml's nominal standard parameters (symoroc model writes a
+// URDF's there), UsageError when it has none.
+Eigen::VectorXd parameters_phi(const Common& common, const robot::ModelHandle& model, const std::string& params);
+
 // The trajectory design the command reads (Common::design_path) for these joints; a robot folder
 // without one gets a UsageError saying how to make one (dynid excite).
 trajectory::TrajectoryDesign read_design(const Common& common, const std::vector<JointInfo>& joints);

@@ -1,11 +1,15 @@
 // Writes a CSV as a robot's own controller could export it, for the command-line tests of the
 // any-robot workflow: `write_export <robot> <file> <seconds> <seed>` for rx90, stanford_rrp or
 // ur5 (from its URDF's inertials); `[velocity Hz]`: the velocity columns through a first-order
-// low-pass at that corner, as a controller's own causal estimate (late by its filter). The
+// low-pass at that corner, as a controller's own causal estimate (late by its filter; 0: none);
+// `[contact J,start,duration,torque]`: an external torque on joint J (1-based) for `duration` s
+// from `start` s after the log's first row, with 2 ms ramps, that the motor's torque gives way to
+// (the motion is the same: tau = ID - tau_ext), for the momentum observer's test. The
 // motion and torque come from the robot's generated model (synthetic_log.hpp) with Coulomb
 // friction (in the truth; a `rigid` model lacks it), an offset of -0.06 N m on the last joint,
 // noise and 5 % stale rows; columns stamp_ms, mode (text), <joint>_pos, _vel (deg, deg/s; m,
 // m/s for a prismatic joint), <joint>_eff (N m; N).
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
@@ -41,6 +45,30 @@ void lag_velocity(symoro::io::Log& log, double corner_hz) {
   }
 }
 
+// The contact a command line names (joint 0: none).
+struct Contact {
+  int joint = 0;
+  double start = 0, duration = 0, torque = 0;
+  double at(double t) const {
+    const double ramp = 0.002, in = t - start, left = start + duration - t;
+    if (joint == 0 || in <= 0 || left <= 0) return 0;
+    return torque * std::min({1.0, in / ramp, left / ramp});
+  }
+};
+
+// The motor gives way to the contact; a stale row repeats the row before as it was logged.
+void add_contact(symoro::io::Log& log, const Contact& c) {
+  if (c.joint == 0) return;
+  const Eigen::MatrixXd q = log.q, qd = log.qd;
+  for (Eigen::Index k = 0; k < log.tau.rows(); ++k) {
+    if (k > 0 && q.row(k) == q.row(k - 1) && qd.row(k) == qd.row(k - 1)) {
+      log.tau.row(k) = log.tau.row(k - 1);
+      continue;
+    }
+    log.tau(k, c.joint - 1) -= c.at(log.time(k) - log.time(0));
+  }
+}
+
 template <class Model>
 int write(const std::string& file, double seconds, unsigned seed, double velocity_hz) {
   symoro::test::Random rng(23);
@@ -56,7 +84,8 @@ int write(const std::string& file, double seconds, unsigned seed, double velocit
 // A robot symoroc model made from its URDF: the truth is the URDF's own inertials (robot.yaml's
 // nominal parameters), with Coulomb friction the URDF does not have (and the offset).
 template <class Model>
-int write_from_nominal(const std::string& file, double seconds, unsigned seed, const std::vector<double>& coulomb) {
+int write_from_nominal(const std::string& file, double seconds, unsigned seed, const std::vector<double>& coulomb,
+                       const Contact& contact) {
   const YAML::Node nominal =
       YAML::LoadFile(std::string(SYMORO_ROBOTS_DIR) + "/" + Model::robot_name + "/robot.yaml")["nominal"];
   Eigen::Matrix<double, Model::ns, 1> s;
@@ -64,8 +93,9 @@ int write_from_nominal(const std::string& file, double seconds, unsigned seed, c
     const auto& p = Model::standard_parameters[i];
     s(i) = std::string(p.family) == "FS" ? coulomb.at(p.joint - 1) : nominal[p.name].template as<double>();
   }
-  const symoro::io::Log log = symoro::test::synthesize<Model>("export", Model::base_from_standard(s), seconds, seed,
-                                                              0.05, symoro::test::offset_on<Model>(Model::nq, -0.06));
+  symoro::io::Log log = symoro::test::synthesize<Model>("export", Model::base_from_standard(s), seconds, seed, 0.05,
+                                                        symoro::test::offset_on<Model>(Model::nq, -0.06));
+  add_contact(log, contact);
   symoro::test::write_export_csv<Model>(log, file);
   return 0;
 }
@@ -73,18 +103,26 @@ int write_from_nominal(const std::string& file, double seconds, unsigned seed, c
 }  // namespace
 
 int main(int argc, char** argv) {
-  if (argc != 5 && argc != 6) {
-    std::fprintf(stderr, "usage: write_export rx90|stanford_rrp|ur5 <file.csv> <seconds> <seed> [velocity Hz]\n");
+  if (argc < 5 || argc > 7) {
+    std::fprintf(stderr,
+                 "usage: write_export rx90|stanford_rrp|ur5 <file.csv> <seconds> <seed> [velocity Hz] "
+                 "[contact J,start,duration,torque (ur5)]\n");
+    return 2;
+  }
+  Contact contact;
+  if (argc == 7 &&
+      std::sscanf(argv[6], "%d,%lf,%lf,%lf", &contact.joint, &contact.start, &contact.duration, &contact.torque) != 4) {
+    std::fprintf(stderr, "write_export: contact '%s' is not J,start,duration,torque\n", argv[6]);
     return 2;
   }
   const std::string robot = argv[1];
   const double seconds = std::stod(argv[3]);
   const unsigned seed = static_cast<unsigned>(std::stoul(argv[4]));
-  const double velocity_hz = argc == 6 ? std::stod(argv[5]) : 0;
+  const double velocity_hz = argc >= 6 ? std::stod(argv[5]) : 0;
   if (robot == "rx90") return write<symoro::rx90::Model>(argv[2], seconds, seed, velocity_hz);
   if (robot == "stanford_rrp") return write<symoro::stanford_rrp::Model>(argv[2], seconds, seed, velocity_hz);
   if (robot == "ur5")
-    return write_from_nominal<symoro::ur5::Model>(argv[2], seconds, seed, {1.5, 1.5, 1.0, 0.3, 0.3, 0.3});
+    return write_from_nominal<symoro::ur5::Model>(argv[2], seconds, seed, {1.5, 1.5, 1.0, 0.3, 0.3, 0.3}, contact);
   std::fprintf(stderr, "unknown robot %s\n", robot.c_str());
   return 2;
 }
