@@ -156,7 +156,8 @@ void run(const Common& common, const ObserverCliOptions& options) {
   const fs::path out(options.out);
   const fs::path events_file = out / "events.csv", thresholds_file = out / "thresholds.yaml";
   const std::vector<NamedLog> logs = read_logs(common, options.input, n, false);
-  std::vector<fs::path> files{events_file, thresholds_file};
+  std::vector<fs::path> files{events_file};
+  if (options.thresholds.empty()) files.push_back(thresholds_file);  // calibrated here: written
   for (const auto& l : logs) files.push_back(out / (l.name + ".residual.csv"));
   for (const auto& f : files)
     if (fs::exists(f) && !options.force)
