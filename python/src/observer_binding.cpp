@@ -186,13 +186,13 @@ void bind_observer(py::module_& m) {
 
   m.def(
       "collision_events",
-      [](py::handle time, py::handle residual, const py::dict& thresholds) {
+      [](py::handle time, py::handle residual, const py::dict& thresholds, double merge_within) {
         const int n = columns_of(residual, "residual");
         const Eigen::MatrixXd r = matrix_of(residual, "residual", n);
         const Eigen::VectorXd t = times_of(time, "time");
         if (t.size() != r.rows()) throw py::value_error("collision_events: time and residual differ in length");
         py::list out;
-        for (const auto& e : observer::collision_events(t, r, thresholds_from(thresholds, n))) {
+        for (const auto& e : observer::collision_events(t, r, thresholds_from(thresholds, n), merge_within)) {
           py::dict d;
           d["joint"] = e.joint;
           d["start"] = e.start;
@@ -203,9 +203,9 @@ void bind_observer(py::module_& m) {
         }
         return out;
       },
-      py::arg("time"), py::arg("residual"), py::arg("thresholds"),
+      py::arg("time"), py::arg("residual"), py::arg("thresholds"), py::arg("merge_within") = observer::kMergeWithin,
       "where a joint's |r - center| exceeds its threshold: [{'joint' (0-based), 'start', 'end', 'peak', "
-      "'peak_time'}], in order of start");
+      "'peak_time'}], in order of start; a span within merge_within s of the last on its joint continues it");
 }
 
 }  // namespace symoro::python

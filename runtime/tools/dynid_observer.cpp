@@ -35,6 +35,7 @@ struct ObserverCliOptions {
   std::string gain_text;  // --gain: one K, or one per joint, comma-separated
   double false_alarms_per_hour = observer::ThresholdOptions{}.false_alarms_per_hour;
   double peak_margin = observer::ThresholdOptions{}.peak_margin;
+  double merge_within = observer::kMergeWithin;
   bool derivatives = false, force = false;
 };
 
@@ -186,7 +187,7 @@ void run(const Common& common, const ObserverCliOptions& options) {
   for (const auto& [name, log] : logs) {
     const Eigen::MatrixXd r = observer::observe_log(obs, log);
     io::write_file_atomically(out / (name + ".residual.csv"), residual_csv(log, r, model.joints()));
-    const auto found = observer::collision_events(log.time, r, t);
+    const auto found = observer::collision_events(log.time, r, t, options.merge_within);
     fmt::print("  {:<12} {:>7} samples: {} event{}\n", name, log.samples(), found.size(), found.size() == 1 ? "" : "s");
     for (const auto& e : found) {
       events += fmt::format("{},{},{},{},{},{}\n", name, model.joints()[e.joint].name, io::number_text(e.start),
@@ -234,6 +235,10 @@ void add_observer_commands(CLI::App& app, Common& common) {
       ->check(numbers::checked(1, 100, false, false, "from 1 to 100"))
       ->capture_default_str();
   cmd->get_option("--calibrate")->excludes(th);
+  cmd->add_option("--merge-within", o->merge_within,
+                  "s: a joint's span outside its band this soon after its last continues that event")
+      ->check(numbers::checked(0, 3600, false, false, "from 0 to 3600 s"))
+      ->capture_default_str();
   cmd->add_flag("--derivatives", o->derivatives,
                 "Mdot qd from the model's inertia derivatives (default: differences of M, as accurate and cheaper)");
   cmd->add_flag("--force", o->force, "Overwrite existing output files");

@@ -195,6 +195,33 @@ TEST(CollisionDetection, ThresholdsRoundTripThroughTheirFileAndBadFilesNameTheLi
   std::filesystem::remove(file);
 }
 
+TEST(CollisionDetection, SpansCloseTogetherOnAJointAreOneEvent) {
+  // r on joint 2 crosses its band at 1.00-1.01 s, again 50 ms later (1.06-1.07 s: the same event)
+  // and 200 ms after that (1.27 s: another); joint 1 crosses at 1.065 s (its own event).
+  const int rows = 2000;
+  Eigen::VectorXd time = Eigen::VectorXd::LinSpaced(rows, 0, (rows - 1) * 0.001);
+  Eigen::MatrixXd r = Eigen::MatrixXd::Zero(rows, 2);
+  for (int k = 1000; k <= 1010; ++k) r(k, 1) = 2;
+  for (int k = 1060; k <= 1070; ++k) r(k, 1) = -3;
+  r(1270, 1) = 2.5;
+  r(1065, 0) = 5;
+  observer::ObserverThresholds t;
+  t.center = Eigen::Vector2d::Zero();
+  t.threshold = Eigen::Vector2d::Ones();
+  const auto events = observer::collision_events(time, r, t);
+  ASSERT_EQ(events.size(), 3u);
+  EXPECT_EQ(events[0].joint, 1);
+  EXPECT_DOUBLE_EQ(events[0].start, time(1000));
+  EXPECT_DOUBLE_EQ(events[0].end, time(1070));
+  EXPECT_DOUBLE_EQ(events[0].peak, -3);
+  EXPECT_DOUBLE_EQ(events[0].peak_time, time(1060));
+  EXPECT_EQ(events[1].joint, 0);
+  EXPECT_DOUBLE_EQ(events[1].start, time(1065));
+  EXPECT_EQ(events[2].joint, 1);
+  EXPECT_DOUBLE_EQ(events[2].start, time(1270));
+  EXPECT_EQ(observer::collision_events(time, r, t, 0.0).size(), 4u);  // no merging: every span
+}
+
 // ---- Detection on the independent arm ------------------------------------------------------
 
 struct Detection {

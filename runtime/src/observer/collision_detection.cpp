@@ -94,11 +94,22 @@ ObserverThresholds observer_thresholds(const std::vector<Eigen::MatrixXd>& resid
 }
 
 std::vector<CollisionEvent> collision_events(const Eigen::VectorXd& time, const Eigen::MatrixXd& residual,
-                                             const ObserverThresholds& thresholds) {
+                                             const ObserverThresholds& thresholds, double merge_within) {
   std::vector<CollisionEvent> out;
   for (Eigen::Index j = 0; j < residual.cols(); ++j) {
     bool open = false;
     CollisionEvent e;
+    const std::size_t first = out.size();  // this joint's events begin here
+    const auto close = [&] {
+      if (out.size() > first && e.start - out.back().end <= merge_within) {
+        CollisionEvent& last = out.back();
+        last.end = e.end;
+        if (std::abs(e.peak) > std::abs(last.peak)) last.peak = e.peak, last.peak_time = e.peak_time;
+      } else {
+        out.push_back(e);
+      }
+      open = false;
+    };
     for (Eigen::Index k = 0; k < residual.rows(); ++k) {
       const double d = residual(k, j) - thresholds.center(j);
       if (std::abs(d) > thresholds.threshold(j)) {
@@ -106,10 +117,10 @@ std::vector<CollisionEvent> collision_events(const Eigen::VectorXd& time, const 
         e.end = time(k);
         if (std::abs(d) > std::abs(e.peak)) e.peak = d, e.peak_time = time(k);
       } else if (open) {
-        out.push_back(e), open = false;
+        close();
       }
     }
-    if (open) out.push_back(e);
+    if (open) close();
   }
   std::stable_sort(out.begin(), out.end(), [](const CollisionEvent& a, const CollisionEvent& b) {
     return a.start < b.start || (a.start == b.start && a.joint < b.joint);

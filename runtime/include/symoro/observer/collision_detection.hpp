@@ -59,9 +59,13 @@ struct CollisionEvent {
   double peak_time = 0;
 };
 
-// Every joint's events, in order of start (then joint).
+// Every joint's events, in order of start (then joint). A span that starts within `merge_within`
+// seconds of the last one's end on the same joint continues it: r crossing its threshold back and
+// forth during one contact (or one stretch of model error) is one event, as a user counts them.
+// The start, what detection time is, is unchanged by it.
+inline constexpr double kMergeWithin = 0.1;  // s: 5 time constants at the default gain
 std::vector<CollisionEvent> collision_events(const Eigen::VectorXd& time, const Eigen::MatrixXd& residual,
-                                             const ObserverThresholds& thresholds);
+                                             const ObserverThresholds& thresholds, double merge_within = kMergeWithin);
 
 // thresholds.yaml (what the observer's thresholds are and how they were made) and back; errors
 // name the file and the line.
