@@ -61,15 +61,16 @@ py::dict thresholds_dict(const observer::ObserverThresholds& t) {
   py::dict d;
   d["center"] = array_of(t.center);
   d["spread"] = array_of(t.spread);
-  d["gaussian"] = array_of(t.gaussian);
+  d["tail"] = array_of(t.tail);
   d["peak"] = array_of(t.peak);
   d["threshold"] = array_of(t.threshold);
-  d["z"] = t.z;
+  d["window"] = t.window;
+  d["windows"] = t.windows;
   d["false_alarms_per_hour"] = t.false_alarms_per_hour;
   d["peak_margin"] = t.peak_margin;
   d["seconds"] = t.seconds;
   d["samples"] = t.samples;
-  d["gaussian_alarms"] = t.gaussian_alarms;
+  d["tail_alarms"] = t.tail_alarms;
   return d;
 }
 
@@ -182,7 +183,7 @@ void bind_observer(py::module_& m) {
       py::arg("false_alarms_per_hour") = observer::ThresholdOptions{}.false_alarms_per_hour,
       py::arg("peak_margin") = observer::ThresholdOptions{}.peak_margin,
       "each joint's band from residuals without contact (lists of (N, nq) and (N,)): {'center', 'threshold', "
-      "'spread', 'gaussian', 'peak', 'z', ...}");
+      "'spread', 'tail', 'peak', 'window', ...}");
 
   m.def(
       "collision_events",

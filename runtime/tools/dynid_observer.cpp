@@ -173,14 +173,15 @@ void run(const Common& common, const ObserverCliOptions& options) {
       "{} model {} with {} parameters: momentum observer, gain {} 1/s; band per joint |r - center| <= "
       "threshold ({}):\n",
       common.robot, model.label(), options.params == "nominal" ? "the nominal" : options.params, gain_text(obs.gain()),
-      thresholds_text.empty() ? options.thresholds
-                              : fmt::format("{} false alarms per hour, z {:.3g}, peak margin {:.3g}",
-                                            io::number_text(t.false_alarms_per_hour), t.z, t.peak_margin));
+      thresholds_text.empty()
+          ? options.thresholds
+          : fmt::format("{} false alarms per hour, {} windows of {:.3g} s, peak margin {:.3g}",
+                        io::number_text(t.false_alarms_per_hour), t.windows, t.window, t.peak_margin));
   for (int j = 0; j < n; ++j)
     fmt::print("  {:<16} center {:+.4f}  threshold {:.4f}\n", model.joints()[j].name, t.center(j), t.threshold(j));
   if (!thresholds_text.empty())
-    fmt::print("  calibrated on {} samples ({:.1f} s); the Gaussian band alone would alarm {} times there\n", t.samples,
-               t.seconds, t.gaussian_alarms);
+    fmt::print("  calibrated on {} samples ({:.1f} s); the tail band alone would alarm {} times there\n", t.samples,
+               t.seconds, t.tail_alarms);
 
   std::string events = "run,joint,start,end,peak,peak_time\n";
   int count = 0;

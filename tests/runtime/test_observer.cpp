@@ -164,10 +164,10 @@ TEST(CollisionDetection, ThresholdsRoundTripThroughTheirFileAndBadFilesNameTheLi
   observer::ObserverThresholds t;
   t.center = Eigen::Vector3d(0.1, -0.2, 1.0 / 3);
   t.spread = Eigen::Vector3d(0.01, 0.02, 0.03);
-  t.gaussian = t.spread * 4.8;
+  t.tail = t.spread * 4.8;
   t.peak = Eigen::Vector3d(0.05, 0.1, 0.2);
-  t.threshold = t.gaussian.cwiseMax(1.25 * t.peak);
-  t.z = 4.8;
+  t.threshold = t.tail.cwiseMax(1.25 * t.peak);
+  t.peak_margin = 1.25;
   t.false_alarms_per_hour = 0.5;
   const std::vector<std::string> joints{"a", "b", "c"};
   const Eigen::Vector3d gain(50, 40, 30);
@@ -265,9 +265,9 @@ void expect_detected(const Detection& d, const test::TorquePulse& pulse, const s
     EXPECT_EQ(e.joint, pulse.joint) << robot << ": an alarm on joint " << e.joint + 1 << " at " << e.start << " s";
   std::cout << robot << ": thresholds";
   for (Eigen::Index j = 0; j < d.thresholds.threshold.size(); ++j) std::cout << " " << d.thresholds.threshold(j);
-  std::cout << " (z " << d.thresholds.z << ", Gaussian band's alarms on calibration " << d.thresholds.gaussian_alarms
-            << "), detected " << 1000 * (first.start - pulse.start) << " ms after the pulse, peak " << first.peak
-            << "\n";
+  std::cout << " (" << d.thresholds.windows << " windows, the tail band's alarms on calibration "
+            << d.thresholds.tail_alarms << "), detected " << 1000 * (first.start - pulse.start)
+            << " ms after the pulse, peak " << first.peak << "\n";
 }
 
 TEST(CollisionDetection, ACraneContactIsFoundOnItsJointWithin10ms) {

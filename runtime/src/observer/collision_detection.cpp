@@ -4,7 +4,6 @@
 #include <cmath>
 #include <stdexcept>
 
-#include <boost/math/distributions/normal.hpp>
 #include <fmt/format.h>
 #include <yaml-cpp/yaml.h>
 
@@ -74,22 +73,46 @@ ObserverThresholds observer_thresholds(const std::vector<Eigen::MatrixXd>& resid
         settle));
   t.center = sum / t.samples;
   t.spread = (sq / t.samples - t.center.cwiseAbs2()).cwiseMax(0).cwiseSqrt();
-  // Independent samples per hour over all joints, and the tail each may take.
-  const double independent = 3600 * 0.5 * gain.mean() * static_cast<double>(n);
-  const double tail = std::min(0.5, options.false_alarms_per_hour / independent);
-  t.z = boost::math::quantile(boost::math::complement(boost::math::normal(), tail / 2));
-  t.gaussian = t.threshold = t.z * t.spread;
   t.false_alarms_per_hour = options.false_alarms_per_hour;
   t.peak_margin = options.peak_margin;
+  t.window = options.window_time_constants / gain.minCoeff();
+  // Each joint's largest |r - center| per whole window, every run cut from its settled start.
+  std::vector<Eigen::VectorXd> maxima;
   t.peak = Eigen::VectorXd::Zero(n);
   for (const auto& [i, first] : used) {
-    const Eigen::Index rows = residuals[i].rows() - first;
-    const Eigen::MatrixXd centered = residuals[i].bottomRows(rows).rowwise() - t.center.transpose();
-    t.peak = t.peak.cwiseMax(centered.cwiseAbs().colwise().maxCoeff().transpose());
-    t.gaussian_alarms +=
-        static_cast<int>(collision_events(times[i].tail(rows), residuals[i].bottomRows(rows), t).size());
+    const Eigen::VectorXd& time = times[i];
+    Eigen::VectorXd m = Eigen::VectorXd::Zero(n);
+    double from = first < time.size() ? time(first) : 0;
+    for (Eigen::Index k = first; k < time.size(); ++k) {
+      if (time(k) - from >= t.window) maxima.push_back(m), m.setZero(), from += t.window;
+      m = m.cwiseMax((residuals[i].row(k).transpose() - t.center).cwiseAbs());
+      t.peak = t.peak.cwiseMax(m);
+    }
   }
-  t.threshold = t.gaussian.cwiseMax(options.peak_margin * t.peak);
+  t.windows = static_cast<int>(maxima.size());
+  if (t.windows < 10)
+    throw std::invalid_argument(
+        fmt::format("observer_thresholds: the calibration holds {} windows of {:.3g} s after the residual settles; "
+                    "at least 10 are needed ({:.3g} s of motion without contact)",
+                    t.windows, t.window, 10 * t.window + settle));
+  // Gumbel by moments: beta = s sqrt(6) / pi, mu = mean - 0.5772 beta; the level a window passes
+  // with probability p is mu - beta ln(-ln(1 - p)).
+  const double p = std::min(0.5, options.false_alarms_per_hour * t.window / 3600 / static_cast<double>(n));
+  t.tail.resize(n);
+  for (Eigen::Index j = 0; j < n; ++j) {
+    double mean = 0, square = 0;
+    for (const auto& m : maxima) mean += m(j), square += m(j) * m(j);
+    mean /= t.windows;
+    const double sd = std::sqrt(std::max(0.0, square / t.windows - mean * mean));
+    const double beta = sd * std::sqrt(6.0) / 3.14159265358979323846, mu = mean - 0.5772156649015329 * beta;
+    t.tail(j) = mu - beta * std::log(-std::log1p(-p));
+  }
+  t.threshold = t.tail;
+  for (const auto& [i, first] : used) {
+    const Eigen::Index rows = residuals[i].rows() - first;
+    t.tail_alarms += static_cast<int>(collision_events(times[i].tail(rows), residuals[i].bottomRows(rows), t).size());
+  }
+  t.threshold = t.tail.cwiseMax(options.peak_margin * t.peak);
   return t;
 }
 
@@ -145,24 +168,24 @@ std::string thresholds_yaml(const ObserverThresholds& t, const std::vector<std::
   for (const auto& j : joints) names += (names.empty() ? "" : ", ") + fmt::format("\"{}\"", j);
   return fmt::format(
       "# The momentum observer's band per joint: an event when |r - center| > threshold (dynid observer).\n"
-      "# threshold = max(z * spread, peak_margin * calibration peak); z from a Gaussian tail at\n"
-      "# false_alarms_per_hour (all joints together), the residual counted as gain / 2 independent\n"
-      "# samples per second. Units: N m (revolute), N (prismatic).\n"
+      "# threshold = max(tail, peak_margin * calibration peak); tail: the level a window passes at\n"
+      "# false_alarms_per_hour (all joints together) by a Gumbel fit of each joint's window maxima.\n"
+      "# Units: N m (revolute), N (prismatic).\n"
       "robot: \"{}\"\nmodel: \"{}\"\njoints: [{}]\ngain: {}  # K, 1/s\n"
-      "false_alarms_per_hour: {}\nz: {}\npeak_margin: {}\ncenter: {}\nspread: {}\nthreshold: {}\n"
-      "calibration:\n  on: \"{}\"\n  samples: {}\n  seconds: {}\n  peak: {}  # max |r - center|\n"
-      "  gaussian: {}  # z * spread\n"
-      "  gaussian_alarms: {}  # events the Gaussian band alone raises on the calibration runs\n",
-      robot, model, names, list(gain), io::number_text(t.false_alarms_per_hour), io::number_text(t.z),
-      io::number_text(t.peak_margin), list(t.center), list(t.spread), list(t.threshold), calibrated_on, t.samples,
-      io::number_text(t.seconds), list(t.peak), list(t.gaussian), t.gaussian_alarms);
+      "false_alarms_per_hour: {}\npeak_margin: {}\ncenter: {}\nspread: {}\nthreshold: {}\n"
+      "calibration:\n  on: \"{}\"\n  samples: {}\n  seconds: {}\n  window: {}  # s\n  windows: {}\n"
+      "  peak: {}  # max |r - center|\n  tail: {}  # the Gumbel level\n"
+      "  tail_alarms: {}  # events the tail band alone raises on the calibration runs\n",
+      robot, model, names, list(gain), io::number_text(t.false_alarms_per_hour), io::number_text(t.peak_margin),
+      list(t.center), list(t.spread), list(t.threshold), calibrated_on, t.samples, io::number_text(t.seconds),
+      io::number_text(t.window), t.windows, list(t.peak), list(t.tail), t.tail_alarms);
 }
 
 ThresholdsFile read_thresholds_yaml(const std::string& file, const std::vector<std::string>& joints) {
   const YAML::Node root = io::load_yaml_file(file);
   if (!root.IsMap()) throw DataError(file, 1, "a thresholds file is a mapping (dynid observer writes one)");
   io::check_keys(root,
-                 {"robot", "model", "joints", "gain", "false_alarms_per_hour", "z", "peak_margin", "center", "spread",
+                 {"robot", "model", "joints", "gain", "false_alarms_per_hour", "peak_margin", "center", "spread",
                   "threshold", "calibration"},
                  file, "a thresholds file");
   const auto line = [](const YAML::Node& n) { return n.Mark().line + 1; };
@@ -200,7 +223,7 @@ ThresholdsFile read_thresholds_yaml(const std::string& file, const std::vector<s
       throw DataError(file, line(root["threshold"]), "every threshold must be positive");
   }
   if (root["false_alarms_per_hour"]) out.thresholds.false_alarms_per_hour = root["false_alarms_per_hour"].as<double>(0);
-  if (root["z"]) out.thresholds.z = root["z"].as<double>(0);
+  if (root["peak_margin"]) out.thresholds.peak_margin = root["peak_margin"].as<double>(0);
   return out;
 }
 

@@ -26,24 +26,30 @@ struct ThresholdOptions {
   // The first samples of each calibration run left out: the residual's own start (r = 0 at the
   // first sample, then the model's error through the filter), 5 time constants.
   double settle_time_constants = 5;
-  // The band is never narrower than this times the largest excursion the calibration runs show:
-  // a model's error is not Gaussian, and its tails would otherwise alarm on motions like them.
+  // The extrapolation's windows, in time constants (0.5 s at K = 50): far longer than r's
+  // correlation time, so that their maxima are nearly independent; at least 10 are needed.
+  double window_time_constants = 25;
+  // The band is never narrower than this times the largest excursion the calibration runs show.
   double peak_margin = 1.25;
 };
 
-// Each joint's band: |r - center| <= threshold. The center and the spread are the joint's mean
-// and standard deviation over the calibration residuals; gaussian = z spread, z from a Gaussian
-// tail at the stated rate, with the residual counted as K / 2 independent samples per second
-// (the first-order filter's correlation time, 2 / K); threshold = the larger of that and
-// peak_margin times the calibration's largest excursion. `gaussian_alarms` counts the events the
-// Gaussian band alone raises on the calibration runs: how far the extrapolation holds.
+// Each joint's band: |r - center| <= threshold, by extreme values: the calibration is cut into
+// windows, and each joint's largest |r - center| per window gets a Gumbel distribution (fitted
+// by its moments); `tail` is the level a window passes with the probability the stated rate
+// gives it (rate x window / 3600 / joints). A model's error is not Gaussian and follows the
+// motion: its maxima are what a band must cover (measured on a UR5, docs/observer.md: a Gaussian
+// tail of the samples raised 8-30x more false alarms on a new motion). threshold = the larger of
+// `tail` and peak_margin times the calibration's largest excursion. `tail_alarms` counts the
+// events the tail band alone raises on the calibration runs. center and spread: the joint's mean
+// and standard deviation.
 struct ObserverThresholds {
-  Eigen::VectorXd center, spread, gaussian, peak, threshold;  // per joint; peak: max |r - center|
-  double z = 0;
+  Eigen::VectorXd center, spread, tail, peak, threshold;  // per joint; peak: max |r - center|
+  double window = 0;                                      // s
+  int windows = 0;                                        // in the calibration
   double false_alarms_per_hour = 0, peak_margin = 0;
-  double seconds = 0;       // calibration samples' total duration
-  int samples = 0;          // calibration samples used
-  int gaussian_alarms = 0;  // events of the Gaussian band alone on the calibration runs
+  double seconds = 0;   // calibration samples' total duration
+  int samples = 0;      // calibration samples used
+  int tail_alarms = 0;  // events of the tail band alone on the calibration runs
 };
 
 ObserverThresholds observer_thresholds(const std::vector<Eigen::MatrixXd>& residuals,
