@@ -1,8 +1,10 @@
 // symoro.MomentumObserver, symoro.observer_thresholds and symoro.collision_events
-// (docs/observer.md): the C++ observer (symoro/observer/) over a Python model, on NumPy arrays.
+// (docs/observer.md): the C++ observer (symoro/observer/) over a Python model, on NumPy arrays
+// (results through pybind11's Eigen conversion, as the workflow's records).
 #include <string>
 #include <vector>
 
+#include <pybind11/eigen.h>
 #include <pybind11/stl.h>
 
 #include "arrays.hpp"
@@ -44,26 +46,13 @@ int columns_of(py::handle value, const char* name) {
   return static_cast<int>(a.shape(1));
 }
 
-py::array_t<double> array_of(const Eigen::VectorXd& v) {
-  py::array_t<double> a(v.size());
-  for (Eigen::Index i = 0; i < v.size(); ++i) a.mutable_data()[i] = v(i);
-  return a;
-}
-
-py::array_t<double> array_of(const Eigen::MatrixXd& m) {
-  py::array_t<double> a({m.rows(), m.cols()});
-  for (Eigen::Index i = 0; i < m.rows(); ++i)
-    for (Eigen::Index j = 0; j < m.cols(); ++j) a.mutable_data()[i * m.cols() + j] = m(i, j);
-  return a;
-}
-
 py::dict thresholds_dict(const observer::ObserverThresholds& t) {
   py::dict d;
-  d["center"] = array_of(t.center);
-  d["spread"] = array_of(t.spread);
-  d["tail"] = array_of(t.tail);
-  d["peak"] = array_of(t.peak);
-  d["threshold"] = array_of(t.threshold);
+  d["center"] = t.center;
+  d["spread"] = t.spread;
+  d["tail"] = t.tail;
+  d["peak"] = t.peak;
+  d["threshold"] = t.threshold;
   d["window"] = t.window;
   d["windows"] = t.windows;
   d["false_alarms_per_hour"] = t.false_alarms_per_hour;
@@ -110,8 +99,8 @@ void bind_observer(py::module_& m) {
            }),
            py::arg("model"), py::arg("phi"), py::arg("gain") = 50.0, py::arg("inertia_rate") = "difference")
       .def_property_readonly("nq", &MomentumObserver::nq)
-      .def_property_readonly("gain", [](const MomentumObserver& o) { return array_of(o.gain()); })
-      .def_property_readonly("residual", [](const MomentumObserver& o) { return array_of(o.residual()); })
+      .def_property_readonly("gain", [](const MomentumObserver& o) { return o.gain(); })
+      .def_property_readonly("residual", [](const MomentumObserver& o) { return o.residual(); })
       .def(
           "reset",
           [](MomentumObserver& o, py::handle q, py::handle qd, py::handle tau) {
@@ -126,7 +115,7 @@ void bind_observer(py::module_& m) {
             const Eigen::VectorXd a = vector_of(q, "q", o.nq()), b = vector_of(qd, "qd", o.nq()),
                                   c = vector_of(tau, "tau", o.nq());
             try {
-              return array_of(o.update(a.data(), b.data(), c.data(), dt));
+              return Eigen::VectorXd(o.update(a.data(), b.data(), c.data(), dt));
             } catch (const std::invalid_argument& e) {
               throw py::value_error(e.what());
             }
@@ -151,7 +140,7 @@ void bind_observer(py::module_& m) {
               py::gil_scoped_release release;
               r = observer::observe_log(o, log);
             }
-            return array_of(r);
+            return r;
           },
           py::arg("time"), py::arg("q"), py::arg("qd"), py::arg("tau"),
           "r at every sample of a log, (N, nq): reset at the first, stepped by the time stamps; a row repeating the "
