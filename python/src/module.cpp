@@ -15,6 +15,7 @@ void bind_results(py::module_& m);
 void bind_export(py::module_& m);
 void bind_diagnose(py::module_& m);
 void bind_observer(py::module_& m);
+void bind_payload(py::module_& m);
 
 }  // namespace symoro::python
 
@@ -42,4 +43,5 @@ PYBIND11_MODULE(_symoro, m) {
   symoro::python::bind_export(m);
   symoro::python::bind_diagnose(m);
   symoro::python::bind_observer(m);
+  symoro::python::bind_payload(m);
 }

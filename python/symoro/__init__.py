@@ -11,14 +11,15 @@
     gap = symoro.compare("study", "study-diagnosed", "gap")   # two studies on their held-out runs
     symoro.export_urdf(arm, "study-physical", "arm.urdf", prior="zero")  # consistent inertials
     obs = symoro.MomentumObserver(arm, study["phi"])          # collision detection (docs/observer.md)
+    tool = symoro.identify_payload(arm, study["phi"], ["tool-data"], full=symoro.models.crane_x7.full)
 
 See docs/python.md.
 """
 
 from ._symoro import (DataError, Model, MomentumObserver, StudyStopped, collision_events, compare, diagnose, export_urdf,
-                      identify, import_logs, observer_thresholds, predict)
+                      identify, identify_payload, import_logs, observer_thresholds, predict)
 from . import models
 from .models import load
 
 __all__ = ["DataError", "Model", "MomentumObserver", "StudyStopped", "collision_events", "compare", "diagnose",
-           "export_urdf", "identify", "import_logs", "load", "models", "observer_thresholds", "predict"]
+           "export_urdf", "identify", "identify_payload", "import_logs", "load", "models", "observer_thresholds", "predict"]

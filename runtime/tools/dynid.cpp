@@ -36,6 +36,7 @@ int main(int argc, char** argv) {
   add_export_commands(app, common);
   add_predict_commands(app, common);
   add_observer_commands(app, common);
+  add_payload_commands(app, common);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

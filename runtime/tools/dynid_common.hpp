@@ -98,6 +98,7 @@ void add_diagnose_commands(CLI::App& app, Common& common);
 void add_control_commands(CLI::App& app, Common& common);
 void add_import_commands(CLI::App& app, Common& common);
 void add_observer_commands(CLI::App& app, Common& common);
+void add_payload_commands(CLI::App& app, Common& common);
 void add_export_commands(CLI::App& app, Common& common);
 void add_predict_commands(CLI::App& app, Common& common);
 

@@ -109,6 +109,34 @@ run(2 out observer --robot ${WORK}/robots/ur5 --params ${WORK}/loaded-study/repo
     ${WORK}/contact-data -o ${WORK}/observer-gain --thresholds ${WORK}/observer-quiet/thresholds.yaml)
 expect("${out}" "made with other gains")
 
+# Payload identification on the robot never compiled (dynid payload): an export of the arm
+# carrying a 1.2 kg body (CoM [10, -20, 60] mm, inertia about it [4, 5, 3] 1e-3 kg m^2, Ixy
+# 0.4e-3, in the URDF tip link's frame) on top of the study's parameters: the mass within 2 %,
+# the CoM within 3 mm, the inertia within 15 %, in that frame; and the known-mass case.
+execute_process(COMMAND ${WRITE_EXPORT} ur5 ${WORK}/payload.csv 40 7 0 - 1.2,0.01,-0.02,0.06,0.004,0.005,0.003,0.0004,0,0
+                RESULT_VARIABLE code)
+if(NOT code EQUAL 0)
+  message(FATAL_ERROR "write_export ur5 (payload) failed")
+endif()
+run(0 out import --robot ${WORK}/robots/ur5 -o ${WORK}/payload-data ${WORK}/payload.csv ${columns})
+run(0 out payload --robot ${WORK}/robots/ur5 --params ${WORK}/loaded-study/report/parameters.yaml
+    ${WORK}/payload-data -o ${WORK}/payload)
+expect("${out}" "in the flange frame wrist_3_link")
+expect("${out}" "mass +1\\.(1[89]|2[0-2])[0-9]* kg")
+expect("${out}" "com +\\[ *([7-9]|1[0-2])\\.[0-9], -(1[7-9]|2[0-2])\\.[0-9], (5[7-9]|6[0-2])\\.[0-9]\\] mm")
+expect("${out}" "Ixx 0\\.00(3[4-9]|4[0-5])[0-9]* Iyy 0\\.00(4[3-9]|5[0-6])[0-9]* Izz 0\\.00(2[6-9]|3[0-4])")
+file(READ ${WORK}/payload/payload.urdf urdf)
+expect("${urdf}" "<parent link=\"wrist_3_link\"/>")
+file(READ ${WORK}/payload/payload.yaml yaml)
+expect("${yaml}" "ur: \"set_target_payload\\(1\\.")
+run(2 out payload --robot ${WORK}/robots/ur5 --params ${WORK}/loaded-study/report/parameters.yaml
+    ${WORK}/payload-data -o ${WORK}/payload)
+expect("${out}" "payload.yaml exists")
+run(0 out payload --robot ${WORK}/robots/ur5 --params ${WORK}/loaded-study/report/parameters.yaml --mass 1.2
+    ${WORK}/payload-data -o ${WORK}/payload-known)
+expect("${out}" "mass +1\\.2 kg \\(given\\)")
+expect("${out}" "com +\\[ *([7-9]|1[0-2])\\.[0-9], -(1[7-9]|2[0-2])\\.[0-9], (5[7-9]|6[0-2])\\.[0-9]\\] mm")
+
 # An edited robot folder is another library: a joint limit changed, the library is rebuilt.
 file(READ ${WORK}/robots/ur5/robot.yaml yaml)
 string(REPLACE "velocity: 3.15" "velocity: 3.0" yaml "${yaml}")

@@ -261,9 +261,13 @@ class Reader {
       field(s, "damping_ratio", "backlash",
             [&](const YAML::Node& v) { e.backlash_damping_ratio = positive(v, "backlash damping_ratio", true); });
     });
-    section("payload", {"mass", "com"}, e.payload, [&](const YAML::Node& s) {
+    section("payload", {"mass", "com", "inertia"}, e.payload, [&](const YAML::Node& s) {
       field(s, "mass", "payload", [&](const YAML::Node& v) { e.payload_mass = positive(v, "payload mass", true); });
       field(s, "com", "payload", [&](const YAML::Node& v) { e.payload_com = vector(v, "payload com", 3); });
+      if (s["inertia"].IsDefined()) {  // optional: without it, a point mass
+        const Eigen::VectorXd i = vector(s["inertia"], "payload inertia", 6);  // ixx ixy ixz iyy iyz izz
+        e.payload_inertia << i(0), i(1), i(2), i(1), i(3), i(4), i(2), i(4), i(5);
+      }
     });
     section("torque_constant_error", {"scale"}, e.torque_constant_error, [&](const YAML::Node& s) {
       field(s, "scale", "torque_constant_error", [&](const YAML::Node& v) {

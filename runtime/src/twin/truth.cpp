@@ -22,6 +22,7 @@ Truth make_truth(const robot::ModelHandle& model, const TwinConfig& c) {
     const int f = payload_frame(model);
     if (f == 0) throw DataError(c.path, 0, "payload: the model has no link with a mass parameter");
     add_point_mass(t.links[f - 1], c.effects.payload_mass, c.effects.payload_com);
+    t.links[f - 1].J += c.effects.payload_inertia;
   }
   const auto& names = model.standard_parameters();
   const Eigen::VectorXd zero = Eigen::VectorXd::Zero(n);

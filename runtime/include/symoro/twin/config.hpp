@@ -67,6 +67,8 @@ struct Effects {
   bool payload = false;
   double payload_mass = 0;
   Eigen::Vector3d payload_com = Eigen::Vector3d::Zero();
+  // kg m^2 about the payload's CoM, in the link's model frame (0: a point mass).
+  Eigen::Matrix3d payload_inertia = Eigen::Matrix3d::Zero();
   bool torque_constant_error = false;
   Eigen::VectorXd torque_constant_scale;
   // The torque lags the current the servo reports (and the controller assumes) by this time:

@@ -1,0 +1,134 @@
+// Payload identification from Python (docs/payload.md): symoro.identify_payload, as dynid
+// payload, returning the payload, its standard deviations and the controllers' forms as a dict.
+#include <cmath>
+#include <filesystem>
+#include <optional>
+#include <vector>
+
+#include <fmt/format.h>
+#include <pybind11/eigen.h>
+#include <pybind11/stl.h>
+#include <pybind11/stl/filesystem.h>
+
+#include "arrays.hpp"
+#include "symoro/io/dataset.hpp"
+#include "symoro/io/parameters_yaml.hpp"
+#include "symoro/payload/payload_formats.hpp"
+#include "symoro/payload/payload_identification.hpp"
+
+namespace symoro::python {
+
+std::shared_ptr<const identify::IdentificationModel> identification_of(py::handle model);
+std::optional<std::filesystem::path> robot_dir_of(py::handle model, const std::optional<std::filesystem::path>& given);
+
+namespace {
+
+Eigen::VectorXd phi_of(const identify::IdentificationModel& model, py::handle params) {
+  const identify::ModelDescription& d = model.description();
+  if (py::isinstance<py::str>(params) || py::hasattr(params, "__fspath__")) {
+    std::vector<std::string> names;
+    for (const auto& p : d.parameters) names.push_back(p.name);
+    return io::read_parameters_yaml(params.cast<std::filesystem::path>().string(), names);
+  }
+  const StateArg phi = state_arg(params, "params", d.np);
+  if (phi.batch) throw py::value_error(fmt::format("params: one vector of {} parameters expected", d.np));
+  return Eigen::Map<const Eigen::VectorXd>(phi.data(), d.np);
+}
+
+std::vector<io::Log> logs_of(const std::vector<std::filesystem::path>& inputs, const identify::ModelDescription& d,
+                             int trial) {
+  std::vector<io::Log> logs;
+  for (const auto& input : inputs) {
+    if (std::filesystem::is_directory(input)) {
+      const io::Dataset data = io::read_dataset(input);
+      io::check_dataset_robot(data, d.robot);
+      for (const auto& r : data.runs)
+        if (r.trial == trial) logs.push_back(io::read_run_log(r, d.robot, d.nq));
+    } else {
+      io::Log log = io::read_log(input);
+      io::check_log_robot(log, input, d.robot, d.nq);
+      logs.push_back(std::move(log));
+    }
+  }
+  if (logs.empty()) throw py::value_error(fmt::format("no run of trial {} in the inputs", trial));
+  return logs;
+}
+
+}  // namespace
+
+void bind_payload(py::module_& m) {
+  m.def(
+      "identify_payload",
+      [](py::handle model, py::handle params, const std::vector<std::filesystem::path>& inputs, py::handle full,
+         std::optional<double> mass, double interval_ms, double torque_delay_ms, int trial,
+         const std::optional<std::filesystem::path>& robot_dir_given) {
+        if (!(std::isfinite(interval_ms) && interval_ms >= 1 && interval_ms <= 10000))
+          throw py::value_error(fmt::format("interval_ms {}: must be from 1 to 10000", interval_ms));
+        if (!(std::isfinite(torque_delay_ms) && torque_delay_ms >= -1000 && torque_delay_ms <= 1000))
+          throw py::value_error(fmt::format("torque_delay_ms {}: must be from -1000 to 1000", torque_delay_ms));
+        if (mass && !(std::isfinite(*mass) && *mass > 0 && *mass <= 1e4))
+          throw py::value_error(fmt::format("mass {}: must be above 0 and at most 1e4 kg", *mass));
+        if (trial < 1) throw py::value_error(fmt::format("trial {}: must be 1 or more", trial));
+        const auto arm = identification_of(model);
+        const auto whole = full.is_none() ? arm : identification_of(full);
+        const identify::ModelDescription& d = arm->description();
+        if (!whole->description().variant.empty())
+          throw py::value_error(fmt::format(
+              "full: the payload's regressor is the robot's full model; give full=<robot>.full (the {} model is "
+              "a variant)",
+              whole->description().variant));
+        const Eigen::VectorXd phi = phi_of(*arm, params);
+        const std::vector<io::Log> logs = logs_of(inputs, d, trial);
+        payload::PayloadOptions o;
+        o.interval = interval_ms / 1000;
+        o.torque_delay = torque_delay_ms / 1000;
+        o.mass = mass;
+        const payload::PayloadLink link = payload::payload_link(*whole);
+        std::string flange = fmt::format("frame {}", link.link);
+        if (const auto dir = robot_dir_of(model, robot_dir_given))
+          flange = payload::robot_flange((*dir / "robot.yaml").string(), link.link, static_cast<int>(d.frames.size()),
+                                         o.flange_in_link);
+        payload::PayloadEstimate e;
+        {
+          py::gil_scoped_release release;
+          e = payload::identify_payload(logs, *arm, phi, *whole, o);
+        }
+        py::dict r;
+        r["mass"] = e.payload.mass;
+        r["com"] = Eigen::VectorXd(e.payload.com);
+        r["inertia"] = Eigen::MatrixXd(e.payload.inertia);
+        r["mass_std"] = e.mass_std;
+        r["com_std"] = Eigen::VectorXd(e.com_std);
+        r["inertia_std"] = Eigen::VectorXd(e.inertia_std);
+        r["flange"] = flange;
+        r["link"] = e.link;
+        r["standard"] = Eigen::VectorXd(e.standard);
+        r["least_squares"] = Eigen::VectorXd(e.least_squares);
+        r["covariance"] = Eigen::MatrixXd(e.covariance);
+        r["known_mass"] = e.known_mass;
+        r["projected"] = e.projected;
+        r["margin"] = e.margin;
+        r["status"] = e.status;
+        r["samples"] = e.samples;
+        r["lags"] = e.lags;
+        r["condition"] = e.condition;
+        r["rms_without"] = e.rms_without;
+        r["rms_with"] = e.rms_with;
+        r["urdf"] =
+            payload::payload_urdf(e.payload, flange.rfind("frame ", 0) == 0 ? "link" + std::to_string(e.link) : flange);
+        r["franka"] = payload::franka_load(e.payload);
+        r["ur"] = payload::ur_payload(e.payload);
+        r["kuka"] = payload::kuka_load(e.payload);
+        return r;
+      },
+      py::arg("model"), py::arg("params"), py::arg("inputs"), py::kw_only(), py::arg("full") = py::none(),
+      py::arg("mass") = py::none(), py::arg("interval_ms") = 10.0, py::arg("torque_delay_ms") = 0.0,
+      py::arg("trial") = 1, py::arg("robot_dir") = py::none(),
+      "A payload's 10 inertial parameters from logs (or datasets) of the arm carrying it, the arm's parameters "
+      "(params: an array or a parameters file of `model`) held: a dict of 'mass', 'com', 'inertia' (about the CoM) "
+      "in the flange frame 'flange', their '*_std', 'standard', 'covariance', 'projected', 'status', 'rms_without', "
+      "'rms_with', and the 'urdf', 'franka', 'ur' and 'kuka' forms. full: the robot's full model when `model` is a "
+      "variant; mass: a known mass (the other 9 identified). docs/payload.md");
+}
+
+}  // namespace symoro::python

@@ -1,0 +1,266 @@
+#include "symoro/payload/payload_identification.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+#include <Eigen/Cholesky>
+#include <Eigen/SVD>
+#include <fmt/format.h>
+
+#include "consistent_payload.hpp"
+#include "symoro/study/prediction.hpp"
+
+namespace symoro::payload {
+
+namespace {
+
+// The stacked payload regression of all logs: rows sample after sample, joint after joint.
+struct Stack {
+  Eigen::MatrixXd X;        // rows x 10
+  Eigen::VectorXd y;        // tau - ID(phi)
+  std::vector<int> log_of;  // per sample
+  int joints = 0, samples = 0;
+};
+
+Stack stack(const std::vector<io::Log>& logs, const identify::IdentificationModel& arm, const Eigen::VectorXd& phi,
+            const identify::IdentificationModel& full, const PayloadLink& link, const PayloadOptions& o) {
+  Stack s;
+  s.joints = arm.description().nq;
+  std::vector<Eigen::MatrixXd> Xs;
+  std::vector<Eigen::VectorXd> ys;
+  for (std::size_t i = 0; i < logs.size(); ++i) {
+    const study::Prediction p = study::predict(logs[i], arm, phi, {o.interval, o.torque_delay});
+    const Eigen::MatrixXd r = p.samples.tau - p.tau_model;
+    Xs.push_back(full.stack_regression(p.samples).W * link.map);
+    Eigen::VectorXd y(r.size());
+    for (Eigen::Index k = 0; k < r.rows(); ++k) y.segment(k * s.joints, s.joints) = r.row(k).transpose();
+    ys.push_back(std::move(y));
+    for (Eigen::Index k = 0; k < r.rows(); ++k) s.log_of.push_back(static_cast<int>(i));
+  }
+  s.samples = static_cast<int>(s.log_of.size());
+  s.X.resize(static_cast<Eigen::Index>(s.samples) * s.joints, kInertialParameters);
+  s.y.resize(s.X.rows());
+  Eigen::Index at = 0;
+  for (std::size_t i = 0; i < Xs.size(); ++i) {
+    s.X.middleRows(at, Xs[i].rows()) = Xs[i];
+    s.y.segment(at, ys[i].size()) = ys[i];
+    at += Xs[i].rows();
+  }
+  return s;
+}
+
+Eigen::VectorXd joint_rms(const Eigen::VectorXd& e, int joints) {
+  const Eigen::Map<const Eigen::MatrixXd> E(e.data(), joints, e.size() / joints);
+  return (E.rowwise().squaredNorm() / static_cast<double>(E.cols())).cwiseSqrt();
+}
+
+// Rows scaled by the joints' weights.
+Eigen::MatrixXd weighted(const Eigen::MatrixXd& A, const Eigen::VectorXd& w) {
+  Eigen::MatrixXd B = A;
+  const int n = static_cast<int>(w.size());
+  for (Eigen::Index r = 0; r < B.rows(); ++r) B.row(r) *= w(r % n);
+  return B;
+}
+
+// The lag past which the residual is uncorrelated: the first lag where its autocorrelation,
+// averaged over the joints, falls below 0.05, doubled (Bartlett's weights halve the lags' terms
+// near it); at most a tenth of the samples.
+int auto_lags(const Eigen::VectorXd& e, const std::vector<int>& log_of, int joints) {
+  const int N = static_cast<int>(log_of.size());
+  const Eigen::Map<const Eigen::MatrixXd> E(e.data(), joints, N);
+  const Eigen::VectorXd var = E.rowwise().squaredNorm();
+  const int most = std::max(1, N / 10);
+  for (int l = 1; l <= most; ++l) {
+    double rho = 0;
+    for (int j = 0; j < joints; ++j) {
+      if (!(var(j) > 0)) continue;
+      double c = 0;
+      for (int k = l; k < N; ++k)
+        if (log_of[static_cast<std::size_t>(k)] == log_of[static_cast<std::size_t>(k - l)]) c += E(j, k) * E(j, k - l);
+      rho += c / var(j) / joints;
+    }
+    if (rho < 0.05) return std::min(most, 2 * l);
+  }
+  return most;
+}
+
+// Newey-West: (X'X)^-1 S (X'X)^-1 with S the scores' long-run covariance (Bartlett weights),
+// lags within a log only.
+Eigen::MatrixXd hac_covariance(const Eigen::MatrixXd& X, const Eigen::VectorXd& e, const std::vector<int>& log_of,
+                               int joints, int lags) {
+  const int N = static_cast<int>(log_of.size()), r = static_cast<int>(X.cols());
+  Eigen::MatrixXd scores(r, N);
+  for (int k = 0; k < N; ++k)
+    scores.col(k) = X.middleRows(static_cast<Eigen::Index>(k) * joints, joints).transpose() *
+                    e.segment(static_cast<Eigen::Index>(k) * joints, joints);
+  Eigen::MatrixXd S = scores * scores.transpose();
+  for (int l = 1; l <= lags; ++l) {
+    const double w = 1 - static_cast<double>(l) / (lags + 1);
+    Eigen::MatrixXd G = Eigen::MatrixXd::Zero(r, r);
+    for (int k = l; k < N; ++k)
+      if (log_of[static_cast<std::size_t>(k)] == log_of[static_cast<std::size_t>(k - l)])
+        G.noalias() += scores.col(k) * scores.col(k - l).transpose();
+    S += w * (G + G.transpose());
+  }
+  const Eigen::MatrixXd B = X.transpose() * X;
+  const Eigen::MatrixXd Bi = B.ldlt().solve(Eigen::MatrixXd::Identity(r, r));
+  return Bi * S * Bi;
+}
+
+// The reported numbers of a standard vector: mass, CoM (3), inertia about the CoM (6).
+Eigen::Matrix<double, 10, 1> reported(const StandardVector& s, const Eigen::Isometry3d& F_in_L) {
+  const PayloadInertial p = PayloadInertial::from_standard(s, F_in_L);
+  Eigen::Matrix<double, 10, 1> v;
+  v << p.mass, p.com, p.inertia(0, 0), p.inertia(1, 1), p.inertia(2, 2), p.inertia(0, 1), p.inertia(0, 2),
+      p.inertia(1, 2);
+  return v;
+}
+
+// Their standard deviations by the delta method (central differences, steps of each
+// parameter's own standard deviation / 1000).
+Eigen::Matrix<double, 10, 1> reported_std(const StandardVector& s, const Eigen::MatrixXd& C,
+                                          const Eigen::Isometry3d& F_in_L) {
+  Eigen::Matrix<double, 10, 10> D = Eigen::Matrix<double, 10, 10>::Zero();
+  for (int i = 0; i < kInertialParameters; ++i) {
+    const double h = std::sqrt(std::max(C(i, i), 0.0)) * 1e-3;
+    if (!(h > 0)) continue;
+    StandardVector a = s, b = s;
+    a(i) += h;
+    b(i) -= h;
+    D.col(i) = (reported(a, F_in_L) - reported(b, F_in_L)) / (2 * h);
+  }
+  return (D * C * D.transpose()).diagonal().cwiseMax(0).cwiseSqrt();
+}
+
+// The parameter the weakest direction of the scaled regressor leans on most, for the message.
+std::string weakest(const Eigen::MatrixXd& Xs, const std::vector<int>& columns) {
+  const Eigen::JacobiSVD<Eigen::MatrixXd> svd(Xs, Eigen::ComputeThinV);
+  const Eigen::VectorXd v = svd.matrixV().col(Xs.cols() - 1);
+  std::string out;
+  for (Eigen::Index i = 0; i < v.size(); ++i)
+    if (std::abs(v(i)) > 0.3)
+      out += fmt::format("{}{:+.2f} {}", out.empty() ? "" : " ", v(i),
+                         payload_standard_names()[static_cast<std::size_t>(columns[static_cast<std::size_t>(i)])]);
+  return out;
+}
+
+}  // namespace
+
+PayloadLink payload_link(const identify::IdentificationModel& model) {
+  const auto& d = model.description();
+  PayloadLink out;
+  for (const auto& p : d.standard)
+    if (std::string(p.family) == "M") out.link = std::max(out.link, p.joint);
+  if (out.link == 0) throw std::invalid_argument(d.robot + ": the model has no link with a mass parameter");
+  const auto& names = payload_standard_names();
+  const int ns = static_cast<int>(d.standard.size());
+  const Eigen::VectorXd zero = model.base_from_standard(Eigen::VectorXd::Zero(ns));
+  out.map = Eigen::MatrixXd::Zero(d.np, kInertialParameters);
+  for (int c = 0; c < kInertialParameters; ++c)
+    for (int k = 0; k < ns; ++k) {
+      const auto& p = d.standard[static_cast<std::size_t>(k)];
+      if (p.joint != out.link || std::string(p.family) != names[static_cast<std::size_t>(c)]) continue;
+      Eigen::VectorXd unit = Eigen::VectorXd::Zero(ns);
+      unit(k) = 1;
+      out.map.col(c) = model.base_from_standard(unit) - zero;
+    }
+  return out;
+}
+
+PayloadEstimate identify_payload(const std::vector<io::Log>& logs, const identify::IdentificationModel& arm,
+                                 const Eigen::VectorXd& phi, const identify::IdentificationModel& full,
+                                 const PayloadOptions& o) {
+  if (logs.empty()) throw std::invalid_argument("identify_payload: no logs");
+  if (arm.description().nq != full.description().nq || arm.description().robot != full.description().robot)
+    throw std::invalid_argument("identify_payload: the arm's model and the full model are of different robots");
+  if (phi.size() != arm.description().np)
+    throw std::invalid_argument(
+        fmt::format("identify_payload: {} parameters for a model of {}", phi.size(), arm.description().np));
+  if (o.mass && !(*o.mass > 0 && std::isfinite(*o.mass)))
+    throw std::invalid_argument(fmt::format("identify_payload: a known mass must be positive, not {}", *o.mass));
+  const PayloadLink link = payload_link(full);
+  const Stack s = stack(logs, arm, phi, full, link, o);
+  const int n = s.joints;
+
+  // The free columns (all 10, or 9 with a known mass taken to the left side).
+  std::vector<int> free;
+  for (int c = 0; c < kInertialParameters; ++c)
+    if (!(o.mass && c == 9)) free.push_back(c);
+  const int r = static_cast<int>(free.size());
+  Eigen::MatrixXd X(s.X.rows(), r);
+  for (int i = 0; i < r; ++i) X.col(i) = s.X.col(free[static_cast<std::size_t>(i)]);
+  Eigen::VectorXd y = s.y;
+  if (o.mass) y -= s.X.col(9) * *o.mass;
+  if (X.rows() < 2 * r) throw std::invalid_argument("identify_payload: too few samples");
+
+  PayloadEstimate out;
+  out.link = link.link;
+  out.samples = s.samples;
+  out.known_mass = o.mass.has_value();
+  out.rms_without = joint_rms(s.y, n);
+
+  // Weighted least squares, the weights re-estimated from the residual.
+  Eigen::VectorXd w = Eigen::VectorXd::Ones(n), beta;
+  for (int it = 0; it <= o.wls_iterations; ++it) {
+    const Eigen::MatrixXd Xw = weighted(X, w);
+    const Eigen::VectorXd norms = Xw.colwise().norm();
+    for (int i = 0; i < r; ++i)
+      if (!(norms(i) > 0))
+        throw std::invalid_argument(fmt::format("the logs do not excite the payload's {}: its column is zero",
+                                                payload_standard_names()[static_cast<std::size_t>(free[i])]));
+    const Eigen::MatrixXd Xs = Xw * norms.cwiseInverse().asDiagonal();
+    const Eigen::JacobiSVD<Eigen::MatrixXd> svd(Xs, Eigen::ComputeThinU | Eigen::ComputeThinV);
+    const Eigen::VectorXd sv = svd.singularValues();
+    out.condition = sv(0) / sv(r - 1);
+    if (!(out.condition < 1e8))
+      throw std::invalid_argument(fmt::format(
+          "the logs do not excite the payload's parameters (scaled condition number {:.3g}): the weakest combination "
+          "is {}; move the wrist joints more (dynid excite --payload)",
+          out.condition, weakest(Xs, free)));
+    beta = norms.cwiseInverse().asDiagonal() * svd.solve(weighted(y, w));
+    if (it == o.wls_iterations) break;
+    const Eigen::VectorXd rms = joint_rms(y - X * beta, n);
+    for (int j = 0; j < n; ++j) w(j) = rms(j) > 0 ? 1 / rms(j) : 1;
+  }
+  out.weights = w;
+
+  // The covariance, the residual's autocorrelation counted.
+  const Eigen::MatrixXd Xw = weighted(X, w);
+  const Eigen::VectorXd ew = weighted(y - X * beta, w);
+  out.lags = o.lags >= 0 ? o.lags : auto_lags(ew, s.log_of, n);
+  const Eigen::MatrixXd C = hac_covariance(Xw, ew, s.log_of, n, out.lags);
+  out.least_squares.setZero();
+  out.covariance.setZero();
+  for (int i = 0; i < r; ++i) {
+    out.least_squares(free[static_cast<std::size_t>(i)]) = beta(i);
+    for (int k = 0; k < r; ++k)
+      out.covariance(free[static_cast<std::size_t>(i)], free[static_cast<std::size_t>(k)]) = C(i, k);
+  }
+  if (o.mass) out.least_squares(9) = *o.mass;
+
+  // A body: the estimate, or the nearest one in the covariance's metric.
+  out.standard = out.least_squares;
+  if (!(consistency_margin(out.least_squares) > 1e-12) || !(out.least_squares(9) > 0)) {
+    const ConsistentPayload c = nearest_body(out.least_squares, out.covariance, o.mass.has_value());
+    out.standard = c.standard;
+    out.distance = c.distance;
+    out.projected = true;
+    out.status = "the least-squares estimate is no body (" + c.why +
+                 "); the nearest body in its covariance's "
+                 "metric is reported";
+  } else {
+    out.status = "the least-squares estimate is a body (positive definite pseudo-inertia)";
+  }
+  out.margin = consistency_margin(out.standard);
+
+  out.payload = PayloadInertial::from_standard(out.standard, o.flange_in_link);
+  const Eigen::Matrix<double, 10, 1> sd = reported_std(out.standard, out.covariance, o.flange_in_link);
+  out.mass_std = o.mass ? 0.0 : sd(0);
+  out.com_std = sd.segment<3>(1);
+  out.inertia_std = sd.segment<6>(4);
+  out.rms_with = joint_rms(s.y - s.X * out.standard, n);
+  return out;
+}
+
+}  // namespace symoro::payload

@@ -1,0 +1,316 @@
+// Payload identification (symoro/payload/): the inertial conversions against hand-derived
+// values; and the payload's 10 parameters from a 20 s wrist motion on top of a known arm, on the
+// project's twin (CRANE-X7 carrying a payload from twin.yaml's payload effect, at the paper's
+// noise, jitter, dropped samples and a 2 ms actuation delay identification is not told of) and
+// on the independent arm (independent_arm.hpp: its own integrator, loop and sensors; an RX-90
+// with a 5 kg tool, the arm identified first from its own runs without the tool).
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+#include <symoro/crane_x7.hpp>
+#include <symoro/rx90.hpp>
+
+#include "independent_arm.hpp"
+#include "independent_rx90.hpp"
+#include "symoro/identify/identification_model.hpp"
+#include "symoro/identify/least_squares.hpp"
+#include "symoro/payload/payload_formats.hpp"
+#include "symoro/payload/payload_identification.hpp"
+#include "symoro/preprocess/preprocess.hpp"
+#include "symoro/robot/compiled_model.hpp"
+#include "symoro/study/options.hpp"
+#include "symoro/twin/simulator.hpp"
+
+namespace {
+
+using namespace symoro;
+using Crane = crane_x7::Model;
+using Rx = rx90::Model;
+
+// A rigid box of sides a, b, c (x, y, z) about its centre: m / 12 (b^2 + c^2), ...
+Eigen::Matrix3d box(double m, double a, double b, double c) {
+  return Eigen::Vector3d(b * b + c * c, a * a + c * c, a * a + b * b).asDiagonal() * (m / 12);
+}
+
+TEST(PayloadInertial, StandardParametersOfABoxAboutAnotherFrameAreTheHandDerivedOnes) {
+  payload::PayloadInertial p;
+  p.mass = 2;
+  p.com = {0.01, -0.02, 0.05};
+  p.inertia = box(2, 0.1, 0.2, 0.3);
+  // F sits 0.1 m along L's z, turned a quarter turn about z: x_F = y_L.
+  Eigen::Isometry3d F = Eigen::Isometry3d::Identity();
+  F.translation() = Eigen::Vector3d(0, 0, 0.1);
+  F.linear() = Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  const payload::StandardVector s = p.standard(F);
+  // In L: c = (0.02, 0.01, 0.15); the box's x and y swap. XX = Ic_yy(F) + m (cy^2 + cz^2).
+  const double cx = 0.02, cy = 0.01, cz = 0.15;
+  EXPECT_NEAR(s(0), 2.0 / 12 * (0.01 + 0.09) + 2 * (cy * cy + cz * cz), 1e-15);
+  EXPECT_NEAR(s(3), 2.0 / 12 * (0.04 + 0.09) + 2 * (cx * cx + cz * cz), 1e-15);
+  EXPECT_NEAR(s(5), 2.0 / 12 * (0.01 + 0.04) + 2 * (cx * cx + cy * cy), 1e-15);
+  EXPECT_NEAR(s(1), -2 * cx * cy, 1e-15);  // XY: the tensor's entry, -m cx cy
+  EXPECT_NEAR(s(2), -2 * cx * cz, 1e-15);
+  EXPECT_NEAR(s(6), 2 * cx, 1e-15);
+  EXPECT_NEAR(s(8), 2 * cz, 1e-15);
+  EXPECT_EQ(s(9), 2);
+  const payload::PayloadInertial back = payload::PayloadInertial::from_standard(s, F);
+  EXPECT_LT((back.com - p.com).norm(), 1e-15);
+  EXPECT_LT((back.inertia - p.inertia).norm(), 1e-15);
+  // A box is a body; so is its pseudo-inertia's standard vector; a rod thinner than nothing is not.
+  EXPECT_GT(payload::consistency_margin(s), 0);
+  EXPECT_LT((payload::standard_of_pseudo_inertia(payload::pseudo_inertia(s)) - s).norm(), 1e-15);
+  payload::PayloadInertial bad = p;
+  bad.inertia(2, 2) = bad.inertia(0, 0) + bad.inertia(1, 1) + 1e-3;  // breaks the triangle inequality
+  EXPECT_LT(payload::consistency_margin(bad.standard()), 0);
+}
+
+TEST(PayloadFormats, ControllersTakeTheSameBody) {
+  payload::PayloadInertial p;
+  p.mass = 1.5;
+  p.com = {0.01, 0.02, 0.08};
+  const Eigen::Matrix3d R =
+      (Eigen::AngleAxisd(0.3, Eigen::Vector3d::UnitZ()) * Eigen::AngleAxisd(-0.2, Eigen::Vector3d::UnitY()) *
+       Eigen::AngleAxisd(0.1, Eigen::Vector3d::UnitX()))
+          .toRotationMatrix();
+  p.inertia = R * box(1.5, 0.05, 0.08, 0.12) * R.transpose();
+  // KUKA: principal moments about the axes A B C turn the flange's into (Z, then Y, then X).
+  const payload::PrincipalLoad l = payload::principal_load(p.inertia);
+  const double d = M_PI / 180;
+  const Eigen::Matrix3d Rabc = (Eigen::AngleAxisd(l.abc(0) * d, Eigen::Vector3d::UnitZ()) *
+                                Eigen::AngleAxisd(l.abc(1) * d, Eigen::Vector3d::UnitY()) *
+                                Eigen::AngleAxisd(l.abc(2) * d, Eigen::Vector3d::UnitX()))
+                                   .toRotationMatrix();
+  EXPECT_LT((Rabc * l.moments.asDiagonal() * Rabc.transpose() - p.inertia).norm(), 1e-12);
+  // The box's own axes are those nearest the flange's: the angles are the ones it was turned by.
+  EXPECT_NEAR(l.abc(0), 0.3 / d, 1e-9);
+  EXPECT_NEAR(l.abc(1), -0.2 / d, 1e-9);
+  EXPECT_NEAR(l.abc(2), 0.1 / d, 1e-9);
+  EXPECT_NE(payload::kuka_load(p).find("{M 1.5,CM {X 10,Y 20,Z 80,A 17.1887,B -11.4592,C 5.72958},J {X "),
+            std::string::npos)
+      << payload::kuka_load(p);
+  // Franka: the inertia column-major; UR: Ixx Iyy Izz Ixy Ixz Iyz.
+  const std::string franka = payload::franka_load(p), ur = payload::ur_payload(p);
+  EXPECT_NE(franka.find("F_x_Cload: [0.01, 0.02, 0.08]"), std::string::npos) << franka;
+  EXPECT_NE(ur.find("set_target_payload(1.5, [0.01, 0.02, 0.08], ["), std::string::npos) << ur;
+  // payload.yaml reads back to the same body.
+  payload::PayloadEstimate e;
+  e.payload = p;
+  e.standard = p.standard();
+  e.rms_without = e.rms_with = Eigen::VectorXd::Zero(2);
+  const auto file = std::filesystem::temp_directory_path() / "payload_roundtrip.yaml";
+  std::ofstream(file) << payload::payload_yaml(e, {"crane_x7", "full", "p.yaml", "frame 7", {}, "a log"});
+  const payload::PayloadFile back = payload::read_payload_yaml(file.string());
+  std::filesystem::remove(file);
+  EXPECT_EQ(back.payload.mass, p.mass);
+  EXPECT_LT((back.payload.com - p.com).norm(), 1e-15);
+  EXPECT_LT((back.payload.inertia - p.inertia).norm(), 1e-15);
+}
+
+// The wrist moves, the rest holds `pose`: on each of `count` joints from index `first`, three
+// sines (0.23, 0.61, 1.13 Hz x a joint factor) of `amplitude` rad in all, faded in and out over 1 s.
+trajectory::SampledReference wrist_reference(const Eigen::VectorXd& pose, int first, int count, double amplitude,
+                                             double seconds) {
+  const int n = static_cast<int>(pose.size());
+  trajectory::SampledReference ref;
+  ref.name = "wrist";
+  ref.period = 0.001;
+  const int K = static_cast<int>(seconds / ref.period) + 1;
+  ref.q = pose.replicate(1, K);
+  ref.qd = ref.qdd = Eigen::MatrixXd::Zero(n, K);
+  const double f[3] = {0.23, 0.61, 1.13}, fade = 1.0;
+  for (int k = 0; k < K; ++k) {
+    const double t = k * ref.period, left = seconds - t;
+    // s(t) = sin^2 (pi t / 2 fade) at either end, 1 between: q, qd, qdd by the product rule.
+    double s = 1, sd = 0, sdd = 0;
+    const double edge = std::min(t, left), sign = t < left ? 1 : -1, w = M_PI / (2 * fade);
+    if (edge < fade) {
+      s = std::pow(std::sin(w * edge), 2);
+      sd = sign * w * std::sin(2 * w * edge);
+      sdd = 2 * w * w * std::cos(2 * w * edge);
+    }
+    for (int m = 0; m < count; ++m) {
+      const int j = first + m;
+      double g = 0, gd = 0, gdd = 0;
+      for (int h = 0; h < 3; ++h) {
+        const double om = 2 * M_PI * f[h] * (1 + 0.17 * m), a = amplitude / 3, ph = 0.7 * h + 1.3 * m;
+        g += a * std::sin(om * t + ph);
+        gd += a * om * std::cos(om * t + ph);
+        gdd -= a * om * om * std::sin(om * t + ph);
+      }
+      ref.q(j, k) = pose(j) + s * g;
+      ref.qd(j, k) = sd * g + s * gd;
+      ref.qdd(j, k) = sdd * g + 2 * sd * gd + s * gdd;
+    }
+  }
+  return ref;
+}
+
+struct Errors {
+  double mass, com, inertia;  // relative, m, relative (Frobenius)
+};
+
+Errors errors(const payload::PayloadInertial& e, const payload::PayloadInertial& truth) {
+  return {std::abs(e.mass - truth.mass) / truth.mass, (e.com - truth.com).norm(),
+          (e.inertia - truth.inertia).norm() / truth.inertia.norm()};
+}
+
+void report(const char* what, const payload::PayloadEstimate& e, const Errors& err) {
+  std::printf(
+      "%s: mass %.4f kg (sd %.4f), com [%.4f %.4f %.4f] m, inertia diag [%.3g %.3g %.3g]: errors mass "
+      "%.2f %%, com %.2f mm, inertia %.1f %%; lags %d, condition %.3g, projected %d\n",
+      what, e.payload.mass, e.mass_std, e.payload.com.x(), e.payload.com.y(), e.payload.com.z(),
+      e.payload.inertia(0, 0), e.payload.inertia(1, 1), e.payload.inertia(2, 2), 100 * err.mass, 1000 * err.com,
+      100 * err.inertia, e.lags, e.condition, e.projected ? 1 : 0);
+}
+
+TEST(PayloadIdentification, TheTwinsUndeclaredPayloadFromA20sWristMotion) {
+  const std::string dir = std::string(SYMORO_ROBOTS_DIR) + "/crane_x7";
+  const auto override_file = std::filesystem::temp_directory_path() / "payload_twin.yaml";
+  // A 0.35 kg body (about a 6 x 4 x 10 cm box) off the flange's axis, its inertia turned about
+  // z, at twin.yaml's noise, jitter, dropped samples and bus delay.
+  std::ofstream(override_file) << "effects:\n  payload: {enabled: true, mass: 0.35, com: [0.012, -0.008, 0.06], "
+                                  "inertia: [1.7e-4, 2.0e-5, 0, 2.0e-4, 0, 1.5e-4]}\n";
+  const twin::TwinConfig with = twin::read_twin_config(dir + "/twin.yaml", Crane::nq, override_file);
+  std::filesystem::remove(override_file);
+  twin::TwinConfig without = with;
+  without.effects.payload = false;
+  payload::PayloadInertial truth;
+  truth.mass = 0.35;
+  truth.com = {0.012, -0.008, 0.06};
+  truth.inertia << 1.7e-4, 2.0e-5, 0, 2.0e-5, 2.0e-4, 0, 0, 0, 1.5e-4;
+
+  // The arm as identification knows it (the full model's parameters of the twin without payload).
+  const robot::ModelHandle& handle = robot::compiled_model<Crane>();
+  const Eigen::VectorXd phi = twin::identified_truth(handle, without);
+  Eigen::VectorXd pose(Crane::nq);
+  pose << 0.3, 0.6, 0, -1.4, 0, 0, 0, 0;
+  twin::RunOptions o;
+  o.robot = "crane_x7";
+  o.seed = 41;
+  // Joints 5-7 move (joint 8, the hand, carries nothing).
+  const trajectory::SampledReference ref = wrist_reference(pose, 4, 3, 1.2, 20);
+  const io::Log log = twin::ClosedLoopTwin(handle, with).run(ref, o);
+  const auto model = identify::identification_model<Crane>();
+  const payload::PayloadEstimate e = payload::identify_payload({log}, *model, phi, *model);
+  const Errors err = errors(e.payload, truth);
+  report("crane_x7 twin", e, err);
+  EXPECT_EQ(e.link, 7);
+  EXPECT_LT(err.mass, 0.02);
+  EXPECT_LT(err.com, 0.003);
+  EXPECT_LT(err.inertia, 0.15);
+  EXPECT_GT(e.margin, 0);
+  // The payload explains the residual the arm alone leaves.
+  for (int j = 0; j < 7; ++j) EXPECT_LT(e.rms_with(j), e.rms_without(j)) << "joint " << j + 1;
+
+  payload::PayloadOptions known;
+  known.mass = truth.mass;
+  const payload::PayloadEstimate k = payload::identify_payload({log}, *model, phi, *model, known);
+  const Errors kerr = errors(k.payload, truth);
+  report("crane_x7 twin, known mass", k, kerr);
+  EXPECT_EQ(k.payload.mass, truth.mass);
+  EXPECT_LT(kerr.com, err.com);
+  EXPECT_LT(kerr.inertia, 0.15);
+
+  // A 2 ms actuation delay (the logged current leads the torque): the inertia about the CoM, a
+  // small difference of large terms, takes it (about 40 % off) unless the payload's fit is given
+  // the delay, as the arm's identification is (--torque-delay).
+  twin::TwinConfig delayed = with;
+  delayed.effects.actuation_delay = true;
+  delayed.effects.actuation_delay_time = 0.002;
+  const io::Log late = twin::ClosedLoopTwin(handle, delayed).run(ref, o);
+  const Errors blind = errors(payload::identify_payload({late}, *model, phi, *model).payload, truth);
+  payload::PayloadOptions told;
+  told.torque_delay = -0.002;
+  const payload::PayloadEstimate d = payload::identify_payload({late}, *model, phi, *model, told);
+  const Errors derr = errors(d.payload, truth);
+  report("crane_x7 twin, 2 ms actuation delay given", d, derr);
+  EXPECT_GT(blind.inertia, 0.3);
+  EXPECT_LT(derr.mass, 0.02);
+  EXPECT_LT(derr.com, 0.003);
+  EXPECT_LT(derr.inertia, 0.15);
+}
+
+TEST(PayloadIdentification, AnIndependentRx90sToolOnAnArmIdentifiedWithoutIt) {
+  // The RX-90 of independent_rx90.hpp; the tool a 5 kg body 0.1 m out along the flange's z,
+  // hung on the last link's chain as any link's inertial (the independent arm takes no effects).
+  twin::TwinConfig arm = test::rx90_twin();
+  payload::PayloadInertial truth;
+  truth.mass = 5;
+  truth.com = {0.02, -0.015, 0.1};
+  const Eigen::Matrix3d R = Eigen::AngleAxisd(0.4, Eigen::Vector3d::UnitX()).toRotationMatrix();
+  truth.inertia = R * box(5, 0.12, 0.08, 0.2) * R.transpose();
+  twin::TwinConfig tool = arm;
+  twin::UrdfInertial body;
+  body.name = "tool";
+  body.on = tool.chain.joints.back().name;
+  body.mass = truth.mass;
+  body.com = truth.com;
+  body.inertia = truth.inertia;
+  tool.chain.inertials.push_back(body);
+
+  // The arm identified first (OLS on its full model) from two runs of all joints without the tool.
+  const auto model = identify::identification_model<Rx>();
+  test::IndependentArmOptions io;
+  identify::Regression all;
+  all.joints = Rx::nq;
+  for (unsigned seed : {61u, 62u}) {
+    io.seed = seed;
+    const io::Log log = test::run_independent_arm<Rx>(arm, test::rx90_reference("arm", 20, seed), io);
+    const preprocess::Samples s = preprocess::preprocess(log, 0.010, study::StudyOptions{}.preprocess);
+    const identify::Regression r = model->stack_regression(s);
+    all.W.conservativeResize(all.W.rows() + r.W.rows(), r.W.cols());
+    all.W.bottomRows(r.W.rows()) = r.W;
+    all.y.conservativeResize(all.y.size() + r.y.size());
+    all.y.tail(r.y.size()) = r.y;
+    all.samples += r.samples;
+  }
+  const Eigen::VectorXd phi = identify::least_squares(all, {true}).phi;
+
+  // The tool on, 20 s of the wrist (joints 4-6) at a pose where the shoulder holds it.
+  Eigen::VectorXd pose(Rx::nq);
+  pose << 0.2, -0.5, 0.8, 0, 0, 0;
+  io.seed = 63;
+  const io::Log log = test::run_independent_arm<Rx>(tool, wrist_reference(pose, 3, 3, 1.5, 20), io);
+  const payload::PayloadEstimate e = payload::identify_payload({log}, *model, phi, *model);
+  const Errors err = errors(e.payload, truth);
+  report("rx90 independent", e, err);
+  EXPECT_EQ(e.link, 6);
+  EXPECT_LT(err.mass, 0.02);
+  EXPECT_LT(err.com, 0.003);
+  EXPECT_LT(err.inertia, 0.15);
+  // Its standard deviations are of the error's size, not far below it (the residual's
+  // autocorrelation counted): within 4 of them.
+  EXPECT_LT(std::abs(e.payload.mass - truth.mass), 4 * e.mass_std + 1e-3 * truth.mass);
+  payload::PayloadOptions known;
+  known.mass = truth.mass;
+  const payload::PayloadEstimate k = payload::identify_payload({log}, *model, phi, *model, known);
+  const Errors kerr = errors(k.payload, truth);
+  report("rx90 independent, known mass", k, kerr);
+  EXPECT_LT(kerr.com, 0.003);
+  EXPECT_LT(kerr.inertia, 0.15);
+
+  // A point mass (no inertia about its CoM: the pseudo-inertia on the cone's edge): the noisy
+  // least-squares estimate is no body, and the nearest body is reported, with the same mass and
+  // CoM and a positive semidefinite pseudo-inertia.
+  twin::TwinConfig point = arm;
+  body.mass = 2;
+  body.com = Eigen::Vector3d(0.03, 0, 0.12);
+  body.inertia.setZero();
+  point.chain.inertials.push_back(body);
+  io.seed = 64;
+  const io::Log plog = test::run_independent_arm<Rx>(point, wrist_reference(pose, 3, 3, 1.5, 20), io);
+  const payload::PayloadEstimate pe = payload::identify_payload({plog}, *model, phi, *model);
+  std::printf("point mass: projected %d (distance %.3g), margin %.3g, ls margin %.3g, mass %.5f, com %.5f %.5f %.5f\n",
+              pe.projected, pe.distance, pe.margin, payload::consistency_margin(pe.least_squares), pe.payload.mass,
+              pe.payload.com.x(), pe.payload.com.y(), pe.payload.com.z());
+  EXPECT_TRUE(pe.projected);
+  EXPECT_LT(payload::consistency_margin(pe.least_squares), 0);
+  EXPECT_GE(pe.margin, -1e-12);
+  EXPECT_LT(std::abs(pe.payload.mass - 2) / 2, 0.02);
+  EXPECT_LT((pe.payload.com - body.com).norm(), 0.003);
+}
+
+}  // namespace
