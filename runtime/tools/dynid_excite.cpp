@@ -15,6 +15,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include "dynid_excite_choice.hpp"
+#include "dynid_excite_payload.hpp"
 #include "dynid_identify.hpp"
 #include "dynid_robots.hpp"
 #include "dynid_numbers.hpp"
@@ -55,6 +56,9 @@ struct ExciteOptions {
   std::vector<std::string> half_spaces;  // "frame:nx,ny,nz:offset"
   double interval_ms = 10;
   std::vector<std::string> compare;  // logs of reference motions rated beside the design
+  bool payload = false;              // one wrist motion D-optimal for a payload (PL01)
+  int payload_joints = 3;
+  PayloadExcitation wrist;  // with payload: which joints move, the parameter map
 };
 
 std::vector<double> numbers_of(const std::string& text, char sep, const std::string& what) {
@@ -150,6 +154,8 @@ excitation::ExcitationDesignOptions design_options(const ExciteOptions& options,
   }
   eo.workspace = half_spaces(options, d);
   eo.starts = options.starts;
+  eo.held = options.wrist.held;
+  eo.parameter_map = options.wrist.map;
   return eo;
 }
 
@@ -230,7 +236,7 @@ struct SeriesDesigner {
     for (std::size_t tries = 0; tries < postures.size() && out.posture.empty(); ++tries, ++next) {
       const std::string candidate = postures[next % postures.size()];
       out.eo = design_options(o, rung, design, candidate, lower, upper, velocity, acceleration, nominal, d);
-      out.eo.name = fmt::format("OF{:02d}", k + 1);
+      out.eo.name = fmt::format("{}{:02d}", o.payload ? "PL" : "OF", k + 1);
       out.eo.seed = o.seed + static_cast<std::uint64_t>(k);
       try {
         out.r = excitation::design_excitation(model, out.eo);
@@ -246,9 +252,10 @@ struct SeriesDesigner {
   std::string yaml_of(const Series& s) const {
     return "\n" + trajectory::fourier_trajectory_yaml(
                       s.eo.name, s.posture, s.r.trajectory, o.periods,
-                      fmt::format("Optimized (D-optimal) from rest at {}: log det {:.4g}, period "
+                      fmt::format("Optimized (D-optimal{}) from rest at {}: log det {:.4g}, period "
                                   "{:.3g} s, {} harmonics",
-                                  s.posture, s.r.criterion, s.rung.period, s.rung.harmonics));
+                                  o.payload ? " for a payload's 10 parameters" : "", s.posture, s.r.criterion,
+                                  s.rung.period, s.rung.harmonics));
   }
 
   // The other passed starts in order of log det: the first that meets the targets replaces the
@@ -395,8 +402,14 @@ std::string optimized_series(const Common& common, SeriesDesigner& sd, const std
   return out;
 }
 
-void run(const Common& common, const ExciteOptions& options) {
-  const auto model = identification_model(common, options.model);
+void run(const Common& common, const ExciteOptions& given, bool periods_given) {
+  ExciteOptions options = given;
+  const auto model = identification_model(common, options.payload ? "full" : options.model);
+  if (options.payload) {
+    options.wrist = payload_setup(*model, options.model, options.payload_joints, options.period, options.harmonics,
+                                  options.harmonics_given, options.periods, periods_given);
+    options.optimized = 1;
+  }
   const identify::ModelDescription& d = model->description();
   const int n = d.nq;
   const fs::path design_file = fs::path(options.out) / "trajectories.yaml";
@@ -439,6 +452,7 @@ void run(const Common& common, const ExciteOptions& options) {
   }
   Eigen::VectorXd velocity, acceleration;
   fastest_level(design, n, velocity, acceleration);
+  wrist_limits(options.wrist, d, velocity, acceleration);
   const double margin = design["limits"]["position_margin"].as<double>() * kDeg;
   so.position_margin = margin;
   Eigen::VectorXd lower, upper;
@@ -472,6 +486,8 @@ void run(const Common& common, const ExciteOptions& options) {
   const std::string optimized_text = optimized_series(common, designer, nominal_from, failure);
   if (options.optimized > 0 && text.find("\ntrajectories:") == std::string::npos)
     throw UsageError("the design has no trajectories list");
+  // A payload's design holds its wrist motion alone.
+  if (options.payload) text = text.substr(0, text.find("\ntrajectories:") + 1) + "trajectories:\n";
   const std::string full = text + (text.empty() || text.back() == '\n' ? "" : "\n") + optimized_text;
   // Read back before it is kept: the file must build, every trajectory inside its limits.
   const fs::path tmp = fs::path(options.out) / "trajectories.yaml.new";
@@ -488,8 +504,12 @@ void run(const Common& common, const ExciteOptions& options) {
   fmt::print("{}: {} trajectories\n", design_file.string(), all.size());
   warn_crossings(all, half_spaces(options, d), d);
 
-  // 4. The excitation quality of each, side by side.
-  const std::string table = trajectory_quality_table(common, all, to, options.model);
+  // 4. The excitation quality of each, side by side (a payload's: of its 10 parameters).
+  std::string table;
+  if (options.payload)
+    for (const auto& t : all) table += payload_quality(*model, options.wrist, t, to);
+  else
+    table = trajectory_quality_table(common, all, to, options.model);
   fmt::print("{}", table);
   io::write_file_atomically(fs::path(options.out) / "quality.txt", table);
   if (!failure.empty())
@@ -536,9 +556,9 @@ void add_excite_commands(CLI::App& app, Common& common) {
                   "Longest optimized trajectory, holds included, s, when the period is chosen")
       ->check(numbers::checked(1, 3600, false, false, "from 1 to 3600 s"))
       ->capture_default_str();
-  cmd->add_option("--periods", o->periods, "Periods each optimized trajectory runs")
-      ->check(numbers::count(1, 100))
-      ->capture_default_str();
+  auto* periods = cmd->add_option("--periods", o->periods, "Periods each optimized trajectory runs")
+                      ->check(numbers::count(1, 100))
+                      ->capture_default_str();
   cmd->add_option("--starts", o->starts, "Random starts of each optimization")
       ->check(numbers::count(1, 100))
       ->capture_default_str();
@@ -563,9 +583,15 @@ void add_excite_commands(CLI::App& app, Common& common) {
   cmd->add_option("--interval", o->interval_ms, "Sampling interval of the quality table, ms")
       ->check(numbers::interval_ms())
       ->capture_default_str();
-  cmd->callback([&common, o, harmonics] {
+  cmd->add_flag("--payload", o->payload,
+                "One wrist motion (PL01, 20 s) D-optimal for a payload's 10 inertial parameters, the other "
+                "joints holding the posture (dynid payload; docs/payload.md)");
+  cmd->add_option("--payload-joints", o->payload_joints, "With --payload: the wrist joints that move")
+      ->check(numbers::count(1, 20))
+      ->capture_default_str();
+  cmd->callback([&common, o, harmonics, periods] {
     o->harmonics_given = harmonics->count() > 0;
-    run(common, *o);
+    run(common, *o, periods->count() > 0);
   });
 }
 

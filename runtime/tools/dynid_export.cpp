@@ -17,6 +17,7 @@
 #include "dynid_robots.hpp"
 #include "dynid_numbers.hpp"
 #include "dynid_urdf_into.hpp"
+#include "symoro/payload/payload_formats.hpp"
 #include "symoro/model_export/model_export.hpp"
 #include "symoro/identify/regression.hpp"
 #include "symoro/model_export/urdf_export.hpp"
@@ -195,6 +196,31 @@ void print_export(const model_export::ModelExport& e, const model_export::ModelE
         files.yaml.string(), rotor);
 }
 
+// The URDF with a payload.yaml's body on its flange: into the user's URDF, on the flange link
+// it names (a URDF tip link); into the model's URDF, on the payload's model frame's link, the
+// flange at its recorded pose there.
+std::string with_payload(const Common& common, const ExportOptions& options, const model_export::UrdfDescription& d,
+                         const std::string& urdf) {
+  const payload::PayloadFile f = payload::read_payload_yaml(options.payload);
+  if (!f.robot.empty() && f.robot != common.robot)
+    throw UsageError(fmt::format("{}: a payload of robot '{}', not {}", options.payload, f.robot, common.robot));
+  const bool frame = f.flange.rfind("frame ", 0) == 0;
+  if (!options.into.empty() && frame)
+    throw UsageError(
+        fmt::format("{}: its flange is the model's {}, not a link of {}: dynid payload names a URDF "
+                    "link as the flange for a robot symoroc model made from a URDF",
+                    options.payload, f.flange, options.into));
+  const std::string parent = options.into.empty() ? model_export::urdf_link_name(d, f.link) : f.flange;
+  try {
+    const std::string out = payload::urdf_with_payload(
+        urdf, f.payload, parent, "payload", options.into.empty() ? f.flange_in_link : Eigen::Isometry3d::Identity());
+    fmt::print("payload: {:.5g} kg on {} (from {})\n", f.payload.mass, parent, options.payload);
+    return out;
+  } catch (const std::invalid_argument& e) {
+    throw UsageError(fmt::format("--payload {}: {}", options.payload, e.what()));
+  }
+}
+
 }  // namespace export_detail
 
 void run_export(const Common& common, const ExportOptions& options, const std::string& label) {
@@ -236,6 +262,7 @@ void run_export(const Common& common, const ExportOptions& options, const std::s
     urdf_text = urdf_into(e.description, (common.robot_dir() / "robot.yaml").string(), options.into, notes);
     for (const auto& note : notes) fmt::print("{}\n", note);
   }
+  if (!options.payload.empty()) urdf_text = export_detail::with_payload(common, options, e.description, urdf_text);
   const model_export::ModelExportFiles files = model_export::write_model_export(e, options.urdf, urdf_text);
   export_detail::print_export(e, files, eo.prior_what);
 }
@@ -283,6 +310,9 @@ void add_export_commands(CLI::App& app, Common& common) {
                 "When no consistent set reproduces the accepted base parameters, export the "
                 "consistent set of the nearest base vector that has one (said in the files) "
                 "instead of failing");
+  cmd->add_option("--payload", o->payload,
+                  "A payload.yaml of dynid payload: the payload as a link on a fixed joint at its flange")
+      ->check(CLI::ExistingFile);
   cmd->add_flag("--force", o->force, "Overwrite the URDF and its .standard.yaml/.csv when they exist");
   cmd->callback([&common, o] {
     // One export to a URDF at a time (its own lock file beside it, held to the end: two at once

@@ -137,6 +137,22 @@ run(0 out payload --robot ${WORK}/robots/ur5 --params ${WORK}/loaded-study/repor
 expect("${out}" "mass +1\\.2 kg \\(given\\)")
 expect("${out}" "com +\\[ *([7-9]|1[0-2])\\.[0-9], -(1[7-9]|2[0-2])\\.[0-9], (5[7-9]|6[0-2])\\.[0-9]\\] mm")
 
+# The payload into the user's URDF beside the identified inertials (export --into --payload): a
+# link on the tip link; the model's own URDF holds it on frame 6's link at the tip's pose.
+run(0 out export --robot ${WORK}/robots/ur5 --study ${WORK}/loaded-study --urdf ${WORK}/payload-urdf/ur5.urdf
+    --into ${URDF_DIR}/ur5_robot.urdf --payload ${WORK}/payload/payload.yaml)
+expect("${out}" "payload: 1\\.(1[89]|2[0-2])[0-9]* kg on wrist_3_link")
+file(READ ${WORK}/payload-urdf/ur5.urdf urdf)
+expect("${urdf}" "<joint name=\"payload_joint\" type=\"fixed\">\n +<parent link=\"wrist_3_link\"/>")
+run(0 out export --robot ${WORK}/robots/ur5 --study ${WORK}/loaded-study --urdf ${WORK}/payload-model/ur5.urdf
+    --payload ${WORK}/payload/payload.yaml)
+file(READ ${WORK}/payload-model/ur5.urdf urdf)
+expect("${urdf}" "<parent link=\"wrist_3_joint_link\"/>\n +<child link=\"payload\"/>\n +<origin xyz=\"0 0 0\" rpy=\"1\\.57")
+# A 20 s wrist motion for the payload (dynid excite --payload): the wrist joints move, the rest holds.
+run(0 out excite --robot ${WORK}/robots/ur5 --payload --starts 1 -o ${WORK}/payload-excite)
+expect("${out}" "payload excitation: wrist_1_joint, wrist_2_joint, wrist_3_joint move")
+expect("${out}" "PL01: 20\\.0 s; payload \\(10 parameters on link 6\\): scaled kappa [1-9]")
+
 # An edited robot folder is another library: a joint limit changed, the library is rebuilt.
 file(READ ${WORK}/robots/ur5/robot.yaml yaml)
 string(REPLACE "velocity: 3.15" "velocity: 3.0" yaml "${yaml}")

@@ -6,6 +6,7 @@
 // with a 5 kg tool, the arm identified first from its own runs without the tool).
 #include <cmath>
 #include <filesystem>
+#include <random>
 #include <fstream>
 #include <string>
 #include <vector>
@@ -16,6 +17,7 @@
 
 #include "independent_arm.hpp"
 #include "independent_rx90.hpp"
+#include "symoro/excitation/design.hpp"
 #include "symoro/identify/identification_model.hpp"
 #include "symoro/identify/least_squares.hpp"
 #include "symoro/payload/payload_formats.hpp"
@@ -311,6 +313,119 @@ TEST(PayloadIdentification, AnIndependentRx90sToolOnAnArmIdentifiedWithoutIt) {
   EXPECT_GE(pe.margin, -1e-12);
   EXPECT_LT(std::abs(pe.payload.mass - 2) / 2, 0.02);
   EXPECT_LT((pe.payload.com - body.com).norm(), 0.003);
+}
+
+// The design's criterion with a parameter map (phi = P theta, the payload's 10): its gradient
+// against central differences, coefficient by coefficient, with the wrist alone moving.
+template <class Model>
+void expect_payload_gradient(const Eigen::VectorXd& start, int first, unsigned seed) {
+  const auto model = identify::identification_model<Model>();
+  excitation::ExcitationCriterion c(*model, excitation::FourierBasis(Model::nq, 3, 8.0, 60, start));
+  c.set_parameter_map(payload::payload_link(*model).map);
+  ASSERT_EQ(c.parameters(), 10);
+  std::mt19937_64 rng(seed);
+  std::normal_distribution<double> g;
+  Eigen::VectorXd x = Eigen::VectorXd::Zero(c.basis().variables());
+  for (int j = first; j < first + 3; ++j)
+    for (int i = 0; i < c.basis().block(); ++i) x(j * c.basis().block() + i) = 0.3 * g(rng);
+  c.scale_columns_at(x);
+  Eigen::VectorXd grad;
+  ASSERT_TRUE(c.value(x, &grad).has_value()) << Model::robot_name;
+  double worst = 0;
+  for (int i = 0; i < x.size(); ++i) {
+    Eigen::VectorXd xp = x, xm = x;
+    xp(i) += 1e-6;
+    xm(i) -= 1e-6;
+    const double fd = (*c.value(xp) - *c.value(xm)) / 2e-6;
+    worst = std::max(worst, std::abs(fd - grad(i)) / std::max(1.0, std::abs(grad(i))));
+  }
+  EXPECT_LT(worst, 2e-5) << Model::robot_name;
+  EXPECT_GT(grad.norm(), 1.0);
+}
+
+TEST(PayloadExcitation, TheCriterionsGradientWithAParameterMapMatchesFiniteDifferences) {
+  Eigen::VectorXd crane(Crane::nq), rx(Rx::nq);
+  crane << 0.3, 0.6, 0, -1.4, 0, 0, 0, 0;
+  rx << 0.2, -0.5, 0.8, 0, 0, 0;
+  expect_payload_gradient<Crane>(crane, 4, 5);
+  expect_payload_gradient<Rx>(rx, 3, 6);
+}
+
+// log det (X'X / N) of the payload regressor X = W P of a motion, per sample.
+double payload_log_det(const identify::IdentificationModel& model, const trajectory::SampledReference& ref) {
+  preprocess::Samples s;
+  const Eigen::Index K = ref.q.cols() / 10;
+  s.q = s.qd = s.qdd = s.tau = Eigen::MatrixXd::Zero(K, ref.q.rows());
+  for (Eigen::Index k = 0; k < K; ++k) {
+    s.q.row(k) = ref.q.col(10 * k).transpose();
+    s.qd.row(k) = ref.qd.col(10 * k).transpose();
+    s.qdd.row(k) = ref.qdd.col(10 * k).transpose();
+  }
+  s.time = Eigen::VectorXd::Zero(K);
+  s.piece.assign(static_cast<std::size_t>(K), 0);
+  const Eigen::MatrixXd X = model.stack_regression(s).W * payload::payload_link(model).map;
+  return std::log((X.transpose() * X / static_cast<double>(K)).determinant());
+}
+
+TEST(PayloadExcitation, ADesigned20sWristMotionHoldsTheArmAndIdentifiesTheTwinsPayload) {
+  // The design of dynid excite --payload: joints 5-7 move within CRANE-X7's limits (velocity 80 %
+  // of 4.8 rad/s, acceleration 10/s times that, 60 deg about the posture), two periods of 8.5 s,
+  // 12 harmonics; the others hold.
+  const auto model = identify::identification_model<Crane>();
+  excitation::ExcitationDesignOptions o;
+  o.name = "PL01";
+  o.period = 8.5;
+  o.harmonics = 12;
+  o.start.resize(Crane::nq);
+  o.start << 0.3, 0.6, 0, -1.4, 0, 0, 0, 0;
+  o.limits.lower = o.start - Eigen::VectorXd::Constant(Crane::nq, M_PI / 3);
+  o.limits.upper = o.start + Eigen::VectorXd::Constant(Crane::nq, M_PI / 3);
+  for (int j = 0; j < Crane::nq; ++j) {
+    o.limits.lower(j) = std::max(o.limits.lower(j), Crane::joints[j].lower);
+    o.limits.upper(j) = std::min(o.limits.upper(j), Crane::joints[j].upper);
+  }
+  o.limits.velocity = Eigen::VectorXd::Constant(Crane::nq, 0.8 * 4.8171);
+  o.limits.acceleration = 10 * o.limits.velocity;
+  o.held = {0, 1, 2, 3, 7};
+  o.parameter_map = payload::payload_link(*model).map;
+  o.starts = 2;
+  const excitation::ExcitationDesign design = excitation::design_excitation(*model, o);
+  const trajectory::SampledReference ref = design.trajectory.sample(0.001, 2);
+  EXPECT_LE(ref.q.cols() * 0.001, 17.01);
+  for (const int j : o.held) EXPECT_EQ((ref.q.row(j).array() - o.start(j)).abs().maxCoeff(), 0) << "joint " << j + 1;
+
+  // More information on the payload per sample than the hand-made wrist motion of the same length
+  // (which moves faster than these limits allow).
+  const trajectory::SampledReference hand = wrist_reference(o.start, 4, 3, 1.2, 17);
+  std::printf("payload log det per sample: designed %.3f, hand-made %.3f\n", payload_log_det(*model, ref),
+              payload_log_det(*model, hand));
+  EXPECT_GT(payload_log_det(*model, ref), payload_log_det(*model, hand));
+
+  // The twin carrying a body it does not declare, on the designed motion.
+  const auto override_file = std::filesystem::temp_directory_path() / "payload_design_twin.yaml";
+  std::ofstream(override_file) << "effects:\n  payload: {enabled: true, mass: 0.25, com: [-0.01, 0.015, 0.05], "
+                                  "inertia: [1.2e-4, 0, 1.0e-5, 1.0e-4, 0, 0.8e-4]}\n";
+  const twin::TwinConfig with =
+      twin::read_twin_config(std::string(SYMORO_ROBOTS_DIR) + "/crane_x7/twin.yaml", Crane::nq, override_file);
+  std::filesystem::remove(override_file);
+  twin::TwinConfig without = with;
+  without.effects.payload = false;
+  const robot::ModelHandle& handle = robot::compiled_model<Crane>();
+  twin::RunOptions ro;
+  ro.robot = "crane_x7";
+  ro.seed = 77;
+  const io::Log log = twin::ClosedLoopTwin(handle, with).run(ref, ro);
+  payload::PayloadInertial truth;
+  truth.mass = 0.25;
+  truth.com = {-0.01, 0.015, 0.05};
+  truth.inertia << 1.2e-4, 0, 1.0e-5, 0, 1.0e-4, 0, 1.0e-5, 0, 0.8e-4;
+  const payload::PayloadEstimate e =
+      payload::identify_payload({log}, *model, twin::identified_truth(handle, without), *model);
+  const Errors err = errors(e.payload, truth);
+  report("crane_x7 twin, designed motion", e, err);
+  EXPECT_LT(err.mass, 0.02);
+  EXPECT_LT(err.com, 0.003);
+  EXPECT_LT(err.inertia, 0.15);
 }
 
 }  // namespace

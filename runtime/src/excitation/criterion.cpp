@@ -98,10 +98,29 @@ ExcitationCriterion::ExcitationCriterion(const identify::IdentificationModel& mo
                                 std::to_string(model.description().np) + " parameters");
 }
 
+void ExcitationCriterion::set_parameter_map(const Eigen::MatrixXd& P) {
+  if (P.size() > 0 && P.rows() != model_.description().np)
+    throw std::invalid_argument("ExcitationCriterion: a parameter map of " + std::to_string(P.rows()) +
+                                " rows for a model of " + std::to_string(model_.description().np) + " parameters");
+  map_ = P;
+  scales_ = Eigen::VectorXd::Ones(parameters());
+}
+
+int ExcitationCriterion::parameters() const {
+  return map_.size() > 0 ? static_cast<int>(map_.cols()) : model_.description().np;
+}
+
+Eigen::MatrixXd ExcitationCriterion::regressor(const Eigen::MatrixXd& q, const Eigen::MatrixXd& qd,
+                                               const Eigen::MatrixXd& qdd) const {
+  Eigen::MatrixXd W = model_.stack_regression(as_samples(q, qd, qdd)).W;
+  if (map_.size() > 0) W = W * map_;
+  return W;
+}
+
 void ExcitationCriterion::scale_columns_at(const Eigen::VectorXd& x) {
   Eigen::MatrixXd q, qd, qdd;
   basis_.states(x, q, qd, qdd);
-  const Eigen::VectorXd norms = model_.stack_regression(as_samples(q, qd, qdd)).W.colwise().norm().transpose();
+  const Eigen::VectorXd norms = regressor(q, qd, qdd).colwise().norm().transpose();
   for (Eigen::Index p = 0; p < norms.size(); ++p) scales_(p) = norms(p) > 0 ? 1 / norms(p) : 1.0;
 }
 
@@ -109,7 +128,7 @@ std::optional<double> ExcitationCriterion::value(const Eigen::VectorXd& x, Eigen
   const int n = basis_.joints(), N = basis_.samples();
   Eigen::MatrixXd q, qd, qdd;
   basis_.states(x, q, qd, qdd);
-  const Eigen::MatrixXd W = model_.stack_regression(as_samples(q, qd, qdd)).W;
+  const Eigen::MatrixXd W = regressor(q, qd, qdd);
   const Eigen::MatrixXd WS = W * scales_.asDiagonal();
   Eigen::MatrixXd A = Eigen::MatrixXd::Zero(W.cols(), W.cols());
   A.selfadjointView<Eigen::Lower>().rankUpdate(WS.adjoint(), 1.0 / N);
@@ -120,10 +139,11 @@ std::optional<double> ExcitationCriterion::value(const Eigen::VectorXd& x, Eigen
   const double f = -2 * diag.array().log().sum();
   if (!gradient) return f;
 
-  // C = S A^-1 S / N; d f / d state_k = -2 sum_i d (W_k(i, :) (W_k C)(i, :)') / d state_k.
+  // C = S A^-1 S / N; d f / d state_k = -2 sum_i d (W_k(i, :) (W_k C)(i, :)') / d state_k. With
+  // a map, W = W_phi P: the row of W_phi times P C P' W(i, :)'.
   const Eigen::MatrixXd C =
       scales_.asDiagonal() * llt.solve(Eigen::MatrixXd::Identity(W.cols(), W.cols())) * scales_.asDiagonal() / N;
-  const Eigen::MatrixXd G = W * C;
+  const Eigen::MatrixXd G = map_.size() > 0 ? Eigen::MatrixXd(W * C * map_.transpose()) : Eigen::MatrixXd(W * C);
   Eigen::MatrixXd Hq = Eigen::MatrixXd::Zero(N, n), Hqd = Hq, Hqdd = Hq;
   identify::StateDerivatives d;
   for (int k = 0; k < N; ++k) {

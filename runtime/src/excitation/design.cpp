@@ -93,6 +93,10 @@ class DesignProblem : public Ipopt::TNLP {
                        Ipopt::Number* g_u) override {
     std::fill(x_l, x_l + V_, -kInfinity);
     std::fill(x_u, x_u + V_, kInfinity);
+    for (const int j : o_.held) {  // held joints: their coefficients fixed at 0
+      std::fill(x_l + j * 2 * L_, x_l + (j + 1) * 2 * L_, 0.0);
+      std::fill(x_u + j * 2 * L_, x_u + (j + 1) * 2 * L_, 0.0);
+    }
     std::fill(g_l, g_l + rp_, 0.0);
     std::fill(g_u, g_u + rp_, 0.0);
     const double s = sampling_factor(L_, N_);
@@ -295,7 +299,9 @@ Eigen::VectorXd random_start(const FourierBasis& basis, const ExcitationDesignOp
     t.a.row(j) *= s;
     t.b.row(j) *= s;
   }
-  return basis.coefficients(t);
+  Eigen::VectorXd x = basis.coefficients(t);
+  for (const int j : options.held) x.segment(j * basis.block(), basis.block()).setZero();
+  return x;
 }
 
 // The statuses after which Ipopt's point is a design (optimal, acceptable, or stopped by a limit
@@ -338,6 +344,8 @@ void refuse_unmeetable(const identify::IdentificationModel& model, const Excitat
   if (!sized(options.start) || !sized(lim.lower) || !sized(lim.upper) || !sized(lim.velocity) ||
       !sized(lim.acceleration) || (lim.torque.size() > 0 && !sized(lim.torque)))
     throw std::invalid_argument(fmt::format("design_excitation: the start pose and the limits need {} joints", n));
+  for (const int j : options.held)
+    if (j < 0 || j >= n) throw std::invalid_argument(fmt::format("design_excitation: held joint index {}", j));
   if (lim.torque.size() > 0 && options.nominal.size() != d.np)
     throw std::invalid_argument(
         fmt::format("design_excitation: torque limits need the nominal model's {} parameters", d.np));
@@ -530,6 +538,7 @@ ExcitationDesign design_excitation(const identify::IdentificationModel& model, c
   const int n = model.description().nq;
   const int samples = options.samples > 0 ? options.samples : std::max(100, 20 * options.harmonics);
   ExcitationCriterion criterion(model, FourierBasis(n, options.harmonics, options.period, samples, options.start));
+  criterion.set_parameter_map(options.parameter_map);
   const FourierBasis& basis = criterion.basis();
 
   ExcitationDesign out;

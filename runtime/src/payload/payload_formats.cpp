@@ -137,10 +137,22 @@ PayloadFile read_payload_yaml(const std::string& file) {
   out.payload.com = Eigen::Vector3d(c[0], c[1], c[2]);
   const auto i = numbers_at(p["inertia"], 6, file, "payload inertia (ixx iyy izz ixy ixz iyz)");
   out.payload.inertia << i[0], i[3], i[4], i[3], i[1], i[5], i[4], i[5], i[2];
+  if (const YAML::Node f = root["flange_in_link"]) {
+    io::check_keys(f, {"link", "xyz", "rpy"}, file, "flange_in_link");
+    out.link = static_cast<int>(number_at(f["link"], file, "flange_in_link link"));
+    const auto xyz = numbers_at(f["xyz"], 3, file, "flange_in_link xyz");
+    const auto rpy = numbers_at(f["rpy"], 3, file, "flange_in_link rpy");
+    out.flange_in_link.linear() =
+        (Eigen::AngleAxisd(rpy[2], Eigen::Vector3d::UnitZ()) * Eigen::AngleAxisd(rpy[1], Eigen::Vector3d::UnitY()) *
+         Eigen::AngleAxisd(rpy[0], Eigen::Vector3d::UnitX()))
+            .toRotationMatrix();
+    out.flange_in_link.translation() = Eigen::Vector3d(xyz[0], xyz[1], xyz[2]);
+  }
   return out;
 }
 
-std::string payload_urdf(const PayloadInertial& p, const std::string& parent, const std::string& name) {
+std::string payload_urdf(const PayloadInertial& p, const std::string& parent, const std::string& name,
+                         const Eigen::Isometry3d& flange_in_parent) {
   const Eigen::Matrix3d& I = p.inertia;
   std::string u;
   u += fmt::format("  <link name=\"{}\">\n    <inertial>\n", name);
@@ -151,8 +163,22 @@ std::string payload_urdf(const PayloadInertial& p, const std::string& parent, co
   u += "    </inertial>\n  </link>\n";
   u += fmt::format("  <joint name=\"{}_joint\" type=\"fixed\">\n    <parent link=\"{}\"/>\n    <child link=\"{}\"/>\n",
                    name, parent, name);
-  u += "    <origin xyz=\"0 0 0\" rpy=\"0 0 0\"/>\n  </joint>\n";
+  const Eigen::Vector3d t = flange_in_parent.translation(), rpy = rpy_of(flange_in_parent.linear());
+  u += fmt::format("    <origin xyz=\"{} {} {}\" rpy=\"{} {} {}\"/>\n  </joint>\n", num(t.x() + 0.0), num(t.y() + 0.0),
+                   num(t.z() + 0.0), num(rpy.x()), num(rpy.y()), num(rpy.z()));
   return u;
+}
+
+std::string urdf_with_payload(const std::string& urdf, const PayloadInertial& p, const std::string& parent,
+                              const std::string& name, const Eigen::Isometry3d& flange_in_parent) {
+  const std::size_t end = urdf.rfind("</robot>");
+  if (end == std::string::npos) throw std::invalid_argument("the URDF has no </robot>");
+  if (urdf.find("<link name=\"" + parent + "\"") == std::string::npos)
+    throw std::invalid_argument("the URDF has no link '" + parent + "' to hold the payload");
+  if (urdf.find("<link name=\"" + name + "\"") != std::string::npos)
+    throw std::invalid_argument("the URDF has a link '" + name + "' already");
+  return urdf.substr(0, end) + "  <!-- dynid payload -->\n" + payload_urdf(p, parent, name, flange_in_parent) +
+         urdf.substr(end);
 }
 
 PrincipalLoad principal_load(const Eigen::Matrix3d& inertia) {

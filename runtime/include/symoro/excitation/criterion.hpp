@@ -74,6 +74,11 @@ class ExcitationCriterion {
   ExcitationCriterion(const identify::IdentificationModel& model, FourierBasis basis);
 
   const FourierBasis& basis() const { return basis_; }
+  // The design's parameters theta when they are not the model's base parameters: phi = P theta
+  // (np x r), e.g. a payload's 10 on the last link (payload/payload_identification.hpp). The
+  // criterion is then log det of the column-scaled (W P)'(W P). Empty: P = 1. Resets the scales.
+  void set_parameter_map(const Eigen::MatrixXd& P);
+  int parameters() const;  // r
   // S: 1 / the column norms of W at x (1 for a column that is zero there).
   void scale_columns_at(const Eigen::VectorXd& x);
   const Eigen::VectorXd& scales() const { return scales_; }
@@ -96,6 +101,8 @@ class ExcitationCriterion {
   const identify::IdentificationModel& model_;
   FourierBasis basis_;
   Eigen::VectorXd scales_;
+  Eigen::MatrixXd map_;  // P, empty for the base parameters
+  Eigen::MatrixXd regressor(const Eigen::MatrixXd& q, const Eigen::MatrixXd& qd, const Eigen::MatrixXd& qdd) const;
 };
 
 // normal . p - offset for each half-space at pose q, and with `dq` its derivative along q

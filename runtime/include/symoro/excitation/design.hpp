@@ -55,6 +55,11 @@ struct ExcitationDesignOptions {
   int max_iterations = 150;    // per start
   double tolerance = 1e-5;     // Ipopt's relative tolerance
   double check_period = 1e-3;  // s
+  // Joints (0-based) that hold `start` throughout: their coefficients are fixed at 0.
+  std::vector<int> held;
+  // The parameters the design is D-optimal for, when not the model's base parameters:
+  // phi = parameter_map theta (ExcitationCriterion::set_parameter_map; empty: phi itself).
+  Eigen::MatrixXd parameter_map;
 };
 
 // A limit the motion comes nearest to (or passes) in the dense check.

@@ -40,12 +40,21 @@ std::string payload_yaml(const PayloadEstimate& e, const PayloadFileContext& con
 struct PayloadFile {
   PayloadInertial payload;
   std::string robot, flange;
+  int link = 0;  // the model frame it rides on, and the flange's pose there
+  Eigen::Isometry3d flange_in_link = Eigen::Isometry3d::Identity();
 };
 PayloadFile read_payload_yaml(const std::string& file);
 
-// <link name> with the payload's <inertial>, and the fixed <joint> that holds it on `parent` (its
-// frame the flange): the text of both, indented by two spaces.
-std::string payload_urdf(const PayloadInertial& p, const std::string& parent, const std::string& name = "payload");
+// <link name> with the payload's <inertial>, and the fixed <joint> that holds it on `parent` with
+// the flange at `flange_in_parent`: the text of both, indented by two spaces.
+std::string payload_urdf(const PayloadInertial& p, const std::string& parent, const std::string& name = "payload",
+                         const Eigen::Isometry3d& flange_in_parent = Eigen::Isometry3d::Identity());
+
+// `urdf` (a whole file's text) with the payload's link and joint before its closing </robot>.
+// std::invalid_argument when the file has no </robot>, no link `parent`, or a link `name` already.
+std::string urdf_with_payload(const std::string& urdf, const PayloadInertial& p, const std::string& parent,
+                              const std::string& name = "payload",
+                              const Eigen::Isometry3d& flange_in_parent = Eigen::Isometry3d::Identity());
 
 // The KUKA form: principal moments and the A B C angles (deg) of the principal axes, the axes
 // ordered and signed to be nearest the flange's own.
