@@ -14,6 +14,7 @@
 #include "symoro/diagnose/gap_report.hpp"
 #include "symoro/model_export/model_export.hpp"
 #include "symoro/study/prediction.hpp"
+#include "symoro/study/prediction_band.hpp"
 #include "symoro/study/robot_folder.hpp"
 #include "symoro/study/validation_io.hpp"
 #include "symoro/io/dataset.hpp"
@@ -78,13 +79,16 @@ void bind_results(py::module_& m) {
   m.def(
       "predict",
       [](py::handle model, py::handle params, const std::filesystem::path& input, double interval_ms,
-         double torque_delay_ms, int trial, const std::optional<std::filesystem::path>& robot_dir_given) {
+         double torque_delay_ms, int trial, const std::optional<std::filesystem::path>& robot_dir_given, double band,
+         const std::optional<std::filesystem::path>& uncertainty_file) {
         // dynid predict's ranges (a NaN or infinite value is named, never computed with).
         if (!(std::isfinite(interval_ms) && interval_ms >= 1 && interval_ms <= 10000))
           throw py::value_error(fmt::format("interval_ms {}: must be from 1 to 10000", interval_ms));
         if (!(std::isfinite(torque_delay_ms) && torque_delay_ms >= -1000 && torque_delay_ms <= 1000))
           throw py::value_error(fmt::format("torque_delay_ms {}: must be from -1000 to 1000", torque_delay_ms));
         if (trial < 1) throw py::value_error(fmt::format("trial {}: must be 1 or more", trial));
+        if (!(std::isfinite(band) && band >= 0 && band < 1))
+          throw py::value_error(fmt::format("band {}: must be from 0 (none) to below 1", band));
         const auto id = identification_of(model);
         const std::optional<std::filesystem::path> robot_dir = robot_dir_of(model, robot_dir_given);
         const identify::ModelDescription& d = id->description();
@@ -102,6 +106,19 @@ void bind_results(py::module_& m) {
           io::check_log_robot(log, input, d.robot, d.nq);
           logs.emplace_back(input.stem().string(), std::move(log));
         }
+        // The band's uncertainty: given, or report/uncertainty.yaml beside a parameters file.
+        std::optional<study::PredictionUncertainty> u;
+        std::optional<std::filesystem::path> ufile = uncertainty_file;
+        if (!ufile && band > 0 && (py::isinstance<py::str>(params) || py::hasattr(params, "__fspath__")) &&
+            params.cast<std::filesystem::path>() != "nominal") {
+          const auto beside = params.cast<std::filesystem::path>().parent_path() / "uncertainty.yaml";
+          if (std::filesystem::exists(beside)) ufile = beside;
+        }
+        if (ufile && band > 0) {
+          std::vector<std::string> names;
+          for (const auto& p : d.parameters) names.push_back(p.name);
+          u = study::read_uncertainty_yaml(ufile->string(), names);
+        }
         std::vector<study::Prediction> out(logs.size());
         {
           py::gil_scoped_release release;
@@ -109,17 +126,30 @@ void bind_results(py::module_& m) {
             out[i] = study::predict(logs[i].second, *id, phi, {interval_ms / 1000, torque_delay_ms / 1000});
         }
         py::list result;
-        for (std::size_t i = 0; i < logs.size(); ++i) result.append(prediction_dict(logs[i].first, out[i]));
+        for (std::size_t i = 0; i < logs.size(); ++i) {
+          py::dict x = prediction_dict(logs[i].first, out[i]);
+          if (u) {
+            const Eigen::MatrixXd b = study::prediction_band(*id, out[i].samples, *u, band);
+            const study::BandCoverage c = study::band_coverage(out[i].samples.tau, out[i].tau_model, b);
+            x["tau_band"] = b;
+            x["band_coverage"] = c.all;
+            x["band_coverage_joint"] = c.joint;
+          }
+          result.append(x);
+        }
         return result;
       },
       py::arg("model"), py::arg("params"), py::arg("input"), py::kw_only(),
       py::arg("interval_ms") = study::PredictionOptions{}.interval * 1000,
       py::arg("torque_delay_ms") = study::PredictionOptions{}.torque_delay * 1000, py::arg("trial") = 1,
-      py::arg("robot_dir") = py::none(),
+      py::arg("robot_dir") = py::none(), py::arg("band") = 0.95, py::arg("uncertainty") = py::none(),
       "The model's torque on a log or a dataset's runs: a list of {'name', 'time', 'q', 'qd', 'qdd', 'tau', "
       "'tau_model', "
       "'rmse', 'rms', 'raw_rmse', 'raw_rmse_overall', 'raw_samples', 'edge_samples', 'context_rows', 'preprocessing'}; "
-      "params: an array, a parameters file or 'nominal' (with robot_dir)");
+      "params: an array, a parameters file or 'nominal' (with robot_dir). With a study's report/uncertainty.yaml "
+      "beside "
+      "the parameters file (or given as uncertainty=), also 'tau_band' (the band's half-width at level `band`), "
+      "'band_coverage' and 'band_coverage_joint' (the share of samples inside)");
 
   m.def(
       "compare",

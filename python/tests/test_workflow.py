@@ -98,9 +98,15 @@ def test_predict_and_compare_equal_the_command_line(tmp_path, robot, dynid, sour
         header, table = read_csv_columns(tmp_path / "predicted" / f"{r['name']}.predicted.csv")
         n = arm.nq
         assert np.array_equal(table[:, 0], r["time"])
-        for k, what in enumerate(["q", "qd", "qdd", "tau", "tau_model"]):
+        for k, what in enumerate(["q", "qd", "qdd", "tau", "tau_model", "tau_band"]):
             assert np.array_equal(table[:, 1 + k * n:1 + (k + 1) * n], r[what]), what
         assert np.all(r["rmse"] < 0.06) and np.all(r["rms"] > 1), (r["rmse"], r["rms"])
+    # The 95 % prediction band (the study's report/uncertainty.yaml beside the parameters): the
+    # held-out run's torque inside it about 95 % of the time, as counted here.
+    check = runs[-1]
+    inside = np.abs(check["tau"] - check["tau_model"]) <= check["tau_band"]
+    assert check["band_coverage"] == pytest.approx(inside.mean(), rel=1e-12)
+    assert 0.90 <= check["band_coverage"] <= 0.98, check["band_coverage_joint"]
 
     # compare: gap.md as dynid compare writes it; the rigid model lacks the friction the logs have.
     gap = symoro.compare(tmp_path / "full", tmp_path / "rigid", tmp_path / "gap")

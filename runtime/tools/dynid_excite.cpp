@@ -118,17 +118,6 @@ void fastest_level(const YAML::Node& design, int n, Eigen::VectorXd& velocity, E
   }
 }
 
-// The period at which the fundamental, at a joint's velocity limit, sweeps half of its box:
-// 2 pi (half width / velocity), the median over the joints, in [5, 60] s to 0.1 s. A slow arm
-// (the Kinova's 0.28 rad/s) needs tens of seconds to use its range; a fast one a few.
-double auto_period(const Eigen::VectorXd& lower, const Eigen::VectorXd& upper, const Eigen::VectorXd& velocity) {
-  std::vector<double> t;
-  for (Eigen::Index j = 0; j < velocity.size(); ++j)
-    t.push_back(2 * 3.14159265358979323846 * (upper(j) - lower(j)) / 4 / velocity(j));
-  std::nth_element(t.begin(), t.begin() + static_cast<std::ptrdiff_t>(t.size() / 2), t.end());
-  return std::round(std::clamp(t[t.size() / 2], 5.0, 60.0) * 10) / 10;
-}
-
 // The design options of one series from rest at `posture`.
 excitation::ExcitationDesignOptions design_options(const ExciteOptions& options, const PeriodRung& rung,
                                                    const YAML::Node& design, const std::string& posture,
@@ -402,6 +391,26 @@ std::string optimized_series(const Common& common, SeriesDesigner& sd, const std
   return out;
 }
 
+// The nominal model's phi for the torque limits: --params, else robot.yaml's nominal, else none
+// (empty; said on stderr). `from` names it.
+Eigen::VectorXd nominal_phi(const Common& common, const ExciteOptions& options,
+                            const identify::IdentificationModel& model, std::string& from) {
+  const identify::ModelDescription& d = model.description();
+  std::vector<std::string> names;
+  for (const auto& p : d.parameters) names.push_back(p.name);
+  if (!options.params.empty()) {
+    from = options.params;
+    return io::read_parameters_yaml(options.params, names);
+  }
+  if (std::vector<double> s; nominal_standard_parameters(common, d.standard, s)) {
+    from = "robot.yaml nominal";
+    return model.base_from_standard(Eigen::Map<const Eigen::VectorXd>(s.data(), static_cast<Eigen::Index>(s.size())));
+  }
+  fmt::print(stderr, "excite: {} has no nominal parameters and no --params was given: torque limits are NOT enforced\n",
+             (common.robot_dir() / "robot.yaml").string());
+  return {};
+}
+
 void run(const Common& common, const ExciteOptions& given, bool periods_given) {
   ExciteOptions options = given;
   const auto model = identification_model(common, options.payload ? "full" : options.model);
@@ -459,22 +468,8 @@ void run(const Common& common, const ExciteOptions& given, bool periods_given) {
   trajectory::structured_box(so, lower, upper);
 
   // 2. The nominal model for the torque limits.
-  Eigen::VectorXd nominal;
   std::string nominal_from;
-  std::vector<std::string> names;
-  for (const auto& p : d.parameters) names.push_back(p.name);
-  if (!options.params.empty()) {
-    nominal = io::read_parameters_yaml(options.params, names);
-    nominal_from = options.params;
-  } else if (std::vector<double> s; nominal_standard_parameters(common, d.standard, s)) {
-    nominal =
-        model->base_from_standard(Eigen::Map<const Eigen::VectorXd>(s.data(), static_cast<Eigen::Index>(s.size())));
-    nominal_from = "robot.yaml nominal";
-  } else {
-    fmt::print(stderr,
-               "excite: {} has no nominal parameters and no --params was given: torque limits are NOT enforced\n",
-               (common.robot_dir() / "robot.yaml").string());
-  }
+  const Eigen::VectorXd nominal = nominal_phi(common, options, *model, nominal_from);
 
   // 3. The optimized series, one per posture in turn, each from rest at its posture.
   TrajectoryOptions to;

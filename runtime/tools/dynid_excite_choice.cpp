@@ -44,4 +44,15 @@ std::vector<PeriodRung> period_ladder(double first, int harmonics, double longes
   return out;
 }
 
+// The period at which the fundamental, at a joint's velocity limit, sweeps half of its box:
+// 2 pi (half width / velocity), the median over the joints, in [5, 60] s to 0.1 s. A slow arm
+// (the Kinova's 0.28 rad/s) needs tens of seconds to use its range; a fast one a few.
+double auto_period(const Eigen::VectorXd& lower, const Eigen::VectorXd& upper, const Eigen::VectorXd& velocity) {
+  std::vector<double> t;
+  for (Eigen::Index j = 0; j < velocity.size(); ++j)
+    t.push_back(2 * 3.14159265358979323846 * (upper(j) - lower(j)) / 4 / velocity(j));
+  std::nth_element(t.begin(), t.begin() + static_cast<std::ptrdiff_t>(t.size() / 2), t.end());
+  return std::round(std::clamp(t[t.size() / 2], 5.0, 60.0) * 10) / 10;
+}
+
 }  // namespace symoro::dynid

@@ -8,7 +8,14 @@
 #include <string>
 #include <vector>
 
+#include <Eigen/Core>
+
 namespace symoro::dynid {
+
+// The period at which the fundamental, at a joint's velocity limit, sweeps half of its box:
+// 2 pi (half width / velocity), the median over the joints, in [5, 60] s to 0.1 s. A slow arm
+// (the Kinova's 0.28 rad/s) needs tens of seconds to use its range; a fast one a few.
+double auto_period(const Eigen::VectorXd& lower, const Eigen::VectorXd& upper, const Eigen::VectorXd& velocity);
 
 struct ExcitationTargets {
   double kappa_scaled = std::numeric_limits<double>::infinity();  // the series' must be below

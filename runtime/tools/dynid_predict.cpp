@@ -7,6 +7,7 @@
 #include <cmath>
 #include <filesystem>
 #include <memory>
+#include <optional>
 
 #include <CLI/CLI.hpp>
 #include <fmt/format.h>
@@ -18,6 +19,7 @@
 #include "dynid_numbers.hpp"
 #include "symoro/io/dataset.hpp"
 #include "symoro/study/prediction.hpp"
+#include "symoro/study/prediction_band.hpp"
 #include "symoro/study/options.hpp"
 #include "symoro/io/atomic_file.hpp"
 #include "symoro/io/log.hpp"
@@ -33,27 +35,50 @@ namespace fs = std::filesystem;
 
 struct PredictOptions {
   std::string params = "nominal", model, input, out;
+  std::string uncertainty;  // "" : report/uncertainty.yaml beside --params when it is there
+  double band = 0.95;       // the band's level (0: none)
   double interval_ms = study::PredictionOptions{}.interval * 1000;
   double torque_delay_ms = study::PredictionOptions{}.torque_delay * 1000;
   int trial = 1;
   bool force = false;
 };
 
-// The prediction of one log, its samples written to `csv`.
+// The parameters' uncertainty for the bands: --uncertainty, else report/uncertainty.yaml beside
+// --params (a study's); none for nominal parameters, --band 0, or a study without one.
+std::optional<study::PredictionUncertainty> uncertainty_of(const PredictOptions& o,
+                                                           const identify::ModelDescription& d) {
+  if (o.band == 0 || (o.uncertainty.empty() && o.params == "nominal")) return std::nullopt;
+  const fs::path file =
+      o.uncertainty.empty() ? fs::path(o.params).parent_path() / "uncertainty.yaml" : fs::path(o.uncertainty);
+  if (o.uncertainty.empty() && !fs::exists(file)) return std::nullopt;
+  std::vector<std::string> names;
+  for (const auto& p : d.parameters) names.push_back(p.name);
+  return study::read_uncertainty_yaml(file.string(), names);
+}
+
+// The prediction of one log, its samples (and the band's half-width) written to `csv`.
 study::Prediction predict_log(const io::Log& log, const identify::IdentificationModel& model,
-                              const Eigen::VectorXd& phi, const PredictOptions& options, const fs::path& csv) {
+                              const Eigen::VectorXd& phi, const PredictOptions& options, const fs::path& csv,
+                              const std::optional<study::PredictionUncertainty>& u, Eigen::MatrixXd& band) {
   study::Prediction p = study::predict(log, model, phi, {options.interval_ms / 1000, options.torque_delay_ms / 1000});
   const preprocess::Samples& s = p.samples;
   const int n = static_cast<int>(s.tau.cols());
   const auto& joints = model.description().joints;
+  std::vector<const char*> what{"q", "qd", "qdd", "tau", "tau_model"};
+  std::vector<const Eigen::MatrixXd*> columns{&s.q, &s.qd, &s.qdd, &s.tau, &p.tau_model};
+  band.resize(0, 0);
+  if (u) {
+    band = study::prediction_band(model, s, *u, options.band);
+    what.push_back("tau_band");
+    columns.push_back(&band);
+  }
   std::string text = "time";
-  for (const char* what : {"q", "qd", "qdd", "tau", "tau_model"})
-    for (int j = 0; j < n; ++j) text += fmt::format(",{}_{}", what, joints[j].name);
+  for (const char* w : what)
+    for (int j = 0; j < n; ++j) text += fmt::format(",{}_{}", w, joints[j].name);
   text += "\n";
   for (Eigen::Index k = 0; k < s.tau.rows(); ++k) {
     text += io::number_text(s.time(k));
-    for (const Eigen::MatrixXd* m :
-         std::initializer_list<const Eigen::MatrixXd*>{&s.q, &s.qd, &s.qdd, &s.tau, &p.tau_model})
+    for (const Eigen::MatrixXd* m : columns)
       for (int j = 0; j < n; ++j) text += "," + io::number_text((*m)(k, j));
     text += "\n";
   }
@@ -93,11 +118,13 @@ void run(const Common& common, const PredictOptions& options) {
   fmt::print("{} model {} with {} parameters, at {:.0f} ms: RMSE of tau - tau_model (RMS of tau) per joint, N m\n",
              common.robot, d.variant.empty() ? "full" : d.variant,
              options.params == "nominal" ? "the nominal" : options.params, options.interval_ms);
-  Eigen::VectorXd sq = Eigen::VectorXd::Zero(d.nq);
+  const std::optional<study::PredictionUncertainty> u = uncertainty_of(options, d);
+  Eigen::VectorXd sq = Eigen::VectorXd::Zero(d.nq), inside = sq;
   int total = 0;
   std::string raw_filter;
   for (std::size_t i = 0; i < logs.size(); ++i) {
-    const study::Prediction p = predict_log(logs[i].second, *model, phi, options, files[i]);
+    Eigen::MatrixXd band;
+    const study::Prediction p = predict_log(logs[i].second, *model, phi, options, files[i], u, band);
     const int samples = static_cast<int>(p.samples.tau.rows());
     std::string line = fmt::format("  {:<10} {:>6} samples:", logs[i].first, samples);
     for (int j = 0; j < d.nq; ++j) line += fmt::format(" {:.4f} ({:.3f})", p.rmse(j), p.rms(j));
@@ -109,6 +136,13 @@ void run(const Common& common, const PredictOptions& options) {
                "", "", p.raw.error.rmse, p.raw.error.rmse_joint.mean());
     if (p.samples.report.edge_samples > 0 || p.samples.report.context_rows > 0)
       fmt::print("  {:<10} {}\n", "", p.samples.report.summary());
+    if (u) {
+      const study::BandCoverage c = study::band_coverage(p.samples.tau, p.tau_model, band);
+      line = fmt::format("  {:<10} {:>6} inside the {:g} % band:", "", "", 100 * options.band);
+      for (int j = 0; j < d.nq; ++j) line += fmt::format(" {:.1f} %", 100 * c.joint(j));
+      fmt::print("{} (all {:.1f} %)\n", line, 100 * c.all);
+      inside += c.joint * samples;
+    }
     if (i + 1 == logs.size()) raw_filter = p.raw.filter;
     sq += p.rmse.cwiseAbs2() * samples;
     total += samples;
@@ -118,6 +152,18 @@ void run(const Common& common, const PredictOptions& options) {
     for (int j = 0; j < d.nq; ++j) line += fmt::format(" {:.4f}", std::sqrt(sq(j) / total));
     fmt::print("{}\n", line);
   }
+  if (u && logs.size() > 1) {
+    std::string line = fmt::format("  {:<10} {:>6} inside the {:g} % band:", "all", total, 100 * options.band);
+    for (int j = 0; j < d.nq; ++j) line += fmt::format(" {:.1f} %", 100 * inside(j) / total);
+    fmt::print("{} (all {:.1f} %)\n", line, 100 * inside.sum() / total / d.nq);
+  }
+  if (u)
+    fmt::print(
+        "band: the parameters' covariance and the residual's level of {} ({}); tau_band_* in the CSV is its "
+        "half-width\n",
+        options.uncertainty.empty() ? (fs::path(options.params).parent_path() / "uncertainty.yaml").string()
+                                    : options.uncertainty,
+        u->source);
   fmt::print("raw: RMSE against the {}\n", raw_filter);
   fmt::print("predicted torque: {}\n", one ? out.string() : (out / "*.predicted.csv").string());
 }
@@ -149,6 +195,14 @@ void add_predict_commands(CLI::App& app, Common& common) {
   cmd->add_option("--trial", o->trial, "Which trial of a dataset's runs")
       ->check(numbers::count(1, 1e6))
       ->capture_default_str();
+  cmd->add_option("--band", o->band,
+                  "Level of the prediction band (tau_band_* columns, and the share of samples inside), from the "
+                  "study's report/uncertainty.yaml beside --params; 0: none")
+      ->check(numbers::checked(0, 0.999, false, false, "from 0 (none) to 0.999"))
+      ->capture_default_str();
+  cmd->add_option("--uncertainty", o->uncertainty,
+                  "The parameters' uncertainty for the band (default: uncertainty.yaml beside --params)")
+      ->check(CLI::ExistingFile);
   cmd->add_flag("--force", o->force, "Overwrite existing output files");
   cmd->callback([&common, o] { run(common, *o); });
 }

@@ -47,6 +47,10 @@ foreach(way loaded compiled)
   run(0 out predict --robot ${robot} --model full --params ${WORK}/${way}-study/report/parameters.yaml
       ${WORK}/${way}-data -o ${WORK}/${way}-predict)
   set(predict_${way} "${out}")
+  # The 95 % band from the study's report/uncertainty.yaml: the held-out run inside it 90-98 % of the time.
+  expect("${out}" "inside the 95 % band:[^\n]*\\(all 9[0-8]\\.[0-9] %\\)\n +all ")  # the last log: held out
+  file(READ ${WORK}/${way}-study/report/report.md report)
+  expect("${report}" "\\| arm_heldout \\| 9[0-8]\\.[0-9] % \\|")
   # The URDF with consistent inertials nearest the URDF's own (robot.yaml's nominal).
   run(0 out export --robot ${robot} --study ${WORK}/${way}-study --urdf ${WORK}/${way}-urdf/ur5.urdf)
   file(READ ${WORK}/${way}-urdf/ur5.urdf urdf_${way})

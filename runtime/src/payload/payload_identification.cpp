@@ -9,6 +9,7 @@
 #include <fmt/format.h>
 
 #include "consistent_payload.hpp"
+#include "symoro/identify/hac_covariance.hpp"
 #include "symoro/study/prediction.hpp"
 
 namespace symoro::payload {
@@ -61,51 +62,6 @@ Eigen::MatrixXd weighted(const Eigen::MatrixXd& A, const Eigen::VectorXd& w) {
   const int n = static_cast<int>(w.size());
   for (Eigen::Index r = 0; r < B.rows(); ++r) B.row(r) *= w(r % n);
   return B;
-}
-
-// The lag past which the residual is uncorrelated: the first lag where its autocorrelation,
-// averaged over the joints, falls below 0.05, doubled (Bartlett's weights halve the lags' terms
-// near it); at most a tenth of the samples.
-int auto_lags(const Eigen::VectorXd& e, const std::vector<int>& log_of, int joints) {
-  const int N = static_cast<int>(log_of.size());
-  const Eigen::Map<const Eigen::MatrixXd> E(e.data(), joints, N);
-  const Eigen::VectorXd var = E.rowwise().squaredNorm();
-  const int most = std::max(1, N / 10);
-  for (int l = 1; l <= most; ++l) {
-    double rho = 0;
-    for (int j = 0; j < joints; ++j) {
-      if (!(var(j) > 0)) continue;
-      double c = 0;
-      for (int k = l; k < N; ++k)
-        if (log_of[static_cast<std::size_t>(k)] == log_of[static_cast<std::size_t>(k - l)]) c += E(j, k) * E(j, k - l);
-      rho += c / var(j) / joints;
-    }
-    if (rho < 0.05) return std::min(most, 2 * l);
-  }
-  return most;
-}
-
-// Newey-West: (X'X)^-1 S (X'X)^-1 with S the scores' long-run covariance (Bartlett weights),
-// lags within a log only.
-Eigen::MatrixXd hac_covariance(const Eigen::MatrixXd& X, const Eigen::VectorXd& e, const std::vector<int>& log_of,
-                               int joints, int lags) {
-  const int N = static_cast<int>(log_of.size()), r = static_cast<int>(X.cols());
-  Eigen::MatrixXd scores(r, N);
-  for (int k = 0; k < N; ++k)
-    scores.col(k) = X.middleRows(static_cast<Eigen::Index>(k) * joints, joints).transpose() *
-                    e.segment(static_cast<Eigen::Index>(k) * joints, joints);
-  Eigen::MatrixXd S = scores * scores.transpose();
-  for (int l = 1; l <= lags; ++l) {
-    const double w = 1 - static_cast<double>(l) / (lags + 1);
-    Eigen::MatrixXd G = Eigen::MatrixXd::Zero(r, r);
-    for (int k = l; k < N; ++k)
-      if (log_of[static_cast<std::size_t>(k)] == log_of[static_cast<std::size_t>(k - l)])
-        G.noalias() += scores.col(k) * scores.col(k - l).transpose();
-    S += w * (G + G.transpose());
-  }
-  const Eigen::MatrixXd B = X.transpose() * X;
-  const Eigen::MatrixXd Bi = B.ldlt().solve(Eigen::MatrixXd::Identity(r, r));
-  return Bi * S * Bi;
 }
 
 // The reported numbers of a standard vector: mass, CoM (3), inertia about the CoM (6).
@@ -228,8 +184,8 @@ PayloadEstimate identify_payload(const std::vector<io::Log>& logs, const identif
   // The covariance, the residual's autocorrelation counted.
   const Eigen::MatrixXd Xw = weighted(X, w);
   const Eigen::VectorXd ew = weighted(y - X * beta, w);
-  out.lags = o.lags >= 0 ? o.lags : auto_lags(ew, s.log_of, n);
-  const Eigen::MatrixXd C = hac_covariance(Xw, ew, s.log_of, n, out.lags);
+  out.lags = o.lags >= 0 ? o.lags : identify::residual_lags(ew, s.log_of, n);
+  const Eigen::MatrixXd C = identify::hac_covariance(Xw, ew, s.log_of, n, out.lags);
   out.least_squares.setZero();
   out.covariance.setZero();
   for (int i = 0; i < r; ++i) {

@@ -16,6 +16,7 @@
 #include "symoro/report/svg_plot.hpp"
 #include "symoro/io/atomic_file.hpp"
 #include "symoro/io/parameters_yaml.hpp"
+#include "symoro/study/prediction_band.hpp"
 #include "symoro/io/number_text.hpp"
 #include "symoro/io/yaml_text.hpp"
 
@@ -189,6 +190,11 @@ std::string validation_figure(const ValidationRecord& v, const std::vector<int>&
       p.lines.push_back(series(v.tau_clie, j, "CLIE", "#1f77b4", 1.3, "6 3"));
     if (v.tau_rescue.rows() == n && j < v.tau_rescue.cols())
       p.lines.push_back(series(v.tau_rescue, j, "PD-rescue", "#d62728", 1.1, ""));
+    // The 95 % prediction band around the accepted torque (prediction_band.hpp).
+    if (v.tau_rescue.rows() == n && v.tau_band.rows() == n && j < v.tau_band.cols()) {
+      p.lines.push_back(series(v.tau_rescue + v.tau_band, j, "95 % band", "#f4a6a6", 0.7, "2 2"));
+      p.lines.push_back(series(v.tau_rescue - v.tau_band, j, "", "#f4a6a6", 0.7, "2 2"));
+    }
     f.panels.push_back(p);
   }
   return f.panels.empty() ? std::string() : svg::render(f);
@@ -443,6 +449,8 @@ std::vector<std::filesystem::path> write_report(const StudyResult& study, const 
   written.push_back(dir / "parameters.yaml");
   write_parameters_csv(study, dir / "parameters.csv");
   written.push_back(dir / "parameters.csv");
+  if (study.uncertainty.covariance.size() > 0)
+    put(dir / "uncertainty.yaml", uncertainty_yaml(study.uncertainty, study.robot));
   return written;
 }
 

@@ -316,6 +316,32 @@ std::string raw_validation_table(const StudyResult& study) {
          table.str() + "\n";
 }
 
+// How often held-out torque falls inside the accepted vector's 95 % prediction band, if banded.
+std::string band_validation_table(const StudyResult& study) {
+  bool any = false;
+  for (const auto& v : study.validation) any = any || std::isfinite(v.band_coverage);
+  if (!any) return "";
+  MarkdownTable table({"Trajectory", "Inside the 95 % band", "Per joint"});
+  for (const auto& v : study.validation) {
+    if (!std::isfinite(v.band_coverage)) continue;
+    std::string joints;
+    for (Eigen::Index j = 0; j < v.band_coverage_joint.size(); ++j)
+      joints += fmt::format("{}{:.1f} %", j ? ", " : "", 100 * v.band_coverage_joint(j));
+    table.row({v.trajectory, fmt::format("{:.1f} %", 100 * v.band_coverage), joints});
+  }
+  const PredictionUncertainty& u = study.uncertainty;
+  std::string level;
+  for (Eigen::Index j = 0; j < u.residual.size(); ++j) level += fmt::format("{}{:.3g}", j ? ", " : "", u.residual(j));
+  return fmt::format(
+             "\nPrediction bands, open loop: the accepted vector's torque +- 1.96 sqrt(w' C w + s_j^2), with C the "
+             "parameters' covariance (Newey-West over {} lags) and s_j the residual's own level ({} N m), both on {} "
+             "({} "
+             "samples); report/uncertainty.yaml holds them. A calibrated band holds about 95 % of the held-out samples "
+             "(docs/uncertainty.md).\n\n",
+             u.lags, level, u.source, u.samples) +
+         table.str() + "\n";
+}
+
 // Where the preprocessing left samples out at a moving log end (preprocess/edges.hpp), if anywhere.
 std::string edge_note(const StudyResult& study) {
   std::string runs, held;
@@ -361,6 +387,7 @@ std::string validation_table(const StudyResult& study) {
   for (const auto& v : study.validation)
     if (!v.note.empty()) out += fmt::format("- {}: {}\n", v.trajectory, v.note);
   out += raw_validation_table(study);
+  out += band_validation_table(study);
   out += edge_note(study);
 
   // Per joint, when the records carry it.

@@ -2,10 +2,13 @@
 // once for every robot.
 #include "symoro/study/study.hpp"
 
+#include "symoro/study/prediction_band.hpp"
+
 #include "symoro/study/raw_torque.hpp"
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <filesystem>
 #include <functional>
 #include <limits>
@@ -507,6 +510,7 @@ class StudyRun {
     const double h = o_.validation_interval > 0 ? o_.validation_interval : sel.interval;
     identify::ClieOptions co = o_.clie;
     co.preprocess = o_.preprocess;
+    uncertainty(data, sel, out);
     for (const auto& name : names) {
       try {
         const io::Log log = load_log(data.find(name, o_.trial));
@@ -528,9 +532,28 @@ class StudyRun {
         v.raw_rmse_rescue = raw.error.rmse;
         v.raw_rmse_joint_rescue = raw.error.rmse_joint;
         v.raw_filter = raw.filter;
+        if (out.uncertainty.covariance.size() > 0) {  // the 95 % band, open loop
+          v.tau_band = prediction_band(model_, s, out.uncertainty, 0.95);
+          const BandCoverage c = band_coverage(s.tau, open(s, out.phi_rescue), v.tau_band);
+          v.band_coverage = c.all;
+          v.band_coverage_joint = c.joint;
+        }
       } catch (const std::exception& e) {
         out.stages.push_back(fmt::format("validation of {}: failed: {}", name, e.what()));
       }
+    }
+  }
+
+  // The accepted vector's uncertainty on the selected run's samples, the samples it was fitted on.
+  void uncertainty(const Dataset& data, const RunRecord& sel, StudyResult& out) const {
+    try {
+      const io::Log log = load_log(data.find(sel.trajectory, o_.trial));
+      const std::vector<preprocess::Samples> s{preprocess::preprocess(log, sel.interval, o_.preprocess)};
+      out.uncertainty = prediction_uncertainty(model_, s, out.phi_rescue,
+                                               fmt::format("{} at {} ms, the selected run", sel.trajectory,
+                                                           static_cast<int>(std::lround(sel.interval * 1000))));
+    } catch (const std::exception& e) {
+      out.stages.push_back(fmt::format("prediction bands: not made: {}", e.what()));
     }
   }
 

@@ -169,6 +169,10 @@ std::vector<std::filesystem::path> write_validation(const StudyResult& study, co
       detail::put_vector(y, "raw_rmse_joint_accepted", v.raw_rmse_joint_rescue);
       y << YAML::Key << "raw_filter" << YAML::Value << v.raw_filter;
     }
+    if (std::isfinite(v.band_coverage)) {
+      y << YAML::Key << "band_coverage" << YAML::Value << v.band_coverage;
+      detail::put_vector(y, "band_coverage_joint", v.band_coverage_joint);
+    }
     y << YAML::Key << "series" << YAML::Value << "validation/" + csv_name(v.trajectory);
     y << YAML::EndMap;
   }
@@ -234,6 +238,10 @@ StudyValidation read_validation(const std::filesystem::path& study_dir) {
       v.raw_rmse_rescue = as<double>(t, "raw_rmse_accepted", file);
       v.raw_rmse_joint_rescue = vec(t, "raw_rmse_joint_accepted", file, true);
       v.raw_filter = t["raw_filter"] ? as<std::string>(t, "raw_filter", file) : "";
+    }
+    if (t["band_coverage"]) {  // studies before prediction bands have none
+      v.band_coverage = as<double>(t, "band_coverage", file);
+      v.band_coverage_joint = vec(t, "band_coverage_joint", file, true);
     }
     read_series(study_dir / as<std::string>(t, "series", file), joints, v);
     s.records.push_back(std::move(v));

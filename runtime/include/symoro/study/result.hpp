@@ -9,6 +9,8 @@
 
 #include <Eigen/Core>
 
+#include "symoro/study/prediction_uncertainty.hpp"
+
 namespace symoro::study {
 
 // One trajectory at one sampling interval: OLS -> audit -> (SDP) -> CLIE.
@@ -107,6 +109,12 @@ struct ValidationRecord {
          raw_rmse_rescue = std::numeric_limits<double>::quiet_NaN();
   Eigen::VectorXd raw_rmse_joint_rescue;
   std::string raw_filter;  // the evaluation's own filter, one sentence
+  // The accepted vector's 95 % prediction band (prediction_band.hpp) on this run, open loop: the
+  // share of samples whose measured torque falls inside, over all joints and per joint (NaN: no
+  // band), and the band's half-width per sample (samples x joints; for the figure).
+  double band_coverage = std::numeric_limits<double>::quiet_NaN();
+  Eigen::VectorXd band_coverage_joint;
+  Eigen::MatrixXd tau_band;
   // The series (for the torque figure and the closed-loop localization): samples x joints; the
   // motion is the measured one, preprocessed like the torque.
   Eigen::VectorXd time;
@@ -144,6 +152,8 @@ struct StudyResult {
   double final_consistency = std::numeric_limits<double>::quiet_NaN();
   std::string final_consistency_note;
   std::vector<ValidationRecord> validation;
+  // The accepted vector's uncertainty on the selected run's samples (empty covariance: none).
+  PredictionUncertainty uncertainty;
   Eigen::VectorXd truth;                       // the twin's true parameters (empty for real data)
   std::string data_source;                     // e.g. "twin (robots/crane_x7/twin.yaml, config ...)"
   std::string data_twin, data_twin_overrides;  // the dataset's twin and overrides ("" for real data)
