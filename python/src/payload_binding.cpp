@@ -12,7 +12,6 @@
 
 #include "arrays.hpp"
 #include "symoro/io/dataset.hpp"
-#include "symoro/io/parameters_yaml.hpp"
 #include "symoro/payload/payload_formats.hpp"
 #include "symoro/payload/payload_identification.hpp"
 
@@ -20,20 +19,10 @@ namespace symoro::python {
 
 std::shared_ptr<const identify::IdentificationModel> identification_of(py::handle model);
 std::optional<std::filesystem::path> robot_dir_of(py::handle model, const std::optional<std::filesystem::path>& given);
+Eigen::VectorXd parameters_of(const identify::IdentificationModel& model, py::handle params,
+                              const std::optional<std::filesystem::path>& robot_dir);
 
 namespace {
-
-Eigen::VectorXd phi_of(const identify::IdentificationModel& model, py::handle params) {
-  const identify::ModelDescription& d = model.description();
-  if (py::isinstance<py::str>(params) || py::hasattr(params, "__fspath__")) {
-    std::vector<std::string> names;
-    for (const auto& p : d.parameters) names.push_back(p.name);
-    return io::read_parameters_yaml(params.cast<std::filesystem::path>().string(), names);
-  }
-  const StateArg phi = state_arg(params, "params", d.np);
-  if (phi.batch) throw py::value_error(fmt::format("params: one vector of {} parameters expected", d.np));
-  return Eigen::Map<const Eigen::VectorXd>(phi.data(), d.np);
-}
 
 std::vector<io::Log> logs_of(const std::vector<std::filesystem::path>& inputs, const identify::ModelDescription& d,
                              int trial) {
@@ -77,7 +66,8 @@ void bind_payload(py::module_& m) {
               "full: the payload's regressor is the robot's full model; give full=<robot>.full (the {} model is "
               "a variant)",
               whole->description().variant));
-        const Eigen::VectorXd phi = phi_of(*arm, params);
+        const std::optional<std::filesystem::path> robot_dir = robot_dir_of(model, robot_dir_given);
+        const Eigen::VectorXd phi = parameters_of(*arm, params, robot_dir);
         const std::vector<io::Log> logs = logs_of(inputs, d, trial);
         payload::PayloadOptions o;
         o.interval = interval_ms / 1000;
@@ -85,9 +75,9 @@ void bind_payload(py::module_& m) {
         o.mass = mass;
         const payload::PayloadLink link = payload::payload_link(*whole);
         std::string flange = fmt::format("frame {}", link.link);
-        if (const auto dir = robot_dir_of(model, robot_dir_given))
-          flange = payload::robot_flange((*dir / "robot.yaml").string(), link.link, static_cast<int>(d.frames.size()),
-                                         o.flange_in_link);
+        if (robot_dir)
+          flange = payload::robot_flange((*robot_dir / "robot.yaml").string(), link.link,
+                                         static_cast<int>(d.frames.size()), o.flange_in_link);
         payload::PayloadEstimate e;
         {
           py::gil_scoped_release release;

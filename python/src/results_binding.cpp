@@ -26,10 +26,8 @@ std::shared_ptr<const identify::IdentificationModel> identification_of(py::handl
 // A loaded model's robot folder when robot_dir is not given (models_binding.cpp).
 std::optional<std::filesystem::path> robot_dir_of(py::handle model, const std::optional<std::filesystem::path>& given);
 
-namespace {
-
 // phi from an array, a parameters file (a study's report/parameters.yaml), or "nominal" (the
-// robot folder's robot.yaml).
+// robot folder's robot.yaml). Shared with payload_binding.cpp.
 Eigen::VectorXd parameters_of(const identify::IdentificationModel& model, py::handle params,
                               const std::optional<std::filesystem::path>& robot_dir) {
   const identify::ModelDescription& d = model.description();
@@ -51,6 +49,8 @@ Eigen::VectorXd parameters_of(const identify::IdentificationModel& model, py::ha
   if (phi.batch) throw py::value_error(fmt::format("params: one vector of {} parameters expected", d.np));
   return Eigen::Map<const Eigen::VectorXd>(phi.data(), d.np);
 }
+
+namespace {
 
 py::dict prediction_dict(const std::string& name, const study::Prediction& p) {
   py::dict x;

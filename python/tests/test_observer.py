@@ -5,8 +5,6 @@ first-order lag integrated here by hand; stepping sample by sample equals observ
 thresholds from a log without contact raise no alarm on another, and the contact is found on
 its joint within 10 ms."""
 
-import os
-import subprocess
 
 import numpy as np
 import pytest
@@ -15,19 +13,8 @@ import symoro
 
 
 @pytest.fixture(scope="module")
-def jaco2(tmp_path_factory, source_dir):
-    symoroc = os.environ.get("SYMORO_SYMOROC")
-    if not symoroc:
-        pytest.fail("SYMORO_SYMOROC is not set (run the tests through ctest)")
-    folder = tmp_path_factory.mktemp("robots") / "jaco2"
-    subprocess.run([symoroc, "model", str(source_dir / "tests" / "urdf" / "kinova.urdf"), "-o", str(folder), "--name",
-                    "jaco2"], check=True, capture_output=True)
-    arm = symoro.load(folder).full
-    rng = np.random.default_rng(5)
-    # Physical standard parameters (positive masses, diagonal inertias): a positive definite M.
-    s = np.array([rng.uniform(0.5, 2.0) if n.rstrip("0123456789") in ("M",) else
-                  rng.uniform(0.01, 0.05) if n.rstrip("0123456789") in ("XX", "YY", "ZZ", "IA", "FV") else 0.0
-                  for n in arm.standard_names])
+def jaco2(jaco2_standard):
+    arm, s = jaco2_standard
     return arm, arm.base_from_standard(s)
 
 

@@ -4,8 +4,6 @@ from the generated model with the body's standard parameters (derived here in Nu
 link, noise and a torque offset the code is not told of; the identified body is the one put in,
 with the known-mass case beside it."""
 
-import os
-import subprocess
 
 import numpy as np
 import pytest
@@ -15,19 +13,8 @@ from synth_logs import MAPPING, RATE, ramp
 
 
 @pytest.fixture(scope="module")
-def jaco2(tmp_path_factory, source_dir):
-    symoroc = os.environ.get("SYMORO_SYMOROC")
-    if not symoroc:
-        pytest.fail("SYMORO_SYMOROC is not set (run the tests through ctest)")
-    folder = tmp_path_factory.mktemp("robots") / "jaco2"
-    subprocess.run([symoroc, "model", str(source_dir / "tests" / "urdf" / "kinova.urdf"), "-o", str(folder), "--name",
-                    "jaco2"], check=True, capture_output=True)
-    arm = symoro.load(folder).full
-    rng = np.random.default_rng(5)
-    s = np.array([rng.uniform(0.5, 2.0) if n.rstrip("0123456789") == "M" else
-                  rng.uniform(0.01, 0.05) if n.rstrip("0123456789") in ("XX", "YY", "ZZ", "IA", "FV") else 0.0
-                  for n in arm.standard_names])
-    return arm, s
+def jaco2(jaco2_standard):
+    return jaco2_standard
 
 
 def body_standard(m, c, I):

@@ -10,7 +10,7 @@ namespace symoro::dynid {
 
 struct ExportOptions {
   std::string study, urdf, model, prior, data;
-  std::string into;  // the user's URDF to write the inertials into (dynid_urdf_into.hpp)
+  std::string into;     // the user's URDF to write the inertials into (dynid_urdf_into.hpp)
   std::string payload;  // a payload.yaml (dynid payload) added as a link on the flange
   // Strictly inside the consistent set, above rounding: a singular pseudo-inertia (lambda_min
   // -2e-17 measured with 0) is a body some simulators reject. The library's defaults.

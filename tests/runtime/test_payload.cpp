@@ -168,6 +168,17 @@ void report(const char* what, const payload::PayloadEstimate& e, const Errors& e
       100 * err.inertia, e.lags, e.condition, e.projected ? 1 : 0);
 }
 
+// The targets: mass within 2 %, CoM within 3 mm, inertia within 15 %.
+Errors expect_within_targets(const payload::PayloadEstimate& e, const payload::PayloadInertial& truth,
+                             const char* what) {
+  const Errors err = errors(e.payload, truth);
+  report(what, e, err);
+  EXPECT_LT(err.mass, 0.02) << what;
+  EXPECT_LT(err.com, 0.003) << what;
+  EXPECT_LT(err.inertia, 0.15) << what;
+  return err;
+}
+
 TEST(PayloadIdentification, TheTwinsUndeclaredPayloadFromA20sWristMotion) {
   const std::string dir = std::string(SYMORO_ROBOTS_DIR) + "/crane_x7";
   const auto override_file = std::filesystem::temp_directory_path() / "payload_twin.yaml";
@@ -197,12 +208,8 @@ TEST(PayloadIdentification, TheTwinsUndeclaredPayloadFromA20sWristMotion) {
   const io::Log log = twin::ClosedLoopTwin(handle, with).run(ref, o);
   const auto model = identify::identification_model<Crane>();
   const payload::PayloadEstimate e = payload::identify_payload({log}, *model, phi, *model);
-  const Errors err = errors(e.payload, truth);
-  report("crane_x7 twin", e, err);
+  const Errors err = expect_within_targets(e, truth, "crane_x7 twin");
   EXPECT_EQ(e.link, 7);
-  EXPECT_LT(err.mass, 0.02);
-  EXPECT_LT(err.com, 0.003);
-  EXPECT_LT(err.inertia, 0.15);
   EXPECT_GT(e.margin, 0);
   // The payload explains the residual the arm alone leaves.
   for (int j = 0; j < 7; ++j) EXPECT_LT(e.rms_with(j), e.rms_without(j)) << "joint " << j + 1;
@@ -227,12 +234,8 @@ TEST(PayloadIdentification, TheTwinsUndeclaredPayloadFromA20sWristMotion) {
   payload::PayloadOptions told;
   told.torque_delay = -0.002;
   const payload::PayloadEstimate d = payload::identify_payload({late}, *model, phi, *model, told);
-  const Errors derr = errors(d.payload, truth);
-  report("crane_x7 twin, 2 ms actuation delay given", d, derr);
+  expect_within_targets(d, truth, "crane_x7 twin, 2 ms actuation delay given");
   EXPECT_GT(blind.inertia, 0.3);
-  EXPECT_LT(derr.mass, 0.02);
-  EXPECT_LT(derr.com, 0.003);
-  EXPECT_LT(derr.inertia, 0.15);
 }
 
 TEST(PayloadIdentification, AnIndependentRx90sToolOnAnArmIdentifiedWithoutIt) {
@@ -277,12 +280,8 @@ TEST(PayloadIdentification, AnIndependentRx90sToolOnAnArmIdentifiedWithoutIt) {
   io.seed = 63;
   const io::Log log = test::run_independent_arm<Rx>(tool, wrist_reference(pose, 3, 3, 1.5, 20), io);
   const payload::PayloadEstimate e = payload::identify_payload({log}, *model, phi, *model);
-  const Errors err = errors(e.payload, truth);
-  report("rx90 independent", e, err);
+  expect_within_targets(e, truth, "rx90 independent");
   EXPECT_EQ(e.link, 6);
-  EXPECT_LT(err.mass, 0.02);
-  EXPECT_LT(err.com, 0.003);
-  EXPECT_LT(err.inertia, 0.15);
   // Its standard deviations are of the error's size, not far below it (the residual's
   // autocorrelation counted): within 4 of them.
   EXPECT_LT(std::abs(e.payload.mass - truth.mass), 4 * e.mass_std + 1e-3 * truth.mass);
@@ -421,11 +420,7 @@ TEST(PayloadExcitation, ADesigned20sWristMotionHoldsTheArmAndIdentifiesTheTwinsP
   truth.inertia << 1.2e-4, 0, 1.0e-5, 0, 1.0e-4, 0, 1.0e-5, 0, 0.8e-4;
   const payload::PayloadEstimate e =
       payload::identify_payload({log}, *model, twin::identified_truth(handle, without), *model);
-  const Errors err = errors(e.payload, truth);
-  report("crane_x7 twin, designed motion", e, err);
-  EXPECT_LT(err.mass, 0.02);
-  EXPECT_LT(err.com, 0.003);
-  EXPECT_LT(err.inertia, 0.15);
+  expect_within_targets(e, truth, "crane_x7 twin, designed motion");
 }
 
 }  // namespace

@@ -264,7 +264,7 @@ class Reader {
     section("payload", {"mass", "com", "inertia"}, e.payload, [&](const YAML::Node& s) {
       field(s, "mass", "payload", [&](const YAML::Node& v) { e.payload_mass = positive(v, "payload mass", true); });
       field(s, "com", "payload", [&](const YAML::Node& v) { e.payload_com = vector(v, "payload com", 3); });
-      if (s["inertia"].IsDefined()) {  // optional: without it, a point mass
+      if (s["inertia"].IsDefined()) {                                          // optional: without it, a point mass
         const Eigen::VectorXd i = vector(s["inertia"], "payload inertia", 6);  // ixx ixy ixz iyy iyz izz
         e.payload_inertia << i(0), i(1), i(2), i(1), i(3), i(4), i(2), i(4), i(5);
       }
