@@ -73,6 +73,34 @@ TEST(HacCovariance, MatchesTheSpreadOfEstimatesUnderAutocorrelatedNoise) {
   }
 }
 
+TEST(HacCovariance, EqualsTheLagByLagSumWithinEachLog) {
+  // The sliding-sum form against the definition: S = sum_k s_k s_k' + sum_{l=1..L} (1 - l / (L + 1))
+  // (G_l + G_l'), G_l over pairs of samples of one log; two logs of 300 and 200 samples.
+  const int N = 500, joints = 3, p = 4, lags = 17;
+  std::mt19937_64 rng(9);
+  std::normal_distribution<double> g;
+  Eigen::MatrixXd X(N * joints, p);
+  Eigen::VectorXd e(N * joints);
+  for (Eigen::Index i = 0; i < X.size(); ++i) X.data()[i] = g(rng);
+  for (Eigen::Index i = 0; i < e.size(); ++i) e(i) = g(rng) + (i > joints ? 0.7 * e(i - joints) : 0.0);
+  std::vector<int> segment(N, 0);
+  for (int k = 300; k < N; ++k) segment[static_cast<std::size_t>(k)] = 1;
+  Eigen::MatrixXd scores(p, N);
+  for (int k = 0; k < N; ++k)
+    scores.col(k) = X.middleRows(k * joints, joints).transpose() * e.segment(k * joints, joints);
+  Eigen::MatrixXd S = scores * scores.transpose();
+  for (int l = 1; l <= lags; ++l)
+    for (int k = l; k < N; ++k)
+      if (segment[static_cast<std::size_t>(k)] == segment[static_cast<std::size_t>(k - l)]) {
+        const Eigen::MatrixXd G = scores.col(k) * scores.col(k - l).transpose();
+        S += (1 - static_cast<double>(l) / (lags + 1)) * (G + G.transpose());
+      }
+  const Eigen::MatrixXd Bi = (X.transpose() * X).inverse();
+  const Eigen::MatrixXd expected = Bi * S * Bi;
+  const Eigen::MatrixXd got = identify::hac_covariance(X, e, segment, joints, lags);
+  EXPECT_LT((got - expected).norm(), 1e-10 * expected.norm());
+}
+
 // phi by least squares on `fit`, its uncertainty there, and the 95 % band's coverage on `held`.
 template <class Model>
 double held_out_coverage(const std::vector<io::Log>& fit, const io::Log& held, const char* what) {
