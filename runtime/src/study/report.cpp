@@ -437,7 +437,11 @@ std::vector<std::filesystem::path> write_report(const StudyResult& study, const 
   md += moves_table(study);
   md += validation_table(study);
   if (!torque_file.empty())
-    md += fmt::format("![{} torques: measured, CLIE and PD-rescue](figures/{})\n\n", options.validation_figure,
+    md += fmt::format("![{} torques: measured, CLIE and PD-rescue{}](figures/{})\n\n", options.validation_figure,
+                      study.uncertainty.covariance.size() > 0
+                          ? ", with the open-loop 95 % prediction band dashed around the PD-rescue (a guide where "
+                            "the simulation is closed-loop)"
+                          : "",
                       torque_file);
   else if (!study.validation.empty())
     md += fmt::format("No torque series for {}; its figure is left out.\n\n", options.validation_figure);
