@@ -27,18 +27,8 @@ namespace {
 std::vector<io::Log> logs_of(const std::vector<std::filesystem::path>& inputs, const identify::ModelDescription& d,
                              int trial) {
   std::vector<io::Log> logs;
-  for (const auto& input : inputs) {
-    if (std::filesystem::is_directory(input)) {
-      const io::Dataset data = io::read_dataset(input);
-      io::check_dataset_robot(data, d.robot);
-      for (const auto& r : data.runs)
-        if (r.trial == trial) logs.push_back(io::read_run_log(r, d.robot, d.nq));
-    } else {
-      io::Log log = io::read_log(input);
-      io::check_log_robot(log, input, d.robot, d.nq);
-      logs.push_back(std::move(log));
-    }
-  }
+  for (const auto& input : inputs)
+    for (auto& l : io::read_input_logs(input, d.robot, d.nq, trial)) logs.push_back(std::move(l.log));
   if (logs.empty()) throw py::value_error(fmt::format("no run of trial {} in the inputs", trial));
   return logs;
 }

@@ -94,18 +94,8 @@ void bind_results(py::module_& m) {
         const identify::ModelDescription& d = id->description();
         const Eigen::VectorXd phi = parameters_of(*id, params, robot_dir);
         // One log, or every run of a dataset's trial (as dynid predict).
-        std::vector<std::pair<std::string, io::Log>> logs;
-        if (std::filesystem::is_directory(input)) {
-          const io::Dataset data = io::read_dataset(input);
-          io::check_dataset_robot(data, d.robot);
-          for (const auto& r : data.runs)
-            if (r.trial == trial) logs.emplace_back(r.trajectory, io::read_run_log(r, d.robot, d.nq));
-          if (logs.empty()) throw py::value_error(fmt::format("{}: no run of trial {}", input.string(), trial));
-        } else {
-          io::Log log = io::read_log(input);
-          io::check_log_robot(log, input, d.robot, d.nq);
-          logs.emplace_back(input.stem().string(), std::move(log));
-        }
+        const std::vector<io::NamedLog> logs = io::read_input_logs(input, d.robot, d.nq, trial);
+        if (logs.empty()) throw py::value_error(fmt::format("{}: no run of trial {}", input.string(), trial));
         // The band's uncertainty: given, or report/uncertainty.yaml beside a parameters file.
         std::optional<study::PredictionUncertainty> u;
         std::optional<std::filesystem::path> ufile = uncertainty_file;
@@ -123,11 +113,11 @@ void bind_results(py::module_& m) {
         {
           py::gil_scoped_release release;
           for (std::size_t i = 0; i < logs.size(); ++i)
-            out[i] = study::predict(logs[i].second, *id, phi, {interval_ms / 1000, torque_delay_ms / 1000});
+            out[i] = study::predict(logs[i].log, *id, phi, {interval_ms / 1000, torque_delay_ms / 1000});
         }
         py::list result;
         for (std::size_t i = 0; i < logs.size(); ++i) {
-          py::dict x = prediction_dict(logs[i].first, out[i]);
+          py::dict x = prediction_dict(logs[i].name, out[i]);
           if (u) {
             const Eigen::MatrixXd b = study::prediction_band(*id, out[i].samples, *u, band);
             const study::BandCoverage c = study::band_coverage(out[i].samples.tau, out[i].tau_model, b);

@@ -50,4 +50,15 @@ inline CLI::Validator count(double lo, double hi) {
 // intervals would share a name; past 10 s no log holds enough samples.
 inline CLI::Validator interval_ms() { return checked(1, 10000, false, false, "from 1 to 10000 ms"); }
 
+// The options of a command that reads logs as identification preprocesses them (predict,
+// payload): --interval (ms), --torque-delay (ms) and --trial.
+inline void add_log_options(CLI::App* cmd, double& interval, double& torque_delay, int& trial) {
+  cmd->add_option("--interval", interval, "Sampling interval in ms, as in identification")
+      ->check(interval_ms())
+      ->capture_default_str();
+  cmd->add_option("--torque-delay", torque_delay, "ms the logged torque lags the links' (as dynid identify)")
+      ->check(checked(-1000, 1000, false, false, "from -1000 to 1000 ms"));
+  cmd->add_option("--trial", trial, "Which trial of a dataset's runs")->check(count(1, 1e6))->capture_default_str();
+}
+
 }  // namespace symoro::dynid::numbers

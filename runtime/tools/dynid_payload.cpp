@@ -47,22 +47,11 @@ void run(const Common& common, const PayloadCliOptions& o) {
 
   std::vector<io::Log> logs;
   std::string names;
-  for (const auto& input : o.inputs) {
-    if (fs::is_directory(input)) {
-      const io::Dataset data = io::read_dataset(input);
-      io::check_dataset_robot(data, common.robot);
-      for (const auto& r : data.runs)
-        if (r.trial == o.trial) {
-          logs.push_back(io::read_run_log(r, common.robot, d.nq));
-          names += (names.empty() ? "" : ", ") + input + ":" + r.trajectory;
-        }
-    } else {
-      io::Log log = io::read_log(input);
-      io::check_log_robot(log, input, d.robot, d.nq);
-      logs.push_back(std::move(log));
-      names += (names.empty() ? "" : ", ") + input;
+  for (const auto& input : o.inputs)
+    for (auto& l : io::read_input_logs(input, d.robot, d.nq, o.trial)) {
+      names += (names.empty() ? "" : ", ") + (fs::is_directory(input) ? input + ":" + l.name : input);
+      logs.push_back(std::move(l.log));
     }
-  }
   if (logs.empty()) throw UsageError(fmt::format("no run of trial {} in {}", o.trial, fmt::join(o.inputs, ", ")));
   const fs::path out(o.out), yaml_file = out / "payload.yaml", urdf_file = out / "payload.urdf";
   for (const auto& f : {yaml_file, urdf_file})
@@ -133,14 +122,7 @@ void add_payload_commands(CLI::App& app, Common& common) {
   cmd->add_option("-o,--out", o->out, "Folder for payload.yaml and payload.urdf")->required();
   cmd->add_option("--mass", o->mass, "The payload's known mass, kg: the other 9 parameters are identified")
       ->check(numbers::checked(0, 1e4, true, false, "above 0 and at most 1e4 kg"));
-  cmd->add_option("--interval", o->interval_ms, "Sampling interval in ms, as in identification")
-      ->check(numbers::interval_ms())
-      ->capture_default_str();
-  cmd->add_option("--torque-delay", o->torque_delay_ms, "ms the logged torque lags the links' (as dynid identify)")
-      ->check(numbers::checked(-1000, 1000, false, false, "from -1000 to 1000 ms"));
-  cmd->add_option("--trial", o->trial, "Which trial of a dataset's runs")
-      ->check(numbers::count(1, 1e6))
-      ->capture_default_str();
+  numbers::add_log_options(cmd, o->interval_ms, o->torque_delay_ms, o->trial);
   cmd->add_flag("--force", o->force, "Overwrite existing output files");
   cmd->callback([&common, o] { run(common, *o); });
 }

@@ -93,23 +93,13 @@ void run(const Common& common, const PredictOptions& options) {
       parameters_phi(common, robot_model(common, d.variant.empty() ? "full" : d.variant), options.params);
 
   // What to predict: one log, or every run of a dataset's trial.
-  std::vector<std::pair<std::string, io::Log>> logs;
   const fs::path input(options.input);
-  if (fs::is_directory(input)) {
-    const io::Dataset data = io::read_dataset(input);
-    io::check_dataset_robot(data, common.robot);
-    for (const auto& r : data.runs)
-      if (r.trial == options.trial) logs.emplace_back(r.trajectory, io::read_run_log(r, common.robot, d.nq));
-    if (logs.empty()) throw UsageError(fmt::format("{}: no run of trial {}", input.string(), options.trial));
-  } else {
-    io::Log log = io::read_log(input);
-    io::check_log_robot(log, input, d.robot, d.nq);
-    logs.emplace_back(input.stem().string(), std::move(log));
-  }
+  const std::vector<io::NamedLog> logs = io::read_input_logs(input, d.robot, d.nq, options.trial);
+  if (logs.empty()) throw UsageError(fmt::format("{}: no run of trial {}", input.string(), options.trial));
   const fs::path out(options.out);
   const bool one = logs.size() == 1 && !fs::is_directory(input);
   std::vector<fs::path> files;
-  for (const auto& [name, log] : logs) files.push_back(one ? out : out / (name + ".predicted.csv"));
+  for (const auto& l : logs) files.push_back(one ? out : out / (l.name + ".predicted.csv"));
   for (const auto& f : files)
     if (fs::exists(f) && !options.force)
       throw UsageError(f.string() + " exists: dynid predict does not overwrite it; choose another --out, or --force");
@@ -124,9 +114,9 @@ void run(const Common& common, const PredictOptions& options) {
   std::string raw_filter;
   for (std::size_t i = 0; i < logs.size(); ++i) {
     Eigen::MatrixXd band;
-    const study::Prediction p = predict_log(logs[i].second, *model, phi, options, files[i], u, band);
+    const study::Prediction p = predict_log(logs[i].log, *model, phi, options, files[i], u, band);
     const int samples = static_cast<int>(p.samples.tau.rows());
-    std::string line = fmt::format("  {:<10} {:>6} samples:", logs[i].first, samples);
+    std::string line = fmt::format("  {:<10} {:>6} samples:", logs[i].name, samples);
     for (int j = 0; j < d.nq; ++j) line += fmt::format(" {:.4f} ({:.3f})", p.rmse(j), p.rms(j));
     fmt::print("{}\n", line);
     line = fmt::format("  {:<10} {:>6} raw:    ", "", p.raw.samples);
@@ -187,14 +177,7 @@ void add_predict_commands(CLI::App& app, Common& common) {
       ->required()
       ->check(CLI::ExistingPath);
   cmd->add_option("-o,--out", o->out, "The CSV to write (a folder of <run>.predicted.csv for a dataset)")->required();
-  cmd->add_option("--interval", o->interval_ms, "Sampling interval in ms, as in identification")
-      ->check(numbers::interval_ms())
-      ->capture_default_str();
-  cmd->add_option("--torque-delay", o->torque_delay_ms, "ms the logged torque lags the links' (as dynid identify)")
-      ->check(numbers::checked(-1000, 1000, false, false, "from -1000 to 1000 ms"));
-  cmd->add_option("--trial", o->trial, "Which trial of a dataset's runs")
-      ->check(numbers::count(1, 1e6))
-      ->capture_default_str();
+  numbers::add_log_options(cmd, o->interval_ms, o->torque_delay_ms, o->trial);
   cmd->add_option("--band", o->band,
                   "Level of the prediction band (tau_band_* columns, and the share of samples inside), from the "
                   "study's report/uncertainty.yaml beside --params; 0: none")

@@ -239,4 +239,20 @@ void check_dataset_robot(const Dataset& dataset, const std::string& robot) {
                   fmt::format("the dataset was made for robot '{}', not '{}'", dataset.robot, robot));
 }
 
+std::vector<NamedLog> read_input_logs(const std::filesystem::path& input, const std::string& robot, int joints,
+                                      int trial) {
+  std::vector<NamedLog> out;
+  if (std::filesystem::is_directory(input)) {
+    const Dataset data = read_dataset(input);
+    check_dataset_robot(data, robot);
+    for (const auto& r : data.runs)
+      if (r.trial == trial) out.push_back({r.trajectory, read_run_log(r, robot, joints)});
+  } else {
+    Log log = read_log(input);
+    check_log_robot(log, input, robot, joints);
+    out.push_back({input.stem().string(), std::move(log)});
+  }
+  return out;
+}
+
 }  // namespace symoro::io

@@ -10,6 +10,7 @@
 #include "symoro/error.hpp"
 #include "symoro/io/number_text.hpp"
 #include "symoro/io/yaml_keys.hpp"
+#include "symoro/io/yaml_numbers.hpp"
 
 namespace symoro::payload {
 
@@ -39,20 +40,17 @@ Eigen::Vector3d rpy_of(const Eigen::Matrix3d& R) {  // R = Rz(yaw) Ry(pitch) Rx(
           std::atan2(R(1, 0), R(0, 0)) + 0.0};
 }
 
-double number_at(const YAML::Node& n, const std::string& file, const std::string& what) {
-  double v = 0;
-  if (!n || !n.IsScalar() || io::parse_number(n.Scalar(), v) != io::NumberParse::ok || !std::isfinite(v))
-    throw DataError(file, n ? n.Mark().line + 1 : 0, what + ": not a finite number");
-  return v;
-}
-
-std::vector<double> numbers_at(const YAML::Node& n, std::size_t count, const std::string& file,
-                               const std::string& what) {
-  if (!n || !n.IsSequence() || n.size() != count)
-    throw DataError(file, n ? n.Mark().line + 1 : 0, fmt::format("{}: a list of {} numbers", what, count));
-  std::vector<double> out;
-  for (const auto& v : n) out.push_back(number_at(v, file, what));
-  return out;
+// A pose {xyz, rpy} (rpy: R = Rz(yaw) Ry(pitch) Rx(roll), as URDF and robot.yaml write it).
+Eigen::Isometry3d pose_at(const YAML::Node& n, const std::string& file, const std::string& what) {
+  const Eigen::VectorXd xyz = io::yaml_numbers(n["xyz"], 3, file, what + " xyz");
+  const Eigen::VectorXd rpy = io::yaml_numbers(n["rpy"], 3, file, what + " rpy");
+  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+  T.linear() =
+      (Eigen::AngleAxisd(rpy(2), Eigen::Vector3d::UnitZ()) * Eigen::AngleAxisd(rpy(1), Eigen::Vector3d::UnitY()) *
+       Eigen::AngleAxisd(rpy(0), Eigen::Vector3d::UnitX()))
+          .toRotationMatrix();
+  T.translation() = xyz;
+  return T;
 }
 
 }  // namespace
@@ -63,14 +61,7 @@ std::string robot_flange(const std::string& robot_yaml, int link, int frames, Ei
   const YAML::Node u = root.IsMap() ? root["urdf"] : YAML::Node();
   if (!u || !u.IsMap() || !u["tip_link"] || !u["tip_in_last_frame"] || link != frames)
     return fmt::format("frame {}", link);
-  const YAML::Node t = u["tip_in_last_frame"];
-  const auto xyz = numbers_at(t["xyz"], 3, robot_yaml, "urdf.tip_in_last_frame xyz");
-  const auto rpy = numbers_at(t["rpy"], 3, robot_yaml, "urdf.tip_in_last_frame rpy");
-  flange_in_link.linear() =
-      (Eigen::AngleAxisd(rpy[2], Eigen::Vector3d::UnitZ()) * Eigen::AngleAxisd(rpy[1], Eigen::Vector3d::UnitY()) *
-       Eigen::AngleAxisd(rpy[0], Eigen::Vector3d::UnitX()))
-          .toRotationMatrix();
-  flange_in_link.translation() = Eigen::Vector3d(xyz[0], xyz[1], xyz[2]);
+  flange_in_link = pose_at(u["tip_in_last_frame"], robot_yaml, "urdf.tip_in_last_frame");
   return u["tip_link"].as<std::string>();
 }
 
@@ -131,22 +122,15 @@ PayloadFile read_payload_yaml(const std::string& file) {
   PayloadFile out;
   out.robot = root["robot"] ? root["robot"].as<std::string>() : "";
   out.flange = root["flange"] ? root["flange"].as<std::string>() : "";
-  out.payload.mass = number_at(p["mass"], file, "payload mass");
+  out.payload.mass = io::yaml_number(p["mass"], file, "payload mass");
   if (!(out.payload.mass > 0)) throw DataError(file, p["mass"].Mark().line + 1, "payload mass: must be positive");
-  const auto c = numbers_at(p["com"], 3, file, "payload com");
-  out.payload.com = Eigen::Vector3d(c[0], c[1], c[2]);
-  const auto i = numbers_at(p["inertia"], 6, file, "payload inertia (ixx iyy izz ixy ixz iyz)");
-  out.payload.inertia << i[0], i[3], i[4], i[3], i[1], i[5], i[4], i[5], i[2];
+  out.payload.com = io::yaml_numbers(p["com"], 3, file, "payload com");
+  const Eigen::VectorXd i = io::yaml_numbers(p["inertia"], 6, file, "payload inertia (ixx iyy izz ixy ixz iyz)");
+  out.payload.inertia << i(0), i(3), i(4), i(3), i(1), i(5), i(4), i(5), i(2);
   if (const YAML::Node f = root["flange_in_link"]) {
     io::check_keys(f, {"link", "xyz", "rpy"}, file, "flange_in_link");
-    out.link = static_cast<int>(number_at(f["link"], file, "flange_in_link link"));
-    const auto xyz = numbers_at(f["xyz"], 3, file, "flange_in_link xyz");
-    const auto rpy = numbers_at(f["rpy"], 3, file, "flange_in_link rpy");
-    out.flange_in_link.linear() =
-        (Eigen::AngleAxisd(rpy[2], Eigen::Vector3d::UnitZ()) * Eigen::AngleAxisd(rpy[1], Eigen::Vector3d::UnitY()) *
-         Eigen::AngleAxisd(rpy[0], Eigen::Vector3d::UnitX()))
-            .toRotationMatrix();
-    out.flange_in_link.translation() = Eigen::Vector3d(xyz[0], xyz[1], xyz[2]);
+    out.link = static_cast<int>(io::yaml_number(f["link"], file, "flange_in_link link"));
+    out.flange_in_link = pose_at(f, file, "flange_in_link");
   }
   return out;
 }

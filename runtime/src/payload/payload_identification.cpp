@@ -10,7 +10,8 @@
 
 #include "consistent_payload.hpp"
 #include "symoro/identify/hac_covariance.hpp"
-#include "symoro/study/prediction.hpp"
+#include "symoro/preprocess/preprocess.hpp"
+#include "symoro/study/options.hpp"
 
 namespace symoro::payload {
 
@@ -30,10 +31,13 @@ Stack stack(const std::vector<io::Log>& logs, const identify::IdentificationMode
   s.joints = arm.description().nq;
   std::vector<Eigen::MatrixXd> Xs;
   std::vector<Eigen::VectorXd> ys;
+  // The identification's preprocessing (study/prediction.hpp's, without its raw-rate scoring).
+  preprocess::Options po = study::StudyOptions{}.preprocess;
+  po.torque_delay = o.torque_delay;
   for (std::size_t i = 0; i < logs.size(); ++i) {
-    const study::Prediction p = study::predict(logs[i], arm, phi, {o.interval, o.torque_delay});
-    const Eigen::MatrixXd r = p.samples.tau - p.tau_model;
-    Xs.push_back(full.stack_regression(p.samples).W * link.map);
+    const preprocess::Samples samples = preprocess::preprocess(logs[i], o.interval, po);
+    const Eigen::MatrixXd r = samples.tau - arm.open_loop_torque(samples, phi);
+    Xs.push_back(full.stack_regression(samples).W * link.map);
     Eigen::VectorXd y(r.size());
     for (Eigen::Index k = 0; k < r.rows(); ++k) y.segment(k * s.joints, s.joints) = r.row(k).transpose();
     ys.push_back(std::move(y));

@@ -11,25 +11,11 @@
 #include "symoro/identify/hac_covariance.hpp"
 #include "symoro/io/number_text.hpp"
 #include "symoro/io/yaml_keys.hpp"
+#include "symoro/io/yaml_numbers.hpp"
 
 namespace symoro::study {
 
 namespace {
-
-double number_at(const YAML::Node& n, const std::string& file, const std::string& what) {
-  double v = 0;
-  if (!n || !n.IsScalar() || io::parse_number(n.Scalar(), v) != io::NumberParse::ok || !std::isfinite(v))
-    throw DataError(file, n ? n.Mark().line + 1 : 0, what + ": not a finite number");
-  return v;
-}
-
-Eigen::VectorXd vector_at(const YAML::Node& n, std::size_t size, const std::string& file, const std::string& what) {
-  if (!n || !n.IsSequence() || n.size() != size)
-    throw DataError(file, n ? n.Mark().line + 1 : 0, fmt::format("{}: a list of {} numbers", what, size));
-  Eigen::VectorXd v(static_cast<Eigen::Index>(size));
-  for (std::size_t i = 0; i < size; ++i) v(static_cast<Eigen::Index>(i)) = number_at(n[i], file, what);
-  return v;
-}
 
 std::string list(const Eigen::VectorXd& v) {
   std::string out = "[";
@@ -128,8 +114,8 @@ PredictionUncertainty read_uncertainty_yaml(const std::string& file, const std::
   u.model = root["model"] ? root["model"].as<std::string>() : "";
   if (u.model == "full") u.model.clear();
   u.source = root["source"] ? root["source"].as<std::string>() : "";
-  u.samples = root["samples"] ? static_cast<int>(number_at(root["samples"], file, "samples")) : 0;
-  u.lags = root["lags"] ? static_cast<int>(number_at(root["lags"], file, "lags")) : 0;
+  u.samples = root["samples"] ? static_cast<int>(io::yaml_number(root["samples"], file, "samples")) : 0;
+  u.lags = root["lags"] ? static_cast<int>(io::yaml_number(root["lags"], file, "lags")) : 0;
   const YAML::Node p = root["parameters"];
   if (!p || !p.IsSequence() || p.size() != names.size())
     throw DataError(file, p ? p.Mark().line + 1 : 0,
@@ -140,13 +126,14 @@ PredictionUncertainty read_uncertainty_yaml(const std::string& file, const std::
                       fmt::format("parameter {} is {}, the model's is {}", i + 1, p[i].as<std::string>(), names[i]));
   u.names = names;
   const YAML::Node r = root["residual"];
-  u.residual = vector_at(r, r && r.IsSequence() ? r.size() : 0, file, "residual");
+  u.residual = io::yaml_numbers(r, r && r.IsSequence() ? r.size() : 0, file, "residual");
   const YAML::Node c = root["covariance"];
   if (!c || !c.IsSequence() || c.size() != names.size())
     throw DataError(file, c ? c.Mark().line + 1 : 0, fmt::format("covariance: {} rows", names.size()));
   u.covariance.resize(static_cast<Eigen::Index>(names.size()), static_cast<Eigen::Index>(names.size()));
   for (std::size_t i = 0; i < names.size(); ++i)
-    u.covariance.row(static_cast<Eigen::Index>(i)) = vector_at(c[i], names.size(), file, "covariance").transpose();
+    u.covariance.row(static_cast<Eigen::Index>(i)) =
+        io::yaml_numbers(c[i], names.size(), file, "covariance").transpose();
   return u;
 }
 

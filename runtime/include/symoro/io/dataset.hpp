@@ -89,4 +89,14 @@ void check_dataset_robot(const Dataset& dataset, const std::string& robot);
 // RMSE of 77 N m and exited 0).
 void check_log_robot(const Log& log, const std::filesystem::path& csv, const std::string& robot, int joints);
 
+// The logs a command's input names, checked as above: every run of `trial` of a dataset folder
+// (named by its trajectory), or one log file (named by its stem). Empty when the dataset has no
+// run of that trial: the caller says what to give instead.
+struct NamedLog {
+  std::string name;
+  Log log;
+};
+std::vector<NamedLog> read_input_logs(const std::filesystem::path& input, const std::string& robot, int joints,
+                                      int trial);
+
 }  // namespace symoro::io
