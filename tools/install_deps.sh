@@ -10,6 +10,9 @@ packages=(
   libgtest-dev libgmock-dev libbenchmark-dev
   libopenmpi-dev openmpi-bin  # optional: the MPI farm and its test (docs/scaling.md)
   procps  # pgrep/ps: the MPI test finds the rank it kills
+  liblz4-dev libzstd-dev  # MCAP chunks: dynid import reads ROS 2 bags (io/mcap.hpp)
+  libmujoco-dev  # dynid export --mjcf is checked against MuJoCo's own inverse dynamics (tests)
+  nodejs npm  # test-only: the MCAP project's writer makes the bags the import tests read (tests/bags)
   libxxhash-dev  # content digests (io/digest.hpp): saved runs, parameters files, robot folders
   liburdfdom-dev liburdfdom-tools  # symoroc model reads URDFs (urdfdom); the export tests read them back (check_urdf)
   libtinyxml-dev  # symoroc model names the line of a malformed URDF (urdfdom's own XML parser)

@@ -21,6 +21,7 @@
 #include "symoro/model_export/model_export.hpp"
 #include "symoro/identify/regression.hpp"
 #include "symoro/model_export/urdf_export.hpp"
+#include "symoro/model_export/mjcf_export.hpp"
 #include "symoro/io/folder_lock.hpp"
 #include "symoro/io/atomic_file.hpp"
 #include "symoro/io/dataset.hpp"
@@ -174,7 +175,7 @@ Eigen::VectorXd export_prior(const Common& common, const ExportOptions& options,
 
 // What the export says: the consistency, the files, and what a URDF consumer loses.
 void print_export(const model_export::ModelExport& e, const model_export::ModelExportFiles& files,
-                  const std::string& prior_what) {
+                  const std::string& prior_what, const ExportOptions& options) {
   const identify::ConsistencyResult& r = e.consistency;
   if (e.nearest)
     fmt::print("WARNING: {}; exported the nearest base vector with a consistent set ({:.4g} away); {}\n", r.message,
@@ -182,7 +183,11 @@ void print_export(const model_export::ModelExport& e, const model_export::ModelE
   fmt::print("{}: {}; max |B s - phi| = {:.3g}, lambda_min = {:.4g}, prior {}\n",
              e.nearest ? "standard parameters of the nearest consistent base vector" : "consistent standard parameters",
              r.message, e.residual, r.lambda_min, prior_what);
-  fmt::print("urdf: {}\nstandard parameters: {}, {}\n", files.urdf.string(), files.yaml.string(), files.csv.string());
+  if (!options.urdf.empty()) fmt::print("urdf: {}\n", options.urdf);
+  if (!options.mjcf.empty())
+    fmt::print("mjcf: {} (rotor inertia as each joint's armature, FV as damping, FS as frictionloss)\n", options.mjcf);
+  fmt::print("standard parameters: {}, {}\n", files.yaml.string(), files.csv.string());
+  if (options.urdf.empty()) return;
   // The rotor inertia (a simulator's joint armature) has no URDF field.
   std::string rotor;
   for (std::size_t k = 0; k < e.description.names.size(); ++k)
@@ -192,8 +197,27 @@ void print_export(const model_export::ModelExport& e, const model_export::ModelE
   if (!rotor.empty())
     fmt::print(
         "rotor inertia has no URDF field: the URDF holds it only as comments, which URDF readers ignore; a "
-        "simulator takes it from {} (MuJoCo: each joint's armature): {}\n",
-        files.yaml.string(), rotor);
+        "simulator takes it from {}{}: {}\n",
+        options.mjcf.empty() ? files.yaml.string() : options.mjcf,
+        options.mjcf.empty() ? " (MuJoCo: each joint's armature; dynid export --mjcf writes it there)"
+                             : " (each joint's armature)",
+        rotor);
+}
+
+// A payload.yaml's body as an MJCF body on its model frame, the flange at its recorded pose.
+model_export::MjcfAttachment payload_body(const Common& common, const ExportOptions& options) {
+  const payload::PayloadFile f = payload::read_payload_yaml(options.payload);
+  if (!f.robot.empty() && f.robot != common.robot)
+    throw UsageError(fmt::format("{}: a payload of robot '{}', not {}", options.payload, f.robot, common.robot));
+  model_export::MjcfAttachment a;
+  a.name = "payload";
+  a.frame = f.link;
+  a.pose = f.flange_in_link;
+  a.inertial.present = true;
+  a.inertial.mass = f.payload.mass;
+  a.inertial.com = f.payload.com;
+  a.inertial.inertia = f.payload.inertia;
+  return a;
 }
 
 // The URDF with a payload.yaml's body on its flange: into the user's URDF, on the flange link
@@ -255,16 +279,31 @@ void run_export(const Common& common, const ExportOptions& options, const std::s
   };
   const model_export::ModelExport e = model_export::export_model(*model, phi, eo);
   std::string urdf_text;
-  if (options.into.empty()) {
+  if (options.urdf.empty()) {
+    if (!options.into.empty()) throw UsageError("--into writes a URDF: give --urdf too");
+  } else if (options.into.empty()) {
     urdf_text = model_export::urdf_text(e.description);
   } else {
     std::vector<std::string> notes;
     urdf_text = urdf_into(e.description, (common.robot_dir() / "robot.yaml").string(), options.into, notes);
     for (const auto& note : notes) fmt::print("{}\n", note);
   }
-  if (!options.payload.empty()) urdf_text = export_detail::with_payload(common, options, e.description, urdf_text);
-  const model_export::ModelExportFiles files = model_export::write_model_export(e, options.urdf, urdf_text);
-  export_detail::print_export(e, files, eo.prior_what);
+  std::vector<model_export::MjcfAttachment> attachments;
+  if (!options.payload.empty()) {
+    if (!options.urdf.empty()) urdf_text = export_detail::with_payload(common, options, e.description, urdf_text);
+    attachments.push_back(export_detail::payload_body(common, options));
+  }
+  std::string mjcf_text;
+  if (!options.mjcf.empty()) try {
+      mjcf_text = model_export::mjcf_text(e.description, full_model(common).gravity(), attachments);
+    } catch (const std::invalid_argument& x) {
+      throw std::runtime_error(std::string("no MJCF written: ") + x.what());
+    }
+  // The standard parameters go beside the URDF, else beside the MJCF.
+  const model_export::ModelExportFiles files = model_export::write_model_export(
+      e, options.urdf.empty() ? options.mjcf : options.urdf, options.urdf.empty() ? mjcf_text : urdf_text);
+  if (!options.urdf.empty() && !options.mjcf.empty()) io::write_file_atomically(options.mjcf, mjcf_text);
+  export_detail::print_export(e, files, eo.prior_what, options);
 }
 
 void add_export_commands(CLI::App& app, Common& common) {
@@ -277,8 +316,10 @@ void add_export_commands(CLI::App& app, Common& common) {
   cmd->add_option("--study", o->study, "Study folder of dynid identify (reads report/parameters.yaml)")
       ->required()
       ->check(CLI::ExistingDirectory);
-  cmd->add_option("--urdf", o->urdf, "URDF file to write; <stem>.standard.yaml and <stem>.standard.csv go beside it")
-      ->required();
+  cmd->add_option("--urdf", o->urdf, "URDF file to write; <stem>.standard.yaml and <stem>.standard.csv go beside it");
+  cmd->add_option("--mjcf", o->mjcf,
+                  "MuJoCo model (MJCF) to write, with rotor inertia as armature (docs/mjcf.md); "
+                  "without --urdf the .standard.yaml/.csv go beside it");
   cmd->add_option("--model", o->model, "Model the study identified (checked; default: the study's own)");
   cmd->add_option("--into", o->into,
                   "The robot's own URDF (the one symoroc model read): --urdf is then that file with "
@@ -313,24 +354,26 @@ void add_export_commands(CLI::App& app, Common& common) {
   cmd->add_option("--payload", o->payload,
                   "A payload.yaml of dynid payload: the payload as a link on a fixed joint at its flange")
       ->check(CLI::ExistingFile);
-  cmd->add_flag("--force", o->force, "Overwrite the URDF and its .standard.yaml/.csv when they exist");
+  cmd->add_flag("--force", o->force, "Overwrite the URDF, the MJCF and the .standard.yaml/.csv when they exist");
   cmd->callback([&common, o] {
     // One export to a URDF at a time (its own lock file beside it, held to the end: two at once
     // both passed the check below, and the last writer won), and, like import and control, an
     // existing file is replaced only when the user says so, before any work is done.
-    const std::filesystem::path target(o->urdf);
+    if (o->urdf.empty() && o->mjcf.empty()) throw UsageError("say what to write: --urdf file, --mjcf file, or both");
+    const std::filesystem::path target(o->urdf.empty() ? o->mjcf : o->urdf);
     const io::FolderLock lock(target.parent_path().empty() ? std::filesystem::path(".") : target.parent_path(),
                               "dynid export", "." + target.filename().string() + ".lock", /*remove_when_done=*/true);
-    std::filesystem::path stem = o->urdf;
+    std::filesystem::path stem = target;
     stem.replace_extension();
-    for (const std::filesystem::path& f :
-         {std::filesystem::path(o->urdf), std::filesystem::path(stem.string() + ".standard.yaml"),
-          std::filesystem::path(stem.string() + ".standard.csv")}) {
+    std::vector<std::filesystem::path> outputs{target, std::filesystem::path(stem.string() + ".standard.yaml"),
+                                               std::filesystem::path(stem.string() + ".standard.csv")};
+    if (!o->urdf.empty() && !o->mjcf.empty()) outputs.emplace_back(o->mjcf);
+    for (const std::filesystem::path& f : outputs) {
       if (std::filesystem::is_directory(f))
-        throw UsageError(fmt::format("{} is a directory: --urdf names the file to write", f.string()));
+        throw UsageError(fmt::format("{} is a directory: --urdf and --mjcf name the files to write", f.string()));
       if (std::filesystem::exists(f) && !o->force)
-        throw UsageError(fmt::format("{} exists: dynid export does not overwrite it; choose another --urdf, or --force",
-                                     f.string()));
+        throw UsageError(fmt::format(
+            "{} exists: dynid export does not overwrite it; choose another --urdf or --mjcf, or --force", f.string()));
     }
     const std::string file = (std::filesystem::path(o->study) / "report" / "parameters.yaml").string();
     const std::string label = study_model(file);

@@ -10,6 +10,7 @@ namespace symoro::dynid {
 
 struct ExportOptions {
   std::string study, urdf, model, prior, data;
+  std::string mjcf;     // the MuJoCo model to write (model_export/mjcf_export.hpp)
   std::string into;     // the user's URDF to write the inertials into (dynid_urdf_into.hpp)
   std::string payload;  // a payload.yaml (dynid payload) added as a link on the flange
   // Strictly inside the consistent set, above rounding: a singular pseudo-inertia (lambda_min

@@ -6,37 +6,17 @@
 
 #include <fmt/format.h>
 
-#include "symoro/io/number_text.hpp"
+#include "export_text.hpp"
 #include "symoro/mdh.hpp"
 
 namespace symoro::model_export {
 
 namespace {
 
-std::string num(double v) { return io::number_text(v == 0 ? 0.0 : v); }  // no "-0"
-
-// XML attribute and comment text: the names come from robot.yaml.
-std::string xml_escaped(const std::string& t) {
-  std::string out;
-  for (char c : t) {
-    if (c == '&')
-      out += "&amp;";
-    else if (c == '<')
-      out += "&lt;";
-    else if (c == '>')
-      out += "&gt;";
-    else if (c == '"')
-      out += "&quot;";
-    else
-      out += c;
-  }
-  return out;
-}
-std::string comment_text(const std::string& t) {  // "--" may not appear in an XML comment
-  std::string out = t;
-  for (std::size_t p; (p = out.find("--")) != std::string::npos;) out.replace(p, 2, "- -");
-  return out;
-}
+using detail::comment_text;
+using detail::joint_of_frame;
+using detail::num;
+using detail::xml_escaped;
 
 int slot_of(const std::string& family) {
   static const char* order[10] = {"XX", "XY", "XZ", "YY", "YZ", "ZZ", "MX", "MY", "MZ", "M"};
@@ -45,15 +25,11 @@ int slot_of(const std::string& family) {
   return -1;
 }
 
-// The joint (index into d.joints) of a movable frame, -1 for a fixed one.
-int joint_of_frame(const UrdfDescription& d, int frame) {
-  int k = -1;
-  for (int f = 1; f <= frame; ++f)
-    if (d.frames[static_cast<std::size_t>(f - 1)].sigma != 2) ++k;
-  return d.frames[static_cast<std::size_t>(frame - 1)].sigma == 2 ? -1 : k;
-}
+}  // namespace
 
-void check(const UrdfDescription& d) {
+namespace detail {
+
+void check_description(const UrdfDescription& d) {
   if (d.s.size() != static_cast<Eigen::Index>(d.names.size()))
     throw std::invalid_argument(
         fmt::format("urdf export: {} standard parameters for {} names", d.s.size(), d.names.size()));
@@ -69,7 +45,7 @@ void check(const UrdfDescription& d) {
     throw std::invalid_argument(fmt::format("urdf export: {} movable frames for {} joints", movable, d.joints.size()));
 }
 
-}  // namespace
+}  // namespace detail
 
 UrdfInertial inertial_about_com(const Eigen::Matrix3d& inertia_origin, const Eigen::Vector3d& first_moment,
                                 double mass) {
@@ -142,7 +118,7 @@ std::string standard_unit(const std::string& family, bool prismatic) {
 }
 
 std::string urdf_text(const UrdfDescription& d) {
-  check(d);
+  detail::check_description(d);
   const int nf = static_cast<int>(d.frames.size());
   std::set<std::string> links, joints;
   for (int f = 0; f <= nf; ++f)
@@ -151,14 +127,8 @@ std::string urdf_text(const UrdfDescription& d) {
   for (int f = 1; f <= nf; ++f)
     if (!joints.insert(urdf_joint_name(d, f)).second)
       throw std::invalid_argument("urdf export: two joints named " + urdf_joint_name(d, f));
-  auto value_of = [&](const char* family, int frame, bool& found) {
-    found = false;
-    for (std::size_t k = 0; k < d.names.size(); ++k)
-      if (d.names[k].joint == frame && std::string(d.names[k].family) == family) {
-        found = true;
-        return d.s(static_cast<Eigen::Index>(k));
-      }
-    return 0.0;
+  const auto value_of = [&](const char* family, int frame, bool& found) {
+    return detail::frame_value(d, family, frame, found);
   };
 
   std::string x = "<?xml version=\"1.0\"?>\n";
@@ -227,7 +197,7 @@ std::string urdf_text(const UrdfDescription& d) {
 }
 
 std::string standard_parameters_yaml(const UrdfDescription& d, const std::string& header) {
-  check(d);
+  detail::check_description(d);
   std::string y = header;
   if (!y.empty() && y.back() != '\n') y += '\n';
   y += "# Frame-origin standard parameters (modified-DH link frames): XX..ZZ about the frame origin, MX MY MZ = M * "
@@ -245,7 +215,7 @@ std::string standard_parameters_yaml(const UrdfDescription& d, const std::string
 }
 
 std::string standard_parameters_csv(const UrdfDescription& d) {
-  check(d);
+  detail::check_description(d);
   std::string c = "name,frame,family,unit,value\n";
   for (std::size_t k = 0; k < d.names.size(); ++k) {
     const auto& p = d.names[k];
