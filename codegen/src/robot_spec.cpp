@@ -252,7 +252,8 @@ void read_joints(const Reader& r, const YAML::Node& root, RobotSpec& spec) {
   std::set<std::string> joint_names;
   for (const auto& j : joints) {
     if (!j.IsMap()) r.fail(j, "a joint must be a mapping (name, lower, upper, velocity, effort)");
-    r.only_keys(j, {"name", "lower", "upper", "velocity", "effort", "audit"}, "a joint");
+    // torque_constant (N m/A): read by dynid import for bags whose effort is motor current.
+    r.only_keys(j, {"name", "lower", "upper", "velocity", "effort", "audit", "torque_constant"}, "a joint");
     JointSpec js;
     js.name = r.string(j["name"], "joint name");
     if (!is_identifier(js.name)) r.fail(j["name"], "joint name '" + js.name + "' is not an identifier");
@@ -274,6 +275,8 @@ void read_joints(const Reader& r, const YAML::Node& root, RobotSpec& spec) {
       js.audit_upper = r.number(a[1], "audit upper bound");
       if (!(js.audit_lower < js.audit_upper)) r.fail(a, "audit: upper must exceed lower");
     }
+    if (const auto k = j["torque_constant"]; k && !(r.number(k, "torque_constant") > 0))
+      r.fail(k, "joint " + js.name + ": torque_constant must be positive (N m/A)");
     spec.joints.push_back(js);
   }
 }

@@ -13,6 +13,7 @@
 #include "dynid_robots.hpp"
 #include "dynid_numbers.hpp"
 #include "symoro/io/import.hpp"
+#include "symoro/io/import_bag.hpp"
 
 namespace symoro::dynid {
 
@@ -37,12 +38,37 @@ io::ImportMapping mapping_of(const ImportOptions& options) {
   return m;
 }
 
+// The bag settings: the command line's, the torque constants from it or robot.yaml.
+io::BagSettings bag_settings_of(const Common& common, const ImportOptions& options, std::size_t joints) {
+  io::BagSettings b;
+  b.topic = options.topic;
+  b.stamp = options.stamp == "receive" ? io::StampSource::receive : io::StampSource::header;
+  b.effort = options.effort == "current" ? io::EffortKind::current : io::EffortKind::torque;
+  if (b.effort == io::EffortKind::torque) {
+    if (!options.torque_constants.empty()) throw UsageError("--torque-constant goes with --effort current");
+    return b;
+  }
+  const std::filesystem::path robot_yaml = common.robot_dir() / "robot.yaml";
+  b.torque_constants =
+      options.torque_constants.empty() ? io::robot_torque_constants(robot_yaml) : options.torque_constants;
+  if (b.torque_constants.size() == 1) b.torque_constants.assign(joints, b.torque_constants[0]);
+  if (b.torque_constants.size() != joints)
+    throw UsageError(
+        fmt::format("--effort current needs the joints' torque constants (N m/A): --torque-constant k (all joints) or "
+                    "k1,...,k{}, or torque_constant on each joint of {}; {} given",
+                    joints, robot_yaml.string(), b.torque_constants.size()));
+  return b;
+}
+
 }  // namespace import_detail
 
 void run_import(const Common& common, const ImportOptions& options, const std::vector<JointInfo>& joints) {
   io::DatasetImport di;
   di.target = io::import_target(common.robot, joints);
-  di.mapping = import_detail::mapping_of(options);
+  const bool text =
+      std::any_of(options.inputs.begin(), options.inputs.end(), [](const std::string& i) { return !io::is_bag(i); });
+  if (text) di.mapping = import_detail::mapping_of(options);
+  di.bag = import_detail::bag_settings_of(common, options, joints.size());
   di.split = options.split;
   di.allow_implausible = options.allow_implausible;
   if (!options.names.empty() && options.names.size() != options.inputs.size())
@@ -63,6 +89,7 @@ void run_import(const Common& common, const ImportOptions& options, const std::v
         l.input.string(), l.rows, log.meta.trajectory, log.samples(), log.time[log.samples() - 1] - log.time[0],
         log.meta.sample_time * 1e3, l.stale_lines.size(), l.duplicate_lines.size(),
         log.meta.velocity == io::Velocity::measured ? "measured" : "differentiated from q");
+    for (const std::string& r : l.remarks) fmt::print("  {}\n", r);
     if (!l.stale_lines.empty())
       fmt::print("  stale rows (same state as the row before, new stamp) on lines {}{}\n", l.stale_lines.front(),
                  l.stale_lines.size() > 1 ? fmt::format(" .. {}", l.stale_lines.back()) : "");
@@ -79,19 +106,25 @@ void run_import(const Common& common, const ImportOptions& options, const std::v
 void add_import_commands(CLI::App& app, Common& common) {
   auto o = std::make_shared<ImportOptions>();
   auto* cmd = app.add_subcommand("import",
-                                 "Import a controller's exported logs (CSV, ';' or whitespace text) into a "
-                                 "dataset folder");
+                                 "Import a controller's exported logs (CSV, ';' or whitespace text) or ROS 2 bags "
+                                 "(MCAP) into a dataset folder");
   cmd->footer(
       "Examples:\n"
       "  dynid import --robot crane_x7 -o data/ run1.csv run2.csv --time t --time-unit ms \\\n"
       "      --q 'pos_*' --qd 'vel_*' --tau 'eff_*' --angle deg --split 0.7\n"
       "  dynid import --robot crane_x7 -o data/ --mapping map.yaml --heldout check.txt long.txt check.txt\n"
       "  dynid import --robot planar2r -o data/ log.txt --time 1 --q 2-3 --tau 4-5   # no header row\n"
+      "  dynid import --robot my_arm -o data/ rosbag2_2026_11_29/ --split 0.7          # a ROS 2 bag folder\n"
+      "  dynid import --robot crane_x7 -o data/ run.mcap --effort current --topic /crane_x7/joint_states\n"
       "A mapping file has the same keys: time, q, qd, tau, q_ref, qd_ref, qdd_ref, units: {time, angle,\n"
       "torque_scale}, header, delimiter (docs/dataset.md). Repeated rows with a new stamp (stale reads) are\n"
       "kept and counted; a repeated stamp with the same values is dropped; without --qd the velocity is\n"
-      "differentiated from q and the log says so.");
-  cmd->add_option("inputs", o->inputs, "Exported files, one run each")->required()->check(CLI::ExistingFile);
+      "differentiated from q and the log says so.\n"
+      "A ROS 2 bag (an .mcap file, or the folder with metadata.yaml) is read for sensor_msgs/msg/JointState on\n"
+      "--topic; joints are matched by name (docs/dataset.md, ROS 2 bags).");
+  cmd->add_option("inputs", o->inputs, "Exported files or ROS 2 bags (.mcap, bag folders), one run each")
+      ->required()
+      ->check(CLI::ExistingPath);
   add_robot_options(cmd, common, "Robot folder name under robots/ (its joints set n)");
   cmd->add_option("-o,--out", o->out, "Dataset folder to create (existing files are never replaced)")->required();
   cmd->add_option("--mapping", o->mapping, "Mapping file (YAML); the options below override it")
@@ -120,6 +153,19 @@ void add_import_commands(CLI::App& app, Common& common) {
   cmd->add_flag("--allow-implausible", o->allow_implausible,
                 "Import positions far beyond the robot's joint limits, or a median time step outside "
                 "[0.1 ms, 0.5 s] (refused by default: a unit declared wrong)");
+  cmd->add_option("--topic", o->topic, "Bags: the sensor_msgs/msg/JointState topic (default /joint_states)");
+  cmd->add_option("--stamp", o->stamp,
+                  "Bags: time from the messages' header.stamp (default) or the recorder's receive time")
+      ->check(CLI::IsMember({"header", "receive"}));
+  cmd->add_option("--effort", o->effort,
+                  "Bags: JointState.effort is joint torque (default) or motor current in A, times the torque "
+                  "constants")
+      ->check(CLI::IsMember({"torque", "current"}));
+  cmd->add_option("--torque-constant", o->torque_constants,
+                  "With --effort current: N m/A, one for all joints or one per joint (default: robot.yaml's "
+                  "torque_constant of each joint)")
+      ->delimiter(',')
+      ->check(numbers::positive(1e6, "> 0"));
   cmd->add_option("--name", o->names, "Run names, one per input (default: the file names' stems)")->delimiter(',');
   cmd->add_option("--heldout", o->heldout, "Inputs held out whole (family V)")->delimiter(',');
   cmd->callback([&common, o] { run_import(common, *o, robot_model(common, "").joints()); });

@@ -14,6 +14,9 @@ struct ImportOptions {
   std::string out, mapping, time, q, qd, tau, q_ref, qd_ref, qdd_ref;
   std::string time_unit, angle, header, delimiter;
   double torque_scale = 0, split = 0;
+  // ROS 2 bags
+  std::string topic = "/joint_states", stamp = "header", effort = "torque";
+  std::vector<double> torque_constants;
   bool allow_implausible = false;
 };
 

@@ -13,6 +13,7 @@
 #include "symoro/io/dataset.hpp"
 #include "symoro/io/folder_lock.hpp"
 #include "symoro/io/import.hpp"
+#include "symoro/io/import_bag.hpp"
 #include "symoro/io/number_text.hpp"
 #include "symoro/io/yaml_text.hpp"
 
@@ -40,8 +41,11 @@ DatasetImportResult read_inputs(const fs::path& out, const DatasetImport& import
   DatasetImportResult result;
   std::set<std::string> names;
   for (const ImportInput& in : import.inputs) {
-    ImportedLog imported = import_log(in.file, import.mapping, import.target);
-    if (!import.allow_implausible) check_plausible(imported, import.mapping, import.target);
+    ImportedLog imported = is_bag(in.file) ? import_bag(in.file, import.bag, import.target)
+                                           : import_log(in.file, import.mapping, import.target);
+    // A bag is in SI units (REP 103): checked as radians and seconds.
+    if (!import.allow_implausible)
+      check_plausible(imported, is_bag(in.file) ? ImportMapping{} : import.mapping, import.target);
     const std::string name = in.name.empty() ? in.file.stem().string() : in.name;
     if (!valid_name(name))
       throw DataError(in.file.string(), 0, fmt::format("'{}' cannot name a run (a file name)", name));
@@ -80,8 +84,17 @@ DatasetImportResult read_inputs(const fs::path& out, const DatasetImport& import
 // import.yaml: the mapping (reusable as --mapping) and what each input gave.
 std::string import_record(const DatasetImport& import, const DatasetImportResult& result) {
   std::string text = import_mapping_yaml(import.mapping);
-  text += fmt::format("imported:\n  robot: {}\n  split: {}\n  inputs:\n", yaml_quoted(import.target.robot),
-                      number_text(import.split));
+  text +=
+      fmt::format("imported:\n  robot: {}\n  split: {}\n", yaml_quoted(import.target.robot), number_text(import.split));
+  if (std::any_of(import.inputs.begin(), import.inputs.end(), [](const ImportInput& i) { return is_bag(i.file); })) {
+    const BagSettings& b = import.bag;
+    std::string k;
+    for (double c : b.torque_constants) k += (k.empty() ? "" : ", ") + number_text(c);
+    text += fmt::format("  bag: {{topic: {}, stamp: {}, effort: {}, torque_constants: [{}]}}\n", yaml_quoted(b.topic),
+                        b.stamp == StampSource::header ? "header" : "receive",
+                        b.effort == EffortKind::torque ? "torque" : "current", k);
+  }
+  text += "  inputs:\n";
   for (const ImportedLog& l : result.logs) {
     text += fmt::format("    - input: {}\n      log: {}\n      rows: {}\n      written: {}\n",
                         yaml_quoted(fs::absolute(l.input).string()), yaml_quoted(l.log.meta.trajectory + ".csv"),
@@ -94,6 +107,8 @@ std::string import_record(const DatasetImport& import, const DatasetImportResult
         fmt::format("      sample_time: {}\n      velocity: {}\n      columns:\n", number_text(l.log.meta.sample_time),
                     l.log.meta.velocity == Velocity::measured ? "measured" : "differentiated");
     for (const auto& [column, source] : l.columns) text += fmt::format("        {}: {}\n", column, yaml_quoted(source));
+    if (!l.remarks.empty()) text += "      remarks:\n";
+    for (const std::string& r : l.remarks) text += fmt::format("        - {}\n", yaml_quoted(r));
   }
   return text;
 }

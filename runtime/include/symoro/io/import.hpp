@@ -86,6 +86,16 @@ struct MappingSettings {
 // std::invalid_argument naming the setting and its choices for a word not among them.
 void apply_settings(ImportMapping& mapping, const MappingSettings& settings);
 
+// How a ROS 2 bag's sensor_msgs/msg/JointState messages become a log (io/import_bag.hpp).
+enum class StampSource { header, receive };  // header.stamp, or the recorder's receive time
+enum class EffortKind { torque, current };   // effort is joint torque, or motor current (A)
+struct BagSettings {
+  std::string topic = "/joint_states";
+  StampSource stamp = StampSource::header;
+  EffortKind effort = EffortKind::torque;
+  std::vector<double> torque_constants;  // N m/A per joint, for EffortKind::current
+};
+
 // One input file, converted.
 struct ImportedLog {
   std::filesystem::path input;
@@ -96,6 +106,7 @@ struct ImportedLog {
   std::vector<int> stale_lines;                // 1-based input lines of stale rows (kept)
   std::vector<int> duplicate_lines;            // 1-based input lines of duplicates (dropped)
   std::map<std::string, std::string> columns;  // log column -> input column ("q1" -> "pos_1 (column 3)")
+  std::vector<std::string> remarks;            // what the import decided and the user should know (bags)
 };
 
 // Reads and converts one input file. Throws DataError as described above; a mapping that does
@@ -131,7 +142,8 @@ struct ImportInput {
 
 struct DatasetImport {
   ImportTarget target;
-  ImportMapping mapping;
+  ImportMapping mapping;  // for text inputs
+  BagSettings bag;        // for ROS 2 bags (an .mcap file or a bag folder: is_bag)
   std::vector<ImportInput> inputs;
   // Fraction of each run (not held out as a whole) used for fitting, by time: the first
   // `split` of its duration; the rest is a second run <name>_heldout. 0: no split.
