@@ -24,12 +24,13 @@ done
 
 # Fuzzing with clang's libFuzzer, each target bounded in time: the grammar (FUZZ_SECONDS, default
 # 60), the DYNAMIXEL Protocol 2.0 decoder (FUZZ_DYNAMIXEL_SECONDS, default 20) and the file readers:
-# the URDF reader, the log reader, the importer's reader, dataset.yaml and the other YAML readers
+# the URDF reader, the log reader, the importer's reader, the ROS 2 bag (MCAP) reader, dataset.yaml and the other YAML readers
 # (FUZZ_IO_SECONDS each, default 20). A fuzzer is one process on one core: two lanes of 80-100 s
 # when there are two cores (the grammar, then the YAML readers; the others one after another), so
 # that each keeps its whole time.
 cmake -S . -B build/fuzz -G Ninja -DSYMORO_BUILD_FUZZER=ON -DCMAKE_CXX_COMPILER=clang++ -DCMAKE_BUILD_TYPE=RelWithDebInfo >/dev/null
-cmake --build build/fuzz -j"$jobs" --target fuzz_grammar fuzz_dynamixel fuzz_log fuzz_import fuzz_dataset fuzz_yaml fuzz_urdf
+cmake --build build/fuzz -j"$jobs" --target fuzz_grammar fuzz_dynamixel fuzz_log fuzz_import fuzz_dataset fuzz_yaml fuzz_urdf \
+  fuzz_mcap
 fuzz() {  # fuzz <target> <corpus folder under tests/fuzz> <seconds> [libFuzzer options...]
   local target=$1 corpus=$2 seconds=$3
   shift 3
@@ -43,7 +44,8 @@ fuzz() {  # fuzz <target> <corpus folder under tests/fuzz> <seconds> [libFuzzer 
 }
 fuzz_first_lane() {
   fuzz fuzz_grammar corpus "${FUZZ_SECONDS:-60}" -max_len=4096 -dict=tests/fuzz/grammar.dict &&
-    fuzz fuzz_yaml corpus_yaml "${FUZZ_IO_SECONDS:-20}" -max_len=16384
+    fuzz fuzz_yaml corpus_yaml "${FUZZ_IO_SECONDS:-20}" -max_len=16384 &&
+    fuzz fuzz_mcap corpus_mcap "${FUZZ_IO_SECONDS:-20}" -max_len=16384
 }
 fuzz_second_lane() {
   # urdfdom leaks what it parsed of a URDF with a joint cycle: suppressed for it alone.

@@ -139,4 +139,36 @@ void write_export_csv(const io::Log& log, const std::filesystem::path& file) {
   if (!out) throw std::runtime_error("cannot write " + file.string());
 }
 
+// The same log as a ROS 2 driver records it, as the spec of tests/bags/write_bag.mjs: one
+// sensor_msgs/msg/JointState per row on /joint_states (the joints' names, SI units, header stamps
+// from a time of day), a gripper joint the robot has not among them, a status topic beside, in
+// zstd chunks. `out` is the MCAP file the writer is to write.
+template <class Model>
+void write_bag_spec(const io::Log& log, const std::filesystem::path& spec, const std::filesystem::path& out) {
+  std::ofstream o(spec);
+  o << "{\"out\":\"" << out.string() << "\",\"compression\":\"zstd\",\"chunked\":true,\"messages\":[";
+  const long long start = 1764400000000000000LL;
+  for (int i = 0; i < log.samples(); ++i) {
+    const long long stamp = start + std::llround(log.time(i) * 1e9);
+    std::string names = "\"gripper_joint\"", q = "0.02", qd = "0", tau = "1.5";
+    for (int j = 0; j < Model::nq; ++j) {
+      names += fmt::format(",\"{}\"", Model::joints[j].name);
+      q += fmt::format(",{:.17g}", log.q(i, j));
+      qd += fmt::format(",{:.17g}", log.qd(i, j));
+      tau += fmt::format(",{:.17g}", log.tau(i, j));
+    }
+    o << fmt::format(
+        "{}{{\"topic\":\"/joint_states\",\"log_time_ns\":\"{}\",\"stamp_sec\":{},\"stamp_nanosec\":{},"
+        "\"name\":[{}],\"position\":[{}],\"velocity\":[{}],\"effort\":[{}]}}",
+        i ? "," : "", stamp + 300000, stamp / 1000000000, stamp % 1000000000, names, q, qd, tau);
+    if (i % 100 == 0)
+      o << fmt::format(
+          ",{{\"topic\":\"/status\",\"type\":\"std_msgs/msg/String\",\"log_time_ns\":\"{}\","
+          "\"data\":\"running\"}}",
+          stamp + 400000);
+  }
+  o << "]}\n";
+  if (!o) throw std::runtime_error("cannot write " + spec.string());
+}
+
 }  // namespace symoro::test

@@ -5,8 +5,8 @@
 // equal to the project's inverse dynamics within 1e-9 relative: rigid body, gravity, rotor
 // inertia (armature) and viscous friction (damping). MuJoCo's dry friction is a constraint, not
 // FS sign(qd): it is disabled in MuJoCo and FS set to 0 in the project's model for the
-// comparison. On CRANE-X7 (a massless hand axis), the RX-90 and the Stanford RRP (a prismatic
-// joint), and with a payload body on the last link.
+// comparison. On CRANE-X7 (a massless hand axis), the RX-90, the Stanford RRP (a prismatic
+// joint) and the UR5 from its URDF, and with a payload body on the last link.
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
@@ -21,6 +21,7 @@
 #include <symoro/crane_x7.hpp>
 #include <symoro/rx90.hpp>
 #include <symoro/stanford_rrp.hpp>
+#include <symoro/ur5.hpp>
 
 #include "symoro/identify/detail/physical_consistency_model.hpp"
 #include "symoro/model_export/mjcf_export.hpp"
@@ -150,6 +151,12 @@ TEST(ExportMjcf, MujocosInverseDynamicsEqualsTheModelsOnCraneX7) { check_against
 TEST(ExportMjcf, MujocosInverseDynamicsEqualsTheModelsOnTheRx90) { check_against_mujoco<symoro::rx90::Model>(4); }
 TEST(ExportMjcf, MujocosInverseDynamicsEqualsTheModelsWithAPrismaticJoint) {
   check_against_mujoco<symoro::stanford_rrp::Model>(5);
+}
+
+// The UR5 as symoroc model makes it from its URDF (fixed frames, rpy offsets): the model of
+// tests/runtime/bag_to_mjcf_cli.cmake, whose loaded robot writes the same MJCF text.
+TEST(ExportMjcf, MujocosInverseDynamicsEqualsTheModelsOnTheUr5FromItsUrdf) {
+  check_against_mujoco<symoro::ur5::Model>(8);
 }
 
 TEST(ExportMjcf, APayloadBodyRidesOnItsFrameAtTheFlangesPose) {

@@ -69,7 +69,9 @@ void write_bag(const std::vector<Msg>& messages, const std::string& where, const
           m.receive_ns, i);
   }
   spec += "]}";
-  const std::string spec_file = ::testing::TempDir() + "/bag_spec.json";
+  // One spec per test: ctest runs the tests as processes side by side.
+  const std::string spec_file =
+      ::testing::TempDir() + "/" + ::testing::UnitTest::GetInstance()->current_test_info()->name() + ".json";
   std::ofstream(spec_file) << spec;
   const std::string cmd = fmt::format("'{}' '{}' '{}'", node, writer, spec_file);
   ASSERT_EQ(std::system(cmd.c_str()), 0) << cmd;

@@ -11,10 +11,13 @@
 // motion and torque come from the robot's generated model (synthetic_log.hpp) with Coulomb
 // friction (in the truth; a `rigid` model lacks it), an offset of -0.06 N m on the last joint,
 // noise and 5 % stale rows; columns stamp_ms, mode (text), <joint>_pos, _vel (deg, deg/s; m,
-// m/s for a prismatic joint), <joint>_eff (N m; N).
+// m/s for a prismatic joint), <joint>_eff (N m; N). A <file> ending in .json is instead the spec
+// of a ROS 2 bag of the same log for tests/bags/write_bag.mjs, whose MCAP file is <file> with
+// .mcap for .json (synthetic_log.hpp: write_bag_spec).
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
 #include <string>
 #include <vector>
@@ -131,7 +134,10 @@ int write_from_nominal(const std::string& file, double seconds, unsigned seed, c
   symoro::io::Log log = symoro::test::synthesize<Model>("export", Model::base_from_standard(s), seconds, seed, 0.05,
                                                         symoro::test::offset_on<Model>(Model::nq, -0.06));
   add_contact(log, contact);
-  symoro::test::write_export_csv<Model>(log, file);
+  if (std::filesystem::path(file).extension() == ".json")
+    symoro::test::write_bag_spec<Model>(log, file, std::filesystem::path(file).replace_extension(".mcap"));
+  else
+    symoro::test::write_export_csv<Model>(log, file);
   return 0;
 }
 

@@ -329,6 +329,13 @@ ImportedLog import_bag(const fs::path& input, const BagSettings& settings, const
   for (Eigen::Index r = 0; r < R; ++r) {
     const Entry& e = rows[static_cast<std::size_t>(r)];
     log.time(r) = static_cast<double>(e.stamp - rows.front().stamp) * 1e-9;
+    // Stamps 1 ns apart long after the first (a clock that jumped years) are one double.
+    if (r > 0 && !(log.time(r) > log.time(r - 1)))
+      throw DataError(input.string(), 0,
+                      fmt::format("stamps {} and {} are too close to tell apart {} s after the first row (a clock "
+                                  "that jumped?)",
+                                  stamp_text(rows[static_cast<std::size_t>(r - 1)].stamp), stamp_text(e.stamp),
+                                  number_text(log.time(r))));
     for (std::size_t j = 0; j < n; ++j) {
       const auto c = static_cast<Eigen::Index>(j);
       log.q(r, c) = e.q[j];
@@ -343,7 +350,14 @@ ImportedLog import_bag(const fs::path& input, const BagSettings& settings, const
       if (stale[static_cast<std::size_t>(r)]) out.stale_lines.push_back(static_cast<int>(e.number));
     }
   }
-  if (!velocity) log.qd = differentiate_positions(log.time, log.q, stale);
+  if (!velocity) {
+    log.qd = differentiate_positions(log.time, log.q, stale);
+    if (!log.qd.allFinite())
+      throw DataError(input.string(), 0,
+                      fmt::format("the velocity differentiated from position overflows (positions up to {:.3g}): no "
+                                  "joint's position in SI units",
+                                  log.q.cwiseAbs().maxCoeff()));
+  }
 
   log.meta.robot = target.robot;
   log.meta.trajectory = input.stem().string();

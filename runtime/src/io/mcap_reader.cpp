@@ -4,6 +4,7 @@
 // specification asks of readers.
 #include "symoro/io/mcap.hpp"
 
+#include <algorithm>
 #include <cstring>
 #include <fstream>
 #include <iterator>
@@ -92,45 +93,67 @@ class Fields {
   const std::string& source_;
 };
 
+// Decompresses a chunk's records. The output grows as the decoder produces it (never to more
+// than the chunk declares): a size field that lies costs no memory the data does not back.
 std::vector<std::uint8_t> decompress(const std::string& compression, const std::uint8_t* in, std::size_t size,
                                      std::uint64_t uncompressed, std::uint64_t offset, const std::string& source) {
   const auto fail = [&](const std::string& why) {
     return DataError(source, 0, fmt::format("byte {}: a chunk compressed with {} {}", offset, compression, why));
   };
+  if (compression != "lz4" && compression != "zstd")
+    throw fail("is not readable: this reader knows lz4, zstd and uncompressed chunks");
   if (uncompressed > kLargestChunk)
     throw fail(
         fmt::format("declares {} bytes decompressed, more than this reader takes ({})", uncompressed, kLargestChunk));
-  std::vector<std::uint8_t> out(static_cast<std::size_t>(uncompressed));
+  const auto want = static_cast<std::size_t>(uncompressed);
+  std::vector<std::uint8_t> out(std::min<std::size_t>(want, 4 * size + 65536));
+  std::size_t done = 0, used = 0;
+  bool finished = false;
+  // One decoder step into out[done..]: how much it wrote and read, and whether its frame ended.
+  const auto grow = [&] {
+    if (out.size() < want && out.size() - done < 65536) out.resize(std::min(want, 2 * out.size()));
+  };
   if (compression == "zstd") {
-    const std::size_t n = ZSTD_decompress(out.data(), out.size(), in, size);
-    if (ZSTD_isError(n)) throw fail(std::string("does not decompress: ") + ZSTD_getErrorName(n));
-    if (n != out.size()) throw fail(fmt::format("gives {} bytes, not the {} it declares", n, out.size()));
-    return out;
-  }
-  if (compression == "lz4") {
+    ZSTD_DCtx* ctx = ZSTD_createDCtx();
+    if (!ctx) throw fail("needs a context zstd refused");
+    while (!finished) {
+      grow();
+      ZSTD_outBuffer o{out.data(), out.size(), done};
+      ZSTD_inBuffer i{in, size, used};
+      const std::size_t r = ZSTD_decompressStream(ctx, &o, &i);
+      if (ZSTD_isError(r)) {
+        ZSTD_freeDCtx(ctx);
+        throw fail(std::string("does not decompress: ") + ZSTD_getErrorName(r));
+      }
+      const bool progress = o.pos != done || i.pos != used;
+      done = o.pos, used = i.pos;
+      finished = r == 0;
+      if (!progress && (done == out.size() ? out.size() == want : used == size)) break;
+    }
+    ZSTD_freeDCtx(ctx);
+  } else {
     LZ4F_dctx* ctx = nullptr;
     if (LZ4F_isError(LZ4F_createDecompressionContext(&ctx, LZ4F_VERSION))) throw fail("needs a context lz4 refused");
-    std::size_t done = 0, used = 0;
-    std::size_t status = 1;
-    while (status != 0 && used < size) {
+    while (!finished) {
+      grow();
       std::size_t dst = out.size() - done, src = size - used;
-      status = LZ4F_decompress(ctx, out.data() + done, &dst, in + used, &src, nullptr);
-      if (LZ4F_isError(status)) {
-        const std::string why = LZ4F_getErrorName(status);
+      const std::size_t r = LZ4F_decompress(ctx, out.data() + done, &dst, in + used, &src, nullptr);
+      if (LZ4F_isError(r)) {
         LZ4F_freeDecompressionContext(ctx);
-        throw fail("does not decompress: " + why);
+        throw fail(std::string("does not decompress: ") + LZ4F_getErrorName(r));
       }
       done += dst;
       used += src;
-      if (dst == 0 && src == 0) break;  // no progress: output full or input exhausted
+      finished = r == 0;
+      if (dst == 0 && src == 0 && (done == out.size() ? out.size() == want : used == size)) break;
     }
     LZ4F_freeDecompressionContext(ctx);
-    if (status != 0 || done != out.size())
-      throw fail(fmt::format("gives {} bytes{}, not the {} it declares", done, status != 0 ? " (frame unfinished)" : "",
-                             out.size()));
-    return out;
   }
-  throw fail("is not readable: this reader knows lz4, zstd and uncompressed chunks");
+  if (!finished || done != want)
+    throw fail(
+        fmt::format("gives {} bytes{}, not the {} it declares", done, finished ? "" : " (frame unfinished)", want));
+  out.resize(done);
+  return out;
 }
 
 class Reader {
