@@ -13,6 +13,8 @@
 #include "arrays.hpp"
 #include "symoro/diagnose/gap_report.hpp"
 #include "symoro/model_export/model_export.hpp"
+#include "symoro/model_export/mjcf_export.hpp"
+#include "symoro/io/atomic_file.hpp"
 #include "symoro/study/prediction.hpp"
 #include "symoro/study/prediction_band.hpp"
 #include "symoro/study/robot_folder.hpp"
@@ -192,7 +194,8 @@ void bind_export(py::module_& m) {
   m.def(
       "export_urdf",
       [](py::handle model, const std::filesystem::path& study, const std::filesystem::path& urdf, py::handle prior,
-         const std::optional<std::filesystem::path>& robot_dir_given, double margin, bool nearest, bool not_accepted) {
+         const std::optional<std::filesystem::path>& robot_dir_given, double margin, bool nearest, bool not_accepted,
+         const std::optional<std::filesystem::path>& mjcf) {
         const auto id = identification_of(model);
         const std::optional<std::filesystem::path> robot_dir = robot_dir_of(model, robot_dir_given);
         const identify::ModelDescription& d = id->description();
@@ -246,9 +249,11 @@ void bind_export(py::module_& m) {
           py::gil_scoped_release release;
           e = model_export::export_model(*id, phi, eo);
           files = model_export::write_model_export(e, urdf, model_export::urdf_text(e.description));
+          if (mjcf) io::write_file_atomically(*mjcf, model_export::mjcf_text(e.description, d.gravity));
         }
         py::dict r;
         r["urdf"] = files.urdf;
+        if (mjcf) r["mjcf"] = *mjcf;
         r["standard_yaml"] = files.yaml;
         r["standard_csv"] = files.csv;
         r["s"] = e.description.s;
@@ -262,9 +267,10 @@ void bind_export(py::module_& m) {
       py::arg("model"), py::arg("study"), py::arg("urdf"), py::kw_only(), py::arg("prior") = py::none(),
       py::arg("robot_dir") = py::none(), py::arg("margin") = model_export::ModelExportOptions{}.margin,
       py::arg("nearest") = model_export::ModelExportOptions{}.nearest, py::arg("not_accepted") = false,
+      py::arg("mjcf") = py::none(),
       "The study's accepted parameters as a URDF (dynid export): the physically consistent standard parameters nearest "
-      "the "
-      "prior that reproduce them, written to urdf and <stem>.standard.yaml/.csv");
+      "the prior that reproduce them, written to urdf and <stem>.standard.yaml/.csv; with mjcf=path, as a MuJoCo "
+      "model too (docs/mjcf.md)");
 }
 
 }  // namespace symoro::python

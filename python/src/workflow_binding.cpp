@@ -22,6 +22,7 @@
 #include "symoro/study/validation_io.hpp"
 #include "symoro/io/folder_lock.hpp"
 #include "symoro/io/import.hpp"
+#include "symoro/io/import_bag.hpp"
 #include "symoro/parallel/farm.hpp"
 
 namespace symoro::python {
@@ -87,7 +88,9 @@ void bind_workflow(py::module_& m) {
          const std::string& q_ref, const std::string& qd_ref, const std::string& qdd_ref, const std::string& time_unit,
          const std::string& angle, double torque_scale, const std::string& header, const std::string& delimiter,
          const std::optional<std::filesystem::path>& mapping, const std::vector<std::string>& names,
-         const std::vector<std::filesystem::path>& heldout, double split, bool allow_implausible) {
+         const std::vector<std::filesystem::path>& heldout, double split, bool allow_implausible,
+         const std::string& topic, const std::string& stamp, const std::string& effort,
+         const std::vector<double>& torque_constants) {
         const identify::ModelDescription& d = identification_of(model)->description();
         io::DatasetImport di;
         di.target = io::import_target(d.robot, d.joints);
@@ -96,8 +99,21 @@ void bind_workflow(py::module_& m) {
         if (mapping) mp = io::read_import_mapping(*mapping);
         io::apply_settings(
             mp, {time, q, qd, tau, q_ref, qd_ref, qdd_ref, time_unit, angle, header, delimiter, torque_scale});
-        if (mp.time.empty() || mp.q.empty() || mp.tau.empty())
+        const bool text =
+            std::any_of(files.begin(), files.end(), [](const std::filesystem::path& f) { return !io::is_bag(f); });
+        if (text && (mp.time.empty() || mp.q.empty() || mp.tau.empty()))
           throw py::value_error("say which columns hold time, q and tau: time=, q=, tau=, or mapping='map.yaml'");
+        // ROS 2 bags (an .mcap file or a bag folder), as dynid import reads them.
+        if (stamp != "header" && stamp != "receive") throw py::value_error("stamp: 'header' or 'receive'");
+        if (effort != "torque" && effort != "current") throw py::value_error("effort: 'torque' or 'current'");
+        di.bag.topic = topic;
+        di.bag.stamp = stamp == "receive" ? io::StampSource::receive : io::StampSource::header;
+        di.bag.effort = effort == "current" ? io::EffortKind::current : io::EffortKind::torque;
+        di.bag.torque_constants = torque_constants;
+        if (di.bag.torque_constants.size() == 1) di.bag.torque_constants.assign(d.joints.size(), torque_constants[0]);
+        if (di.bag.effort == io::EffortKind::current && di.bag.torque_constants.size() != d.joints.size())
+          throw py::value_error(
+              fmt::format("effort='current' needs torque_constants: one, or one per joint ({})", d.joints.size()));
         if (!names.empty() && names.size() != files.size())
           throw py::value_error(fmt::format("names: {} names for {} input files", names.size(), files.size()));
         for (const auto& h : heldout)
@@ -124,6 +140,7 @@ void bind_workflow(py::module_& m) {
           x["duplicate_rows"] = l.duplicate_lines.size();
           x["sample_time"] = l.log.meta.sample_time;
           x["velocity"] = l.log.meta.velocity == io::Velocity::measured ? "measured" : "differentiated";
+          x["remarks"] = l.remarks;
           logs.append(x);
         }
         py::list runs;
@@ -146,7 +163,9 @@ void bind_workflow(py::module_& m) {
       py::arg("time_unit") = "", py::arg("angle") = "", py::arg("torque_scale") = 0.0, py::arg("header") = "",
       py::arg("delimiter") = "", py::arg("mapping") = py::none(), py::arg("names") = std::vector<std::string>{},
       py::arg("heldout") = std::vector<std::filesystem::path>{}, py::arg("split") = 0.0,
-      py::arg("allow_implausible") = false);
+      py::arg("allow_implausible") = false, py::arg("topic") = "/joint_states", py::arg("stamp") = "header",
+      py::arg("effort") = "torque", py::arg("torque_constants") = std::vector<double>{},
+      "Controllers' exports (CSV, text) or ROS 2 bags (.mcap files, bag folders) into a dataset folder (dynid import)");
 
   // dynid identify's defaults are the request's (StudyOptions' own): taken from it.
   const study::StudyRequest defaults;
