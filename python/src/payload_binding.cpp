@@ -40,7 +40,9 @@ void bind_payload(py::module_& m) {
       "identify_payload",
       [](py::handle model, py::handle params, const std::vector<std::filesystem::path>& inputs, py::handle full,
          std::optional<double> mass, double interval_ms, double torque_delay_ms, int trial,
-         const std::optional<std::filesystem::path>& robot_dir_given) {
+         const std::optional<std::filesystem::path>& robot_dir_given, const std::string& instruments) {
+        if (instruments != "none" && instruments != "reference")
+          throw py::value_error(fmt::format("instruments '{}': 'none' or 'reference'", instruments));
         if (!(std::isfinite(interval_ms) && interval_ms >= 1 && interval_ms <= 10000))
           throw py::value_error(fmt::format("interval_ms {}: must be from 1 to 10000", interval_ms));
         if (!(std::isfinite(torque_delay_ms) && torque_delay_ms >= -1000 && torque_delay_ms <= 1000))
@@ -63,6 +65,7 @@ void bind_payload(py::module_& m) {
         o.interval = interval_ms / 1000;
         o.torque_delay = torque_delay_ms / 1000;
         o.mass = mass;
+        o.reference_instruments = instruments == "reference";
         const payload::PayloadLink link = payload::payload_link(*whole);
         std::string flange = fmt::format("frame {}", link.link);
         if (robot_dir)
@@ -103,7 +106,7 @@ void bind_payload(py::module_& m) {
       },
       py::arg("model"), py::arg("params"), py::arg("inputs"), py::kw_only(), py::arg("full") = py::none(),
       py::arg("mass") = py::none(), py::arg("interval_ms") = 10.0, py::arg("torque_delay_ms") = 0.0,
-      py::arg("trial") = 1, py::arg("robot_dir") = py::none(),
+      py::arg("trial") = 1, py::arg("robot_dir") = py::none(), py::arg("instruments") = "none",
       "A payload's 10 inertial parameters from logs (or datasets) of the arm carrying it, the arm's parameters "
       "(params: an array or a parameters file of `model`) held: a dict of 'mass', 'com', 'inertia' (about the CoM) "
       "in the flange frame 'flange', their '*_std', 'standard', 'covariance', 'projected', 'status', 'rms_without', "

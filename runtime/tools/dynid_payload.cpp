@@ -36,6 +36,7 @@ struct PayloadCliOptions {
   double torque_delay_ms = 0;
   int trial = 1;
   bool force = false;
+  std::string instruments = "none";
 };
 
 void run(const Common& common, const PayloadCliOptions& o) {
@@ -62,6 +63,7 @@ void run(const Common& common, const PayloadCliOptions& o) {
   po.interval = o.interval_ms / 1000;
   po.torque_delay = o.torque_delay_ms / 1000;
   if (o.mass > 0) po.mass = o.mass;
+  po.reference_instruments = o.instruments == "reference";
   const payload::PayloadLink link = payload::payload_link(*full);
   const std::string flange = payload::robot_flange((common.robot_dir() / "robot.yaml").string(), link.link,
                                                    static_cast<int>(d.frames.size()), po.flange_in_link);
@@ -82,6 +84,8 @@ void run(const Common& common, const PayloadCliOptions& o) {
   fmt::print("          +- {:.2g} {:.2g} {:.2g} {:.2g} {:.2g} {:.2g}\n", e.inertia_std(0), e.inertia_std(1),
              e.inertia_std(2), e.inertia_std(3), e.inertia_std(4), e.inertia_std(5));
   fmt::print("  {}\n", e.status);
+  fmt::print("  estimator: {}\n",
+             e.instrumented ? "instrumental variables (the reference motion's regressor)" : "least squares");
   fmt::print("  {} samples at {:.0f} ms, covariance over {} lags, scaled condition number {:.3g}\n", e.samples,
              o.interval_ms, e.lags, e.condition);
   std::string line = "  residual RMS per joint, N m, the arm alone -> with the payload:";
@@ -123,6 +127,11 @@ void add_payload_commands(CLI::App& app, Common& common) {
   cmd->add_option("--mass", o->mass, "The payload's known mass, kg: the other 9 parameters are identified")
       ->check(numbers::checked(0, 1e4, true, false, "above 0 and at most 1e4 kg"));
   numbers::add_log_options(cmd, o->interval_ms, o->torque_delay_ms, o->trial);
+  cmd->add_option("--instruments", o->instruments,
+                  "reference: instrumental variables, the regressor of the logged reference motion (q_ref, "
+                  "qd_ref) instrumenting the measured one; unbiased by the encoders' noise a closed loop answers "
+                  "(docs/payload.md), needs logs with reference columns (default none: least squares)")
+      ->check(CLI::IsMember({"none", "reference"}));
   cmd->add_flag("--force", o->force, "Overwrite existing output files");
   cmd->callback([&common, o] { run(common, *o); });
 }

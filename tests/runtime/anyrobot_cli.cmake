@@ -12,10 +12,6 @@ file(REMOVE_RECURSE ${WORK})
 file(MAKE_DIRECTORY ${WORK})
 
 include(${CMAKE_CURRENT_LIST_DIR}/cli_test_helpers.cmake)
-function(run expect_code out_var)  # dynid <arguments>
-  run_command(${expect_code} out ${DYNID} ${ARGN})
-  set(${out_var} "${out}" PARENT_SCOPE)
-endfunction()
 
 foreach(robot rx90 stanford_rrp)
   set(w ${WORK}/${robot})
@@ -143,7 +139,7 @@ foreach(robot rx90 stanford_rrp)
   run(0 out export --robot ${robot} --study ${w}/study-${after} --urdf ${w}/urdf/${robot}.urdf --prior zero --nearest)
   expect("${out}" "urdf: .*${robot}.urdf")
   # The rotor inertia the URDF cannot hold is said, with where a simulator takes it from.
-  expect("${out}" "rotor inertia has no URDF field: .*${robot}.standard.yaml \\(MuJoCo: each joint's armature\\): IA[0-9]")
+  expect("${out}" "rotor inertia has no URDF field: .*${robot}.standard.yaml \\(MuJoCo: each joint's armature; dynid export --mjcf writes it there\\): IA[0-9]")
   foreach(f ${robot}.urdf ${robot}.standard.yaml ${robot}.standard.csv)
     if(NOT EXISTS ${w}/urdf/${f})
       message(FATAL_ERROR "dynid export wrote no ${f}")

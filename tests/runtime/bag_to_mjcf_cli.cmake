@@ -9,10 +9,6 @@ file(REMOVE_RECURSE ${WORK})
 file(MAKE_DIRECTORY ${WORK})
 set(ENV{SYMORO_CACHE_DIR} ${WORK}/cache)
 include(${CMAKE_CURRENT_LIST_DIR}/cli_test_helpers.cmake)
-function(run expect_code out_var)  # dynid <arguments>
-  run_command(${expect_code} out ${DYNID} ${ARGN})
-  set(${out_var} "${out}" PARENT_SCOPE)
-endfunction()
 
 run_command(0 out ${SYMOROC} model ${URDF_DIR}/ur5_robot.urdf -o ${WORK}/robots/ur5 --name ur5)
 run_command(0 out ${WRITE_EXPORT} ur5 ${WORK}/arm.json 40 5)

@@ -1,4 +1,5 @@
-# What the command-line test scripts share (included by dynid_cli, anyrobot_cli, mpi_ranks).
+# What the command-line test scripts share (included by dynid_cli, anyrobot_cli, loaded_robot_cli,
+# bag_to_mjcf_cli, mpi_ranks).
 
 # Runs a command; fails the test unless it exits with expect_code. out_var: stdout and stderr.
 function(run_command expect_code out_var)
@@ -13,4 +14,10 @@ function(expect text pattern)
   if(NOT text MATCHES "${pattern}")
     message(FATAL_ERROR "expected /${pattern}/ in:\n${text}")
   endif()
+endfunction()
+
+# Runs ${DYNID} <arguments> (the scripts' -DDYNID) with run_command.
+function(run expect_code out_var)
+  run_command(${expect_code} out ${DYNID} ${ARGN})
+  set(${out_var} "${out}" PARENT_SCOPE)
 endfunction()

@@ -5,10 +5,6 @@ file(REMOVE_RECURSE ${WORK})
 file(MAKE_DIRECTORY ${WORK})
 
 include(${CMAKE_CURRENT_LIST_DIR}/cli_test_helpers.cmake)
-function(run expect_code out_var)  # dynid <arguments>
-  run_command(${expect_code} out ${DYNID} ${ARGN})
-  set(${out_var} "${out}" PARENT_SCOPE)
-endfunction()
 
 set(ds ${WORK}/data)
 run(0 out twin dataset --robot crane_x7 -o ${ds} --trials 2 --seed 4 --only V01 V02 --jobs 2)
@@ -353,8 +349,10 @@ expect("${out}" "max \\|B s - phi\\| = [0-9.e-]+")
 # is no file.
 file(SHA256 ${WORK}/control/crane-physical.urdf before)
 run(2 out export --robot crane_x7 --study ${WORK}/control/study-physical --urdf ${WORK}/control/crane-physical.urdf)
-expect("${out}" "crane-physical.urdf exists: dynid export does not overwrite it; choose another --urdf, or --force")
+expect("${out}" "crane-physical.urdf exists: dynid export does not overwrite it; choose another --urdf or --mjcf, or --force")
 run(0 out export --robot crane_x7 --study ${WORK}/control/study-physical --urdf ${WORK}/control/crane-physical.urdf --force)
+run(2 out export --robot crane_x7 --study ${WORK}/control/study-physical)
+expect("${out}" "say what to write: --urdf file, --mjcf file, or both")
 file(MAKE_DIRECTORY ${WORK}/control/folder.urdf)
 run(2 out export --robot crane_x7 --study ${WORK}/control/study-physical --urdf ${WORK}/control/folder.urdf)
 expect("${out}" "folder.urdf is a directory")

@@ -13,10 +13,6 @@ file(REMOVE_RECURSE ${WORK})
 file(MAKE_DIRECTORY ${WORK})
 set(ENV{SYMORO_CACHE_DIR} ${WORK}/cache)
 include(${CMAKE_CURRENT_LIST_DIR}/cli_test_helpers.cmake)
-function(run expect_code out_var)  # dynid <arguments>
-  run_command(${expect_code} out ${DYNID} ${ARGN})
-  set(${out_var} "${out}" PARENT_SCOPE)
-endfunction()
 
 run_command(0 out ${SYMOROC} model ${URDF_DIR}/ur5_robot.urdf -o ${WORK}/robots/ur5 --name ur5)
 execute_process(COMMAND ${WRITE_EXPORT} ur5 ${WORK}/export.csv 40 5 RESULT_VARIABLE code)
@@ -136,6 +132,10 @@ expect("${yaml}" "ur: \"set_target_payload\\(1\\.")
 run(2 out payload --robot ${WORK}/robots/ur5 --params ${WORK}/loaded-study/report/parameters.yaml
     ${WORK}/payload-data -o ${WORK}/payload)
 expect("${out}" "payload.yaml exists")
+# A controller's CSV export without reference columns cannot instrument the fit.
+run(2 out payload --robot ${WORK}/robots/ur5 --params ${WORK}/loaded-study/report/parameters.yaml
+    ${WORK}/payload-data -o ${WORK}/payload-iv --instruments reference)
+expect("${out}" "reference instruments: [a-z_]+ has no reference columns \\(q_ref, qd_ref, qdd_ref\\)")
 run(0 out payload --robot ${WORK}/robots/ur5 --params ${WORK}/loaded-study/report/parameters.yaml --mass 1.2
     ${WORK}/payload-data -o ${WORK}/payload-known)
 expect("${out}" "mass +1\\.2 kg \\(given\\)")

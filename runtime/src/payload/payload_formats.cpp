@@ -89,7 +89,8 @@ std::string payload_yaml(const PayloadEstimate& e, const PayloadFileContext& c) 
   y += fmt::format("known_mass: {}\n", e.known_mass ? "true" : "false");
   y += fmt::format("consistency: {{projected: {}, margin: {}, distance: {}}}  # {}\n", e.projected ? "true" : "false",
                    num(e.margin), num(e.distance), e.status);
-  y += fmt::format("fit: {{samples: {}, lags: {}, condition: {}}}\n", e.samples, e.lags, num(e.condition));
+  y += fmt::format("fit: {{samples: {}, lags: {}, condition: {}, estimator: {}}}\n", e.samples, e.lags,
+                   num(e.condition), e.instrumented ? "instrumental variables (reference motion)" : "least squares");
   y += fmt::format("rms_without_payload: {}  # N m per joint: measured minus the arm's model\n", list(e.rms_without));
   y += fmt::format("rms_with_payload: {}  # N m per joint: minus the arm's and the payload's\n", list(e.rms_with));
   y += fmt::format("standard:  # link {}'s standard parameters added by the payload, its model frame\n", e.link);

@@ -2,9 +2,11 @@
 
 #include <algorithm>
 #include <cmath>
+#include <memory>
 #include <stdexcept>
 
 #include <Eigen/Cholesky>
+#include <Eigen/LU>
 #include <Eigen/SVD>
 #include <fmt/format.h>
 
@@ -20,16 +22,52 @@ namespace {
 // The stacked payload regression of all logs: rows sample after sample, joint after joint.
 struct Stack {
   Eigen::MatrixXd X;        // rows x 10
+  Eigen::MatrixXd Z;        // the instruments (reference_instruments), rows x 10; else empty
   Eigen::VectorXd y;        // tau - ID(phi)
   std::vector<int> log_of;  // per sample
   int joints = 0, samples = 0;
 };
 
+// The log with its reference motion in place of the measured one (a window's whole file too).
+io::Log as_reference(const io::Log& log) {
+  io::Log r = log;
+  r.q = log.q_ref;
+  r.qd = log.qd_ref;
+  if (log.file) r.file = std::make_shared<const io::Log>(as_reference(*log.file));
+  return r;
+}
+
+// The payload regressor of the reference motion on the measured samples' instants.
+Eigen::MatrixXd instruments(const io::Log& log, const preprocess::Samples& measured,
+                            const identify::IdentificationModel& full, const PayloadLink& link, double interval,
+                            const preprocess::Options& po) {
+  const std::string name = log.meta.trajectory.empty() ? std::string("a log") : log.meta.trajectory;
+  if (!log.has_references())
+    throw std::invalid_argument(
+        fmt::format("reference instruments: {} has no reference columns (q_ref, qd_ref, qdd_ref)", name));
+  const preprocess::Samples ref = preprocess::preprocess(as_reference(log), interval, po);
+  const Eigen::MatrixXd Wr = full.stack_regression(ref).W * link.map;
+  const int n = static_cast<int>(measured.q.cols());
+  Eigen::MatrixXd Z(measured.time.size() * n, Wr.cols());
+  // The reference has no stale rows to leave out: its samples are a superset of the measured
+  // ones' instants, matched by time.
+  Eigen::Index k = 0;
+  for (Eigen::Index i = 0; i < measured.time.size(); ++i) {
+    while (k < ref.time.size() && ref.time(k) < measured.time(i) - 1e-9) ++k;
+    if (k == ref.time.size() || std::abs(ref.time(k) - measured.time(i)) > 1e-9)
+      throw std::invalid_argument(
+          fmt::format("reference instruments: {}'s reference has no sample at {} s, where its measured motion has one",
+                      name, measured.time(i)));
+    Z.middleRows(i * n, n) = Wr.middleRows(k * n, n);
+  }
+  return Z;
+}
+
 Stack stack(const std::vector<io::Log>& logs, const identify::IdentificationModel& arm, const Eigen::VectorXd& phi,
             const identify::IdentificationModel& full, const PayloadLink& link, const PayloadOptions& o) {
   Stack s;
   s.joints = arm.description().nq;
-  std::vector<Eigen::MatrixXd> Xs;
+  std::vector<Eigen::MatrixXd> Xs, Zs;
   std::vector<Eigen::VectorXd> ys;
   // The identification's preprocessing (study/prediction.hpp's, without its raw-rate scoring).
   preprocess::Options po = study::StudyOptions{}.preprocess;
@@ -38,6 +76,7 @@ Stack stack(const std::vector<io::Log>& logs, const identify::IdentificationMode
     const preprocess::Samples samples = preprocess::preprocess(logs[i], o.interval, po);
     const Eigen::MatrixXd r = samples.tau - arm.open_loop_torque(samples, phi);
     Xs.push_back(full.stack_regression(samples).W * link.map);
+    if (o.reference_instruments) Zs.push_back(instruments(logs[i], samples, full, link, o.interval, po));
     Eigen::VectorXd y(r.size());
     for (Eigen::Index k = 0; k < r.rows(); ++k) y.segment(k * s.joints, s.joints) = r.row(k).transpose();
     ys.push_back(std::move(y));
@@ -46,9 +85,11 @@ Stack stack(const std::vector<io::Log>& logs, const identify::IdentificationMode
   s.samples = static_cast<int>(s.log_of.size());
   s.X.resize(static_cast<Eigen::Index>(s.samples) * s.joints, kInertialParameters);
   s.y.resize(s.X.rows());
+  if (o.reference_instruments) s.Z.resize(s.X.rows(), s.X.cols());
   Eigen::Index at = 0;
   for (std::size_t i = 0; i < Xs.size(); ++i) {
     s.X.middleRows(at, Xs[i].rows()) = Xs[i];
+    if (o.reference_instruments) s.Z.middleRows(at, Xs[i].rows()) = Zs[i];
     s.y.segment(at, ys[i].size()) = ys[i];
     at += Xs[i].rows();
   }
@@ -66,6 +107,20 @@ Eigen::MatrixXd weighted(const Eigen::MatrixXd& A, const Eigen::VectorXd& w) {
   const int n = static_cast<int>(w.size());
   for (Eigen::Index r = 0; r < B.rows(); ++r) B.row(r) *= w(r % n);
   return B;
+}
+
+// The columns `free` of A.
+Eigen::MatrixXd free_columns(const Eigen::MatrixXd& A, const std::vector<int>& free) {
+  Eigen::MatrixXd B(A.rows(), static_cast<Eigen::Index>(free.size()));
+  for (std::size_t i = 0; i < free.size(); ++i) B.col(static_cast<Eigen::Index>(i)) = A.col(free[i]);
+  return B;
+}
+
+// The weighted instrumental-variable estimate (Z'W X)^-1 Z'W y (rows weighted as in weighted()).
+Eigen::VectorXd instrumented(const Eigen::MatrixXd& Z, const Eigen::MatrixXd& X, const Eigen::VectorXd& y,
+                             const Eigen::VectorXd& w) {
+  const Eigen::MatrixXd Zw = weighted(Z, w);
+  return (Zw.transpose() * weighted(X, w)).fullPivLu().solve(Zw.transpose() * weighted(y, w));
 }
 
 // The reported numbers of a standard vector: mass, CoM (3), inertia about the CoM (6).
@@ -158,6 +213,7 @@ PayloadEstimate identify_payload(const std::vector<io::Log>& logs, const identif
   out.link = link.link;
   out.samples = s.samples;
   out.known_mass = o.mass.has_value();
+  out.instrumented = o.reference_instruments;
   out.rms_without = joint_rms(s.y, n);
 
   // Weighted least squares, the weights re-estimated from the residual.
@@ -179,6 +235,7 @@ PayloadEstimate identify_payload(const std::vector<io::Log>& logs, const identif
           "is {}; move the wrist joints more (dynid excite --payload)",
           out.condition, weakest(Xs, free)));
     beta = norms.cwiseInverse().asDiagonal() * svd.solve(weighted(y, w));
+    if (o.reference_instruments) beta = instrumented(free_columns(s.Z, free), X, y, w);
     if (it == o.wls_iterations) break;
     const Eigen::VectorXd rms = joint_rms(y - X * beta, n);
     for (int j = 0; j < n; ++j) w(j) = rms(j) > 0 ? 1 / rms(j) : 1;
@@ -189,7 +246,14 @@ PayloadEstimate identify_payload(const std::vector<io::Log>& logs, const identif
   const Eigen::MatrixXd Xw = weighted(X, w);
   const Eigen::VectorXd ew = weighted(y - X * beta, w);
   out.lags = o.lags >= 0 ? o.lags : identify::residual_lags(ew, s.log_of, n);
-  const Eigen::MatrixXd C = identify::hac_covariance(Xw, ew, s.log_of, n, out.lags);
+  Eigen::MatrixXd C = identify::hac_covariance(Xw, ew, s.log_of, n, out.lags);
+  if (o.reference_instruments) {
+    // (Z'X)^-1 S_Z (X'Z)^-1, S_Z the long-run covariance of the instruments' scores, which
+    // hac_covariance gives between (Z'Z)^-1 factors.
+    const Eigen::MatrixXd Zw = weighted(free_columns(s.Z, free), w);
+    const Eigen::MatrixXd ZZ = Zw.transpose() * Zw, ZXi = (Zw.transpose() * Xw).inverse();
+    C = ZXi * ZZ * identify::hac_covariance(Zw, ew, s.log_of, n, out.lags) * ZZ * ZXi.transpose();
+  }
   out.least_squares.setZero();
   out.covariance.setZero();
   for (int i = 0; i < r; ++i) {

@@ -48,6 +48,13 @@ struct PayloadOptions {
   Eigen::Isometry3d flange_in_link = Eigen::Isometry3d::Identity();
   int lags = -1;           // the covariance's lags; < 0: from the residual's autocorrelation
   int wls_iterations = 3;  // re-estimations of the joints' weights (0: unweighted)
+  // Instrumental variables: the payload regressor of the logged reference motion (q_ref, qd_ref,
+  // through the same preprocessing) instruments the measured one, theta = (Z'W X)^-1 Z'W y. The
+  // measured positions carry the encoders' noise, to which a closed-loop controller's current
+  // answers: least squares then takes the payload about 0.5 % light on the CRANE-X7 twin (mass
+  // -0.5 %, CoM 0.3 mm); the instruments do not share that noise (mass 0.03 %, CoM 0.1 mm), at a
+  // larger variance of the inertia (docs/payload.md). Needs logs with reference columns.
+  bool reference_instruments = false;
 };
 
 struct PayloadEstimate {
@@ -61,10 +68,11 @@ struct PayloadEstimate {
   StandardVector least_squares;  // the unconstrained estimate (= standard unless projected)
   Eigen::Matrix<double, kInertialParameters, kInertialParameters> covariance;  // of least_squares
   bool known_mass = false;
-  bool projected = false;  // the estimate was no body: standard is the nearest body
-  double distance = 0;     // Mahalanobis distance of the projection (0 when none)
-  double margin = 0;       // consistency_margin(standard) (> 0: a body)
-  int link = 0;            // the model frame the payload rides on
+  bool instrumented = false;  // PayloadOptions::reference_instruments
+  bool projected = false;     // the estimate was no body: standard is the nearest body
+  double distance = 0;        // Mahalanobis distance of the projection (0 when none)
+  double margin = 0;          // consistency_margin(standard) (> 0: a body)
+  int link = 0;               // the model frame the payload rides on
   int samples = 0, lags = 0;
   double condition = 0;         // of the column-scaled weighted payload regressor
   Eigen::VectorXd weights;      // per joint, 1 / N m
