@@ -238,16 +238,11 @@ std::vector<double> robot_torque_constants(const fs::path& robot_yaml) {
   return k;
 }
 
-ImportedLog import_bag(const fs::path& input, const BagSettings& settings, const ImportTarget& target) {
-  const std::size_t n = target.joints.size();
-  if (settings.effort == EffortKind::current && settings.torque_constants.size() != n)
-    throw DataError(input.string(), 0,
-                    fmt::format("effort as motor current needs a torque constant per joint ({}), {} given", n,
-                                settings.torque_constants.size()));
-  const std::vector<fs::path> files = bag_files(input);
-  Gatherer g(input, settings, target);
-  for (const fs::path& f : files) g.file(f);
-  Gathered& got = g.out;
+namespace {
+
+// The errors a bag's messages can show before any row is made.
+void check_gathered(const Gathered& got, const fs::path& input, const BagSettings& settings,
+                    const ImportTarget& target) {
   if (got.entries.empty()) {
     std::string topics;
     for (const auto& [t, c] : got.other_topics) topics += fmt::format("{}{} ({})", topics.empty() ? "" : ", ", t, c);
@@ -260,7 +255,7 @@ ImportedLog import_bag(const fs::path& input, const BagSettings& settings, const
                     fmt::format("every message on {} has header.stamp 0 (the driver does not stamp them): use the "
                                 "recorder's receive time (--stamp receive)",
                                 settings.topic));
-  for (std::size_t j = 0; j < n; ++j)
+  for (std::size_t j = 0; j < target.joints.size(); ++j)
     if (std::all_of(got.entries.begin(), got.entries.end(), [&](const Entry& e) { return std::isnan(e.q[j]); })) {
       std::vector<std::string> seen(got.ignored_names.begin(), got.ignored_names.end());
       throw DataError(input.string(), 0,
@@ -269,20 +264,33 @@ ImportedLog import_bag(const fs::path& input, const BagSettings& settings, const
                                   settings.topic, target.joints[j], joined(target.joints),
                                   seen.empty() ? std::string("none") : joined(seen)));
     }
+}
 
-  // Rows: one per stamp, its messages merged.
+// One row per stamp, its messages merged; the partial stamps counted, not kept.
+struct Merged {
+  std::vector<Entry> rows;
+  std::vector<int> partial_by_joint;
+  int partial = 0;
+  std::vector<int> duplicates;  // message numbers
+  int stamps() const { return static_cast<int>(rows.size()) + partial; }
+  std::string missing_most(const ImportTarget& target) const {
+    std::vector<std::string> names;
+    const int worst = *std::max_element(partial_by_joint.begin(), partial_by_joint.end());
+    for (std::size_t j = 0; j < partial_by_joint.size(); ++j)
+      if (partial_by_joint[j] == worst) names.push_back(target.joints[j]);
+    return fmt::format("{} (missing at {} stamps)", joined(names), worst);
+  }
+};
+
+Merged merge_stamps(Gathered& got, const fs::path& input, const BagSettings& settings, const ImportTarget& target) {
+  const std::size_t n = target.joints.size();
   std::stable_sort(got.entries.begin(), got.entries.end(),
                    [](const Entry& a, const Entry& b) { return a.stamp < b.stamp; });
-  std::vector<Entry> rows;
-  std::vector<int> partial_by_joint(n, 0);
-  int partial = 0;
-  ImportedLog out;
-  out.input = input;
-  out.rows = static_cast<int>(got.entries.size());
+  Merged m;
+  m.partial_by_joint.assign(n, 0);
   for (std::size_t i = 0; i < got.entries.size();) {
     Entry row = got.entries[i];
     std::size_t k = i + 1;
-    bool adds = false;
     for (; k < got.entries.size() && got.entries[k].stamp == row.stamp; ++k) {
       const Entry& e = got.entries[k];
       std::size_t j = 0;
@@ -291,39 +299,38 @@ ImportedLog import_bag(const fs::path& input, const BagSettings& settings, const
         throw DataError(input.string(), 0,
                         fmt::format("messages {} and {} on {} give joint {} different values at stamp {}", row.number,
                                     e.number, settings.topic, target.joints[j], stamp_text(row.stamp)));
-      adds = false;
-      for (std::size_t m = 0; m < n; ++m) adds = adds || (std::isnan(before[m]) && !std::isnan(e.q[m]));
-      if (!adds) out.duplicate_lines.push_back(static_cast<int>(e.number));
+      bool adds = false;
+      for (std::size_t c = 0; c < n; ++c) adds = adds || (std::isnan(before[c]) && !std::isnan(e.q[c]));
+      if (!adds) m.duplicates.push_back(static_cast<int>(e.number));
     }
     i = k;
     if (whole(row.q) && whole(row.tau)) {
-      rows.push_back(std::move(row));
+      m.rows.push_back(std::move(row));
     } else {
-      ++partial;
-      for (std::size_t j = 0; j < n; ++j) partial_by_joint[j] += std::isnan(row.q[j]) || std::isnan(row.tau[j]);
+      ++m.partial;
+      for (std::size_t j = 0; j < n; ++j) m.partial_by_joint[j] += std::isnan(row.q[j]) || std::isnan(row.tau[j]);
     }
   }
-  const auto stamps = static_cast<int>(rows.size()) + partial;
-  const auto missing_most = [&] {
-    std::vector<std::string> names;
-    const int worst = *std::max_element(partial_by_joint.begin(), partial_by_joint.end());
-    for (std::size_t j = 0; j < n; ++j)
-      if (partial_by_joint[j] == worst) names.push_back(target.joints[j]);
-    return fmt::format("{} (missing at {} stamps)", joined(names), worst);
-  };
-  if (rows.size() < 4 || 2 * partial > stamps)
+  if (m.rows.size() < 4 || 2 * m.partial > m.stamps())
     throw DataError(input.string(), 0,
                     fmt::format("only {} of the {} stamps on {} give every joint's position and effort; the joints "
                                 "missing most: {}. Are they published with other stamps (another driver), or "
                                 "without effort?",
-                                rows.size(), stamps, settings.topic, missing_most()));
+                                m.rows.size(), m.stamps(), settings.topic, m.missing_most(target)));
+  return m;
+}
 
+// The log's samples from the rows (time from the first, effort as torque); returns whether the
+// velocity was measured in every row (else it is differentiated from q).
+bool fill_samples(const Merged& m, const fs::path& input, const BagSettings& settings, ImportedLog& out) {
+  const std::vector<Entry>& rows = m.rows;
   const auto R = static_cast<Eigen::Index>(rows.size());
+  const auto n = static_cast<Eigen::Index>(rows.front().q.size());
   Log& log = out.log;
   log.time.resize(R);
-  log.q.resize(R, static_cast<Eigen::Index>(n));
-  log.qd.resize(R, static_cast<Eigen::Index>(n));
-  log.tau.resize(R, static_cast<Eigen::Index>(n));
+  log.q.resize(R, n);
+  log.qd.resize(R, n);
+  log.tau.resize(R, n);
   bool velocity = true;
   std::vector<bool> stale(rows.size(), false);
   for (Eigen::Index r = 0; r < R; ++r) {
@@ -336,8 +343,8 @@ ImportedLog import_bag(const fs::path& input, const BagSettings& settings, const
                                   "that jumped?)",
                                   stamp_text(rows[static_cast<std::size_t>(r - 1)].stamp), stamp_text(e.stamp),
                                   number_text(log.time(r))));
-    for (std::size_t j = 0; j < n; ++j) {
-      const auto c = static_cast<Eigen::Index>(j);
+    for (Eigen::Index c = 0; c < n; ++c) {
+      const auto j = static_cast<std::size_t>(c);
       log.q(r, c) = e.q[j];
       log.qd(r, c) = e.qd[j];
       log.tau(r, c) = settings.effort == EffortKind::current ? e.tau[j] * settings.torque_constants[j] : e.tau[j];
@@ -358,43 +365,35 @@ ImportedLog import_bag(const fs::path& input, const BagSettings& settings, const
                                   "joint's position in SI units",
                                   log.q.cwiseAbs().maxCoeff()));
   }
+  return velocity;
+}
 
-  log.meta.robot = target.robot;
-  log.meta.trajectory = input.stem().string();
-  log.meta.source = "robot";
-  log.meta.joints = target.joints;
-  log.meta.velocity = velocity ? Velocity::measured : Velocity::differentiated;
-  log.meta.sample_time = median_sample_time(log.time, input.string());
+// What the import decided, for the user (remarks, the sidecar's notes) and import.yaml (columns).
+void describe(const Gathered& got, const Merged& m, std::size_t files, bool velocity, const BagSettings& settings,
+              const ImportTarget& target, ImportedLog& out) {
   const std::string stamps_from =
       settings.stamp == StampSource::header ? "header.stamp" : "the recorder's receive time (log_time)";
-  const std::string effort = settings.effort == EffortKind::torque
-                                 ? "joint torque (N m) as published"
-                                 : fmt::format("motor current (A) times the torque constants [{}] N m/A", [&] {
-                                     std::string k;
-                                     for (double c : settings.torque_constants)
-                                       k += (k.empty() ? "" : ", ") + number_text(c);
-                                     return k;
-                                   }());
-  out.remarks.push_back(fmt::format("{} MCAP file{}, {} messages on {} (sensor_msgs/msg/JointState){}", files.size(),
-                                    files.size() == 1 ? "" : "s", got.entries.size(), settings.topic, [&] {
-                                      std::string o;
-                                      for (const auto& [t, c] : got.other_topics)
-                                        o += fmt::format("{}{} {}", o.empty() ? "; other topics: " : ", ", t, c);
-                                      return o;
-                                    }()));
+  std::string constants, others;
+  for (double c : settings.torque_constants) constants += (constants.empty() ? "" : ", ") + number_text(c);
+  for (const auto& [t, c] : got.other_topics)
+    others += fmt::format("{}{} {}", others.empty() ? "; other topics: " : ", ", t, c);
+  out.remarks.push_back(fmt::format("{} MCAP file{}, {} messages on {} (sensor_msgs/msg/JointState){}", files,
+                                    files == 1 ? "" : "s", got.entries.size(), settings.topic, others));
   out.remarks.push_back(
-      fmt::format("time from {}, 0 at the first row (stamp {})", stamps_from, stamp_text(rows.front().stamp)));
+      fmt::format("time from {}, 0 at the first row (stamp {})", stamps_from, stamp_text(m.rows.front().stamp)));
   out.remarks.push_back(fmt::format(
-      "{} rows from {} stamps; {} partial stamps left out{}; {} duplicate messages", rows.size(), stamps, partial,
-      partial ? " (joints missing most: " + missing_most() + ")" : "", out.duplicate_lines.size()));
-  out.remarks.push_back("effort: " + effort);
+      "{} rows from {} stamps; {} partial stamps left out{}; {} duplicate messages", m.rows.size(), m.stamps(),
+      m.partial, m.partial ? " (joints missing most: " + m.missing_most(target) + ")" : "", m.duplicates.size()));
+  out.remarks.push_back("effort: " + (settings.effort == EffortKind::torque
+                                          ? std::string("joint torque (N m) as published")
+                                          : "motor current (A) times the torque constants [" + constants + "] N m/A"));
   out.remarks.push_back(velocity ? "velocity: measured (JointState.velocity)"
                                  : "velocity: differentiated from position (some messages carry none)");
   if (!got.ignored_names.empty())
     out.remarks.push_back("names the robot has not, ignored: " +
                           joined({got.ignored_names.begin(), got.ignored_names.end()}));
   for (const std::string& c : got.cut) out.remarks.push_back(c);
-  for (std::size_t j = 0; j < n; ++j) {
+  for (std::size_t j = 0; j < target.joints.size(); ++j) {
     const std::string& name = target.joints[j];
     const std::string i = std::to_string(j + 1);
     out.columns["q" + i] = fmt::format("{} position[{}]", settings.topic, name);
@@ -404,9 +403,36 @@ ImportedLog import_bag(const fs::path& input, const BagSettings& settings, const
         "{} effort[{}]{}", settings.topic, name,
         settings.effort == EffortKind::current ? " x " + number_text(settings.torque_constants[j]) + " N m/A" : "");
   }
-  std::string notes = "imported from ROS 2 bag " + input.filename().string();
-  for (const std::string& r : out.remarks) notes += "; " + r;
-  log.meta.notes = notes;
+}
+
+}  // namespace
+
+ImportedLog import_bag(const fs::path& input, const BagSettings& settings, const ImportTarget& target) {
+  const std::size_t n = target.joints.size();
+  if (settings.effort == EffortKind::current && settings.torque_constants.size() != n)
+    throw DataError(input.string(), 0,
+                    fmt::format("effort as motor current needs a torque constant per joint ({}), {} given", n,
+                                settings.torque_constants.size()));
+  const std::vector<fs::path> files = bag_files(input);
+  Gatherer g(input, settings, target);
+  for (const fs::path& f : files) g.file(f);
+  check_gathered(g.out, input, settings, target);
+  const Merged m = merge_stamps(g.out, input, settings, target);
+  ImportedLog out;
+  out.input = input;
+  out.rows = static_cast<int>(g.out.entries.size());
+  out.duplicate_lines = m.duplicates;
+  const bool velocity = fill_samples(m, input, settings, out);
+  Log& log = out.log;
+  log.meta.robot = target.robot;
+  log.meta.trajectory = input.stem().string();
+  log.meta.source = "robot";
+  log.meta.joints = target.joints;
+  log.meta.velocity = velocity ? Velocity::measured : Velocity::differentiated;
+  log.meta.sample_time = median_sample_time(log.time, input.string());
+  describe(g.out, m, files.size(), velocity, settings, target, out);
+  log.meta.notes = "imported from ROS 2 bag " + input.filename().string();
+  for (const std::string& r : out.remarks) log.meta.notes += "; " + r;
   return out;
 }
 
