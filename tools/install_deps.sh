@@ -12,7 +12,6 @@ packages=(
   procps  # pgrep/ps: the MPI test finds the rank it kills
   liblz4-dev libzstd-dev  # MCAP chunks: dynid import reads ROS 2 bags (io/mcap.hpp)
   libmujoco-dev  # dynid export --mjcf is checked against MuJoCo's own inverse dynamics (tests)
-  nodejs npm  # test-only: the MCAP project's writer makes the bags the import tests read (tests/bags)
   libxxhash-dev  # content digests (io/digest.hpp): saved runs, parameters files, robot folders
   liburdfdom-dev liburdfdom-tools  # symoroc model reads URDFs (urdfdom); the export tests read them back (check_urdf)
   libtinyxml-dev  # symoroc model names the line of a malformed URDF (urdfdom's own XML parser)
@@ -24,6 +23,12 @@ missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
 done
+# Test-only: node and npm run the MCAP project's writer, which makes the bags the import tests read
+# (tests/bags). Judged by the commands, not the packages: a Node.js from another source (e.g.
+# NodeSource's, which bundles npm and conflicts with Debian's npm package) serves as well.
+if ! command -v node >/dev/null || ! command -v npm >/dev/null; then
+  missing+=(nodejs npm)
+fi
 if ((${#missing[@]})); then
   echo "Installing: ${missing[*]}"
   sudo_cmd=()
