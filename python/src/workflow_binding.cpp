@@ -103,17 +103,15 @@ void bind_workflow(py::module_& m) {
             std::any_of(files.begin(), files.end(), [](const std::filesystem::path& f) { return !io::is_bag(f); });
         if (text && (mp.time.empty() || mp.q.empty() || mp.tau.empty()))
           throw py::value_error("say which columns hold time, q and tau: time=, q=, tau=, or mapping='map.yaml'");
-        // ROS 2 bags (an .mcap file or a bag folder), as dynid import reads them.
-        if (stamp != "header" && stamp != "receive") throw py::value_error("stamp: 'header' or 'receive'");
-        if (effort != "torque" && effort != "current") throw py::value_error("effort: 'torque' or 'current'");
-        di.bag.topic = topic;
-        di.bag.stamp = stamp == "receive" ? io::StampSource::receive : io::StampSource::header;
-        di.bag.effort = effort == "current" ? io::EffortKind::current : io::EffortKind::torque;
-        di.bag.torque_constants = torque_constants;
-        if (di.bag.torque_constants.size() == 1) di.bag.torque_constants.assign(d.joints.size(), torque_constants[0]);
-        if (di.bag.effort == io::EffortKind::current && di.bag.torque_constants.size() != d.joints.size())
-          throw py::value_error(
-              fmt::format("effort='current' needs torque_constants: one, or one per joint ({})", d.joints.size()));
+        // ROS 2 bags (an .mcap file or a bag folder) as dynid import reads them, with robot.yaml's torque
+        // constants when none are given (the loaded model's folder).
+        const std::optional<std::filesystem::path> dir = robot_dir_of(model, std::nullopt);
+        try {
+          di.bag = io::bag_settings(topic, stamp, effort, torque_constants, d.joints.size(),
+                                    dir ? *dir / "robot.yaml" : std::filesystem::path());
+        } catch (const std::invalid_argument& e) {
+          throw py::value_error(std::string("stamp, effort, torque_constants: ") + e.what());
+        }
         if (!names.empty() && names.size() != files.size())
           throw py::value_error(fmt::format("names: {} names for {} input files", names.size(), files.size()));
         for (const auto& h : heldout)

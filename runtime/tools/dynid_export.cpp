@@ -204,11 +204,16 @@ void print_export(const model_export::ModelExport& e, const model_export::ModelE
         rotor);
 }
 
-// A payload.yaml's body as an MJCF body on its model frame, the flange at its recorded pose.
-model_export::MjcfAttachment payload_body(const Common& common, const ExportOptions& options) {
-  const payload::PayloadFile f = payload::read_payload_yaml(options.payload);
+// --payload's file, of this robot.
+payload::PayloadFile payload_file(const Common& common, const ExportOptions& options) {
+  payload::PayloadFile f = payload::read_payload_yaml(options.payload);
   if (!f.robot.empty() && f.robot != common.robot)
     throw UsageError(fmt::format("{}: a payload of robot '{}', not {}", options.payload, f.robot, common.robot));
+  return f;
+}
+
+// A payload.yaml's body as an MJCF body on its model frame, the flange at its recorded pose.
+model_export::MjcfAttachment payload_body(const payload::PayloadFile& f) {
   model_export::MjcfAttachment a;
   a.name = "payload";
   a.frame = f.link;
@@ -223,11 +228,8 @@ model_export::MjcfAttachment payload_body(const Common& common, const ExportOpti
 // The URDF with a payload.yaml's body on its flange: into the user's URDF, on the flange link
 // it names (a URDF tip link); into the model's URDF, on the payload's model frame's link, the
 // flange at its recorded pose there.
-std::string with_payload(const Common& common, const ExportOptions& options, const model_export::UrdfDescription& d,
-                         const std::string& urdf) {
-  const payload::PayloadFile f = payload::read_payload_yaml(options.payload);
-  if (!f.robot.empty() && f.robot != common.robot)
-    throw UsageError(fmt::format("{}: a payload of robot '{}', not {}", options.payload, f.robot, common.robot));
+std::string with_payload(const payload::PayloadFile& f, const ExportOptions& options,
+                         const model_export::UrdfDescription& d, const std::string& urdf) {
   const bool frame = f.flange.rfind("frame ", 0) == 0;
   if (!options.into.empty() && frame)
     throw UsageError(
@@ -280,7 +282,7 @@ void run_export(const Common& common, const ExportOptions& options, const std::s
   const model_export::ModelExport e = model_export::export_model(*model, phi, eo);
   std::string urdf_text;
   if (options.urdf.empty()) {
-    if (!options.into.empty()) throw UsageError("--into writes a URDF: give --urdf too");
+    // MJCF only (--into needs --urdf: refused before the work)
   } else if (options.into.empty()) {
     urdf_text = model_export::urdf_text(e.description);
   } else {
@@ -290,8 +292,9 @@ void run_export(const Common& common, const ExportOptions& options, const std::s
   }
   std::vector<model_export::MjcfAttachment> attachments;
   if (!options.payload.empty()) {
-    if (!options.urdf.empty()) urdf_text = export_detail::with_payload(common, options, e.description, urdf_text);
-    attachments.push_back(export_detail::payload_body(common, options));
+    const payload::PayloadFile f = export_detail::payload_file(common, options);
+    if (!options.urdf.empty()) urdf_text = export_detail::with_payload(f, options, e.description, urdf_text);
+    attachments.push_back(export_detail::payload_body(f));
   }
   std::string mjcf_text;
   if (!options.mjcf.empty()) try {
@@ -360,6 +363,7 @@ void add_export_commands(CLI::App& app, Common& common) {
     // both passed the check below, and the last writer won), and, like import and control, an
     // existing file is replaced only when the user says so, before any work is done.
     if (o->urdf.empty() && o->mjcf.empty()) throw UsageError("say what to write: --urdf file, --mjcf file, or both");
+    if (o->urdf.empty() && !o->into.empty()) throw UsageError("--into writes a URDF: give --urdf too");
     const std::filesystem::path target(o->urdf.empty() ? o->mjcf : o->urdf);
     const io::FolderLock lock(target.parent_path().empty() ? std::filesystem::path(".") : target.parent_path(),
                               "dynid export", "." + target.filename().string() + ".lock", /*remove_when_done=*/true);

@@ -40,24 +40,12 @@ io::ImportMapping mapping_of(const ImportOptions& options) {
 
 // The bag settings: the command line's, the torque constants from it or robot.yaml.
 io::BagSettings bag_settings_of(const Common& common, const ImportOptions& options, std::size_t joints) {
-  io::BagSettings b;
-  b.topic = options.topic;
-  b.stamp = options.stamp == "receive" ? io::StampSource::receive : io::StampSource::header;
-  b.effort = options.effort == "current" ? io::EffortKind::current : io::EffortKind::torque;
-  if (b.effort == io::EffortKind::torque) {
-    if (!options.torque_constants.empty()) throw UsageError("--torque-constant goes with --effort current");
-    return b;
+  try {
+    return io::bag_settings(options.topic, options.stamp, options.effort, options.torque_constants, joints,
+                            common.robot_dir() / "robot.yaml");
+  } catch (const std::invalid_argument& e) {
+    throw UsageError(std::string("--effort, --torque-constant: ") + e.what());
   }
-  const std::filesystem::path robot_yaml = common.robot_dir() / "robot.yaml";
-  b.torque_constants =
-      options.torque_constants.empty() ? io::robot_torque_constants(robot_yaml) : options.torque_constants;
-  if (b.torque_constants.size() == 1) b.torque_constants.assign(joints, b.torque_constants[0]);
-  if (b.torque_constants.size() != joints)
-    throw UsageError(
-        fmt::format("--effort current needs the joints' torque constants (N m/A): --torque-constant k (all joints) or "
-                    "k1,...,k{}, or torque_constant on each joint of {}; {} given",
-                    joints, robot_yaml.string(), b.torque_constants.size()));
-  return b;
 }
 
 }  // namespace import_detail

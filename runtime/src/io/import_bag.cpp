@@ -407,6 +407,33 @@ void describe(const Gathered& got, const Merged& m, std::size_t files, bool velo
 
 }  // namespace
 
+BagSettings bag_settings(const std::string& topic, const std::string& stamp, const std::string& effort,
+                         const std::vector<double>& torque_constants, std::size_t joints, const fs::path& robot_yaml) {
+  if (stamp != "header" && stamp != "receive")
+    throw std::invalid_argument(fmt::format("stamp '{}': header or receive", stamp));
+  if (effort != "torque" && effort != "current")
+    throw std::invalid_argument(fmt::format("effort '{}': torque or current", effort));
+  BagSettings b;
+  b.topic = topic;
+  b.stamp = stamp == "receive" ? StampSource::receive : StampSource::header;
+  b.effort = effort == "current" ? EffortKind::current : EffortKind::torque;
+  if (b.effort == EffortKind::torque) {
+    if (!torque_constants.empty()) throw std::invalid_argument("torque constants go with effort as motor current");
+    return b;
+  }
+  std::error_code ec;
+  b.torque_constants = torque_constants.empty() && fs::is_regular_file(robot_yaml, ec)
+                           ? robot_torque_constants(robot_yaml)
+                           : torque_constants;
+  if (b.torque_constants.size() == 1) b.torque_constants.assign(joints, b.torque_constants[0]);
+  if (b.torque_constants.size() != joints)
+    throw std::invalid_argument(fmt::format(
+        "effort as motor current needs the joints' torque constants (N m/A): one for all joints or {}, or "
+        "torque_constant on each joint of {}; {} given",
+        joints, robot_yaml.empty() ? std::string("robot.yaml") : robot_yaml.string(), b.torque_constants.size()));
+  return b;
+}
+
 ImportedLog import_bag(const fs::path& input, const BagSettings& settings, const ImportTarget& target) {
   const std::size_t n = target.joints.size();
   if (settings.effort == EffortKind::current && settings.torque_constants.size() != n)

@@ -234,8 +234,8 @@ PayloadEstimate identify_payload(const std::vector<io::Log>& logs, const identif
           "the logs do not excite the payload's parameters (scaled condition number {:.3g}): the weakest combination "
           "is {}; move the wrist joints more (dynid excite --payload)",
           out.condition, weakest(Xs, free)));
-    beta = norms.cwiseInverse().asDiagonal() * svd.solve(weighted(y, w));
-    if (o.reference_instruments) beta = instrumented(free_columns(s.Z, free), X, y, w);
+    beta = o.reference_instruments ? instrumented(free_columns(s.Z, free), X, y, w)
+                                   : Eigen::VectorXd(norms.cwiseInverse().asDiagonal() * svd.solve(weighted(y, w)));
     if (it == o.wls_iterations) break;
     const Eigen::VectorXd rms = joint_rms(y - X * beta, n);
     for (int j = 0; j < n; ++j) w(j) = rms(j) > 0 ? 1 / rms(j) : 1;
@@ -246,8 +246,10 @@ PayloadEstimate identify_payload(const std::vector<io::Log>& logs, const identif
   const Eigen::MatrixXd Xw = weighted(X, w);
   const Eigen::VectorXd ew = weighted(y - X * beta, w);
   out.lags = o.lags >= 0 ? o.lags : identify::residual_lags(ew, s.log_of, n);
-  Eigen::MatrixXd C = identify::hac_covariance(Xw, ew, s.log_of, n, out.lags);
-  if (o.reference_instruments) {
+  Eigen::MatrixXd C;
+  if (!o.reference_instruments) {
+    C = identify::hac_covariance(Xw, ew, s.log_of, n, out.lags);
+  } else {
     // (Z'X)^-1 S_Z (X'Z)^-1, S_Z the long-run covariance of the instruments' scores, which
     // hac_covariance gives between (Z'Z)^-1 factors.
     const Eigen::MatrixXd Zw = weighted(free_columns(s.Z, free), w);

@@ -15,6 +15,7 @@
 #pragma once
 
 #include <filesystem>
+#include <string>
 #include <vector>
 
 #include "symoro/io/import.hpp"
@@ -33,6 +34,14 @@ std::vector<std::filesystem::path> bag_files(const std::filesystem::path& input)
 // empty when no joint has one. DataError(robot.yaml, line) when some joints have one and others
 // not, or one is not a positive number.
 std::vector<double> robot_torque_constants(const std::filesystem::path& robot_yaml);
+
+// The settings by name (dynid import's options, symoro.import_logs' keywords): stamp "header" |
+// "receive", effort "torque" | "current"; torque constants one for all `joints` or one each, else,
+// for effort "current", robot.yaml's (robot_yaml, when it is a file). std::invalid_argument naming what is
+// wrong (an unknown word, constants with effort "torque", the wrong number of constants).
+BagSettings bag_settings(const std::string& topic, const std::string& stamp, const std::string& effort,
+                         const std::vector<double>& torque_constants, std::size_t joints,
+                         const std::filesystem::path& robot_yaml = {});
 
 // One bag, converted as described above. DataError naming the bag (and the MCAP file and byte,
 // or the message's index and receive time) for: no message on the topic (the topics there are
