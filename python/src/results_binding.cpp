@@ -199,11 +199,13 @@ void bind_export(py::module_& m) {
         const auto id = identification_of(model);
         const std::optional<std::filesystem::path> robot_dir = robot_dir_of(model, robot_dir_given);
         const identify::ModelDescription& d = id->description();
-        if (!id->supports_physical_consistency())
+        if (const std::vector<std::string> effects = identify::effect_parameter_names(d); !effects.empty())
           throw py::value_error(
-              fmt::format("model '{}' has model-gap effect parameters, which have no URDF counterpart and no "
-                          "standard-parameter form: export a study of a model without effects",
-                          d.variant));
+              fmt::format("model '{}' has model-gap effect parameters ({}), which no URDF or MJCF field carries: "
+                          "export a study of a model without effects",
+                          d.variant, fmt::join(effects, ", ")));
+        if (!id->supports_physical_consistency())
+          throw py::value_error(fmt::format("model '{}' has no physical consistency to export", d.variant));
         // As dynid export: the study's accepted vector, refused when its final audit did not accept it.
         const std::filesystem::path params = study / "report" / "parameters.yaml";
         std::vector<std::string> names;

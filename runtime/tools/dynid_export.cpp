@@ -254,11 +254,13 @@ void run_export(const Common& common, const ExportOptions& options, const std::s
   const std::shared_ptr<const identify::IdentificationModel> model = identification_model(common, label);
   const std::shared_ptr<const identify::IdentificationModel> parent = identification_model(common, "full");
   const identify::ModelDescription& d = model->description();
-  if (!model->supports_physical_consistency())
+  if (const std::vector<std::string> effects = identify::effect_parameter_names(d); !effects.empty())
     throw UsageError(
-        fmt::format("model '{}' has model-gap effect parameters, which have no URDF counterpart and no "
-                    "standard-parameter form: export a study of a model without effects",
-                    d.variant));
+        fmt::format("model '{}' has model-gap effect parameters ({}), which no URDF or MJCF field carries: export a "
+                    "study of a model without effects",
+                    d.variant, fmt::join(effects, ", ")));
+  if (!model->supports_physical_consistency())
+    throw UsageError(fmt::format("model '{}' has no physical consistency to export", d.variant));
   const std::filesystem::path params = std::filesystem::path(options.study) / "report" / "parameters.yaml";
   bool accepted = false;
   const Eigen::VectorXd phi = export_detail::read_study_parameters(common, options, d, params, accepted);

@@ -60,12 +60,13 @@ double smallest_link_eigenvalue(const VectorXd& s) {
   }
   return worst;
 }
+// Friction levels of a variant's effects too (Coulomb, Stribeck: effect_table.hpp's positive rows).
 template <class Model>
 double smallest_drive_parameter(const VectorXd& s) {
   double worst = INFINITY;
   for (int k = 0; k < Model::ns; ++k) {
     const std::string f = Model::standard_parameters[static_cast<std::size_t>(k)].family;
-    if (f == "IA" || f == "FV" || f == "FS") worst = std::min(worst, s(k));
+    if (f == "IA" || f == "FV" || f == "FS" || f == "FC" || f == "FST" || f == "FSE") worst = std::min(worst, s(k));
   }
   return worst;
 }
@@ -82,9 +83,11 @@ void expect_consistent(const ConsistencyResult& r, const VectorXd& phi, double m
   const double tol = 1e-10 * std::max(1.0, phi.cwiseAbs().maxCoeff());
   const VectorXd back = base_of<Model>(r.s);
   EXPECT_LE((back - phi).cwiseAbs().maxCoeff(), tol);
-  // A variant: the full base vector too (the fixed combinations at their values).
-  const VectorXd full = base_of<typename Model::Parent>(r.s);
-  EXPECT_LE((full - symoro::identify::consistency_target<Model>(phi)).cwiseAbs().maxCoeff(), tol);
+  // A variant: the full base vector too (the fixed combinations at their values), from the
+  // rigid part of s (a variant's effect parameters are its last ne entries).
+  using Parent = typename Model::Parent;
+  const VectorXd full = base_of<Parent>(r.s.head(Parent::ns));
+  EXPECT_LE((full - symoro::identify::consistency_target<Model>(phi).head(Parent::np)).cwiseAbs().maxCoeff(), tol);
   EXPECT_GE(smallest_link_eigenvalue<Model>(r.s), margin - 1e-9);
   EXPECT_GE(smallest_drive_parameter<Model>(r.s), -1e-12);
   EXPECT_NEAR(r.lambda_min, smallest_link_eigenvalue<Model>(r.s), 1e-12);

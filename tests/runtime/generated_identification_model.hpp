@@ -103,7 +103,11 @@ class GeneratedIdentificationModel final : public IdentificationModel {
   Eigen::VectorXd parent_base_from_standard(const Eigen::VectorXd& s) const override {
     if constexpr (identify::supports_physical_consistency<Model>()) {
       using Parent = typename Model::Parent;
-      return Parent::base_from_standard(Eigen::Matrix<double, Parent::ns, 1>(s));
+      constexpr int ne = identify::detail::effect_count<Model>();
+      Eigen::VectorXd target(Parent::np + ne);
+      target.head(Parent::np) = Parent::base_from_standard(Eigen::Matrix<double, Parent::ns, 1>(s.head(Parent::ns)));
+      target.tail(ne) = s.tail(ne);
+      return target;
     } else {
       throw std::logic_error(unsupported());
     }
@@ -111,8 +115,7 @@ class GeneratedIdentificationModel final : public IdentificationModel {
 
  private:
   static std::string unsupported() {
-    return std::string("the ") + Model::variant_name +
-           " model has effect parameters, which have no standard-parameter form";
+    return std::string("the ") + Model::variant_name + " model's standard vector is not its full model's";
   }
   ModelDescription d_;
   bool has_fixed_ = false;

@@ -17,6 +17,7 @@
 #include <gtest/gtest.h>
 
 #include <symoro/crane_x7.hpp>
+#include <symoro/planar2r.hpp>
 #include <symoro/rx90.hpp>
 
 #include "consistency_test_support.hpp"
@@ -33,6 +34,7 @@ using namespace symoro;
 using Eigen::MatrixXd;
 using Eigen::VectorXd;
 using Reduced = crane_x7::reduced::Model;
+using Diagnosed = crane_x7::reduced_diagnosed::Model;  // reduced with an offset on 5, smooth Coulomb on 2 and 4
 using Rx90 = rx90::Model;
 
 template <class Model>
@@ -47,8 +49,8 @@ int index_of(const std::string& name) {
 template <class Model>
 VectorXd consistent_truth(unsigned seed) {
   test::Random rng(seed);
-  if constexpr (std::is_same_v<Model, Reduced>)
-    return test::diagonal_consistent_standard<Model>(rng);
+  if constexpr (std::is_same_v<Model, Reduced> || std::is_same_v<Model, Diagnosed>)
+    return test::diagonal_consistent_standard<Model>(rng);  // effect parameters 0
   else
     return test::random_standard_parameters<Model>(rng).s;
 }
@@ -150,22 +152,121 @@ TEST(PhysicalProjection, APriorKeepsTheProjectionNearTheTruthRx90) {
   a_prior_keeps_the_projection_near_the_truth<Rx90>(31);
 }
 
-TEST(PhysicalProjection, ModelsWithEffectsAreRefusedWithTheReason) {
-  using Diagnosed = crane_x7::reduced_diagnosed::Model;
-  static_assert(!identify::supports_physical_consistency<Diagnosed>());
-  const identify::ConsistencyResult r = identify::physical_check<Diagnosed>(VectorXd::Zero(Diagnosed::np));
-  EXPECT_EQ(r.status, identify::ConsistencyStatus::SolverFailure);
-  EXPECT_NE(r.message.find("effect parameters"), std::string::npos) << r.message;
-  study::StudyOptions o;
-  o.data = "/nonexistent";
-  o.consistency = study::Consistency::physical;
-  study::Study study(identify::identification_model<Diagnosed>(), o, study::ClosedLoopSource{});
-  try {
-    study.run();
-    ADD_FAILURE() << "a physical study of a model with effects ran";
-  } catch (const std::invalid_argument& e) {
-    EXPECT_NE(std::string(e.what()).find("reduced_diagnosed"), std::string::npos) << e.what();
+// A variant's effect parameters join the projection (dynid diagnose --apply's models on the
+// physical path). phi0 has no consistent set (one link's ZZ term negative) and, where the variant
+// has one, a friction level below 0; projected in a random full metric C, the answer has a
+// consistent set and the level at or above 0, and it is C's nearest such vector: the cost
+// (phi - phi0)' C (phi - phi0) is stationary along every free effect parameter (C (phi - phi0) is 0
+// there), grows inward along a bounded one that sits at its bound, and no consistent vector we
+// know of (the truth's) costs less. With every effect free, a second route gives the same answer:
+// the rigid body's parameters projected alone in the Schur complement of C's effect block, the
+// effects then set to their best given those (rigid: the variant's base model, e.g. reduced).
+template <class Model>
+VectorXd truth_with_effects(unsigned seed) {
+  test::Random rng(seed);
+  VectorXd s = test::diagonal_consistent_standard<Model>(rng);  // no products of inertia
+  for (int k = 0; k < Model::ns; ++k)  // Coulomb friction inside its bound (a variant may fix it to 0)
+    if (std::string(Model::standard_parameters[static_cast<std::size_t>(k)].family) == "FS")
+      s(k) = rng.uniform(0.05, 0.3);
+  constexpr int ne = identify::detail::effect_count<Model>();
+  for (int k = Model::ns - ne; k < Model::ns; ++k)
+    s(k) = identify::detail::positive_effect_family(Model::standard_parameters[static_cast<std::size_t>(k)].family)
+               ? rng.uniform(0.05, 0.3)
+               : rng.uniform(-0.3, 0.3);
+  return s;
+}
+
+// The solve's pull towards its prior, which would move the answer off the metric's nearest point
+// by its own weight, made negligible.
+identify::ConsistencyOptions exact() {
+  identify::ConsistencyOptions o;
+  o.prior_regularization = 1e-14;
+  return o;
+}
+
+template <class Model>
+identify::PhysicalProjection projects_effects_with_the_rigid_body(const std::string& negative,
+                                                                  const std::string& bounded, unsigned seed) {
+  constexpr int ne = identify::detail::effect_count<Model>(), nr = Model::np - ne;
+  const VectorXd truth = truth_with_effects<Model>(seed);
+  const VectorXd phi_truth = test::base_of<Model>(truth);
+  EXPECT_TRUE(identify::physical_check<Model>(phi_truth).ok());
+  VectorXd phi0 = phi_truth;
+  phi0(index_of<Model>(negative)) = -0.2 * std::abs(phi0(index_of<Model>(negative))) - 1e-3;
+  if (!bounded.empty()) phi0(index_of<Model>(bounded)) = -0.05;
+  const MatrixXd C = random_metric(Model::np, seed + 1);
+  const identify::PhysicalProjection p = identify::physical_projection<Model>(phi0, {}, C, 1e-6, exact());
+  std::printf("  %s: %s (%.3f s)\n", Model::description, p.status.c_str(), p.wall);
+  EXPECT_TRUE(p.projected && p.feasible) << p.status;
+  if (!p.feasible) return p;
+  // Solved again (phase 1: the answer sits a clearance inside the set's edge) and checked apart.
+  identify::ConsistencyOptions phase1;
+  phase1.feasibility_only = true;
+  const identify::ConsistencyResult again = identify::consistent_standard_parameters<Model>(p.phi, truth, phase1);
+  test::expect_consistent<Model>(again, p.phi, 0);
+  // Each gradient entry against its size without cancellation, sum_j |C_ij| |phi_j - phi0_j|.
+  const VectorXd change = p.phi - phi0, gradient = C * change, size = C.cwiseAbs() * change.cwiseAbs();
+  double worst = 0;
+  for (int i = nr; i < Model::np; ++i) {
+    const std::string name = Model::parameters[static_cast<std::size_t>(i)].name;
+    if (name == bounded) {
+      EXPECT_NEAR(p.phi(i), 0, 1e-9) << name;
+      EXPECT_GT(gradient(i), 0.01 * size(i)) << name << ": the bound holds it";
+    } else {
+      worst = std::max(worst, std::abs(gradient(i)) / size(i));
+    }
   }
+  std::printf("  free effects: largest |gradient| %.3g of its size\n", worst);
+  EXPECT_LE(worst, 1e-5);
+  const double cost = (p.phi - phi0).dot(C * (p.phi - phi0)),
+               truth_cost = (phi_truth - phi0).dot(C * (phi_truth - phi0));
+  std::printf("  cost %.6g, the truth's %.6g\n", cost, truth_cost);
+  EXPECT_LT(cost, truth_cost);
+  EXPECT_NEAR(p.distance, std::sqrt(cost), 1e-9 * p.distance);
+  // The loaded model's implementation (what dynid runs) gives the same vector.
+  const identify::PhysicalProjection q =
+      identify::identification_model<Model>()->physical_projection(phi0, C, 1e-6, {}, exact().prior_regularization);
+  EXPECT_EQ(q.phi, p.phi);
+  EXPECT_EQ(q.status, p.status);
+  return p;
+}
+
+TEST(PhysicalProjection, EffectParametersMoveWithTheRigidBodyCraneX7) {
+  static_assert(identify::supports_physical_consistency<Diagnosed>());
+  const identify::PhysicalProjection p = projects_effects_with_the_rigid_body<Diagnosed>("ZZ7", "", 41);
+  ASSERT_TRUE(p.feasible);
+  // The second route: the reduced model's projection in the Schur complement metric.
+  constexpr int ne = Diagnosed::ne, nr = Diagnosed::np - ne;
+  static_assert(nr == Reduced::np);
+  const VectorXd phi_truth = test::base_of<Diagnosed>(truth_with_effects<Diagnosed>(41));
+  VectorXd phi0 = phi_truth;
+  phi0(index_of<Diagnosed>("ZZ7")) = -0.2 * std::abs(phi0(index_of<Diagnosed>("ZZ7"))) - 1e-3;
+  const MatrixXd C = random_metric(Diagnosed::np, 42);
+  const MatrixXd Cee_inv_Cer = C.bottomRightCorner(ne, ne).ldlt().solve(C.bottomLeftCorner(ne, nr));
+  const MatrixXd schur = C.topLeftCorner(nr, nr) - C.topRightCorner(nr, ne) * Cee_inv_Cer;
+  const identify::PhysicalProjection r =
+      identify::physical_projection<Reduced>(phi0.head(nr), {}, 0.5 * (schur + schur.transpose()), 1e-6, exact());
+  ASSERT_TRUE(r.feasible) << r.status;
+  VectorXd via_schur(Diagnosed::np);
+  via_schur.head(nr) = r.phi;
+  via_schur.tail(ne) = phi0.tail(ne) - Cee_inv_Cer * (r.phi - phi0.head(nr));
+  const MatrixXd R = C.llt().matrixU();
+  std::printf("  the two routes differ by %.3g in the metric (distance %.6g)\n", (R * (p.phi - via_schur)).norm(),
+              p.distance);
+  EXPECT_LE((R * (p.phi - via_schur)).norm(), 1e-5 * p.distance);
+}
+
+// What the exports refuse to write (no URDF or MJCF field carries them), by name.
+TEST(PhysicalProjection, EffectParameterNamesAreTheVariantsLastEntries) {
+  EXPECT_EQ(identify::effect_parameter_names(identify::identification_model<Diagnosed>()->description()),
+            (std::vector<std::string>{"OFF5", "FC2", "FC4"}));
+  EXPECT_TRUE(identify::effect_parameter_names(identify::identification_model<Reduced>()->description()).empty());
+}
+
+TEST(PhysicalProjection, EffectParametersMoveWithTheRigidBodyAndFrictionStaysPositivePlanar2r) {
+  // Every effect of the table: offsets, Stribeck, asymmetric viscous, harmonics, smooth Coulomb,
+  // Tustin's Stribeck; Stribeck's level pushed below 0.
+  projects_effects_with_the_rigid_body<planar2r::effects::Model>("ZZ2", "FST2", 51);
 }
 
 // The whole study on both paths, open loop (no controller: OLS, audit, projection, selection,
@@ -184,8 +285,8 @@ class PhysicalStudy : public ::testing::Test {
     manifest.robot = Model::robot_name;
     const char* names[] = {"R1", "R2", "R3", "H1"};
     for (int r = 0; r < 4; ++r) {
-      const io::Log log =
-          test::synthesize<Model>(names[r], truth_, 12.0, 200 + r, kNoise, test::offset_on<Model>(2, kOffset));
+      const io::Log log = test::synthesize<Model>(names[r], truth_, 12.0, 200 + r, kNoise,
+                                                  test::offset_on<Model>(kOffsetJoint, kOffset));
       io::write_log(dir_ / "data" / (std::string(names[r]) + ".csv"), log);
       manifest.runs.push_back({names[r], r < 3 ? "F" : "V", 1, std::string(names[r]) + ".csv"});
     }
@@ -210,11 +311,14 @@ class PhysicalStudy : public ::testing::Test {
   // tests are about: 0.3 N m on the CRANE-X7's reduced model; the RX-90's logs, filtered whole with
   // their moving ends' settling time left out (preprocess/edges.hpp), need 1 N m for it.
   static constexpr double kNoise = std::is_same_v<Model, Rx90> ? 1.0 : 0.3, kOffset = 0.1;
+  // The offset the models lack (joint 2), or the one the diagnosed variant has a parameter for.
+  static constexpr int kOffsetJoint = std::is_same_v<Model, Diagnosed> ? 5 : 2;
   std::filesystem::path dir_;
   VectorXd truth_;
 };
 
-using Robots = ::testing::Types<Reduced, Rx90>;
+// Diagnosed: the physical path with effect parameters, its offset found beside a consistent body.
+using Robots = ::testing::Types<Reduced, Rx90, Diagnosed>;
 TYPED_TEST_SUITE(PhysicalStudy, Robots);
 
 // The physical path with the paper's start: the runs are the PD path's (same starts and final
@@ -271,6 +375,13 @@ TYPED_TEST(PhysicalStudy, AcceptsAVectorWithAConsistentSetAndValidatesLikeThePdP
   std::printf("  held-out RMSE: physical %.5f N m, PD %.5f N m\n", phys.validation[0].rmse_rescue,
               pd.validation[0].rmse_rescue);
   EXPECT_LT(phys.validation[0].rmse_rescue, 1.05 * pd.validation[0].rmse_rescue);
+  if constexpr (std::is_same_v<Model, Diagnosed>) {
+    const double off5 = phys.phi_rescue(index_of<Model>("OFF5"));
+    std::printf("  OFF5 %.4f N m (the logs' offset %.2f)\n", off5, this->kOffset);
+    EXPECT_NEAR(off5, this->kOffset, 0.01);
+    EXPECT_GE(phys.phi_rescue(index_of<Model>("FC2")), -1e-9);
+    EXPECT_GE(phys.phi_rescue(index_of<Model>("FC4")), -1e-9);
+  }
 }
 
 // With physical_start every run's start (here its final vector: no CLIE) has a consistent set:

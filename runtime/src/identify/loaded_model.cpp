@@ -93,7 +93,8 @@ ConsistencyStructure consistency_structure(const ModelHandle& model, const Model
     B.col(k) = column;
     unit(k) = 0;
   }
-  return identify::consistency_structure(model.standard_parameters(), std::move(B));
+  return identify::consistency_structure(model.standard_parameters(),
+                                         model.ne() ? with_effect_block(B, model.ne()) : std::move(B));
 }
 
 class LoadedIdentificationModel final : public IdentificationModel {
@@ -109,7 +110,7 @@ class LoadedIdentificationModel final : public IdentificationModel {
     d_.frames = m_.frames();
     d_.gravity = m_.gravity();
     for (const auto& f : m_.fixed_parameters()) has_fixed_ = has_fixed_ || f.value != 0;
-    supports_ = m_.ne() == 0 && full_.ns() == m_.ns();
+    supports_ = full_.ns() == m_.ns() - m_.ne();
     if (supports_) structure_ = consistency_structure(m_, full_);
   }
   const ModelDescription& description() const override { return d_; }
@@ -200,17 +201,14 @@ class LoadedIdentificationModel final : public IdentificationModel {
     PhysicalProjection p;
     p.phi = phi0;
     if (!supports_) {
-      p.status = fmt::format(
-          "physical consistency is not available for the {} model: its effect parameters are not "
-          "standard inertial parameters (use the PD path)",
-          m_.variant());
+      p.status = unsupported();
       return p;
     }
     ConsistencyOptions options;
     options.prior_regularization = prior_weight;
     if (metric.rows() != m_.np() || metric.cols() != m_.np())
       throw std::invalid_argument("physical_projection: the metric must be np x np");
-    const Eigen::VectorXd prior = prior_in.size() ? prior_in : Eigen::VectorXd::Zero(full_.ns());
+    const Eigen::VectorXd prior = detail::standard_prior(prior_in, m_.ns(), m_.ne());
     options.held_rows = fixed_parent_rows();
     options.base_metric_root = parent_metric_root(metric);
     options.infeasible_clearance = clearance;
@@ -219,10 +217,10 @@ class LoadedIdentificationModel final : public IdentificationModel {
     if (p.check.ok()) {
       p.consistent = p.feasible = true;
       p.status = "consistent: " + p.check.message;
-    } else if (p.check.status == ConsistencyStatus::NoConsistentSet && p.check.phi_consistent.size() == full_.np()) {
+    } else if (p.check.status == ConsistencyStatus::NoConsistentSet &&
+               p.check.phi_consistent.size() == full_.np() + m_.ne()) {
       p.projected = true;
-      p.phi.resize(m_.np());
-      m_.from_parent(p.check.phi_consistent.data(), p.phi.data());
+      p.phi = from_target(p.check.phi_consistent);
       p.distance = (options.base_metric_root * (consistency_target(p.phi) - consistency_target(phi0))).norm();
       const ConsistencyResult v = check(p.phi, prior);
       p.feasible = v.ok();
@@ -240,26 +238,46 @@ class LoadedIdentificationModel final : public IdentificationModel {
   ConsistencyResult consistent_standard_parameters(const Eigen::VectorXd& phi, const Eigen::VectorXd& prior,
                                                    const ConsistencyOptions& options) const override {
     if (!supports_) throw std::logic_error(unsupported());
-    return identify::consistent_standard_parameters(structure_, consistency_target(phi), prior, options);
+    return identify::consistent_standard_parameters(structure_, consistency_target(phi),
+                                                    detail::standard_prior(prior, m_.ns(), m_.ne()), options);
   }
+  // The full model's base vector, then the effect parameters (physical_consistency_model.hpp).
   Eigen::VectorXd consistency_target(const Eigen::VectorXd& phi) const override {
     if (!supports_) throw std::logic_error(unsupported());
     check_phi(phi);
-    Eigen::VectorXd full(full_.np());
-    m_.to_parent(phi.data(), full.data());
-    return full;
+    Eigen::VectorXd target(full_.np() + m_.ne());
+    m_.to_parent(phi.data(), target.data());
+    target.tail(m_.ne()) = phi.tail(m_.ne());
+    return target;
   }
   Eigen::VectorXd parent_base_from_standard(const Eigen::VectorXd& s) const override {
     if (!supports_) throw std::logic_error(unsupported());
-    if (s.size() != full_.ns())
+    if (s.size() != m_.ns())
       throw std::invalid_argument("base_from_standard: " + std::to_string(s.size()) + " standard parameters for " +
-                                  std::to_string(full_.ns()));
-    return full_.base_from_standard(s);
+                                  std::to_string(m_.ns()));
+    Eigen::VectorXd target(full_.np() + m_.ne());
+    target.head(full_.np()) = full_.base_from_standard(Eigen::VectorXd(s.head(full_.ns())));
+    target.tail(m_.ne()) = s.tail(m_.ne());
+    return target;
   }
 
  private:
   std::string unsupported() const {
-    return "the " + m_.variant() + " model has effect parameters, which have no standard-parameter form";
+    return fmt::format(
+        "physical consistency is not available for the {} model: its standard vector ({} entries, {} of them "
+        "effect parameters) is not its full model's ({})",
+        m_.variant(), m_.ns(), m_.ne(), full_.ns());
+  }
+  // physical_projection.hpp's target_row and from_target over the handles.
+  int target_row(int i) const {
+    const int parent = m_.parent_index()[static_cast<std::size_t>(i)];
+    return parent >= 0 ? parent : full_.np() + i - (m_.np() - m_.ne());
+  }
+  Eigen::VectorXd from_target(const Eigen::VectorXd& target) const {
+    Eigen::VectorXd phi(m_.np());
+    m_.from_parent(target.data(), phi.data());
+    phi.tail(m_.ne()) = target.tail(m_.ne());
+    return phi;
   }
   void check_phi(const Eigen::VectorXd& phi) const {
     if (phi.size() != m_.np())
@@ -269,27 +287,26 @@ class LoadedIdentificationModel final : public IdentificationModel {
   ConsistencyResult check(const Eigen::VectorXd& phi, Eigen::VectorXd prior) const {
     ConsistencyResult r;
     if (!supports_) {
-      r.message = fmt::format("not checked: the {} model's effect parameters are not standard inertial parameters",
-                              m_.variant());
+      r.message = "not checked: " + unsupported();
       return r;
     }
-    if (!prior.size()) prior = Eigen::VectorXd::Zero(full_.ns());
+    prior = detail::standard_prior(prior, m_.ns(), m_.ne());
     ConsistencyOptions o;
     o.feasibility_only = true;
     return identify::consistent_standard_parameters(structure_, consistency_target(phi), prior, o);
   }
   std::vector<int> fixed_parent_rows() const {
-    std::vector<int> free(static_cast<std::size_t>(full_.np()), 0), held;
-    for (int i = 0; i < m_.np(); ++i)
-      free[static_cast<std::size_t>(m_.parent_index()[static_cast<std::size_t>(i)])] = 1;
-    for (int i = 0; i < full_.np(); ++i)
+    const int rows = full_.np() + m_.ne();
+    std::vector<int> free(static_cast<std::size_t>(rows), 0), held;
+    for (int i = 0; i < m_.np(); ++i) free[static_cast<std::size_t>(target_row(i))] = 1;
+    for (int i = 0; i < rows; ++i)
       if (!free[static_cast<std::size_t>(i)]) held.push_back(i);
     return held;
   }
   Eigen::MatrixXd parent_metric_root(const Eigen::MatrixXd& metric) const {
     const Eigen::MatrixXd R = metric.llt().matrixU();
-    Eigen::MatrixXd Rp = Eigen::MatrixXd::Zero(m_.np(), full_.np());
-    for (int i = 0; i < m_.np(); ++i) Rp.col(m_.parent_index()[static_cast<std::size_t>(i)]) = R.col(i);
+    Eigen::MatrixXd Rp = Eigen::MatrixXd::Zero(m_.np(), full_.np() + m_.ne());
+    for (int i = 0; i < m_.np(); ++i) Rp.col(target_row(i)) = R.col(i);
     return Rp;
   }
 

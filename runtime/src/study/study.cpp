@@ -57,10 +57,8 @@ class StudyRun {
   StudyResult run() {
     const auto t0 = std::chrono::steady_clock::now();
     if (o_.consistency == Consistency::physical && !model_.supports_physical_consistency())
-      throw std::invalid_argument(
-          fmt::format("--consistency physical: the {} model has effect parameters (not standard "
-                      "inertial parameters); identify it with the PD path",
-                      d_.variant));
+      throw std::invalid_argument(fmt::format("--consistency physical: {}; identify it with the PD path",
+                                              model_.physical_check(Eigen::VectorXd::Zero(d_.np)).message));
     const Dataset data = io::read_dataset(o_.data);
     io::check_dataset_robot(data, d_.robot);
     StudyResult out = described(data);

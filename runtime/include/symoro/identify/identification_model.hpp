@@ -13,6 +13,7 @@
 
 #include <Eigen/Core>
 
+#include "symoro/effect_table.hpp"
 #include "symoro/identify/closed_loop.hpp"
 #include "symoro/identify/inertia_function.hpp"
 #include "symoro/identify/physical_projection.hpp"
@@ -64,7 +65,9 @@ class IdentificationModel {
   virtual std::unique_ptr<ClosedLoop> closed_loop(const ClosedLoopSetup& setup,
                                                   const trajectory::SampledReference& reference) const = 0;
 
-  // The physical path (physical_projection.hpp); a model with effect parameters has none.
+  // The physical path (physical_projection.hpp): the rigid body's and drives' standard
+  // parameters consistent, a variant's effect parameters beside them (free, or >= 0 for a
+  // friction level). A variant whose standard vector is not its full model's has none.
   virtual bool supports_physical_consistency() const = 0;
   virtual ConsistencyResult physical_check(const Eigen::VectorXd& phi) const = 0;
   // prior: standard parameters (description().standard's order) the projection leans towards
@@ -75,13 +78,23 @@ class IdentificationModel {
                                                  double prior_weight = 1e-6) const = 0;
   // The export's solve (model_export.hpp): the consistent standard parameters nearest `prior`
   // that reproduce phi in the full model's base (consistency_target: a variant's fixed
-  // parameters included), and the full model's base_from_standard. A model without physical
-  // consistency throws std::logic_error.
+  // parameters included, then its effect parameters), and the full model's base_from_standard
+  // (the effect parameters passed through). A model without physical consistency throws
+  // std::logic_error.
   virtual ConsistencyResult consistent_standard_parameters(const Eigen::VectorXd& phi, const Eigen::VectorXd& prior,
                                                            const ConsistencyOptions& options) const = 0;
   virtual Eigen::VectorXd consistency_target(const Eigen::VectorXd& phi) const = 0;
   virtual Eigen::VectorXd parent_base_from_standard(const Eigen::VectorXd& s) const = 0;
 };
+
+// The names of a model's effect parameters (offsets, friction laws, harmonics: the last entries
+// of phi), which no URDF or MJCF field carries; empty for a rigid model.
+inline std::vector<std::string> effect_parameter_names(const ModelDescription& d) {
+  std::vector<std::string> names;
+  for (const ParameterInfo& p : d.parameters)
+    if (variant_adds_family(p.family)) names.emplace_back(p.name);
+  return names;
+}
 
 // The interface of a generated Model, one shared instance per model. Defined in
 // identification_model-inl.hpp and compiled for every model of a robot into the library
