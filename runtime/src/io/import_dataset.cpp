@@ -46,6 +46,8 @@ DatasetImportResult read_inputs(const fs::path& out, const DatasetImport& import
     // A bag is in SI units (REP 103): checked as radians and seconds.
     if (!import.allow_implausible)
       check_plausible(imported, is_bag(in.file) ? ImportMapping{} : import.mapping, import.target);
+    if (imported.log.meta.velocity == Velocity::measured)
+      imported.remarks.push_back(detail::velocity_remark(imported.log));
     const std::string name = in.name.empty() ? in.file.stem().string() : in.name;
     if (!valid_name(name))
       throw DataError(in.file.string(), 0, fmt::format("'{}' cannot name a run (a file name)", name));

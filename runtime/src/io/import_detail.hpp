@@ -55,4 +55,8 @@ int mapping_line(const ImportMapping& mapping, const std::string& key);
 const char* time_unit_name(TimeUnit u);
 double time_divisor(TimeUnit u);
 
+// One line for the import's remarks: how the measured velocity agrees with the stamps
+// (velocity_agreement), the joints off by more than 2 % named.
+std::string velocity_remark(const Log& log);
+
 }  // namespace symoro::io::detail

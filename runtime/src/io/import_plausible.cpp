@@ -37,6 +37,14 @@ constexpr double kEffortFactor = 5, kMaxTorque = 1e6;
 // jitter are milliseconds; a second and a thousand steps are no sampling.
 constexpr double kMaxGap = 1.0, kMaxGapSteps = 1000;
 
+// The logged velocity against the stamps (velocity_agreement): a unit mistake is a factor of 57
+// (deg/s beside rad), 1000 (ms) or 60 (rpm); a controller's filtered velocity, jittered stamps
+// and stale rows stay within 1 %. A window whose position changes by more than kMaxChange (rad or
+// m; 31 rad/s over 0.1 s) spans a wrap of a continuous joint or a glitch; a joint needs
+// kMinWindows windows and kMinChange of RMS change per window to be judged.
+constexpr double kMinVelocityScale = 0.8, kMaxMismatch = 0.5, kMaxChange = 3.14, kMinChange = 1e-3;
+constexpr int kMinWindows = 10;
+
 // The sample (row, joint) whose score most exceeds `floor` (row -1: none does).
 struct Worst {
   Eigen::Index row = -1, joint = -1;
@@ -178,13 +186,90 @@ void check_time(const ImportedLog& imported, const ImportMapping& mapping) {
   }
 }
 
+// Velocity: its integral over the stamps against the position's change (velocity_agreement).
+void check_velocity(const ImportedLog& imported) {
+  const Log& log = imported.log;
+  if (log.meta.velocity != Velocity::measured) return;
+  const VelocityAgreement a = velocity_agreement(log);
+  for (Eigen::Index j = 0; j < a.scale.size(); ++j) {
+    const double k = a.scale(j);
+    if (std::isnan(k) || (k >= kMinVelocityScale && k <= 1 / kMinVelocityScale && a.mismatch(j) <= kMaxMismatch))
+      continue;
+    throw DataError(
+        imported.input.string(), 0,
+        fmt::format("joint {} '{}': its position changes {} times what its logged velocity integrates to "
+                    "over the stamps ({} windows of {} rows; {} of the change unexplained): is the velocity "
+                    "in the position's unit per second (rad/s, m/s), the time unit right, and the velocity "
+                    "column the joint's? {}",
+                    j + 1, log.meta.joints[static_cast<std::size_t>(j)], g(k), a.windows, a.window, g(a.mismatch(j)),
+                    kOverride));
+  }
+}
+
 }  // namespace
+
+VelocityAgreement velocity_agreement(const Log& log, double span) {
+  const Eigen::Index n = log.q.cols(), rows = log.samples();
+  VelocityAgreement a;
+  // About `span` s of rows (5 to 100: a stale row at a window's end then moves its change by a
+  // row in 5 at most, in 100 at 1 kHz); 20 windows at least in a short log.
+  const double step = log.meta.sample_time > 0 ? log.meta.sample_time : 1e-3;
+  const Eigen::Index wanted = std::clamp<Eigen::Index>(std::lround(span / step), 5, 100);
+  a.window = static_cast<int>(std::max<Eigen::Index>(2, std::min<Eigen::Index>(wanted, rows / 20)));
+  a.scale = a.mismatch = Eigen::VectorXd::Constant(n, std::numeric_limits<double>::quiet_NaN());
+  const Eigen::Index w = a.window, count = rows > w ? (rows - 1) / w : 0;
+  for (Eigen::Index j = 0; j < n; ++j) {
+    double di = 0, ii = 0, dd = 0;
+    int used = 0;
+    Eigen::VectorXd D(count), I(count);
+    for (Eigen::Index c = 0; c < count; ++c) {
+      double integral = 0;
+      for (Eigen::Index k = c * w; k < (c + 1) * w; ++k)
+        integral += 0.5 * (log.qd(k, j) + log.qd(k + 1, j)) * (log.time(k + 1) - log.time(k));
+      const double change = log.q((c + 1) * w, j) - log.q(c * w, j);
+      if (!std::isfinite(change) || !std::isfinite(integral) || std::abs(change) > kMaxChange) continue;
+      D(used) = change;
+      I(used) = integral;
+      di += change * integral;
+      ii += integral * integral;
+      dd += change * change;
+      ++used;
+    }
+    a.windows = std::max(a.windows, used);
+    if (used < kMinWindows || std::max(dd, ii) < used * kMinChange * kMinChange) continue;  // barely moves
+    const double k = ii > 0 ? di / ii : std::numeric_limits<double>::infinity();
+    a.scale(j) = k;
+    a.mismatch(j) = ii > 0 ? std::sqrt((D.head(used) - k * I.head(used)).squaredNorm() / dd) : 1.0;
+  }
+  return a;
+}
+
+std::string detail::velocity_remark(const Log& log) {
+  const VelocityAgreement a = velocity_agreement(log);
+  double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+  std::string off;
+  for (Eigen::Index j = 0; j < a.scale.size(); ++j) {
+    const double k = a.scale(j);
+    if (std::isnan(k)) continue;
+    lo = std::min(lo, k);
+    hi = std::max(hi, k);
+    if (std::abs(k - 1) > 0.02)
+      off += fmt::format("; joint {} '{}' {:.4f}: its stamps or its velocity are off", j + 1,
+                         log.meta.joints[static_cast<std::size_t>(j)], k);
+  }
+  if (lo > hi) return "velocity against the stamps: no joint moves enough to compare";
+  return fmt::format(
+      "velocity against the stamps: each moving joint's position changes {:.4f}-{:.4f} times its logged velocity's "
+      "integral ({} windows of {} rows; 1 when stamps, positions and velocity agree){}",
+      lo, hi, a.windows, a.window, off);
+}
 
 void check_plausible(const ImportedLog& imported, const ImportMapping& mapping, const ImportTarget& target) {
   check_positions(imported, mapping, target);
   check_torques(imported, target);
   check_angle_unit(imported, mapping, target);
   check_time(imported, mapping);
+  check_velocity(imported);
 }
 
 }  // namespace symoro::io

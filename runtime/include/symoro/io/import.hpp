@@ -120,9 +120,25 @@ ImportedLog import_log(const std::filesystem::path& input, const ImportMapping& 
 //   the median time step is outside [0.1 ms, 0.5 s];
 //   a gap between two rows exceeds 1 s and 1000 median steps;
 //   the angles are declared in deg but every revolute joint stays within +-2 pi and moves less
-//     than 2 pi as written (radians declared as degrees).
+//     than 2 pi as written (radians declared as degrees);
+//   a measured velocity whose integral over the stamps is not the position's change
+//     (velocity_agreement: a moving joint's scale outside [0.8, 1.25], or its mismatch over 0.5):
+//     a velocity unit, a time unit or a column mapped wrong.
 // import_dataset calls it on every input unless DatasetImport::allow_implausible.
 void check_plausible(const ImportedLog& imported, const ImportMapping& mapping, const ImportTarget& target);
+
+// How a log's measured velocity agrees with its stamps and positions, per joint: over windows of
+// about `span` s (5 to 100 rows), the position's change against the trapezoid integral of the
+// logged velocity over the same stamps. scale = sum(dq I) / sum(I^2) is 1 when the three agree; a velocity in deg/s
+// beside radians gives 1/57, stamps read 2 % too close together 0.98 (Gaz et al.'s Panda export:
+// 0.9997-1.0005 on its stamps, 1.008-1.038 read 1 ms apart). Windows across a wrap or a jump
+// (|dq| > 3.14) are left out; a joint that barely moves (RMS change per window under 1e-3) has
+// NaN. mismatch: RMS of dq - scale I over RMS of dq (0: the velocity follows the position).
+struct VelocityAgreement {
+  Eigen::VectorXd scale, mismatch;  // per joint
+  int window = 0, windows = 0;
+};
+VelocityAgreement velocity_agreement(const Log& log, double span = 0.1);
 
 // The velocity written when the input has none: per joint, the derivative of the parabola
 // through each row and its neighbours (second order on irregular stamps; the end rows use the
