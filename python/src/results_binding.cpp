@@ -68,6 +68,7 @@ py::dict prediction_dict(const std::string& name, const study::Prediction& p) {
   x["raw_rmse"] = p.raw.error.rmse_joint;
   x["raw_rmse_overall"] = p.raw.error.rmse;
   x["raw_samples"] = p.raw.samples;
+  x["raw_floor"] = p.raw.floor_joint;  // the raw torque's own content above the cutoff, per joint
   // What the preprocessing left out or filtered through (preprocess/edges.hpp), and its line.
   x["edge_samples"] = p.samples.report.edge_samples;
   x["context_rows"] = p.samples.report.context_rows;

@@ -95,6 +95,15 @@ def test_the_held_out_raw_score_is_what_numpy_gives(tmp_path, robot):
     assert held_prediction["edge_samples"] > 0 and held_prediction["context_rows"] > 10000
     assert "moving end left out" in held_prediction["preprocessing"]
     assert np.sqrt(np.mean(raw**2)) == pytest.approx(held[0]["raw_rmse_rescue"], rel=1e-12)
+    # The floor beside the score: the raw torque's own content above the 20 Hz cutoff, as NumPy finds
+    # it on the held-out window (the low-pass of the whole log), about 0.977 of the white noise added.
+    d = np.genfromtxt(tmp_path / "data" / "cut.csv", delimiter=",", names=True)
+    tau = np.column_stack([d[f"tau{j + 1}"] for j in range(arm.nq)])
+    above = tau - zero_phase_lowpass(tau, np.median(np.diff(d["time"])), 20.0)
+    floor = np.sqrt(np.mean(above[d["time"] >= window[0]] ** 2, axis=0))
+    assert held_prediction["raw_floor"] == pytest.approx(floor, rel=0.05)
+    assert held_prediction["raw_floor"].mean() == pytest.approx(0.977 * NOISE, rel=0.05)
+    assert (held_prediction["raw_floor"] < raw).all()
     # At what the truth itself scores (the torque's noise and the 16-bit encoder's quantization through
     # the acceleration: 0.14 N m on the RX-90), not twice that.
     truth, _, _ = rescore(arm, tmp_path / "data" / "cut.csv", true_phi(arm), window[0])

@@ -109,9 +109,11 @@ void run_identify(const Common& common, const IdentifyOptions& options) {
       if (std::isfinite(v.raw_rmse_rescue))
         fmt::print(
             "validation {} against the raw torque, open loop: RMSE {:.4f} / {:.4f} N m (final / accepted), mean of the "
-            "joints' RMSE {:.4f} N m (accepted)\n",
+            "joints' RMSE {:.4f} N m (accepted); the torque's own content above the evaluation's cutoff, which no "
+            "model of the filtered motion follows: {:.4f} N m (mean of the joints)\n",
             v.trajectory, v.raw_rmse_clie, v.raw_rmse_rescue,
-            v.raw_rmse_joint_rescue.size() > 0 ? v.raw_rmse_joint_rescue.mean() : std::nan(""));
+            v.raw_rmse_joint_rescue.size() > 0 ? v.raw_rmse_joint_rescue.mean() : std::nan(""),
+            v.raw_floor_joint.size() > 0 ? v.raw_floor_joint.mean() : std::nan(""));
     }
   }
   // The held-out series on disk: dynid compare reads them to set two model variants side by side.

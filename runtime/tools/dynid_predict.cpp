@@ -122,8 +122,14 @@ void run(const Common& common, const PredictOptions& options) {
     line = fmt::format("  {:<10} {:>6} raw:    ", "", p.raw.samples);
     for (int j = 0; j < d.nq; ++j) line += fmt::format(" {:.4f}        ", p.raw.error.rmse_joint(j));
     fmt::print("{}\n", line);
-    fmt::print("  {:<10} {:>6} raw RMSE {:.4f} N m over all joints and samples, mean of the joints' RMSE {:.4f} N m\n",
-               "", "", p.raw.error.rmse, p.raw.error.rmse_joint.mean());
+    line = fmt::format("  {:<10} {:>6} floor:  ", "", "");
+    for (int j = 0; j < d.nq; ++j) line += fmt::format(" {:.4f}        ", p.raw.floor_joint(j));
+    fmt::print("{}\n", line);
+    fmt::print(
+        "  {:<10} {:>6} raw RMSE {:.4f} N m over all joints and samples, mean of the joints' RMSE {:.4f} N m; floor: "
+        "the "
+        "torque's own content above the cutoff, which no model of the filtered motion follows, mean {:.4f} N m\n",
+        "", "", p.raw.error.rmse, p.raw.error.rmse_joint.mean(), p.raw.floor_joint.mean());
     if (p.samples.report.edge_samples > 0 || p.samples.report.context_rows > 0)
       fmt::print("  {:<10} {}\n", "", p.samples.report.summary());
     if (u) {

@@ -1,20 +1,39 @@
 #include "symoro/study/raw_torque.hpp"
 
+#include <stdexcept>
+
 #include <fmt/format.h>
 
 #include "symoro/preprocess/preprocess.hpp"
 
 namespace symoro::study {
 
-preprocess::Samples raw_torque_samples(const io::Log& log, const RawTorqueOptions& options) {
+namespace {
+preprocess::Options raw_options(const RawTorqueOptions& options) {
   preprocess::Options po;
   po.derivative_cutoff = options.cutoff;
   po.filter_torque = false;
   // qd and qdd from q, zero phase: a controller's logged velocity is its own causal estimate,
   // late by its filter's delay, and would favour a model fitted on the same late signal.
   po.use_logged_velocity = false;
+  return po;
+}
+}  // namespace
+
+preprocess::Samples raw_torque_samples(const io::Log& log, const RawTorqueOptions& options) {
+  const preprocess::Options po = raw_options(options);
+  return preprocess::preprocess(log, preprocess::base_period(log, po), po);
+}
+
+Eigen::VectorXd raw_torque_floor(const io::Log& log, const RawTorqueOptions& options) {
+  preprocess::Options po = raw_options(options);
   const double base = preprocess::base_period(log, po);
-  return preprocess::preprocess(log, base, po);
+  const preprocess::Samples raw = preprocess::preprocess(log, base, po);
+  po.filter_torque = true;  // the same samples (the settling trim follows the motion), torque low-passed
+  const preprocess::Samples low = preprocess::preprocess(log, base, po);
+  if (low.time != raw.time) throw std::logic_error("raw_torque_floor: the filtered samples are not the raw ones");
+  const Eigen::MatrixXd above = raw.tau - low.tau;
+  return (above.colwise().squaredNorm() / static_cast<double>(above.rows())).cwiseSqrt().transpose();
 }
 
 std::string raw_torque_filter_text(const RawTorqueOptions& options) {
@@ -26,7 +45,9 @@ std::string raw_torque_filter_text(const RawTorqueOptions& options) {
 
 RawTorqueScore raw_torque_error(const io::Log& log, const OpenLoopTorque& model, const Eigen::VectorXd& phi,
                                 const RawTorqueOptions& options) {
-  return raw_torque_error(raw_torque_samples(log, options), model, phi, options);
+  RawTorqueScore r = raw_torque_error(raw_torque_samples(log, options), model, phi, options);
+  r.floor_joint = raw_torque_floor(log, options);
+  return r;
 }
 
 RawTorqueScore raw_torque_error(const preprocess::Samples& s, const OpenLoopTorque& model, const Eigen::VectorXd& phi,

@@ -299,20 +299,27 @@ std::string raw_validation_table(const StudyResult& study) {
     if (std::isfinite(v.raw_rmse_rescue)) filter = v.raw_filter;
   if (filter.empty()) return "";
   MarkdownTable table({"Trajectory", "Final RMSE [N m]", "Accepted RMSE [N m]",
-                       "Accepted, mean of the joints' RMSE [N m]", "Accepted, per joint [N m]"});
+                       "Accepted, mean of the joints' RMSE [N m]", "Accepted, per joint [N m]",
+                       "The torque's own content above the cutoff, per joint (mean) [N m]"});
   for (const auto& v : study.validation) {
     if (!std::isfinite(v.raw_rmse_rescue)) continue;
-    std::string joints;
+    std::string joints, floor;
     for (Eigen::Index j = 0; j < v.raw_rmse_joint_rescue.size(); ++j)
       joints += (j ? ", " : "") + sig(v.raw_rmse_joint_rescue(j), 3);
+    for (Eigen::Index j = 0; j < v.raw_floor_joint.size(); ++j) floor += (j ? ", " : "") + sig(v.raw_floor_joint(j), 3);
+    if (v.raw_floor_joint.size() > 0) floor += " (" + sig(v.raw_floor_joint.mean(), 4) + ")";
     const double mean = v.raw_rmse_joint_rescue.size() > 0 ? v.raw_rmse_joint_rescue.mean() : std::nan("");
-    table.row({v.trajectory, sig(v.raw_rmse_clie, 6), sig(v.raw_rmse_rescue, 6), sig(mean, 6), joints});
+    table.row({v.trajectory, sig(v.raw_rmse_clie, 6), sig(v.raw_rmse_rescue, 6), sig(mean, 6), joints,
+               floor.empty() ? "-" : floor});
   }
   return "\nAgainst the raw measured torque, open loop at the log's own rate: " + filter +
          ". RMSE: over all joints and samples together, sqrt(sum e^2 / (samples x joints)); mean of the joints' RMSE: "
          "the "
          "average over joints of sqrt(sum_k e_j(k)^2 / samples) (docs/identification.md, \"Validation against the raw "
-         "torque\", rescores it with NumPy).\n\n" +
+         "torque\", rescores it with NumPy). The last column is the raw torque minus its own zero-phase low-pass at "
+         "the "
+         "cutoff, on the same samples: a model of the low-passed motion follows next to none of it, so it is the "
+         "floor of these errors on this log (sensor noise and dynamics beyond the band).\n\n" +
          table.str() + "\n";
 }
 

@@ -167,6 +167,7 @@ std::vector<std::filesystem::path> write_validation(const StudyResult& study, co
       y << YAML::Key << "raw_rmse_clie" << YAML::Value << v.raw_rmse_clie;
       y << YAML::Key << "raw_rmse_accepted" << YAML::Value << v.raw_rmse_rescue;
       detail::put_vector(y, "raw_rmse_joint_accepted", v.raw_rmse_joint_rescue);
+      if (v.raw_floor_joint.size() > 0) detail::put_vector(y, "raw_floor_joint", v.raw_floor_joint);
       y << YAML::Key << "raw_filter" << YAML::Value << v.raw_filter;
     }
     if (std::isfinite(v.band_coverage)) {
@@ -237,6 +238,7 @@ StudyValidation read_validation(const std::filesystem::path& study_dir) {
       v.raw_rmse_clie = as<double>(t, "raw_rmse_clie", file);
       v.raw_rmse_rescue = as<double>(t, "raw_rmse_accepted", file);
       v.raw_rmse_joint_rescue = vec(t, "raw_rmse_joint_accepted", file, true);
+      v.raw_floor_joint = vec(t, "raw_floor_joint", file, true);  // studies before it have none
       v.raw_filter = t["raw_filter"] ? as<std::string>(t, "raw_filter", file) : "";
     }
     if (t["band_coverage"]) {  // studies before prediction bands have none

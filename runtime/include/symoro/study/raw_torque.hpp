@@ -26,6 +26,11 @@ struct RawTorqueScore {
   TorqueError error;
   int samples = 0;
   std::string filter;  // what the evaluation did, one sentence for reports
+  // Per joint: the RMS of the raw torque's own content above `cutoff` (the raw torque minus its
+  // zero-phase low-pass at the cutoff, on the same samples; raw_torque_floor). A model of the
+  // motion through that low-pass follows next to none of it: the error's floor on this log, sensor
+  // noise and dynamics beyond the band alike. Empty from the samples-only overload.
+  Eigen::VectorXd floor_joint;
 };
 
 // Throws DataError (naming the log) as preprocess::preprocess does.
@@ -34,6 +39,10 @@ RawTorqueScore raw_torque_error(const io::Log& log, const OpenLoopTorque& model,
 // The same on samples raw_torque_samples made (several vectors on one log: preprocessed once).
 RawTorqueScore raw_torque_error(const preprocess::Samples& samples, const OpenLoopTorque& model,
                                 const Eigen::VectorXd& phi, const RawTorqueOptions& options = {});
+
+// RawTorqueScore::floor_joint of a log: sqrt(mean((tau_raw - tau_lowpass)^2)) per joint over the
+// samples raw_torque_samples keeps.
+Eigen::VectorXd raw_torque_floor(const io::Log& log, const RawTorqueOptions& options = {});
 
 // The motion and raw torque raw_torque_error scores on (Samples at the log's base period).
 preprocess::Samples raw_torque_samples(const io::Log& log, const RawTorqueOptions& options = {});

@@ -108,7 +108,8 @@ struct ValidationRecord {
   double raw_rmse_clie = std::numeric_limits<double>::quiet_NaN(),
          raw_rmse_rescue = std::numeric_limits<double>::quiet_NaN();
   Eigen::VectorXd raw_rmse_joint_rescue;
-  std::string raw_filter;  // the evaluation's own filter, one sentence
+  Eigen::VectorXd raw_floor_joint;  // the raw torque's content above the evaluation's cutoff (raw_torque.hpp)
+  std::string raw_filter;           // the evaluation's own filter, one sentence
   // The accepted vector's 95 % prediction band (prediction_band.hpp) on this run, open loop: the
   // share of samples whose measured torque falls inside, over all joints and per joint (NaN: no
   // band), and the band's half-width per sample (samples x joints; for the figure).
