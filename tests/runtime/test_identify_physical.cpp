@@ -256,6 +256,25 @@ TEST(PhysicalProjection, EffectParametersMoveWithTheRigidBodyCraneX7) {
   EXPECT_LE((R * (p.phi - via_schur)).norm(), 1e-5 * p.distance);
 }
 
+// A vector projected a hair inside the set's edge (clearance 1e-6, no pull towards a prior): the
+// solve nearest a prior stalls there (CSDP: "stuck at the edge of primal feasibility"), and phase
+// 1's set, consistent all the same, is the answer, said to be not the nearest (it was a
+// SolverFailure before). Checked independently of the solver.
+TEST(PhysicalProjection, AVectorAtTheEdgeGetsPhaseOnesSetWhenPhaseTwoStalls) {
+  using Planar = planar2r::Model;
+  test::Random rng(51);
+  const VectorXd truth = test::diagonal_consistent_standard<Planar>(rng);
+  VectorXd phi0 = test::base_of<Planar>(truth);
+  phi0(index_of<Planar>("ZZ2")) = -0.2 * std::abs(phi0(index_of<Planar>("ZZ2"))) - 1e-3;
+  const identify::PhysicalProjection p =
+      identify::physical_projection<Planar>(phi0, {}, random_metric(Planar::np, 52), 1e-6, exact());
+  ASSERT_TRUE(p.projected && p.feasible) << p.status;
+  const identify::ConsistencyResult r = identify::consistent_standard_parameters<Planar>(p.phi, truth);
+  std::printf("  %s\n", r.message.c_str());
+  EXPECT_NE(r.message.find("phase 1's set, not the nearest to the prior"), std::string::npos) << r.message;
+  test::expect_consistent<Planar>(r, p.phi, 0);
+}
+
 // What the exports refuse to write (no URDF or MJCF field carries them), by name.
 TEST(PhysicalProjection, EffectParameterNamesAreTheVariantsLastEntries) {
   EXPECT_EQ(identify::effect_parameter_names(identify::identification_model<Diagnosed>()->description()),
