@@ -60,13 +60,15 @@ double smallest_link_eigenvalue(const VectorXd& s) {
   }
   return worst;
 }
-// Friction levels of a variant's effects too (Coulomb, Stribeck: effect_table.hpp's positive rows).
+// Friction levels of a variant's effects too (Coulomb, Stribeck: effect_table.hpp's positive rows,
+// the rule the solve bounds them by).
 template <class Model>
 double smallest_drive_parameter(const VectorXd& s) {
   double worst = INFINITY;
   for (int k = 0; k < Model::ns; ++k) {
     const std::string f = Model::standard_parameters[static_cast<std::size_t>(k)].family;
-    if (f == "IA" || f == "FV" || f == "FS" || f == "FC" || f == "FST" || f == "FSE") worst = std::min(worst, s(k));
+    if (f == "IA" || f == "FV" || f == "FS" || symoro::identify::detail::positive_effect_family(f))
+      worst = std::min(worst, s(k));
   }
   return worst;
 }

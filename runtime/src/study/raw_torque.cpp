@@ -25,12 +25,10 @@ preprocess::Samples raw_torque_samples(const io::Log& log, const RawTorqueOption
   return preprocess::preprocess(log, preprocess::base_period(log, po), po);
 }
 
-Eigen::VectorXd raw_torque_floor(const io::Log& log, const RawTorqueOptions& options) {
+Eigen::VectorXd raw_torque_floor(const io::Log& log, const preprocess::Samples& raw, const RawTorqueOptions& options) {
   preprocess::Options po = raw_options(options);
-  const double base = preprocess::base_period(log, po);
-  const preprocess::Samples raw = preprocess::preprocess(log, base, po);
   po.filter_torque = true;  // the same samples (the settling trim follows the motion), torque low-passed
-  const preprocess::Samples low = preprocess::preprocess(log, base, po);
+  const preprocess::Samples low = preprocess::preprocess(log, preprocess::base_period(log, po), po);
   if (low.time != raw.time) throw std::logic_error("raw_torque_floor: the filtered samples are not the raw ones");
   const Eigen::MatrixXd above = raw.tau - low.tau;
   return (above.colwise().squaredNorm() / static_cast<double>(above.rows())).cwiseSqrt().transpose();
@@ -45,8 +43,9 @@ std::string raw_torque_filter_text(const RawTorqueOptions& options) {
 
 RawTorqueScore raw_torque_error(const io::Log& log, const OpenLoopTorque& model, const Eigen::VectorXd& phi,
                                 const RawTorqueOptions& options) {
-  RawTorqueScore r = raw_torque_error(raw_torque_samples(log, options), model, phi, options);
-  r.floor_joint = raw_torque_floor(log, options);
+  const preprocess::Samples raw = raw_torque_samples(log, options);
+  RawTorqueScore r = raw_torque_error(raw, model, phi, options);
+  r.floor_joint = raw_torque_floor(log, raw, options);
   return r;
 }
 

@@ -529,7 +529,7 @@ class StudyRun {
         v.raw_rmse_clie = raw_clie.error.rmse;
         v.raw_rmse_rescue = raw.error.rmse;
         v.raw_rmse_joint_rescue = raw.error.rmse_joint;
-        v.raw_floor_joint = raw_torque_floor(log);
+        v.raw_floor_joint = raw_torque_floor(log, raw_samples);
         v.raw_filter = raw.filter;
         if (out.uncertainty.covariance.size() > 0) {  // the 95 % band, open loop
           v.tau_band = prediction_band(model_, s, out.uncertainty, 0.95);

@@ -40,9 +40,11 @@ RawTorqueScore raw_torque_error(const io::Log& log, const OpenLoopTorque& model,
 RawTorqueScore raw_torque_error(const preprocess::Samples& samples, const OpenLoopTorque& model,
                                 const Eigen::VectorXd& phi, const RawTorqueOptions& options = {});
 
-// RawTorqueScore::floor_joint of a log: sqrt(mean((tau_raw - tau_lowpass)^2)) per joint over the
-// samples raw_torque_samples keeps.
-Eigen::VectorXd raw_torque_floor(const io::Log& log, const RawTorqueOptions& options = {});
+// RawTorqueScore::floor_joint of a log: sqrt(mean((tau_raw - tau_lowpass)^2)) per joint over
+// `raw`, the samples raw_torque_samples made of it (the log preprocessed once more, torque
+// low-passed).
+Eigen::VectorXd raw_torque_floor(const io::Log& log, const preprocess::Samples& raw,
+                                 const RawTorqueOptions& options = {});
 
 // The motion and raw torque raw_torque_error scores on (Samples at the log's base period).
 preprocess::Samples raw_torque_samples(const io::Log& log, const RawTorqueOptions& options = {});
