@@ -51,9 +51,10 @@ struct PayloadOptions {
   // Instrumental variables: the payload regressor of the logged reference motion (q_ref, qd_ref,
   // through the same preprocessing) instruments the measured one, theta = (Z'W X)^-1 Z'W y. The
   // measured positions carry the encoders' noise, to which a closed-loop controller's current
-  // answers: least squares then takes the payload about 0.5 % light on the CRANE-X7 twin (mass
-  // -0.5 %, CoM 0.3 mm); the instruments do not share that noise (mass 0.03 %, CoM 0.1 mm), at a
-  // larger variance of the inertia (docs/payload.md). Needs logs with reference columns.
+  // answers: least squares then takes the payload about 0.5 % light on the CRANE-X7 twin, and
+  // its inertia about x and y 5-8 % low; the instruments do not share that noise (mass within
+  // about 0.1 %, the inertia's error halved, at the same scatter: docs/payload.md). Needs logs
+  // with reference columns.
   bool reference_instruments = false;
 };
 
