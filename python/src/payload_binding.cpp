@@ -21,6 +21,9 @@ std::shared_ptr<const identify::IdentificationModel> identification_of(py::handl
 std::optional<std::filesystem::path> robot_dir_of(py::handle model, const std::optional<std::filesystem::path>& given);
 Eigen::VectorXd parameters_of(const identify::IdentificationModel& model, py::handle params,
                               const std::optional<std::filesystem::path>& robot_dir);
+// The logged torque's delay (ms) a fit on top of `params` takes: the one given, else a parameters
+// file's torque_delay_ms, else 0 (results_binding.cpp).
+double torque_delay_of(py::handle params, std::optional<double> given_ms);
 
 namespace {
 
@@ -39,12 +42,15 @@ void bind_payload(py::module_& m) {
   m.def(
       "identify_payload",
       [](py::handle model, py::handle params, const std::vector<std::filesystem::path>& inputs, py::handle full,
-         std::optional<double> mass, double interval_ms, double torque_delay_ms, int trial,
+         std::optional<double> mass, double interval_ms, std::optional<double> torque_delay_given, int trial,
          const std::optional<std::filesystem::path>& robot_dir_given, const std::string& instruments) {
         if (instruments != "none" && instruments != "reference")
           throw py::value_error(fmt::format("instruments '{}': 'none' or 'reference'", instruments));
         if (!(std::isfinite(interval_ms) && interval_ms >= 1 && interval_ms <= 10000))
           throw py::value_error(fmt::format("interval_ms {}: must be from 1 to 10000", interval_ms));
+        // The arm's timing unless told otherwise: a parameters file's torque_delay_ms (its rotor
+        // inertias carry the logged torque's timing, docs/payload.md), else 0.
+        const double torque_delay_ms = torque_delay_of(params, torque_delay_given);
         if (!(std::isfinite(torque_delay_ms) && torque_delay_ms >= -1000 && torque_delay_ms <= 1000))
           throw py::value_error(fmt::format("torque_delay_ms {}: must be from -1000 to 1000", torque_delay_ms));
         if (mass && !(std::isfinite(*mass) && *mass > 0 && *mass <= 1e4))
@@ -93,6 +99,7 @@ void bind_payload(py::module_& m) {
         r["margin"] = e.margin;
         r["status"] = e.status;
         r["samples"] = e.samples;
+        r["torque_delay_ms"] = torque_delay_ms;
         r["lags"] = e.lags;
         r["condition"] = e.condition;
         r["rms_without"] = e.rms_without;
@@ -105,13 +112,14 @@ void bind_payload(py::module_& m) {
         return r;
       },
       py::arg("model"), py::arg("params"), py::arg("inputs"), py::kw_only(), py::arg("full") = py::none(),
-      py::arg("mass") = py::none(), py::arg("interval_ms") = 10.0, py::arg("torque_delay_ms") = 0.0,
+      py::arg("mass") = py::none(), py::arg("interval_ms") = 10.0, py::arg("torque_delay_ms") = py::none(),
       py::arg("trial") = 1, py::arg("robot_dir") = py::none(), py::arg("instruments") = "none",
       "A payload's 10 inertial parameters from logs (or datasets) of the arm carrying it, the arm's parameters "
       "(params: an array or a parameters file of `model`) held: a dict of 'mass', 'com', 'inertia' (about the CoM) "
       "in the flange frame 'flange', their '*_std', 'standard', 'covariance', 'projected', 'status', 'rms_without', "
       "'rms_with', and the 'urdf', 'franka', 'ur' and 'kuka' forms. full: the robot's full model when `model` is a "
-      "variant; mass: a known mass (the other 9 identified). docs/payload.md");
+      "variant; mass: a known mass (the other 9 identified); torque_delay_ms: the logged torque's delay, by default "
+      "the parameters file's (the arm's; 0 for an array), returned as 'torque_delay_ms'. docs/payload.md");
 }
 
 }  // namespace symoro::python

@@ -78,13 +78,23 @@ py::dict prediction_dict(const std::string& name, const study::Prediction& p) {
 
 }  // namespace
 
+double torque_delay_of(py::handle params, std::optional<double> given_ms) {
+  if (given_ms) return *given_ms;
+  // A parameters file's timing (the arm's identification's, as dynid predict and payload take it).
+  const bool file =
+      (py::isinstance<py::str>(params) && params.cast<std::string>() != "nominal") || py::hasattr(params, "__fspath__");
+  return file ? io::parameters_torque_delay(py::str(params).cast<std::string>()).value_or(0) * 1000 : 0.0;
+}
+
 void bind_results(py::module_& m) {
   m.def(
       "predict",
       [](py::handle model, py::handle params, const std::filesystem::path& input, double interval_ms,
-         double torque_delay_ms, int trial, const std::optional<std::filesystem::path>& robot_dir_given, double band,
+         std::optional<double> torque_delay_given, int trial,
+         const std::optional<std::filesystem::path>& robot_dir_given, double band,
          const std::optional<std::filesystem::path>& uncertainty_file) {
         // dynid predict's ranges (a NaN or infinite value is named, never computed with).
+        const double torque_delay_ms = torque_delay_of(params, torque_delay_given);
         if (!(std::isfinite(interval_ms) && interval_ms >= 1 && interval_ms <= 10000))
           throw py::value_error(fmt::format("interval_ms {}: must be from 1 to 10000", interval_ms));
         if (!(std::isfinite(torque_delay_ms) && torque_delay_ms >= -1000 && torque_delay_ms <= 1000))
@@ -133,9 +143,9 @@ void bind_results(py::module_& m) {
         return result;
       },
       py::arg("model"), py::arg("params"), py::arg("input"), py::kw_only(),
-      py::arg("interval_ms") = study::PredictionOptions{}.interval * 1000,
-      py::arg("torque_delay_ms") = study::PredictionOptions{}.torque_delay * 1000, py::arg("trial") = 1,
-      py::arg("robot_dir") = py::none(), py::arg("band") = 0.95, py::arg("uncertainty") = py::none(),
+      py::arg("interval_ms") = study::PredictionOptions{}.interval * 1000, py::arg("torque_delay_ms") = py::none(),
+      py::arg("trial") = 1, py::arg("robot_dir") = py::none(), py::arg("band") = 0.95,
+      py::arg("uncertainty") = py::none(),
       "The model's torque on a log or a dataset's runs: a list of {'name', 'time', 'q', 'qd', 'qdd', 'tau', "
       "'tau_model', "
       "'rmse', 'rms', 'raw_rmse', 'raw_rmse_overall', 'raw_samples', 'edge_samples', 'context_rows', 'preprocessing'}; "

@@ -82,3 +82,15 @@ def test_the_body_on_the_last_link_is_found(jaco2, tmp_path):
 
     with pytest.raises(ValueError, match="mass"):
         symoro.identify_payload(arm, arm.base_from_standard(s_arm), [tmp_path / "data"], mass=-1.0)
+
+    # A parameters file's timing (torque_delay_ms, the arm's identification's) is the default; given
+    # 0, the file's values fit as the array did, bit for bit.
+    phi = arm.base_from_standard(s_arm)
+    params = tmp_path / "parameters.yaml"
+    params.write_text(f"robot: \"{arm.robot}\"\nmodel: \"full\"\ntorque_delay_ms: 2\nparameters:\n" +
+                      "".join(f"  - {{name: \"{n}\", value: {v!r}}}\n" for n, v in zip(arm.parameter_names, phi)))
+    shifted = symoro.identify_payload(arm, params, [tmp_path / "data"])
+    told = symoro.identify_payload(arm, params, [tmp_path / "data"], torque_delay_ms=0.0)
+    assert shifted["torque_delay_ms"] == 2.0 and told["torque_delay_ms"] == 0.0 and r["torque_delay_ms"] == 0.0
+    assert np.array_equal(told["standard"], r["standard"])
+    assert not np.array_equal(shifted["standard"], r["standard"])

@@ -56,7 +56,9 @@ inline void add_log_options(CLI::App* cmd, double& interval, double& torque_dela
   cmd->add_option("--interval", interval, "Sampling interval in ms, as in identification")
       ->check(interval_ms())
       ->capture_default_str();
-  cmd->add_option("--torque-delay", torque_delay, "ms the logged torque lags the links' (as dynid identify)")
+  cmd->add_option("--torque-delay", torque_delay,
+                  "ms the logged torque lags the links' (as dynid identify; default: the --params file's "
+                  "torque_delay_ms, the delay the parameters were identified with)")
       ->check(checked(-1000, 1000, false, false, "from -1000 to 1000 ms"));
   cmd->add_option("--trial", trial, "Which trial of a dataset's runs")->check(count(1, 1e6))->capture_default_str();
 }

@@ -2,8 +2,10 @@
 // it, on top of the arm's identified parameters (held), with standard deviations, physically
 // consistent, optionally with a known mass; written as payload.yaml (with Franka's, UR's and
 // KUKA's load settings) and payload.urdf (a link on a fixed joint). docs/payload.md.
+#include <algorithm>
 #include <filesystem>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -34,6 +36,7 @@ struct PayloadCliOptions {
   double mass = 0;  // kg, > 0: known
   double interval_ms = study::PredictionOptions{}.interval * 1000;
   double torque_delay_ms = 0;
+  bool torque_delay_given = false;  // else the arm's (fit_torque_delay)
   int trial = 1;
   bool force = false;
   std::string instruments = "none";
@@ -61,7 +64,10 @@ void run(const Common& common, const PayloadCliOptions& o) {
 
   payload::PayloadOptions po;
   po.interval = o.interval_ms / 1000;
-  po.torque_delay = o.torque_delay_ms / 1000;
+  const FitTiming timing =
+      fit_torque_delay(o.params, o.torque_delay_given ? std::optional<double>(o.torque_delay_ms) : std::nullopt);
+  po.torque_delay = timing.torque_delay_ms / 1000;
+  if (!timing.warning.empty()) fmt::print(stderr, "warning: {}\n", timing.warning);
   if (o.mass > 0) po.mass = o.mass;
   po.reference_instruments = o.instruments == "reference";
   const payload::PayloadLink link = payload::payload_link(*full);
@@ -86,8 +92,14 @@ void run(const Common& common, const PayloadCliOptions& o) {
   fmt::print("  {}\n", e.status);
   fmt::print("  estimator: {}\n",
              e.instrumented ? "instrumental variables (the reference motion's regressor)" : "least squares");
-  fmt::print("  {} samples at {:.0f} ms, covariance over {} lags, scaled condition number {:.3g}\n", e.samples,
-             o.interval_ms, e.lags, e.condition);
+  if (!e.instrumented && std::all_of(logs.begin(), logs.end(), [](const io::Log& l) { return l.has_references(); }))
+    fmt::print(
+        "  the logs carry their reference motion: --instruments reference takes out least squares' bias from "
+        "the encoders' noise a closed loop answers (docs/payload.md)\n");
+  fmt::print(
+      "  {} samples at {:.0f} ms, torque delay {:g} ms ({}), covariance over {} lags, scaled condition number "
+      "{:.3g}\n",
+      e.samples, o.interval_ms, timing.torque_delay_ms, timing.why, e.lags, e.condition);
   std::string line = "  residual RMS per joint, N m, the arm alone -> with the payload:";
   for (int j = 0; j < d.nq; ++j) line += fmt::format(" {:.4f}->{:.4f}", e.rms_without(j), e.rms_with(j));
   fmt::print("{}\n", line);
@@ -133,7 +145,10 @@ void add_payload_commands(CLI::App& app, Common& common) {
                   "(docs/payload.md), needs logs with reference columns (default none: least squares)")
       ->check(CLI::IsMember({"none", "reference"}));
   cmd->add_flag("--force", o->force, "Overwrite existing output files");
-  cmd->callback([&common, o] { run(common, *o); });
+  cmd->callback([&common, o, cmd] {
+    o->torque_delay_given = cmd->count("--torque-delay") > 0;
+    run(common, *o);
+  });
 }
 
 }  // namespace symoro::dynid

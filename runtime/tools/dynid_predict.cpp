@@ -39,6 +39,7 @@ struct PredictOptions {
   double band = 0.95;       // the band's level (0: none)
   double interval_ms = study::PredictionOptions{}.interval * 1000;
   double torque_delay_ms = study::PredictionOptions{}.torque_delay * 1000;
+  bool torque_delay_given = false;  // else the parameters file's (fit_torque_delay)
   int trial = 1;
   bool force = false;
 };
@@ -86,7 +87,12 @@ study::Prediction predict_log(const io::Log& log, const identify::Identification
   return p;
 }
 
-void run(const Common& common, const PredictOptions& options) {
+void run(const Common& common, const PredictOptions& given) {
+  PredictOptions options = given;
+  const FitTiming timing = fit_torque_delay(
+      options.params, options.torque_delay_given ? std::optional<double>(options.torque_delay_ms) : std::nullopt);
+  options.torque_delay_ms = timing.torque_delay_ms;
+  if (!timing.warning.empty()) fmt::print(stderr, "warning: {}\n", timing.warning);
   const auto model = identification_model(common, parameters_model(options.params, options.model));
   const identify::ModelDescription& d = model->description();
   const Eigen::VectorXd phi =
@@ -105,9 +111,12 @@ void run(const Common& common, const PredictOptions& options) {
       throw UsageError(f.string() + " exists: dynid predict does not overwrite it; choose another --out, or --force");
   if (!one) fs::create_directories(out);
 
-  fmt::print("{} model {} with {} parameters, at {:.0f} ms: RMSE of tau - tau_model (RMS of tau) per joint, N m\n",
-             common.robot, d.variant.empty() ? "full" : d.variant,
-             options.params == "nominal" ? "the nominal" : options.params, options.interval_ms);
+  fmt::print(
+      "{} model {} with {} parameters, at {:.0f} ms, torque delay {:g} ms ({}): RMSE of tau - tau_model (RMS of tau) "
+      "per joint, N m\n",
+      common.robot, d.variant.empty() ? "full" : d.variant,
+      options.params == "nominal" ? "the nominal" : options.params, options.interval_ms, timing.torque_delay_ms,
+      timing.why);
   const std::optional<study::PredictionUncertainty> u = uncertainty_of(options, d);
   Eigen::VectorXd sq = Eigen::VectorXd::Zero(d.nq), inside = sq;
   int total = 0;
@@ -193,7 +202,10 @@ void add_predict_commands(CLI::App& app, Common& common) {
                   "The parameters' uncertainty for the band (default: uncertainty.yaml beside --params)")
       ->check(CLI::ExistingFile);
   cmd->add_flag("--force", o->force, "Overwrite existing output files");
-  cmd->callback([&common, o] { run(common, *o); });
+  cmd->callback([&common, o, cmd] {
+    o->torque_delay_given = cmd->count("--torque-delay") > 0;
+    run(common, *o);
+  });
 }
 
 }  // namespace symoro::dynid

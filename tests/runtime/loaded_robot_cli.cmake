@@ -125,6 +125,18 @@ expect("${out}" "in the flange frame wrist_3_link")
 expect("${out}" "mass +1\\.(1[89]|2[0-2])[0-9]* kg")
 expect("${out}" "com +\\[ *([7-9]|1[0-2])\\.[0-9], -(1[7-9]|2[0-2])\\.[0-9], (5[7-9]|6[0-2])\\.[0-9]\\] mm")
 expect("${out}" "Ixx 0\\.00(3[4-9]|4[0-5])[0-9]* Iyy 0\\.00(4[3-9]|5[0-6])[0-9]* Izz 0\\.00(2[6-9]|3[0-4])")
+# The arm's timing by default (its parameters file's torque_delay_ms), another given with a warning.
+expect("${out}" "torque delay 0 ms \\(the arm's, from [^)]*loaded-study/report/parameters.yaml\\)")
+file(READ ${WORK}/loaded-study/report/parameters.yaml params)
+string(REPLACE "torque_delay_ms: 0\n" "torque_delay_ms: 1.5\n" shifted "${params}")
+file(WRITE ${WORK}/shifted-parameters.yaml "${shifted}")
+run(0 out payload --robot ${WORK}/robots/ur5 --params ${WORK}/shifted-parameters.yaml ${WORK}/payload-data
+    -o ${WORK}/payload-shifted)
+expect("${out}" "torque delay 1.5 ms \\(the arm's, from [^)]*shifted-parameters.yaml\\)")
+run(0 out payload --robot ${WORK}/robots/ur5 --params ${WORK}/shifted-parameters.yaml ${WORK}/payload-data
+    -o ${WORK}/payload-told --torque-delay 0)
+expect("${out}" "torque delay 0 ms \\(given\\)")
+expect("${out}" "warning: --torque-delay 0 ms, but [^ ]*shifted-parameters.yaml was identified at 1.5 ms")
 file(READ ${WORK}/payload/payload.urdf urdf)
 expect("${urdf}" "<parent link=\"wrist_3_link\"/>")
 file(READ ${WORK}/payload/payload.yaml yaml)

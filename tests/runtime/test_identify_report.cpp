@@ -4,6 +4,7 @@
 // data, and the reproduction table without a controller. The figures:
 // test_identify_report_figures.cpp.
 #include "report_test_support.hpp"
+#include "symoro/io/parameters_yaml.hpp"
 
 namespace {
 
@@ -262,6 +263,18 @@ TEST_F(Report, ParametersYamlReadsBackBitForBit) {
     EXPECT_EQ(p[i]["unit"].as<std::string>(), study().units[i]);
     EXPECT_EQ(bits(p[i]["value"].as<double>()), bits(study().phi_rescue(i))) << study().names[i];
   }
+}
+
+// The study's torque timing, which fits on top of the parameters default to (dynid payload,
+// predict): 0 for this study, and a shifted one's as it was given.
+TEST_F(Report, ParametersYamlCarriesTheStudysTorqueDelay) {
+  EXPECT_EQ(symoro::io::parameters_torque_delay((*dir_ / "parameters.yaml").string()), 0.0);
+  StudyResult shifted = study();
+  shifted.torque_delay = -0.0023;
+  const fs::path file = *dir_ / "shifted.parameters.yaml";
+  write_parameters_yaml(shifted, file);
+  EXPECT_DOUBLE_EQ(symoro::io::parameters_torque_delay(file.string()).value_or(0), -0.0023);
+  fs::remove(file);
 }
 
 TEST_F(Report, ParametersCsvRowsParseBack) {

@@ -194,5 +194,28 @@ TEST(ParametersDigest, AnEditedValueOrFlagBreaksIt) {
   std::filesystem::remove_all(dir);
 }
 
+// The timing the parameters were identified with: read in seconds; absent in files from before the
+// key; anything but a number of ms within +-1000 refused with its line.
+TEST(ParametersTiming, TheTorqueDelayReadsBackAndABadOneIsNamed) {
+  const auto dir = scratch("timing");
+  const auto write = [&](const std::string& file, const std::string& line) {
+    std::ofstream(dir / file) << "robot: \"ur5\"\nmodel: \"full\"\n"
+                              << line << "parameters:\n  - {name: \"ZZR1\", value: 0.0121}\n";
+    return (dir / file).string();
+  };
+  EXPECT_EQ(parameters_torque_delay(write("ms.yaml", "torque_delay_ms: -2.5\n")), -0.0025);
+  EXPECT_FALSE(parameters_torque_delay(write("old.yaml", "")).has_value());
+  for (const std::string& bad : {"torque_delay_ms: soon\n", "torque_delay_ms: 1e9\n", "torque_delay_ms: .nan\n"}) {
+    const std::string file = write("bad.yaml", bad);
+    try {
+      parameters_torque_delay(file);
+      ADD_FAILURE() << bad;
+    } catch (const DataError& e) {
+      EXPECT_EQ(std::string(e.what()), file + ":3: error: torque_delay_ms: expected a number of ms from -1000 to 1000");
+    }
+  }
+  std::filesystem::remove_all(dir);
+}
+
 }  // namespace
 }  // namespace symoro::io

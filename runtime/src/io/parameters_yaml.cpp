@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <limits>
 #include <map>
 
 #include <fmt/format.h>
@@ -73,6 +74,20 @@ bool parameters_accepted(const std::string& path) {
   } catch (const YAML::Exception&) {
     throw DataError(path, flag.Mark().line + 1, "accepted: expected true or false");
   }
+}
+
+std::optional<double> parameters_torque_delay(const std::string& path) {
+  const YAML::Node root = parameters_root(path);
+  const YAML::Node n = root["torque_delay_ms"];
+  if (!n) return std::nullopt;
+  double ms = std::numeric_limits<double>::quiet_NaN();
+  try {
+    ms = n.as<double>();
+  } catch (const YAML::Exception&) {
+  }
+  if (!std::isfinite(ms) || std::abs(ms) > 1000)
+    throw DataError(path, n.Mark().line + 1, "torque_delay_ms: expected a number of ms from -1000 to 1000");
+  return ms / 1000;
 }
 
 std::string parameters_digest(const std::string& robot, const std::string& model, bool accepted,

@@ -370,6 +370,9 @@ void write_parameters_yaml(const StudyResult& study, const std::filesystem::path
   y += fmt::format("accepted: {}\n", study.accepted);
   y += "consistency: " + yaml_quoted(study.consistency) + "\n";
   y += fmt::format("physically_consistent: {}\n", study.final_consistent);
+  // The timing the values carry (an arm's rotor inertias take the logged torque's lead): dynid
+  // payload and predict default to it.
+  y += "torque_delay_ms: " + yaml_number(study.torque_delay * 1000) + "\n";
   // What dynid control checks before it drives an arm with these values: an edit breaks it.
   std::vector<std::string> names;
   for (Eigen::Index i = 0; i < phi.size(); ++i) names.push_back(name_of(study, static_cast<int>(i)));

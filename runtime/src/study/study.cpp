@@ -101,6 +101,7 @@ class StudyRun {
     out.robot = d_.robot;
     out.model = d_.variant;
     out.consistency = to_string(o_.consistency);
+    out.torque_delay = o_.preprocess.torque_delay;
     for (const auto& p : d_.parameters) {
       out.names.push_back(p.name);
       out.units.push_back(p.unit);

@@ -3,6 +3,7 @@
 // earlier identification's gap (dynid control --params, dynid diagnose --params) use it.
 #pragma once
 
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -18,6 +19,14 @@ Eigen::VectorXd read_parameters_yaml(const std::string& path, const std::vector<
 // without it is not accepted. Throws DataError with the file and line on a flag that is not a
 // boolean.
 bool parameters_accepted(const std::string& path);
+
+// The file's `torque_delay_ms:` in seconds: the shift of the logged torque the parameters were
+// identified with (preprocess::Options::torque_delay). A fit on top of them (dynid payload, dynid
+// predict) takes the same unless told otherwise: an arm's identification takes the logged
+// torque's timing into its rotor inertias, and another timing shows as inertia (docs/payload.md).
+// Empty for a file written before the key existed. Throws DataError with the file and line on a
+// value that is not a number of ms within +-1000.
+std::optional<double> parameters_torque_delay(const std::string& path);
 
 // The digest identify writes under `digest:` (io/digest.hpp): of the robot, the model, the
 // `accepted:` flag and every parameter's exact value, in `names` order. An edited value or flag

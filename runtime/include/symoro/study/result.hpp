@@ -146,6 +146,9 @@ struct StudyResult {
   // (acceptance.hpp) says why not.
   bool accepted = false;
   std::string consistency = "pd";  // the path: pd (the paper's) or physical
+  // The logged torque's shift the parameters were identified with (s, preprocess::Options::
+  // torque_delay): parameters.yaml's torque_delay_ms, which fits on top of them default to.
+  double torque_delay = 0;
   // The accepted vector's physical consistency, checked on both paths where the model allows
   // (physical_projection.hpp): a consistent standard set maps onto it, phase 1's margin (NaN: not
   // needed), or why it was not checked.
