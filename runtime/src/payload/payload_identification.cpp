@@ -109,13 +109,6 @@ Eigen::MatrixXd weighted(const Eigen::MatrixXd& A, const Eigen::VectorXd& w) {
   return B;
 }
 
-// The columns `free` of A.
-Eigen::MatrixXd free_columns(const Eigen::MatrixXd& A, const std::vector<int>& free) {
-  Eigen::MatrixXd B(A.rows(), static_cast<Eigen::Index>(free.size()));
-  for (std::size_t i = 0; i < free.size(); ++i) B.col(static_cast<Eigen::Index>(i)) = A.col(free[i]);
-  return B;
-}
-
 // The weighted instrumental-variable estimate (Z'W X)^-1 Z'W y (rows weighted as in weighted()).
 Eigen::VectorXd instrumented(const Eigen::MatrixXd& Z, const Eigen::MatrixXd& X, const Eigen::VectorXd& y,
                              const Eigen::VectorXd& w) {
@@ -149,14 +142,13 @@ Eigen::Matrix<double, 10, 1> reported_std(const StandardVector& s, const Eigen::
 }
 
 // The parameter the weakest direction of the scaled regressor leans on most, for the message.
-std::string weakest(const Eigen::MatrixXd& Xs, const std::vector<int>& columns) {
+std::string weakest(const Eigen::MatrixXd& Xs, const std::vector<std::string>& names) {
   const Eigen::JacobiSVD<Eigen::MatrixXd> svd(Xs, Eigen::ComputeThinV);
   const Eigen::VectorXd v = svd.matrixV().col(Xs.cols() - 1);
   std::string out;
   for (Eigen::Index i = 0; i < v.size(); ++i)
     if (std::abs(v(i)) > 0.3)
-      out += fmt::format("{}{:+.2f} {}", out.empty() ? "" : " ", v(i),
-                         payload_standard_names()[static_cast<std::size_t>(columns[static_cast<std::size_t>(i)])]);
+      out += fmt::format("{}{:+.2f} {}", out.empty() ? "" : " ", v(i), names[static_cast<std::size_t>(i)]);
   return out;
 }
 
@@ -186,6 +178,12 @@ PayloadLink payload_link(const identify::IdentificationModel& model) {
 PayloadEstimate identify_payload(const std::vector<io::Log>& logs, const identify::IdentificationModel& arm,
                                  const Eigen::VectorXd& phi, const identify::IdentificationModel& full,
                                  const PayloadOptions& o) {
+  return identify_payload(logs, {}, arm, phi, full, o);
+}
+
+PayloadEstimate identify_payload(const std::vector<io::Log>& logs, const std::vector<io::Log>& tare,
+                                 const identify::IdentificationModel& arm, const Eigen::VectorXd& phi,
+                                 const identify::IdentificationModel& full, const PayloadOptions& o) {
   if (logs.empty()) throw std::invalid_argument("identify_payload: no logs");
   if (arm.description().nq != full.description().nq || arm.description().robot != full.description().robot)
     throw std::invalid_argument("identify_payload: the arm's model and the full model are of different robots");
@@ -196,18 +194,46 @@ PayloadEstimate identify_payload(const std::vector<io::Log>& logs, const identif
     throw std::invalid_argument(fmt::format("identify_payload: a known mass must be positive, not {}", *o.mass));
   const PayloadLink link = payload_link(full);
   const Stack s = stack(logs, arm, phi, full, link, o);
+  const Stack t = tare.empty() ? Stack{} : stack(tare, arm, phi, full, link, o);
   const int n = s.joints;
+  const bool tared = !tare.empty();
 
-  // The free columns (all 10, or 9 with a known mass taken to the left side).
+  // The unknowns: the payload's free parameters (all 10, or 9 with a known mass taken to the
+  // left side), then with tare logs the arm's error delta along all 10. Rows: the payload's logs,
+  // then the tare's (theta's columns 0 there).
   std::vector<int> free;
+  std::vector<std::string> names;
   for (int c = 0; c < kInertialParameters; ++c)
-    if (!(o.mass && c == 9)) free.push_back(c);
-  const int r = static_cast<int>(free.size());
-  Eigen::MatrixXd X(s.X.rows(), r);
-  for (int i = 0; i < r; ++i) X.col(i) = s.X.col(free[static_cast<std::size_t>(i)]);
-  Eigen::VectorXd y = s.y;
-  if (o.mass) y -= s.X.col(9) * *o.mass;
-  if (X.rows() < 2 * r) throw std::invalid_argument("identify_payload: too few samples");
+    if (!(o.mass && c == 9)) {
+      free.push_back(c);
+      names.push_back(payload_standard_names()[static_cast<std::size_t>(c)]);
+    }
+  const int r = static_cast<int>(free.size()), cols = r + (tared ? kInertialParameters : 0);
+  if (tared)
+    for (int c = 0; c < kInertialParameters; ++c)
+      names.push_back(std::string("tare ") + payload_standard_names()[static_cast<std::size_t>(c)]);
+  const Eigen::Index rows_s = s.X.rows(), rows = rows_s + t.X.rows();
+  Eigen::MatrixXd X = Eigen::MatrixXd::Zero(rows, cols), Z;
+  for (int i = 0; i < r; ++i) X.col(i).head(rows_s) = s.X.col(free[static_cast<std::size_t>(i)]);
+  if (o.reference_instruments) {
+    Z = Eigen::MatrixXd::Zero(rows, cols);
+    for (int i = 0; i < r; ++i) Z.col(i).head(rows_s) = s.Z.col(free[static_cast<std::size_t>(i)]);
+  }
+  if (tared) {
+    X.block(0, r, rows_s, kInertialParameters) = s.X;
+    X.block(rows_s, r, t.X.rows(), kInertialParameters) = t.X;
+    if (o.reference_instruments) {
+      Z.block(0, r, rows_s, kInertialParameters) = s.Z;
+      Z.block(rows_s, r, t.X.rows(), kInertialParameters) = t.Z;
+    }
+  }
+  Eigen::VectorXd y(rows);
+  y.head(rows_s) = s.y;
+  y.tail(t.y.size()) = t.y;
+  if (o.mass) y.head(rows_s) -= s.X.col(9) * *o.mass;
+  std::vector<int> log_of = s.log_of;
+  for (int l : t.log_of) log_of.push_back(l + static_cast<int>(logs.size()));
+  if (X.rows() < 2 * cols) throw std::invalid_argument("identify_payload: too few samples");
 
   PayloadEstimate out;
   out.link = link.link;
@@ -221,20 +247,20 @@ PayloadEstimate identify_payload(const std::vector<io::Log>& logs, const identif
   for (int it = 0; it <= o.wls_iterations; ++it) {
     const Eigen::MatrixXd Xw = weighted(X, w);
     const Eigen::VectorXd norms = Xw.colwise().norm();
-    for (int i = 0; i < r; ++i)
+    for (int i = 0; i < cols; ++i)
       if (!(norms(i) > 0))
         throw std::invalid_argument(fmt::format("the logs do not excite the payload's {}: its column is zero",
-                                                payload_standard_names()[static_cast<std::size_t>(free[i])]));
+                                                names[static_cast<std::size_t>(i)]));
     const Eigen::MatrixXd Xs = Xw * norms.cwiseInverse().asDiagonal();
     const Eigen::JacobiSVD<Eigen::MatrixXd> svd(Xs, Eigen::ComputeThinU | Eigen::ComputeThinV);
     const Eigen::VectorXd sv = svd.singularValues();
-    out.condition = sv(0) / sv(r - 1);
+    out.condition = sv(0) / sv(cols - 1);
     if (!(out.condition < 1e8))
       throw std::invalid_argument(fmt::format(
           "the logs do not excite the payload's parameters (scaled condition number {:.3g}): the weakest combination "
           "is {}; move the wrist joints more (dynid excite --payload)",
-          out.condition, weakest(Xs, free)));
-    beta = o.reference_instruments ? instrumented(free_columns(s.Z, free), X, y, w)
+          out.condition, weakest(Xs, names)));
+    beta = o.reference_instruments ? instrumented(Z, X, y, w)
                                    : Eigen::VectorXd(norms.cwiseInverse().asDiagonal() * svd.solve(weighted(y, w)));
     if (it == o.wls_iterations) break;
     const Eigen::VectorXd rms = joint_rms(y - X * beta, n);
@@ -245,16 +271,16 @@ PayloadEstimate identify_payload(const std::vector<io::Log>& logs, const identif
   // The covariance, the residual's autocorrelation counted.
   const Eigen::MatrixXd Xw = weighted(X, w);
   const Eigen::VectorXd ew = weighted(y - X * beta, w);
-  out.lags = o.lags >= 0 ? o.lags : identify::residual_lags(ew, s.log_of, n);
+  out.lags = o.lags >= 0 ? o.lags : identify::residual_lags(ew, log_of, n);
   Eigen::MatrixXd C;
   if (!o.reference_instruments) {
-    C = identify::hac_covariance(Xw, ew, s.log_of, n, out.lags);
+    C = identify::hac_covariance(Xw, ew, log_of, n, out.lags);
   } else {
     // (Z'X)^-1 S_Z (X'Z)^-1, S_Z the long-run covariance of the instruments' scores, which
     // hac_covariance gives between (Z'Z)^-1 factors.
-    const Eigen::MatrixXd Zw = weighted(free_columns(s.Z, free), w);
+    const Eigen::MatrixXd Zw = weighted(Z, w);
     const Eigen::MatrixXd ZZ = Zw.transpose() * Zw, ZXi = (Zw.transpose() * Xw).inverse();
-    C = ZXi * ZZ * identify::hac_covariance(Zw, ew, s.log_of, n, out.lags) * ZZ * ZXi.transpose();
+    C = ZXi * ZZ * identify::hac_covariance(Zw, ew, log_of, n, out.lags) * ZZ * ZXi.transpose();
   }
   out.least_squares.setZero();
   out.covariance.setZero();
@@ -264,6 +290,8 @@ PayloadEstimate identify_payload(const std::vector<io::Log>& logs, const identif
       out.covariance(free[static_cast<std::size_t>(i)], free[static_cast<std::size_t>(k)]) = C(i, k);
   }
   if (o.mass) out.least_squares(9) = *o.mass;
+  if (tared) out.tare = beta.tail(kInertialParameters);
+  out.tare_samples = t.samples;
 
   // A body: the estimate, or the nearest one in the covariance's metric.
   out.standard = out.least_squares;
@@ -285,7 +313,7 @@ PayloadEstimate identify_payload(const std::vector<io::Log>& logs, const identif
   out.mass_std = o.mass ? 0.0 : sd(0);
   out.com_std = sd.segment<3>(1);
   out.inertia_std = sd.segment<6>(4);
-  out.rms_with = joint_rms(s.y - s.X * out.standard, n);
+  out.rms_with = joint_rms(s.y - s.X * (out.standard + out.tare), n);
   return out;
 }
 

@@ -78,8 +78,12 @@ struct PayloadEstimate {
   double condition = 0;         // of the column-scaled weighted payload regressor
   Eigen::VectorXd weights;      // per joint, 1 / N m
   Eigen::VectorXd rms_without;  // N m per joint: tau - ID(phi), the arm alone
-  Eigen::VectorXd rms_with;     // N m per joint: with the payload
+  Eigen::VectorXd rms_with;     // N m per joint: with the payload (and the tare's correction)
   std::string status;           // one sentence
+  // With tare logs: the arm's own error along the payload's 10 parameters, which they measured
+  // and which was taken out of the payload (zero without), and their sample count.
+  StandardVector tare = StandardVector::Zero();
+  int tare_samples = 0;
 };
 
 // `logs` of the arm carrying the payload; `arm` and `phi` the arm's identified model (its
@@ -89,5 +93,16 @@ struct PayloadEstimate {
 PayloadEstimate identify_payload(const std::vector<io::Log>& logs, const identify::IdentificationModel& arm,
                                  const Eigen::VectorXd& phi, const identify::IdentificationModel& full,
                                  const PayloadOptions& options = {});
+
+// The same with `tare` logs: the arm without the payload, best on the same motion. The payload
+// is only as good as the arm's parameters of its link: an error there of a fraction of the
+// payload's inertia about its CoM (a small difference of large second moments) goes straight
+// into it. The tare logs measure that error, delta, along the payload's 10 parameters, and the
+// fit takes it out: tau - ID(phi) = X (theta + delta) carrying, X delta without, solved together
+// (theta's mass alone held when known). On the CRANE-X7 twin with the main study's arm:
+// docs/payload.md.
+PayloadEstimate identify_payload(const std::vector<io::Log>& logs, const std::vector<io::Log>& tare,
+                                 const identify::IdentificationModel& arm, const Eigen::VectorXd& phi,
+                                 const identify::IdentificationModel& full, const PayloadOptions& options = {});
 
 }  // namespace symoro::payload
