@@ -32,7 +32,7 @@ namespace fs = std::filesystem;
 
 struct PayloadCliOptions {
   std::string params, model, out;
-  std::vector<std::string> inputs;
+  std::vector<std::string> inputs, tare;
   double mass = 0;  // kg, > 0: known
   double interval_ms = study::PredictionOptions{}.interval * 1000;
   double torque_delay_ms = 0;
@@ -57,6 +57,11 @@ void run(const Common& common, const PayloadCliOptions& o) {
       logs.push_back(std::move(l.log));
     }
   if (logs.empty()) throw UsageError(fmt::format("no run of trial {} in {}", o.trial, fmt::join(o.inputs, ", ")));
+  std::vector<io::Log> tare;
+  for (const auto& input : o.tare)
+    for (auto& l : io::read_input_logs(input, d.robot, d.nq, o.trial)) tare.push_back(std::move(l.log));
+  if (!o.tare.empty() && tare.empty())
+    throw UsageError(fmt::format("--tare: no run of trial {} in {}", o.trial, fmt::join(o.tare, ", ")));
   const fs::path out(o.out), yaml_file = out / "payload.yaml", urdf_file = out / "payload.urdf";
   for (const auto& f : {yaml_file, urdf_file})
     if (fs::exists(f) && !o.force)
@@ -75,7 +80,7 @@ void run(const Common& common, const PayloadCliOptions& o) {
                                                    static_cast<int>(d.frames.size()), po.flange_in_link);
   payload::PayloadEstimate e;
   try {
-    e = payload::identify_payload(logs, *arm, phi, *full, po);
+    e = payload::identify_payload(logs, tare, *arm, phi, *full, po);
   } catch (const std::invalid_argument& err) {
     throw UsageError(err.what());
   }
@@ -96,6 +101,13 @@ void run(const Common& common, const PayloadCliOptions& o) {
     fmt::print(
         "  the logs carry their reference motion: --instruments reference takes out least squares' bias from "
         "the encoders' noise a closed loop answers (docs/payload.md)\n");
+  if (e.tare_samples > 0)
+    fmt::print(
+        "  tare: {} samples without the payload; the arm's own error along the payload's parameters, taken out: "
+        "mass {:.3g} kg, first moments [{:.3g}, {:.3g}, {:.3g}] kg m, second moments XX..ZZ [{:.3g} {:.3g} {:.3g} "
+        "{:.3g} {:.3g} {:.3g}] kg m^2 (link frame)\n",
+        e.tare_samples, e.tare(9), e.tare(6), e.tare(7), e.tare(8), e.tare(0), e.tare(1), e.tare(2), e.tare(3),
+        e.tare(4), e.tare(5));
   fmt::print(
       "  {} samples at {:.0f} ms, torque delay {:g} ms ({}), covariance over {} lags, scaled condition number "
       "{:.3g}\n",
@@ -136,6 +148,13 @@ void add_payload_commands(CLI::App& app, Common& common) {
       ->required()
       ->check(CLI::ExistingPath);
   cmd->add_option("-o,--out", o->out, "Folder for payload.yaml and payload.urdf")->required();
+  cmd->add_option("--tare", o->tare,
+                  "Logs or dataset folders of the arm without the payload, best on the same motion: the arm's own "
+                  "error along the payload's parameters is fitted from them and taken out (docs/payload.md); one path "
+                  "each, repeatable")
+      ->expected(1)
+      ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll)
+      ->check(CLI::ExistingPath);
   cmd->add_option("--mass", o->mass, "The payload's known mass, kg: the other 9 parameters are identified")
       ->check(numbers::checked(0, 1e4, true, false, "above 0 and at most 1e4 kg"));
   numbers::add_log_options(cmd, o->interval_ms, o->torque_delay_ms, o->trial);

@@ -1095,6 +1095,29 @@ TEST(PreprocessEdges, EndsAtRestKeepEverySample) {
   EXPECT_EQ(s.time[0], 0.0);
 }
 
+// A joint held still without a sensor's steps (a logged reference, a simulated hold) is still:
+// interpolating it onto the grid between jittered stamps leaves differences of a rounding, and
+// its ends were taken to move (a reference's first samples left out, the measured log's kept).
+TEST(PreprocessEdges, AJointHeldExactlyStillIsNotMoving) {
+  const double seconds = 4, w = 2 * kPi / seconds;
+  const int n = static_cast<int>(seconds / kH) + 1;
+  symoro::io::Log log = sized_log("held", n, 2);
+  for (int k = 0; k < n; ++k) {
+    const double t = k * kH, c = 1 - std::cos(w * t);
+    log.time[k] = t + (k % 7 == 3 ? 1e-4 : 0.0) - (k % 11 == 5 ? 7e-5 : 0.0);
+    log.q(k, 0) = 0.7309217653;
+    log.q(k, 1) = -1.3 + 0.5 * c * c;
+    log.qd(k, 0) = 0;
+    log.qd(k, 1) = w * c * std::sin(w * t);
+    log.tau(k, 0) = 0.1 * std::sin(3 * t);
+    log.tau(k, 1) = log.q(k, 1);
+  }
+  const pp::Samples s = pp::preprocess(log, 0.010);
+  EXPECT_EQ(s.report.moving_ends, 0);
+  EXPECT_EQ(s.report.edge_samples, 0);
+  EXPECT_EQ(s.time[0], 0.0);
+}
+
 // A run's window of a longer file (a split's held-out part, io::read_run_log) is filtered as the
 // whole file: its samples are the uncut file's at the same instants, to rounding, whatever clock
 // the caller counts it on; a window whose rows no longer match its file is filtered alone.

@@ -91,6 +91,11 @@ std::string payload_yaml(const PayloadEstimate& e, const PayloadFileContext& c) 
                    num(e.margin), num(e.distance), e.status);
   y += fmt::format("fit: {{samples: {}, lags: {}, condition: {}, estimator: {}}}\n", e.samples, e.lags,
                    num(e.condition), e.instrumented ? "instrumental variables (reference motion)" : "least squares");
+  if (e.tare_samples > 0)
+    y += fmt::format(
+        "tare: {{samples: {}, standard: {}}}  # the arm's own error along XX..M{}, from the runs without the "
+        "payload, taken out\n",
+        e.tare_samples, list(Eigen::VectorXd(e.tare)), e.link);
   y += fmt::format("rms_without_payload: {}  # N m per joint: measured minus the arm's model\n", list(e.rms_without));
   y += fmt::format("rms_with_payload: {}  # N m per joint: minus the arm's and the payload's\n", list(e.rms_with));
   y += fmt::format("standard:  # link {}'s standard parameters added by the payload, its model frame\n", e.link);
@@ -115,7 +120,7 @@ PayloadFile read_payload_yaml(const std::string& file) {
     throw DataError(file, 0, "not a payload file (format: symoro-payload 1; dynid payload writes one)");
   io::check_keys(root,
                  {"format", "robot", "flange", "flange_in_link", "payload", "std_dev", "known_mass", "consistency",
-                  "fit", "rms_without_payload", "rms_with_payload", "standard", "franka", "ur", "kuka"},
+                  "fit", "tare", "rms_without_payload", "rms_with_payload", "standard", "franka", "ur", "kuka"},
                  file, "a payload file");
   const YAML::Node p = root["payload"];
   if (!p || !p.IsMap()) throw DataError(file, 0, "no payload: section");

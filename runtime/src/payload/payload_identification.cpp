@@ -45,7 +45,12 @@ Eigen::MatrixXd instruments(const io::Log& log, const preprocess::Samples& measu
   if (!log.has_references())
     throw std::invalid_argument(
         fmt::format("reference instruments: {} has no reference columns (q_ref, qd_ref, qdd_ref)", name));
-  const preprocess::Samples ref = preprocess::preprocess(as_reference(log), interval, po);
+  // Every row kept: whether an end of the reference moves within the filter's settling time is
+  // judged on its own smooth q (no encoder steps), which can differ from the measured motion's
+  // judgement; the measured samples choose which instants count.
+  preprocess::Options all = po;
+  all.trim_settling = false;
+  const preprocess::Samples ref = preprocess::preprocess(as_reference(log), interval, all);
   const Eigen::MatrixXd Wr = full.stack_regression(ref).W * link.map;
   const int n = static_cast<int>(measured.q.cols());
   Eigen::MatrixXd Z(measured.time.size() * n, Wr.cols());

@@ -29,7 +29,8 @@ Eigen::ArrayXd smallest_steps(const Eigen::MatrixXd& x);
 // Whether the arm moves within `count` rows of one end of q (unfiltered, on the grid; the first
 // rows when at_start, else the last): some joint's q spans more there than four of its quanta
 // (an encoder toggling at rest spans one or two) and 1e-3 of its span over the whole of q (noise
-// on a log of floats). Moving includes a reversal (qd = 0, qdd != 0): it spans qdd t^2 / 2.
+// on a log of floats), and 1e-9 (a channel without steps, interpolated, differs from itself by a
+// rounding). Moving includes a reversal (qd = 0, qdd != 0): it spans qdd t^2 / 2.
 bool moving_at_end(const Channels& q, int count, bool at_start, const Eigen::ArrayXd& quantum);
 
 }  // namespace symoro::preprocess
