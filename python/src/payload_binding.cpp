@@ -43,7 +43,8 @@ void bind_payload(py::module_& m) {
       "identify_payload",
       [](py::handle model, py::handle params, const std::vector<std::filesystem::path>& inputs, py::handle full,
          std::optional<double> mass, double interval_ms, std::optional<double> torque_delay_given, int trial,
-         const std::optional<std::filesystem::path>& robot_dir_given, const std::string& instruments) {
+         const std::optional<std::filesystem::path>& robot_dir_given, const std::string& instruments,
+         const std::vector<std::filesystem::path>& tare_inputs) {
         if (instruments != "none" && instruments != "reference")
           throw py::value_error(fmt::format("instruments '{}': 'none' or 'reference'", instruments));
         if (!(std::isfinite(interval_ms) && interval_ms >= 1 && interval_ms <= 10000))
@@ -67,6 +68,7 @@ void bind_payload(py::module_& m) {
         const std::optional<std::filesystem::path> robot_dir = robot_dir_of(model, robot_dir_given);
         const Eigen::VectorXd phi = parameters_of(*arm, params, robot_dir);
         const std::vector<io::Log> logs = logs_of(inputs, d, trial);
+        const std::vector<io::Log> tare = tare_inputs.empty() ? std::vector<io::Log>{} : logs_of(tare_inputs, d, trial);
         payload::PayloadOptions o;
         o.interval = interval_ms / 1000;
         o.torque_delay = torque_delay_ms / 1000;
@@ -80,7 +82,7 @@ void bind_payload(py::module_& m) {
         payload::PayloadEstimate e;
         {
           py::gil_scoped_release release;
-          e = payload::identify_payload(logs, *arm, phi, *whole, o);
+          e = payload::identify_payload(logs, tare, *arm, phi, *whole, o);
         }
         py::dict r;
         r["mass"] = e.payload.mass;
@@ -100,6 +102,8 @@ void bind_payload(py::module_& m) {
         r["status"] = e.status;
         r["samples"] = e.samples;
         r["torque_delay_ms"] = torque_delay_ms;
+        r["tare"] = Eigen::VectorXd(e.tare);
+        r["tare_samples"] = e.tare_samples;
         r["lags"] = e.lags;
         r["condition"] = e.condition;
         r["rms_without"] = e.rms_without;
@@ -114,12 +118,15 @@ void bind_payload(py::module_& m) {
       py::arg("model"), py::arg("params"), py::arg("inputs"), py::kw_only(), py::arg("full") = py::none(),
       py::arg("mass") = py::none(), py::arg("interval_ms") = 10.0, py::arg("torque_delay_ms") = py::none(),
       py::arg("trial") = 1, py::arg("robot_dir") = py::none(), py::arg("instruments") = "none",
+      py::arg("tare") = std::vector<std::filesystem::path>{},
       "A payload's 10 inertial parameters from logs (or datasets) of the arm carrying it, the arm's parameters "
       "(params: an array or a parameters file of `model`) held: a dict of 'mass', 'com', 'inertia' (about the CoM) "
       "in the flange frame 'flange', their '*_std', 'standard', 'covariance', 'projected', 'status', 'rms_without', "
       "'rms_with', and the 'urdf', 'franka', 'ur' and 'kuka' forms. full: the robot's full model when `model` is a "
       "variant; mass: a known mass (the other 9 identified); torque_delay_ms: the logged torque's delay, by default "
-      "the parameters file's (the arm's; 0 for an array), returned as 'torque_delay_ms'. docs/payload.md");
+      "the parameters file's (the arm's; 0 for an array), returned as 'torque_delay_ms'; tare: logs or datasets of "
+      "the arm without the payload, whose error along the payload's parameters is fitted and taken out (returned as "
+      "'tare'). docs/payload.md");
 }
 
 }  // namespace symoro::python

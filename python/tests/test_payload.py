@@ -23,7 +23,7 @@ def body_standard(m, c, I):
     return np.array([J[0, 0], J[0, 1], J[0, 2], J[1, 1], J[1, 2], J[2, 2], *(m * c), m])
 
 
-def export(path, arm, s, seed, seconds=20.0):
+def export(path, arm, s, seed, seconds=20.0, noise_seed=None):
     rng = np.random.default_rng(seed)
     t = np.arange(0, seconds, 1 / RATE)
     w, dw, ddw = ramp(t, seconds - 1 / RATE)
@@ -39,7 +39,8 @@ def export(path, arm, s, seed, seconds=20.0):
         q[:, j] += 0.2 * mid[j]
     tau = arm.inverse_dynamics(q, qd, qdd, arm.base_from_standard(s))
     tau[:, 1] += 0.03
-    tau += rng.normal(0, 0.01, tau.shape)
+    # The same motion with other noise when noise_seed is given (a tare run of the same motion).
+    tau += (rng if noise_seed is None else np.random.default_rng(noise_seed)).normal(0, 0.01, tau.shape)
     cols = ["t_ms"] + [f"pos{j + 1}" for j in range(arm.nq)] + [f"vel{j + 1}" for j in range(arm.nq)] + \
            [f"eff{j + 1}" for j in range(arm.nq)]
     data = np.column_stack([t * 1000, np.degrees(q), np.degrees(qd), tau])
@@ -94,3 +95,27 @@ def test_the_body_on_the_last_link_is_found(jaco2, tmp_path):
     assert shifted["torque_delay_ms"] == 2.0 and told["torque_delay_ms"] == 0.0 and r["torque_delay_ms"] == 0.0
     assert np.array_equal(told["standard"], r["standard"])
     assert not np.array_equal(shifted["standard"], r["standard"])
+
+    # Arm parameters off along the body's link (a third of the body's second moments): without a
+    # tare the body's inertia is far off; a run of the same motion without the body (other noise)
+    # measures that error and takes it out.
+    error = np.zeros(len(names))
+    error[idx] = body_standard(m, c, I)[:10] * np.array([0.3, 0.3, 0.3, 0.3, 0.3, 0.3, 0.05, 0.05, 0.05, 0.05])
+    off = arm.base_from_standard(s_arm + error)
+    export(tmp_path / "bare.csv", arm, s_arm, 3, noise_seed=11)
+    symoro.import_logs(arm, tmp_path / "tare", [tmp_path / "bare.csv"], **MAPPING)
+
+    def body(res):  # mass, CoM and inertia about it in the link's frame, from 'standard'
+        st = res["standard"]
+        cc = st[6:9] / st[9]
+        J = np.array([[st[0], st[1], st[2]], [st[1], st[3], st[4]], [st[2], st[4], st[5]]])
+        return st[9], cc, J - st[9] * (cc @ cc * np.eye(3) - np.outer(cc, cc))
+
+    blind = symoro.identify_payload(arm, off, [tmp_path / "data"])
+    tared = symoro.identify_payload(arm, off, [tmp_path / "data"], tare=[tmp_path / "tare"])
+    assert np.linalg.norm(body(blind)[2] - I) / np.linalg.norm(I) > 0.15 and tared["tare_samples"] > 0
+    m_t, c_t, I_t = body(tared)
+    assert abs(m_t - m) / m < 0.02 and np.linalg.norm(c_t - c) < 0.003
+    assert np.linalg.norm(I_t - I) / np.linalg.norm(I) < 0.15
+    # The tare reads the error (less the noise): its second moments within 25 %.
+    assert np.linalg.norm(tared["tare"][:6] + error[idx][:6]) < 0.25 * np.linalg.norm(error[idx][:6])

@@ -152,6 +152,21 @@ run(0 out payload --robot ${WORK}/robots/ur5 --params ${WORK}/loaded-study/repor
     ${WORK}/payload-data -o ${WORK}/payload-known)
 expect("${out}" "mass +1\\.2 kg \\(given\\)")
 expect("${out}" "com +\\[ *([7-9]|1[0-2])\\.[0-9], -(1[7-9]|2[0-2])\\.[0-9], (5[7-9]|6[0-2])\\.[0-9]\\] mm")
+# With a tare: an export of the arm without the body (another motion and noise); the body within
+# the same bounds, and the tare's record in payload.yaml.
+execute_process(COMMAND ${WRITE_EXPORT} ur5 ${WORK}/tare.csv 40 8 0 RESULT_VARIABLE code)
+if(NOT code EQUAL 0)
+  message(FATAL_ERROR "write_export ur5 (tare) failed")
+endif()
+run(0 out import --robot ${WORK}/robots/ur5 -o ${WORK}/tare-data ${WORK}/tare.csv ${columns})
+run(0 out payload --robot ${WORK}/robots/ur5 --params ${WORK}/loaded-study/report/parameters.yaml
+    ${WORK}/payload-data --tare ${WORK}/tare-data -o ${WORK}/payload-tared)
+expect("${out}" "tare: [0-9]+ samples without the payload")
+expect("${out}" "mass +1\\.(1[89]|2[0-2])[0-9]* kg")
+expect("${out}" "com +\\[ *([7-9]|1[0-2])\\.[0-9], -(1[7-9]|2[0-2])\\.[0-9], (5[7-9]|6[0-2])\\.[0-9]\\] mm")
+expect("${out}" "Ixx 0\\.00(3[4-9]|4[0-5])[0-9]* Iyy 0\\.00(4[3-9]|5[0-6])[0-9]* Izz 0\\.00(2[6-9]|3[0-4])")
+file(READ ${WORK}/payload-tared/payload.yaml yaml)
+expect("${yaml}" "\ntare: {samples: [0-9]+, standard: \\[")
 
 # The payload into the user's URDF beside the identified inertials (export --into --payload): a
 # link on the tip link; the model's own URDF holds it on frame 6's link at the tip's pose.
