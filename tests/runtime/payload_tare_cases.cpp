@@ -81,22 +81,10 @@ TEST(PayloadTare, ARunWithoutTheToolTakesTheArmsErrorOutOfTheIndependentRx90sToo
   truth.mass = 5;
   truth.com = {0.02, -0.015, 0.1};
   truth.inertia = Eigen::Vector3d(0.02, 0.018, 0.01).asDiagonal();
-  twin::TwinConfig tool = arm;
-  twin::UrdfInertial body;
-  body.name = "tool";
-  body.on = tool.chain.joints.back().name;
-  body.mass = truth.mass;
-  body.com = truth.com;
-  body.inertia = truth.inertia;
-  tool.chain.inertials.push_back(body);
+  const twin::TwinConfig tool = carrying(arm, truth);
   const auto model = identify::identification_model<Rx>();
+  const Eigen::VectorXd phi = rx90_arm_identified(arm);
   test::IndependentArmOptions io;
-  std::vector<io::Log> arm_logs;
-  for (unsigned seed : {61u, 62u}) {
-    io.seed = seed;
-    arm_logs.push_back(test::run_independent_arm<Rx>(arm, test::rx90_reference("arm", 20, seed), io));
-  }
-  const Eigen::VectorXd phi = identify::least_squares(stacked<Rx>(*model, arm_logs), {true}).phi;
   Eigen::VectorXd pose(Rx::nq);
   pose << 0.2, -0.5, 0.8, 0, 0, 0;
   const trajectory::SampledReference wrist = wrist_reference(pose, 3, 3, 1.5, 20);

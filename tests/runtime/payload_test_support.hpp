@@ -11,6 +11,10 @@
 
 #include <gtest/gtest.h>
 #include <symoro/crane_x7.hpp>
+#include <symoro/rx90.hpp>
+
+#include "independent_arm.hpp"
+#include "independent_rx90.hpp"
 
 #include "symoro/identify/identification_model.hpp"
 #include "symoro/identify/least_squares.hpp"
@@ -165,6 +169,33 @@ inline io::Log crane_run(const twin::TwinConfig& c, const trajectory::SampledRef
   o.robot = "crane_x7";
   o.seed = seed;
   return twin::ClosedLoopTwin(robot::compiled_model<Crane>(), c).run(ref, o);
+}
+
+// The arm `arm` carrying a rigid body on its last link, as one more inertial of its chain (the
+// independent arm takes no effects).
+inline twin::TwinConfig carrying(const twin::TwinConfig& arm, const symoro::payload::PayloadInertial& b) {
+  twin::TwinConfig tool = arm;
+  twin::UrdfInertial body;
+  body.name = "tool";
+  body.on = tool.chain.joints.back().name;
+  body.mass = b.mass;
+  body.com = b.com;
+  body.inertia = b.inertia;
+  tool.chain.inertials.push_back(body);
+  return tool;
+}
+
+// The independent RX-90 identified without a tool: least squares on its full model from two 20 s
+// runs of all joints (seeds 61 and 62).
+inline Eigen::VectorXd rx90_arm_identified(const twin::TwinConfig& arm) {
+  const auto model = identify::identification_model<rx90::Model>();
+  test::IndependentArmOptions io;
+  std::vector<io::Log> logs;
+  for (unsigned seed : {61u, 62u}) {
+    io.seed = seed;
+    logs.push_back(test::run_independent_arm<rx90::Model>(arm, test::rx90_reference("arm", 20, seed), io));
+  }
+  return identify::least_squares(stacked<rx90::Model>(*model, logs), {true}).phi;
 }
 
 }  // namespace symoro::test::payload_support

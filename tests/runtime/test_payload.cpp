@@ -240,24 +240,11 @@ TEST(PayloadIdentification, AnIndependentRx90sToolOnAnArmIdentifiedWithoutIt) {
   truth.com = {0.02, -0.015, 0.1};
   const Eigen::Matrix3d R = Eigen::AngleAxisd(0.4, Eigen::Vector3d::UnitX()).toRotationMatrix();
   truth.inertia = R * box(5, 0.12, 0.08, 0.2) * R.transpose();
-  twin::TwinConfig tool = arm;
-  twin::UrdfInertial body;
-  body.name = "tool";
-  body.on = tool.chain.joints.back().name;
-  body.mass = truth.mass;
-  body.com = truth.com;
-  body.inertia = truth.inertia;
-  tool.chain.inertials.push_back(body);
-
+  const twin::TwinConfig tool = carrying(arm, truth);
   // The arm identified first (OLS on its full model) from two runs of all joints without the tool.
   const auto model = identify::identification_model<Rx>();
+  const Eigen::VectorXd phi = rx90_arm_identified(arm);
   test::IndependentArmOptions io;
-  std::vector<io::Log> arm_logs;
-  for (unsigned seed : {61u, 62u}) {
-    io.seed = seed;
-    arm_logs.push_back(test::run_independent_arm<Rx>(arm, test::rx90_reference("arm", 20, seed), io));
-  }
-  const Eigen::VectorXd phi = identify::least_squares(stacked<Rx>(*model, arm_logs), {true}).phi;
 
   // The tool on, 20 s of the wrist (joints 4-6) at a pose where the shoulder holds it.
   Eigen::VectorXd pose(Rx::nq);
@@ -292,11 +279,10 @@ TEST(PayloadIdentification, AnIndependentRx90sToolOnAnArmIdentifiedWithoutIt) {
   // A point mass (no inertia about its CoM: the pseudo-inertia on the cone's edge): the noisy
   // least-squares estimate is no body, and the nearest body is reported, with the same mass and
   // CoM and a positive semidefinite pseudo-inertia.
-  twin::TwinConfig point = arm;
+  payload::PayloadInertial body;
   body.mass = 2;
   body.com = Eigen::Vector3d(0.03, 0, 0.12);
-  body.inertia.setZero();
-  point.chain.inertials.push_back(body);
+  const twin::TwinConfig point = carrying(arm, body);
   io.seed = 64;
   const io::Log plog = test::run_independent_arm<Rx>(point, wrist_reference(pose, 3, 3, 1.5, 20), io);
   const payload::PayloadEstimate pe = payload::identify_payload({plog}, *model, phi, *model);
