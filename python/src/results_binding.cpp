@@ -28,6 +28,16 @@ std::shared_ptr<const identify::IdentificationModel> identification_of(py::handl
 // A loaded model's robot folder when robot_dir is not given (models_binding.cpp).
 std::optional<std::filesystem::path> robot_dir_of(py::handle model, const std::optional<std::filesystem::path>& given);
 
+namespace {
+// The parameters file `params` names (a str or a path other than "nominal"), if it names one.
+std::optional<std::filesystem::path> parameters_file(py::handle params) {
+  if (!py::isinstance<py::str>(params) && !py::hasattr(params, "__fspath__")) return std::nullopt;
+  const auto file = params.cast<std::filesystem::path>();
+  if (file == "nominal") return std::nullopt;
+  return file;
+}
+}  // namespace
+
 // phi from an array, a parameters file (a study's report/parameters.yaml), or "nominal" (the
 // robot folder's robot.yaml). Shared with payload_binding.cpp.
 Eigen::VectorXd parameters_of(const identify::IdentificationModel& model, py::handle params,
@@ -42,10 +52,10 @@ Eigen::VectorXd parameters_of(const identify::IdentificationModel& model, py::ha
                                        : std::string("no robot_dir given")));
     return model.base_from_standard(Eigen::Map<const Eigen::VectorXd>(s.data(), static_cast<Eigen::Index>(s.size())));
   }
-  if (py::isinstance<py::str>(params) || py::hasattr(params, "__fspath__")) {
+  if (const auto file = parameters_file(params)) {
     std::vector<std::string> names;
     for (const auto& p : d.parameters) names.push_back(p.name);
-    return io::read_parameters_yaml(params.cast<std::filesystem::path>().string(), names);
+    return io::read_parameters_yaml(file->string(), names);
   }
   const StateArg phi = state_arg(params, "params", d.np);
   if (phi.batch) throw py::value_error(fmt::format("params: one vector of {} parameters expected", d.np));
@@ -81,9 +91,8 @@ py::dict prediction_dict(const std::string& name, const study::Prediction& p) {
 double torque_delay_of(py::handle params, std::optional<double> given_ms) {
   if (given_ms) return *given_ms;
   // A parameters file's timing (the arm's identification's, as dynid predict and payload take it).
-  const bool file =
-      (py::isinstance<py::str>(params) && params.cast<std::string>() != "nominal") || py::hasattr(params, "__fspath__");
-  return file ? io::parameters_torque_delay(py::str(params).cast<std::string>()).value_or(0) * 1000 : 0.0;
+  const auto file = parameters_file(params);
+  return file ? io::parameters_torque_delay(file->string()).value_or(0) * 1000 : 0.0;
 }
 
 void bind_results(py::module_& m) {
@@ -112,9 +121,8 @@ void bind_results(py::module_& m) {
         // The band's uncertainty: given, or report/uncertainty.yaml beside a parameters file.
         std::optional<study::PredictionUncertainty> u;
         std::optional<std::filesystem::path> ufile = uncertainty_file;
-        if (!ufile && band > 0 && (py::isinstance<py::str>(params) || py::hasattr(params, "__fspath__")) &&
-            params.cast<std::filesystem::path>() != "nominal") {
-          const auto beside = params.cast<std::filesystem::path>().parent_path() / "uncertainty.yaml";
+        if (const auto file = parameters_file(params); !ufile && band > 0 && file) {
+          const auto beside = file->parent_path() / "uncertainty.yaml";
           if (std::filesystem::exists(beside)) ufile = beside;
         }
         if (ufile && band > 0) {

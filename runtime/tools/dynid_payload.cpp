@@ -49,19 +49,20 @@ void run(const Common& common, const PayloadCliOptions& o) {
       parameters_phi(common, robot_model(common, d.variant.empty() ? "full" : d.variant), o.params);
   const auto full = identification_model(common, "full");
 
-  std::vector<io::Log> logs;
+  // The runs of --trial in each input (a log or a dataset), named for payload.yaml.
   std::string names;
-  for (const auto& input : o.inputs)
-    for (auto& l : io::read_input_logs(input, d.robot, d.nq, o.trial)) {
-      names += (names.empty() ? "" : ", ") + (fs::is_directory(input) ? input + ":" + l.name : input);
-      logs.push_back(std::move(l.log));
-    }
-  if (logs.empty()) throw UsageError(fmt::format("no run of trial {} in {}", o.trial, fmt::join(o.inputs, ", ")));
-  std::vector<io::Log> tare;
-  for (const auto& input : o.tare)
-    for (auto& l : io::read_input_logs(input, d.robot, d.nq, o.trial)) tare.push_back(std::move(l.log));
-  if (!o.tare.empty() && tare.empty())
-    throw UsageError(fmt::format("--tare: no run of trial {} in {}", o.trial, fmt::join(o.tare, ", ")));
+  const auto runs = [&](const std::vector<std::string>& inputs, const char* what, std::string* named) {
+    std::vector<io::Log> out;
+    for (const auto& input : inputs)
+      for (auto& l : io::read_input_logs(input, d.robot, d.nq, o.trial)) {
+        if (named) *named += (named->empty() ? "" : ", ") + (fs::is_directory(input) ? input + ":" + l.name : input);
+        out.push_back(std::move(l.log));
+      }
+    if (out.empty() && !inputs.empty())
+      throw UsageError(fmt::format("{}no run of trial {} in {}", what, o.trial, fmt::join(inputs, ", ")));
+    return out;
+  };
+  const std::vector<io::Log> logs = runs(o.inputs, "", &names), tare = runs(o.tare, "--tare: ", nullptr);
   const fs::path out(o.out), yaml_file = out / "payload.yaml", urdf_file = out / "payload.urdf";
   for (const auto& f : {yaml_file, urdf_file})
     if (fs::exists(f) && !o.force)
@@ -72,7 +73,6 @@ void run(const Common& common, const PayloadCliOptions& o) {
   const FitTiming timing =
       fit_torque_delay(o.params, o.torque_delay_given ? std::optional<double>(o.torque_delay_ms) : std::nullopt);
   po.torque_delay = timing.torque_delay_ms / 1000;
-  if (!timing.warning.empty()) fmt::print(stderr, "warning: {}\n", timing.warning);
   if (o.mass > 0) po.mass = o.mass;
   po.reference_instruments = o.instruments == "reference";
   const payload::PayloadLink link = payload::payload_link(*full);

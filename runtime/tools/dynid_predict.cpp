@@ -92,7 +92,6 @@ void run(const Common& common, const PredictOptions& given) {
   const FitTiming timing = fit_torque_delay(
       options.params, options.torque_delay_given ? std::optional<double>(options.torque_delay_ms) : std::nullopt);
   options.torque_delay_ms = timing.torque_delay_ms;
-  if (!timing.warning.empty()) fmt::print(stderr, "warning: {}\n", timing.warning);
   const auto model = identification_model(common, parameters_model(options.params, options.model));
   const identify::ModelDescription& d = model->description();
   const Eigen::VectorXd phi =

@@ -134,15 +134,15 @@ Eigen::VectorXd parameters_phi(const Common& common, const robot::ModelHandle& m
 FitTiming fit_torque_delay(const std::string& params, std::optional<double> given_ms) {
   const std::optional<double> arm = params == "nominal" ? std::nullopt : io::parameters_torque_delay(params);
   if (!given_ms) {
-    if (arm) return {*arm * 1000, "the arm's, from " + params, ""};
-    return {0, params == "nominal" ? "nominal parameters carry no timing" : params + " does not say the arm's", ""};
+    if (arm) return {*arm * 1000, "the arm's, from " + params};
+    return {0, params == "nominal" ? "nominal parameters carry no timing" : params + " does not say the arm's"};
   }
   if (arm && std::abs(*arm * 1000 - *given_ms) > 1e-9)
-    return {*given_ms, "given",
-            fmt::format("--torque-delay {:g} ms, but {} was identified at {:g} ms: the difference shows in the fit "
-                        "as inertia (docs/payload.md)",
-                        *given_ms, params, *arm * 1000)};
-  return {*given_ms, "given", ""};
+    fmt::print(stderr,
+               "warning: --torque-delay {:g} ms, but {} was identified at {:g} ms: the difference shows in the fit "
+               "as inertia (docs/payload.md)\n",
+               *given_ms, params, *arm * 1000);
+  return {*given_ms, "given"};
 }
 
 }  // namespace symoro::dynid

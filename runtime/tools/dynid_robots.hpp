@@ -64,13 +64,12 @@ std::string parameters_model(const std::string& params, const std::string& model
 Eigen::VectorXd parameters_phi(const Common& common, const robot::ModelHandle& model, const std::string& params);
 
 // The logged torque's delay a fit on top of --params takes (ms), and why: the one given (with a
-// warning when the parameters file says the arm was identified at another), else the file's
-// torque_delay_ms (the arm's identification's: its rotor inertias carry that timing), else 0
-// (nominal parameters, or a file from before the key).
+// warning on stderr, as parameters_phi's, when the parameters file says the arm was identified at
+// another), else the file's torque_delay_ms (the arm's identification's: its rotor inertias carry
+// that timing), else 0 (nominal parameters, or a file from before the key).
 struct FitTiming {
   double torque_delay_ms = 0;
   std::string why;
-  std::string warning;  // empty unless the given delay is not the arm's
 };
 FitTiming fit_torque_delay(const std::string& params, std::optional<double> given_ms);
 
